@@ -1,0 +1,35 @@
+# Every dependency is a Debian 12 package (tools/debian-packages.txt). A missing
+# one stops configure with the package to install.
+
+function(cloudbench_require found name package)
+  if(NOT ${found})
+    message(FATAL_ERROR "cloudbench needs ${name}, which was not found.\n"
+                        "On Debian 12 install it with:  apt-get install ${package}\n"
+                        "(or run tools/setup.sh, which installs everything the build needs)")
+  endif()
+endfunction()
+
+find_package(Threads REQUIRED)
+
+find_package(TBB CONFIG QUIET)
+cloudbench_require(TBB_FOUND "oneTBB" libtbb-dev)
+
+find_package(nlohmann_json CONFIG QUIET)
+cloudbench_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)
+
+# Through pkg-config: Debian 12's OpenImageIO CMake config also demands the
+# command-line tools (package openimageio-tools), which we do not need.
+find_package(PkgConfig QUIET)
+cloudbench_require(PKG_CONFIG_FOUND "pkg-config" pkg-config)
+pkg_check_modules(OpenImageIO QUIET IMPORTED_TARGET OpenImageIO)
+cloudbench_require(OpenImageIO_FOUND "OpenImageIO" libopenimageio-dev)
+
+if(CLOUDBENCH_BUILD_TESTS)
+  find_package(GTest CONFIG QUIET)
+  cloudbench_require(GTest_FOUND "GoogleTest" libgtest-dev)
+endif()
+
+if(CLOUDBENCH_BUILD_BENCHMARKS)
+  find_package(benchmark CONFIG QUIET)
+  cloudbench_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
+endif()

@@ -1,0 +1,132 @@
+// The backend-neutral interface: one entry per SPEC stage. impl_cpu, impl_gl and
+// impl_vk each implement it in their own library; the harness links whichever
+// were built and picks them by name (CreateBackend).
+//
+// Data lives in backend-owned Buffers whose internal layout is the backend's
+// business (the CPU packs bit fields 64 voxels to a word). Upload and Download
+// convert to and from the canonical layout of SPEC.md section 0, so the harness
+// can feed any stage another backend's output (stage-isolated conformance) and
+// time transfers apart from stages. Every stage call returns when its outputs
+// are complete. No exceptions cross this interface: failures come back as Status.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/Error.h"
+#include "core/Grid.h"
+#include "core/Rules.h"
+#include "core/Stage.h"
+
+namespace cb {
+
+// Canonical element types (SPEC 0): bit fields are one byte per voxel (0 or 1).
+enum class BufferFormat : uint8_t {
+    Bits,   // canonical uint8 0/1
+    U8,     // canonical uint8
+    F32,    // canonical float32
+};
+
+size_t CanonicalElementBytes(BufferFormat format);
+
+class Buffer {
+  public:
+    Buffer(BufferFormat format, Extent3 extent) : mFormat(format), mExtent(extent) {}
+    virtual ~Buffer() = default;
+    Buffer(const Buffer&) = delete;
+    Buffer& operator=(const Buffer&) = delete;
+
+    BufferFormat Format() const { return mFormat; }
+    const Extent3& Extent() const { return mExtent; }
+    size_t CanonicalBytes() const { return mExtent.Count() * CanonicalElementBytes(mFormat); }
+
+  private:
+    BufferFormat mFormat;
+    Extent3 mExtent;
+};
+
+// The automaton's three bit fields at one step.
+struct CaFields {
+    Buffer* hum = nullptr;
+    Buffer* act = nullptr;
+    Buffer* cld = nullptr;
+};
+struct ConstCaFields {
+    const Buffer* hum = nullptr;
+    const Buffer* act = nullptr;
+    const Buffer* cld = nullptr;
+};
+
+// Inputs of one automaton step t -> t+1 (SPEC 3). Probabilities are already
+// quantised: q* = Q(p*).
+struct CaStepParams {
+    uint32_t seed = 0;
+    uint32_t step = 0;
+    uint32_t qExt = 0, qHum = 0, qAct = 0;
+    // Empty, or one (sx, sy) per slice k.
+    std::span<const int32_t> shiftX, shiftY;
+};
+
+struct CaInitParams {
+    uint32_t seed = 0;
+    uint32_t qHum0 = 0, qAct0 = 0;
+};
+
+// Outputs of the density stage (SPEC 5) for one step. The tile and band
+// occupancy are this step's alone; the renderer ORs the two steps it
+// interpolates between (docs/pipeline.md).
+struct DensityOutputs {
+    Buffer* columnSum = nullptr;  // F32, (nx, ny, 1): D
+    Buffer* tiles = nullptr;      // U8, (ceil(nx/T), ceil(ny/T), 1): 1 iff D > 0 in the tile
+    Buffer* bands = nullptr;      // U8, (ceil(nx/T), ceil(ny/T), ceil(nz/B)): 1 iff q > 0 in tile x band
+    uint32_t coveredColumns = 0;  // columns (i, j) with any cld = 1
+};
+
+struct DensityParams {
+    uint32_t tile = 32;
+    uint32_t band = 4;
+};
+
+class Backend {
+  public:
+    virtual ~Backend() = default;
+
+    // "cpu", "gl" or "vk".
+    virtual std::string Name() const = 0;
+    // A one-line description of the device (e.g. "2 threads, TBB").
+    virtual std::string Device() const = 0;
+    virtual bool Supports(Stage stage) const = 0;
+
+    // ---- Buffers and transfers (timed apart from stages) ----
+    virtual Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) = 0;
+    // `canonical` must hold exactly buffer.CanonicalBytes().
+    virtual Status Upload(Buffer& buffer, std::span<const std::byte> canonical) = 0;
+    virtual Status Download(const Buffer& buffer, std::span<std::byte> canonical) = 0;
+
+    // ---- Stages (SPEC names) ----
+    // region: R = max-blend of the ellipsoids; out is U8 of the grid size.
+    virtual Status Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) = 0;
+    // ca (initial state, t = 0).
+    virtual Status CaInitialize(const CaInitParams& params, CaFields out) = 0;
+    // ca: one step; `in` and `out` must be distinct buffers.
+    virtual Status CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) = 0;
+    // smooth: q (F32) from cld (Bits); radius 0, 1 or 2.
+    virtual Status Smooth(int radius, const Buffer& cld, Buffer& q) = 0;
+    // density: D, this step's tile and band occupancy from q, and cover from cld.
+    virtual Status Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) = 0;
+};
+
+// The backends compiled into this build, in preference order.
+std::vector<std::string> BuiltBackends();
+
+struct BackendOptions {
+    int cpuThreads = 0;  // 0: every hardware thread
+};
+
+// Creates a backend by name. An unknown name, or one whose device is missing,
+// comes back as an Error that says why (the harness reports it and goes on).
+Result<std::unique_ptr<Backend>> CreateBackend(const std::string& name, const BackendOptions& options = {});
+
+}  // namespace cb

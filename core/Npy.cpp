@@ -1,0 +1,75 @@
+#include "core/Npy.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace cb {
+namespace {
+
+const char* Descr(NpyType type) { return type == NpyType::U8 ? "|u1" : "<f4"; }
+size_t ElementBytes(NpyType type) { return type == NpyType::U8 ? 1 : 4; }
+
+}  // namespace
+
+Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t> shape, std::span<const std::byte> data) {
+    uint64_t count = 1;
+    for (uint64_t d : shape) count *= d;
+    if (count * ElementBytes(type) != data.size()) return MakeError(path + ": npy data size does not match its shape");
+
+    std::ostringstream dict;
+    dict << "{'descr': '" << Descr(type) << "', 'fortran_order': False, 'shape': (";
+    for (size_t n = 0; n < shape.size(); ++n) dict << shape[n] << (shape.size() == 1 || n + 1 < shape.size() ? ", " : "");
+    dict << "), }";
+    std::string header = dict.str();
+    // magic(6) + version(2) + length(2) + header + '\n' is padded to a multiple of 64.
+    size_t total = 10 + header.size() + 1;
+    header.append((64 - total % 64) % 64, ' ');
+    header.push_back('\n');
+
+    std::ofstream out(path, std::ios::binary);
+    if (!out) return MakeError(path + ": cannot write: " + std::strerror(errno));
+    const char magic[8] = {'\x93', 'N', 'U', 'M', 'P', 'Y', 1, 0};
+    out.write(magic, 8);
+    const uint16_t length = static_cast<uint16_t>(header.size());
+    const char lengthBytes[2] = {char(length & 0xff), char(length >> 8)};
+    out.write(lengthBytes, 2);
+    out.write(header.data(), std::streamsize(header.size()));
+    out.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size()));
+    if (!out) return MakeError(path + ": write failed: " + std::strerror(errno));
+    return {};
+}
+
+Result<NpyArray> ReadNpy(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return MakeError(path + ": cannot read: " + std::strerror(errno));
+    char magic[10];
+    if (!in.read(magic, 10) || std::memcmp(magic, "\x93NUMPY\x01\x00", 8) != 0)
+        return MakeError(path + ": not a version 1.0 .npy file");
+    const size_t length = uint8_t(magic[8]) | (size_t(uint8_t(magic[9])) << 8);
+    std::string header(length, '\0');
+    if (!in.read(header.data(), std::streamsize(length))) return MakeError(path + ": truncated .npy header");
+
+    NpyArray array;
+    if (header.find("'descr': '|u1'") != std::string::npos) array.type = NpyType::U8;
+    else if (header.find("'descr': '<f4'") != std::string::npos) array.type = NpyType::F32;
+    else return MakeError(path + ": unsupported dtype (expected |u1 or <f4)");
+    if (header.find("'fortran_order': False") == std::string::npos) return MakeError(path + ": not C order");
+    size_t open = header.find("'shape': (");
+    size_t close = header.find(')', open);
+    if (open == std::string::npos || close == std::string::npos) return MakeError(path + ": no shape in header");
+    std::istringstream dims(header.substr(open + 10, close - open - 10));
+    uint64_t count = 1;
+    for (std::string token; std::getline(dims, token, ',');) {
+        if (token.find_first_not_of(' ') == std::string::npos) continue;
+        array.shape.push_back(std::stoull(token));
+        count *= array.shape.back();
+    }
+    array.data.resize(count * ElementBytes(array.type));
+    if (!in.read(reinterpret_cast<char*>(array.data.data()), std::streamsize(array.data.size())))
+        return MakeError(path + ": truncated .npy data");
+    return array;
+}
+
+}  // namespace cb

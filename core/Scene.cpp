@@ -1,0 +1,895 @@
+// Scene loading: JSON text -> overrides -> validation -> Scene. Every check
+// reports into one list of "label: field: reason" lines, so a user sees all
+// problems of a file at once. The format is documented in docs/scenes.md.
+#include "core/Scene.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+namespace cb {
+namespace {
+
+// ordered_json keeps the file's key order, so errors come out in reading order.
+using Json = nlohmann::ordered_json;
+
+constexpr int64_t kU32Max = std::numeric_limits<uint32_t>::max();
+constexpr int64_t kI32Min = std::numeric_limits<int32_t>::min();
+constexpr int64_t kI32Max = std::numeric_limits<int32_t>::max();
+constexpr int64_t kSeed64Max = int64_t(1) << 53;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr size_t kMaxShownChars = 60;  // longest value text quoted in an error
+
+constexpr Stage kDefaultStages[] = {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density};
+
+// ---- Small formatting helpers ---------------------------------------------------------------------------------
+
+// Shortest text that reads back as the same double ("0.35", "400", "1e+20", "inf").
+std::string FormatNumber(double value) {
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char buffer[64];
+    auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    if (ec != std::errc()) return "?";
+    return std::string(buffer, end);
+}
+
+// A JSON value as it appears in an error: strings quoted, long values cut short.
+std::string Describe(const Json& value) {
+    std::string text;
+    if (value.is_number_float()) {
+        text = FormatNumber(value.get<double>());
+    } else {
+        text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
+    }
+    if (text.size() > kMaxShownChars) text = text.substr(0, kMaxShownChars - 3) + "...";
+    return text;
+}
+
+std::string Quote(std::string_view text) { return "\"" + std::string(text) + "\""; }
+
+std::string JoinField(std::string_view parent, std::string_view key) {
+    if (parent.empty()) return std::string(key);
+    return std::string(parent) + "." + std::string(key);
+}
+
+std::string IndexField(std::string_view parent, size_t index) {
+    return std::string(parent) + "[" + std::to_string(index) + "]";
+}
+
+// Case-insensitive edit distance, for "did you mean" suggestions.
+size_t EditDistance(std::string_view a, std::string_view b) {
+    auto lower = [](char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; };
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const size_t above = row[j];
+            const size_t substitute = diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
+            row[j] = std::min({above + 1, row[j - 1] + 1, substitute});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+// " (did you mean "x"?)" when one known name is close to `name`, else "".
+std::string Suggestion(std::string_view name, std::span<const std::string_view> known) {
+    std::string_view best;
+    size_t bestDistance = std::numeric_limits<size_t>::max();
+    for (std::string_view candidate : known) {
+        const size_t d = EditDistance(name, candidate);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = candidate;
+        }
+    }
+    // Close means at most two edits, and fewer edits than the shorter name has letters.
+    if (best.empty() || bestDistance > 2 || bestDistance >= std::min(name.size(), best.size())) return "";
+    return " (did you mean " + Quote(best) + "?)";
+}
+
+uint64_t SatAdd(uint64_t a, uint64_t b) {
+    uint64_t r;
+    return __builtin_add_overflow(a, b, &r) ? std::numeric_limits<uint64_t>::max() : r;
+}
+
+uint64_t SatMul(uint64_t a, uint64_t b) {
+    uint64_t r;
+    return __builtin_mul_overflow(a, b, &r) ? std::numeric_limits<uint64_t>::max() : r;
+}
+
+uint64_t CeilDiv64(uint64_t a, uint64_t b) { return b == 0 ? a : a / b + (a % b != 0 ? 1 : 0); }
+
+// Physical memory in bytes, or nullopt when the system does not say.
+std::optional<uint64_t> PhysicalMemoryBytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES);
+    const long pageSize = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || pageSize <= 0) return std::nullopt;
+    return SatMul(uint64_t(pages), uint64_t(pageSize));
+}
+
+std::string FormatGiB(uint64_t bytes) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "%.1f", double(bytes) / double(uint64_t(1) << 30));
+    return buffer;
+}
+
+// ---- JSON parsing --------------------------------------------------------------------------------------------
+
+// Builds the document like nlohmann's own DOM parser, but keeps the byte
+// position of a failure (also for number overflow, which json::parse reports
+// without one) and refuses duplicate keys instead of silently keeping the last.
+class DomBuilder final : public nlohmann::json_sax<Json> {
+  public:
+    explicit DomBuilder(Json& root) : mRoot(root) {}
+
+    bool null() override { return Put(nullptr); }
+    bool boolean(bool value) override { return Put(value); }
+    bool number_integer(number_integer_t value) override { return Put(value); }
+    bool number_unsigned(number_unsigned_t value) override { return Put(value); }
+    bool number_float(number_float_t value, const string_t&) override { return Put(value); }
+    bool string(string_t& value) override { return Put(std::move(value)); }
+    bool binary(binary_t& value) override { return Put(Json::binary(std::move(value))); }
+    bool start_object(std::size_t) override { return Open(Json::object()); }
+    bool start_array(std::size_t) override { return Open(Json::array()); }
+    bool end_object() override { return Close(); }
+    bool end_array() override { return Close(); }
+
+    bool key(string_t& name) override {
+        Frame& top = mStack.back();
+        if (top.node->contains(name)) mDuplicates.push_back(JoinField(top.field, name));
+        top.key = std::move(name);
+        return true;
+    }
+
+    bool parse_error(std::size_t position, const std::string& lastToken, const Json::exception& error) override {
+        mErrorPosition = position;
+        mErrorToken = lastToken;
+        mErrorId = error.id;
+        mErrorText = error.what();
+        return false;
+    }
+
+    // Set after a failed parse: byte count read when it failed (1-based), nlohmann's id and text.
+    size_t mErrorPosition = 0;
+    std::string mErrorToken;
+    int mErrorId = 0;
+    std::string mErrorText;
+    std::vector<std::string> mDuplicates;  // dotted fields of repeated keys
+
+  private:
+    struct Frame {
+        Json* node;
+        std::string field;  // dotted path of `node`
+        std::string key;    // last key read, when `node` is an object
+    };
+
+    // Stores `value` at the current position; returns its place and field path.
+    std::pair<Json*, std::string> Place(Json value) {
+        if (mStack.empty()) {
+            mRoot = std::move(value);
+            return {&mRoot, ""};
+        }
+        Frame& top = mStack.back();
+        if (top.node->is_array()) {
+            top.node->push_back(std::move(value));
+            return {&top.node->back(), IndexField(top.field, top.node->size() - 1)};
+        }
+        Json& slot = (*top.node)[top.key];
+        slot = std::move(value);
+        return {&slot, JoinField(top.field, top.key)};
+    }
+
+    bool Put(Json value) {
+        Place(std::move(value));
+        return true;
+    }
+
+    bool Open(Json container) {
+        auto [node, field] = Place(std::move(container));
+        mStack.push_back(Frame{node, std::move(field), {}});
+        return true;
+    }
+
+    bool Close() {
+        mStack.pop_back();
+        return true;
+    }
+
+    Json& mRoot;
+    std::vector<Frame> mStack;
+};
+
+// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix.
+std::string ShortReason(const std::string& what) {
+    std::string text = what;
+    if (size_t p = text.find("] "); p != std::string::npos) text = text.substr(p + 2);
+    if (text.starts_with("parse error")) {
+        if (size_t p = text.find(": "); p != std::string::npos) text = text.substr(p + 2);
+    }
+    return text;
+}
+
+// "line L, column C" (1-based) of the character at byte `position` - 1 of `text`.
+std::string LineColumn(std::string_view text, size_t position) {
+    const size_t offset = std::min(position == 0 ? 0 : position - 1, text.size());
+    size_t line = 1, lineStart = 0;
+    for (size_t i = 0; i < offset; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            lineStart = i + 1;
+        }
+    }
+    return "line " + std::to_string(line) + ", column " + std::to_string(offset - lineStart + 1);
+}
+
+// ---- Validation ----------------------------------------------------------------------------------------------
+
+// Collects error lines "label: field: reason" and reads typed values out of the document.
+class Validator {
+  public:
+    explicit Validator(std::string label) : mLabel(std::move(label)) {}
+
+    void MarkOverridden(std::string path) { mOverridden.push_back(std::move(path)); }
+
+    // Adds one error line; fields under a --set path get " (set with --set)".
+    void Fail(std::string_view field, std::string_view reason) {
+        std::string line = mLabel + ": " + std::string(field) + ": " + std::string(reason);
+        if (IsOverridden(field)) line += " (set with --set)";
+        mErrors.push_back(std::move(line));
+    }
+
+    // An error with no field (malformed JSON, unreadable file).
+    void FailWhole(std::string_view reason) { mErrors.push_back(mLabel + ": " + std::string(reason)); }
+
+    size_t ErrorCount() const { return mErrors.size(); }
+
+    std::string Message() const {
+        std::string message;
+        for (const std::string& line : mErrors) {
+            if (!message.empty()) message += '\n';
+            message += line;
+        }
+        return message;
+    }
+
+    // Reports every key of `object` that is not in `known`.
+    void CheckKeys(const Json& object, std::string_view field, std::span<const std::string_view> known) {
+        for (const auto& [key, value] : object.items()) {
+            if (std::find(known.begin(), known.end(), key) == known.end())
+                Fail(JoinField(field, key), "unknown field" + Suggestion(key, known));
+        }
+    }
+
+    // The member `key` of `object`, or nullptr when absent.
+    static const Json* Find(const Json& object, std::string_view key) {
+        auto it = object.find(std::string(key));
+        return it == object.end() ? nullptr : &*it;
+    }
+
+    // The object section `key` of `parent` after checking its type and keys; nullptr when absent or wrong.
+    const Json* Section(const Json& parent, std::string_view parentField, std::string_view key,
+                        std::span<const std::string_view> known) {
+        const Json* section = Find(parent, key);
+        if (!section) return nullptr;
+        const std::string field = JoinField(parentField, key);
+        if (!section->is_object()) {
+            Fail(field, "expected an object, got " + Describe(*section));
+            return nullptr;
+        }
+        CheckKeys(*section, field, known);
+        return section;
+    }
+
+    // A whole number in [lo, hi]; integral floats such as 1e6 are accepted.
+    std::optional<int64_t> Integer(const Json& value, std::string_view field, int64_t lo, int64_t hi) {
+        int64_t result = 0;
+        bool inRange = true;
+        if (value.is_number_unsigned()) {
+            const uint64_t u = value.get<uint64_t>();
+            inRange = u <= uint64_t(std::numeric_limits<int64_t>::max());
+            result = inRange ? int64_t(u) : 0;
+        } else if (value.is_number_integer()) {
+            result = value.get<int64_t>();
+        } else if (value.is_number_float()) {
+            const double d = value.get<double>();
+            if (!std::isfinite(d)) {
+                Fail(field, "must be a finite integer, got " + Describe(value));
+                return std::nullopt;
+            }
+            if (d != std::floor(d)) {
+                Fail(field, "expected an integer, got " + Describe(value));
+                return std::nullopt;
+            }
+            inRange = d >= -9.2e18 && d <= 9.2e18;
+            result = inRange ? int64_t(d) : 0;
+        } else {
+            Fail(field, "expected an integer, got " + Describe(value));
+            return std::nullopt;
+        }
+        if (!inRange || result < lo || result > hi) {
+            Fail(field, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                            Describe(value));
+            return std::nullopt;
+        }
+        return result;
+    }
+
+    // Allowed interval of a number; infinite bounds mean "no bound", open bounds exclude the value.
+    struct Range {
+        double lo = -kInf;
+        bool loOpen = false;
+        double hi = kInf;
+        bool hiOpen = false;
+    };
+
+    // A finite number inside `range`.
+    std::optional<double> Number(const Json& value, std::string_view field, Range range) {
+        if (!value.is_number()) {
+            Fail(field, "expected a number, got " + Describe(value));
+            return std::nullopt;
+        }
+        const double d = value.get<double>();
+        if (!std::isfinite(d)) {
+            Fail(field, "must be a finite number, got " + Describe(value));
+            return std::nullopt;
+        }
+        const bool loOk = range.loOpen ? d > range.lo : d >= range.lo;
+        const bool hiOk = range.hiOpen ? d < range.hi : d <= range.hi;
+        if (loOk && hiOk) return d;
+        std::string reason;
+        if (std::isinf(range.hi)) {
+            reason = std::string("must be ") + (range.loOpen ? "> " : ">= ") + FormatNumber(range.lo);
+        } else if (std::isinf(range.lo)) {
+            reason = std::string("must be ") + (range.hiOpen ? "< " : "<= ") + FormatNumber(range.hi);
+        } else {
+            reason = std::string("must be in ") + (range.loOpen ? "(" : "[") + FormatNumber(range.lo) + ", " +
+                     FormatNumber(range.hi) + (range.hiOpen ? ")" : "]");
+        }
+        Fail(field, reason + ", got " + Describe(value));
+        return std::nullopt;
+    }
+
+    std::optional<std::string> String(const Json& value, std::string_view field) {
+        if (!value.is_string()) {
+            Fail(field, "expected a string, got " + Describe(value));
+            return std::nullopt;
+        }
+        return value.get<std::string>();
+    }
+
+    // An array of exactly N numbers, each inside `range`.
+    template <size_t N>
+    std::optional<std::array<double, N>> Numbers(const Json& value, std::string_view field, Range range) {
+        if (!value.is_array() || value.size() != N) {
+            Fail(field, "expected an array of " + std::to_string(N) + " numbers, got " + Describe(value));
+            return std::nullopt;
+        }
+        std::array<double, N> result{};
+        bool ok = true;
+        for (size_t i = 0; i < N; ++i) {
+            auto d = Number(value[i], IndexField(field, i), range);
+            if (d) result[i] = *d;
+            ok = ok && d.has_value();
+        }
+        return ok ? std::optional(result) : std::nullopt;
+    }
+
+    // An array of exactly N integers, each in [lo, hi].
+    template <size_t N>
+    std::optional<std::array<int64_t, N>> Integers(const Json& value, std::string_view field, int64_t lo,
+                                                   int64_t hi) {
+        if (!value.is_array() || value.size() != N) {
+            Fail(field, "expected an array of " + std::to_string(N) + " integers, got " + Describe(value));
+            return std::nullopt;
+        }
+        std::array<int64_t, N> result{};
+        bool ok = true;
+        for (size_t i = 0; i < N; ++i) {
+            auto n = Integer(value[i], IndexField(field, i), lo, hi);
+            if (n) result[i] = *n;
+            ok = ok && n.has_value();
+        }
+        return ok ? std::optional(result) : std::nullopt;
+    }
+
+  private:
+    // True when `field` is an overridden path or lies under one.
+    bool IsOverridden(std::string_view field) const {
+        for (const std::string& path : mOverridden) {
+            if (!field.starts_with(path)) continue;
+            if (field.size() == path.size() || field[path.size()] == '.' || field[path.size()] == '[') return true;
+        }
+        return false;
+    }
+
+    std::string mLabel;
+    std::vector<std::string> mErrors;
+    std::vector<std::string> mOverridden;
+};
+
+using Range = Validator::Range;
+constexpr Range kFinite{};
+constexpr Range kPositive{.lo = 0, .loOpen = true};
+constexpr Range kNonNegative{.lo = 0};
+constexpr Range kProbability{.lo = 0, .hi = 1};
+
+// Applies one --set to the document. Missing objects along the path are created.
+void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
+    const std::string where = "--set " + item.path;
+    std::vector<std::string> keys;
+    for (size_t start = 0;;) {
+        const size_t dot = item.path.find('.', start);
+        keys.push_back(item.path.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+        if (dot == std::string::npos) break;
+        start = dot + 1;
+    }
+    for (const std::string& key : keys) {
+        if (key.empty()) {
+            check.Fail(where, "expected a dotted field path such as ca.seed");
+            return;
+        }
+    }
+
+    // The value is JSON text; anything that does not parse is taken as a string.
+    Json value;
+    DomBuilder builder(value);
+    const bool parsed = Json::sax_parse(item.value, &builder);
+    if (!parsed && builder.mErrorId == 406) {
+        // Number overflow (1e999): keep it as a non-finite number so the field's own check names it.
+        const size_t first = item.value.find_first_not_of(" \t\r\n");
+        value = (first != std::string::npos && item.value[first] == '-') ? -kInf : kInf;
+    } else if (!parsed) {
+        value = item.value;
+    }
+
+    Json* node = &root;
+    std::string prefix;
+    for (size_t i = 0; i + 1 < keys.size(); ++i) {
+        prefix = JoinField(prefix, keys[i]);
+        auto it = node->find(keys[i]);
+        if (it == node->end()) {
+            node = &((*node)[keys[i]] = Json::object());
+        } else if (it->is_object()) {
+            node = &*it;
+        } else {
+            check.Fail(where, Quote(prefix) + " is not an object");
+            return;
+        }
+    }
+    (*node)[keys.back()] = std::move(value);
+    check.MarkOverridden(item.path);
+    if (parsed) {
+        for (const std::string& duplicate : builder.mDuplicates)
+            check.Fail(JoinField(item.path, duplicate), "duplicate field");
+    }
+}
+
+// ---- The sections ---------------------------------------------------------------------------------------------
+
+constexpr std::string_view kTopKeys[] = {"name",  "description", "grid",       "steps",  "warmup_steps",
+                                         "stages", "ca",         "ellipsoids", "smooth", "density"};
+constexpr std::string_view kGridKeys[] = {"size", "voxel_size", "origin"};
+constexpr std::string_view kCaKeys[] = {"seed", "hum0", "act0", "p_ext", "p_hum", "p_act", "wind_shift"};
+constexpr std::string_view kEllipsoidKeys[] = {
+    "seed",          "target_count",      "density_adaption", "size_mean", "size_variance", "lifetime_mean",
+    "lifetime_variance", "shrink_steps", "margin",           "height_range", "wind",        "jitter"};
+constexpr std::string_view kWindGridKeys[] = {"grid", "vectors"};
+constexpr std::string_view kSmoothKeys[] = {"radius"};
+constexpr std::string_view kDensityKeys[] = {"tile", "band"};
+
+// Returns true when grid.size is present and valid.
+bool ReadGrid(const Json& root, Validator& check, GridSettings& grid) {
+    const Json* section = Validator::Find(root, "grid");
+    if (!section) {
+        check.Fail("grid.size", "required field is missing");
+        return false;
+    }
+    section = check.Section(root, "", "grid", kGridKeys);
+    if (!section) return false;
+
+    bool sizeOk = false;
+    if (const Json* size = Validator::Find(*section, "size")) {
+        if (auto n = check.Integers<3>(*size, "grid.size", 1, kU32Max)) {
+            grid.size = Extent3{uint32_t((*n)[0]), uint32_t((*n)[1]), uint32_t((*n)[2])};
+            sizeOk = true;
+        }
+    } else {
+        check.Fail("grid.size", "required field is missing");
+    }
+    if (const Json* v = Validator::Find(*section, "voxel_size")) {
+        if (auto d = check.Number(*v, "grid.voxel_size", kPositive)) grid.voxelSize = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "origin")) {
+        if (auto a = check.Numbers<3>(*v, "grid.origin", kFinite)) grid.origin = *a;
+    }
+    return sizeOk;
+}
+
+void ReadStages(const Json& root, Validator& check, StageSet& stages) {
+    const Json* list = Validator::Find(root, "stages");
+    if (!list) {
+        for (Stage stage : kDefaultStages) stages.Add(stage);
+        return;
+    }
+    if (!list->is_array()) {
+        check.Fail("stages", "expected an array of stage names, got " + Describe(*list));
+        return;
+    }
+    if (list->empty()) {
+        check.Fail("stages", "must name at least one stage, got []");
+        return;
+    }
+    std::vector<std::string_view> known;
+    for (Stage stage : kAllStages) known.push_back(StageName(stage));
+
+    bool allOk = true;
+    for (size_t i = 0; i < list->size(); ++i) {
+        const std::string field = IndexField("stages", i);
+        auto name = check.String((*list)[i], field);
+        if (!name) {
+            allOk = false;
+            continue;
+        }
+        std::optional<Stage> stage = ParseStage(*name);
+        if (!stage) {
+            std::string all;
+            for (std::string_view k : known) all += (all.empty() ? "" : ", ") + std::string(k);
+            check.Fail(field, "unknown stage " + Quote(*name) + Suggestion(*name, known) + "; known: " + all);
+            allOk = false;
+        } else if (stages.Has(*stage)) {
+            check.Fail(field, "duplicate stage " + Quote(*name));
+            allOk = false;
+        } else {
+            stages.Add(*stage);
+        }
+    }
+    // Dependencies are checked only on a clean list, so one typo does not cascade.
+    if (!allOk) return;
+    constexpr std::pair<Stage, Stage> kNeeds[] = {
+        {Stage::Ca, Stage::Region}, {Stage::Smooth, Stage::Ca}, {Stage::Density, Stage::Smooth}};
+    for (auto [stage, needed] : kNeeds) {
+        if (stages.Has(stage) && !stages.Has(needed))
+            check.Fail("stages", Quote(StageName(stage)) + " needs " + Quote(StageName(needed)));
+    }
+}
+
+// Reads ca; the wind shift stays as written (one pair or nz pairs) until the size checks passed.
+void ReadCa(const Json& root, Validator& check, std::optional<uint32_t> nz, CaSettings& ca) {
+    const Json* section = check.Section(root, "", "ca", kCaKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "seed")) {
+        if (auto n = check.Integer(*v, "ca.seed", 0, kU32Max)) ca.seed = uint32_t(*n);
+    }
+    const std::pair<std::string_view, double*> probabilities[] = {
+        {"hum0", &ca.hum0}, {"act0", &ca.act0}, {"p_ext", &ca.pExt}, {"p_hum", &ca.pHum}, {"p_act", &ca.pAct}};
+    for (auto [key, target] : probabilities) {
+        if (const Json* v = Validator::Find(*section, key)) {
+            if (auto d = check.Number(*v, JoinField("ca", key), kProbability)) *target = *d;
+        }
+    }
+    const Json* shifts = Validator::Find(*section, "wind_shift");
+    if (!shifts) return;
+    if (!shifts->is_array()) {
+        check.Fail("ca.wind_shift", "expected an array of [sx, sy] integer pairs, got " + Describe(*shifts));
+        return;
+    }
+    if (nz && shifts->size() != 0 && shifts->size() != 1 && shifts->size() != *nz) {
+        check.Fail("ca.wind_shift", "expected 1 pair (for every slice) or nz = " + std::to_string(*nz) +
+                                        " pairs, got " + std::to_string(shifts->size()));
+    }
+    ca.windShift.clear();
+    for (size_t i = 0; i < shifts->size(); ++i) {
+        if (auto pair = check.Integers<2>((*shifts)[i], IndexField("ca.wind_shift", i), kI32Min, kI32Max))
+            ca.windShift.push_back(SliceShift{int32_t((*pair)[0]), int32_t((*pair)[1])});
+    }
+}
+
+void ReadWind(const Json& value, Validator& check, EllipsoidWind& wind) {
+    const std::string field = "ellipsoids.wind";
+    if (value.is_array()) {
+        if (auto v = check.Numbers<2>(value, field, kFinite)) wind.vector = *v;
+        return;
+    }
+    if (!value.is_object()) {
+        check.Fail(field, "expected [wx, wy] or {\"grid\": [gx, gy], \"vectors\": [[wx, wy], ...]}, got " +
+                              Describe(value));
+        return;
+    }
+    check.CheckKeys(value, field, kWindGridKeys);
+    const Json* grid = Validator::Find(value, "grid");
+    const Json* vectors = Validator::Find(value, "vectors");
+    if (!grid) check.Fail(field + ".grid", "required field is missing");
+    if (!vectors) check.Fail(field + ".vectors", "required field is missing");
+
+    std::optional<std::array<int64_t, 2>> size;
+    if (grid) size = check.Integers<2>(*grid, field + ".grid", 1, kU32Max);
+    if (!vectors) return;
+    if (!vectors->is_array()) {
+        check.Fail(field + ".vectors", "expected an array of [wx, wy] pairs, got " + Describe(*vectors));
+        return;
+    }
+    if (size) {
+        const uint64_t expected = uint64_t((*size)[0]) * uint64_t((*size)[1]);
+        if (vectors->size() != expected) {
+            check.Fail(field + ".vectors", "expected " + std::to_string(expected) + " pairs (grid " +
+                                               std::to_string((*size)[0]) + " x " + std::to_string((*size)[1]) +
+                                               "), got " + std::to_string(vectors->size()));
+        }
+        wind.gridNx = uint32_t((*size)[0]);
+        wind.gridNy = uint32_t((*size)[1]);
+    }
+    wind.grid.clear();
+    for (size_t i = 0; i < vectors->size(); ++i) {
+        if (auto v = check.Numbers<2>((*vectors)[i], IndexField(field + ".vectors", i), kFinite))
+            wind.grid.push_back(*v);
+    }
+}
+
+void ReadEllipsoids(const Json& root, Validator& check, EllipsoidSettings& e) {
+    const Json* section = check.Section(root, "", "ellipsoids", kEllipsoidKeys);
+    if (!section) return;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    auto field = [](std::string_view key) { return JoinField("ellipsoids", key); };
+
+    if (const Json* v = find("seed")) {
+        if (auto n = check.Integer(*v, field("seed"), 0, kSeed64Max)) e.seed = uint64_t(*n);
+    }
+    if (const Json* v = find("target_count")) {
+        if (auto n = check.Integer(*v, field("target_count"), 0, 100000)) e.targetCount = uint32_t(*n);
+    }
+    if (const Json* v = find("density_adaption")) {
+        if (auto n = check.Integer(*v, field("density_adaption"), 0, 100000)) e.densityAdaption = uint32_t(*n);
+    }
+    // Each variance must not exceed its mean; the message names whichever of the two the file gave.
+    bool sizeMeanOk = true, sizeVarianceOk = true;
+    if (const Json* v = find("size_mean")) {
+        auto a = check.Numbers<3>(*v, field("size_mean"), kPositive);
+        if (a) e.sizeMean = *a;
+        sizeMeanOk = a.has_value();
+    }
+    const Json* sizeVariance = find("size_variance");
+    if (sizeVariance) {
+        auto a = check.Numbers<3>(*sizeVariance, field("size_variance"), kNonNegative);
+        if (a) e.sizeVariance = *a;
+        sizeVarianceOk = a.has_value();
+    }
+    for (size_t i = 0; sizeMeanOk && sizeVarianceOk && i < 3; ++i) {
+        if (e.sizeVariance[i] <= e.sizeMean[i]) continue;
+        const std::string index = "[" + std::to_string(i) + "]";
+        if (sizeVariance)
+            check.Fail(field("size_variance") + index, "must be <= size_mean" + index + " (" +
+                                                           FormatNumber(e.sizeMean[i]) + "), got " +
+                                                           FormatNumber(e.sizeVariance[i]));
+        else
+            check.Fail(field("size_mean") + index, "must be >= size_variance" + index + " (" +
+                                                       FormatNumber(e.sizeVariance[i]) + "), got " +
+                                                       FormatNumber(e.sizeMean[i]));
+    }
+    bool lifetimeMeanOk = true, lifetimeVarianceOk = true;
+    if (const Json* v = find("lifetime_mean")) {
+        auto d = check.Number(*v, field("lifetime_mean"), Range{.lo = 1});
+        if (d) e.lifetimeMean = *d;
+        lifetimeMeanOk = d.has_value();
+    }
+    const Json* lifetimeVariance = find("lifetime_variance");
+    if (lifetimeVariance) {
+        auto d = check.Number(*lifetimeVariance, field("lifetime_variance"), kNonNegative);
+        if (d) e.lifetimeVariance = *d;
+        lifetimeVarianceOk = d.has_value();
+    }
+    if (lifetimeMeanOk && lifetimeVarianceOk && e.lifetimeVariance >= e.lifetimeMean) {
+        if (lifetimeVariance)
+            check.Fail(field("lifetime_variance"), "must be < lifetime_mean (" + FormatNumber(e.lifetimeMean) +
+                                                       "), got " + FormatNumber(e.lifetimeVariance));
+        else
+            check.Fail(field("lifetime_mean"), "must be > lifetime_variance (" + FormatNumber(e.lifetimeVariance) +
+                                                   "), got " + FormatNumber(e.lifetimeMean));
+    }
+    if (const Json* v = find("shrink_steps")) {
+        if (auto n = check.Integer(*v, field("shrink_steps"), 0, kU32Max)) e.shrinkSteps = uint32_t(*n);
+    }
+    if (const Json* v = find("margin")) {
+        if (auto d = check.Number(*v, field("margin"), kNonNegative)) e.margin = *d;
+    }
+    if (const Json* v = find("height_range")) {
+        if (auto a = check.Numbers<2>(*v, field("height_range"), kProbability)) {
+            if ((*a)[0] > (*a)[1])
+                check.Fail(field("height_range"), "lo must be <= hi, got " + Describe(*v));
+            else
+                e.heightRange = *a;
+        }
+    }
+    if (const Json* v = find("wind")) ReadWind(*v, check, e.wind);
+    if (const Json* v = find("jitter")) {
+        if (auto d = check.Number(*v, field("jitter"), kNonNegative)) e.jitter = *d;
+    }
+}
+
+// The whole validation after parsing and overrides; `scene` holds defaults on entry.
+void ReadScene(const Json& root, const std::string& label, Validator& check, Scene& scene) {
+    check.CheckKeys(root, "", kTopKeys);
+
+    scene.name = std::filesystem::path(label).stem().string();
+    if (const Json* v = Validator::Find(root, "name")) {
+        if (auto s = check.String(*v, "name")) {
+            if (s->empty())
+                check.Fail("name", "must not be empty");
+            else
+                scene.name = *s;
+        }
+    }
+    if (const Json* v = Validator::Find(root, "description")) check.String(*v, "description");
+
+    const bool sizeOk = ReadGrid(root, check, scene.grid);
+
+    bool stepsOk = true;
+    if (const Json* v = Validator::Find(root, "steps")) {
+        auto n = check.Integer(*v, "steps", 1, 10000000);
+        if (n) scene.steps = uint32_t(*n);
+        stepsOk = n.has_value();
+    }
+    if (const Json* v = Validator::Find(root, "warmup_steps")) {
+        if (auto n = check.Integer(*v, "warmup_steps", 0, kU32Max)) {
+            scene.warmupSteps = uint32_t(*n);
+            if (stepsOk && scene.warmupSteps >= scene.steps)
+                check.Fail("warmup_steps", "must be < steps (" + std::to_string(scene.steps) + "), got " +
+                                               std::to_string(scene.warmupSteps));
+        }
+    }
+
+    ReadStages(root, check, scene.stages);
+    ReadCa(root, check, sizeOk ? std::optional(scene.grid.size.nz) : std::nullopt, scene.ca);
+
+    // The ellipsoid seed follows ca.seed unless given.
+    scene.ellipsoids.seed = scene.ca.seed;
+    ReadEllipsoids(root, check, scene.ellipsoids);
+
+    if (const Json* section = check.Section(root, "", "smooth", kSmoothKeys)) {
+        if (const Json* v = Validator::Find(*section, "radius")) {
+            if (auto n = check.Integer(*v, "smooth.radius", 0, 2)) scene.smooth.radius = int(*n);
+        }
+    }
+    if (const Json* section = check.Section(root, "", "density", kDensityKeys)) {
+        if (const Json* v = Validator::Find(*section, "tile")) {
+            if (auto n = check.Integer(*v, "density.tile", 1, kU32Max)) scene.density.tile = uint32_t(*n);
+        }
+        if (const Json* v = Validator::Find(*section, "band")) {
+            if (auto n = check.Integer(*v, "density.band", 1, kU32Max)) scene.density.band = uint32_t(*n);
+        }
+    }
+
+    // Size checks, before anything grid-sized exists.
+    if (!sizeOk) return;
+    const Extent3& size = scene.grid.size;
+    const uint64_t count = size.Count();
+    if (count > kU32Max) {
+        check.Fail("grid.size", "[" + std::to_string(size.nx) + ", " + std::to_string(size.ny) + ", " +
+                                    std::to_string(size.nz) + "] is " + std::to_string(count) +
+                                    " voxels; the voxel index is 32-bit, so at most " + std::to_string(kU32Max));
+        return;
+    }
+    const uint64_t needed = EstimateSceneBytes(scene);
+    if (std::optional<uint64_t> physical = PhysicalMemoryBytes(); physical && needed > *physical) {
+        check.Fail("grid.size", "the enabled stages need " + FormatGiB(needed) + " GiB, more than this machine's " +
+                                    FormatGiB(*physical) + " GiB");
+    }
+}
+
+Result<Scene> ParseSceneChecked(const std::string& text, const std::string& label,
+                                const std::vector<SceneOverride>& overrides) {
+    Validator check(label);
+    Json root;
+    DomBuilder builder(root);
+    if (!Json::sax_parse(text, &builder)) {
+        if (builder.mErrorId == 406) {
+            // Number overflow: the position is the token's last character; point at its first.
+            const size_t length = builder.mErrorToken.size();
+            const size_t start = builder.mErrorPosition > length ? builder.mErrorPosition - length + 1 : 1;
+            check.FailWhole(LineColumn(text, start) + ": the number " + builder.mErrorToken +
+                            " is out of range (not finite)");
+        } else {
+            check.FailWhole(LineColumn(text, builder.mErrorPosition) + ": malformed JSON: " +
+                            ShortReason(builder.mErrorText));
+        }
+        return MakeError(check.Message());
+    }
+    for (const std::string& duplicate : builder.mDuplicates) check.Fail(duplicate, "duplicate field");
+    if (!root.is_object()) {
+        check.FailWhole("expected a JSON object at the top level, got " + Describe(root));
+        return MakeError(check.Message());
+    }
+    for (const SceneOverride& item : overrides) ApplyOverride(root, item, check);
+
+    Scene scene;
+    ReadScene(root, label, check, scene);
+    if (check.ErrorCount() > 0) return MakeError(check.Message());
+
+    // One pair means "the same shift for every slice"; expanded only now that nz is known to be sane.
+    if (scene.ca.windShift.size() == 1 && scene.grid.size.nz > 1)
+        scene.ca.windShift.assign(scene.grid.size.nz, scene.ca.windShift[0]);
+    return scene;
+}
+
+}  // namespace
+
+Result<Scene> ParseScene(const std::string& text, const std::string& label,
+                         const std::vector<SceneOverride>& overrides) {
+    try {
+        return ParseSceneChecked(text, label, overrides);
+    } catch (const std::exception& e) {
+        return MakeError(label + ": internal error while reading the scene: " + e.what());
+    } catch (...) {
+        return MakeError(label + ": internal error while reading the scene");
+    }
+}
+
+Result<Scene> LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides) {
+    try {
+        std::FILE* file = std::fopen(path.c_str(), "rb");
+        if (!file) return MakeError(path + ": cannot read the file: " + std::strerror(errno));
+        std::string text;
+        char buffer[1 << 16];
+        size_t n;
+        while ((n = std::fread(buffer, 1, sizeof(buffer), file)) > 0) text.append(buffer, n);
+        const bool failed = std::ferror(file) != 0;
+        const int error = errno;
+        std::fclose(file);
+        if (failed) return MakeError(path + ": cannot read the file: " + std::strerror(error));
+
+        Result<Scene> scene = ParseScene(text, path, overrides);
+        if (scene) scene->path = path;
+        return scene;
+    } catch (const std::exception& e) {
+        return MakeError(path + ": internal error while reading the scene: " + e.what());
+    } catch (...) {
+        return MakeError(path + ": internal error while reading the scene");
+    }
+}
+
+uint64_t EstimateSceneBytes(const Scene& scene) {
+    const Extent3& e = scene.grid.size;
+    const uint64_t voxels = SatMul(SatMul(e.nx, e.ny), e.nz);
+    // One bit field: rows of 64-voxel words.
+    const uint64_t bitField = SatMul(SatMul(SatMul(CeilDiv64(e.nx, 64), e.ny), e.nz), 8);
+
+    uint64_t bytes = SatMul(voxels, 4);  // canonical dump staging buffer, float32 per voxel
+    if (scene.stages.Has(Stage::Region)) bytes = SatAdd(bytes, SatAdd(voxels, 64));
+    if (scene.stages.Has(Stage::Ca)) {
+        // hum/act/cld for two steps, plus three advection scratch fields with wind.
+        bytes = SatAdd(bytes, SatMul(bitField, scene.ca.HasWind() ? 9 : 6));
+    }
+    if (scene.stages.Has(Stage::Smooth)) {
+        // q for the previous and current step, plus a byte-per-voxel scratch pair.
+        bytes = SatAdd(bytes, SatAdd(SatMul(voxels, 8), SatMul(voxels, 2)));
+    }
+    if (scene.stages.Has(Stage::Density)) {
+        const uint64_t columns = SatMul(e.nx, e.ny);
+        const uint64_t tile = std::max<uint32_t>(scene.density.tile, 1);
+        const uint64_t band = std::max<uint32_t>(scene.density.band, 1);
+        const uint64_t tiles = SatMul(CeilDiv64(e.nx, tile), CeilDiv64(e.ny, tile));
+        bytes = SatAdd(bytes, SatMul(columns, 8));  // D for two steps, float32
+        bytes = SatAdd(bytes, SatMul(SatMul(tiles, SatAdd(CeilDiv64(e.nz, band), 1)), 2));
+    }
+    // Other stages do not have an estimate yet and count 0.
+    return bytes;
+}
+
+}  // namespace cb

@@ -1,0 +1,37 @@
+// The `cloudbench` subcommands. Each returns the process exit code
+// (docs/cli.md): 0 success, 1 a stage failed or an output could not be written,
+// 2 bad command line, 3 bad scene, 4 none of the requested backends available.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/Scene.h"
+
+namespace cb {
+
+enum ExitCode : int {
+    kExitOk = 0,
+    kExitFailed = 1,
+    kExitUsage = 2,
+    kExitBadScene = 3,
+    kExitNoBackend = 4,
+};
+
+struct CommonOptions {
+    std::string scene;                    // name in scenes/ or a path; "" = default scene
+    std::vector<std::string> backends;    // empty = every built backend (run) / cpu (dump)
+    std::vector<SceneOverride> overrides; // --set, and --steps as "steps"
+    std::string outDir;                   // "" = out/<scene name>[/dump]
+    int cpuThreads = 0;
+    bool quiet = false;
+};
+
+int RunCommand(const CommonOptions& options);
+int DumpCommand(const CommonOptions& options);
+
+// scenes/<name>.json for a bare name, the argument itself for a path.
+std::string ResolveScenePath(const std::string& nameOrPath);
+inline constexpr const char* kDefaultScene = "thesis-medium";
+
+}  // namespace cb

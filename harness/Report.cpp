@@ -1,0 +1,154 @@
+#include "harness/Report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <OpenImageIO/imagebuf.h>
+
+namespace cb {
+namespace {
+
+double Quantile(const std::vector<double>& sorted, double p) {
+    double pos = p * double(sorted.size() - 1);
+    size_t lo = size_t(std::floor(pos));
+    size_t hi = std::min(lo + 1, sorted.size() - 1);
+    return sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - double(lo));
+}
+
+// Post-warm-up samples of one stage.
+std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage) {
+    std::vector<double> out;
+    for (const StepRecord& r : run.steps)
+        if (r.step >= scene.warmupSteps && r.stageMs[size_t(stage)]) out.push_back(*r.stageMs[size_t(stage)]);
+    return out;
+}
+
+double CoverFraction(const Scene& scene, uint32_t columns) {
+    return double(columns) / (double(scene.grid.size.nx) * scene.grid.size.ny);
+}
+
+nlohmann::json SummaryJson(const std::vector<double>& samples) {
+    Summary s = Summarize(samples);
+    return {{"samples_ms", samples}, {"median_ms", s.median}, {"q1_ms", s.q1}, {"q3_ms", s.q3},
+            {"min_ms", s.min}, {"max_ms", s.max}, {"count", s.count}};
+}
+
+}  // namespace
+
+Summary Summarize(std::vector<double> samples) {
+    Summary s;
+    s.count = samples.size();
+    if (samples.empty()) return s;
+    std::sort(samples.begin(), samples.end());
+    s.min = samples.front();
+    s.max = samples.back();
+    s.median = Quantile(samples, 0.5);
+    s.q1 = Quantile(samples, 0.25);
+    s.q3 = Quantile(samples, 0.75);
+    return s;
+}
+
+nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs) {
+    nlohmann::json stages = nlohmann::json::array();
+    for (Stage stage : kAllStages)
+        if (scene.stages.Has(stage)) stages.push_back(StageName(stage));
+    nlohmann::json doc = {
+        {"format", "cloudbench-results/1"},
+        {"scene",
+         {{"name", scene.name},
+          {"path", scene.path},
+          {"grid", {scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz}},
+          {"steps", scene.steps},
+          {"warmup_steps", scene.warmupSteps},
+          {"stages", stages}}},
+        {"backends", nlohmann::json::object()},
+    };
+    for (const BackendRun& run : runs) {
+        nlohmann::json b = {{"status", run.status}, {"device", run.device}, {"steps_completed", run.steps.size()}};
+        if (!run.error.empty()) b["error"] = run.error;
+        nlohmann::json timing = nlohmann::json::object();
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            timing[std::string(StageName(stage))] = SummaryJson(StageSamples(scene, run, stage));
+        }
+        b["stages"] = timing;
+        std::vector<double> hostSamples;
+        for (const StepRecord& r : run.steps)
+            if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region)) hostSamples.push_back(r.ellipsoidUpdateMs);
+        b["host"] = {{"ellipsoid_update", SummaryJson(hostSamples)}};
+        if (scene.stages.Has(Stage::Density)) {
+            nlohmann::json cover = nlohmann::json::array();
+            std::vector<double> after;
+            for (const StepRecord& r : run.steps) {
+                double c = r.coveredColumns ? CoverFraction(scene, *r.coveredColumns) : 0.0;
+                cover.push_back(c);
+                if (r.step >= scene.warmupSteps) after.push_back(c);
+            }
+            b["cover"] = cover;
+            Summary s = Summarize(after);
+            double mean = 0;
+            for (double c : after) mean += c;
+            b["cover_summary"] = {{"mean", after.empty() ? 0.0 : mean / double(after.size())},
+                                  {"median", s.median}, {"min", s.min}, {"max", s.max}};
+        }
+        doc["backends"][run.name] = b;
+    }
+    return doc;
+}
+
+std::string TimingTable(const Scene& scene, const BackendRun& run) {
+    std::string out;
+    char line[256];
+    std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, statistics over steps %u..%zu\n", run.name.c_str(),
+                  run.device.c_str(), run.steps.size(), scene.warmupSteps,
+                  run.steps.empty() ? size_t(0) : run.steps.size() - 1);
+    out += line;
+    std::snprintf(line, sizeof line, "  %-18s %10s %10s %10s %10s %10s\n", "stage", "median ms", "q1", "q3", "min",
+                  "max");
+    out += line;
+    auto row = [&](const std::string& name, const std::vector<double>& samples) {
+        Summary s = Summarize(samples);
+        std::snprintf(line, sizeof line, "  %-18s %10.3f %10.3f %10.3f %10.3f %10.3f\n", name.c_str(), s.median, s.q1,
+                      s.q3, s.min, s.max);
+        out += line;
+    };
+    for (Stage stage : kAllStages)
+        if (scene.stages.Has(stage)) row(std::string(StageName(stage)), StageSamples(scene, run, stage));
+    if (scene.stages.Has(Stage::Region)) {
+        std::vector<double> host;
+        for (const StepRecord& r : run.steps)
+            if (r.step >= scene.warmupSteps) host.push_back(r.ellipsoidUpdateMs);
+        row("(host) ellipsoids", host);
+    }
+    if (scene.stages.Has(Stage::Density) && !run.steps.empty()) {
+        std::vector<double> after;
+        for (const StepRecord& r : run.steps)
+            if (r.step >= scene.warmupSteps && r.coveredColumns) after.push_back(CoverFraction(scene, *r.coveredColumns));
+        Summary s = Summarize(after);
+        const StepRecord& last = run.steps.back();
+        std::snprintf(line, sizeof line, "  cloud cover: last step %.1f %%, median %.1f %% (min %.1f, max %.1f)\n",
+                      last.coveredColumns ? 100.0 * CoverFraction(scene, *last.coveredColumns) : 0.0, 100 * s.median,
+                      100 * s.min, 100 * s.max);
+        out += line;
+    }
+    return out;
+}
+
+Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz) {
+    OIIO::ImageSpec spec(int(nx), int(ny), 1, OIIO::TypeDesc::UINT8);
+    OIIO::ImageBuf image(spec);
+    // Optical-depth look: brightness 1 - exp(-D / 4); a column of 4 full voxels is ~63 % white.
+    (void)nz;
+    for (uint32_t y = 0; y < ny; ++y) {
+        const uint32_t j = ny - 1 - y;  // top row first, y up
+        for (uint32_t i = 0; i < nx; ++i) {
+            float v = 1.0f - std::exp(-columnSum[size_t(i) + size_t(nx) * j] / 4.0f);
+            image.setpixel(int(i), int(y), &v, 1);
+        }
+    }
+    if (!image.write(path)) return MakeError(path + ": cannot write the PNG: " + image.geterror());
+    return {};
+}
+
+}  // namespace cb

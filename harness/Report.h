@@ -1,0 +1,44 @@
+// What a run reports: per-stage timing statistics, cover, results.json
+// (format in docs/results.md) and the top-view PNG of the density map.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/Backend.h"
+#include "core/Scene.h"
+#include "harness/Simulation.h"
+
+namespace cb {
+
+// Order statistics of a sample (quantiles interpolate linearly between order
+// statistics, NumPy's default "linear" method).
+struct Summary {
+    size_t count = 0;
+    double median = 0, q1 = 0, q3 = 0, min = 0, max = 0;
+};
+Summary Summarize(std::vector<double> samples);
+
+// Everything one backend produced for a run; kept even when the run stopped
+// early, so that nothing already computed is lost.
+struct BackendRun {
+    std::string name;
+    std::string device;
+    std::string status = "ok";  // "ok", "unavailable" or "failed"
+    std::string error;
+    std::vector<StepRecord> steps;
+};
+
+nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs);
+
+// The per-stage timing table and the cover line, as printed by `run`.
+std::string TimingTable(const Scene& scene, const BackendRun& run);
+
+// Writes D as a grey top view (x right, y up, white = densest column), 8-bit
+// PNG through OpenImageIO. `columnSum` is canonical D, nx*ny floats.
+Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz);
+
+}  // namespace cb

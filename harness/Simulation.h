@@ -1,0 +1,71 @@
+// Runs a scene's enabled stages on one backend, one step at a time. Only the
+// buffers of enabled stages are allocated (SPEC 14).
+//
+// Step t, in order:
+//   region   R_t from the ellipsoid list L_t
+//   smooth   q_t from cld_t
+//   density  D_t, occupancy and cover from q_t and cld_t
+//   (observer: everything above plus hum_t, act_t, cld_t is readable here)
+//   ca       state_t -> state_{t+1} using R_t
+//   host     L_{t+1} = update(L_t)
+#pragma once
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "core/Backend.h"
+#include "core/Ellipsoids.h"
+#include "core/Scene.h"
+
+namespace cb {
+
+inline constexpr size_t kStageCount = kAllStages.size();
+
+struct StepRecord {
+    uint32_t step = 0;
+    // Wall time of each stage in ms; empty for stages that did not run.
+    std::array<std::optional<double>, kStageCount> stageMs{};
+    double ellipsoidUpdateMs = 0;           // host-side list update
+    std::optional<uint32_t> coveredColumns;  // from the density stage
+};
+
+class Simulation {
+  public:
+    // Allocates the enabled stages' buffers and computes the initial state.
+    static Result<std::unique_ptr<Simulation>> Create(const Scene& scene, Backend& backend);
+
+    using Observer = std::function<Status(const Simulation&)>;
+    // Runs step CurrentStep() and advances to the next.
+    Status Step(StepRecord& record, const Observer& observe = {});
+
+    uint32_t CurrentStep() const { return mStep; }
+    const Scene& GetScene() const { return mScene; }
+    Backend& GetBackend() const { return mBackend; }
+
+    // Buffers of the current step; nullptr when their stage is not enabled.
+    const Buffer* Hum() const { return mHum[mCurrent].get(); }
+    const Buffer* Act() const { return mAct[mCurrent].get(); }
+    const Buffer* Cld() const { return mCld[mCurrent].get(); }
+    const Buffer* Region() const { return mRegion.get(); }
+    const Buffer* Q() const { return mQ.get(); }
+    const Buffer* ColumnSum() const { return mColumnSum.get(); }
+    const Buffer* Tiles() const { return mTiles.get(); }
+    const Buffer* Bands() const { return mBands.get(); }
+
+  private:
+    Simulation(const Scene& scene, Backend& backend);
+
+    const Scene mScene;
+    Backend& mBackend;
+    EllipsoidList mEllipsoids;
+    uint32_t mStep = 0;
+    int mCurrent = 0;  // which of the two automaton states is step t
+    std::vector<int32_t> mShiftX, mShiftY;
+
+    std::unique_ptr<Buffer> mHum[2], mAct[2], mCld[2];
+    std::unique_ptr<Buffer> mRegion, mQ, mColumnSum, mTiles, mBands;
+};
+
+}  // namespace cb

@@ -1,0 +1,136 @@
+// cloudbench: cross-backend validation and benchmark harness for the cloud
+// pipeline of SPEC.md. Command-line front end; docs/cli.md describes it.
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+#include "harness/Commands.h"
+
+namespace {
+
+constexpr const char* kMainHelp = R"(usage: cloudbench <command> [options]
+
+Commands:
+  run    Run a scene on one or more backends, time every stage, write results.json
+  dump   Write each step's canonical stage outputs as NumPy .npy files
+  help   Show help for a command: cloudbench help run
+
+Exit codes: 0 success, 1 a stage failed or an output could not be written,
+2 bad command line, 3 bad scene file or --set value, 4 no requested backend available.
+)";
+
+constexpr const char* kRunHelp = R"(usage: cloudbench run [SCENE] [options]
+
+Runs SCENE (a name in scenes/ or a path to a .json file; default: thesis-medium)
+on each backend, prints a per-stage timing table (median and spread over the
+steps after warm-up) and the cloud cover, and writes DIR/results.json and a top
+view of the last density map, DIR/topview-<backend>.png.
+
+Options:
+  --backend LIST     comma-separated backends (cpu, gl, vk); default: all built.
+                     An unavailable backend is reported and the others still run.
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>)
+  --set PATH=VALUE   override a scene field by its dotted path, validated like
+                     the file: --set ca.seed=42 --set grid.size=[64,16,64]
+  --threads N        CPU backend threads (default: all)
+  --quiet            no progress lines
+)";
+
+constexpr const char* kDumpHelp = R"(usage: cloudbench dump [SCENE] [options]
+
+Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
+  hum.npy act.npy cld.npy  uint8 0/1, the automaton state at step t
+  region.npy               uint8, the region volume used for step t -> t+1
+  q.npy                    float32, smoothed from cld at step t
+  density.npy              float32 D, shape (1, ny, nx)
+  tiles.npy bands.npy      uint8 tile and height-band occupancy of step t
+Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
+
+Options:
+  --backend NAME     the backend to dump (default: cpu)
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>/dump)
+  --set PATH=VALUE   override a scene field (see cloudbench help run)
+  --threads N        CPU backend threads (default: all)
+  --quiet            no progress lines
+)";
+
+int Usage(const char* message, const char* help) {
+    std::fprintf(stderr, "cloudbench: %s\n\n%s", message, help);
+    return cb::kExitUsage;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        std::fputs(kMainHelp, stderr);
+        return cb::kExitUsage;
+    }
+    const std::string_view command = argv[1];
+    if (command == "--help" || command == "-h") {
+        std::fputs(kMainHelp, stdout);
+        return cb::kExitOk;
+    }
+    if (command == "help") {
+        std::string_view topic = argc > 2 ? argv[2] : "";
+        std::fputs(topic == "run" ? kRunHelp : topic == "dump" ? kDumpHelp : kMainHelp, stdout);
+        return cb::kExitOk;
+    }
+    const char* help = command == "run" ? kRunHelp : command == "dump" ? kDumpHelp : nullptr;
+    if (!help) return Usage(("unknown command '" + std::string(command) + "'").c_str(), kMainHelp);
+
+    cb::CommonOptions options;
+    // A dump has no statistics, so no warm-up to keep below --steps.
+    if (command == "dump") options.overrides.push_back({"warmup_steps", "0"});
+    bool sceneGiven = false;
+    for (int n = 2; n < argc; ++n) {
+        const std::string_view arg = argv[n];
+        auto value = [&]() -> const char* { return n + 1 < argc ? argv[++n] : nullptr; };
+        if (arg == "--help" || arg == "-h") {
+            std::fputs(help, stdout);
+            return cb::kExitOk;
+        } else if (arg == "--backend" || arg == "--backends") {
+            const char* v = value();
+            if (!v) return Usage("--backend needs a list, e.g. --backend cpu", help);
+            std::string list = v;
+            for (size_t start = 0; start <= list.size();) {
+                size_t comma = list.find(',', start);
+                if (comma == std::string::npos) comma = list.size();
+                if (comma > start) options.backends.push_back(list.substr(start, comma - start));
+                start = comma + 1;
+            }
+        } else if (arg == "--steps") {
+            const char* v = value();
+            if (!v) return Usage("--steps needs a number", help);
+            options.overrides.push_back({"steps", v});
+        } else if (arg == "--out") {
+            const char* v = value();
+            if (!v) return Usage("--out needs a folder", help);
+            options.outDir = v;
+        } else if (arg == "--set") {
+            const char* v = value();
+            const char* eq = v ? std::strchr(v, '=') : nullptr;
+            if (!eq || eq == v) return Usage("--set needs PATH=VALUE, e.g. --set ca.seed=42", help);
+            options.overrides.push_back({std::string(v, eq), std::string(eq + 1)});
+        } else if (arg == "--threads") {
+            const char* v = value();
+            char* end = nullptr;
+            long threads = v ? std::strtol(v, &end, 10) : -1;
+            if (!v || *end != '\0' || threads < 1 || threads > 1024) return Usage("--threads needs a number from 1", help);
+            options.cpuThreads = int(threads);
+        } else if (arg == "--quiet") {
+            options.quiet = true;
+        } else if (arg.starts_with("-")) {
+            return Usage(("unknown option '" + std::string(arg) + "'").c_str(), help);
+        } else if (!sceneGiven) {
+            options.scene = std::string(arg);
+            sceneGiven = true;
+        } else {
+            return Usage(("unexpected argument '" + std::string(arg) + "' (one scene at a time)").c_str(), help);
+        }
+    }
+    return command == "run" ? cb::RunCommand(options) : cb::DumpCommand(options);
+}

@@ -1,0 +1,64 @@
+// The CPU backend: bit-field automaton (64 voxels per word) and plain float
+// volumes, parallelised with TBB inside a task arena of a chosen size.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+#include "core/Backend.h"
+#include "impl_cpu/BitField.h"
+
+namespace cb::cpu {
+
+// Buffer storage on the CPU. U8 volumes carry kPadding spare zero bytes at the
+// end so that kernels may read a full 64-voxel word past a row's end.
+class BufferCpu final : public Buffer {
+  public:
+    static constexpr size_t kPadding = 64;
+
+    BufferCpu(BufferFormat format, Extent3 extent);
+
+    BitField& Bits() { return mBits; }
+    const BitField& Bits() const { return mBits; }
+    uint8_t* U8() { return mU8.data(); }
+    const uint8_t* U8() const { return mU8.data(); }
+    float* F32() { return mF32.data(); }
+    const float* F32() const { return mF32.data(); }
+
+  private:
+    BitField mBits;
+    std::vector<uint8_t> mU8;
+    std::vector<float> mF32;
+};
+
+class BackendCpu final : public Backend {
+  public:
+    // threads = 0: all hardware threads.
+    explicit BackendCpu(int threads = 0);
+
+    std::string Name() const override { return "cpu"; }
+    std::string Device() const override;
+    bool Supports(Stage stage) const override;
+
+    Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
+    Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
+    Status Download(const Buffer& buffer, std::span<std::byte> canonical) override;
+
+    Status Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) override;
+    Status CaInitialize(const CaInitParams& params, CaFields out) override;
+    Status CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) override;
+    Status Smooth(int radius, const Buffer& cld, Buffer& q) override;
+    Status Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) override;
+
+    int Threads() const { return mArena.max_concurrency(); }
+
+  private:
+    tbb::task_arena mArena;
+    // Scratch kept between calls so that steady-state steps do not allocate.
+    std::vector<BitField> mAdvectScratch;
+    std::vector<uint16_t> mSmoothScratch;
+};
+
+}  // namespace cb::cpu

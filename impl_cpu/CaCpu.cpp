@@ -1,0 +1,170 @@
+// Stage `ca` on the CPU (SPEC 3): Dobashi's bit-field automaton, 64 voxels per
+// word, rows spread over the TBB arena.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/Random.h"
+#include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/CaKernels.h"
+
+namespace cb::cpu {
+namespace {
+
+// Bits [start, start + 64) of a row as one word; bits outside [0, 64*words) are 0.
+inline uint64_t BitsAt(const uint64_t* row, int64_t words, int64_t start) {
+    int64_t word = start >> 6;  // floor division (arithmetic shift)
+    int shift = int(start & 63);
+    auto at = [&](int64_t w) -> uint64_t { return (w >= 0 && w < words) ? row[w] : 0; };
+    if (shift == 0) return at(word);
+    return (at(word) >> shift) | (at(word + 1) << (64 - shift));
+}
+
+// X'(i, j, k) = X(i - sx, j - sy, k), zero-filled (SPEC 3 step 4).
+void AdvectField(const BitField& src, BitField& dst, std::span<const int32_t> shiftX,
+                 std::span<const int32_t> shiftY) {
+    const Extent3 e = src.Extent();
+    const uint32_t words = src.WordsPerRow();
+    const uint64_t lastMask = src.LastWordMask();
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
+        for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
+            uint32_t j = r % e.ny, k = r / e.ny;
+            uint64_t* out = dst.Row(j, k);
+            const uint64_t* in = src.RowOrNull(int64_t(j) - shiftY[k], k);
+            if (!in) {
+                std::fill(out, out + words, 0);
+                continue;
+            }
+            for (uint32_t w = 0; w < words; ++w) out[w] = BitsAt(in, words, int64_t(w) * 64 - shiftX[k]);
+            out[words - 1] &= lastMask;
+        }
+    });
+}
+
+}  // namespace
+
+Status BackendCpu::CaInitialize(const CaInitParams& params, CaFields out) {
+    auto& hum = static_cast<BufferCpu&>(*out.hum).Bits();
+    auto& act = static_cast<BufferCpu&>(*out.act).Bits();
+    auto& cld = static_cast<BufferCpu&>(*out.cld).Bits();
+    const Extent3 e = hum.Extent();
+    const uint32_t keyHum = StreamKey(params.seed, kInitialStateStep, kStreamHumidity);
+    const uint32_t keyAct = StreamKey(params.seed, kInitialStateStep, kStreamActivation);
+    mArena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
+            for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
+                uint32_t j = r % e.ny, k = r / e.ny;
+                uint64_t* h = hum.Row(j, k);
+                uint64_t* a = act.Row(j, k);
+                uint64_t* c = cld.Row(j, k);
+                uint32_t base = VoxelIndex(e, 0, j, k);
+                for (uint32_t w = 0; w < hum.WordsPerRow(); ++w) h[w] = a[w] = c[w] = 0;
+                for (uint32_t i = 0; i < e.nx; ++i) {
+                    uint64_t bit = 1ull << (i & 63);
+                    if (Rand24FromKey(keyHum, base + i) < params.qHum0) h[i >> 6] |= bit;
+                    if (Rand24FromKey(keyAct, base + i) < params.qAct0) a[i >> 6] |= bit;
+                }
+            }
+        });
+    });
+    return {};
+}
+
+Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& regionBuffer, CaFields out) {
+    const BitField& hum = static_cast<const BufferCpu&>(*in.hum).Bits();
+    const BitField& act = static_cast<const BufferCpu&>(*in.act).Bits();
+    const BitField& cld = static_cast<const BufferCpu&>(*in.cld).Bits();
+    const uint8_t* region = static_cast<const BufferCpu&>(regionBuffer).U8();
+    const Extent3 e = hum.Extent();
+    const uint32_t words = hum.WordsPerRow();
+    const uint64_t lastMask = hum.LastWordMask();
+
+    bool wind = false;
+    for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
+
+    // Without wind the rules write straight into `out`; with wind they write
+    // into scratch and the advection pass moves the result into `out`.
+    BitField* dst[3] = {&static_cast<BufferCpu&>(*out.hum).Bits(), &static_cast<BufferCpu&>(*out.act).Bits(),
+                        &static_cast<BufferCpu&>(*out.cld).Bits()};
+    if (wind) {
+        if (mAdvectScratch.size() != 3 || !(mAdvectScratch[0].Extent() == e)) mAdvectScratch.assign(3, BitField(e));
+        for (int f = 0; f < 3; ++f) dst[f] = &mAdvectScratch[f];
+    }
+
+    const uint32_t keyExt = StreamKey(params.seed, params.step, kStreamExtinction);
+    const uint32_t keyHum = StreamKey(params.seed, params.step, kStreamHumidity);
+    const uint32_t keyAct = StreamKey(params.seed, params.step, kStreamActivation);
+
+    auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
+        for (uint32_t r = range.begin(); r != range.end(); ++r) {
+            const uint32_t j = r % e.ny, k = r / e.ny;
+            const uint64_t* a = act.Row(j, k);
+            const uint64_t* h = hum.Row(j, k);
+            const uint64_t* c = cld.Row(j, k);
+            // The 7 neighbour rows of the growth rule that are not in this row.
+            const uint64_t* across[7] = {act.RowOrNull(j + 1, k),     act.RowOrNull(int64_t(j) - 1, k),
+                                         act.RowOrNull(j + 2, k),     act.RowOrNull(int64_t(j) - 2, k),
+                                         act.RowOrNull(j, k + 1),     act.RowOrNull(j, int64_t(k) - 1),
+                                         act.RowOrNull(j, int64_t(k) - 2)};
+            const uint8_t* rRow = region + size_t(e.nx) * (j + size_t(e.ny) * k);
+            uint64_t* hOut = dst[0]->Row(j, k);
+            uint64_t* aOut = dst[1]->Row(j, k);
+            uint64_t* cOut = dst[2]->Row(j, k);
+            const uint32_t rowBase = VoxelIndex(e, 0, j, k);
+
+            for (uint32_t w = 0; w < words; ++w) {
+                const uint64_t aw = a[w];
+                const uint64_t prev = w > 0 ? a[w - 1] : 0;
+                const uint64_t next = w + 1 < words ? a[w + 1] : 0;
+                // f(i) reads act(i-1), act(i+1), act(i-2), act(i+2) within the row.
+                uint64_t f = (aw << 1 | prev >> 63) | (aw >> 1 | next << 63) | (aw << 2 | prev >> 62) |
+                             (aw >> 2 | next << 62);
+                for (const uint64_t* n : across)
+                    if (n) f |= n[w];
+
+                // 1. Growth.
+                const uint64_t hum1 = h[w] & ~aw;
+                const uint64_t cld1 = c[w] | aw;
+                const uint64_t act1 = ~aw & h[w] & f;  // h has no bits past nx, so neither has act1
+
+                // 2-3. Region-scaled events. Where R = 0 no event can change the
+                // result (P_hum = P_act = 0 and cld is cleared), so only voxels
+                // with R > 0 that an event could flip draw random numbers.
+                const uint32_t i0 = 64 * w;
+                const uint8_t* rWord = rRow + i0;
+                uint64_t inRegion = NonZeroMaskVector(rWord);
+                if (w == words - 1) inRegion &= lastMask;
+                const uint32_t v0 = rowBase + i0;
+
+                uint64_t cld2 = cld1 & inRegion;
+                const uint64_t extCandidates = cld2;
+                if (extCandidates && params.qExt)
+                    cld2 &= ~(EventBitsVector(keyExt, v0, rWord, params.qExt, /*invert=*/true) & extCandidates);
+                uint64_t hum2 = hum1;
+                const uint64_t humCandidates = ~hum1 & inRegion;
+                if (humCandidates && params.qHum)
+                    hum2 |= EventBitsVector(keyHum, v0, rWord, params.qHum, false) & humCandidates;
+                uint64_t act2 = act1;
+                const uint64_t actCandidates = ~act1 & inRegion;
+                if (actCandidates && params.qAct)
+                    act2 |= EventBitsVector(keyAct, v0, rWord, params.qAct, false) & actCandidates;
+
+                hOut[w] = hum2;
+                aOut[w] = act2;
+                cOut[w] = cld2;
+            }
+        }
+    };
+
+    mArena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 16), rows);
+        if (wind) {
+            for (int f = 0; f < 3; ++f) {
+                BitField& target = static_cast<BufferCpu&>(f == 0 ? *out.hum : f == 1 ? *out.act : *out.cld).Bits();
+                AdvectField(*dst[f], target, params.shiftX, params.shiftY);
+            }
+        }
+    });
+    return {};
+}
+
+}  // namespace cb::cpu

@@ -1,0 +1,206 @@
+// Google Benchmark programs for the CPU stages on the thesis-sized scenes, and
+// the machine figures (memory bandwidth, hash rate) their floors are worked
+// out from (docs/performance.md). Each stage runs on a state taken after the
+// scene's warm-up, so the numbers are those of a running simulation.
+#include <benchmark/benchmark.h>
+
+#include <cstring>
+#include <map>
+#include <numeric>
+
+#include "core/Ellipsoids.h"
+#include "core/Random.h"
+#include "core/Scene.h"
+#include "impl_cpu/BackendCpu.h"
+
+namespace cb {
+namespace {
+
+// A scene's state after warm-up, held in one backend's buffers.
+struct WarmState {
+    Scene scene;
+    std::unique_ptr<cpu::BackendCpu> backend;
+    std::unique_ptr<Buffer> hum[2], act[2], cld[2], region, q, D, tiles, bands;
+    std::vector<RasterEllipsoid> raster;
+    CaStepParams params;
+    double cover = 0;
+};
+
+std::unique_ptr<Buffer> Make(Backend& b, BufferFormat f, Extent3 e) { return std::move(*b.CreateBuffer(f, e)); }
+
+WarmState& Warm(const std::string& name, int threads) {
+    static std::map<std::pair<std::string, int>, std::unique_ptr<WarmState>> cache;
+    auto& slot = cache[{name, threads}];
+    if (slot) return *slot;
+    slot = std::make_unique<WarmState>();
+    WarmState& w = *slot;
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/" + name + ".json");
+    if (!scene) {
+        std::fprintf(stderr, "%s\n", scene.error().message.c_str());
+        std::exit(1);
+    }
+    w.scene = *scene;
+    const Extent3 e = w.scene.grid.size;
+    w.backend = std::make_unique<cpu::BackendCpu>(threads);
+    Backend& b = *w.backend;
+    for (int s = 0; s < 2; ++s) {
+        w.hum[s] = Make(b, BufferFormat::Bits, e);
+        w.act[s] = Make(b, BufferFormat::Bits, e);
+        w.cld[s] = Make(b, BufferFormat::Bits, e);
+    }
+    w.region = Make(b, BufferFormat::U8, e);
+    w.q = Make(b, BufferFormat::F32, e);
+    const uint32_t T = w.scene.density.tile, B = w.scene.density.band;
+    w.D = Make(b, BufferFormat::F32, {e.nx, e.ny, 1});
+    w.tiles = Make(b, BufferFormat::U8, {CeilDiv(e.nx, T), CeilDiv(e.ny, T), 1});
+    w.bands = Make(b, BufferFormat::U8, {CeilDiv(e.nx, T), CeilDiv(e.ny, T), CeilDiv(e.nz, B)});
+    const CaSettings& ca = w.scene.ca;
+    (void)b.CaInitialize({ca.seed, QuantizeProbability(ca.hum0), QuantizeProbability(ca.act0)},
+                         {w.hum[0].get(), w.act[0].get(), w.cld[0].get()});
+    w.params = {ca.seed, 0, QuantizeProbability(ca.pExt), QuantizeProbability(ca.pHum), QuantizeProbability(ca.pAct), {}, {}};
+    EllipsoidList list(w.scene.ellipsoids, e);
+    int cur = 0;
+    for (uint32_t t = 0; t < w.scene.warmupSteps; ++t) {
+        w.raster = list.Raster();
+        (void)b.Region(w.raster, *w.region);
+        w.params.step = t;
+        (void)b.CaStep(w.params, {w.hum[cur].get(), w.act[cur].get(), w.cld[cur].get()}, *w.region,
+                       {w.hum[1 - cur].get(), w.act[1 - cur].get(), w.cld[1 - cur].get()});
+        cur = 1 - cur;
+        list.Update();
+    }
+    if (cur == 1) {
+        std::swap(w.hum[0], w.hum[1]);
+        std::swap(w.act[0], w.act[1]);
+        std::swap(w.cld[0], w.cld[1]);
+    }
+    w.raster = list.Raster();
+    (void)b.Region(w.raster, *w.region);
+    (void)b.Smooth(w.scene.smooth.radius, *w.cld[0], *w.q);
+    DensityOutputs out{w.D.get(), w.tiles.get(), w.bands.get(), 0};
+    (void)b.Density({T, B}, *w.q, *w.cld[0], out);
+    w.cover = double(out.coveredColumns) / (double(e.nx) * e.ny);
+    return w;
+}
+
+void Label(benchmark::State& state, const WarmState& w) {
+    state.counters["voxels"] = double(w.scene.grid.size.Count());
+    state.counters["cover"] = w.cover;
+    state.counters["threads"] = w.backend->Threads();
+}
+
+void BM_Region(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    for (auto _ : state) (void)w.backend->Region(w.raster, *w.region);
+    Label(state, w);
+    state.counters["ellipsoids"] = double(w.raster.size());
+}
+
+void BM_CaStep(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    // Always step from the same warm state (index 0) into index 1, so every
+    // iteration does the same work.
+    for (auto _ : state)
+        (void)w.backend->CaStep(w.params, {w.hum[0].get(), w.act[0].get(), w.cld[0].get()}, *w.region,
+                                {w.hum[1].get(), w.act[1].get(), w.cld[1].get()});
+    Label(state, w);
+}
+
+void BM_Smooth(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    const int radius = int(state.range(1));
+    for (auto _ : state) (void)w.backend->Smooth(radius, *w.cld[0], *w.q);
+    Label(state, w);
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(w.scene.grid.size.Count()) * 4);
+}
+
+void BM_Density(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    DensityOutputs out{w.D.get(), w.tiles.get(), w.bands.get(), 0};
+    const DensityParams params{w.scene.density.tile, w.scene.density.band};
+    for (auto _ : state) (void)w.backend->Density(params, *w.q, *w.cld[0], out);
+    Label(state, w);
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(w.scene.grid.size.Count()) * 4);
+}
+
+// ---- Machine figures for the floors ------------------------------------------
+
+// Streaming read of a 64 MiB float array (larger than L3): DRAM read bandwidth.
+void BM_MachineReadDram(benchmark::State& state) {
+    std::vector<float> data(size_t(16) << 20, 1.0f);
+    for (auto _ : state) benchmark::DoNotOptimize(std::accumulate(data.begin(), data.end(), 0.0f));
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(data.size() * 4));
+}
+
+// Read of an 8 MiB array (a 256x32x256 float volume), which stays in L3.
+void BM_MachineReadL3(benchmark::State& state) {
+    std::vector<float> data(size_t(2) << 20, 1.0f);
+    for (auto _ : state) {
+        float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+        for (size_t n = 0; n < data.size(); n += 4) {
+            s0 += data[n];
+            s1 += data[n + 1];
+            s2 += data[n + 2];
+            s3 += data[n + 3];
+        }
+        benchmark::DoNotOptimize(s0 + s1 + s2 + s3);
+    }
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(data.size() * 4));
+}
+
+// Write of an 8 MiB array.
+void BM_MachineWriteL3(benchmark::State& state) {
+    std::vector<float> data(size_t(2) << 20);
+    float value = 0;
+    for (auto _ : state) {
+        std::fill(data.begin(), data.end(), value += 1);
+        benchmark::ClobberMemory();
+    }
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(data.size() * 4));
+}
+
+// rand24 draws per second on one core (scalar, as the compiler vectorises it).
+void BM_MachineHashRate(benchmark::State& state) {
+    std::vector<uint32_t> out(1 << 16);
+    uint32_t key = StreamKey(1, 2, 3);
+    for (auto _ : state) {
+        for (uint32_t v = 0; v < out.size(); ++v) out[v] = Rand24FromKey(key, v);
+        benchmark::DoNotOptimize(out.data());
+        key++;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(out.size()));
+}
+
+void Register() {
+    const char* scenes[] = {"thesis-low", "thesis-medium", "thesis-high"};
+    for (const char* scene : scenes) {
+        std::string s = scene;
+        benchmark::RegisterBenchmark(("Region/" + s).c_str(), BM_Region, s)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("CaStep/" + s).c_str(), BM_CaStep, s)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("Smooth/" + s).c_str(), BM_Smooth, s)
+            ->Args({1, 1})->Args({2, 1})->Args({2, 0})->Args({2, 2})->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("Density/" + s).c_str(), BM_Density, s)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+    }
+    // Small variants for the CTest smoke run.
+    std::string small = "ci-small";
+    benchmark::RegisterBenchmark("Small/Region", BM_Region, small)->Arg(2);
+    benchmark::RegisterBenchmark("Small/CaStep", BM_CaStep, small)->Arg(2);
+    benchmark::RegisterBenchmark("Small/Smooth", BM_Smooth, small)->Args({2, 1});
+    benchmark::RegisterBenchmark("Small/Density", BM_Density, small)->Arg(2);
+    benchmark::RegisterBenchmark("Machine/ReadDram64MiB", BM_MachineReadDram)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("Machine/ReadL3_8MiB", BM_MachineReadL3)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("Machine/WriteL3_8MiB", BM_MachineWriteL3)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("Machine/HashRate", BM_MachineHashRate);
+}
+
+}  // namespace
+}  // namespace cb
+
+int main(int argc, char** argv) {
+    cb::Register();
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
