@@ -453,12 +453,12 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
     DomBuilder builder(value);
     const bool parsed = Json::sax_parse(item.value, &builder);
     if (!parsed && builder.mErrorId == 406) {
-        // Number overflow (1e999): keep it as a non-finite number so the field's own check names it.
-        const size_t first = item.value.find_first_not_of(" \t\r\n");
-        value = (first != std::string::npos && item.value[first] == '-') ? -kInf : kInf;
-    } else if (!parsed) {
-        value = item.value;
+        // Number overflow (1e999) is a number, not a bare word: refuse it rather than take it as a string.
+        check.MarkOverridden(item.path);
+        check.Fail(item.path, "the number " + builder.mErrorToken + " is out of range (not finite)");
+        return;
     }
+    if (!parsed) value = item.value;
 
     Json* node = &root;
     std::string prefix;
