@@ -60,7 +60,14 @@ std::string Describe(const Json& value) {
     return text;
 }
 
-std::string Quote(std::string_view text) { return "\"" + std::string(text) + "\""; }
+std::string Quote(std::string_view text) {
+    // Built with append rather than operator+: GCC 12 raises a false -Wrestrict
+    // on "literal" + std::string (GCC bug 105651).
+    std::string quoted;
+    quoted.reserve(text.size() + 2);
+    quoted.append(1, '"').append(text).append(1, '"');
+    return quoted;
+}
 
 std::string JoinField(std::string_view parent, std::string_view key) {
     if (parent.empty()) return std::string(key);

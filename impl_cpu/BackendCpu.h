@@ -58,7 +58,6 @@ class BackendCpu final : public Backend {
     tbb::task_arena mArena;
     // Scratch kept between calls so that steady-state steps do not allocate.
     std::vector<BitField> mAdvectScratch;
-    std::vector<uint16_t> mSmoothScratch;
 };
 
 }  // namespace cb::cpu

@@ -11,6 +11,27 @@
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
+namespace {
+
+// Writes flags[tx] = 1 iff some value > 0 in tile column tx of `rows` rows of
+// length nx (tiles of T columns). `columnMax` is scratch of nx floats. The rows
+// are folded into one by a max across i first, which vectorises.
+void TileFlags(const float* values, uint32_t nx, uint32_t rows, uint32_t T, std::vector<float>& columnMax,
+               uint8_t* flags) {
+    columnMax.assign(values, values + nx);
+    for (uint32_t r = 1; r < rows; ++r) {
+        const float* row = values + size_t(nx) * r;
+        for (uint32_t i = 0; i < nx; ++i) columnMax[i] = std::max(columnMax[i], row[i]);
+    }
+    for (uint32_t tx = 0, i0 = 0; i0 < nx; ++tx, i0 += T) {
+        const uint32_t i1 = std::min(nx, i0 + T);
+        float m = 0.0f;
+        for (uint32_t i = i0; i < i1; ++i) m = std::max(m, columnMax[i]);
+        flags[tx] = uint8_t(m > 0.0f);
+    }
+}
+
+}  // namespace
 
 Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer& cldBuffer,
                            DensityOutputs& out) {
@@ -27,33 +48,43 @@ Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, c
 
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, tilesY, 1), [&](const tbb::blocked_range<uint32_t>& tileRows) {
+            // The columns of one row of tiles are contiguous in D and in each
+            // slice of q, so every inner loop runs over T*nx consecutive floats.
+            std::vector<float> bandMax;  // per column: the largest q within the current band
+            std::vector<float> columnMax;
             for (uint32_t ty = tileRows.begin(); ty != tileRows.end(); ++ty) {
-                uint8_t* tileRow = tiles + size_t(tilesX) * ty;
-                std::fill(tileRow, tileRow + tilesX, 0);
-                for (uint32_t b = 0; b < bandCount; ++b)
-                    std::fill_n(bands + tilesX * (ty + size_t(tilesY) * b), tilesX, 0);
-                const uint32_t j1 = std::min(e.ny, (ty + 1) * T);
-                for (uint32_t j = ty * T; j < j1; ++j) {
-                    float* d = D + size_t(e.nx) * j;
-                    std::fill(d, d + e.nx, 0.0f);
-                    for (uint32_t k = 0; k < e.nz; ++k) {  // k ascending: the order every backend sums in
-                        const float* row = q + sliceSize * k + size_t(e.nx) * j;
-                        uint8_t* bandRow = bands + tilesX * (ty + size_t(tilesY) * (k / B));
-                        for (uint32_t tx = 0; tx < tilesX; ++tx) {
-                            const uint32_t i0 = tx * T, i1 = std::min(e.nx, i0 + T);
-                            bool any = false;
-                            for (uint32_t i = i0; i < i1; ++i) {
-                                d[i] += row[i];
-                                any |= row[i] > 0.0f;
-                            }
-                            bandRow[tx] |= uint8_t(any);
+                const uint32_t j0 = ty * T, j1 = std::min(e.ny, j0 + T);
+                const size_t count = size_t(j1 - j0) * e.nx;
+                float* d = D + size_t(e.nx) * j0;
+                std::fill(d, d + count, 0.0f);
+                bandMax.resize(count);
+                for (uint32_t b = 0; b < bandCount; ++b) {
+                    std::fill(bandMax.begin(), bandMax.end(), 0.0f);
+                    const uint32_t kEnd = std::min(e.nz, (b + 1) * B);
+                    // k ascending, the order every backend sums in; four slices per
+                    // pass so that d and bandMax are loaded and stored once per four.
+                    uint32_t k = b * B;
+                    for (; k + 4 <= kEnd; k += 4) {
+                        const float* s0 = q + sliceSize * k + size_t(e.nx) * j0;
+                        const float *s1 = s0 + sliceSize, *s2 = s1 + sliceSize, *s3 = s2 + sliceSize;
+                        float* m = bandMax.data();
+                        for (size_t n = 0; n < count; ++n) {
+                            d[n] = (((d[n] + s0[n]) + s1[n]) + s2[n]) + s3[n];
+                            m[n] = std::max(std::max(m[n], s0[n]), std::max(s1[n], std::max(s2[n], s3[n])));
                         }
                     }
-                    for (uint32_t tx = 0; tx < tilesX; ++tx) {
-                        const uint32_t i0 = tx * T, i1 = std::min(e.nx, i0 + T);
-                        for (uint32_t i = i0; i < i1; ++i) tileRow[tx] |= uint8_t(d[i] > 0.0f);
+                    for (; k < kEnd; ++k) {
+                        const float* slice = q + sliceSize * k + size_t(e.nx) * j0;
+                        for (size_t n = 0; n < count; ++n) {
+                            d[n] += slice[n];
+                            bandMax[n] = std::max(bandMax[n], slice[n]);
+                        }
                     }
+                    uint8_t* bandRow = bands + tilesX * (ty + size_t(tilesY) * b);
+                    TileFlags(bandMax.data(), e.nx, j1 - j0, T, columnMax, bandRow);
                 }
+                uint8_t* tileRow = tiles + size_t(tilesX) * ty;
+                TileFlags(d, e.nx, j1 - j0, T, columnMax, tileRow);
             }
         });
 

@@ -1,87 +1,150 @@
 // Stage `smooth` on the CPU (SPEC 4): the separable binomial filter on integer
-// numerators (x, then y per slice, then z), scaled by 1/W once at the end, so
-// the float result is exact.
+// numerators, scaled by 1/W once at the end, so the float result is exact.
+//
+// Schedule: each task owns a run of output slices. It expands the bit rows of
+// the slices it needs (its own plus `radius` either side) to bytes, filters
+// them in x and then y into a small ring of slices that stays in L2, and sums
+// that ring in z straight into the float output. Every inner loop runs over a
+// whole row of bytes or integers, which the compiler vectorises.
+#include <array>
+#include <cstring>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
+namespace {
+
+// Eight bits -> eight bytes of 0/1, little-endian: entry b has byte n = bit n of b.
+constexpr std::array<uint64_t, 256> MakeExpandTable() {
+    std::array<uint64_t, 256> table{};
+    for (uint32_t b = 0; b < 256; ++b)
+        for (uint32_t n = 0; n < 8; ++n) table[b] |= uint64_t((b >> n) & 1) << (8 * n);
+    return table;
+}
+constexpr std::array<uint64_t, 256> kExpand = MakeExpandTable();
+
+// bytes[0 .. 8*ceil(nx/8)) = cld bits of one row (0/1).
+void ExpandRow(const uint64_t* row, uint32_t nx, uint8_t* bytes) {
+    const uint32_t octets = CeilDiv(nx, 8);
+    for (uint32_t o = 0; o < octets; ++o) {
+        uint64_t eight = kExpand[(row[o >> 3] >> (8 * (o & 7))) & 0xff];
+        std::memcpy(bytes + 8 * o, &eight, 8);
+    }
+}
+
+// Numerator type after the y pass: r = 1 fits bytes (<= 16, <= 64 after z);
+// r = 2 needs 16 bits (<= 256, <= 4096 after z).
+template <int R>
+using Acc = std::conditional_t<R == 1, uint8_t, uint16_t>;
+
+template <int R>
+constexpr int W(int d) {
+    return SmoothWeight(R, d);
+}
+
+// x then y pass of slice k into `out` (nx*ny numerators); `padded` is scratch of
+// (nx + 2R) bytes per row, zero in the R bytes at both ends.
+template <int R>
+void FilterSliceXY(const BitField& cld, uint32_t k, std::vector<uint8_t>& xs, std::vector<uint8_t>& padded,
+                   Acc<R>* out) {
+    const Extent3 e = cld.Extent();
+    const uint32_t nx = e.nx;
+    for (uint32_t j = 0; j < e.ny; ++j) {
+        ExpandRow(cld.Row(j, k), nx, padded.data() + R);
+        std::fill(padded.begin() + R + nx, padded.end(), 0);  // the expansion writes up to 7 bytes past nx
+        uint8_t* x = xs.data() + size_t(nx) * j;
+        const uint8_t* p = padded.data() + R;
+        // Shifted row pointers: i - 1 on an unsigned index would wrap.
+        const uint8_t *m2 = p - R, *m1 = p - 1, *p1 = p + 1, *p2 = p + R;
+        if constexpr (R == 1) {
+            for (uint32_t i = 0; i < nx; ++i) x[i] = uint8_t(m1[i] + 2 * p[i] + p1[i]);
+        } else {
+            for (uint32_t i = 0; i < nx; ++i) x[i] = uint8_t(m2[i] + 4 * m1[i] + 6 * p[i] + 4 * p1[i] + p2[i]);
+        }
+    }
+    for (uint32_t j = 0; j < e.ny; ++j) {
+        Acc<R>* o = out + size_t(nx) * j;
+        std::fill(o, o + nx, Acc<R>(0));
+        for (int d = -R; d <= R; ++d) {
+            const int64_t jj = int64_t(j) + d;
+            if (jj < 0 || jj >= e.ny) continue;
+            const uint8_t* x = xs.data() + size_t(nx) * jj;
+            const Acc<R> w = Acc<R>(W<R>(d));
+            for (uint32_t i = 0; i < nx; ++i) o[i] = Acc<R>(o[i] + w * x[i]);
+        }
+    }
+}
+
+template <int R>
+void SmoothSlices(const BitField& cld, float* q, uint32_t k0, uint32_t k1) {
+    const Extent3 e = cld.Extent();
+    const size_t sliceSize = size_t(e.nx) * e.ny;
+    const float invW = 1.0f / float(SmoothNormaliser(R));  // a power of two: exact
+    constexpr int kRing = 2 * R + 1;
+    // ring[k mod kRing] holds the xy numerators of slice k.
+    std::vector<Acc<R>> ring(sliceSize * kRing);
+    std::vector<uint8_t> xs(sliceSize), padded(e.nx + 2 * R + 8, 0);
+    std::vector<uint32_t> acc(e.nx);
+    auto slot = [&](int64_t k) { return ring.data() + sliceSize * size_t(k % kRing); };
+
+    const int64_t first = std::max<int64_t>(0, int64_t(k0) - R);
+    int64_t filtered = first;  // next slice to filter
+    for (uint32_t k = k0; k < k1; ++k) {
+        const int64_t need = std::min<int64_t>(int64_t(k) + R, int64_t(e.nz) - 1);
+        for (; filtered <= need; ++filtered) FilterSliceXY<R>(cld, uint32_t(filtered), xs, padded, slot(filtered));
+        for (uint32_t j = 0; j < e.ny; ++j) {
+            float* out = q + sliceSize * k + size_t(e.nx) * j;
+            std::fill(acc.begin(), acc.end(), 0u);
+            for (int d = -R; d <= R; ++d) {
+                const int64_t kk = int64_t(k) + d;
+                if (kk < 0 || kk >= e.nz) continue;
+                const Acc<R>* in = slot(kk) + size_t(e.nx) * j;
+                const uint32_t w = uint32_t(W<R>(d));
+                for (uint32_t i = 0; i < e.nx; ++i) acc[i] += w * in[i];
+            }
+            for (uint32_t i = 0; i < e.nx; ++i) out[i] = float(acc[i]) * invW;
+        }
+    }
+}
+
+}  // namespace
 
 Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer) {
     if (radius < 0 || radius > 2) return MakeError("cpu: smooth radius must be 0, 1 or 2");
     const BitField& cld = static_cast<const BufferCpu&>(cldBuffer).Bits();
     float* q = static_cast<BufferCpu&>(qBuffer).F32();
     const Extent3 e = cld.Extent();
-    const size_t sliceSize = size_t(e.nx) * e.ny;
 
     if (radius == 0) {
         mArena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
+                std::vector<uint8_t> bytes(e.nx + 8);
                 for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
-                    const uint64_t* row = cld.Row(r % e.ny, r / e.ny);
+                    ExpandRow(cld.Row(r % e.ny, r / e.ny), e.nx, bytes.data());
                     float* out = q + size_t(e.nx) * r;
-                    for (uint32_t i = 0; i < e.nx; ++i) out[i] = float((row[i >> 6] >> (i & 63)) & 1);
+                    for (uint32_t i = 0; i < e.nx; ++i) out[i] = float(bytes[i]);
                 }
             });
         });
         return {};
     }
 
-    int w[5] = {};
-    for (int d = -radius; d <= radius; ++d) w[d + radius] = SmoothWeight(radius, d);
-    const float invW = 1.0f / float(SmoothNormaliser(radius));  // a power of two: exact
-    mSmoothScratch.resize(e.Count());
-    uint16_t* xy = mSmoothScratch.data();  // numerators after the x and y passes (<= 256)
-
+    // One run of slices per thread: each run recomputes `radius` slices of
+    // x/y filtering on either side, so fewer, longer runs waste less.
+    const uint32_t runs = std::min<uint32_t>(e.nz, uint32_t(mArena.max_concurrency()));
+    const uint32_t grain = CeilDiv(e.nz, runs);
     mArena.execute([&] {
-        // x then y, one slice at a time.
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.nz, 1), [&](const tbb::blocked_range<uint32_t>& slices) {
-            std::vector<uint8_t> bits(e.nx + 4);
-            std::vector<uint8_t> xs(sliceSize);  // x-pass numerators, <= 16
-            for (uint32_t k = slices.begin(); k != slices.end(); ++k) {
-                for (uint32_t j = 0; j < e.ny; ++j) {
-                    const uint64_t* row = cld.Row(j, k);
-                    // bits[i + 2] = cld(i); two zero voxels of padding on each side.
-                    for (uint32_t i = 0; i < e.nx; ++i) bits[i + 2] = uint8_t((row[i >> 6] >> (i & 63)) & 1);
-                    uint8_t* out = xs.data() + size_t(e.nx) * j;
-                    for (uint32_t i = 0; i < e.nx; ++i) {
-                        int sum = 0;
-                        for (int d = -radius; d <= radius; ++d) sum += w[d + radius] * bits[i + 2 + d];
-                        out[i] = uint8_t(sum);
-                    }
-                }
-                uint16_t* slice = xy + sliceSize * k;
-                for (uint32_t j = 0; j < e.ny; ++j) {
-                    uint16_t* out = slice + size_t(e.nx) * j;
-                    std::fill(out, out + e.nx, 0);
-                    for (int d = -radius; d <= radius; ++d) {
-                        int64_t jj = int64_t(j) + d;
-                        if (jj < 0 || jj >= e.ny) continue;
-                        const uint8_t* in = xs.data() + size_t(e.nx) * jj;
-                        const uint16_t weight = uint16_t(w[d + radius]);
-                        for (uint32_t i = 0; i < e.nx; ++i) out[i] = uint16_t(out[i] + weight * in[i]);
-                    }
-                }
-            }
-        });
-        // z, and the scale to float.
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 16), [&](const tbb::blocked_range<uint32_t>& rows) {
-            std::vector<uint32_t> acc(e.nx);
-            for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
-                const uint32_t j = r % e.ny, k = r / e.ny;
-                std::fill(acc.begin(), acc.end(), 0);
-                for (int d = -radius; d <= radius; ++d) {
-                    int64_t kk = int64_t(k) + d;
-                    if (kk < 0 || kk >= e.nz) continue;
-                    const uint16_t* in = xy + sliceSize * kk + size_t(e.nx) * j;
-                    const uint32_t weight = uint32_t(w[d + radius]);
-                    for (uint32_t i = 0; i < e.nx; ++i) acc[i] += weight * in[i];
-                }
-                float* out = q + size_t(e.nx) * r;
-                for (uint32_t i = 0; i < e.nx; ++i) out[i] = float(acc[i]) * invW;
-            }
-        });
+        tbb::parallel_for(
+            tbb::blocked_range<uint32_t>(0, e.nz, grain),
+            [&](const tbb::blocked_range<uint32_t>& slices) {
+                if (radius == 1) SmoothSlices<1>(cld, q, slices.begin(), slices.end());
+                else SmoothSlices<2>(cld, q, slices.begin(), slices.end());
+            },
+            tbb::simple_partitioner());
     });
     return {};
 }
