@@ -37,10 +37,11 @@ inline float EllipsoidWeight(const RasterEllipsoid& e, float px, float py, float
 }
 
 // R = min(255, floor(255 * w + 0.5)). Monotone in w, so max-blending the
-// quantised values equals quantising the max.
-inline uint8_t QuantizeRegion(float w) {
+// quantised values equals quantising the max. Returns 0..255 as int, which
+// keeps the caller's loop vectorisable (float -> int, not float -> uint8).
+inline int QuantizeRegion(float w) {
     float r = std::floor(255.0f * w + 0.5f);
-    return static_cast<uint8_t>(std::min(255.0f, r));
+    return static_cast<int>(std::min(255.0f, r));
 }
 
 // ---- Cellular automaton (SPEC 3) -------------------------------------------

@@ -884,8 +884,10 @@ uint64_t EstimateSceneBytes(const Scene& scene) {
         bytes = SatAdd(bytes, SatMul(bitField, scene.ca.HasWind() ? 9 : 6));
     }
     if (scene.stages.Has(Stage::Smooth)) {
-        // q for the previous and current step, plus a byte-per-voxel scratch pair.
-        bytes = SatAdd(bytes, SatAdd(SatMul(voxels, 8), SatMul(voxels, 2)));
+        // q for the previous and current step, plus each thread's ring of up to
+        // five 16-bit slices (counted for 64 threads: an upper bound).
+        const uint64_t slice = uint64_t(scene.grid.size.nx) * scene.grid.size.ny;
+        bytes = SatAdd(bytes, SatAdd(SatMul(voxels, 8), SatMul(slice, 64 * 5 * 2)));
     }
     if (scene.stages.Has(Stage::Density)) {
         const uint64_t columns = SatMul(e.nx, e.ny);

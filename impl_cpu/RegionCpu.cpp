@@ -1,8 +1,7 @@
-// Stage `region` on the CPU (SPEC 2): each ellipsoid is rasterised only over the
+// Stage `region` on the CPU (SPEC 2): each ellipsoid is evaluated only over the
 // voxels of each row that its surface can reach, and max-blended into R.
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -47,12 +46,20 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
     for (size_t n = 0; n < ellipsoids.size(); ++n) bounds[n] = ComputeBounds(ellipsoids[n]);
 
     auto rows = [&](const tbb::blocked_range2d<uint32_t>& range) {
+        // The largest w of the row so far, blended in float (16 lanes a vector)
+        // and quantised once per row: quantising is monotone, so this equals
+        // max-blending the quantised values.
+        // Locals, not captures: stores through uint8_t* may alias anything the
+        // lambda reaches by reference, which would stop the loops vectorising.
+        const uint32_t nx = e.nx;
+        std::vector<float> wMax(nx);
+        float* w = wMax.data();
         for (uint32_t k = range.rows().begin(); k != range.rows().end(); ++k) {
             const double pz = k + 0.5;
             for (uint32_t j = range.cols().begin(); j != range.cols().end(); ++j) {
                 const double py = j + 0.5;
                 uint8_t* row = region + size_t(e.nx) * (j + size_t(e.ny) * k);
-                std::memset(row, 0, e.nx);
+                std::fill(w, w + nx, 0.0f);
                 for (size_t n = 0; n < ellipsoids.size(); ++n) {
                     const EllipsoidBounds& b = bounds[n];
                     if (pz < b.zLo || pz > b.zHi || py < b.yLo || py > b.yHi) continue;
@@ -71,12 +78,13 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
                     const double iLo = std::ceil(el.center[0] + u0 - 0.5) - 1;
                     const double iHi = std::floor(el.center[0] + u1 - 0.5) + 1;
                     const int64_t i0 = std::max<int64_t>(0, int64_t(iLo));
-                    const int64_t i1 = std::min<int64_t>(int64_t(e.nx) - 1, int64_t(iHi));
-                    for (int64_t i = i0; i <= i1; ++i) {
-                        uint8_t value = QuantizeRegion(EllipsoidWeight(el, float(i) + 0.5f, float(py), float(pz)));
-                        row[i] = std::max(row[i], value);
-                    }
+                    const int64_t i1 = std::min<int64_t>(int64_t(nx) - 1, int64_t(iHi));
+                    const RasterEllipsoid local = el;
+                    const float fy = float(py), fz = float(pz);
+                    for (int32_t i = int32_t(i0); i <= int32_t(i1); ++i)
+                        w[i] = std::max(w[i], EllipsoidWeight(local, float(i) + 0.5f, fy, fz));
                 }
+                for (uint32_t i = 0; i < nx; ++i) row[i] = uint8_t(QuantizeRegion(w[i]));
             }
         }
     };

@@ -73,7 +73,7 @@ TEST(Region, EqualsBruteForceOnRandomEllipsoids) {
             for (uint32_t i = 0; i < e.nx; ++i) {
                 uint8_t best = 0;
                 for (const RasterEllipsoid& el : list)
-                    best = std::max(best, QuantizeRegion(EllipsoidWeight(el, i + 0.5f, j + 0.5f, k + 0.5f)));
+                    best = uint8_t(std::max<int>(best, QuantizeRegion(EllipsoidWeight(el, i + 0.5f, j + 0.5f, k + 0.5f))));
                 expected[VoxelIndex(e, i, j, k)] = best;
             }
     for (int threads : {1, 2}) {
