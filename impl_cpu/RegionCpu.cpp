@@ -12,23 +12,26 @@ namespace cb::cpu {
 namespace {
 
 // Where an ellipsoid can be nonzero, in double precision (scheduling only: the
-// value written is always Rules.h's float EllipsoidWeight).
+// value written is always Rules.h's float EllipsoidWeight). Along a row,
+// rho^2(u) = A u^2 + kB*Y u + kC*Y^2 + Z^2/c^2 with u = px - cx, Y = py - cy,
+// Z = pz - cz; the row's span is where that is below 1.
 struct EllipsoidBounds {
     double zLo, zHi, yLo, yHi;  // voxel-centre coordinates that may lie inside
-    // rho^2(u) = A u^2 + B(Y) u + C(Y, Z) with u = px - cx, Y = py - cy, Z = pz - cz
-    double a2inv, b2inv, c2inv, cosYaw, sinYaw, quadA;
+    double kB, kC, c2inv, inv2A, disc4A;  // inv2A = 1/(2A), disc4A = 4A
 };
 
 EllipsoidBounds ComputeBounds(const RasterEllipsoid& e) {
     EllipsoidBounds b{};
-    double a = e.semiAxes[0], bb = e.semiAxes[1], c = e.semiAxes[2];
-    b.cosYaw = e.cosYaw;
-    b.sinYaw = e.sinYaw;
-    b.a2inv = 1.0 / (a * a);
-    b.b2inv = 1.0 / (bb * bb);
+    const double a = e.semiAxes[0], bb = e.semiAxes[1], c = e.semiAxes[2];
+    const double cs = e.cosYaw, sn = e.sinYaw;
+    const double a2inv = 1.0 / (a * a), b2inv = 1.0 / (bb * bb);
+    const double quadA = cs * cs * a2inv + sn * sn * b2inv;
+    b.kB = 2.0 * cs * sn * (a2inv - b2inv);
+    b.kC = sn * sn * a2inv + cs * cs * b2inv;
     b.c2inv = 1.0 / (c * c);
-    b.quadA = b.cosYaw * b.cosYaw * b.a2inv + b.sinYaw * b.sinYaw * b.b2inv;
-    double ey = std::sqrt(a * a * b.sinYaw * b.sinYaw + bb * bb * b.cosYaw * b.cosYaw);
+    b.inv2A = 1.0 / (2.0 * quadA);
+    b.disc4A = 4.0 * quadA;
+    const double ey = std::sqrt(a * a * sn * sn + bb * bb * cs * cs);
     // One voxel of slack on every side covers float rounding at the surface.
     b.zLo = e.center[2] - c - 1;
     b.zHi = e.center[2] + c + 1;
@@ -52,29 +55,43 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
         // Locals, not captures: stores through uint8_t* may alias anything the
         // lambda reaches by reference, which would stop the loops vectorising.
         const uint32_t nx = e.nx;
+        const uint32_t count = uint32_t(ellipsoids.size());
+        struct SliceEntry {
+            uint32_t index;
+            double zTerm;  // Z^2/c^2 - 1
+        };
+        std::vector<SliceEntry> slice;
+        slice.reserve(count);
         std::vector<float> wMax(nx);
         float* w = wMax.data();
         for (uint32_t k = range.rows().begin(); k != range.rows().end(); ++k) {
             const double pz = k + 0.5;
+            // The ellipsoids that reach this slice, and their z term.
+            slice.clear();
+            for (uint32_t n = 0; n < count; ++n) {
+                const EllipsoidBounds& b = bounds[n];
+                if (pz < b.zLo || pz > b.zHi) continue;
+                const double Z = pz - ellipsoids[n].center[2];
+                slice.push_back({n, Z * Z * b.c2inv - 1.0});
+            }
             for (uint32_t j = range.cols().begin(); j != range.cols().end(); ++j) {
                 const double py = j + 0.5;
-                uint8_t* row = region + size_t(e.nx) * (j + size_t(e.ny) * k);
+                uint8_t* row = region + size_t(nx) * (j + size_t(e.ny) * k);
                 std::fill(w, w + nx, 0.0f);
-                for (size_t n = 0; n < ellipsoids.size(); ++n) {
-                    const EllipsoidBounds& b = bounds[n];
-                    if (pz < b.zLo || pz > b.zHi || py < b.yLo || py > b.yHi) continue;
-                    const RasterEllipsoid& el = ellipsoids[n];
-                    const double Y = py - el.center[1], Z = pz - el.center[2];
-                    const double quadB = 2.0 * Y * b.cosYaw * b.sinYaw * (b.a2inv - b.b2inv);
-                    const double quadC = Y * Y * (b.sinYaw * b.sinYaw * b.a2inv + b.cosYaw * b.cosYaw * b.b2inv) +
-                                         Z * Z * b.c2inv - 1.0;
-                    const double disc = quadB * quadB - 4.0 * b.quadA * quadC;
+                for (const SliceEntry& entry : slice) {
+                    const EllipsoidBounds& b = bounds[entry.index];
+                    if (py < b.yLo || py > b.yHi) continue;
+                    const RasterEllipsoid& el = ellipsoids[entry.index];
+                    const double Y = py - el.center[1];
+                    const double quadB = b.kB * Y;
+                    const double quadC = b.kC * Y * Y + entry.zTerm;
+                    const double disc = quadB * quadB - b.disc4A * quadC;
                     // disc < 0: rho^2 > 1 on the whole row in exact arithmetic. A voxel
                     // needs rho <= 1 - 1/510 to quantise to R >= 1, far beyond float error.
                     if (disc < 0) continue;
                     const double root = std::sqrt(disc);
-                    const double u0 = (-quadB - root) / (2.0 * b.quadA);
-                    const double u1 = (-quadB + root) / (2.0 * b.quadA);
+                    const double u0 = (-quadB - root) * b.inv2A;
+                    const double u1 = (-quadB + root) * b.inv2A;
                     const double iLo = std::ceil(el.center[0] + u0 - 0.5) - 1;
                     const double iHi = std::floor(el.center[0] + u1 - 0.5) + 1;
                     const int64_t i0 = std::max<int64_t>(0, int64_t(iLo));
