@@ -165,6 +165,19 @@ void BM_MachineHashRate(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(out.size()));
 }
 
+// Ellipsoid evaluations per second with no span overhead: the region stage on
+// a 256x256x32 grid under one ellipsoid that covers every voxel, so every row
+// is one full-length span. The compute floor of `region` is its evaluation
+// count divided by this rate.
+void BM_MachineEllipsoidRate(benchmark::State& state) {
+    cpu::BackendCpu backend(int(state.threads() > 1 ? 2 : state.range(0)));
+    const Extent3 e{256, 256, 32};
+    auto region = Make(backend, BufferFormat::U8, e);
+    const RasterEllipsoid all{{128.0f, 128.0f, 16.0f}, {1000.0f, 1000.0f, 1000.0f}, 1.0f, 0.0f};
+    for (auto _ : state) (void)backend.Region({&all, 1}, *region);
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(e.Count()));
+}
+
 void Register() {
     const char* scenes[] = {"thesis-low", "thesis-medium", "thesis-high"};
     for (const char* scene : scenes) {
@@ -185,6 +198,7 @@ void Register() {
     benchmark::RegisterBenchmark("Machine/ReadL3", BM_MachineReadL3)->Threads(1)->Threads(2)->UseRealTime();
     benchmark::RegisterBenchmark("Machine/WriteL3", BM_MachineWriteL3)->Threads(1)->Threads(2)->UseRealTime();
     benchmark::RegisterBenchmark("Machine/HashRate", BM_MachineHashRate)->Threads(1)->Threads(2)->UseRealTime();
+    benchmark::RegisterBenchmark("Machine/EllipsoidRate", BM_MachineEllipsoidRate)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 }
 
 }  // namespace
