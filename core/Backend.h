@@ -15,8 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
+#include "core/Shading.h"
 #include "core/Rules.h"
 #include "core/Stage.h"
 
@@ -89,6 +91,61 @@ struct DensityParams {
     uint32_t band = 4;
 };
 
+// Inputs of the shade stage (SPEC 6) besides q.
+struct ShadeParams {
+    Vec3 sun{0, 0, 1};          // unit vector toward the sun
+    AttenuationKind attenuation = AttenuationKind::Beer;
+    float sigma = 0.02f;        // 1/m at q = 1
+    float voxelSize = 50;       // h, metres
+    float thesisAr = 0.9f;
+    SampleFilter filter = SampleFilter::Bilinear;
+    int resolution = 1;         // 1, 2 or 4
+    StorageFormat storage = StorageFormat::Fp32;
+    bool scattering = false;
+    float albedo = 0.9f, solidAngle = 0.05f;
+    PhaseParams phase;
+};
+
+// Inputs of the shadow stage (SPEC 7) besides D.
+struct ShadowParams {
+    Vec3 sun{0, 0, 1};
+    AttenuationKind form = AttenuationKind::Beer;
+    float sigma = 0.02f, voxelSize = 50, kappa = 0.25f;
+    uint32_t nz = 1;            // grid height in voxels (the volume's mid-height is nz/2)
+};
+
+// Inputs of the splat renderer (SPEC 8). The order is computed on the host
+// (MakeSplatOrder) and shared by every backend.
+struct SplatParams {
+    CameraFrame camera;
+    const SplatOrder* order = nullptr;
+    Vec3 sun{0, 0, 1};          // toward the sun
+    Vec3 sunRadiance{1, 1, 1};  // colour * intensity
+    Vec3 ambient{0, 0, 0}, background{0, 0, 0};
+    PhaseParams phase;
+    float qMin = 0.3f, splatDiameter = 75, opacity = 0.6f, alpha = 0.5f;
+    std::array<float, 3> origin{0, 0, 0};
+    float voxelSize = 50;
+    bool culling = true, skipping = true;
+    uint32_t tile = 32, band = 4;  // of the occupancy maps
+};
+
+struct SplatInputs {
+    const Buffer* qPrev = nullptr;  // F32 volume
+    const Buffer* qCur = nullptr;   // F32 volume
+    const Buffer* T = nullptr;      // F32 volume: full-resolution transmittance
+    // Occupancy of both steps (density stage); read only when skipping.
+    const Buffer* tilesPrev = nullptr;
+    const Buffer* tilesCur = nullptr;
+    const Buffer* bandsPrev = nullptr;
+    const Buffer* bandsCur = nullptr;
+};
+
+struct SplatStats {
+    uint64_t splats = 0;          // splats drawn (q_alpha > q_min, in front of the near plane, not culled)
+    uint64_t voxelsVisited = 0;   // voxels the renderer looked at after culling and skipping
+};
+
 class Backend {
   public:
     virtual ~Backend() = default;
@@ -116,6 +173,13 @@ class Backend {
     virtual Status Smooth(int radius, const Buffer& cld, Buffer& q) = 0;
     // density: D, this step's tile and band occupancy from q, and cover from cld.
     virtual Status Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) = 0;
+    // shade: T (F32, grid size) from q.
+    virtual Status Shade(const ShadeParams& params, const Buffer& q, Buffer& T) = 0;
+    // shadow: G (F32, (nx, ny, 1)) from D.
+    virtual Status Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) = 0;
+    // render_splat: a linear RGB image, F32 with extent (3, width, height):
+    // channel fastest, then x, then y, row 0 at the top.
+    virtual Status RenderSplat(const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats) = 0;
 };
 
 // The backends compiled into this build, in preference order.

@@ -14,6 +14,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -38,12 +39,15 @@ constexpr Stage kDefaultStages[] = {Stage::Region, Stage::Ca, Stage::Smooth, Sta
 
 // ---- Small formatting helpers ---------------------------------------------------------------------------------
 
-// Shortest text that reads back as the same double ("0.35", "400", "1e+20", "inf").
+// Shortest text that reads back as the same double ("0.35", "400", "100000", "1e+20", "inf").
 std::string FormatNumber(double value) {
     if (std::isnan(value)) return "nan";
     if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
     char buffer[64];
-    auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    // Whole numbers below 1e15 are written out ("100000", not the shorter "1e+05").
+    const bool whole = value == std::floor(value) && std::fabs(value) < 1e15;
+    auto [end, ec] = whole ? std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::fixed)
+                           : std::to_chars(buffer, buffer + sizeof(buffer), value);
     if (ec != std::errc()) return "?";
     return std::string(buffer, end);
 }
@@ -98,6 +102,18 @@ size_t EditDistance(std::string_view a, std::string_view b) {
 
 // " (did you mean "x"?)" when one known name is close to `name`, else "".
 std::string Suggestion(std::string_view name, std::span<const std::string_view> known) {
+    // A name that one known name starts with ("fov" for "fov_deg") is a shortening, not a misspelling.
+    if (name.size() >= 3) {
+        std::string_view extended;
+        size_t matches = 0;
+        for (std::string_view candidate : known) {
+            if (candidate.size() > name.size() && EditDistance(candidate.substr(0, name.size()), name) == 0) {
+                extended = candidate;
+                ++matches;
+            }
+        }
+        if (matches == 1) return " (did you mean " + Quote(extended) + "?)";
+    }
     std::string_view best;
     size_t bestDistance = std::numeric_limits<size_t>::max();
     for (std::string_view candidate : known) {
@@ -382,6 +398,55 @@ class Validator {
         return value.get<std::string>();
     }
 
+    // A JSON true or false; numbers and strings such as 1 or "true" are refused.
+    std::optional<bool> Boolean(const Json& value, std::string_view field) {
+        if (!value.is_boolean()) {
+            Fail(field, "expected true or false, got " + Describe(value));
+            return std::nullopt;
+        }
+        return value.get<bool>();
+    }
+
+    // One of a fixed set of strings (case-sensitive), mapped to its value.
+    template <typename T, size_t N>
+    std::optional<T> Choice(const Json& value, std::string_view field,
+                            const std::pair<std::string_view, T> (&options)[N]) {
+        if (value.is_string()) {
+            const std::string& text = value.get_ref<const std::string&>();
+            for (const auto& [name, result] : options)
+                if (name == text) return result;
+        }
+        std::array<std::string_view, N> names;
+        std::string list;
+        for (size_t i = 0; i < N; ++i) {
+            names[i] = options[i].first;
+            list += (i == 0 ? "" : ", ") + Quote(options[i].first);
+        }
+        std::string reason = "must be one of " + list + ", got " + Describe(value);
+        if (value.is_string()) reason += Suggestion(value.get_ref<const std::string&>(), names);
+        Fail(field, reason);
+        return std::nullopt;
+    }
+
+    // A whole number from a short list; `allowedText` reads e.g. "1, 2 or 4".
+    std::optional<int64_t> IntegerChoice(const Json& value, std::string_view field, std::span<const int64_t> allowed,
+                                         std::string_view allowedText) {
+        // Whole numbers beyond int64 are simply not in the list (rather than outside int64's range).
+        const bool huge = (value.is_number_unsigned() &&
+                           value.get<uint64_t>() > uint64_t(std::numeric_limits<int64_t>::max())) ||
+                          (value.is_number_float() && std::isfinite(value.get<double>()) &&
+                           value.get<double>() == std::floor(value.get<double>()) &&
+                           std::fabs(value.get<double>()) > 9.2e18);
+        std::optional<int64_t> n;
+        if (!huge) {
+            n = Integer(value, field, std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+            if (!n) return std::nullopt;  // not an integer: already reported
+            if (std::find(allowed.begin(), allowed.end(), *n) != allowed.end()) return n;
+        }
+        Fail(field, "must be " + std::string(allowedText) + ", got " + Describe(value));
+        return std::nullopt;
+    }
+
     // An array of exactly N numbers, each inside `range`.
     template <size_t N>
     std::optional<std::array<double, N>> Numbers(const Json& value, std::string_view field, Range range) {
@@ -491,8 +556,9 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
 
 // ---- The sections ---------------------------------------------------------------------------------------------
 
-constexpr std::string_view kTopKeys[] = {"name",  "description", "grid",       "steps",  "warmup_steps",
-                                         "stages", "ca",         "ellipsoids", "smooth", "density"};
+constexpr std::string_view kTopKeys[] = {"name",  "description", "grid",   "steps",   "warmup_steps", "stages",
+                                         "ca",    "ellipsoids",  "smooth", "density", "sun",          "lighting",
+                                         "phase", "shade",       "shadow", "render"};
 constexpr std::string_view kGridKeys[] = {"size", "voxel_size", "origin"};
 constexpr std::string_view kCaKeys[] = {"seed", "hum0", "act0", "p_ext", "p_hum", "p_act", "wind_shift"};
 constexpr std::string_view kEllipsoidKeys[] = {
@@ -501,6 +567,29 @@ constexpr std::string_view kEllipsoidKeys[] = {
 constexpr std::string_view kWindGridKeys[] = {"grid", "vectors"};
 constexpr std::string_view kSmoothKeys[] = {"radius"};
 constexpr std::string_view kDensityKeys[] = {"tile", "band"};
+constexpr std::string_view kSunKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
+constexpr std::string_view kPhaseKeys[] = {"function", "g"};
+constexpr std::string_view kShadeKeys[] = {"attenuation", "sigma",   "thesis_ar", "filter",
+                                           "resolution",  "storage", "scattering"};
+constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angle"};
+constexpr std::string_view kShadowKeys[] = {"form", "kappa"};
+constexpr std::string_view kRenderKeys[] = {"width", "height",  "q_min",    "splat_scale", "opacity",
+                                            "alpha", "culling", "skipping", "every_steps", "cameras"};
+constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
+
+constexpr std::pair<std::string_view, PhaseKind> kPhaseKinds[] = {
+    {"none", PhaseKind::None},
+    {"henyey-greenstein", PhaseKind::HenyeyGreenstein},
+    {"cornette-shanks", PhaseKind::CornetteShanks}};
+constexpr std::pair<std::string_view, AttenuationKind> kAttenuationKinds[] = {{"beer", AttenuationKind::Beer},
+                                                                              {"thesis", AttenuationKind::Thesis}};
+constexpr std::pair<std::string_view, SampleFilter> kFilters[] = {{"bilinear", SampleFilter::Bilinear},
+                                                                  {"nearest", SampleFilter::Nearest}};
+constexpr std::pair<std::string_view, StorageFormat> kStorageFormats[] = {
+    {"fp32", StorageFormat::Fp32}, {"fp16", StorageFormat::Fp16}, {"unorm8", StorageFormat::Unorm8}};
+constexpr int64_t kShadeResolutions[] = {1, 2, 4};
+constexpr int64_t kMaxImageEdge = 16384;
 
 // Returns true when grid.size is present and valid.
 bool ReadGrid(const Json& root, Validator& check, GridSettings& grid) {
@@ -571,7 +660,9 @@ void ReadStages(const Json& root, Validator& check, StageSet& stages) {
     // Dependencies are checked only on a clean list, so one typo does not cascade.
     if (!allOk) return;
     constexpr std::pair<Stage, Stage> kNeeds[] = {
-        {Stage::Ca, Stage::Region}, {Stage::Smooth, Stage::Ca}, {Stage::Density, Stage::Smooth}};
+        {Stage::Ca, Stage::Region},         {Stage::Smooth, Stage::Ca},          {Stage::Density, Stage::Smooth},
+        {Stage::Shade, Stage::Smooth},      {Stage::Shadow, Stage::Density},     {Stage::RenderSplat, Stage::Shade},
+        {Stage::RenderSplat, Stage::Density}};
     for (auto [stage, needed] : kNeeds) {
         if (stages.Has(stage) && !stages.Has(needed))
             check.Fail("stages", Quote(StageName(stage)) + " needs " + Quote(StageName(needed)));
@@ -730,6 +821,237 @@ void ReadEllipsoids(const Json& root, Validator& check, EllipsoidSettings& e) {
     }
 }
 
+void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
+    const Json* section = check.Section(root, "", "sun", kSunKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "elevation_deg")) {
+        if (auto d = check.Number(*v, "sun.elevation_deg", Range{.lo = -90, .hi = 90})) sun.elevationDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "azimuth_deg")) {
+        if (auto d = check.Number(*v, "sun.azimuth_deg", kFinite)) sun.azimuthDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "color")) {
+        if (auto a = check.Numbers<3>(*v, "sun.color", kNonNegative)) sun.color = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "intensity")) {
+        if (auto d = check.Number(*v, "sun.intensity", kNonNegative)) sun.intensity = *d;
+    }
+}
+
+void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting) {
+    const Json* section = check.Section(root, "", "lighting", kLightingKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "ambient")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.ambient", kNonNegative)) lighting.ambient = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "background")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.background", kNonNegative)) lighting.background = *a;
+    }
+}
+
+void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
+    const Json* section = check.Section(root, "", "phase", kPhaseKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "function")) {
+        if (auto kind = check.Choice(*v, "phase.function", kPhaseKinds)) phase.kind = *kind;
+    }
+    if (const Json* v = Validator::Find(*section, "g")) {
+        if (auto d = check.Number(*v, "phase.g", Range{.lo = -1, .loOpen = true, .hi = 1, .hiOpen = true})) {
+            // g is kept as a float: a value within 2^-25 of +-1 would become +-1 there.
+            if (std::fabs(float(*d)) >= 1.0f)
+                check.Fail("phase.g", "must be in (-1, 1) in single precision, got " + Describe(*v));
+            else
+                phase.g = float(*d);
+        }
+    }
+}
+
+void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
+    const Json* section = check.Section(root, "", "shade", kShadeKeys);
+    if (!section) return;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    if (const Json* v = find("attenuation")) {
+        if (auto kind = check.Choice(*v, "shade.attenuation", kAttenuationKinds)) shade.attenuation = *kind;
+    }
+    if (const Json* v = find("sigma")) {
+        if (auto d = check.Number(*v, "shade.sigma", kNonNegative)) shade.sigma = *d;
+    }
+    if (const Json* v = find("thesis_ar")) {
+        if (auto d = check.Number(*v, "shade.thesis_ar", kProbability)) shade.thesisAr = *d;
+    }
+    if (const Json* v = find("filter")) {
+        if (auto filter = check.Choice(*v, "shade.filter", kFilters)) shade.filter = *filter;
+    }
+    if (const Json* v = find("resolution")) {
+        if (auto n = check.IntegerChoice(*v, "shade.resolution", kShadeResolutions, "1, 2 or 4"))
+            shade.resolution = int(*n);
+    }
+    if (const Json* v = find("storage")) {
+        if (auto format = check.Choice(*v, "shade.storage", kStorageFormats)) shade.storage = *format;
+    }
+    const Json* scattering = check.Section(*section, "shade", "scattering", kScatteringKeys);
+    if (!scattering) return;
+    if (const Json* v = Validator::Find(*scattering, "enabled")) {
+        if (auto b = check.Boolean(*v, "shade.scattering.enabled")) shade.scattering = *b;
+    }
+    if (const Json* v = Validator::Find(*scattering, "albedo")) {
+        if (auto d = check.Number(*v, "shade.scattering.albedo", kProbability)) shade.albedo = *d;
+    }
+    if (const Json* v = Validator::Find(*scattering, "solid_angle")) {
+        const Range solidAngle{.lo = 0, .loOpen = true, .hi = 4 * std::numbers::pi};
+        if (auto d = check.Number(*v, "shade.scattering.solid_angle", solidAngle)) shade.solidAngle = *d;
+    }
+}
+
+void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
+    const Json* section = check.Section(root, "", "shadow", kShadowKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "form")) {
+        if (auto kind = check.Choice(*v, "shadow.form", kAttenuationKinds)) shadow.form = *kind;
+    }
+    if (const Json* v = Validator::Find(*section, "kappa")) {
+        if (auto d = check.Number(*v, "shadow.kappa", kNonNegative)) shadow.kappa = *d;
+    }
+}
+
+// One entry of render.cameras; nullopt when anything in it is wrong (all of it reported).
+std::optional<CameraSettings> ReadCamera(const Json& value, const std::string& field, size_t index,
+                                         Validator& check) {
+    if (!value.is_object()) {
+        check.Fail(field, "expected a camera object, got " + Describe(value));
+        return std::nullopt;
+    }
+    const size_t errorsBefore = check.ErrorCount();
+    check.CheckKeys(value, field, kCameraKeys);
+    auto find = [&](std::string_view key) { return Validator::Find(value, key); };
+    auto sub = [&](std::string_view key) { return JoinField(field, key); };
+
+    CameraSettings camera;
+    camera.name = "view" + std::to_string(index);
+    if (const Json* v = find("name")) {
+        if (auto s = check.String(*v, sub("name"))) {
+            if (s->empty())
+                check.Fail(sub("name"), "must not be empty");
+            else
+                camera.name = *s;
+        }
+    }
+    std::optional<std::array<double, 3>> eye, target;
+    if (const Json* v = find("eye")) {
+        eye = check.Numbers<3>(*v, sub("eye"), kFinite);
+    } else {
+        check.Fail(sub("eye"), "required field is missing");
+    }
+    if (const Json* v = find("target")) {
+        target = check.Numbers<3>(*v, sub("target"), kFinite);
+    } else {
+        check.Fail(sub("target"), "required field is missing");
+    }
+    if (eye && target && *eye == *target) check.Fail(sub("target"), "must differ from eye");
+    if (eye) camera.eye = *eye;
+    if (target) camera.target = *target;
+    if (const Json* v = find("up")) {
+        if (auto a = check.Numbers<3>(*v, sub("up"), kFinite)) {
+            if ((*a)[0] == 0 && (*a)[1] == 0 && (*a)[2] == 0)
+                check.Fail(sub("up"), "must not be all zero, got " + Describe(*v));
+            else
+                camera.up = *a;
+        }
+    }
+    if (const Json* v = find("fov_deg")) {
+        const Range fov{.lo = 0, .loOpen = true, .hi = 180, .hiOpen = true};
+        if (auto d = check.Number(*v, sub("fov_deg"), fov)) camera.fovDeg = *d;
+    }
+    // far must exceed near; the message names whichever of the two the file gave (far when both).
+    bool nearOk = true, farOk = true;
+    if (const Json* v = find("near")) {
+        auto d = check.Number(*v, sub("near"), kPositive);
+        if (d) camera.nearPlane = *d;
+        nearOk = d.has_value();
+    }
+    const Json* far = find("far");
+    if (far) {
+        auto d = check.Number(*far, sub("far"), kFinite);
+        if (d) camera.farPlane = *d;
+        farOk = d.has_value();
+    }
+    if (nearOk && farOk && camera.farPlane <= camera.nearPlane) {
+        if (far)
+            check.Fail(sub("far"), "must be > near (" + FormatNumber(camera.nearPlane) + "), got " +
+                                       FormatNumber(camera.farPlane));
+        else
+            check.Fail(sub("near"), "must be < far (" + FormatNumber(camera.farPlane) + "), got " +
+                                        FormatNumber(camera.nearPlane));
+    }
+    if (check.ErrorCount() != errorsBefore) return std::nullopt;
+    return camera;
+}
+
+// Reads render; returns false when render.cameras was given but is wrong (so "needs a camera" is not piled on).
+bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
+    const Json* section = check.Section(root, "", "render", kRenderKeys);
+    if (!section) return true;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    auto field = [](std::string_view key) { return JoinField("render", key); };
+
+    if (const Json* v = find("width")) {
+        if (auto n = check.Integer(*v, field("width"), 1, kMaxImageEdge)) render.width = uint32_t(*n);
+    }
+    if (const Json* v = find("height")) {
+        if (auto n = check.Integer(*v, field("height"), 1, kMaxImageEdge)) render.height = uint32_t(*n);
+    }
+    if (const Json* v = find("q_min")) {
+        if (auto d = check.Number(*v, field("q_min"), kNonNegative)) render.qMin = *d;
+    }
+    if (const Json* v = find("splat_scale")) {
+        if (auto d = check.Number(*v, field("splat_scale"), kPositive)) render.splatScale = *d;
+    }
+    if (const Json* v = find("opacity")) {
+        if (auto d = check.Number(*v, field("opacity"), kProbability)) render.opacity = *d;
+    }
+    if (const Json* v = find("alpha")) {
+        if (auto d = check.Number(*v, field("alpha"), kProbability)) render.alpha = *d;
+    }
+    if (const Json* v = find("culling")) {
+        if (auto b = check.Boolean(*v, field("culling"))) render.culling = *b;
+    }
+    if (const Json* v = find("skipping")) {
+        if (auto b = check.Boolean(*v, field("skipping"))) render.skipping = *b;
+    }
+    if (const Json* v = find("every_steps")) {
+        if (auto n = check.Integer(*v, field("every_steps"), 0, kU32Max)) render.everySteps = uint32_t(*n);
+    }
+
+    const Json* cameras = find("cameras");
+    if (!cameras) return true;
+    if (!cameras->is_array()) {
+        check.Fail(field("cameras"), "expected an array of camera objects, got " + Describe(*cameras));
+        return false;
+    }
+    bool allOk = true;
+    render.cameras.clear();
+    for (size_t i = 0; i < cameras->size(); ++i) {
+        const std::string cameraField = IndexField(field("cameras"), i);
+        std::optional<CameraSettings> camera = ReadCamera((*cameras)[i], cameraField, i, check);
+        if (!camera) {
+            allOk = false;
+            continue;
+        }
+        const bool duplicate = std::any_of(render.cameras.begin(), render.cameras.end(),
+                                           [&](const CameraSettings& c) { return c.name == camera->name; });
+        if (duplicate) {
+            // A defaulted name ("view1") can clash with a name given earlier; say so, since the file has no name here.
+            const bool given = Validator::Find((*cameras)[i], "name") != nullptr;
+            check.Fail(JoinField(cameraField, "name"), "duplicate camera name " + Quote(camera->name) +
+                                                           (given ? "" : " (its default name)"));
+            allOk = false;
+            continue;
+        }
+        render.cameras.push_back(std::move(*camera));
+    }
+    return allOk;
+}
+
 // The whole validation after parsing and overrides; `scene` holds defaults on entry.
 void ReadScene(const Json& root, const std::string& label, Validator& check, Scene& scene) {
     check.CheckKeys(root, "", kTopKeys);
@@ -782,6 +1104,15 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
             if (auto n = check.Integer(*v, "density.band", 1, kU32Max)) scene.density.band = uint32_t(*n);
         }
     }
+
+    ReadSun(root, check, scene.sun);
+    ReadLighting(root, check, scene.lighting);
+    ReadPhase(root, check, scene.phase);
+    ReadShade(root, check, scene.shade);
+    ReadShadow(root, check, scene.shadow);
+    const bool camerasOk = ReadRender(root, check, scene.render);
+    if (scene.stages.Has(Stage::RenderSplat) && camerasOk && scene.render.cameras.empty())
+        check.Fail("render.cameras", Quote(StageName(Stage::RenderSplat)) + " needs at least one camera");
 
     // Size checks, before anything grid-sized exists.
     if (!sizeOk) return;
@@ -896,6 +1227,21 @@ uint64_t EstimateSceneBytes(const Scene& scene) {
         const uint64_t tiles = SatMul(CeilDiv64(e.nx, tile), CeilDiv64(e.ny, tile));
         bytes = SatAdd(bytes, SatMul(columns, 8));  // D for two steps, float32
         bytes = SatAdd(bytes, SatMul(SatMul(tiles, SatAdd(CeilDiv64(e.nz, band), 1)), 2));
+    }
+    if (scene.stages.Has(Stage::Shade)) {
+        // T, float32 per voxel; below full resolution also the coarse q and T grids.
+        bytes = SatAdd(bytes, SatMul(voxels, 4));
+        const uint64_t f = uint64_t(std::max(scene.shade.resolution, 1));
+        if (f > 1) {
+            const uint64_t coarse = SatMul(SatMul(CeilDiv64(e.nx, f), CeilDiv64(e.ny, f)), CeilDiv64(e.nz, f));
+            bytes = SatAdd(bytes, SatMul(coarse, 2 * 4));
+        }
+    }
+    if (scene.stages.Has(Stage::Shadow)) bytes = SatAdd(bytes, SatMul(SatMul(e.nx, e.ny), 4));  // G, float32
+    if (scene.stages.Has(Stage::RenderSplat)) {
+        // One more q volume (the previous step, for the alpha interpolation) and the RGB float32 image.
+        bytes = SatAdd(bytes, SatMul(voxels, 4));
+        bytes = SatAdd(bytes, SatMul(SatMul(scene.render.width, scene.render.height), 3 * 4));
     }
     // Other stages do not have an estimate yet and count 0.
     return bytes;

@@ -8,8 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
+#include "core/Shading.h"
 #include "core/Stage.h"
 
 namespace cb {
@@ -75,6 +77,61 @@ struct DensitySettings {
     uint32_t band = 4;   // slices per height band
 };
 
+// The sun (SPEC 0): direction from elevation and azimuth, and its radiance.
+struct SunSettings {
+    double elevationDeg = 40;   // above the horizon, degrees
+    double azimuthDeg = 30;     // from +x toward +y, degrees
+    std::array<double, 3> color{1.0, 0.96, 0.9};  // linear RGB
+    double intensity = 1.0;     // multiplies color
+
+    // Unit vector toward the sun.
+    Vec3 Direction() const {
+        constexpr double kDeg = 3.14159265358979323846 / 180.0;
+        return SunDirection(elevationDeg * kDeg, azimuthDeg * kDeg);
+    }
+    // color * intensity.
+    Vec3 Radiance() const {
+        return {float(color[0] * intensity), float(color[1] * intensity), float(color[2] * intensity)};
+    }
+};
+
+struct LightingSettings {
+    std::array<double, 3> ambient{0.25, 0.3, 0.38};    // linear RGB, added to every splat
+    std::array<double, 3> background{0.45, 0.6, 0.85}; // linear RGB behind the clouds
+};
+
+// Stage `shade` (SPEC 6).
+struct ShadeSettings {
+    AttenuationKind attenuation = AttenuationKind::Beer;
+    double sigma = 0.02;        // extinction coefficient at q = 1, 1/m (beer, and tau for scattering)
+    double thesisAr = 0.9;      // a_r of the thesis's linear form
+    SampleFilter filter = SampleFilter::Bilinear;
+    int resolution = 1;         // 1, 2 or 4
+    StorageFormat storage = StorageFormat::Fp32;
+    bool scattering = false;    // multiple forward scattering (seed 002 eq. 5-7)
+    double albedo = 0.9;        // alpha_s
+    double solidAngle = 0.05;   // gamma, steradians
+};
+
+// Stage `shadow` (SPEC 7).
+struct ShadowSettings {
+    AttenuationKind form = AttenuationKind::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D)
+    double kappa = 0.25;        // thesis form: shadow per unit of D
+};
+
+// Stage `render_splat` (SPEC 8).
+struct RenderSettings {
+    uint32_t width = 320, height = 240;
+    double qMin = 0.3;          // a voxel makes a splat iff q_alpha > q_min
+    double splatScale = 1.5;    // splat diameter d = splatScale * voxel size
+    double opacity = 0.6;
+    double alpha = 0.5;         // interpolation between the previous and the current step
+    bool culling = true;        // view-frustum culling of tile-band boxes
+    bool skipping = true;       // empty-space skipping from the density map
+    uint32_t everySteps = 0;    // render every N steps after warm-up (and the last); 0 = last step only
+    std::vector<CameraSettings> cameras;  // at least one when render_splat runs
+};
+
 struct Scene {
     std::string name;
     std::string path;  // file it was read from ("" for built-in)
@@ -86,6 +143,12 @@ struct Scene {
     EllipsoidSettings ellipsoids;
     SmoothSettings smooth;
     DensitySettings density;
+    SunSettings sun;
+    LightingSettings lighting;
+    PhaseParams phase;          // used by shade (scattering) and render_splat
+    ShadeSettings shade;
+    ShadowSettings shadow;
+    RenderSettings render;
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

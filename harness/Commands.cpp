@@ -114,6 +114,21 @@ int RunCommand(const CommonOptions& options) {
                 run.steps.push_back(record);
                 progress.Update(t + 1);
             }
+            // The last frame of each camera.
+            if (auto rendered = (*sim)->LastRenderedStep()) {
+                for (size_t n = 0; n < scene.render.cameras.size(); ++n) {
+                    auto rgb = DownloadAll<float>(**backend, *(*sim)->Image(n));
+                    if (!rgb) {
+                        std::fprintf(stderr, "%s\n", rgb.error().message.c_str());
+                        anyFailed = true;
+                        continue;
+                    }
+                    auto paths = WriteFrame(outDir + "/frame-" + scene.render.cameras[n].name + "-" + name, *rgb,
+                                            scene.render.width, scene.render.height);
+                    if (paths) written.insert(written.end(), paths->begin(), paths->end());
+                    else std::fprintf(stderr, "%s\n", paths.error().message.c_str()), anyFailed = true;
+                }
+            }
             // The density map of the last step, seen from above.
             if (const Buffer* columnSum = (*sim)->ColumnSum(); columnSum && !run.steps.empty()) {
                 auto d = DownloadAll<float>(**backend, *columnSum);
@@ -165,7 +180,7 @@ int DumpCommand(const CommonOptions& options) {
         std::fprintf(stderr, "backend %s unavailable: %s\n", name.c_str(), backend.error().message.c_str());
         return kExitNoBackend;
     }
-    auto sim = Simulation::Create(scene, **backend);
+    auto sim = Simulation::Create(scene, **backend, /*everyStepOutputs=*/true);
     if (!sim) {
         std::fprintf(stderr, "%s\n", sim.error().message.c_str());
         return kExitFailed;
@@ -195,6 +210,16 @@ int DumpCommand(const CommonOptions& options) {
         CB_TRY(write(dir, "density.npy", s.ColumnSum()));
         CB_TRY(write(dir, "tiles.npy", s.Tiles()));
         CB_TRY(write(dir, "bands.npy", s.Bands()));
+        CB_TRY(write(dir, "T.npy", s.T()));
+        CB_TRY(write(dir, "shadow.npy", s.Shadow()));
+        // frame.exr is the first camera; the others are frame-<camera>.exr.
+        for (size_t n = 0; s.Image(n); ++n) {
+            auto rgb = DownloadAll<float>(s.GetBackend(), *s.Image(n));
+            if (!rgb) return std::unexpected(rgb.error());
+            const std::string stem = dir + (n == 0 ? "/frame" : "/frame-" + scene.render.cameras[n].name);
+            auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, /*png=*/false);
+            if (!paths) return std::unexpected(paths.error());
+        }
         return {};
     };
     Progress progress("dump " + name, scene.steps, options.quiet);

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 
 namespace cb {
 namespace {
@@ -77,6 +78,27 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         for (const StepRecord& r : run.steps)
             if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region)) hostSamples.push_back(r.ellipsoidUpdateMs);
         b["host"] = {{"ellipsoid_update", SummaryJson(hostSamples)}};
+        if (scene.stages.Has(Stage::RenderSplat)) {
+            // Per camera: every frame's time and splat count, and their summary.
+            nlohmann::json cameras = nlohmann::json::object();
+            for (const CameraSettings& camera : scene.render.cameras) {
+                std::vector<double> ms;
+                nlohmann::json steps = nlohmann::json::array(), splats = nlohmann::json::array();
+                for (const StepRecord& r : run.steps)
+                    for (const FrameRecord& f : r.frames)
+                        if (f.camera == camera.name) {
+                            ms.push_back(f.ms);
+                            steps.push_back(r.step);
+                            splats.push_back(f.stats.splats);
+                        }
+                nlohmann::json c = SummaryJson(ms);
+                c["steps"] = steps;
+                c["splats"] = splats;
+                c["fps_median"] = ms.empty() ? 0.0 : 1000.0 / Summarize(ms).median;
+                cameras[camera.name] = c;
+            }
+            b["frames"] = cameras;
+        }
         if (scene.stages.Has(Stage::Density)) {
             nlohmann::json cover = nlohmann::json::array();
             std::vector<double> after;
@@ -115,6 +137,23 @@ std::string TimingTable(const Scene& scene, const BackendRun& run) {
     };
     for (Stage stage : kAllStages)
         if (scene.stages.Has(stage)) row(std::string(StageName(stage)), StageSamples(scene, run, stage));
+    if (scene.stages.Has(Stage::RenderSplat)) {
+        for (const CameraSettings& camera : scene.render.cameras) {
+            std::vector<double> ms;
+            uint64_t lastSplats = 0;
+            for (const StepRecord& r : run.steps)
+                for (const FrameRecord& f : r.frames)
+                    if (f.camera == camera.name) {
+                        ms.push_back(f.ms);
+                        lastSplats = f.stats.splats;
+                    }
+            Summary s = Summarize(ms);
+            std::snprintf(line, sizeof line, "  %-18s %10.3f %10.3f %10.3f %10.3f %10.3f  %zu frames, %.1f fps, %llu splats\n",
+                          ("  frame " + camera.name).substr(0, 18).c_str(), s.median, s.q1, s.q3, s.min, s.max, s.count,
+                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(lastSplats));
+            out += line;
+        }
+    }
     if (scene.stages.Has(Stage::Region)) {
         std::vector<double> host;
         for (const StepRecord& r : run.steps)
@@ -149,6 +188,26 @@ Status WriteTopView(const std::string& path, const std::vector<float>& columnSum
     }
     if (!image.write(path)) return MakeError(path + ": cannot write the PNG: " + image.geterror());
     return {};
+}
+
+Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
+                                            uint32_t height, bool png) {
+    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
+    OIIO::ImageBuf linear(spec, const_cast<float*>(rgb.data()));  // wraps, does not copy
+    std::vector<std::string> written;
+    const std::string exr = stem + ".exr";
+    if (!linear.write(exr)) return MakeError(exr + ": cannot write: " + linear.geterror());
+    written.push_back(exr);
+    if (png) {
+        OIIO::ImageBuf srgb;
+        if (!OIIO::ImageBufAlgo::colorconvert(srgb, linear, "linear", "sRGB"))
+            return MakeError(stem + ".png: colour conversion failed: " + srgb.geterror());
+        const std::string path = stem + ".png";
+        srgb.set_write_format(OIIO::TypeDesc::UINT8);
+        if (!srgb.write(path)) return MakeError(path + ": cannot write: " + srgb.geterror());
+        written.push_back(path);
+    }
+    return written;
 }
 
 }  // namespace cb

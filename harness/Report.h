@@ -41,4 +41,10 @@ std::string TimingTable(const Scene& scene, const BackendRun& run);
 // PNG through OpenImageIO. `columnSum` is canonical D, nx*ny floats.
 Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz);
 
+// Writes a linear RGB float image (3 floats a pixel, row 0 at the top) as
+// `stem`.exr (float, linear) and, with png = true, `stem`.png (8-bit sRGB),
+// through OpenImageIO. Returns the paths written.
+Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
+                                            uint32_t height, bool png = true);
+
 }  // namespace cb

@@ -20,15 +20,23 @@ Status Timed(StepRecord& record, Stage stage, Fn&& fn) {
 
 }  // namespace
 
-Simulation::Simulation(const Scene& scene, Backend& backend)
-    : mScene(scene), mBackend(backend), mEllipsoids(scene.ellipsoids, scene.grid.size) {}
+Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs)
+    : mScene(scene), mBackend(backend), mEllipsoids(scene.ellipsoids, scene.grid.size),
+      mEveryStepOutputs(everyStepOutputs) {}
 
-Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backend& backend) {
+bool Simulation::IsOutputStep(uint32_t step) const {
+    if (mEveryStepOutputs || !mScene.stages.Has(Stage::RenderSplat)) return true;
+    if (step + 1 == mScene.steps) return true;
+    const uint32_t every = mScene.render.everySteps;
+    return every > 0 && step >= mScene.warmupSteps && (step - mScene.warmupSteps) % every == 0;
+}
+
+Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backend& backend, bool everyStepOutputs) {
     for (Stage stage : kAllStages) {
         if (scene.stages.Has(stage) && !backend.Supports(stage))
             return MakeError(backend.Name() + " does not implement stage '" + std::string(StageName(stage)) + "' yet");
     }
-    std::unique_ptr<Simulation> sim(new Simulation(scene, backend));
+    std::unique_ptr<Simulation> sim(new Simulation(scene, backend, everyStepOutputs));
     const Extent3 grid = scene.grid.size;
     auto make = [&](std::unique_ptr<Buffer>& slot, BufferFormat format, Extent3 extent) -> Status {
         auto buffer = backend.CreateBuffer(format, extent);
@@ -61,6 +69,19 @@ Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backe
         CB_TRY(make(sim->mColumnSum, BufferFormat::F32, {grid.nx, grid.ny, 1}));
         CB_TRY(make(sim->mTiles, BufferFormat::U8, tiles));
         CB_TRY(make(sim->mBands, BufferFormat::U8, {tiles.nx, tiles.ny, CeilDiv(grid.nz, B)}));
+        if (stages.Has(Stage::RenderSplat) && scene.render.skipping) {
+            CB_TRY(make(sim->mTilesPrev, BufferFormat::U8, tiles));
+            CB_TRY(make(sim->mBandsPrev, BufferFormat::U8, {tiles.nx, tiles.ny, CeilDiv(grid.nz, B)}));
+        }
+    }
+    if (stages.Has(Stage::Shade)) CB_TRY(make(sim->mT, BufferFormat::F32, grid));
+    if (stages.Has(Stage::Shadow)) CB_TRY(make(sim->mShadow, BufferFormat::F32, {grid.nx, grid.ny, 1}));
+    if (stages.Has(Stage::RenderSplat)) {
+        CB_TRY(make(sim->mQPrev, BufferFormat::F32, grid));
+        for (size_t n = 0; n < scene.render.cameras.size(); ++n) {
+            sim->mImages.emplace_back();
+            CB_TRY(make(sim->mImages.back(), BufferFormat::F32, {3, scene.render.width, scene.render.height}));
+        }
     }
     return sim;
 }
@@ -75,8 +96,15 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
         std::vector<RasterEllipsoid> raster = mEllipsoids.Raster();
         CB_TRY(Timed(record, Stage::Region, [&] { return mBackend.Region(raster, *mRegion); }));
     }
+    // Keep step t-1's q and occupancy for the renderer (the first step has none: it uses its own).
+    if (mQPrev && mStep > 0) std::swap(mQ, mQPrev);
+    if (mTilesPrev && mStep > 0) {
+        std::swap(mTiles, mTilesPrev);
+        std::swap(mBands, mBandsPrev);
+    }
     if (stages.Has(Stage::Smooth)) {
         CB_TRY(Timed(record, Stage::Smooth, [&] { return mBackend.Smooth(mScene.smooth.radius, *mCld[cur], *mQ); }));
+        mShadeCurrent = false;
     }
     if (stages.Has(Stage::Density)) {
         DensityOutputs out{mColumnSum.get(), mTiles.get(), mBands.get(), 0};
@@ -84,6 +112,21 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
         CB_TRY(Timed(record, Stage::Density, [&] { return mBackend.Density(params, *mQ, *mCld[cur], out); }));
         record.coveredColumns = out.coveredColumns;
     }
+    if (mStep == 0 && mQPrev) {
+        // No previous step yet: interpolate between q_0 and itself.
+        std::vector<std::byte> copy(mQ->CanonicalBytes());
+        CB_TRY(mBackend.Download(*mQ, copy));
+        CB_TRY(mBackend.Upload(*mQPrev, copy));
+        if (mTilesPrev) {
+            copy.resize(mTiles->CanonicalBytes());
+            CB_TRY(mBackend.Download(*mTiles, copy));
+            CB_TRY(mBackend.Upload(*mTilesPrev, copy));
+            copy.resize(mBands->CanonicalBytes());
+            CB_TRY(mBackend.Download(*mBands, copy));
+            CB_TRY(mBackend.Upload(*mBandsPrev, copy));
+        }
+    }
+    if (IsOutputStep(mStep)) CB_TRY(RunLighting(record));
     if (observe) CB_TRY(observe(*this));
 
     if (stages.Has(Stage::Ca)) {
@@ -108,6 +151,77 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
     ++mStep;
+    return {};
+}
+
+Status Simulation::RunLighting(StepRecord& record) {
+    const Scene& sc = mScene;
+    const Vec3 sun = sc.sun.Direction();
+    if (sc.stages.Has(Stage::Shade) && !mShadeCurrent) {
+        ShadeParams p;
+        p.sun = sun;
+        p.attenuation = sc.shade.attenuation;
+        p.sigma = float(sc.shade.sigma);
+        p.voxelSize = float(sc.grid.voxelSize);
+        p.thesisAr = float(sc.shade.thesisAr);
+        p.filter = sc.shade.filter;
+        p.resolution = sc.shade.resolution;
+        p.storage = sc.shade.storage;
+        p.scattering = sc.shade.scattering;
+        p.albedo = float(sc.shade.albedo);
+        p.solidAngle = float(sc.shade.solidAngle);
+        p.phase = sc.phase;
+        CB_TRY(Timed(record, Stage::Shade, [&] { return mBackend.Shade(p, *mQ, *mT); }));
+        mShadeCurrent = true;
+    }
+    if (sc.stages.Has(Stage::Shadow)) {
+        ShadowParams p;
+        p.sun = sun;
+        p.form = sc.shadow.form;
+        p.sigma = float(sc.shade.sigma);
+        p.voxelSize = float(sc.grid.voxelSize);
+        p.kappa = float(sc.shadow.kappa);
+        p.nz = sc.grid.size.nz;
+        CB_TRY(Timed(record, Stage::Shadow, [&] { return mBackend.Shadow(p, *mColumnSum, *mShadow); }));
+    }
+    if (sc.stages.Has(Stage::RenderSplat)) {
+        double total = 0;
+        for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
+            SplatParams p;
+            p.camera = MakeCameraFrame(sc.render.cameras[n], sc.render.width, sc.render.height);
+            // The order is host work shared by all backends, outside the stage time.
+            const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
+            p.order = &order;
+            p.sun = sun;
+            p.sunRadiance = sc.sun.Radiance();
+            for (int c = 0; c < 3; ++c) {
+                p.ambient[c] = float(sc.lighting.ambient[c]);
+                p.background[c] = float(sc.lighting.background[c]);
+            }
+            p.phase = sc.phase;
+            p.qMin = float(sc.render.qMin);
+            p.splatDiameter = float(sc.render.splatScale * sc.grid.voxelSize);
+            p.opacity = float(sc.render.opacity);
+            p.alpha = float(sc.render.alpha);
+            p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
+            p.voxelSize = float(sc.grid.voxelSize);
+            p.culling = sc.render.culling;
+            p.skipping = sc.render.skipping;
+            p.tile = sc.density.tile;
+            p.band = sc.density.band;
+            SplatInputs in{mQPrev.get(), mQ.get(), mT.get(), mTilesPrev.get(), mTiles.get(), mBandsPrev.get(), mBands.get()};
+            FrameRecord frame;
+            frame.camera = sc.render.cameras[n].name;
+            auto start = std::chrono::steady_clock::now();
+            Status status = mBackend.RenderSplat(p, in, *mImages[n], &frame.stats);
+            frame.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
+            total += frame.ms;
+            record.frames.push_back(frame);
+        }
+        record.stageMs[size_t(Stage::RenderSplat)] = total;
+        mLastRendered = mStep;
+    }
     return {};
 }
 

@@ -5,9 +5,14 @@
 //   region   R_t from the ellipsoid list L_t
 //   smooth   q_t from cld_t
 //   density  D_t, occupancy and cover from q_t and cld_t
+//   shade    T_t from q_t           } on output steps only, and shade only when
+//   shadow   G_t from D_t           } q changed since it last ran
+//   render   one image per camera from q_{t-1}, q_t (interpolated by alpha), T_t
 //   (observer: everything above plus hum_t, act_t, cld_t is readable here)
 //   ca       state_t -> state_{t+1} using R_t
 //   host     L_{t+1} = update(L_t)
+// Output steps: every step when dumping or when the scene does not render;
+// otherwise the render steps (render.every_steps).
 #pragma once
 
 #include <array>
@@ -23,18 +28,28 @@ namespace cb {
 
 inline constexpr size_t kStageCount = kAllStages.size();
 
+// One rendered image.
+struct FrameRecord {
+    std::string camera;
+    double ms = 0;
+    SplatStats stats;
+};
+
 struct StepRecord {
     uint32_t step = 0;
     // Wall time of each stage in ms; empty for stages that did not run.
     std::array<std::optional<double>, kStageCount> stageMs{};
     double ellipsoidUpdateMs = 0;           // host-side list update
     std::optional<uint32_t> coveredColumns;  // from the density stage
+    std::vector<FrameRecord> frames;         // render_splat, one per camera
 };
 
 class Simulation {
   public:
     // Allocates the enabled stages' buffers and computes the initial state.
-    static Result<std::unique_ptr<Simulation>> Create(const Scene& scene, Backend& backend);
+    // everyStepOutputs: shade, shadow and render on every step (for dumps).
+    static Result<std::unique_ptr<Simulation>> Create(const Scene& scene, Backend& backend,
+                                                      bool everyStepOutputs = false);
 
     using Observer = std::function<Status(const Simulation&)>;
     // Runs step CurrentStep() and advances to the next.
@@ -53,9 +68,17 @@ class Simulation {
     const Buffer* ColumnSum() const { return mColumnSum.get(); }
     const Buffer* Tiles() const { return mTiles.get(); }
     const Buffer* Bands() const { return mBands.get(); }
+    const Buffer* T() const { return mT.get(); }
+    const Buffer* Shadow() const { return mShadow.get(); }
+    // The image of camera `n` (F32, extent (3, width, height)); valid after a render step.
+    const Buffer* Image(size_t n) const { return n < mImages.size() ? mImages[n].get() : nullptr; }
+    // The step whose images are in Image(); nullopt before the first render.
+    std::optional<uint32_t> LastRenderedStep() const { return mLastRendered; }
+    bool IsOutputStep(uint32_t step) const;
 
   private:
-    Simulation(const Scene& scene, Backend& backend);
+    Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs);
+    Status RunLighting(StepRecord& record);
 
     const Scene mScene;
     Backend& mBackend;
@@ -66,6 +89,13 @@ class Simulation {
 
     std::unique_ptr<Buffer> mHum[2], mAct[2], mCld[2];
     std::unique_ptr<Buffer> mRegion, mQ, mColumnSum, mTiles, mBands;
+    // Previous step's q and occupancy, for interpolation and skipping (render only).
+    std::unique_ptr<Buffer> mQPrev, mTilesPrev, mBandsPrev;
+    std::unique_ptr<Buffer> mT, mShadow;
+    std::vector<std::unique_ptr<Buffer>> mImages;
+    const bool mEveryStepOutputs;
+    bool mShadeCurrent = false;  // T matches the current q
+    std::optional<uint32_t> mLastRendered;
 };
 
 }  // namespace cb

@@ -27,7 +27,10 @@ bool BackendCpu::Supports(Stage stage) const {
         case Stage::Region:
         case Stage::Ca:
         case Stage::Smooth:
-        case Stage::Density: return true;
+        case Stage::Density:
+        case Stage::Shade:
+        case Stage::Shadow:
+        case Stage::RenderSplat: return true;
         default: return false;
     }
 }

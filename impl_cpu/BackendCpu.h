@@ -51,6 +51,9 @@ class BackendCpu final : public Backend {
     Status CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) override;
     Status Smooth(int radius, const Buffer& cld, Buffer& q) override;
     Status Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) override;
+    Status Shade(const ShadeParams& params, const Buffer& q, Buffer& T) override;
+    Status Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) override;
+    Status RenderSplat(const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats) override;
 
     int Threads() const { return mArena.max_concurrency(); }
 
@@ -58,6 +61,7 @@ class BackendCpu final : public Backend {
     tbb::task_arena mArena;
     // Scratch kept between calls so that steady-state steps do not allocate.
     std::vector<BitField> mAdvectScratch;
+    std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
 };
 
 }  // namespace cb::cpu

@@ -192,10 +192,140 @@ TEST(SceneTest, IntegralFloatIsAnInteger) {
     EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "steps": 1e3})").steps, 1000u);
 }
 
-// Test that known stages outside the default four are accepted without dependency rules.
+// Test that the stages without dependency rules (render_march, noise) are accepted on their own.
 TEST(SceneTest, OtherKnownStagesNeedNothing) {
-    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "stages": ["shade", "noise"]})").stages,
-              Stages({Stage::Shade, Stage::Noise}));
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "stages": ["render_march", "noise"]})").stages,
+              Stages({Stage::RenderMarch, Stage::Noise}));
+}
+
+// Test that a scene with none of the lighting sections gets every documented default for them.
+TEST(SceneTest, LightingSectionsDefaults) {
+    Scene scene = Parsed(kMinimal);
+    EXPECT_EQ(scene.sun.elevationDeg, 40.0);
+    EXPECT_EQ(scene.sun.azimuthDeg, 30.0);
+    EXPECT_EQ(scene.sun.color, (std::array<double, 3>{1, 0.96, 0.9}));
+    EXPECT_EQ(scene.sun.intensity, 1.0);
+    EXPECT_EQ(scene.lighting.ambient, (std::array<double, 3>{0.25, 0.3, 0.38}));
+    EXPECT_EQ(scene.lighting.background, (std::array<double, 3>{0.45, 0.6, 0.85}));
+    EXPECT_EQ(scene.phase.kind, PhaseKind::HenyeyGreenstein);
+    EXPECT_EQ(scene.phase.g, 0.6f);
+    EXPECT_EQ(scene.shade.attenuation, AttenuationKind::Beer);
+    EXPECT_EQ(scene.shade.sigma, 0.02);
+    EXPECT_EQ(scene.shade.thesisAr, 0.9);
+    EXPECT_EQ(scene.shade.filter, SampleFilter::Bilinear);
+    EXPECT_EQ(scene.shade.resolution, 1);
+    EXPECT_EQ(scene.shade.storage, StorageFormat::Fp32);
+    EXPECT_FALSE(scene.shade.scattering);
+    EXPECT_EQ(scene.shade.albedo, 0.9);
+    EXPECT_EQ(scene.shade.solidAngle, 0.05);
+    EXPECT_EQ(scene.shadow.form, AttenuationKind::Beer);
+    EXPECT_EQ(scene.shadow.kappa, 0.25);
+    EXPECT_EQ(scene.render.width, 320u);
+    EXPECT_EQ(scene.render.height, 240u);
+    EXPECT_EQ(scene.render.qMin, 0.3);
+    EXPECT_EQ(scene.render.splatScale, 1.5);
+    EXPECT_EQ(scene.render.opacity, 0.6);
+    EXPECT_EQ(scene.render.alpha, 0.5);
+    EXPECT_TRUE(scene.render.culling);
+    EXPECT_TRUE(scene.render.skipping);
+    EXPECT_EQ(scene.render.everySteps, 0u);
+    EXPECT_TRUE(scene.render.cameras.empty());
+}
+
+// Test that a camera giving only eye and target gets the name view<index> and the other camera defaults.
+TEST(SceneTest, CameraDefaults) {
+    Scene scene = Parsed(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [
+        {"name": "first", "eye": [0, 0, 0], "target": [1, 0, 0]},
+        {"eye": [-10, 5, 2.5], "target": [100, 200, 0]}]}})");
+    ASSERT_EQ(scene.render.cameras.size(), 2u);
+    const CameraSettings& c = scene.render.cameras[1];
+    EXPECT_EQ(c.name, "view1");
+    EXPECT_EQ(c.eye, (std::array<double, 3>{-10, 5, 2.5}));
+    EXPECT_EQ(c.target, (std::array<double, 3>{100, 200, 0}));
+    EXPECT_EQ(c.up, (std::array<double, 3>{0, 0, 1}));
+    EXPECT_EQ(c.fovDeg, 60.0);
+    EXPECT_EQ(c.nearPlane, 1.0);
+    EXPECT_EQ(c.farPlane, 100000.0);
+}
+
+// Test that a scene giving every lighting, shading and render field (two cameras) lands in the right members.
+TEST(SceneTest, FullSceneParsesEveryLightingField) {
+    Scene scene = Parsed(R"({
+        "grid": {"size": [8, 4, 6]},
+        "stages": ["region", "ca", "smooth", "density", "shade", "shadow", "render_splat"],
+        "sun": {"elevation_deg": -12.5, "azimuth_deg": 400, "color": [0.5, 0, 2], "intensity": 3},
+        "lighting": {"ambient": [0, 0.1, 0.2], "background": [1, 2, 3]},
+        "phase": {"function": "cornette-shanks", "g": -0.25},
+        "shade": {"attenuation": "thesis", "sigma": 0.5, "thesis_ar": 0.75, "filter": "nearest",
+                  "resolution": 4, "storage": "unorm8",
+                  "scattering": {"enabled": true, "albedo": 0.8, "solid_angle": 12.5}},
+        "shadow": {"form": "thesis", "kappa": 0},
+        "render": {"width": 16384, "height": 1, "q_min": 0, "splat_scale": 0.25, "opacity": 1, "alpha": 0,
+                   "culling": false, "skipping": false, "every_steps": 5,
+                   "cameras": [
+                       {"name": "top", "eye": [200, 100, 5000], "target": [200, 100, 0], "up": [0, 1, 0],
+                        "fov_deg": 179.5, "near": 0.5, "far": 20000},
+                       {"name": "side", "eye": [-500, 100, 150], "target": [200, 100, 150], "up": [0, 0, 2],
+                        "fov_deg": 0.5, "near": 10, "far": 10.5}]}
+    })");
+    EXPECT_EQ(scene.stages, Stages({Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density, Stage::Shade,
+                                    Stage::Shadow, Stage::RenderSplat}));
+    EXPECT_EQ(scene.sun.elevationDeg, -12.5);
+    EXPECT_EQ(scene.sun.azimuthDeg, 400.0);
+    EXPECT_EQ(scene.sun.color, (std::array<double, 3>{0.5, 0, 2}));
+    EXPECT_EQ(scene.sun.intensity, 3.0);
+    EXPECT_EQ(scene.lighting.ambient, (std::array<double, 3>{0, 0.1, 0.2}));
+    EXPECT_EQ(scene.lighting.background, (std::array<double, 3>{1, 2, 3}));
+    EXPECT_EQ(scene.phase.kind, PhaseKind::CornetteShanks);
+    EXPECT_EQ(scene.phase.g, -0.25f);
+    EXPECT_EQ(scene.shade.attenuation, AttenuationKind::Thesis);
+    EXPECT_EQ(scene.shade.sigma, 0.5);
+    EXPECT_EQ(scene.shade.thesisAr, 0.75);
+    EXPECT_EQ(scene.shade.filter, SampleFilter::Nearest);
+    EXPECT_EQ(scene.shade.resolution, 4);
+    EXPECT_EQ(scene.shade.storage, StorageFormat::Unorm8);
+    EXPECT_TRUE(scene.shade.scattering);
+    EXPECT_EQ(scene.shade.albedo, 0.8);
+    EXPECT_EQ(scene.shade.solidAngle, 12.5);
+    EXPECT_EQ(scene.shadow.form, AttenuationKind::Thesis);
+    EXPECT_EQ(scene.shadow.kappa, 0.0);
+    EXPECT_EQ(scene.render.width, 16384u);
+    EXPECT_EQ(scene.render.height, 1u);
+    EXPECT_EQ(scene.render.qMin, 0.0);
+    EXPECT_EQ(scene.render.splatScale, 0.25);
+    EXPECT_EQ(scene.render.opacity, 1.0);
+    EXPECT_EQ(scene.render.alpha, 0.0);
+    EXPECT_FALSE(scene.render.culling);
+    EXPECT_FALSE(scene.render.skipping);
+    EXPECT_EQ(scene.render.everySteps, 5u);
+    ASSERT_EQ(scene.render.cameras.size(), 2u);
+    const CameraSettings& top = scene.render.cameras[0];
+    EXPECT_EQ(top.name, "top");
+    EXPECT_EQ(top.eye, (std::array<double, 3>{200, 100, 5000}));
+    EXPECT_EQ(top.target, (std::array<double, 3>{200, 100, 0}));
+    EXPECT_EQ(top.up, (std::array<double, 3>{0, 1, 0}));
+    EXPECT_EQ(top.fovDeg, 179.5);
+    EXPECT_EQ(top.nearPlane, 0.5);
+    EXPECT_EQ(top.farPlane, 20000.0);
+    const CameraSettings& side = scene.render.cameras[1];
+    EXPECT_EQ(side.name, "side");
+    EXPECT_EQ(side.eye, (std::array<double, 3>{-500, 100, 150}));
+    EXPECT_EQ(side.target, (std::array<double, 3>{200, 100, 150}));
+    EXPECT_EQ(side.up, (std::array<double, 3>{0, 0, 2}));
+    EXPECT_EQ(side.fovDeg, 0.5);
+    EXPECT_EQ(side.nearPlane, 10.0);
+    EXPECT_EQ(side.farPlane, 10.5);
+}
+
+// Test that each choice string maps to its enum value (the ones the full scene above does not use).
+TEST(SceneTest, EveryChoiceString) {
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "phase": {"function": "none"}})").phase.kind, PhaseKind::None);
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "phase": {"function": "henyey-greenstein"}})").phase.kind,
+              PhaseKind::HenyeyGreenstein);
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "shade": {"storage": "fp16"}})").shade.storage,
+              StorageFormat::Fp16);
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "shade": {"storage": "fp32", "attenuation": "beer",
+                        "filter": "bilinear", "resolution": 2}})").shade.resolution, 2);
 }
 
 // ---- Refused scenes ------------------------------------------------------------------------------------------
@@ -288,6 +418,166 @@ TEST(SceneTest, WindShiftWrongLength) {
                         R"(test.json: ca.wind_shift[0]: expected an array of 2 integers, got "abc")"));
 }
 
+// Test that a choice string not in its list is refused with the choices, and a near miss gets a suggestion.
+TEST(SceneTest, BadChoiceString) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "shade": {"filter": "cubic", "storage": "fp-16"},
+                                      "phase": {"function": "Henyey-Greenstein"}, "shadow": {"form": 1}})");
+    EXPECT_TRUE(HasLine(message, R"(test.json: shade.filter: must be one of "bilinear", "nearest", got "cubic")"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: shade.storage: must be one of "fp32", "fp16", "unorm8", got "fp-16" )"
+                                 R"((did you mean "fp16"?))"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: phase.function: must be one of "none", "henyey-greenstein", )"
+                                 R"("cornette-shanks", got "Henyey-Greenstein" (did you mean "henyey-greenstein"?))"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: shadow.form: must be one of "beer", "thesis", got 1)"));
+    EXPECT_EQ(SplitLines(message).size(), 4u) << message;
+}
+
+// Test that a shade resolution other than 1, 2 or 4 is refused, and a fractional one as not an integer.
+TEST(SceneTest, ShadeResolutionThree) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "shade": {"resolution": 3}})"),
+                        "test.json: shade.resolution: must be 1, 2 or 4, got 3"));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "shade": {"resolution": 1e30}})"),
+                        "test.json: shade.resolution: must be 1, 2 or 4, got 1e+30"));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "shade": {"resolution": 1.5}})"),
+                        "test.json: shade.resolution: expected an integer, got 1.5"));
+}
+
+// Test that the phase asymmetry g = 1 is refused (open interval), and so is a g that becomes 1 as a float.
+TEST(SceneTest, PhaseGOne) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "phase": {"g": 1}})"),
+                        "test.json: phase.g: must be in (-1, 1), got 1"));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "phase": {"g": -0.99999999999}})"),
+                        "test.json: phase.g: must be in (-1, 1) in single precision, got -0.99999999999"));
+}
+
+// Test that a sun elevation above 90 degrees is refused.
+TEST(SceneTest, SunElevation91) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "sun": {"elevation_deg": 91}})"),
+                        "test.json: sun.elevation_deg: must be in [-90, 90], got 91"));
+}
+
+// Test that a negative colour component is refused, in the sun and in the lighting colours.
+TEST(SceneTest, NegativeColourComponent) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "sun": {"color": [1, -0.5, 1]},
+                                      "lighting": {"background": [0.1, 0.2, -3]}})");
+    EXPECT_TRUE(HasLine(message, "test.json: sun.color[1]: must be >= 0, got -0.5"));
+    EXPECT_TRUE(HasLine(message, "test.json: lighting.background[2]: must be >= 0, got -3"));
+}
+
+// Test that a camera without eye is refused: eye is required.
+TEST(SceneTest, CameraMissingEye) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [{"target": [1, 2, 3]}]}})"),
+                        "test.json: render.cameras[0].eye: required field is missing"));
+}
+
+// Test that a camera looking at its own eye position is refused.
+TEST(SceneTest, CameraTargetEqualsEye) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [
+                                        {"eye": [1, 2, 3], "target": [1, 2, 4]},
+                                        {"eye": [5, 5, 5], "target": [5, 5, 5.0]}]}})"),
+                        "test.json: render.cameras[1].target: must differ from eye"));
+}
+
+// Test that an up vector of all zeros is refused.
+TEST(SceneTest, CameraUpAllZero) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [
+                                        {"eye": [0, 0, 0], "target": [1, 0, 0], "up": [0, -0.0, 0]}]}})"),
+                        "test.json: render.cameras[0].up: must not be all zero, got [0,-0.0,0]"));
+}
+
+// Test that a field of view of 180 degrees is refused (open interval).
+TEST(SceneTest, CameraFov180) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [
+                                        {"eye": [0, 0, 0], "target": [1, 0, 0], "fov_deg": 180}]}})"),
+                        "test.json: render.cameras[0].fov_deg: must be in (0, 180), got 180"));
+}
+
+// Test that far must exceed near, reported on far, or on near when only near was given.
+TEST(SceneTest, CameraFarNotBeyondNear) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [
+                                      {"eye": [0, 0, 0], "target": [1, 0, 0], "near": 5, "far": 5},
+                                      {"eye": [0, 0, 0], "target": [1, 0, 0], "near": 2e5}]}})");
+    EXPECT_TRUE(HasLine(message, "test.json: render.cameras[0].far: must be > near (5), got 5"));
+    EXPECT_TRUE(HasLine(message, "test.json: render.cameras[1].near: must be < far (100000), got 200000"));
+}
+
+// Test that two cameras with one name are refused, also when the second name is the default view<index>.
+TEST(SceneTest, DuplicateCameraNames) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": [
+                                      {"name": "a", "eye": [0, 0, 0], "target": [1, 0, 0]},
+                                      {"name": "a", "eye": [0, 0, 0], "target": [0, 1, 0]},
+                                      {"name": "view3", "eye": [0, 0, 0], "target": [0, 1, 0]},
+                                      {"eye": [0, 0, 0], "target": [0, 0, 1]}]}})");
+    EXPECT_TRUE(HasLine(message, R"(test.json: render.cameras[1].name: duplicate camera name "a")"));
+    EXPECT_TRUE(HasLine(message,
+                        R"(test.json: render.cameras[3].name: duplicate camera name "view3" (its default name))"));
+    EXPECT_EQ(SplitLines(message).size(), 2u) << message;
+}
+
+// Test that render_splat without any camera is refused, whether cameras is missing or empty.
+TEST(SceneTest, RenderSplatWithoutCameras) {
+    const std::string stages = R"("stages": ["region", "ca", "smooth", "density", "shade", "render_splat"])";
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + stages + "}"),
+                        R"(test.json: render.cameras: "render_splat" needs at least one camera)"));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"cameras": []}, )" + stages + "}"),
+                        R"(test.json: render.cameras: "render_splat" needs at least one camera)"));
+}
+
+// Test each dependency of the lighting stages: shade needs smooth, shadow density, render_splat shade and density.
+TEST(SceneTest, LightingStageDependencies) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["shade"]})"),
+                        R"(test.json: stages: "shade" needs "smooth")"));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["region", "ca", "smooth", "shadow"]})"),
+                        R"(test.json: stages: "shadow" needs "density")"));
+    const std::string camera = R"("render": {"cameras": [{"eye": [0, 0, 0], "target": [1, 0, 0]}]})";
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + camera +
+                                R"(, "stages": ["region", "ca", "smooth", "density", "render_splat"]})"),
+                        R"(test.json: stages: "render_splat" needs "shade")"));
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + camera +
+                                  R"(, "stages": ["region", "ca", "smooth", "shade", "render_splat"]})");
+    EXPECT_TRUE(HasLine(message, R"(test.json: stages: "render_splat" needs "density")"));
+    EXPECT_EQ(SplitLines(message).size(), 1u) << message;
+}
+
+// Test that a number or a string where a boolean belongs is refused.
+TEST(SceneTest, WrongBooleanType) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"culling": 1},
+                                      "shade": {"scattering": {"enabled": "true"}}})");
+    EXPECT_TRUE(HasLine(message, "test.json: render.culling: expected true or false, got 1"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: shade.scattering.enabled: expected true or false, got "true")"));
+}
+
+// Test that the other new fields refuse out-of-range values with their ranges (a sample of each kind of bound).
+TEST(SceneTest, LightingFieldRanges) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "sun": {"intensity": -1},
+        "shade": {"sigma": -0.1, "scattering": {"solid_angle": 13, "albedo": 1.5}}, "shadow": {"kappa": -1},
+        "render": {"width": 0, "height": 16385, "splat_scale": 0, "opacity": 2, "every_steps": -1,
+                   "cameras": {"eye": [0, 0, 0]}}})");
+    EXPECT_TRUE(HasLine(message, "test.json: sun.intensity: must be >= 0, got -1"));
+    EXPECT_TRUE(HasLine(message, "test.json: shade.sigma: must be >= 0, got -0.1"));
+    EXPECT_TRUE(
+        HasLine(message, "test.json: shade.scattering.solid_angle: must be in (0, 12.566370614359172], got 13"));
+    EXPECT_TRUE(HasLine(message, "test.json: shade.scattering.albedo: must be in [0, 1], got 1.5"));
+    EXPECT_TRUE(HasLine(message, "test.json: shadow.kappa: must be >= 0, got -1"));
+    EXPECT_TRUE(HasLine(message, "test.json: render.width: must be in [1, 16384], got 0"));
+    EXPECT_TRUE(HasLine(message, "test.json: render.height: must be in [1, 16384], got 16385"));
+    EXPECT_TRUE(HasLine(message, "test.json: render.splat_scale: must be > 0, got 0"));
+    EXPECT_TRUE(HasLine(message, "test.json: render.opacity: must be in [0, 1], got 2"));
+    EXPECT_TRUE(HasLine(message, "test.json: render.every_steps: must be in [0, 4294967295], got -1"));
+    EXPECT_TRUE(HasLine(message,
+                        R"(test.json: render.cameras: expected an array of camera objects, got {"eye":[0,0,0]})"));
+    EXPECT_EQ(SplitLines(message).size(), 11u) << message;
+}
+
+// Test that unknown keys inside the new sections and a camera are refused, a shortened key suggesting the full one.
+TEST(SceneTest, LightingUnknownKeys) {
+    std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "sun": {"elevation": 10},
+        "shade": {"scattering": {"enable": true}}, "render": {"cameras": [
+        {"eye": [0, 0, 0], "target": [1, 0, 0], "fov": 50}]}})");
+    EXPECT_TRUE(HasLine(message, R"(test.json: sun.elevation: unknown field (did you mean "elevation_deg"?))"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: shade.scattering.enable: unknown field (did you mean "enabled"?))"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: render.cameras[0].fov: unknown field (did you mean "fov_deg"?))"));
+}
+
 // Test that a wind grid must carry exactly gx*gy vectors.
 TEST(SceneTest, WindGridVectorCountMismatch) {
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]},
@@ -325,7 +615,7 @@ TEST(SceneTest, MemoryTooLarge) {
                                              "this machine's "));
 }
 
-// Test the memory estimate on a small grid, term by term, and on the largest scene.
+// Test the memory estimate on a small grid, term by term (lighting stages too), and on the largest scene.
 TEST(SceneTest, EstimateSceneBytes) {
     Scene scene = Parsed(R"({"grid": {"size": [100, 4, 6]}})");
     const uint64_t v = 100 * 4 * 6;
@@ -337,6 +627,22 @@ TEST(SceneTest, EstimateSceneBytes) {
     EXPECT_EQ(EstimateSceneBytes(scene), 4 * v + (v + 64) + 9 * bitField + smooth + density);
     scene.stages = Stages({Stage::Region});
     EXPECT_EQ(EstimateSceneBytes(scene), 4 * v + (v + 64));
+
+    // The lighting stages: shade's T, shadow's G, render_splat's previous q and RGB float image.
+    Scene lit = Parsed(R"({"grid": {"size": [100, 4, 6]},
+        "stages": ["region", "ca", "smooth", "density", "shade", "shadow", "render_splat"],
+        "render": {"width": 10, "height": 7, "cameras": [{"eye": [0, 0, 0], "target": [1, 0, 0]}]}})");
+    const uint64_t simulation = 4 * v + (v + 64) + 6 * bitField + smooth + density;
+    const uint64_t shade = 4 * v, shadow = 4 * 100 * 4, render = 4 * v + 3 * 4 * 10 * 7;
+    EXPECT_EQ(EstimateSceneBytes(lit), simulation + shade + shadow + render);
+    // Half resolution adds coarse q and T grids of ceil(100/2) x ceil(4/2) x ceil(6/2) floats.
+    lit.shade.resolution = 2;
+    EXPECT_EQ(EstimateSceneBytes(lit), simulation + shade + 2 * 4 * (50 * 2 * 3) + shadow + render);
+    // Quarter resolution: ceil(100/4) x ceil(4/4) x ceil(6/4).
+    lit.shade.resolution = 4;
+    EXPECT_EQ(EstimateSceneBytes(lit), simulation + shade + 2 * 4 * (25 * 1 * 2) + shadow + render);
+    lit.stages = Stages({Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density, Stage::Shadow});
+    EXPECT_EQ(EstimateSceneBytes(lit), simulation + shadow);
 
     Scene huge;
     huge.grid.size = Extent3{1, 65535, 65535};
@@ -459,6 +765,19 @@ TEST(SceneTest, OverrideUnknownField) {
 TEST(SceneTest, OverrideThroughNonObject) {
     EXPECT_TRUE(HasLine(ErrorOf(kMinimal, {{"grid.size.x", "1"}}),
                         R"(test.json: --set grid.size.x: "grid.size" is not an object)"));
+}
+
+// Test that --set shade.storage=fp16 (a bare word) selects fp16, and --set render.culling=false a boolean.
+TEST(SceneTest, OverrideShadeStorage) {
+    Scene scene = Parsed(kMinimal, {{"shade.storage", "fp16"}, {"render.culling", "false"}});
+    EXPECT_EQ(scene.shade.storage, StorageFormat::Fp16);
+    EXPECT_FALSE(scene.render.culling);
+}
+
+// Test that --set shade.resolution=3 is refused and marked as coming from --set.
+TEST(SceneTest, OverrideShadeResolutionRefused) {
+    EXPECT_TRUE(HasLine(ErrorOf(kMinimal, {{"shade.resolution", "3"}}),
+                        "test.json: shade.resolution: must be 1, 2 or 4, got 3 (set with --set)"));
 }
 
 // Test that an override value that overflows to infinity is refused, not used.

@@ -1,0 +1,62 @@
+// Cameras and the shared back-to-front splat order (SPEC.md section 8).
+// Everything here runs on the host, once per frame, and is handed to every
+// backend, so all backends project and sort the same way.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/Grid.h"
+#include "core/Shading.h"
+
+namespace cb {
+
+struct CameraSettings {
+    std::string name = "view";
+    std::array<double, 3> eye{0, 0, 0};     // world, metres
+    std::array<double, 3> target{1, 0, 0};  // world, metres
+    std::array<double, 3> up{0, 0, 1};
+    double fovDeg = 60;                     // vertical field of view
+    double nearPlane = 1, farPlane = 100000;
+};
+
+// A camera resolved for one image size: orthonormal basis (right-handed look-at,
+// OpenGL style: the camera looks down -z of its own frame) and the focal length
+// in pixels. If `up` is parallel to the view direction (looking straight up or
+// down), +y, then +x, stands in for it (docs/pipeline.md).
+struct CameraFrame {
+    Vec3 eye{}, forward{}, right{}, upVector{};
+    float focalPx = 1;  // H / (2 tan(fov/2))
+    uint32_t width = 1, height = 1;
+    float nearPlane = 1, farPlane = 1;
+
+    // View-space depth along `forward` (> 0 in front of the eye).
+    float Depth(const Vec3& p) const {
+        return (p[0] - eye[0]) * forward[0] + (p[1] - eye[1]) * forward[1] + (p[2] - eye[2]) * forward[2];
+    }
+};
+
+CameraFrame MakeCameraFrame(const CameraSettings& camera, uint32_t width, uint32_t height);
+
+// Where a world point lands: pixel position (row 0 at the top) and depth.
+// Follows SPEC 8: OpenGL-style perspective, px = (ndc_x + 1)/2 W,
+// py = (1 - ndc_y)/2 H. Only meaningful for depth > 0.
+struct Projected {
+    float px, py, depth;
+};
+Projected Project(const CameraFrame& frame, const Vec3& p);
+
+// The total back-to-front order of SPEC 8: axes by decreasing |view direction
+// component| (ties: x before y before z), and along each axis the indices by
+// decreasing |index + 0.5 - eye index|, ties by lower index.
+struct SplatOrder {
+    std::array<int, 3> axes{};                // outermost first
+    std::array<std::vector<uint32_t>, 3> indices;  // indices[axis]: that axis's order
+};
+SplatOrder MakeSplatOrder(const CameraFrame& frame, const Extent3& grid, const std::array<double, 3>& origin,
+                          double voxelSize);
+
+}  // namespace cb

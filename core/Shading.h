@@ -1,0 +1,172 @@
+// The algorithm of the lighting stages (SPEC.md sections 6-9): sun direction,
+// principal axis, per-slice attenuation, phase functions, storage rounding,
+// and the splat kernel. Backends keep only their schedule.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+
+namespace cb {
+
+using Vec3 = std::array<float, 3>;
+
+// s = (cos el cos az, cos el sin az, sin el): unit vector toward the sun.
+inline Vec3 SunDirection(double elevationRad, double azimuthRad) {
+    return {float(std::cos(elevationRad) * std::cos(azimuthRad)), float(std::cos(elevationRad) * std::sin(azimuthRad)),
+            float(std::sin(elevationRad))};
+}
+
+// Principal axis w (0 = x, 1 = y, 2 = z): z if |s_z| >= max(|s_x|, |s_y|),
+// else y if |s_y| >= |s_x|, else x. Ties go to the later axis in that order.
+inline int PrincipalAxis(const Vec3& s) {
+    const float ax = std::fabs(s[0]), ay = std::fabs(s[1]), az = std::fabs(s[2]);
+    if (az >= std::max(ax, ay)) return 2;
+    if (ay >= ax) return 1;
+    return 0;
+}
+
+// ---- exp ---------------------------------------------------------------------
+
+// exp(x) for x <= 0 in float, within 2 ulp of the correctly rounded result for
+// x in [-87, 0] (tested against std::exp in double), and exactly 0 below -87,
+// so no result is subnormal. Written so that loops over it vectorise
+// (std::exp does not without -ffast-math).
+inline float ExpNonPositive(float x) {
+    const bool underflows = x < -87.0f;
+    x = std::max(x, -87.0f);
+    // x = k ln2 + r, |r| <= ln2/2, with ln2 split in a high part exact in float.
+    const float k = std::nearbyint(x * 1.44269504088896341f);
+    float r = x - k * 0.693145751953125f;
+    r = r - k * 1.42860682030941723212e-6f;
+    // exp(r) by its Taylor series to r^7 (|error| < 2^-26 on |r| <= ln2/2).
+    float p = 1.0f / 5040.0f;
+    p = p * r + 1.0f / 720.0f;
+    p = p * r + 1.0f / 120.0f;
+    p = p * r + 1.0f / 24.0f;
+    p = p * r + 1.0f / 6.0f;
+    p = p * r + 0.5f;
+    p = p * r + 1.0f;
+    p = p * r + 1.0f;
+    // 2^k, k in [-126, 0]: build the float exponent directly.
+    const int32_t bits = (int32_t(k) + 127) << 23;
+    const float result = p * std::bit_cast<float>(bits);
+    return underflows ? 0.0f : result;
+}
+
+// Transmittance below this is stored as 0: products of many small factors would
+// otherwise reach subnormal floats, which are slow on CPUs and flushed on GPUs.
+inline constexpr float kTransmittanceFloor = 1e-30f;
+
+// ---- Storage precision of T (SPEC 6) -------------------------------------------
+
+enum class StorageFormat : uint8_t { Fp32, Fp16, Unorm8 };
+
+// Rounds to the nearest IEEE half (ties to even) and back. T is in [0, 1], so
+// the result is never infinite; subnormal halves are kept.
+inline float RoundToHalf(float value) {
+    const uint32_t bits = std::bit_cast<uint32_t>(value);
+    const uint32_t sign = bits & 0x80000000u;
+    const uint32_t magnitude = bits & 0x7fffffffu;
+    if (magnitude >= 0x477ff000u) return std::bit_cast<float>(sign | 0x7f800000u);  // overflow: not reached for T
+    if (magnitude < 0x38800000u) {
+        // Half subnormal range: quantum 2^-24. Rounding x * 2^24 to an integer
+        // (ties to even, the default mode) is exact rounding here.
+        const float scaled = std::nearbyint(std::fabs(value) * 16777216.0f);
+        return std::copysign(scaled * (1.0f / 16777216.0f), value);
+    }
+    // Normal: keep 10 of the 23 mantissa bits, ties to even.
+    const uint32_t lsb = (magnitude >> 13) & 1u;
+    const uint32_t rounded = (magnitude + 0x0fffu + lsb) & ~0x1fffu;
+    return std::bit_cast<float>(sign | rounded);
+}
+
+// Rounds to k/255 for the nearest integer k (ties to even); value in [0, 1].
+inline float RoundToUnorm8(float value) { return std::nearbyint(std::clamp(value, 0.0f, 1.0f) * 255.0f) / 255.0f; }
+
+inline float RoundToStorage(StorageFormat format, float value) {
+    switch (format) {
+        case StorageFormat::Fp32: return value;
+        case StorageFormat::Fp16: return RoundToHalf(value);
+        case StorageFormat::Unorm8: return RoundToUnorm8(value);
+    }
+    return value;
+}
+
+// One storage quantum at value v: the comparison tolerance for fp16/unorm8 (SPEC 6).
+inline float StorageQuantum(StorageFormat format) {
+    switch (format) {
+        case StorageFormat::Fp32: return 0.0f;
+        case StorageFormat::Fp16: return 1.0f / 2048.0f;  // half spacing just below 1
+        case StorageFormat::Unorm8: return 1.0f / 255.0f;
+    }
+    return 0.0f;
+}
+
+// ---- Phase functions (SPEC 9), normalised so that isotropic gives 1 ----------
+
+enum class PhaseKind : uint8_t { None, HenyeyGreenstein, CornetteShanks };
+
+struct PhaseParams {
+    PhaseKind kind = PhaseKind::HenyeyGreenstein;
+    float g = 0.6f;
+};
+
+// P^(cos theta) = 4 pi p(theta).
+inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
+    const float g = phase.g;
+    switch (phase.kind) {
+        case PhaseKind::None: return 1.0f;
+        case PhaseKind::HenyeyGreenstein: {
+            const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
+            return (1.0f - g * g) / (denom * std::sqrt(denom));
+        }
+        case PhaseKind::CornetteShanks: {
+            const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
+            return 1.5f * (1.0f - g * g) / (2.0f + g * g) * (1.0f + cosTheta * cosTheta) / (denom * std::sqrt(denom));
+        }
+    }
+    return 1.0f;
+}
+
+// ---- Per-slice attenuation (SPEC 6) --------------------------------------------
+
+enum class AttenuationKind : uint8_t { Beer, Thesis };
+enum class SampleFilter : uint8_t { Bilinear, Nearest };
+
+struct SliceAttenuation {
+    AttenuationKind kind = AttenuationKind::Beer;
+    float opticalDepthPerQ = 0;  // sigma * h_slice / |s_w| (beer, and tau for scattering)
+    float thesisAr = 0.9f;       // a_r of the thesis form
+    float scatterGain = 0;       // albedo * P^(0) * gamma / (4 pi); 0 = no multiple scattering
+
+    // The factor by which light is multiplied crossing a slice of density q,
+    // clamped to [0, 1] (forward scattering may otherwise exceed 1).
+    float Factor(float q) const {
+        const float tau = opticalDepthPerQ * q;
+        float a = kind == AttenuationKind::Beer ? ExpNonPositive(-tau) : 1.0f - (1.0f - thesisAr) * q;
+        a += scatterGain * tau;
+        return std::clamp(a, 0.0f, 1.0f);
+    }
+};
+
+// Bilinear blend of four taps: t00 at (0,0), t10 at (1,0), t01 at (0,1), t11 at (1,1).
+inline float Bilinear(float t00, float t10, float t01, float t11, float fu, float fv) {
+    const float a = t00 * (1.0f - fu) + t10 * fu;
+    const float b = t01 * (1.0f - fu) + t11 * fu;
+    return a * (1.0f - fv) + b * fv;
+}
+
+// ---- Splat kernel (SPEC 8) -------------------------------------------------------
+
+// kappa = max(0, 1 - rho^2)^2 at splat coordinate (a, b) in [0, 1]^2.
+inline float SplatKernel(float a, float b) {
+    const float x = 2.0f * a - 1.0f, y = 2.0f * b - 1.0f;
+    const float t = std::max(0.0f, 1.0f - (x * x + y * y));
+    return t * t;
+}
+
+}  // namespace cb

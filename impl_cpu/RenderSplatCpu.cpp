@@ -1,0 +1,237 @@
+// Stage `render_splat` on the CPU (SPEC 8): a deterministic tile-free splat
+// rasteriser.
+//   1. Culling and skipping decide, per tile x height-band box, whether any of
+//      its voxels can make a visible splat (conservatively: the image is the
+//      same with both off).
+//   2. Splats are generated in the shared back-to-front order, one outer-axis
+//      slice per task, and concatenated in order.
+//   3. A counting sort bins them by bands of image rows, keeping their order.
+//   4. Each row band composites its splats in order, in parallel.
+// Every pixel sees its splats in the same order for any thread count.
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "impl_cpu/BackendCpu.h"
+
+namespace cb::cpu {
+namespace {
+
+struct Splat {
+    float px, py, size;  // centre in pixels, edge length in pixels
+    float alphaScale;    // q_alpha * opacity
+    float color[3];
+    int32_t x0, x1, y0, y1;  // covered pixels, inclusive (x0 > x1 when none)
+};
+
+constexpr uint32_t kRowsPerBand = 8;
+
+// A plane n.(P - eye) <= offset keeps the visible side.
+struct Plane {
+    Vec3 n;
+};
+
+// The four side planes of the frustum widened by one pixel, so that a voxel
+// whose splat touches the image lies within splatRadius of their inside.
+std::array<Plane, 4> SidePlanes(const CameraFrame& c) {
+    const float halfW = 0.5f * float(c.width) + 1.0f, halfH = 0.5f * float(c.height) + 1.0f;
+    auto make = [&](const Vec3& axis, float sign, float half) {
+        Vec3 n;
+        for (int i = 0; i < 3; ++i) n[i] = sign * c.focalPx * axis[i] - half * c.forward[i];
+        const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (float& x : n) x /= len;
+        return Plane{n};
+    };
+    // Image y grows downward while upVector points up; the planes are symmetric, so only the pair matters.
+    return {make(c.right, 1, halfW), make(c.right, -1, halfW), make(c.upVector, 1, halfH), make(c.upVector, -1, halfH)};
+}
+
+// True when no voxel centre in [lo, hi] can make a splat that covers a pixel.
+bool BoxCulled(const CameraFrame& c, const std::array<Plane, 4>& planes, float radius, const Vec3& lo, const Vec3& hi) {
+    // Behind the near plane: the largest depth over the box is <= near.
+    float maxDepth = 0;
+    for (int i = 0; i < 3; ++i) {
+        const float a = (lo[i] - c.eye[i]) * c.forward[i], b = (hi[i] - c.eye[i]) * c.forward[i];
+        maxDepth += std::max(a, b);
+    }
+    if (maxDepth <= c.nearPlane) return true;
+    for (const Plane& plane : planes) {
+        float minDistance = 0;  // the smallest n.(P - eye) over the box
+        for (int i = 0; i < 3; ++i) {
+            const float a = (lo[i] - c.eye[i]) * plane.n[i], b = (hi[i] - c.eye[i]) * plane.n[i];
+            minDistance += std::min(a, b);
+        }
+        if (minDistance > radius) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& imageBuffer, SplatStats* stats) {
+    if (!p.order || !in.qPrev || !in.qCur || !in.T) return MakeError("cpu: render_splat needs q (both steps), T and an order");
+    if (p.skipping && (!in.tilesPrev || !in.tilesCur || !in.bandsPrev || !in.bandsCur))
+        return MakeError("cpu: render_splat with skipping needs both steps' occupancy");
+    const Extent3 e = in.qCur->Extent();
+    const Extent3 imageExtent = imageBuffer.Extent();
+    if (imageExtent.nx != 3) return MakeError("cpu: render_splat image must have extent (3, width, height)");
+    const uint32_t W = imageExtent.ny, H = imageExtent.nz;
+    const float* qPrev = static_cast<const BufferCpu&>(*in.qPrev).F32();
+    const float* qCur = static_cast<const BufferCpu&>(*in.qCur).F32();
+    const float* T = static_cast<const BufferCpu&>(*in.T).F32();
+    float* image = static_cast<BufferCpu&>(imageBuffer).F32();
+    const CameraFrame& cam = p.camera;
+
+    // 1. Which tile x band boxes can contribute.
+    const uint32_t tilesX = CeilDiv(e.nx, p.tile), tilesY = CeilDiv(e.ny, p.tile), bandCount = CeilDiv(e.nz, p.band);
+    std::vector<uint8_t> boxVisible(size_t(tilesX) * tilesY * bandCount, 1);
+    if (p.skipping) {
+        const uint8_t* a = static_cast<const BufferCpu&>(*in.bandsPrev).U8();
+        const uint8_t* b = static_cast<const BufferCpu&>(*in.bandsCur).U8();
+        for (size_t n = 0; n < boxVisible.size(); ++n) boxVisible[n] = a[n] | b[n];
+    }
+    if (p.culling) {
+        const std::array<Plane, 4> planes = SidePlanes(cam);
+        const float radius = 0.5f * p.splatDiameter;
+        for (uint32_t b = 0; b < bandCount; ++b)
+            for (uint32_t ty = 0; ty < tilesY; ++ty)
+                for (uint32_t tx = 0; tx < tilesX; ++tx) {
+                    uint8_t& visible = boxVisible[tx + size_t(tilesX) * (ty + size_t(tilesY) * b)];
+                    if (!visible) continue;
+                    // Box of the voxel centres in the tile-band.
+                    const float h = p.voxelSize;
+                    const Vec3 lo{p.origin[0] + (float(tx * p.tile) + 0.5f) * h, p.origin[1] + (float(ty * p.tile) + 0.5f) * h,
+                                  p.origin[2] + (float(b * p.band) + 0.5f) * h};
+                    const Vec3 hi{p.origin[0] + (float(std::min(e.nx, (tx + 1) * p.tile)) - 0.5f) * h,
+                                  p.origin[1] + (float(std::min(e.ny, (ty + 1) * p.tile)) - 0.5f) * h,
+                                  p.origin[2] + (float(std::min(e.nz, (b + 1) * p.band)) - 0.5f) * h};
+                    if (BoxCulled(cam, planes, radius, lo, hi)) visible = 0;
+                }
+    }
+
+    // 2. Splats in the shared order: task `n` makes those of the n-th outer slice.
+    const SplatOrder& order = *p.order;
+    const int outer = order.axes[0], middle = order.axes[1], inner = order.axes[2];
+    const std::vector<uint32_t>& outerIdx = order.indices[outer];
+    std::vector<std::vector<Splat>> perSlice(outerIdx.size());
+    std::vector<uint64_t> visitedPerSlice(outerIdx.size(), 0);
+    const float sunR[3] = {p.sunRadiance[0], p.sunRadiance[1], p.sunRadiance[2]};
+    mArena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t n = range.begin(); n != range.end(); ++n) {
+                std::vector<Splat>& out = perSlice[n];
+                uint32_t idx[3];
+                idx[outer] = outerIdx[n];
+                for (uint32_t mIndex : order.indices[middle]) {
+                    idx[middle] = mIndex;
+                    for (uint32_t iIndex : order.indices[inner]) {
+                        idx[inner] = iIndex;
+                        const uint32_t i = idx[0], j = idx[1], k = idx[2];
+                        if (!boxVisible[i / p.tile + size_t(tilesX) * (j / p.tile + size_t(tilesY) * (k / p.band))])
+                            continue;
+                        ++visitedPerSlice[n];
+                        const uint32_t v = VoxelIndex(e, i, j, k);
+                        const float qa = qPrev[v] + p.alpha * (qCur[v] - qPrev[v]);
+                        if (!(qa > p.qMin)) continue;
+                        const Vec3 centre{p.origin[0] + (float(i) + 0.5f) * p.voxelSize,
+                                          p.origin[1] + (float(j) + 0.5f) * p.voxelSize,
+                                          p.origin[2] + (float(k) + 0.5f) * p.voxelSize};
+                        const Projected pr = Project(cam, centre);
+                        if (!(pr.depth > cam.nearPlane)) continue;
+                        Splat s;
+                        s.px = pr.px;
+                        s.py = pr.py;
+                        s.size = std::clamp(p.splatDiameter * cam.focalPx / pr.depth, 1.0f, 255.0f);
+                        s.alphaScale = qa * p.opacity;
+                        const float vx = centre[0] - cam.eye[0], vy = centre[1] - cam.eye[1], vz = centre[2] - cam.eye[2];
+                        const float len = std::sqrt(vx * vx + vy * vy + vz * vz);
+                        const float cosTheta = (p.sun[0] * vx + p.sun[1] * vy + p.sun[2] * vz) / len;
+                        const float light = T[v] * PhaseValue(p.phase, cosTheta);
+                        for (int c = 0; c < 3; ++c) s.color[c] = sunR[c] * light + p.ambient[c];
+                        // Covered pixels: px - s/2 <= x + 0.5 < px + s/2.
+                        const float half = 0.5f * s.size;
+                        s.x0 = int32_t(std::max(0.0f, std::ceil(s.px - half - 0.5f)));
+                        s.x1 = int32_t(std::min(float(W) - 1.0f, std::ceil(s.px + half - 0.5f) - 1.0f));
+                        s.y0 = int32_t(std::max(0.0f, std::ceil(s.py - half - 0.5f)));
+                        s.y1 = int32_t(std::min(float(H) - 1.0f, std::ceil(s.py + half - 0.5f) - 1.0f));
+                        out.push_back(s);
+                    }
+                }
+            }
+        });
+    });
+    std::vector<Splat> splats;
+    uint64_t visited = 0;
+    {
+        size_t total = 0;
+        for (const auto& slice : perSlice) total += slice.size();
+        splats.reserve(total);
+        for (size_t n = 0; n < perSlice.size(); ++n) {
+            splats.insert(splats.end(), perSlice[n].begin(), perSlice[n].end());
+            visited += visitedPerSlice[n];
+            std::vector<Splat>().swap(perSlice[n]);
+        }
+    }
+    if (stats) {
+        stats->splats = splats.size();
+        stats->voxelsVisited = visited;
+    }
+
+    // 3. Bin by bands of rows, keeping the order (counting sort).
+    const uint32_t bands = CeilDiv(H, kRowsPerBand);
+    std::vector<uint32_t> count(bands + 1, 0);
+    auto bandRange = [&](const Splat& s, uint32_t& b0, uint32_t& b1) {
+        if (s.x0 > s.x1 || s.y0 > s.y1) return false;
+        b0 = uint32_t(s.y0) / kRowsPerBand;
+        b1 = uint32_t(s.y1) / kRowsPerBand;
+        return true;
+    };
+    for (const Splat& s : splats) {
+        uint32_t b0, b1;
+        if (bandRange(s, b0, b1))
+            for (uint32_t b = b0; b <= b1; ++b) ++count[b + 1];
+    }
+    for (uint32_t b = 0; b < bands; ++b) count[b + 1] += count[b];
+    std::vector<uint32_t> binned(count[bands]);
+    {
+        std::vector<uint32_t> cursor(count.begin(), count.end() - 1);
+        for (uint32_t n = 0; n < splats.size(); ++n) {
+            uint32_t b0, b1;
+            if (bandRange(splats[n], b0, b1))
+                for (uint32_t b = b0; b <= b1; ++b) binned[cursor[b]++] = n;
+        }
+    }
+
+    // 4. Composite each band: C <- alpha c + (1 - alpha) C, from the background.
+    mArena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, bands), [&](const tbb::blocked_range<uint32_t>& range) {
+            for (uint32_t b = range.begin(); b != range.end(); ++b) {
+                const uint32_t rowLo = b * kRowsPerBand, rowHi = std::min(H, rowLo + kRowsPerBand) - 1;
+                for (uint32_t y = rowLo; y <= rowHi; ++y) {
+                    float* row = image + size_t(3) * W * y;
+                    for (uint32_t x = 0; x < W; ++x)
+                        for (int c = 0; c < 3; ++c) row[3 * x + c] = p.background[c];
+                }
+                for (uint32_t n = count[b]; n < count[b + 1]; ++n) {
+                    const Splat& s = splats[binned[n]];
+                    const int32_t y0 = std::max<int32_t>(s.y0, int32_t(rowLo)), y1 = std::min<int32_t>(s.y1, int32_t(rowHi));
+                    for (int32_t y = y0; y <= y1; ++y) {
+                        const float bCoord = (float(y) + 0.5f - s.py) / s.size + 0.5f;
+                        float* row = image + size_t(3) * W * uint32_t(y);
+                        for (int32_t x = s.x0; x <= s.x1; ++x) {
+                            const float aCoord = (float(x) + 0.5f - s.px) / s.size + 0.5f;
+                            const float alpha = std::clamp(s.alphaScale * SplatKernel(aCoord, bCoord), 0.0f, 1.0f);
+                            float* px = row + 3 * size_t(x);
+                            for (int c = 0; c < 3; ++c) px[c] = alpha * s.color[c] + (1.0f - alpha) * px[c];
+                        }
+                    }
+                }
+            }
+        });
+    });
+    return {};
+}
+
+}  // namespace cb::cpu

@@ -1,0 +1,326 @@
+// Light attenuation (SPEC 6), the ground shadow (SPEC 7) and their shared math.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <immintrin.h>
+
+#include "core/Random.h"
+#include "core/Shading.h"
+#include "impl_cpu/BackendCpu.h"
+#include "tests/TestUtil.h"
+
+namespace cb {
+namespace {
+
+std::vector<float> ShadeOnCpu(const Extent3& e, const std::vector<float>& q, const ShadeParams& p, int threads = 0) {
+    cpu::BackendCpu backend(threads);
+    auto qb = test::MakeFilled(backend, BufferFormat::F32, e, q);
+    auto T = test::MakeBuffer(backend, BufferFormat::F32, e);
+    Status s = backend.Shade(p, *qb, *T);
+    EXPECT_TRUE(s.has_value()) << (s ? "" : s.error().message);
+    return test::Read<float>(backend, *T);
+}
+
+Vec3 Normalized(float x, float y, float z) {
+    const float l = std::sqrt(x * x + y * y + z * z);
+    return {x / l, y / l, z / l};
+}
+
+// Test the accurate vectorisable exp against std::exp in double: within 2 ulp
+// on [-87, 0], exactly 0 below.
+TEST(ShadingMath, ExpWithinTwoUlp) {
+    for (int n = 0; n <= 870000; ++n) {
+        const float x = -float(n) * 1e-4f;
+        const float got = ExpNonPositive(x);
+        const double want = std::exp(double(x));
+        const double ulp = std::nextafter(float(want), 1.0f) - float(want);
+        ASSERT_LE(std::fabs(got - want), 2 * ulp) << "x = " << x;
+    }
+    EXPECT_EQ(ExpNonPositive(0.0f), 1.0f);
+    EXPECT_EQ(ExpNonPositive(-88.0f), 0.0f);
+    EXPECT_EQ(ExpNonPositive(-1e30f), 0.0f);
+}
+
+// Test the software float -> half rounding against the CPU's F16C conversion
+// (round to nearest even) on every float in [0, 1] with a step of 2^-20 and
+// on every value near half's subnormal boundary.
+TEST(ShadingMath, RoundToHalfMatchesF16C) {
+    if (!__builtin_cpu_supports("f16c")) GTEST_SKIP() << "unsupported here: no F16C";
+    auto hardware = [](float v) { return _cvtsh_ss(_cvtss_sh(v, _MM_FROUND_TO_NEAREST_INT)); };
+    for (uint32_t n = 0; n <= (1u << 20); ++n) {
+        const float v = float(n) / float(1u << 20);
+        ASSERT_EQ(RoundToHalf(v), hardware(v)) << v;
+    }
+    for (uint32_t bits = 0x38000000u; bits < 0x38900000u; bits += 7) {
+        const float v = std::bit_cast<float>(bits);
+        ASSERT_EQ(RoundToHalf(v), hardware(v)) << v;
+    }
+}
+
+// Test unorm8 rounding: multiples of 1/255, nearest.
+TEST(ShadingMath, RoundToUnorm8) {
+    EXPECT_EQ(RoundToUnorm8(0.0f), 0.0f);
+    EXPECT_EQ(RoundToUnorm8(1.0f), 1.0f);
+    EXPECT_EQ(RoundToUnorm8(0.5f), 128.0f / 255.0f);  // 127.5 -> 128 (ties to even)
+    EXPECT_EQ(RoundToUnorm8(0.1f), 26.0f / 255.0f);   // 25.5 -> 26 (25.5000004 in float)
+}
+
+// Test the principal axis rule, including exact ties (z wins over y, y over x).
+TEST(ShadingMath, PrincipalAxisTies) {
+    EXPECT_EQ(PrincipalAxis({0, 0, 1}), 2);
+    EXPECT_EQ(PrincipalAxis({1, 0, 1}), 2);   // |s_z| = |s_x|: z
+    EXPECT_EQ(PrincipalAxis({1, 1, 0.5f}), 1);  // |s_y| = |s_x|: y
+    EXPECT_EQ(PrincipalAxis({-1, 0.5f, 0.5f}), 0);
+    EXPECT_EQ(PrincipalAxis({0.3f, -0.9f, 0.2f}), 1);
+}
+
+// Test the phase functions: isotropic HG (g = 0) is 1, HG forward peak
+// (1+g)/(1-g)^2, Cornette-Shanks at g = 0 is 3/4 (1 + cos^2).
+TEST(ShadingMath, PhaseFunctionsHandWorked) {
+    EXPECT_FLOAT_EQ(PhaseValue({PhaseKind::HenyeyGreenstein, 0.0f}, 0.3f), 1.0f);
+    EXPECT_FLOAT_EQ(PhaseValue({PhaseKind::HenyeyGreenstein, 0.5f}, 1.0f), 1.5f / 0.25f);
+    EXPECT_FLOAT_EQ(PhaseValue({PhaseKind::CornetteShanks, 0.0f}, 1.0f), 1.5f);
+    EXPECT_FLOAT_EQ(PhaseValue({PhaseKind::CornetteShanks, 0.0f}, 0.0f), 0.75f);
+    EXPECT_EQ(PhaseValue({PhaseKind::None, 0.9f}, -1.0f), 1.0f);
+    // Normalisation: the mean of P^ over the sphere is 1 (midpoint rule in cos theta).
+    for (PhaseKind kind : {PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks}) {
+        double sum = 0;
+        const int n = 200000;
+        for (int i = 0; i < n; ++i) sum += PhaseValue({kind, 0.6f}, -1.0f + 2.0f * (float(i) + 0.5f) / float(n));
+        EXPECT_NEAR(sum / n, 1.0, 2e-3) << int(kind);
+    }
+}
+
+// Test that an empty volume shades to exactly 1 under every option.
+TEST(Shade, EmptyVolumeIsExactlyOne) {
+    const Extent3 e{13, 9, 7};
+    std::vector<float> q(e.Count(), 0.0f);
+    for (AttenuationKind att : {AttenuationKind::Beer, AttenuationKind::Thesis})
+        for (int f : {1, 2, 4})
+            for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Fp16, StorageFormat::Unorm8}) {
+                ShadeParams p;
+                p.sun = Normalized(0.3f, -0.5f, 0.8f);
+                p.attenuation = att;
+                p.resolution = f;
+                p.storage = storage;
+                p.scattering = true;
+                for (float t : ShadeOnCpu(e, q, p)) ASSERT_EQ(t, 1.0f);
+            }
+}
+
+// Test that with the sun exactly along an axis (no bilinear offset) T is the
+// exact product of the per-slice factors above each voxel, for the sun
+// overhead (w = z) and along -x (w = x, slices visited from x = 0).
+TEST(Shade, AxisAlignedSunIsExactProduct) {
+    const Extent3 e{11, 6, 9};
+    Pcg32 rng(3);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = rng.Below(3) == 0 ? float(rng.Below(65)) / 64.0f : 0.0f;
+    ShadeParams p;
+    p.sigma = 0.01f;
+    p.voxelSize = 50;
+    SliceAttenuation a;
+    a.opticalDepthPerQ = p.sigma * p.voxelSize;
+    // Overhead: T(i,j,k) = prod over k' = nz-1 down to k+1 of A(q(i,j,k')).
+    p.sun = {0, 0, 1};
+    std::vector<float> T = ShadeOnCpu(e, q, p);
+    for (uint32_t j = 0; j < e.ny; ++j)
+        for (uint32_t i = 0; i < e.nx; ++i) {
+            float t = 1.0f;
+            for (int k = int(e.nz) - 1; k >= 0; --k) {
+                ASSERT_EQ(T[VoxelIndex(e, i, j, k)], t) << i << "," << j << "," << k;
+                t = t * a.Factor(q[VoxelIndex(e, i, j, k)]);
+            }
+        }
+    // Along -x: light enters at x = 0.
+    p.sun = {-1, 0, 0};
+    T = ShadeOnCpu(e, q, p);
+    for (uint32_t k = 0; k < e.nz; ++k)
+        for (uint32_t j = 0; j < e.ny; ++j) {
+            float t = 1.0f;
+            for (uint32_t i = 0; i < e.nx; ++i) {
+                ASSERT_EQ(T[VoxelIndex(e, i, j, k)], t) << i << "," << j << "," << k;
+                t = t * a.Factor(q[VoxelIndex(e, i, j, k)]);
+            }
+        }
+}
+
+// Test a homogeneous slab (q = 1 in slices [k0, k1)) against the closed form
+// T = exp(-sigma (z_top - z) / s_z) at voxel centres, for tilted suns. The
+// scheme attenuates whole slices, so a voxel inside the slab sees the slices
+// above it but not the half of its own voxel: its optical depth is short by
+// tau/2 with tau = sigma h / s_z, and |T - T_exact| <= T_exact (e^(tau/2) - 1).
+// Above the slab T is 1; below, the scheme is exact.
+TEST(Shade, HomogeneousSlabMatchesClosedForm) {
+    const Extent3 e{48, 48, 12};
+    const uint32_t k0 = 3, k1 = 9;
+    std::vector<float> q(e.Count(), 0.0f);
+    for (uint32_t k = k0; k < k1; ++k)
+        for (uint32_t j = 0; j < e.ny; ++j)
+            for (uint32_t i = 0; i < e.nx; ++i) q[VoxelIndex(e, i, j, k)] = 1.0f;
+    for (float elevationDeg : {90.0f, 70.0f, 50.0f}) {
+        ShadeParams p;
+        p.sigma = 0.004f;
+        p.voxelSize = 50;
+        const float el = elevationDeg * std::numbers::pi_v<float> / 180.0f;
+        p.sun = {std::cos(el) * 0.6f, std::cos(el) * 0.8f, std::sin(el)};
+        const std::vector<float> T = ShadeOnCpu(e, q, p);
+        const double tau = double(p.sigma) * p.voxelSize / p.sun[2];
+        // Interior columns whose path to the top stays inside the grid.
+        for (uint32_t k = 0; k < e.nz; ++k)
+            for (uint32_t j = 16; j < 32; ++j)
+                for (uint32_t i = 16; i < 32; ++i) {
+                    double depthVoxels = 0;  // cloud between the voxel centre and the top, in voxels along z
+                    if (k < k0) depthVoxels = k1 - k0;
+                    else if (k < k1) depthVoxels = k1 - (k + 0.5);
+                    const double exact = std::exp(-tau * depthVoxels);
+                    const double bound = (k >= k0 && k < k1) ? exact * (std::exp(tau / 2) - 1) : 0.0;
+                    ASSERT_NEAR(T[VoxelIndex(e, i, j, k)], exact, bound + 2e-6) << "el " << elevationDeg << " k " << k;
+                }
+    }
+}
+
+// Test the resolution option on a slab. A coarse slice is f voxels thick, so
+// the coarse scheme misses up to half a coarse slice of optical depth
+// (e^(tau f/2) - 1), and reading T back linearly between coarse centres across
+// the slab's top edge adds at most the slope tau times half a coarse cell.
+TEST(Shade, CoarseResolutionStaysNearTheClosedForm) {
+    const Extent3 e{32, 32, 16};
+    std::vector<float> q(e.Count(), 0.0f);
+    for (uint32_t k = 4; k < 12; ++k)
+        for (uint32_t j = 0; j < e.ny; ++j)
+            for (uint32_t i = 0; i < e.nx; ++i) q[VoxelIndex(e, i, j, k)] = 1.0f;
+    for (int f : {2, 4}) {
+        ShadeParams p;
+        p.sigma = 0.002f;
+        p.voxelSize = 50;
+        p.sun = {0, 0, 1};
+        p.resolution = f;
+        const std::vector<float> T = ShadeOnCpu(e, q, p);
+        const double tau = double(p.sigma) * p.voxelSize;
+        for (uint32_t k = 0; k < e.nz; ++k) {
+            double depthVoxels = k < 4 ? 8.0 : k < 12 ? 12 - (k + 0.5) : 0.0;
+            const double exact = std::exp(-tau * depthVoxels);
+            const double bound = std::exp(tau * f / 2) - 1 + tau * f / 2;
+            EXPECT_NEAR(T[VoxelIndex(e, 16, 16, k)], exact, bound) << "f " << f << " k " << k;
+        }
+    }
+}
+
+// Test every combination of options, with the sun overhead, on and within
+// 1e-6 rad of the 45-degree axis switches, near and below the horizon, and
+// sigma 0 and 1e6: T is finite and in [0, 1]; sigma = 0 gives exactly 1 (beer).
+TEST(Shade, EveryOptionFiniteAndBounded) {
+    const Extent3 e{13, 11, 7};
+    Pcg32 rng(5);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = float(rng.Below(65)) / 64.0f;
+    const float d45 = std::numbers::pi_v<float> / 4;
+    std::vector<Vec3> suns = {{0, 0, 1}, {0, 0, -1}, SunDirection(0.0, 0.3), SunDirection(1e-4, 0.2),
+                              SunDirection(-0.3, 1.0), SunDirection(0.5, 0.0)};
+    for (double eps : {-1e-6, 0.0, 1e-6}) {
+        suns.push_back(SunDirection(d45 + eps, 0.0));          // z/x switch
+        suns.push_back(SunDirection(0.3, d45 + eps));           // y/x switch
+        suns.push_back(SunDirection(std::atan(1 / std::sqrt(2.0)) + eps, d45));  // all three equal
+    }
+    for (const Vec3& sun : suns)
+        for (AttenuationKind att : {AttenuationKind::Beer, AttenuationKind::Thesis})
+            for (SampleFilter filter : {SampleFilter::Bilinear, SampleFilter::Nearest})
+                for (int f : {1, 2, 4})
+                    for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Fp16, StorageFormat::Unorm8})
+                        for (bool scattering : {false, true})
+                            for (PhaseKind phase : {PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks})
+                                for (float sigma : {0.0f, 0.02f, 1e6f}) {
+                                    ShadeParams p;
+                                    p.sun = sun;
+                                    p.attenuation = att;
+                                    p.filter = filter;
+                                    p.resolution = f;
+                                    p.storage = storage;
+                                    p.scattering = scattering;
+                                    p.phase = {phase, 0.8f};
+                                    p.sigma = sigma;
+                                    for (float t : ShadeOnCpu(e, q, p, 1)) {
+                                        ASSERT_TRUE(std::isfinite(t));
+                                        ASSERT_GE(t, 0.0f);
+                                        ASSERT_LE(t, 1.0f);
+                                        if (sigma == 0 && att == AttenuationKind::Beer) {
+                                            ASSERT_EQ(t, 1.0f);
+                                        }
+                                    }
+                                }
+}
+
+// Test that sigma = 1e6 blocks all light below any cloud, exactly, without
+// subnormal values anywhere.
+TEST(Shade, HugeSigmaGivesZero) {
+    const Extent3 e{5, 5, 6};
+    std::vector<float> q(e.Count(), 0.0f);
+    for (uint32_t j = 0; j < 5; ++j)
+        for (uint32_t i = 0; i < 5; ++i) q[VoxelIndex(e, i, j, 4)] = 0.5f;
+    ShadeParams p;
+    p.sun = {0, 0, 1};
+    p.sigma = 1e6f;
+    const std::vector<float> T = ShadeOnCpu(e, q, p);
+    for (uint32_t k = 0; k < e.nz; ++k)
+        for (uint32_t v = 0; v < 25; ++v) {
+            const float t = T[v + 25 * k];
+            ASSERT_EQ(t, k >= 4 ? 1.0f : 0.0f) << k;
+        }
+}
+
+// Test that shading does not depend on the thread count.
+TEST(Shade, SameForOneAndTwoThreads) {
+    const Extent3 e{64, 300, 9};
+    Pcg32 rng(9);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = rng.Below(2) ? float(rng.Below(65)) / 64.0f : 0.0f;
+    ShadeParams p;
+    p.sun = Normalized(0.2f, 0.5f, 0.8f);
+    EXPECT_EQ(ShadeOnCpu(e, q, p, 1), ShadeOnCpu(e, q, p, 2));
+}
+
+std::vector<float> ShadowOnCpu(const Extent3& e, const std::vector<float>& D, const ShadowParams& p) {
+    cpu::BackendCpu backend;
+    auto d = test::MakeFilled(backend, BufferFormat::F32, {e.nx, e.ny, 1}, D);
+    auto G = test::MakeBuffer(backend, BufferFormat::F32, {e.nx, e.ny, 1});
+    EXPECT_TRUE(backend.Shadow(p, *d, *G).has_value());
+    return test::Read<float>(backend, *G);
+}
+
+// Test the ground shadow: overhead sun reads D straight above (exp(-sigma h D));
+// a sun at 45 degrees in x reads D nz/2 cells toward +x; the thesis form is
+// 1 - clamp(kappa D); no sun above the horizon gives 1.
+TEST(Shadow, HandWorked) {
+    const Extent3 e{10, 4, 8};
+    std::vector<float> D(40, 0.0f);
+    D[5 + 10 * 2] = 2.0f;
+    ShadowParams p;
+    p.sigma = 0.01f;
+    p.voxelSize = 50;
+    p.nz = e.nz;
+    p.sun = {0, 0, 1};
+    std::vector<float> G = ShadowOnCpu(e, D, p);
+    EXPECT_FLOAT_EQ(G[5 + 10 * 2], std::exp(-0.01f * 50 * 2.0f));
+    EXPECT_EQ(G[4 + 10 * 2], 1.0f);
+    const float s = std::sqrt(0.5f);
+    p.sun = {s, 0, s};  // offset nz/2 = 4 cells toward +x
+    G = ShadowOnCpu(e, D, p);
+    EXPECT_NEAR(G[1 + 10 * 2], std::exp(-0.01f * 50 * 2.0f / s), 1e-6);
+    EXPECT_EQ(G[5 + 10 * 2], 1.0f);
+    p.form = AttenuationKind::Thesis;
+    p.kappa = 0.3f;
+    G = ShadowOnCpu(e, D, p);
+    EXPECT_NEAR(G[1 + 10 * 2], 1.0f - 0.6f, 1e-6);
+    p.kappa = 1.0f;
+    EXPECT_EQ(ShadowOnCpu(e, D, p)[1 + 10 * 2], 0.0f);  // clamped
+    p.sun = {1, 0, 0};
+    for (float g : ShadowOnCpu(e, D, p)) EXPECT_EQ(g, 1.0f);
+    p.sun = {0.6f, 0, -0.8f};
+    for (float g : ShadowOnCpu(e, D, p)) EXPECT_EQ(g, 1.0f);
+    p.sun = SunDirection(1e-4, 0.0);  // grazing: finite
+    for (float g : ShadowOnCpu(e, D, p)) EXPECT_TRUE(std::isfinite(g));
+}
+
+}  // namespace
+}  // namespace cb
