@@ -14,6 +14,49 @@
 namespace cb::cpu {
 namespace {
 
+constexpr uint32_t kMaxStackRow = 512;
+
+// The per-voxel work of one slice, with the options fixed at compile time so
+// that the loop over a row vectorises (a switch per voxel stops it).
+struct ShadeKernel {
+    SliceAttenuation attenuation;
+    StorageFormat storage;
+};
+
+template <AttenuationKind kAttenuation, StorageFormat kStorage>
+void ShadeRowT(const SliceAttenuation& att, const float* __restrict t0, const float* __restrict t1,
+               const float* __restrict q0, const float* __restrict q1, float fu, float fv, float* __restrict out,
+               uint32_t n) {
+    const float depthPerQ = att.opticalDepthPerQ, gain = att.scatterGain, ar = att.thesisAr;
+    for (uint32_t a = 0; a < n; ++a) {
+        const float t = Bilinear(t0[a], t0[a + 1], t1[a], t1[a + 1], fu, fv);
+        const float qs = Bilinear(q0[a], q0[a + 1], q1[a], q1[a + 1], fu, fv);
+        // SliceAttenuation::Factor with the kind fixed.
+        const float tau = depthPerQ * qs;
+        float factor = kAttenuation == AttenuationKind::Beer ? ExpNonPositive(-tau) : 1.0f - (1.0f - ar) * qs;
+        factor = std::clamp(factor + gain * tau, 0.0f, 1.0f);
+        const float value = RoundToStorage(kStorage, t * factor);
+        out[a] = value < kTransmittanceFloor ? 0.0f : value;
+    }
+}
+
+void ShadeRow(const ShadeKernel& k, const float* t0, const float* t1, const float* q0, const float* q1, float fu,
+              float fv, float* out, uint32_t n) {
+    const SliceAttenuation& a = k.attenuation;
+    const bool beer = a.kind == AttenuationKind::Beer;
+    switch (k.storage) {
+        case StorageFormat::Fp32:
+            return beer ? ShadeRowT<AttenuationKind::Beer, StorageFormat::Fp32>(a, t0, t1, q0, q1, fu, fv, out, n)
+                        : ShadeRowT<AttenuationKind::Thesis, StorageFormat::Fp32>(a, t0, t1, q0, q1, fu, fv, out, n);
+        case StorageFormat::Fp16:
+            return beer ? ShadeRowT<AttenuationKind::Beer, StorageFormat::Fp16>(a, t0, t1, q0, q1, fu, fv, out, n)
+                        : ShadeRowT<AttenuationKind::Thesis, StorageFormat::Fp16>(a, t0, t1, q0, q1, fu, fv, out, n);
+        case StorageFormat::Unorm8:
+            return beer ? ShadeRowT<AttenuationKind::Beer, StorageFormat::Unorm8>(a, t0, t1, q0, q1, fu, fv, out, n)
+                        : ShadeRowT<AttenuationKind::Thesis, StorageFormat::Unorm8>(a, t0, t1, q0, q1, fu, fv, out, n);
+    }
+}
+
 // A volume with explicit sizes, for the shading grid (full or coarse).
 struct Grid3 {
     uint32_t n[3];
@@ -37,6 +80,8 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
     attenuation.opticalDepthPerQ = p.sigma * cellSize / sw;
     attenuation.thesisAr = p.thesisAr;
     if (p.scattering) attenuation.scatterGain = p.albedo * PhaseValue(p.phase, 1.0f) * p.solidAngle / (4.0f * std::numbers::pi_v<float>);
+
+    const ShadeKernel kernel{attenuation, p.storage};
 
     // Taps of output (u, v) in the previous slice: base (u + u0, v + v0) and +1.
     const bool nearest = p.filter == SampleFilter::Nearest;
@@ -62,17 +107,17 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
             auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
                 for (uint32_t b = range.begin(); b != range.end(); ++b) {
                     const float* t0 = prevT.data() + padded(u0, int64_t(b) + v0);
-                    const float* t1 = t0 + pitch;
                     const float* q0 = prevQ.data() + padded(u0, int64_t(b) + v0);
-                    const float* q1 = q0 + pitch;
                     float* out = grid.T + sliceBase + stride[v] * b;
-                    const size_t su = stride[u];
-                    for (uint32_t a = 0; a < nu; ++a) {
-                        const float t = Bilinear(t0[a], t0[a + 1], t1[a], t1[a + 1], fu, fv);
-                        const float qs = Bilinear(q0[a], q0[a + 1], q1[a], q1[a + 1], fu, fv);
-                        float value = RoundToStorage(p.storage, t * attenuation.Factor(qs));
-                        value = value < kTransmittanceFloor ? 0.0f : value;
-                        out[su * a] = value;
+                    if (stride[u] == 1) ShadeRow(kernel, t0, t0 + pitch, q0, q0 + pitch, fu, fv, out, nu);
+                    else {
+                        // u is not x: shade into a contiguous row, then scatter.
+                        float row[kMaxStackRow];
+                        for (uint32_t a0 = 0; a0 < nu; a0 += kMaxStackRow) {
+                            const uint32_t count = std::min(kMaxStackRow, nu - a0);
+                            ShadeRow(kernel, t0 + a0, t0 + pitch + a0, q0 + a0, q0 + pitch + a0, fu, fv, row, count);
+                            for (uint32_t a = 0; a < count; ++a) out[stride[u] * (a0 + a)] = row[a];
+                        }
                     }
                 }
             };

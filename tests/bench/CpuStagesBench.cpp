@@ -8,6 +8,7 @@
 #include <map>
 #include <numeric>
 
+#include "core/Camera.h"
 #include "core/Ellipsoids.h"
 #include "core/Random.h"
 #include "core/Scene.h"
@@ -20,13 +21,26 @@ namespace {
 struct WarmState {
     Scene scene;
     std::unique_ptr<cpu::BackendCpu> backend;
-    std::unique_ptr<Buffer> hum[2], act[2], cld[2], region, q, D, tiles, bands;
+    std::unique_ptr<Buffer> hum[2], act[2], cld[2], region, q, D, tiles, bands, T, image;
     std::vector<RasterEllipsoid> raster;
     CaStepParams params;
     double cover = 0;
 };
 
 std::unique_ptr<Buffer> Make(Backend& b, BufferFormat f, Extent3 e) { return std::move(*b.CreateBuffer(f, e)); }
+
+ShadeParams MakeShadeParams(const Scene& sc, int resolution) {
+    ShadeParams p;
+    p.sun = sc.sun.Direction();
+    p.attenuation = sc.shade.attenuation;
+    p.sigma = float(sc.shade.sigma);
+    p.voxelSize = float(sc.grid.voxelSize);
+    p.filter = sc.shade.filter;
+    p.resolution = resolution;
+    p.storage = sc.shade.storage;
+    p.phase = sc.phase;
+    return p;
+}
 
 WarmState& Warm(const std::string& name, int threads) {
     static std::map<std::pair<std::string, int>, std::unique_ptr<WarmState>> cache;
@@ -80,6 +94,9 @@ WarmState& Warm(const std::string& name, int threads) {
     DensityOutputs out{w.D.get(), w.tiles.get(), w.bands.get(), 0};
     (void)b.Density({T, B}, *w.q, *w.cld[0], out);
     w.cover = double(out.coveredColumns) / (double(e.nx) * e.ny);
+    w.T = Make(b, BufferFormat::F32, e);
+    (void)b.Shade(MakeShadeParams(w.scene, w.scene.shade.resolution), *w.q, *w.T);
+    w.image = Make(b, BufferFormat::F32, {3, w.scene.render.width, w.scene.render.height});
     return w;
 }
 
@@ -121,6 +138,51 @@ void BM_Density(benchmark::State& state, const std::string& scene) {
     for (auto _ : state) (void)w.backend->Density(params, *w.q, *w.cld[0], out);
     Label(state, w);
     state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(w.scene.grid.size.Count()) * 4);
+}
+
+// Shading at resolution range(1), with the scene's sun (25 degrees: slices along y).
+void BM_Shade(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    const ShadeParams p = MakeShadeParams(w.scene, int(state.range(1)));
+    for (auto _ : state) (void)w.backend->Shade(p, *w.q, *w.T);
+    Label(state, w);
+}
+
+// Splat rendering of camera range(1) at the scene's 1024x768, with
+// range(2) = 0: no culling, 1: view-frustum culling, 2: culling and empty-space skipping
+// (the thesis's Tables 8.2, 8.3 and 8.4).
+void BM_RenderSplat(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    const Scene& sc = w.scene;
+    const CameraSettings& camera = sc.render.cameras.at(size_t(state.range(1)));
+    SplatParams p;
+    p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
+    const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
+    p.order = &order;
+    p.sun = sc.sun.Direction();
+    p.sunRadiance = sc.sun.Radiance();
+    for (int c = 0; c < 3; ++c) {
+        p.ambient[c] = float(sc.lighting.ambient[c]);
+        p.background[c] = float(sc.lighting.background[c]);
+    }
+    p.phase = sc.phase;
+    p.qMin = float(sc.render.qMin);
+    p.splatDiameter = float(sc.render.splatScale * sc.grid.voxelSize);
+    p.opacity = float(sc.render.opacity);
+    p.alpha = float(sc.render.alpha);
+    p.voxelSize = float(sc.grid.voxelSize);
+    p.culling = state.range(2) >= 1;
+    p.skipping = state.range(2) >= 2;
+    p.tile = sc.density.tile;
+    p.band = sc.density.band;
+    const SplatInputs in{w.q.get(), w.q.get(), w.T.get(), w.tiles.get(), w.tiles.get(), w.bands.get(), w.bands.get()};
+    SplatStats stats;
+    for (auto _ : state) (void)w.backend->RenderSplat(p, in, *w.image, &stats);
+    Label(state, w);
+    state.counters["splats"] = double(stats.splats);
+    state.counters["visited"] = double(stats.voxelsVisited);
+    state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+    state.SetLabel(camera.name + (state.range(2) == 0 ? " none" : state.range(2) == 1 ? " VFC" : " VFC+ESS"));
 }
 
 // ---- Machine figures for the floors ------------------------------------------
@@ -187,6 +249,10 @@ void Register() {
         benchmark::RegisterBenchmark(("Smooth/" + s).c_str(), BM_Smooth, s)
             ->Args({1, 1})->Args({2, 1})->Args({2, 0})->Args({2, 2})->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("Density/" + s).c_str(), BM_Density, s)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("Shade/" + s).c_str(), BM_Shade, s)
+            ->Args({2, 1})->Args({2, 2})->Args({1, 1})->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("RenderSplat/" + s).c_str(), BM_RenderSplat, s)
+            ->ArgsProduct({{2}, {0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
     }
     // Small variants for the CTest smoke run.
     std::string small = "ci-small";
@@ -194,6 +260,8 @@ void Register() {
     benchmark::RegisterBenchmark("Small/CaStep", BM_CaStep, small)->Arg(2);
     benchmark::RegisterBenchmark("Small/Smooth", BM_Smooth, small)->Args({2, 1});
     benchmark::RegisterBenchmark("Small/Density", BM_Density, small)->Arg(2);
+    benchmark::RegisterBenchmark("Small/Shade", BM_Shade, small)->Args({2, 1});
+    benchmark::RegisterBenchmark("Small/RenderSplat", BM_RenderSplat, small)->Args({2, 0, 2});
     benchmark::RegisterBenchmark("Machine/ReadDram", BM_MachineReadDram)->Threads(1)->Threads(2)->UseRealTime();
     benchmark::RegisterBenchmark("Machine/ReadL3", BM_MachineReadL3)->Threads(1)->Threads(2)->UseRealTime();
     benchmark::RegisterBenchmark("Machine/WriteL3", BM_MachineWriteL3)->Threads(1)->Threads(2)->UseRealTime();
