@@ -24,8 +24,9 @@ constexpr const char* kRunHelp = R"(usage: cloudbench run [SCENE] [options]
 
 Runs SCENE (a name in scenes/ or a path to a .json file; default: thesis-medium)
 on each backend, prints a per-stage timing table (median and spread over the
-steps after warm-up) and the cloud cover, and writes DIR/results.json and a top
-view of the last density map, DIR/topview-<backend>.png.
+steps after warm-up), each camera's frame rate and the cloud cover, and writes
+DIR/results.json, the last frame of each camera (DIR/frame-<camera>-<backend>
+.exr and .png) and a top view of the last density map, DIR/topview-<backend>.png.
 
 Options:
   --backend LIST     comma-separated backends (cpu, gl, vk); default: all built.
@@ -46,6 +47,9 @@ Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
   q.npy                    float32, smoothed from cld at step t
   density.npy              float32 D, shape (1, ny, nx)
   tiles.npy bands.npy      uint8 tile and height-band occupancy of step t
+  T.npy                    float32, the transmittance of step t
+  shadow.npy               float32 ground shadow, shape (1, ny, nx)
+  frame.exr                step t from the first camera (frame-<camera>.exr: others)
 Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
 
 Options:

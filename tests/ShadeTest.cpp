@@ -207,6 +207,53 @@ TEST(Shade, CoarseResolutionStaysNearTheClosedForm) {
     }
 }
 
+// Test resolution f against its definition, exactly: on a volume constant in
+// every f^3 block (partial blocks at the odd edges included), shading at f
+// must equal shading the coarse volume at f = 1 with voxels f times larger,
+// read back trilinearly at (i + 0.5)/f - 0.5 (clamped), blended in y and z and
+// then in x. This checks the block means and the periodic read-back fast path.
+TEST(Shade, ResolutionEqualsCoarseShadeReadTrilinearly) {
+    const Extent3 e{37, 29, 11};
+    for (int f : {2, 4}) {
+        const Extent3 c{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+        Pcg32 rng(17 + f);
+        std::vector<float> coarseQ(c.Count());
+        for (float& v : coarseQ) v = rng.Below(2) ? float(rng.Below(65)) / 64.0f : 0.0f;
+        std::vector<float> q(e.Count());
+        for (uint32_t k = 0; k < e.nz; ++k)
+            for (uint32_t j = 0; j < e.ny; ++j)
+                for (uint32_t i = 0; i < e.nx; ++i) q[VoxelIndex(e, i, j, k)] = coarseQ[VoxelIndex(c, i / f, j / f, k / f)];
+        ShadeParams p;
+        p.sun = Normalized(0.3f, 0.6f, 0.7f);
+        p.resolution = f;
+        const std::vector<float> got = ShadeOnCpu(e, q, p);
+        ShadeParams coarse = p;
+        coarse.resolution = 1;
+        coarse.voxelSize = p.voxelSize * float(f);
+        const std::vector<float> ct = ShadeOnCpu(c, coarseQ, coarse);
+        auto tap = [&](uint32_t i, uint32_t cells, uint32_t& i0, uint32_t& i1, float& t) {
+            const float x = std::clamp((float(i) + 0.5f) / float(f) - 0.5f, 0.0f, float(cells - 1));
+            i0 = uint32_t(x);
+            i1 = std::min(i0 + 1, cells - 1);
+            t = x - float(i0);
+        };
+        for (uint32_t k = 0; k < e.nz; ++k)
+            for (uint32_t j = 0; j < e.ny; ++j)
+                for (uint32_t i = 0; i < e.nx; ++i) {
+                    uint32_t x0, x1, y0, y1, z0, z1;
+                    float tx, ty, tz;
+                    tap(i, c.nx, x0, x1, tx);
+                    tap(j, c.ny, y0, y1, ty);
+                    tap(k, c.nz, z0, z1, tz);
+                    auto at = [&](uint32_t x, uint32_t y, uint32_t z) { return ct[VoxelIndex(c, x, y, z)]; };
+                    const float b0 = Bilinear(at(x0, y0, z0), at(x0, y1, z0), at(x0, y0, z1), at(x0, y1, z1), ty, tz);
+                    const float b1 = Bilinear(at(x1, y0, z0), at(x1, y1, z0), at(x1, y0, z1), at(x1, y1, z1), ty, tz);
+                    const float expected = b0 * (1.0f - tx) + b1 * tx;
+                    ASSERT_EQ(got[VoxelIndex(e, i, j, k)], expected) << "f " << f << " at " << i << "," << j << "," << k;
+                }
+    }
+}
+
 // Test every combination of options, with the sun overhead, on and within
 // 1e-6 rad of the 45-degree axis switches, near and below the horizon, and
 // sigma 0 and 1e6: T is finite and in [0, 1]; sigma = 0 gives exactly 1 (beer).
