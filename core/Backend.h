@@ -144,6 +144,7 @@ struct SplatInputs {
 struct SplatStats {
     uint64_t splats = 0;          // splats drawn (q_alpha > q_min, in front of the near plane, not culled)
     uint64_t voxelsVisited = 0;   // voxels the renderer looked at after culling and skipping
+    uint64_t fragments = 0;       // pixel blends: covered pixels summed over splats, clipped to the image
 };
 
 class Backend {

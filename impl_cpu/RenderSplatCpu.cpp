@@ -194,6 +194,11 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
             for (uint32_t b = b0; b <= b1; ++b) ++count[b + 1];
     }
     for (uint32_t b = 0; b < bands; ++b) count[b + 1] += count[b];
+    if (stats) {
+        stats->fragments = 0;
+        for (const Splat& s : splats)
+            if (s.x0 <= s.x1 && s.y0 <= s.y1) stats->fragments += uint64_t(s.x1 - s.x0 + 1) * uint64_t(s.y1 - s.y0 + 1);
+    }
     std::vector<uint32_t> binned(count[bands]);
     {
         std::vector<uint32_t> cursor(count.begin(), count.end() - 1);

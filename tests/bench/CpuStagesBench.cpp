@@ -181,6 +181,7 @@ void BM_RenderSplat(benchmark::State& state, const std::string& scene) {
     Label(state, w);
     state.counters["splats"] = double(stats.splats);
     state.counters["visited"] = double(stats.voxelsVisited);
+    state.counters["fragments"] = double(stats.fragments);
     state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
     state.SetLabel(camera.name + (state.range(2) == 0 ? " none" : state.range(2) == 1 ? " VFC" : " VFC+ESS"));
 }
