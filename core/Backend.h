@@ -187,7 +187,9 @@ class Backend {
 std::vector<std::string> BuiltBackends();
 
 struct BackendOptions {
-    int cpuThreads = 0;  // 0: every hardware thread
+    int cpuThreads = 0;      // 0: every hardware thread
+    std::string vkDevice;    // Vulkan device index or name substring; "" = the first
+    bool vkValidation = false;  // Khronos validation layer (also CLOUDBENCH_VK_VALIDATION=1)
 };
 
 // Creates a backend by name. An unknown name, or one whose device is missing,

@@ -8,6 +8,9 @@
 #include <fstream>
 
 #include "core/Npy.h"
+#if CLOUDBENCH_HAVE_VK
+#include "impl_vk/VulkanContext.h"
+#endif
 #include "harness/Report.h"
 #include "harness/Simulation.h"
 
@@ -87,7 +90,7 @@ int RunCommand(const CommonOptions& options) {
     for (const std::string& name : names) {
         BackendRun run;
         run.name = name;
-        auto backend = CreateBackend(name, {options.cpuThreads});
+        auto backend = CreateBackend(name, options.Backend());
         if (!backend) {
             run.status = "unavailable";
             run.error = backend.error().message;
@@ -95,8 +98,20 @@ int RunCommand(const CommonOptions& options) {
             runs.push_back(std::move(run));
             continue;
         }
-        anyAvailable = true;
         run.device = (*backend)->Device();
+        // A backend that lacks one of the scene's stages is skipped, not failed.
+        std::string missing;
+        for (Stage stage : kAllStages)
+            if (scene.stages.Has(stage) && !(*backend)->Supports(stage))
+                missing += (missing.empty() ? "" : ", ") + std::string(StageName(stage));
+        if (!missing.empty()) {
+            run.status = "unsupported";
+            run.error = name + " does not implement " + missing + " yet";
+            std::fprintf(stderr, "backend %s skipped: %s\n", name.c_str(), run.error.c_str());
+            runs.push_back(std::move(run));
+            continue;
+        }
+        anyAvailable = true;
         auto sim = Simulation::Create(scene, **backend);
         Progress progress(name, scene.steps, options.quiet);
         if (!sim) {
@@ -175,7 +190,7 @@ int DumpCommand(const CommonOptions& options) {
     }
     const std::string name = options.backends.empty() ? "cpu" : options.backends[0];
     const std::string outDir = options.outDir.empty() ? "out/" + scene.name + "/dump" : options.outDir;
-    auto backend = CreateBackend(name, {options.cpuThreads});
+    auto backend = CreateBackend(name, options.Backend());
     if (!backend) {
         std::fprintf(stderr, "backend %s unavailable: %s\n", name.c_str(), backend.error().message.c_str());
         return kExitNoBackend;
@@ -234,6 +249,26 @@ int DumpCommand(const CommonOptions& options) {
     }
     std::printf("dumped %u steps of scene %s (%ux%ux%u, backend %s) to %s/step_0000 .. step_%04u\n", scene.steps,
                 scene.name.c_str(), g.nx, g.ny, g.nz, name.c_str(), outDir.c_str(), scene.steps - 1);
+    return kExitOk;
+}
+
+int DevicesCommand() {
+    std::printf("backends in this build:");
+    for (const std::string& name : BuiltBackends()) std::printf(" %s", name.c_str());
+    std::printf("\n");
+#if CLOUDBENCH_HAVE_VK
+    auto devices = vk::ListDevices();
+    if (!devices) {
+        std::printf("vk: %s\n", devices.error().message.c_str());
+        return kExitNoBackend;
+    }
+    std::printf("Vulkan devices (--vk-device INDEX or a part of the name):\n");
+    for (const vk::DeviceInfo& d : *devices)
+        std::printf("  %u  %s (%s, Vulkan %u.%u)\n", d.index, d.name.c_str(), d.type.c_str(), VK_API_VERSION_MAJOR(d.apiVersion),
+                    VK_API_VERSION_MINOR(d.apiVersion));
+#else
+    std::printf("vk: not built in this build\n");
+#endif
     return kExitOk;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/Backend.h"
 #include "core/Scene.h"
 
 namespace cb {
@@ -24,11 +25,21 @@ struct CommonOptions {
     std::vector<SceneOverride> overrides; // --set, and --steps as "steps"
     std::string outDir;                   // "" = out/<scene name>[/dump]
     int cpuThreads = 0;
+    std::string vkDevice;                 // --vk-device INDEX|NAME
     bool quiet = false;
+
+    BackendOptions Backend() const {
+        BackendOptions b;
+        b.cpuThreads = cpuThreads;
+        b.vkDevice = vkDevice;
+        return b;
+    }
 };
 
 int RunCommand(const CommonOptions& options);
 int DumpCommand(const CommonOptions& options);
+// Lists the Vulkan devices (and says which other backends this build has).
+int DevicesCommand();
 
 // scenes/<name>.json for a bare name, the argument itself for a path.
 std::string ResolveScenePath(const std::string& nameOrPath);

@@ -12,8 +12,9 @@ namespace {
 constexpr const char* kMainHelp = R"(usage: cloudbench <command> [options]
 
 Commands:
-  run    Run a scene on one or more backends, time every stage, write results.json
-  dump   Write each step's canonical stage outputs as NumPy .npy files
+  run      Run a scene on one or more backends, time every stage, write results.json
+  dump     Write each step's canonical stage outputs as NumPy .npy files
+  devices  List the backends of this build and the Vulkan devices
   help   Show help for a command: cloudbench help run
 
 Exit codes: 0 success, 1 a stage failed or an output could not be written,
@@ -36,6 +37,7 @@ Options:
   --set PATH=VALUE   override a scene field by its dotted path, validated like
                      the file: --set ca.seed=42 --set grid.size=[64,16,64]
   --threads N        CPU backend threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
   --quiet            no progress lines
 )";
 
@@ -58,6 +60,7 @@ Options:
   --out DIR          output folder (default: out/<scene name>/dump)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
   --quiet            no progress lines
 )";
 
@@ -83,6 +86,7 @@ int main(int argc, char** argv) {
         std::fputs(topic == "run" ? kRunHelp : topic == "dump" ? kDumpHelp : kMainHelp, stdout);
         return cb::kExitOk;
     }
+    if (command == "devices") return cb::DevicesCommand();
     const char* help = command == "run" ? kRunHelp : command == "dump" ? kDumpHelp : nullptr;
     if (!help) return Usage(("unknown command '" + std::string(command) + "'").c_str(), kMainHelp);
 
@@ -125,6 +129,10 @@ int main(int argc, char** argv) {
             long threads = v ? std::strtol(v, &end, 10) : -1;
             if (!v || *end != '\0' || threads < 1 || threads > 1024) return Usage("--threads needs a number from 1", help);
             options.cpuThreads = int(threads);
+        } else if (arg == "--vk-device") {
+            const char* v = value();
+            if (!v) return Usage("--vk-device needs an index or a name", help);
+            options.vkDevice = v;
         } else if (arg == "--quiet") {
             options.quiet = true;
         } else if (arg.starts_with("-")) {

@@ -1,0 +1,130 @@
+// The Vulkan objects a backend needs: instance, one device and its compute
+// queue, memory, compute pipelines from the build's SPIR-V, and a synchronous
+// submit with timestamp queries. Every Vulkan call is checked and its failure
+// says what was being done (CheckVk).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/Error.h"
+
+namespace cb::vk {
+
+// "doing X: VK_ERROR_..." for a failed call.
+Status CheckVk(VkResult result, const char* what);
+
+struct DeviceInfo {
+    uint32_t index;
+    std::string name;
+    std::string type;  // "cpu", "integrated GPU", "discrete GPU", ...
+    uint32_t apiVersion;
+};
+
+// The Vulkan devices on this machine; an Error says why there are none.
+Result<std::vector<DeviceInfo>> ListDevices();
+
+// A device-local storage buffer.
+struct DeviceBuffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceSize size = 0;
+};
+
+// One compute pipeline: N storage buffers at bindings 0..N-1 and up to 128
+// bytes of push constants.
+struct Pipeline {
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    uint32_t bindings = 0;
+};
+
+class VulkanContext {
+  public:
+    // device: an index, a substring of the device name, or "" for the first.
+    // validation: enable VK_LAYER_KHRONOS_validation and count its messages.
+    static Result<std::unique_ptr<VulkanContext>> Create(const std::string& device, bool validation);
+    ~VulkanContext();
+    VulkanContext(const VulkanContext&) = delete;
+    VulkanContext& operator=(const VulkanContext&) = delete;
+
+    const std::string& DeviceName() const { return mDeviceName; }
+    uint32_t ValidationMessages() const { return mValidationMessages; }
+
+    Result<DeviceBuffer> CreateBuffer(VkDeviceSize size);
+    void DestroyBuffer(DeviceBuffer& buffer);
+    Status Upload(const DeviceBuffer& buffer, std::span<const std::byte> data);
+    Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);
+
+    // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
+    Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings);
+
+    // Records with `record`, submits, waits; returns the device time between
+    // the first and last timestamp in ms.
+    class Recorder {
+      public:
+        // Binds `buffers` to a fresh descriptor set and dispatches ceil(invocations/64) groups.
+        void Dispatch(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+                      uint32_t pushBytes, uint32_t invocations);
+        // Makes every earlier shader write visible to later shader reads and writes.
+        void Barrier();
+        void Fill(const DeviceBuffer& buffer, uint32_t value);
+
+      private:
+        friend class VulkanContext;
+        explicit Recorder(VulkanContext& context, VkCommandBuffer cmd) : mContext(context), mCmd(cmd) {}
+        VulkanContext& mContext;
+        VkCommandBuffer mCmd;
+        std::vector<VkDescriptorSet> mSets;
+    };
+    template <typename Fn>
+    Result<double> Run(const char* what, Fn&& record) {
+        CB_TRY(Begin());
+        Recorder recorder(*this, mCmd);
+        record(recorder);
+        return Submit(what, recorder);
+    }
+
+  private:
+    VulkanContext() = default;
+    Status Begin();
+    Result<double> Submit(const char* what, Recorder& recorder);
+    Result<DeviceBuffer> CreateRawBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags properties);
+    Status EnsureStaging(VkDeviceSize size);
+    Status CopyBuffer(VkBuffer from, VkBuffer to, VkDeviceSize size, const char* what);
+
+    static VKAPI_ATTR VkBool32 VKAPI_CALL OnValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                             VkDebugUtilsMessageTypeFlagsEXT type,
+                                                             const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                             void* user);
+
+    VkInstance mInstance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT mMessenger = VK_NULL_HANDLE;
+    VkPhysicalDevice mPhysical = VK_NULL_HANDLE;
+    VkDevice mDevice = VK_NULL_HANDLE;
+    VkQueue mQueue = VK_NULL_HANDLE;
+    uint32_t mQueueFamily = 0;
+    VkCommandPool mPool = VK_NULL_HANDLE;
+    VkCommandBuffer mCmd = VK_NULL_HANDLE;
+    VkFence mFence = VK_NULL_HANDLE;
+    VkQueryPool mQueries = VK_NULL_HANDLE;
+    VkDescriptorPool mDescriptors = VK_NULL_HANDLE;
+    VkPhysicalDeviceMemoryProperties mMemory{};
+    float mTimestampPeriodNs = 1;
+    bool mTimestamps = false;
+    std::string mDeviceName;
+    uint32_t mValidationMessages = 0;
+    DeviceBuffer mStaging;
+    VkDeviceMemory mStagingMemory = VK_NULL_HANDLE;
+    void* mStagingMap = nullptr;
+    std::map<std::string, Pipeline> mPipelines;
+};
+
+}  // namespace cb::vk

@@ -1,0 +1,23 @@
+#version 450
+// Stage `density` (SPEC 5), columns: D = sum of q over k ascending (the order
+// every backend sums in), and the cover count from cld.
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer Q { float q[]; };
+layout(std430, binding = 1) readonly buffer Cld { uint cld[]; };
+layout(std430, binding = 2) writeonly buffer D { float d[]; };
+layout(std430, binding = 3) buffer Cover { uint covered; };
+layout(push_constant) uniform Params { uint nx, ny, nz, words; } pc;
+
+void main() {
+    const uint column = gl_GlobalInvocationID.x;
+    if (column >= pc.nx * pc.ny) return;
+    const uint i = column % pc.nx, j = column / pc.nx;
+    float sum = 0.0;
+    uint any = 0u;
+    for (uint k = 0u; k < pc.nz; ++k) {
+        sum += q[column + pc.nx * pc.ny * k];
+        any |= (cld[(i >> 5) + pc.words * (j + pc.ny * k)] >> (i & 31u)) & 1u;
+    }
+    d[column] = sum;
+    if (any != 0u) atomicAdd(covered, 1u);
+}

@@ -1,0 +1,29 @@
+#version 450
+// Stage `region` (SPEC 2): one invocation per voxel, max over the ellipsoids
+// that can reach it, then quantised once (quantising is monotone).
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_8bit_storage : require
+#include "rules.glsl"
+
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer Ellipsoids { float ellipsoid[]; };  // 8 floats each
+layout(std430, binding = 1) writeonly buffer Region { uint8_t region[]; };
+layout(push_constant) uniform Params { uint nx, ny, nz, count; } pc;
+
+void main() {
+    const uint v = gl_GlobalInvocationID.x;
+    if (v >= pc.nx * pc.ny * pc.nz) return;
+    const uint i = v % pc.nx, j = (v / pc.nx) % pc.ny, k = v / (pc.nx * pc.ny);
+    const vec3 p = vec3(float(i) + 0.5, float(j) + 0.5, float(k) + 0.5);
+    float best = 0.0;
+    for (uint n = 0u; n < pc.count; ++n) {
+        const uint b = 8u * n;
+        const vec3 c = vec3(ellipsoid[b], ellipsoid[b + 1u], ellipsoid[b + 2u]);
+        const vec3 axes = vec3(ellipsoid[b + 3u], ellipsoid[b + 4u], ellipsoid[b + 5u]);
+        // Cheap rejection: outside the bounding cylinder (plus a voxel) w is 0.
+        const float reach = max(axes.x, axes.y) + 1.0;
+        if (abs(p.z - c.z) > axes.z + 1.0 || abs(p.x - c.x) > reach || abs(p.y - c.y) > reach) continue;
+        best = max(best, EllipsoidWeight(c, axes, ellipsoid[b + 6u], ellipsoid[b + 7u], p));
+    }
+    region[v] = uint8_t(QuantizeRegion(best));
+}

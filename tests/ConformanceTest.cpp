@@ -1,0 +1,257 @@
+// Stage-isolated conformance (SPEC's comparison rules): every backend's stage
+// is fed exactly the inputs the CPU reference gets, and the outputs are
+// compared by the stage's rule. Written once, instantiated for every backend;
+// a backend that cannot start here is skipped with the reason.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <tuple>
+
+#include "core/Ellipsoids.h"
+#include "core/Scene.h"
+#include "harness/Simulation.h"
+#include "core/Random.h"
+#include "impl_cpu/BackendCpu.h"
+#include "tests/TestUtil.h"
+#if CLOUDBENCH_HAVE_VK
+#include "impl_vk/BackendVk.h"
+#endif
+
+namespace cb {
+namespace {
+
+struct SizeCase {
+    const char* name;
+    Extent3 size;
+};
+void PrintTo(const SizeCase& c, std::ostream* os) { *os << c.name; }
+
+using Param = std::tuple<std::string, SizeCase>;
+
+class Conformance : public ::testing::TestWithParam<Param> {
+  protected:
+    void SetUp() override {
+        BackendOptions options;
+        options.vkValidation = true;  // the tests run with the Khronos layer and expect no message
+        auto backend = CreateBackend(std::get<0>(GetParam()), options);
+        if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
+        mBackend = std::move(*backend);
+    }
+    void TearDown() override {
+#if CLOUDBENCH_HAVE_VK
+        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) {
+            EXPECT_EQ(vk->ValidationMessages(), 0u);
+        }
+#endif
+    }
+    Extent3 Size() const { return std::get<1>(GetParam()).size; }
+
+    // Location of voxel v as "(i, j, k)".
+    static std::string Where(const Extent3& e, size_t v) {
+        std::ostringstream s;
+        s << "(" << v % e.nx << ", " << (v / e.nx) % e.ny << ", " << v / (size_t(e.nx) * e.ny) << ")";
+        return s.str();
+    }
+    // Bit-exact comparison that reports the first differing voxel and how many differ.
+    template <typename T>
+    void ExpectExact(const std::vector<T>& reference, const std::vector<T>& got, const Extent3& e, const char* what) {
+        ASSERT_EQ(reference.size(), got.size());
+        size_t first = reference.size(), count = 0;
+        for (size_t v = 0; v < reference.size(); ++v)
+            if (std::memcmp(&reference[v], &got[v], sizeof(T)) != 0) {
+                if (first == reference.size()) first = v;
+                ++count;
+            }
+        EXPECT_EQ(count, 0u) << what << ": " << count << " of " << reference.size() << " differ; first at "
+                             << Where(e, first) << ": cpu " << +reference[first] << ", " << mBackend->Name() << " "
+                             << +got[first];
+    }
+
+    cpu::BackendCpu mCpu;
+    std::unique_ptr<Backend> mBackend;
+};
+
+std::vector<RasterEllipsoid> RandomEllipsoids(const Extent3& e, uint32_t seed) {
+    Pcg32 rng(seed);
+    std::vector<RasterEllipsoid> list;
+    for (int n = 0; n < 25; ++n) {
+        const double yaw = rng.Uniform(0, 6.283185307179586);
+        list.push_back({{float(rng.Uniform(-5, e.nx + 5)), float(rng.Uniform(-5, e.ny + 5)), float(rng.Uniform(0, e.nz))},
+                        {float(rng.Uniform(1, 14)), float(rng.Uniform(1, 10)), float(rng.Uniform(1, 5))},
+                        float(std::cos(yaw)), float(std::sin(yaw))});
+    }
+    return list;
+}
+
+// Test region: |dR| <= 1 everywhere and at most 0.5 % of voxels differ (SPEC 2).
+TEST_P(Conformance, Region) {
+    const Extent3 e = Size();
+    const std::vector<RasterEllipsoid> list = RandomEllipsoids(e, 3);
+    auto ref = test::MakeBuffer(mCpu, BufferFormat::U8, e);
+    auto got = test::MakeBuffer(*mBackend, BufferFormat::U8, e);
+    ASSERT_TRUE(mCpu.Region(list, *ref));
+    Status s = mBackend->Region(list, *got);
+    ASSERT_TRUE(s.has_value()) << s.error().message;
+    const auto a = test::Read<uint8_t>(mCpu, *ref), b = test::Read<uint8_t>(*mBackend, *got);
+    size_t differ = 0, worst = 0;
+    int worstDelta = 0;
+    for (size_t v = 0; v < a.size(); ++v) {
+        const int d = std::abs(int(a[v]) - int(b[v]));
+        differ += d != 0;
+        if (d > worstDelta) worstDelta = d, worst = v;
+    }
+    EXPECT_LE(worstDelta, 1) << "worst at " << Where(e, worst) << ": cpu " << +a[worst] << ", " << mBackend->Name() << " "
+                             << +b[worst];
+    EXPECT_LE(double(differ), 0.005 * double(a.size())) << differ << " voxels differ";
+}
+
+// Test the automaton: the initial state, then steps each fed the CPU's state
+// and region, with and without wind, bit for bit (SPEC 3).
+TEST_P(Conformance, CaSteps) {
+    const Extent3 e = Size();
+    const uint32_t seed = 11;
+    CaInitParams init{seed, QuantizeProbability(0.4), QuantizeProbability(0.02)};
+    std::unique_ptr<Buffer> ref[3], got[3], refOut[3], gotOut[3];
+    for (int f = 0; f < 3; ++f) {
+        ref[f] = test::MakeBuffer(mCpu, BufferFormat::Bits, e);
+        refOut[f] = test::MakeBuffer(mCpu, BufferFormat::Bits, e);
+        got[f] = test::MakeBuffer(*mBackend, BufferFormat::Bits, e);
+        gotOut[f] = test::MakeBuffer(*mBackend, BufferFormat::Bits, e);
+    }
+    ASSERT_TRUE(mCpu.CaInitialize(init, {ref[0].get(), ref[1].get(), ref[2].get()}));
+    Status s = mBackend->CaInitialize(init, {got[0].get(), got[1].get(), got[2].get()});
+    ASSERT_TRUE(s.has_value()) << s.error().message;
+    const char* names[3] = {"hum", "act", "cld"};
+    for (int f = 0; f < 3; ++f)
+        ExpectExact(test::Read<uint8_t>(mCpu, *ref[f]), test::Read<uint8_t>(*mBackend, *got[f]), e, names[f]);
+
+    std::vector<RasterEllipsoid> list = RandomEllipsoids(e, 5);
+    auto region = test::MakeBuffer(mCpu, BufferFormat::U8, e);
+    std::vector<int32_t> sx(e.nz), sy(e.nz);
+    for (uint32_t k = 0; k < e.nz; ++k) sx[k] = int32_t(k % 5) - 2, sy[k] = k % 3 == 0 ? 1 : -int32_t(k % 2);
+    for (uint32_t t = 0; t < 8; ++t) {
+        const bool wind = t % 2 == 1;
+        ASSERT_TRUE(mCpu.Region(list, *region));
+        const std::vector<uint8_t> r = test::Read<uint8_t>(mCpu, *region);
+        auto gotRegion = test::MakeFilled(*mBackend, BufferFormat::U8, e, r);
+        // The backend starts from the CPU's state (stage isolation).
+        for (int f = 0; f < 3; ++f) {
+            const std::vector<uint8_t> state = test::Read<uint8_t>(mCpu, *ref[f]);
+            ASSERT_TRUE(mBackend->Upload(*got[f], std::as_bytes(std::span(state))));
+        }
+        CaStepParams p{seed, t, QuantizeProbability(0.2), QuantizeProbability(0.1), QuantizeProbability(0.05), {}, {}};
+        if (wind) p.shiftX = sx, p.shiftY = sy;
+        ASSERT_TRUE(mCpu.CaStep(p, {ref[0].get(), ref[1].get(), ref[2].get()}, *region,
+                                {refOut[0].get(), refOut[1].get(), refOut[2].get()}));
+        s = mBackend->CaStep(p, {got[0].get(), got[1].get(), got[2].get()}, *gotRegion,
+                             {gotOut[0].get(), gotOut[1].get(), gotOut[2].get()});
+        ASSERT_TRUE(s.has_value()) << s.error().message;
+        for (int f = 0; f < 3; ++f) {
+            SCOPED_TRACE("step " + std::to_string(t) + (wind ? " with wind" : ""));
+            ExpectExact(test::Read<uint8_t>(mCpu, *refOut[f]), test::Read<uint8_t>(*mBackend, *gotOut[f]), e, names[f]);
+            std::swap(ref[f], refOut[f]);
+        }
+        for (RasterEllipsoid& el : list) el.center[0] += 0.7f;
+    }
+}
+
+// Test smoothing with r = 0, 1, 2 on a random field, bit for bit (SPEC 4).
+TEST_P(Conformance, Smooth) {
+    const Extent3 e = Size();
+    Pcg32 rng(7);
+    std::vector<uint8_t> cld(e.Count());
+    for (uint8_t& c : cld) c = rng.Below(3) == 0;
+    auto refBits = test::MakeFilled(mCpu, BufferFormat::Bits, e, cld);
+    auto gotBits = test::MakeFilled(*mBackend, BufferFormat::Bits, e, cld);
+    for (int radius : {0, 1, 2}) {
+        auto ref = test::MakeBuffer(mCpu, BufferFormat::F32, e);
+        auto got = test::MakeBuffer(*mBackend, BufferFormat::F32, e);
+        ASSERT_TRUE(mCpu.Smooth(radius, *refBits, *ref));
+        Status s = mBackend->Smooth(radius, *gotBits, *got);
+        ASSERT_TRUE(s.has_value()) << s.error().message;
+        SCOPED_TRACE("radius " + std::to_string(radius));
+        ExpectExact(test::Read<float>(mCpu, *ref), test::Read<float>(*mBackend, *got), e, "q");
+    }
+}
+
+// Test the density stage: D, tiles, bands and cover, bit for bit (SPEC 5).
+TEST_P(Conformance, Density) {
+    const Extent3 e = Size();
+    Pcg32 rng(13);
+    std::vector<uint8_t> cld(e.Count());
+    for (uint8_t& c : cld) c = rng.Below(9) == 0;
+    auto refBits = test::MakeFilled(mCpu, BufferFormat::Bits, e, cld);
+    auto q = test::MakeBuffer(mCpu, BufferFormat::F32, e);
+    ASSERT_TRUE(mCpu.Smooth(1, *refBits, *q));
+    const std::vector<float> qData = test::Read<float>(mCpu, *q);
+    auto gotQ = test::MakeFilled(*mBackend, BufferFormat::F32, e, qData);
+    auto gotBits = test::MakeFilled(*mBackend, BufferFormat::Bits, e, cld);
+    const DensityParams params{8, 4};
+    const Extent3 tiles{CeilDiv(e.nx, 8), CeilDiv(e.ny, 8), 1}, bands{tiles.nx, tiles.ny, CeilDiv(e.nz, 4)};
+    std::unique_ptr<Buffer> out[2][3];
+    Backend* backends[2] = {&mCpu, mBackend.get()};
+    DensityOutputs results[2];
+    for (int n = 0; n < 2; ++n) {
+        out[n][0] = test::MakeBuffer(*backends[n], BufferFormat::F32, {e.nx, e.ny, 1});
+        out[n][1] = test::MakeBuffer(*backends[n], BufferFormat::U8, tiles);
+        out[n][2] = test::MakeBuffer(*backends[n], BufferFormat::U8, bands);
+        results[n] = {out[n][0].get(), out[n][1].get(), out[n][2].get(), 0};
+    }
+    ASSERT_TRUE(mCpu.Density(params, *q, *refBits, results[0]));
+    Status s = mBackend->Density(params, *gotQ, *gotBits, results[1]);
+    ASSERT_TRUE(s.has_value()) << s.error().message;
+    ExpectExact(test::Read<float>(mCpu, *out[0][0]), test::Read<float>(*mBackend, *out[1][0]), {e.nx, e.ny, 1}, "D");
+    ExpectExact(test::Read<uint8_t>(mCpu, *out[0][1]), test::Read<uint8_t>(*mBackend, *out[1][1]), tiles, "tiles");
+    ExpectExact(test::Read<uint8_t>(mCpu, *out[0][2]), test::Read<uint8_t>(*mBackend, *out[1][2]), bands, "bands");
+    EXPECT_EQ(results[0].coveredColumns, results[1].coveredColumns);
+}
+
+// Test end to end: the simulation stages of ci-small for 15 steps, each backend
+// on its own state. Where the region volumes are identical the automaton
+// states must be identical too, step after step; where a region differs (SPEC
+// allows |dR| <= 1), the states may drift and only the cover is compared, within
+// 2 percentage points.
+TEST_P(Conformance, EndToEndSimulation) {
+    if (std::get<1>(GetParam()).size.nx != 64) GTEST_SKIP() << "runs once per backend, on ci-small";
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json",
+                           {{"stages", R"(["region", "ca", "smooth", "density"])"}, {"steps", "15"}, {"warmup_steps", "0"}});
+    ASSERT_TRUE(scene.has_value()) << scene.error().message;
+    auto ref = Simulation::Create(*scene, mCpu);
+    auto got = Simulation::Create(*scene, *mBackend);
+    ASSERT_TRUE(ref.has_value() && got.has_value());
+    bool regionsIdentical = true;
+    const Extent3 e = scene->grid.size;
+    for (uint32_t t = 0; t < scene->steps; ++t) {
+        StepRecord a, b;
+        ASSERT_TRUE((*ref)->Step(a).has_value());
+        Status s = (*got)->Step(b);
+        ASSERT_TRUE(s.has_value()) << s.error().message;
+        // After Step, Region() holds R_t and Cld() the state t+1.
+        regionsIdentical = regionsIdentical && test::Read<uint8_t>(mCpu, *(*ref)->Region()) ==
+                                                   test::Read<uint8_t>(*mBackend, *(*got)->Region());
+        if (regionsIdentical) {
+            SCOPED_TRACE("step " + std::to_string(t));
+            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Cld()), test::Read<uint8_t>(*mBackend, *(*got)->Cld()), e, "cld");
+            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Hum()), test::Read<uint8_t>(*mBackend, *(*got)->Hum()), e, "hum");
+            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Act()), test::Read<uint8_t>(*mBackend, *(*got)->Act()), e, "act");
+        }
+        const double columns = double(e.nx) * e.ny;
+        EXPECT_NEAR(*a.coveredColumns / columns, *b.coveredColumns / columns, regionsIdentical ? 0.0 : 0.02) << "step " << t;
+    }
+}
+
+std::vector<std::string> AllBackends() { return {"cpu", "vk", "gl"}; }
+
+INSTANTIATE_TEST_SUITE_P(
+    Stages, Conformance,
+    ::testing::Combine(::testing::ValuesIn(AllBackends()),
+                       ::testing::Values(SizeCase{"Small64x64x16", {64, 64, 16}}, SizeCase{"Odd70x33x17", {70, 33, 17}},
+                                         SizeCase{"Thin1x1x9", {1, 1, 9}})),
+    [](const ::testing::TestParamInfo<Param>& info) {
+        return std::string(std::get<1>(info.param).name) + "_" + std::get<0>(info.param);
+    });
+
+}  // namespace
+}  // namespace cb
