@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -156,6 +157,9 @@ class Backend {
     // A one-line description of the device (e.g. "2 threads, TBB").
     virtual std::string Device() const = 0;
     virtual bool Supports(Stage stage) const = 0;
+    // Device time of the last stage call in ms, for backends that measure it
+    // (GPU timestamp queries); nullopt where wall time is all there is.
+    virtual std::optional<double> LastDeviceMs() const { return std::nullopt; }
 
     // ---- Buffers and transfers (timed apart from stages) ----
     virtual Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) = 0;

@@ -9,11 +9,12 @@ namespace {
 
 // Runs one stage call and records its wall time.
 template <typename Fn>
-Status Timed(StepRecord& record, Stage stage, Fn&& fn) {
+Status Timed(StepRecord& record, Stage stage, const Backend& backend, Fn&& fn) {
     auto start = std::chrono::steady_clock::now();
     Status status = fn();
     std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
     record.stageMs[size_t(stage)] = elapsed.count();
+    record.deviceMs[size_t(stage)] = backend.LastDeviceMs();
     if (!status) return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
     return {};
 }
@@ -94,7 +95,7 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
 
     if (stages.Has(Stage::Region)) {
         std::vector<RasterEllipsoid> raster = mEllipsoids.Raster();
-        CB_TRY(Timed(record, Stage::Region, [&] { return mBackend.Region(raster, *mRegion); }));
+        CB_TRY(Timed(record, Stage::Region, mBackend, [&] { return mBackend.Region(raster, *mRegion); }));
     }
     // Keep step t-1's q and occupancy for the renderer (the first step has none: it uses its own).
     if (mQPrev && mStep > 0) std::swap(mQ, mQPrev);
@@ -103,13 +104,13 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
         std::swap(mBands, mBandsPrev);
     }
     if (stages.Has(Stage::Smooth)) {
-        CB_TRY(Timed(record, Stage::Smooth, [&] { return mBackend.Smooth(mScene.smooth.radius, *mCld[cur], *mQ); }));
+        CB_TRY(Timed(record, Stage::Smooth, mBackend, [&] { return mBackend.Smooth(mScene.smooth.radius, *mCld[cur], *mQ); }));
         mShadeCurrent = false;
     }
     if (stages.Has(Stage::Density)) {
         DensityOutputs out{mColumnSum.get(), mTiles.get(), mBands.get(), 0};
         DensityParams params{mScene.density.tile, mScene.density.band};
-        CB_TRY(Timed(record, Stage::Density, [&] { return mBackend.Density(params, *mQ, *mCld[cur], out); }));
+        CB_TRY(Timed(record, Stage::Density, mBackend, [&] { return mBackend.Density(params, *mQ, *mCld[cur], out); }));
         record.coveredColumns = out.coveredColumns;
     }
     if (mStep == 0 && mQPrev) {
@@ -138,7 +139,7 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
         params.qAct = QuantizeProbability(mScene.ca.pAct);
         params.shiftX = mShiftX;
         params.shiftY = mShiftY;
-        CB_TRY(Timed(record, Stage::Ca, [&] {
+        CB_TRY(Timed(record, Stage::Ca, mBackend, [&] {
             return mBackend.CaStep(params, {mHum[cur].get(), mAct[cur].get(), mCld[cur].get()}, *mRegion,
                                    {mHum[next].get(), mAct[next].get(), mCld[next].get()});
         }));
@@ -171,7 +172,7 @@ Status Simulation::RunLighting(StepRecord& record) {
         p.albedo = float(sc.shade.albedo);
         p.solidAngle = float(sc.shade.solidAngle);
         p.phase = sc.phase;
-        CB_TRY(Timed(record, Stage::Shade, [&] { return mBackend.Shade(p, *mQ, *mT); }));
+        CB_TRY(Timed(record, Stage::Shade, mBackend, [&] { return mBackend.Shade(p, *mQ, *mT); }));
         mShadeCurrent = true;
     }
     if (sc.stages.Has(Stage::Shadow)) {
@@ -182,7 +183,7 @@ Status Simulation::RunLighting(StepRecord& record) {
         p.voxelSize = float(sc.grid.voxelSize);
         p.kappa = float(sc.shadow.kappa);
         p.nz = sc.grid.size.nz;
-        CB_TRY(Timed(record, Stage::Shadow, [&] { return mBackend.Shadow(p, *mColumnSum, *mShadow); }));
+        CB_TRY(Timed(record, Stage::Shadow, mBackend, [&] { return mBackend.Shadow(p, *mColumnSum, *mShadow); }));
     }
     if (sc.stages.Has(Stage::RenderSplat)) {
         double total = 0;

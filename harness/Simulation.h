@@ -39,6 +39,8 @@ struct StepRecord {
     uint32_t step = 0;
     // Wall time of each stage in ms; empty for stages that did not run.
     std::array<std::optional<double>, kStageCount> stageMs{};
+    // Device time of each stage in ms, where the backend measures it.
+    std::array<std::optional<double>, kStageCount> deviceMs{};
     double ellipsoidUpdateMs = 0;           // host-side list update
     std::optional<uint32_t> coveredColumns;  // from the density stage
     std::vector<FrameRecord> frames;         // render_splat, one per camera

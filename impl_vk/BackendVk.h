@@ -51,7 +51,7 @@ class BackendVk final : public Backend {
     Status RenderSplat(const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats) override;
 
     // Device time of the last stage call (timestamp queries), in ms.
-    std::optional<double> LastDeviceMs() const { return mLastDeviceMs; }
+    std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
     uint32_t ValidationMessages() const { return mContext->ValidationMessages(); }
 
   private:
