@@ -160,6 +160,49 @@ inline float Bilinear(float t00, float t10, float t01, float t11, float fu, floa
     return a * (1.0f - fv) + b * fv;
 }
 
+// The geometry of one shear-warp pass (SPEC 6), shared by every backend:
+// principal axis w, the other two axes u, v (x, y, z order), and where output
+// (u, v) reads the previous slice: taps at (u + u0, v + v0) and +1, weights fu, fv.
+struct ShearWarp {
+    int w = 2, u = 0, v = 1;
+    float absSw = 1;      // |s_w|
+    bool sunAbove = true; // s_w > 0: slices are visited from the highest w index down
+    int u0 = 0, v0 = 0;
+    float fu = 0, fv = 0;
+};
+
+inline ShearWarp MakeShearWarp(const Vec3& s, SampleFilter filter) {
+    ShearWarp g;
+    g.w = PrincipalAxis(s);
+    g.u = g.w == 0 ? 1 : 0;
+    g.v = g.w == 2 ? 1 : 2;
+    g.absSw = std::fabs(s[g.w]);
+    g.sunAbove = s[g.w] > 0;
+    const float du = s[g.u] / g.absSw, dv = s[g.v] / g.absSw;  // |du|, |dv| <= 1
+    if (filter == SampleFilter::Nearest) {
+        g.u0 = int(std::floor(du + 0.5f));
+        g.v0 = int(std::floor(dv + 0.5f));
+    } else {
+        g.u0 = int(std::floor(du));
+        g.v0 = int(std::floor(dv));
+        g.fu = du - std::floor(du);
+        g.fv = dv - std::floor(dv);
+    }
+    return g;
+}
+
+// The per-slice factor for slices `cellSize` metres thick.
+inline SliceAttenuation MakeSliceAttenuation(AttenuationKind kind, float sigma, float cellSize, float absSw,
+                                             float thesisAr, bool scattering, float albedo, float solidAngle,
+                                             const PhaseParams& phase) {
+    SliceAttenuation a;
+    a.kind = kind;
+    a.opticalDepthPerQ = sigma * cellSize / absSw;
+    a.thesisAr = thesisAr;
+    if (scattering) a.scatterGain = albedo * PhaseValue(phase, 1.0f) * solidAngle / (4.0f * std::numbers::pi_v<float>);
+    return a;
+}
+
 // ---- Splat kernel (SPEC 8) -------------------------------------------------------
 
 // kappa = max(0, 1 - rho^2)^2 at splat coordinate (a, b) in [0, 1]^2.

@@ -66,29 +66,15 @@ struct Grid3 {
 
 // Shades `grid` with voxels of edge `cellSize` metres.
 void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::task_arena& arena) {
-    const Vec3& s = p.sun;
-    const int w = PrincipalAxis(s);
-    const int u = w == 0 ? 1 : 0;
-    const int v = w == 2 ? 1 : 2;
+    const ShearWarp g = MakeShearWarp(p.sun, p.filter);
+    const int w = g.w, u = g.u, v = g.v;
     const uint32_t nu = grid.n[u], nv = grid.n[v], nw = grid.n[w];
     const size_t stride[3] = {1, grid.n[0], size_t(grid.n[0]) * grid.n[1]};
-    const float sw = std::fabs(s[w]);
-    const float du = s[u] / sw, dv = s[v] / sw;  // |du|, |dv| <= 1: w is the largest component
-
-    SliceAttenuation attenuation;
-    attenuation.kind = p.attenuation;
-    attenuation.opticalDepthPerQ = p.sigma * cellSize / sw;
-    attenuation.thesisAr = p.thesisAr;
-    if (p.scattering) attenuation.scatterGain = p.albedo * PhaseValue(p.phase, 1.0f) * p.solidAngle / (4.0f * std::numbers::pi_v<float>);
-
+    const SliceAttenuation attenuation = MakeSliceAttenuation(p.attenuation, p.sigma, cellSize, g.absSw, p.thesisAr,
+                                                              p.scattering, p.albedo, p.solidAngle, p.phase);
     const ShadeKernel kernel{attenuation, p.storage};
-
-    // Taps of output (u, v) in the previous slice: base (u + u0, v + v0) and +1.
-    const bool nearest = p.filter == SampleFilter::Nearest;
-    const int u0 = nearest ? int(std::floor(du + 0.5f)) : int(std::floor(du));
-    const int v0 = nearest ? int(std::floor(dv + 0.5f)) : int(std::floor(dv));
-    const float fu = nearest ? 0.0f : du - std::floor(du);
-    const float fv = nearest ? 0.0f : dv - std::floor(dv);
+    const int u0 = g.u0, v0 = g.v0;
+    const float fu = g.fu, fv = g.fv;
 
     // Padded previous slice: index (a + 1) + pitch * (b + 1) holds (a, b), with
     // one ring below and two above (taps reach u - 1 .. u + 2).
@@ -96,7 +82,7 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
     std::vector<float> prevT(size_t(pitch) * (nv + 3), 1.0f), prevQ(size_t(pitch) * (nv + 3), 0.0f);
     auto padded = [&](int64_t a, int64_t b) { return size_t(a + 1) + size_t(pitch) * size_t(b + 1); };
 
-    const bool sunAbove = s[w] > 0;  // sun toward +w: the first slice is the last index
+    const bool sunAbove = g.sunAbove;
     for (uint32_t m = 0; m < nw; ++m) {
         const uint32_t wIndex = sunAbove ? nw - 1 - m : m;
         const size_t sliceBase = stride[w] * wIndex;

@@ -196,10 +196,11 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
         q.queryCount = 2;
         CB_TRY(CheckVk(vkCreateQueryPool(ctx->mDevice, &q, nullptr, &ctx->mQueries), "creating the timestamp queries"));
     }
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4096};
+    // Enough sets for one stage call: shading records one dispatch per slice.
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 32768};
     VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     dp.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
-    dp.maxSets = 512;
+    dp.maxSets = 8192;
     dp.poolSizeCount = 1;
     dp.pPoolSizes = &size;
     CB_TRY(CheckVk(vkCreateDescriptorPool(ctx->mDevice, &dp, nullptr, &ctx->mDescriptors), "creating the descriptor pool"));

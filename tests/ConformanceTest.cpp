@@ -208,6 +208,84 @@ TEST_P(Conformance, Density) {
     EXPECT_EQ(results[0].coveredColumns, results[1].coveredColumns);
 }
 
+// Largest |a - b| and where it is.
+template <typename T>
+std::pair<double, size_t> WorstDifference(const std::vector<T>& a, const std::vector<T>& b) {
+    double worst = 0;
+    size_t at = 0;
+    for (size_t v = 0; v < a.size(); ++v) {
+        const double d = std::fabs(double(a[v]) - double(b[v]));
+        if (!(d <= worst)) worst = d, at = v;  // NaN counts as worst
+    }
+    return {worst, at};
+}
+
+// Test shading for every option and several suns: max |dT| <= 1e-5 for fp32,
+// one storage quantum for fp16 and unorm8 (SPEC 6).
+TEST_P(Conformance, Shade) {
+    const Extent3 e = Size();
+    Pcg32 rng(21);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = rng.Below(3) == 0 ? float(rng.Below(65)) / 64.0f : 0.0f;
+    auto refQ = test::MakeFilled(mCpu, BufferFormat::F32, e, q);
+    auto gotQ = test::MakeFilled(*mBackend, BufferFormat::F32, e, q);
+    auto refT = test::MakeBuffer(mCpu, BufferFormat::F32, e);
+    auto gotT = test::MakeBuffer(*mBackend, BufferFormat::F32, e);
+    const Vec3 suns[] = {{0, 0, 1}, SunDirection(0.44, 1.05), SunDirection(0.7853981633974483, 0.3), SunDirection(0.2, 3.5)};
+    for (const Vec3& sun : suns)
+        for (AttenuationKind att : {AttenuationKind::Beer, AttenuationKind::Thesis})
+            for (SampleFilter filter : {SampleFilter::Bilinear, SampleFilter::Nearest})
+                for (int f : {1, 2, 4})
+                    for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Fp16, StorageFormat::Unorm8})
+                        for (bool scattering : {false, true}) {
+                            ShadeParams p;
+                            p.sun = sun;
+                            p.attenuation = att;
+                            p.filter = filter;
+                            p.resolution = f;
+                            p.storage = storage;
+                            p.scattering = scattering;
+                            p.sigma = 0.01f;
+                            ASSERT_TRUE(mCpu.Shade(p, *refQ, *refT));
+                            Status s = mBackend->Shade(p, *gotQ, *gotT);
+                            ASSERT_TRUE(s.has_value()) << s.error().message;
+                            const auto a = test::Read<float>(mCpu, *refT), b = test::Read<float>(*mBackend, *gotT);
+                            const auto [worst, at] = WorstDifference(a, b);
+                            const double tolerance = storage == StorageFormat::Fp32 ? 1e-5 : StorageQuantum(storage);
+                            ASSERT_LE(worst, tolerance)
+                                << "sun (" << sun[0] << ", " << sun[1] << ", " << sun[2] << ") att " << int(att) << " filter "
+                                << int(filter) << " f " << f << " storage " << int(storage) << " scattering " << scattering
+                                << ": worst at " << Where(e, at) << ": cpu " << a[at] << ", " << mBackend->Name() << " " << b[at];
+                        }
+}
+
+// Test the ground shadow in both forms, several suns: max |dG| <= 1e-5 (SPEC 7).
+TEST_P(Conformance, Shadow) {
+    const Extent3 e = Size();
+    Pcg32 rng(23);
+    std::vector<float> D(size_t(e.nx) * e.ny);
+    for (float& v : D) v = float(rng.Below(200)) / 64.0f;
+    const Extent3 map{e.nx, e.ny, 1};
+    auto refD = test::MakeFilled(mCpu, BufferFormat::F32, map, D);
+    auto gotD = test::MakeFilled(*mBackend, BufferFormat::F32, map, D);
+    auto refG = test::MakeBuffer(mCpu, BufferFormat::F32, map);
+    auto gotG = test::MakeBuffer(*mBackend, BufferFormat::F32, map);
+    for (const Vec3& sun : {Vec3{0, 0, 1}, SunDirection(0.5, 0.7), SunDirection(0.05, 2.0), SunDirection(-0.1, 0.0)})
+        for (AttenuationKind form : {AttenuationKind::Beer, AttenuationKind::Thesis}) {
+            ShadowParams p;
+            p.sun = sun;
+            p.form = form;
+            p.nz = e.nz;
+            ASSERT_TRUE(mCpu.Shadow(p, *refD, *refG));
+            Status s = mBackend->Shadow(p, *gotD, *gotG);
+            ASSERT_TRUE(s.has_value()) << s.error().message;
+            const auto a = test::Read<float>(mCpu, *refG), b = test::Read<float>(*mBackend, *gotG);
+            const auto [worst, at] = WorstDifference(a, b);
+            EXPECT_LE(worst, 1e-5) << "form " << int(form) << ": worst at " << Where(map, at) << ": cpu " << a[at] << ", "
+                                   << mBackend->Name() << " " << b[at];
+        }
+}
+
 // Test end to end: the simulation stages of ci-small for 15 steps, each backend
 // on its own state. Where the region volumes are identical the automaton
 // states must be identical too, step after step; where a region differs (SPEC
