@@ -11,6 +11,7 @@
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/VulkanContext.h"
 #endif
+#include "harness/Conform.h"
 #include "harness/Report.h"
 #include "harness/Simulation.h"
 
@@ -250,6 +251,40 @@ int DumpCommand(const CommonOptions& options) {
     std::printf("dumped %u steps of scene %s (%ux%ux%u, backend %s) to %s/step_0000 .. step_%04u\n", scene.steps,
                 scene.name.c_str(), g.nx, g.ny, g.nz, name.c_str(), outDir.c_str(), scene.steps - 1);
     return kExitOk;
+}
+
+int ConformCommand(const CommonOptions& options) {
+    Result<Scene> loaded = Load(options);
+    if (!loaded) {
+        std::fprintf(stderr, "%s\n", loaded.error().message.c_str());
+        return kExitBadScene;
+    }
+    const Scene& scene = *loaded;
+    const std::string outDir = options.outDir.empty() ? "out/" + scene.name + "/conform" : options.outDir;
+    if (Status s = MakeOutDir(outDir); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    const std::vector<std::string> names = options.backends.empty() ? BuiltBackends() : options.backends;
+    std::printf("conformance of scene %s (%ux%ux%u, %u steps) against the cpu backend\n", scene.name.c_str(),
+                scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps);
+    auto rows = RunConformance(scene, names, options.Backend());
+    if (!rows) {
+        std::fprintf(stderr, "conform: %s\n", rows.error().message.c_str());
+        return kExitFailed;
+    }
+    std::printf("%s", ConformTable(*rows).c_str());
+    const std::string path = outDir + "/conform.json";
+    std::ofstream json(path);
+    json << ConformJson(scene, *rows).dump(1) << "\n";
+    std::printf("results: %s\n", path.c_str());
+    bool failed = false, compared = false;
+    for (const ConformRow& r : *rows) {
+        failed |= r.status == "fail";
+        compared |= r.status != "skipped";
+    }
+    if (failed) return kExitNonConformant;
+    return compared ? kExitOk : kExitNoBackend;
 }
 
 int DevicesCommand() {

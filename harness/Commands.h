@@ -1,6 +1,7 @@
 // The `cloudbench` subcommands. Each returns the process exit code
 // (docs/cli.md): 0 success, 1 a stage failed or an output could not be written,
-// 2 bad command line, 3 bad scene, 4 none of the requested backends available.
+// 2 bad command line, 3 bad scene, 4 none of the requested backends available,
+// 5 a conformance check failed.
 #pragma once
 
 #include <string>
@@ -17,6 +18,7 @@ enum ExitCode : int {
     kExitUsage = 2,
     kExitBadScene = 3,
     kExitNoBackend = 4,
+    kExitNonConformant = 5,
 };
 
 struct CommonOptions {
@@ -40,6 +42,7 @@ int RunCommand(const CommonOptions& options);
 int DumpCommand(const CommonOptions& options);
 // Lists the Vulkan devices (and says which other backends this build has).
 int DevicesCommand();
+int ConformCommand(const CommonOptions& options);
 
 // scenes/<name>.json for a bare name, the argument itself for a path.
 std::string ResolveScenePath(const std::string& nameOrPath);

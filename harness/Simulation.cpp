@@ -94,8 +94,8 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     const int cur = mCurrent, next = 1 - mCurrent;
 
     if (stages.Has(Stage::Region)) {
-        std::vector<RasterEllipsoid> raster = mEllipsoids.Raster();
-        CB_TRY(Timed(record, Stage::Region, mBackend, [&] { return mBackend.Region(raster, *mRegion); }));
+        mRaster = mEllipsoids.Raster();
+        CB_TRY(Timed(record, Stage::Region, mBackend, [&] { return mBackend.Region(mRaster, *mRegion); }));
     }
     // Keep step t-1's q and occupancy for the renderer (the first step has none: it uses its own).
     if (mQPrev && mStep > 0) std::swap(mQ, mQPrev);

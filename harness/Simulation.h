@@ -77,6 +77,8 @@ class Simulation {
     // The step whose images are in Image(); nullopt before the first render.
     std::optional<uint32_t> LastRenderedStep() const { return mLastRendered; }
     bool IsOutputStep(uint32_t step) const;
+    // The ellipsoids the current step's region came from.
+    const std::vector<RasterEllipsoid>& RasterList() const { return mRaster; }
 
   private:
     Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs);
@@ -85,6 +87,7 @@ class Simulation {
     const Scene mScene;
     Backend& mBackend;
     EllipsoidList mEllipsoids;
+    std::vector<RasterEllipsoid> mRaster;  // the list step t's region was rasterised from
     uint32_t mStep = 0;
     int mCurrent = 0;  // which of the two automaton states is step t
     std::vector<int32_t> mShiftX, mShiftY;
