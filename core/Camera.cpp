@@ -77,4 +77,53 @@ SplatOrder MakeSplatOrder(const CameraFrame& frame, const Extent3& grid, const s
     return order;
 }
 
+namespace {
+
+// The four side planes of the frustum widened by one pixel; a voxel whose
+// splat touches the image lies within splatDiameter/2 of their inside.
+std::array<Vec3, 4> SidePlanes(const CameraFrame& c) {
+    const float halfW = 0.5f * float(c.width) + 1.0f, halfH = 0.5f * float(c.height) + 1.0f;
+    auto make = [&](const Vec3& axis, float sign, float half) {
+        Vec3 n;
+        for (int i = 0; i < 3; ++i) n[i] = sign * c.focalPx * axis[i] - half * c.forward[i];
+        const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (float& x : n) x /= len;
+        return n;
+    };
+    return {make(c.right, 1, halfW), make(c.right, -1, halfW), make(c.upVector, 1, halfH), make(c.upVector, -1, halfH)};
+}
+
+bool BoxCulled(const CameraFrame& c, const std::array<Vec3, 4>& planes, float radius, const Vec3& lo, const Vec3& hi) {
+    float maxDepth = 0;  // the largest depth over the box
+    for (int i = 0; i < 3; ++i) maxDepth += std::max((lo[i] - c.eye[i]) * c.forward[i], (hi[i] - c.eye[i]) * c.forward[i]);
+    if (maxDepth <= c.nearPlane) return true;
+    for (const Vec3& n : planes) {
+        float minDistance = 0;  // the smallest n.(P - eye) over the box
+        for (int i = 0; i < 3; ++i) minDistance += std::min((lo[i] - c.eye[i]) * n[i], (hi[i] - c.eye[i]) * n[i]);
+        if (minDistance > radius) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+std::vector<uint8_t> FrustumVisibleBoxes(const CameraFrame& camera, const Extent3& e, const std::array<float, 3>& origin,
+                                         float h, uint32_t tile, uint32_t band, float splatDiameter) {
+    const uint32_t tilesX = CeilDiv(e.nx, tile), tilesY = CeilDiv(e.ny, tile), bands = CeilDiv(e.nz, band);
+    std::vector<uint8_t> visible(size_t(tilesX) * tilesY * bands, 1);
+    const std::array<Vec3, 4> planes = SidePlanes(camera);
+    for (uint32_t b = 0; b < bands; ++b)
+        for (uint32_t ty = 0; ty < tilesY; ++ty)
+            for (uint32_t tx = 0; tx < tilesX; ++tx) {
+                // The box of the voxel centres in the tile-band.
+                const Vec3 lo{origin[0] + (float(tx * tile) + 0.5f) * h, origin[1] + (float(ty * tile) + 0.5f) * h,
+                              origin[2] + (float(b * band) + 0.5f) * h};
+                const Vec3 hi{origin[0] + (float(std::min(e.nx, (tx + 1) * tile)) - 0.5f) * h,
+                              origin[1] + (float(std::min(e.ny, (ty + 1) * tile)) - 0.5f) * h,
+                              origin[2] + (float(std::min(e.nz, (b + 1) * band)) - 0.5f) * h};
+                if (BoxCulled(camera, planes, 0.5f * splatDiameter, lo, hi)) visible[tx + size_t(tilesX) * (ty + size_t(tilesY) * b)] = 0;
+            }
+    return visible;
+}
+
 }  // namespace cb

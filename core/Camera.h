@@ -59,4 +59,11 @@ struct SplatOrder {
 SplatOrder MakeSplatOrder(const CameraFrame& frame, const Extent3& grid, const std::array<double, 3>& origin,
                           double voxelSize);
 
+// View-frustum culling of tile x height-band boxes (SPEC 8): 1 where a box of
+// voxel centres may hold a splat that covers a pixel, 0 where it certainly
+// does not (conservative; docs/pipeline.md derives the bound). Index
+// tx + tilesX * (ty + tilesY * band), the layout of the density stage's bands.
+std::vector<uint8_t> FrustumVisibleBoxes(const CameraFrame& camera, const Extent3& grid, const std::array<float, 3>& origin,
+                                         float voxelSize, uint32_t tile, uint32_t band, float splatDiameter);
+
 }  // namespace cb

@@ -28,46 +28,6 @@ struct Splat {
 
 constexpr uint32_t kRowsPerBand = 8;
 
-// A plane n.(P - eye) <= offset keeps the visible side.
-struct Plane {
-    Vec3 n;
-};
-
-// The four side planes of the frustum widened by one pixel, so that a voxel
-// whose splat touches the image lies within splatRadius of their inside.
-std::array<Plane, 4> SidePlanes(const CameraFrame& c) {
-    const float halfW = 0.5f * float(c.width) + 1.0f, halfH = 0.5f * float(c.height) + 1.0f;
-    auto make = [&](const Vec3& axis, float sign, float half) {
-        Vec3 n;
-        for (int i = 0; i < 3; ++i) n[i] = sign * c.focalPx * axis[i] - half * c.forward[i];
-        const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        for (float& x : n) x /= len;
-        return Plane{n};
-    };
-    // Image y grows downward while upVector points up; the planes are symmetric, so only the pair matters.
-    return {make(c.right, 1, halfW), make(c.right, -1, halfW), make(c.upVector, 1, halfH), make(c.upVector, -1, halfH)};
-}
-
-// True when no voxel centre in [lo, hi] can make a splat that covers a pixel.
-bool BoxCulled(const CameraFrame& c, const std::array<Plane, 4>& planes, float radius, const Vec3& lo, const Vec3& hi) {
-    // Behind the near plane: the largest depth over the box is <= near.
-    float maxDepth = 0;
-    for (int i = 0; i < 3; ++i) {
-        const float a = (lo[i] - c.eye[i]) * c.forward[i], b = (hi[i] - c.eye[i]) * c.forward[i];
-        maxDepth += std::max(a, b);
-    }
-    if (maxDepth <= c.nearPlane) return true;
-    for (const Plane& plane : planes) {
-        float minDistance = 0;  // the smallest n.(P - eye) over the box
-        for (int i = 0; i < 3; ++i) {
-            const float a = (lo[i] - c.eye[i]) * plane.n[i], b = (hi[i] - c.eye[i]) * plane.n[i];
-            minDistance += std::min(a, b);
-        }
-        if (minDistance > radius) return true;
-    }
-    return false;
-}
-
 }  // namespace
 
 Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& imageBuffer, SplatStats* stats) {
@@ -93,22 +53,9 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
         for (size_t n = 0; n < boxVisible.size(); ++n) boxVisible[n] = a[n] | b[n];
     }
     if (p.culling) {
-        const std::array<Plane, 4> planes = SidePlanes(cam);
-        const float radius = 0.5f * p.splatDiameter;
-        for (uint32_t b = 0; b < bandCount; ++b)
-            for (uint32_t ty = 0; ty < tilesY; ++ty)
-                for (uint32_t tx = 0; tx < tilesX; ++tx) {
-                    uint8_t& visible = boxVisible[tx + size_t(tilesX) * (ty + size_t(tilesY) * b)];
-                    if (!visible) continue;
-                    // Box of the voxel centres in the tile-band.
-                    const float h = p.voxelSize;
-                    const Vec3 lo{p.origin[0] + (float(tx * p.tile) + 0.5f) * h, p.origin[1] + (float(ty * p.tile) + 0.5f) * h,
-                                  p.origin[2] + (float(b * p.band) + 0.5f) * h};
-                    const Vec3 hi{p.origin[0] + (float(std::min(e.nx, (tx + 1) * p.tile)) - 0.5f) * h,
-                                  p.origin[1] + (float(std::min(e.ny, (ty + 1) * p.tile)) - 0.5f) * h,
-                                  p.origin[2] + (float(std::min(e.nz, (b + 1) * p.band)) - 0.5f) * h};
-                    if (BoxCulled(cam, planes, radius, lo, hi)) visible = 0;
-                }
+        const std::vector<uint8_t> inFrustum =
+            FrustumVisibleBoxes(cam, e, p.origin, p.voxelSize, p.tile, p.band, p.splatDiameter);
+        for (size_t n = 0; n < boxVisible.size(); ++n) boxVisible[n] &= inFrustum[n];
     }
 
     // 2. Splats in the shared order: task `n` makes those of the n-th outer slice.
