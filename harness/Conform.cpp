@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/Random.h"
+#include "harness/Report.h"
 #include "harness/Simulation.h"
 
 namespace cb {
@@ -244,7 +245,68 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
                     tally.Within("shadow", c.name, t, map, *Read<float>(cpu, *s.Shadow()), *Read<float>(b, **G), 1e-5,
                                  "|dG| <= 1e-05");
                 }
-                if (st.Has(Stage::RenderSplat)) skip(Stage::RenderSplat);
+                if (st.Has(Stage::RenderSplat) && !skip(Stage::RenderSplat) && s.Image(0)) {
+                    // Feed the CPU's q of both steps, T and occupancy; render every camera.
+                    auto copy = [&](const Buffer* from, BufferFormat format) -> Result<std::unique_ptr<Buffer>> {
+                        if (!from) return std::unique_ptr<Buffer>();
+                        std::vector<std::byte> data(from->CanonicalBytes());
+                        CB_TRY(cpu.Download(*from, data));
+                        auto to = b.CreateBuffer(format, from->Extent());
+                        if (!to) return std::unexpected(to.error());
+                        CB_TRY(b.Upload(**to, data));
+                        return std::move(*to);
+                    };
+                    auto qp = copy(s.QPrev(), BufferFormat::F32);
+                    auto qc = copy(s.Q(), BufferFormat::F32);
+                    auto T = copy(s.T(), BufferFormat::F32);
+                    auto tp = copy(s.TilesPrev(), BufferFormat::U8);
+                    auto tc = copy(s.Tiles(), BufferFormat::U8);
+                    auto bp = copy(s.BandsPrev(), BufferFormat::U8);
+                    auto bc = copy(s.Bands(), BufferFormat::U8);
+                    if (!qp || !qc || !T || !tp || !tc || !bp || !bc) return MakeError("render_splat: copying inputs failed");
+                    const RenderSettings& rs = scene.render;
+                    for (size_t n = 0; n < rs.cameras.size(); ++n) {
+                        SplatParams p;
+                        p.camera = MakeCameraFrame(rs.cameras[n], rs.width, rs.height);
+                        const SplatOrder order = MakeSplatOrder(p.camera, e, scene.grid.origin, scene.grid.voxelSize);
+                        p.order = &order;
+                        p.sun = scene.sun.Direction();
+                        p.sunRadiance = scene.sun.Radiance();
+                        for (int ch = 0; ch < 3; ++ch) {
+                            p.ambient[ch] = float(scene.lighting.ambient[ch]);
+                            p.background[ch] = float(scene.lighting.background[ch]);
+                        }
+                        p.phase = scene.phase;
+                        p.qMin = float(rs.qMin);
+                        p.splatDiameter = float(rs.splatScale * scene.grid.voxelSize);
+                        p.opacity = float(rs.opacity);
+                        p.alpha = float(rs.alpha);
+                        p.origin = {float(scene.grid.origin[0]), float(scene.grid.origin[1]), float(scene.grid.origin[2])};
+                        p.voxelSize = float(scene.grid.voxelSize);
+                        p.culling = rs.culling;
+                        p.skipping = rs.skipping;
+                        p.tile = scene.density.tile;
+                        p.band = scene.density.band;
+                        auto image = b.CreateBuffer(BufferFormat::F32, {3, rs.width, rs.height});
+                        if (!image) return std::unexpected(image.error());
+                        SplatInputs in{qp->get(), qc->get(), T->get(), tp->get(), tc->get(), bp->get(), bc->get()};
+                        CB_TRY(b.RenderSplat(p, in, **image, nullptr));
+                        auto ref = Read<float>(cpu, *s.Image(n));
+                        auto got = Read<float>(b, **image);
+                        if (!ref || !got) return MakeError("render_splat: download failed");
+                        const ImageComparison cmp = CompareImages(*ref, *got, rs.width, rs.height);
+                        ConformRow& row = tally.Row("render_splat", c.name, "2/255 on 99.9 %, 8/255 max", 8.0 / 255.0);
+                        if (!(cmp.maxError <= row.worst)) {
+                            row.worst = cmp.maxError;
+                            char detail[256];
+                            std::snprintf(detail, sizeof detail,
+                                          "step %u camera %s: worst pixel (%d, %d), %zu pixels over 2/255, PSNR %.1f dB",
+                                          t, rs.cameras[n].name.c_str(), cmp.worstX, cmp.worstY, cmp.pixelsOver2, cmp.psnr);
+                            row.detail = detail;
+                        }
+                        if (!cmp.Passes()) row.status = "fail";
+                    }
+                }
             }
             return {};
         };

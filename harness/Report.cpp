@@ -205,6 +205,32 @@ Status WriteTopView(const std::string& path, const std::vector<float>& columnSum
     return {};
 }
 
+ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
+                              uint32_t height) {
+    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
+    OIIO::ImageBuf a(spec, const_cast<float*>(reference.data())), b(spec, const_cast<float*>(candidate.data()));
+    // failthresh 8/255, warnthresh 2/255: a pixel counts once, as a failure or a warning.
+    const auto result = OIIO::ImageBufAlgo::compare(a, b, 8.0f / 255.0f, 2.0f / 255.0f);
+    ImageComparison c;
+    c.maxError = result.maxerror;
+    c.meanError = result.meanerror;
+    c.psnr = result.PSNR;
+    c.pixelsOver2 = size_t(result.nfail + result.nwarn);  // compare counts pixels over warn (2/255) and fail (8/255) apart
+    c.pixels = size_t(width) * height;
+    c.worstX = result.maxx;
+    c.worstY = result.maxy;
+    return c;
+}
+
+Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
+                            const std::vector<float>& candidate, uint32_t width, uint32_t height) {
+    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
+    OIIO::ImageBuf a(spec, const_cast<float*>(reference.data())), b(spec, const_cast<float*>(candidate.data()));
+    OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(a, b);
+    if (!diff.write(path)) return MakeError(path + ": cannot write: " + diff.geterror());
+    return {};
+}
+
 Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
                                             uint32_t height, bool png) {
     OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);

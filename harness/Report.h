@@ -41,6 +41,22 @@ std::string TimingTable(const Scene& scene, const BackendRun& run);
 // PNG through OpenImageIO. `columnSum` is canonical D, nx*ny floats.
 Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz);
 
+// SPEC 8's image rule: per channel |d| <= 2/255 on at least 99.9 % of pixels
+// and <= 8/255 everywhere; with PSNR and mean absolute error, from
+// OpenImageIO's ImageBufAlgo::compare.
+struct ImageComparison {
+    double maxError = 0, meanError = 0, psnr = 0;
+    size_t pixelsOver2 = 0;   // pixels with a channel off by more than 2/255
+    size_t pixels = 0;
+    int worstX = 0, worstY = 0;
+    bool Passes() const { return maxError <= 8.0 / 255.0 && double(pixelsOver2) <= 0.001 * double(pixels); }
+};
+ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
+                              uint32_t height);
+// Writes |reference - candidate| as an EXR (for a failed comparison).
+Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
+                            const std::vector<float>& candidate, uint32_t width, uint32_t height);
+
 // Writes a linear RGB float image (3 floats a pixel, row 0 at the top) as
 // `stem`.exr (float, linear) and, with png = true, `stem`.png (8-bit sRGB),
 // through OpenImageIO. Returns the paths written.

@@ -71,6 +71,10 @@ class Simulation {
     const Buffer* Tiles() const { return mTiles.get(); }
     const Buffer* Bands() const { return mBands.get(); }
     const Buffer* T() const { return mT.get(); }
+    // The previous step's q and band occupancy (render_splat only).
+    const Buffer* QPrev() const { return mQPrev.get(); }
+    const Buffer* TilesPrev() const { return mTilesPrev.get(); }
+    const Buffer* BandsPrev() const { return mBandsPrev.get(); }
     const Buffer* Shadow() const { return mShadow.get(); }
     // The image of camera `n` (F32, extent (3, width, height)); valid after a render step.
     const Buffer* Image(size_t n) const { return n < mImages.size() ? mImages[n].get() : nullptr; }

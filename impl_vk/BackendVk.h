@@ -62,9 +62,10 @@ class BackendVk final : public Backend {
 
     std::unique_ptr<VulkanContext> mContext;
     std::optional<double> mLastDeviceMs;
-    // Reused between calls: 0 ellipsoids, 1-3 advection, 4 shifts, 5 cover counter.
+    // Reused between calls: 0 ellipsoids, 1-3 advection, 4 shifts, 5 cover
+    // counter, 6-7 coarse shading grids, 8-18 the splat renderer's buffers.
     // A fixed array, so pointers to one slot stay valid while others grow.
-    std::array<DeviceBuffer, 8> mScratch{};
+    std::array<DeviceBuffer, 20> mScratch{};
 };
 
 }  // namespace cb::vk

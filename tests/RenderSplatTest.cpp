@@ -5,6 +5,7 @@
 
 #include "core/Camera.h"
 #include "core/Random.h"
+#include "harness/Report.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 
@@ -224,6 +225,33 @@ TEST(Camera, DegenerateUpFallsBack) {
     EXPECT_FLOAT_EQ(p.px, 4);
     EXPECT_FLOAT_EQ(p.py, 4);
     EXPECT_FLOAT_EQ(p.depth, 5);
+}
+
+}  // namespace
+}  // namespace cb
+
+namespace cb {
+namespace {
+
+// Test SPEC 8's image rule as CompareImages applies it: one pixel 8/255 off
+// fails, a channel 2.5/255 off on 0.05 % of pixels passes and on 0.2 % fails.
+TEST(ImageRule, ThresholdsAndCounts) {
+    const uint32_t W = 100, H = 100;
+    const std::vector<float> a(3 * W * H, 0.5f);
+    std::vector<float> b = a;
+    EXPECT_TRUE(CompareImages(a, b, W, H).Passes());
+    b[3 * (10 + W * 20) + 1] += 9.0f / 255.0f;
+    ImageComparison c = CompareImages(a, b, W, H);
+    EXPECT_FALSE(c.Passes());
+    EXPECT_EQ(c.worstX, 10);
+    EXPECT_EQ(c.worstY, 20);
+    b = a;
+    for (uint32_t n = 0; n < 5; ++n) b[3 * n] += 2.5f / 255.0f;  // 5 of 10000 pixels
+    c = CompareImages(a, b, W, H);
+    EXPECT_EQ(c.pixelsOver2, 5u);
+    EXPECT_TRUE(c.Passes());
+    for (uint32_t n = 5; n < 20; ++n) b[3 * n] += 2.5f / 255.0f;  // 20 of 10000
+    EXPECT_FALSE(CompareImages(a, b, W, H).Passes());
 }
 
 }  // namespace

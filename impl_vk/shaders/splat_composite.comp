@@ -1,0 +1,42 @@
+#version 450
+// Splat compositing: one invocation per pixel walks its screen tile's splats
+// in the shared back-to-front order: C <- alpha c + (1 - alpha) C.
+#extension GL_GOOGLE_include_directive : require
+#include "shading.glsl"
+layout(local_size_x = 64) in;
+struct Splat {
+    float px, py, size, alphaScale;
+    float r, g, b, pad;
+    int x0, x1, y0, y1;
+};
+layout(std430, binding = 0) readonly buffer Splats { Splat splats[]; };
+layout(std430, binding = 1) readonly buffer Bases { uint bases[]; };
+layout(std430, binding = 2) readonly buffer List { uint list[]; };
+layout(std430, binding = 3) writeonly buffer Image { float image[]; };
+layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec4 background; } pc;
+
+float SplatKernel(float a, float b) {
+    precise float x = 2.0 * a - 1.0, y = 2.0 * b - 1.0;
+    precise float t = max(0.0, 1.0 - (x * x + y * y));
+    return t * t;
+}
+
+void main() {
+    const uint id = gl_GlobalInvocationID.x;
+    if (id >= pc.width * pc.height) return;
+    const int x = int(id % pc.width), y = int(id / pc.width);
+    const uint tile = uint(x) / pc.tileSize + pc.tilesX * (uint(y) / pc.tileSize);
+    vec3 c = pc.background.rgb;
+    for (uint n = bases[tile]; n < bases[tile + 1u]; ++n) {
+        const Splat s = splats[list[n]];
+        if (x < s.x0 || x > s.x1 || y < s.y0 || y > s.y1) continue;
+        precise float a = (float(x) + 0.5 - s.px) / s.size + 0.5;
+        precise float b = (float(y) + 0.5 - s.py) / s.size + 0.5;
+        precise float alpha = clamp(s.alphaScale * SplatKernel(a, b), 0.0, 1.0);
+        precise vec3 blended = alpha * vec3(s.r, s.g, s.b) + (1.0 - alpha) * c;
+        c = blended;
+    }
+    image[3u * id] = c.r;
+    image[3u * id + 1u] = c.g;
+    image[3u * id + 2u] = c.b;
+}
