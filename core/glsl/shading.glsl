@@ -65,4 +65,11 @@ float PhaseValue(uint kind, float g, float cosTheta) {
     return cs;
 }
 
+// kappa = max(0, 1 - rho^2)^2 at splat coordinate (a, b) (core/Shading.h SplatKernel).
+float SplatKernel(float a, float b) {
+    precise float x = 2.0 * a - 1.0, y = 2.0 * b - 1.0;
+    precise float t = max(0.0, 1.0 - (x * x + y * y));
+    return t * t;
+}
+
 #endif

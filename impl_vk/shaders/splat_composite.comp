@@ -15,12 +15,6 @@ layout(std430, binding = 2) readonly buffer List { uint list[]; };
 layout(std430, binding = 3) writeonly buffer Image { float image[]; };
 layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec4 background; } pc;
 
-float SplatKernel(float a, float b) {
-    precise float x = 2.0 * a - 1.0, y = 2.0 * b - 1.0;
-    precise float t = max(0.0, 1.0 - (x * x + y * y));
-    return t * t;
-}
-
 void main() {
     const uint id = gl_GlobalInvocationID.x;
     if (id >= pc.width * pc.height) return;
