@@ -39,10 +39,14 @@ Status MakeOutDir(const std::string& dir) {
     return {};
 }
 
+// Reads a buffer back in canonical form; adds the time it took to `timesMs` when given.
 template <typename T>
-Result<std::vector<T>> DownloadAll(Backend& backend, const Buffer& buffer) {
+Result<std::vector<T>> DownloadAll(Backend& backend, const Buffer& buffer, std::vector<double>* timesMs = nullptr) {
     std::vector<T> data(buffer.CanonicalBytes() / sizeof(T));
+    const auto start = std::chrono::steady_clock::now();
     CB_TRY(backend.Download(buffer, std::as_writable_bytes(std::span(data))));
+    if (timesMs)
+        timesMs->push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     return data;
 }
 
@@ -133,7 +137,7 @@ int RunCommand(const CommonOptions& options) {
             // The last frame of each camera.
             if (auto rendered = (*sim)->LastRenderedStep()) {
                 for (size_t n = 0; n < scene.render.cameras.size(); ++n) {
-                    auto rgb = DownloadAll<float>(**backend, *(*sim)->Image(n));
+                    auto rgb = DownloadAll<float>(**backend, *(*sim)->Image(n), &run.downloadMs);
                     if (!rgb) {
                         std::fprintf(stderr, "%s\n", rgb.error().message.c_str());
                         anyFailed = true;
@@ -147,7 +151,7 @@ int RunCommand(const CommonOptions& options) {
             }
             // The density map of the last step, seen from above.
             if (const Buffer* columnSum = (*sim)->ColumnSum(); columnSum && !run.steps.empty()) {
-                auto d = DownloadAll<float>(**backend, *columnSum);
+                auto d = DownloadAll<float>(**backend, *columnSum, &run.downloadMs);
                 std::string png = outDir + "/topview-" + name + ".png";
                 Status s = d ? WriteTopView(png, *d, scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz)
                              : Status(std::unexpected(d.error()));

@@ -83,6 +83,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         for (const StepRecord& r : run.steps)
             if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region)) hostSamples.push_back(r.ellipsoidUpdateMs);
         b["host"] = {{"ellipsoid_update", SummaryJson(hostSamples)}};
+        b["transfers"] = {{"download", SummaryJson(run.downloadMs)}};
         if (scene.stages.Has(Stage::RenderSplat)) {
             // Per camera: every frame's time and splat count, and their summary.
             nlohmann::json cameras = nlohmann::json::object();
@@ -175,6 +176,7 @@ std::string TimingTable(const Scene& scene, const BackendRun& run) {
             if (r.step >= scene.warmupSteps) host.push_back(r.ellipsoidUpdateMs);
         row("(host) ellipsoids", host, {});
     }
+    if (!run.downloadMs.empty()) row("(transfer) download", run.downloadMs, {});
     if (scene.stages.Has(Stage::Density) && !run.steps.empty()) {
         std::vector<double> after;
         for (const StepRecord& r : run.steps)

@@ -30,6 +30,8 @@ struct BackendRun {
     std::string status = "ok";  // "ok", "unavailable" or "failed"
     std::string error;
     std::vector<StepRecord> steps;
+    // Read-backs of outputs (frames, density map), timed apart from the stages.
+    std::vector<double> downloadMs;
 };
 
 nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs);

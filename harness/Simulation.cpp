@@ -187,6 +187,7 @@ Status Simulation::RunLighting(StepRecord& record) {
     }
     if (sc.stages.Has(Stage::RenderSplat)) {
         double total = 0;
+        std::optional<double> deviceTotal;
         for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
             SplatParams p;
             p.camera = MakeCameraFrame(sc.render.cameras[n], sc.render.width, sc.render.height);
@@ -218,9 +219,11 @@ Status Simulation::RunLighting(StepRecord& record) {
             frame.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
             total += frame.ms;
+            if (auto device = mBackend.LastDeviceMs()) deviceTotal = deviceTotal.value_or(0) + *device;
             record.frames.push_back(frame);
         }
         record.stageMs[size_t(Stage::RenderSplat)] = total;
+        record.deviceMs[size_t(Stage::RenderSplat)] = deviceTotal;
         mLastRendered = mStep;
     }
     return {};
