@@ -9,6 +9,7 @@
 #include "core/Random.h"
 #include "harness/Report.h"
 #include "harness/Simulation.h"
+#include "harness/StageParams.h"
 
 namespace cb {
 namespace {
@@ -208,19 +209,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
                     auto q = Filled(b, BufferFormat::F32, e, *qData);
                     auto T = b.CreateBuffer(BufferFormat::F32, e);
                     if (!q || !T) return MakeError("shade: allocation failed");
-                    ShadeParams p;
-                    p.sun = scene.sun.Direction();
-                    p.attenuation = scene.shade.attenuation;
-                    p.sigma = float(scene.shade.sigma);
-                    p.voxelSize = float(scene.grid.voxelSize);
-                    p.thesisAr = float(scene.shade.thesisAr);
-                    p.filter = scene.shade.filter;
-                    p.resolution = scene.shade.resolution;
-                    p.storage = scene.shade.storage;
-                    p.scattering = scene.shade.scattering;
-                    p.albedo = float(scene.shade.albedo);
-                    p.solidAngle = float(scene.shade.solidAngle);
-                    p.phase = scene.phase;
+                    const ShadeParams p = MakeShadeParams(scene);
                     CB_TRY(b.Shade(p, **q, **T));
                     const double tolerance = p.storage == StorageFormat::Fp32 ? 1e-5 : StorageQuantum(p.storage);
                     char rule[64];
@@ -234,13 +223,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
                     auto D = Filled(b, BufferFormat::F32, map, *dData);
                     auto G = b.CreateBuffer(BufferFormat::F32, map);
                     if (!D || !G) return MakeError("shadow: allocation failed");
-                    ShadowParams p;
-                    p.sun = scene.sun.Direction();
-                    p.form = scene.shadow.form;
-                    p.sigma = float(scene.shade.sigma);
-                    p.voxelSize = float(scene.grid.voxelSize);
-                    p.kappa = float(scene.shadow.kappa);
-                    p.nz = e.nz;
+                    const ShadowParams p = MakeShadowParams(scene);
                     CB_TRY(b.Shadow(p, **D, **G));
                     tally.Within("shadow", c.name, t, map, *Read<float>(cpu, *s.Shadow()), *Read<float>(b, **G), 1e-5,
                                  "|dG| <= 1e-05");
@@ -266,27 +249,9 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
                     if (!qp || !qc || !T || !tp || !tc || !bp || !bc) return MakeError("render_splat: copying inputs failed");
                     const RenderSettings& rs = scene.render;
                     for (size_t n = 0; n < rs.cameras.size(); ++n) {
-                        SplatParams p;
-                        p.camera = MakeCameraFrame(rs.cameras[n], rs.width, rs.height);
+                        SplatParams p = MakeSplatParams(scene, rs.cameras[n]);
                         const SplatOrder order = MakeSplatOrder(p.camera, e, scene.grid.origin, scene.grid.voxelSize);
                         p.order = &order;
-                        p.sun = scene.sun.Direction();
-                        p.sunRadiance = scene.sun.Radiance();
-                        for (int ch = 0; ch < 3; ++ch) {
-                            p.ambient[ch] = float(scene.lighting.ambient[ch]);
-                            p.background[ch] = float(scene.lighting.background[ch]);
-                        }
-                        p.phase = scene.phase;
-                        p.qMin = float(rs.qMin);
-                        p.splatDiameter = float(rs.splatScale * scene.grid.voxelSize);
-                        p.opacity = float(rs.opacity);
-                        p.alpha = float(rs.alpha);
-                        p.origin = {float(scene.grid.origin[0]), float(scene.grid.origin[1]), float(scene.grid.origin[2])};
-                        p.voxelSize = float(scene.grid.voxelSize);
-                        p.culling = rs.culling;
-                        p.skipping = rs.skipping;
-                        p.tile = scene.density.tile;
-                        p.band = scene.density.band;
                         auto image = b.CreateBuffer(BufferFormat::F32, {3, rs.width, rs.height});
                         if (!image) return std::unexpected(image.error());
                         SplatInputs in{qp->get(), qc->get(), T->get(), tp->get(), tc->get(), bp->get(), bc->get()};

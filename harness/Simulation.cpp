@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "core/Random.h"
+#include "harness/StageParams.h"
 
 namespace cb {
 namespace {
@@ -157,60 +158,23 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
 
 Status Simulation::RunLighting(StepRecord& record) {
     const Scene& sc = mScene;
-    const Vec3 sun = sc.sun.Direction();
     if (sc.stages.Has(Stage::Shade) && !mShadeCurrent) {
-        ShadeParams p;
-        p.sun = sun;
-        p.attenuation = sc.shade.attenuation;
-        p.sigma = float(sc.shade.sigma);
-        p.voxelSize = float(sc.grid.voxelSize);
-        p.thesisAr = float(sc.shade.thesisAr);
-        p.filter = sc.shade.filter;
-        p.resolution = sc.shade.resolution;
-        p.storage = sc.shade.storage;
-        p.scattering = sc.shade.scattering;
-        p.albedo = float(sc.shade.albedo);
-        p.solidAngle = float(sc.shade.solidAngle);
-        p.phase = sc.phase;
+        const ShadeParams p = MakeShadeParams(sc);
         CB_TRY(Timed(record, Stage::Shade, mBackend, [&] { return mBackend.Shade(p, *mQ, *mT); }));
         mShadeCurrent = true;
     }
     if (sc.stages.Has(Stage::Shadow)) {
-        ShadowParams p;
-        p.sun = sun;
-        p.form = sc.shadow.form;
-        p.sigma = float(sc.shade.sigma);
-        p.voxelSize = float(sc.grid.voxelSize);
-        p.kappa = float(sc.shadow.kappa);
-        p.nz = sc.grid.size.nz;
+        const ShadowParams p = MakeShadowParams(sc);
         CB_TRY(Timed(record, Stage::Shadow, mBackend, [&] { return mBackend.Shadow(p, *mColumnSum, *mShadow); }));
     }
     if (sc.stages.Has(Stage::RenderSplat)) {
         double total = 0;
         std::optional<double> deviceTotal;
         for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
-            SplatParams p;
-            p.camera = MakeCameraFrame(sc.render.cameras[n], sc.render.width, sc.render.height);
+            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
             // The order is host work shared by all backends, outside the stage time.
             const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
             p.order = &order;
-            p.sun = sun;
-            p.sunRadiance = sc.sun.Radiance();
-            for (int c = 0; c < 3; ++c) {
-                p.ambient[c] = float(sc.lighting.ambient[c]);
-                p.background[c] = float(sc.lighting.background[c]);
-            }
-            p.phase = sc.phase;
-            p.qMin = float(sc.render.qMin);
-            p.splatDiameter = float(sc.render.splatScale * sc.grid.voxelSize);
-            p.opacity = float(sc.render.opacity);
-            p.alpha = float(sc.render.alpha);
-            p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
-            p.voxelSize = float(sc.grid.voxelSize);
-            p.culling = sc.render.culling;
-            p.skipping = sc.render.skipping;
-            p.tile = sc.density.tile;
-            p.band = sc.density.band;
             SplatInputs in{mQPrev.get(), mQ.get(), mT.get(), mTilesPrev.get(), mTiles.get(), mBandsPrev.get(), mBands.get()};
             FrameRecord frame;
             frame.camera = sc.render.cameras[n].name;

@@ -12,6 +12,7 @@
 #include "core/Ellipsoids.h"
 #include "core/Random.h"
 #include "core/Scene.h"
+#include "harness/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb {
@@ -30,15 +31,8 @@ struct WarmState {
 std::unique_ptr<Buffer> Make(Backend& b, BufferFormat f, Extent3 e) { return std::move(*b.CreateBuffer(f, e)); }
 
 ShadeParams MakeShadeParams(const Scene& sc, int resolution) {
-    ShadeParams p;
-    p.sun = sc.sun.Direction();
-    p.attenuation = sc.shade.attenuation;
-    p.sigma = float(sc.shade.sigma);
-    p.voxelSize = float(sc.grid.voxelSize);
-    p.filter = sc.shade.filter;
+    ShadeParams p = cb::MakeShadeParams(sc);
     p.resolution = resolution;
-    p.storage = sc.shade.storage;
-    p.phase = sc.phase;
     return p;
 }
 
@@ -155,26 +149,11 @@ void BM_RenderSplat(benchmark::State& state, const std::string& scene) {
     WarmState& w = Warm(scene, int(state.range(0)));
     const Scene& sc = w.scene;
     const CameraSettings& camera = sc.render.cameras.at(size_t(state.range(1)));
-    SplatParams p;
-    p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
+    SplatParams p = cb::MakeSplatParams(sc, camera);
     const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
     p.order = &order;
-    p.sun = sc.sun.Direction();
-    p.sunRadiance = sc.sun.Radiance();
-    for (int c = 0; c < 3; ++c) {
-        p.ambient[c] = float(sc.lighting.ambient[c]);
-        p.background[c] = float(sc.lighting.background[c]);
-    }
-    p.phase = sc.phase;
-    p.qMin = float(sc.render.qMin);
-    p.splatDiameter = float(sc.render.splatScale * sc.grid.voxelSize);
-    p.opacity = float(sc.render.opacity);
-    p.alpha = float(sc.render.alpha);
-    p.voxelSize = float(sc.grid.voxelSize);
     p.culling = state.range(2) >= 1;
     p.skipping = state.range(2) >= 2;
-    p.tile = sc.density.tile;
-    p.band = sc.density.band;
     const SplatInputs in{w.q.get(), w.q.get(), w.T.get(), w.tiles.get(), w.tiles.get(), w.bands.get(), w.bands.get()};
     SplatStats stats;
     for (auto _ : state) (void)w.backend->RenderSplat(p, in, *w.image, &stats);

@@ -1,0 +1,56 @@
+#include "harness/StageParams.h"
+
+namespace cb {
+
+ShadeParams MakeShadeParams(const Scene& sc) {
+    ShadeParams p;
+    p.sun = sc.sun.Direction();
+    p.attenuation = sc.shade.attenuation;
+    p.sigma = float(sc.shade.sigma);
+    p.voxelSize = float(sc.grid.voxelSize);
+    p.thesisAr = float(sc.shade.thesisAr);
+    p.filter = sc.shade.filter;
+    p.resolution = sc.shade.resolution;
+    p.storage = sc.shade.storage;
+    p.scattering = sc.shade.scattering;
+    p.albedo = float(sc.shade.albedo);
+    p.solidAngle = float(sc.shade.solidAngle);
+    p.phase = sc.phase;
+    return p;
+}
+
+ShadowParams MakeShadowParams(const Scene& sc) {
+    ShadowParams p;
+    p.sun = sc.sun.Direction();
+    p.form = sc.shadow.form;
+    p.sigma = float(sc.shade.sigma);
+    p.voxelSize = float(sc.grid.voxelSize);
+    p.kappa = float(sc.shadow.kappa);
+    p.nz = sc.grid.size.nz;
+    return p;
+}
+
+SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
+    SplatParams p;
+    p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
+    p.sun = sc.sun.Direction();
+    p.sunRadiance = sc.sun.Radiance();
+    for (int c = 0; c < 3; ++c) {
+        p.ambient[c] = float(sc.lighting.ambient[c]);
+        p.background[c] = float(sc.lighting.background[c]);
+    }
+    p.phase = sc.phase;
+    p.qMin = float(sc.render.qMin);
+    p.splatDiameter = float(sc.render.splatScale * sc.grid.voxelSize);
+    p.opacity = float(sc.render.opacity);
+    p.alpha = float(sc.render.alpha);
+    p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
+    p.voxelSize = float(sc.grid.voxelSize);
+    p.culling = sc.render.culling;
+    p.skipping = sc.render.skipping;
+    p.tile = sc.density.tile;
+    p.band = sc.density.band;
+    return p;
+}
+
+}  // namespace cb
