@@ -194,6 +194,7 @@ struct BackendOptions {
     int cpuThreads = 0;      // 0: every hardware thread
     std::string vkDevice;    // Vulkan device index or name substring; "" = the first
     bool vkValidation = false;  // Khronos validation layer (also CLOUDBENCH_VK_VALIDATION=1)
+    std::string glContext;   // "osmesa" (default) or "egl"
 };
 
 // Creates a backend by name. An unknown name, or one whose device is missing,

@@ -28,12 +28,14 @@ struct CommonOptions {
     std::string outDir;                   // "" = out/<scene name>[/dump]
     int cpuThreads = 0;
     std::string vkDevice;                 // --vk-device INDEX|NAME
+    std::string glContext;                // --gl-context osmesa|egl
     bool quiet = false;
 
     BackendOptions Backend() const {
         BackendOptions b;
         b.cpuThreads = cpuThreads;
         b.vkDevice = vkDevice;
+        b.glContext = glContext;
         return b;
     }
 };

@@ -40,6 +40,7 @@ Options:
                      the file: --set ca.seed=42 --set grid.size=[64,16,64]
   --threads N        CPU backend threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
+  --gl-context CTX   OpenGL context: osmesa (default, llvmpipe) or egl (GPU or surfaceless)
   --quiet            no progress lines
 )";
 
@@ -153,6 +154,11 @@ int main(int argc, char** argv) {
             long threads = v ? std::strtol(v, &end, 10) : -1;
             if (!v || *end != '\0' || threads < 1 || threads > 1024) return Usage("--threads needs a number from 1", help);
             options.cpuThreads = int(threads);
+        } else if (arg == "--gl-context") {
+            const char* v = value();
+            if (!v || (std::string_view(v) != "osmesa" && std::string_view(v) != "egl"))
+                return Usage("--gl-context needs osmesa or egl", help);
+            options.glContext = v;
         } else if (arg == "--vk-device") {
             const char* v = value();
             if (!v) return Usage("--vk-device needs an index or a name", help);

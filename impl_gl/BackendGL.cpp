@@ -1,0 +1,140 @@
+#include "impl_gl/BackendGL.h"
+
+#include <chrono>
+#include <vector>
+
+namespace cb::gl {
+namespace {
+
+struct TexelFormat {
+    GLenum internal, format, type;
+};
+
+TexelFormat FormatOf(BufferFormat format) {
+    switch (format) {
+        case BufferFormat::Bits: return {GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT};
+        case BufferFormat::U8: return {GL_R8UI, GL_RED_INTEGER, GL_UNSIGNED_BYTE};
+        case BufferFormat::F32: return {GL_R32F, GL_RED, GL_FLOAT};
+    }
+    return {GL_R32F, GL_RED, GL_FLOAT};
+}
+
+const BufferGL& Tex(const Buffer& b) { return static_cast<const BufferGL&>(b); }
+
+}  // namespace
+
+Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context) {
+    if (!context.empty() && context != "osmesa" && context != "egl")
+        return MakeError("gl: unknown context '" + context + "' (osmesa or egl)");
+    auto ctx = GLContext::Create(context == "egl" ? ContextKind::Egl : ContextKind::OSMesa);
+    if (!ctx) return std::unexpected(ctx.error());
+    return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx)));
+}
+
+bool BackendGL::Supports(Stage stage) const { return stage == Stage::Smooth; }
+
+Status BackendGL::NotYet(const char* stage) const {
+    return MakeError(std::string("gl: stage '") + stage + "' is not implemented yet (issue 5)");
+}
+
+Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Extent3 extent) {
+    if (extent.Count() == 0) return MakeError("gl: cannot create an empty buffer");
+    const Functions& f = mContext->F();
+    const TexelFormat t = FormatOf(format);
+    GLuint texture = 0;
+    f.CreateTextures(GL_TEXTURE_2D_ARRAY, 1, &texture);
+    const GLsizei width = GLsizei(format == BufferFormat::Bits ? (extent.nx + 31) / 32 : extent.nx);
+    f.TextureStorage3D(texture, 1, t.internal, width, GLsizei(extent.ny), GLsizei(extent.nz));
+    f.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    f.TextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    auto buffer = std::make_unique<BufferGL>(format, extent, f, texture);
+    CB_TRY(mContext->Check("creating a texture"));
+    return std::unique_ptr<Buffer>(std::move(buffer));
+}
+
+Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
+    if (canonical.size() != buffer.CanonicalBytes()) return MakeError("gl: upload size does not match the buffer");
+    const Functions& f = mContext->F();
+    const BufferGL& b = Tex(buffer);
+    const Extent3 e = b.Extent();
+    const TexelFormat t = FormatOf(b.Format());
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    std::vector<uint32_t> packed;
+    const void* data = canonical.data();
+    if (b.Format() == BufferFormat::Bits) {
+        const uint32_t words = b.Width();
+        packed.assign(size_t(words) * e.ny * e.nz, 0);
+        const auto* src = reinterpret_cast<const uint8_t*>(canonical.data());
+        for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
+            for (uint32_t i = 0; i < e.nx; ++i) packed[row * words + i / 32] |= uint32_t(src[row * e.nx + i] != 0) << (i % 32);
+        data = packed.data();
+    }
+    f.TextureSubImage3D(b.Texture(), 0, 0, 0, 0, GLsizei(b.Width()), GLsizei(e.ny), GLsizei(e.nz), t.format, t.type, data);
+    return mContext->Check("uploading a texture");
+}
+
+Status BackendGL::Download(const Buffer& buffer, std::span<std::byte> canonical) {
+    if (canonical.size() != buffer.CanonicalBytes()) return MakeError("gl: download size does not match the buffer");
+    const Functions& f = mContext->F();
+    const BufferGL& b = Tex(buffer);
+    const Extent3 e = b.Extent();
+    const TexelFormat t = FormatOf(b.Format());
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    if (b.Format() != BufferFormat::Bits) {
+        f.GetTextureImage(b.Texture(), 0, t.format, t.type, GLsizei(canonical.size()), canonical.data());
+        return mContext->Check("downloading a texture");
+    }
+    const uint32_t words = b.Width();
+    std::vector<uint32_t> packed(size_t(words) * e.ny * e.nz);
+    f.GetTextureImage(b.Texture(), 0, t.format, t.type, GLsizei(packed.size() * 4), packed.data());
+    CB_TRY(mContext->Check("downloading a texture"));
+    auto* dst = reinterpret_cast<uint8_t*>(canonical.data());
+    for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
+        for (uint32_t i = 0; i < e.nx; ++i) dst[row * e.nx + i] = uint8_t((packed[row * words + i / 32] >> (i % 32)) & 1);
+    return {};
+}
+
+Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
+    if (radius < 0 || radius > 2) return MakeError("gl: smooth radius must be 0, 1 or 2");
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("smooth");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = cld.Extent();
+    GLuint queries[2];
+    f.GenQueries(2, queries);
+    f.QueryCounter(queries[0], GL_TIMESTAMP);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindTextureUnit(0, Tex(cld).Texture());
+    f.Uniform1i(f.GetUniformLocation(*program, "radius"), radius);
+    f.Uniform1f(f.GetUniformLocation(*program, "invW"), 1.0f / float(SmoothNormaliser(radius)));
+    f.Uniform3i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    const GLint layerLocation = f.GetUniformLocation(*program, "layer");
+    f.BindFramebuffer(GL_FRAMEBUFFER, mContext->Framebuffer());
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        f.NamedFramebufferTextureLayer(mContext->Framebuffer(), GL_COLOR_ATTACHMENT0, Tex(q).Texture(), 0, GLint(k));
+        if (k == 0 && f.CheckNamedFramebufferStatus(mContext->Framebuffer(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            return MakeError("gl: smooth: the R32F slice is not a complete framebuffer");
+        f.Uniform1i(layerLocation, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    f.QueryCounter(queries[1], GL_TIMESTAMP);
+    f.Finish();
+    GLuint64 t0 = 0, t1 = 0;
+    f.GetQueryObjectui64v(queries[0], GL_QUERY_RESULT, &t0);
+    f.GetQueryObjectui64v(queries[1], GL_QUERY_RESULT, &t1);
+    f.DeleteQueries(2, queries);
+    mLastDeviceMs = double(t1 - t0) * 1e-6;
+    return mContext->Check("smooth");
+}
+
+Status BackendGL::Region(std::span<const RasterEllipsoid>, Buffer&) { return NotYet("region"); }
+Status BackendGL::CaInitialize(const CaInitParams&, CaFields) { return NotYet("ca"); }
+Status BackendGL::CaStep(const CaStepParams&, ConstCaFields, const Buffer&, CaFields) { return NotYet("ca"); }
+Status BackendGL::Density(const DensityParams&, const Buffer&, const Buffer&, DensityOutputs&) { return NotYet("density"); }
+Status BackendGL::Shade(const ShadeParams&, const Buffer&, Buffer&) { return NotYet("shade"); }
+Status BackendGL::Shadow(const ShadowParams&, const Buffer&, Buffer&) { return NotYet("shadow"); }
+Status BackendGL::RenderSplat(const SplatParams&, const SplatInputs&, Buffer&, SplatStats*) { return NotYet("render_splat"); }
+
+}  // namespace cb::gl

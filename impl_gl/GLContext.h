@@ -1,0 +1,50 @@
+// An OpenGL 4.5 core context without a window: OSMesa (llvmpipe, the default)
+// or EGL (surfaceless or device platform, for real GPUs). Programs come from
+// the shader sources embedded at build time (impl_gl/shaders), each with the
+// shared GLSL includes of core/glsl prepended.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "core/Error.h"
+#include "impl_gl/GLFunctions.h"
+
+namespace cb::gl {
+
+enum class ContextKind { OSMesa, Egl };
+
+class GLContext {
+  public:
+    static Result<std::unique_ptr<GLContext>> Create(ContextKind kind);
+    ~GLContext();
+    GLContext(const GLContext&) = delete;
+    GLContext& operator=(const GLContext&) = delete;
+
+    const Functions& F() const { return mF; }
+    std::string Renderer() const;
+    // "doing X: GL_INVALID_OPERATION" for a pending GL error; ok otherwise.
+    Status Check(const char* what) const;
+    // The linked program of a fragment pass (shaders/<name>.frag with the
+    // full-screen vertex shader); a compile or link failure carries its log.
+    Result<GLuint> Program(const std::string& name);
+    // An empty vertex array for attribute-less draws.
+    GLuint EmptyVao() const { return mVao; }
+    GLuint Framebuffer() const { return mFramebuffer; }
+
+  private:
+    GLContext() = default;
+    Status LoadFunctions(void* (*resolve)(const char*));
+
+    ContextKind mKind = ContextKind::OSMesa;
+    void* mOsmesa = nullptr;            // OSMesaContext
+    std::unique_ptr<unsigned char[]> mOsmesaBuffer;
+    void* mEglDisplay = nullptr;        // EGLDisplay
+    void* mEglContext = nullptr;        // EGLContext
+    Functions mF;
+    GLuint mVao = 0, mFramebuffer = 0;
+    std::map<std::string, GLuint> mPrograms;
+};
+
+}  // namespace cb::gl

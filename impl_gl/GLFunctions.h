@@ -1,0 +1,63 @@
+// The OpenGL 4.5 core entry points the backend uses, resolved from the current
+// context (OSMesaGetProcAddress or eglGetProcAddress): neither OSMesa nor EGL
+// contexts go through libglvnd's GLX dispatch, so the table is filled here.
+#pragma once
+
+#include <GL/glcorearb.h>
+
+#define CB_GL_FUNCTIONS(X)                                                     \
+    X(PFNGLGETSTRINGPROC, GetString)                                           \
+    X(PFNGLGETERRORPROC, GetError)                                             \
+    X(PFNGLGETINTEGERVPROC, GetIntegerv)                                       \
+    X(PFNGLCREATESHADERPROC, CreateShader)                                     \
+    X(PFNGLSHADERSOURCEPROC, ShaderSource)                                     \
+    X(PFNGLCOMPILESHADERPROC, CompileShader)                                   \
+    X(PFNGLGETSHADERIVPROC, GetShaderiv)                                       \
+    X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                             \
+    X(PFNGLDELETESHADERPROC, DeleteShader)                                     \
+    X(PFNGLCREATEPROGRAMPROC, CreateProgram)                                   \
+    X(PFNGLATTACHSHADERPROC, AttachShader)                                     \
+    X(PFNGLLINKPROGRAMPROC, LinkProgram)                                       \
+    X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                     \
+    X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                           \
+    X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                                   \
+    X(PFNGLUSEPROGRAMPROC, UseProgram)                                         \
+    X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                         \
+    X(PFNGLUNIFORM1IPROC, Uniform1i)                                           \
+    X(PFNGLUNIFORM3IPROC, Uniform3i)                                           \
+    X(PFNGLUNIFORM1UIPROC, Uniform1ui)                                         \
+    X(PFNGLUNIFORM1FPROC, Uniform1f)                                           \
+    X(PFNGLCREATETEXTURESPROC, CreateTextures)                                 \
+    X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                 \
+    X(PFNGLTEXTURESTORAGE3DPROC, TextureStorage3D)                             \
+    X(PFNGLTEXTURESUBIMAGE3DPROC, TextureSubImage3D)                           \
+    X(PFNGLGETTEXTUREIMAGEPROC, GetTextureImage)                               \
+    X(PFNGLTEXTUREPARAMETERIPROC, TextureParameteri)                           \
+    X(PFNGLBINDTEXTUREUNITPROC, BindTextureUnit)                               \
+    X(PFNGLCREATEFRAMEBUFFERSPROC, CreateFramebuffers)                         \
+    X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                         \
+    X(PFNGLNAMEDFRAMEBUFFERTEXTURELAYERPROC, NamedFramebufferTextureLayer)     \
+    X(PFNGLCHECKNAMEDFRAMEBUFFERSTATUSPROC, CheckNamedFramebufferStatus)       \
+    X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                               \
+    X(PFNGLCREATEVERTEXARRAYSPROC, CreateVertexArrays)                         \
+    X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                         \
+    X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                               \
+    X(PFNGLVIEWPORTPROC, Viewport)                                             \
+    X(PFNGLDISABLEPROC, Disable)                                               \
+    X(PFNGLDRAWARRAYSPROC, DrawArrays)                                         \
+    X(PFNGLPIXELSTOREIPROC, PixelStorei)                                       \
+    X(PFNGLFINISHPROC, Finish)                                                 \
+    X(PFNGLGENQUERIESPROC, GenQueries)                                         \
+    X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                   \
+    X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \
+    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
+
+namespace cb::gl {
+
+struct Functions {
+#define CB_GL_DECLARE(type, name) type name = nullptr;
+    CB_GL_FUNCTIONS(CB_GL_DECLARE)
+#undef CB_GL_DECLARE
+};
+
+}  // namespace cb::gl
