@@ -31,7 +31,7 @@ Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context)
     return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx)));
 }
 
-bool BackendGL::Supports(Stage stage) const { return stage == Stage::Smooth; }
+bool BackendGL::Supports(Stage stage) const { return stage == Stage::Smooth || stage == Stage::Density; }
 
 Status BackendGL::NotYet(const char* stage) const {
     return MakeError(std::string("gl: stage '") + stage + "' is not implemented yet (issue 5)");
@@ -132,7 +132,88 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
 Status BackendGL::Region(std::span<const RasterEllipsoid>, Buffer&) { return NotYet("region"); }
 Status BackendGL::CaInitialize(const CaInitParams&, CaFields) { return NotYet("ca"); }
 Status BackendGL::CaStep(const CaStepParams&, ConstCaFields, const Buffer&, CaFields) { return NotYet("ca"); }
-Status BackendGL::Density(const DensityParams&, const Buffer&, const Buffer&, DensityOutputs&) { return NotYet("density"); }
+Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) {
+    if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
+    const Functions& f = mContext->F();
+    auto sum = mContext->Program("density_sum");
+    if (!sum) return std::unexpected(sum.error());
+    auto cover = mContext->Program("density_cover");
+    if (!cover) return std::unexpected(cover.error());
+    auto occupancy = mContext->Program("occupancy");
+    if (!occupancy) return std::unexpected(occupancy.error());
+    const Extent3 e = q.Extent();
+    const GLuint fb = mContext->Framebuffer();
+    const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
+    const uint32_t bandCount = CeilDiv(e.nz, params.band);
+    GLuint queries[2];
+    f.GenQueries(2, queries);
+    f.QueryCounter(queries[0], GL_TIMESTAMP);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindFramebuffer(GL_FRAMEBUFFER, fb);
+
+    // D: additive blending of the slices, k ascending.
+    const float zero = 0.0f;
+    f.ClearTexImage(Tex(*out.columnSum).Texture(), 0, GL_RED, GL_FLOAT, &zero);
+    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.columnSum).Texture(), 0, 0);
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    f.UseProgram(*sum);
+    f.BindTextureUnit(0, Tex(q).Texture());
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.BlendFunc(GL_ONE, GL_ONE);
+    const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        f.Uniform1i(sumLayer, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    f.Disable(GL_BLEND);
+
+    // Cover: an atomic counter over the columns; the column flags land in a scratch R8UI layer.
+    GLuint counter = 0;
+    f.CreateBuffers(1, &counter);
+    const GLuint initial = 0;
+    f.NamedBufferData(counter, sizeof initial, &initial, GL_DYNAMIC_READ);
+    f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
+    auto flags = CreateBuffer(BufferFormat::U8, {e.nx, e.ny, 1});
+    if (!flags) return std::unexpected(flags.error());
+    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(**flags).Texture(), 0, 0);
+    f.UseProgram(*cover);
+    f.BindTextureUnit(0, Tex(cld).Texture());
+    f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+
+    // Occupancy: max-downsampling to tiles (from D) and to tile x band (from q).
+    f.UseProgram(*occupancy);
+    f.BindTextureUnit(0, Tex(q).Texture());
+    f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
+    f.Uniform3i(f.GetUniformLocation(*occupancy, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform2i(f.GetUniformLocation(*occupancy, "tileBand"), GLint(params.tile), GLint(params.band));
+    const GLint mode = f.GetUniformLocation(*occupancy, "mode"), layer = f.GetUniformLocation(*occupancy, "layer");
+    f.Viewport(0, 0, GLsizei(tilesX), GLsizei(tilesY));
+    f.Uniform1i(mode, 0);
+    for (uint32_t b = 0; b < bandCount; ++b) {
+        f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.bands).Texture(), 0, GLint(b));
+        f.Uniform1i(layer, GLint(b));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    f.Uniform1i(mode, 1);
+    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.tiles).Texture(), 0, 0);
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+
+    f.QueryCounter(queries[1], GL_TIMESTAMP);
+    f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    f.Finish();
+    GLuint covered = 0;
+    f.GetNamedBufferSubData(counter, 0, sizeof covered, &covered);
+    f.DeleteBuffers(1, &counter);
+    out.coveredColumns = covered;
+    GLuint64 t0 = 0, t1 = 0;
+    f.GetQueryObjectui64v(queries[0], GL_QUERY_RESULT, &t0);
+    f.GetQueryObjectui64v(queries[1], GL_QUERY_RESULT, &t1);
+    f.DeleteQueries(2, queries);
+    mLastDeviceMs = double(t1 - t0) * 1e-6;
+    return mContext->Check("density");
+}
 Status BackendGL::Shade(const ShadeParams&, const Buffer&, Buffer&) { return NotYet("shade"); }
 Status BackendGL::Shadow(const ShadowParams&, const Buffer&, Buffer&) { return NotYet("shadow"); }
 Status BackendGL::RenderSplat(const SplatParams&, const SplatInputs&, Buffer&, SplatStats*) { return NotYet("render_splat"); }

@@ -25,6 +25,7 @@
     X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                         \
     X(PFNGLUNIFORM1IPROC, Uniform1i)                                           \
     X(PFNGLUNIFORM3IPROC, Uniform3i)                                           \
+    X(PFNGLUNIFORM2IPROC, Uniform2i)                                           \
     X(PFNGLUNIFORM1UIPROC, Uniform1ui)                                         \
     X(PFNGLUNIFORM1FPROC, Uniform1f)                                           \
     X(PFNGLCREATETEXTURESPROC, CreateTextures)                                 \
@@ -44,6 +45,16 @@
     X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                               \
     X(PFNGLVIEWPORTPROC, Viewport)                                             \
     X(PFNGLDISABLEPROC, Disable)                                               \
+    X(PFNGLENABLEPROC, Enable)                                                 \
+    X(PFNGLBLENDFUNCPROC, BlendFunc)                                           \
+    X(PFNGLBLENDEQUATIONPROC, BlendEquation)                                   \
+    X(PFNGLCLEARTEXIMAGEPROC, ClearTexImage)                                   \
+    X(PFNGLCREATEBUFFERSPROC, CreateBuffers)                                   \
+    X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                                   \
+    X(PFNGLNAMEDBUFFERDATAPROC, NamedBufferData)                               \
+    X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                 \
+    X(PFNGLGETNAMEDBUFFERSUBDATAPROC, GetNamedBufferSubData)                   \
+    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                   \
     X(PFNGLDRAWARRAYSPROC, DrawArrays)                                         \
     X(PFNGLPIXELSTOREIPROC, PixelStorei)                                       \
     X(PFNGLFINISHPROC, Finish)                                                 \
