@@ -1,6 +1,8 @@
 #include "impl_gl/BackendGL.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 namespace cb::gl {
@@ -31,7 +33,9 @@ Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context)
     return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx)));
 }
 
-bool BackendGL::Supports(Stage stage) const { return stage == Stage::Smooth || stage == Stage::Density; }
+bool BackendGL::Supports(Stage stage) const {
+    return stage == Stage::Smooth || stage == Stage::Density || stage == Stage::Shadow;
+}
 
 Status BackendGL::NotYet(const char* stage) const {
     return MakeError(std::string("gl: stage '") + stage + "' is not implemented yet (issue 5)");
@@ -215,7 +219,52 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     return mContext->Check("density");
 }
 Status BackendGL::Shade(const ShadeParams&, const Buffer&, Buffer&) { return NotYet("shade"); }
-Status BackendGL::Shadow(const ShadowParams&, const Buffer&, Buffer&) { return NotYet("shadow"); }
+Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) {
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("shadow");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = columnSum.Extent();
+    const Vec3& s = params.sun;
+    GLint bx = 0, by = 0;
+    float fx = 0, fy = 0, opticalDepthPerD = 0;
+    if (s[2] > 0.0f) {
+        // The same offset arithmetic as the CPU (impl_cpu/ShadeCpu.cpp).
+        const float climb = 0.5f * float(params.nz) / s[2];
+        const float limit = float(e.nx + e.ny) + 2.0f;
+        const float cx = std::clamp(s[0] * climb, -limit, limit), cy = std::clamp(s[1] * climb, -limit, limit);
+        bx = GLint(std::floor(cx));
+        by = GLint(std::floor(cy));
+        fx = cx - std::floor(cx);
+        fy = cy - std::floor(cy);
+        opticalDepthPerD = params.sigma * params.voxelSize / s[2];
+    }
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindTextureUnit(0, Tex(columnSum).Texture());
+    f.Uniform2i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny));
+    f.Uniform2i(f.GetUniformLocation(*program, "base"), bx, by);
+    f.Uniform2f(f.GetUniformLocation(*program, "fraction"), fx, fy);
+    f.Uniform1i(f.GetUniformLocation(*program, "beer"), params.form == AttenuationKind::Beer ? 1 : 0);
+    f.Uniform1f(f.GetUniformLocation(*program, "opticalDepthPerD"), opticalDepthPerD);
+    f.Uniform1f(f.GetUniformLocation(*program, "kappa"), params.kappa);
+    f.Uniform1i(f.GetUniformLocation(*program, "noSun"), s[2] <= 0.0f ? 1 : 0);
+    const GLuint fb = mContext->Framebuffer();
+    f.BindFramebuffer(GL_FRAMEBUFFER, fb);
+    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(G).Texture(), 0, 0);
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    GLuint queries[2];
+    f.GenQueries(2, queries);
+    f.QueryCounter(queries[0], GL_TIMESTAMP);
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    f.QueryCounter(queries[1], GL_TIMESTAMP);
+    f.Finish();
+    GLuint64 t0 = 0, t1 = 0;
+    f.GetQueryObjectui64v(queries[0], GL_QUERY_RESULT, &t0);
+    f.GetQueryObjectui64v(queries[1], GL_QUERY_RESULT, &t1);
+    f.DeleteQueries(2, queries);
+    mLastDeviceMs = double(t1 - t0) * 1e-6;
+    return mContext->Check("shadow");
+}
 Status BackendGL::RenderSplat(const SplatParams&, const SplatInputs&, Buffer&, SplatStats*) { return NotYet("render_splat"); }
 
 }  // namespace cb::gl
