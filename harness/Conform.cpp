@@ -285,7 +285,12 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
             const std::vector<uint8_t> region = *Read<uint8_t>(cpu, *(*sim)->Region());
             for (Candidate& c : others) {
                 Backend& b = *c.backend;
-                if (!b.Supports(Stage::Ca)) continue;
+                if (!b.Supports(Stage::Ca)) {
+                    ConformRow& row = tally.Row("ca", c.name, "", 0);
+                    row.status = "skipped";
+                    row.detail = c.name + " does not implement it yet";
+                    continue;
+                }
                 std::unique_ptr<Buffer> in[3], out[3];
                 for (int f = 0; f < 3; ++f) {
                     auto buffer = Filled(b, BufferFormat::Bits, e, stateBefore[f]);
