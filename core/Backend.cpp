@@ -4,4 +4,20 @@ namespace cb {
 
 size_t CanonicalElementBytes(BufferFormat format) { return format == BufferFormat::F32 ? 4 : 1; }
 
+std::vector<uint32_t> PackBits32(std::span<const std::byte> canonical, const Extent3& e) {
+    const uint32_t words = CeilDiv(e.nx, 32);
+    std::vector<uint32_t> packed(size_t(words) * e.ny * e.nz, 0);
+    const auto* src = reinterpret_cast<const uint8_t*>(canonical.data());
+    for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
+        for (uint32_t i = 0; i < e.nx; ++i) packed[row * words + i / 32] |= uint32_t(src[row * e.nx + i] != 0) << (i % 32);
+    return packed;
+}
+
+void UnpackBits32(std::span<const uint32_t> packed, const Extent3& e, std::span<std::byte> canonical) {
+    const uint32_t words = CeilDiv(e.nx, 32);
+    auto* dst = reinterpret_cast<uint8_t*>(canonical.data());
+    for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
+        for (uint32_t i = 0; i < e.nx; ++i) dst[row * e.nx + i] = uint8_t((packed[row * words + i / 32] >> (i % 32)) & 1);
+}
+
 }  // namespace cb

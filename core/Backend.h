@@ -34,6 +34,11 @@ enum class BufferFormat : uint8_t {
 
 size_t CanonicalElementBytes(BufferFormat format);
 
+// Canonical bit fields (one byte, 0 or 1, per voxel) to 32 voxels per uint32
+// along x, rows of ceil(nx/32) words, and back: the GPU backends' layout.
+std::vector<uint32_t> PackBits32(std::span<const std::byte> canonical, const Extent3& extent);
+void UnpackBits32(std::span<const uint32_t> packed, const Extent3& extent, std::span<std::byte> canonical);
+
 class Buffer {
   public:
     Buffer(BufferFormat format, Extent3 extent) : mFormat(format), mExtent(extent) {}

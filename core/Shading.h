@@ -203,6 +203,34 @@ inline SliceAttenuation MakeSliceAttenuation(AttenuationKind kind, float sigma, 
     return a;
 }
 
+// Where the ground shadow reads D (SPEC 7), shared by every backend. From
+// ground cell (i, j) along s to mid-height (nz/2 voxels up), D is read
+// bilinearly at (i + ox, j + oy): taps at (i + baseX, j + baseY) and +1 with
+// weights fx, fy. `noSun` (s_z <= 0) means G = 1 everywhere.
+struct ShadowLookup {
+    bool noSun = true;
+    int32_t baseX = 0, baseY = 0;
+    float fx = 0, fy = 0;
+    float opticalDepthPerD = 0;  // sigma h / s_z, the beer form's factor
+};
+
+inline ShadowLookup MakeShadowLookup(const Vec3& s, uint32_t nx, uint32_t ny, uint32_t nz, float sigma, float voxelSize) {
+    ShadowLookup l;
+    if (s[2] <= 0.0f) return l;
+    l.noSun = false;
+    const float climb = 0.5f * float(nz) / s[2];
+    // Offsets beyond the grid put every tap outside; clamping them keeps the
+    // integer conversion defined and changes no result.
+    const float limit = float(nx + ny) + 2.0f;
+    const float cx = std::clamp(s[0] * climb, -limit, limit), cy = std::clamp(s[1] * climb, -limit, limit);
+    l.baseX = int32_t(std::floor(cx));
+    l.baseY = int32_t(std::floor(cy));
+    l.fx = cx - std::floor(cx);
+    l.fy = cy - std::floor(cy);
+    l.opticalDepthPerD = sigma * voxelSize / s[2];
+    return l;
+}
+
 // ---- Splat kernel (SPEC 8) -------------------------------------------------------
 
 // kappa = max(0, 1 - rho^2)^2 at splat coordinate (a, b) in [0, 1]^2.

@@ -265,34 +265,22 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
     const float* D = static_cast<const BufferCpu&>(columnSumBuffer).F32();
     float* G = static_cast<BufferCpu&>(GBuffer).F32();
     const Extent3 e = columnSumBuffer.Extent();
-    const Vec3& s = params.sun;
-    if (s[2] <= 0.0f) {  // no sun above the horizon: no shadow (docs/pipeline.md)
+    const ShadowLookup l = MakeShadowLookup(params.sun, e.nx, e.ny, params.nz, params.sigma, params.voxelSize);
+    if (l.noSun) {  // no sun above the horizon: no shadow (docs/pipeline.md)
         std::fill(G, G + size_t(e.nx) * e.ny, 1.0f);
         return {};
     }
-    // From ground cell (i, j) along s to mid-height (nz/2 voxels up), D is read
-    // at (i + ox, j + oy) in voxel-centre coordinates.
-    const float climb = 0.5f * float(params.nz) / s[2];
-    const float ox = s[0] * climb, oy = s[1] * climb;
-    const float opticalDepthPerD = params.sigma * params.voxelSize / s[2];
     auto tap = [&](int64_t i, int64_t j) -> float {
         return (i < 0 || j < 0 || i >= e.nx || j >= e.ny) ? 0.0f : D[size_t(i) + size_t(e.nx) * size_t(j)];
     };
-    // Offsets beyond the grid put every tap outside; clamp them so the integer
-    // conversion below stays defined.
-    const float limit = float(e.nx + e.ny) + 2.0f;
-    const float cx = std::clamp(ox, -limit, limit), cy = std::clamp(oy, -limit, limit);
-    const float floorX = std::floor(cx), floorY = std::floor(cy);
-    const int64_t bx = int64_t(floorX), by = int64_t(floorY);
-    const float fx = cx - floorX, fy = cy - floorY;
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny, 8), [&](const tbb::blocked_range<uint32_t>& rows) {
             for (uint32_t j = rows.begin(); j != rows.end(); ++j)
                 for (uint32_t i = 0; i < e.nx; ++i) {
-                    const int64_t x = int64_t(i) + bx, y = int64_t(j) + by;
-                    const float d = Bilinear(tap(x, y), tap(x + 1, y), tap(x, y + 1), tap(x + 1, y + 1), fx, fy);
+                    const int64_t x = int64_t(i) + l.baseX, y = int64_t(j) + l.baseY;
+                    const float d = Bilinear(tap(x, y), tap(x + 1, y), tap(x, y + 1), tap(x + 1, y + 1), l.fx, l.fy);
                     G[i + size_t(e.nx) * j] = params.form == AttenuationKind::Beer
-                                                  ? ExpNonPositive(-opticalDepthPerD * d)
+                                                  ? ExpNonPositive(-l.opticalDepthPerD * d)
                                                   : 1.0f - std::clamp(params.kappa * d, 0.0f, 1.0f);
                 }
         });

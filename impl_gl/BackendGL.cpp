@@ -66,11 +66,7 @@ Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
     std::vector<uint32_t> packed;
     const void* data = canonical.data();
     if (b.Format() == BufferFormat::Bits) {
-        const uint32_t words = b.Width();
-        packed.assign(size_t(words) * e.ny * e.nz, 0);
-        const auto* src = reinterpret_cast<const uint8_t*>(canonical.data());
-        for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
-            for (uint32_t i = 0; i < e.nx; ++i) packed[row * words + i / 32] |= uint32_t(src[row * e.nx + i] != 0) << (i % 32);
+        packed = PackBits32(canonical, e);
         data = packed.data();
     }
     f.TextureSubImage3D(b.Texture(), 0, 0, 0, 0, GLsizei(b.Width()), GLsizei(e.ny), GLsizei(e.nz), t.format, t.type, data);
@@ -88,13 +84,10 @@ Status BackendGL::Download(const Buffer& buffer, std::span<std::byte> canonical)
         f.GetTextureImage(b.Texture(), 0, t.format, t.type, GLsizei(canonical.size()), canonical.data());
         return mContext->Check("downloading a texture");
     }
-    const uint32_t words = b.Width();
-    std::vector<uint32_t> packed(size_t(words) * e.ny * e.nz);
+    std::vector<uint32_t> packed(size_t(b.Width()) * e.ny * e.nz);
     f.GetTextureImage(b.Texture(), 0, t.format, t.type, GLsizei(packed.size() * 4), packed.data());
     CB_TRY(mContext->Check("downloading a texture"));
-    auto* dst = reinterpret_cast<uint8_t*>(canonical.data());
-    for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
-        for (uint32_t i = 0; i < e.nx; ++i) dst[row * e.nx + i] = uint8_t((packed[row * words + i / 32] >> (i % 32)) & 1);
+    UnpackBits32(packed, e, canonical);
     return {};
 }
 
@@ -224,30 +217,17 @@ Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     auto program = mContext->Program("shadow");
     if (!program) return std::unexpected(program.error());
     const Extent3 e = columnSum.Extent();
-    const Vec3& s = params.sun;
-    GLint bx = 0, by = 0;
-    float fx = 0, fy = 0, opticalDepthPerD = 0;
-    if (s[2] > 0.0f) {
-        // The same offset arithmetic as the CPU (impl_cpu/ShadeCpu.cpp).
-        const float climb = 0.5f * float(params.nz) / s[2];
-        const float limit = float(e.nx + e.ny) + 2.0f;
-        const float cx = std::clamp(s[0] * climb, -limit, limit), cy = std::clamp(s[1] * climb, -limit, limit);
-        bx = GLint(std::floor(cx));
-        by = GLint(std::floor(cy));
-        fx = cx - std::floor(cx);
-        fy = cy - std::floor(cy);
-        opticalDepthPerD = params.sigma * params.voxelSize / s[2];
-    }
+    const ShadowLookup l = MakeShadowLookup(params.sun, e.nx, e.ny, params.nz, params.sigma, params.voxelSize);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindTextureUnit(0, Tex(columnSum).Texture());
     f.Uniform2i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny));
-    f.Uniform2i(f.GetUniformLocation(*program, "base"), bx, by);
-    f.Uniform2f(f.GetUniformLocation(*program, "fraction"), fx, fy);
+    f.Uniform2i(f.GetUniformLocation(*program, "base"), l.baseX, l.baseY);
+    f.Uniform2f(f.GetUniformLocation(*program, "fraction"), l.fx, l.fy);
     f.Uniform1i(f.GetUniformLocation(*program, "beer"), params.form == AttenuationKind::Beer ? 1 : 0);
-    f.Uniform1f(f.GetUniformLocation(*program, "opticalDepthPerD"), opticalDepthPerD);
+    f.Uniform1f(f.GetUniformLocation(*program, "opticalDepthPerD"), l.opticalDepthPerD);
     f.Uniform1f(f.GetUniformLocation(*program, "kappa"), params.kappa);
-    f.Uniform1i(f.GetUniformLocation(*program, "noSun"), s[2] <= 0.0f ? 1 : 0);
+    f.Uniform1i(f.GetUniformLocation(*program, "noSun"), l.noSun ? 1 : 0);
     const GLuint fb = mContext->Framebuffer();
     f.BindFramebuffer(GL_FRAMEBUFFER, fb);
     f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(G).Texture(), 0, 0);

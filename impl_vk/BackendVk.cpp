@@ -74,14 +74,7 @@ Result<std::unique_ptr<Buffer>> BackendVk::CreateBuffer(BufferFormat format, Ext
 Status BackendVk::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
     if (canonical.size() != buffer.CanonicalBytes()) return MakeError("vk: upload size does not match the buffer");
     if (buffer.Format() != BufferFormat::Bits) return mContext->Upload(Dev(buffer), canonical);
-    // Pack canonical bytes (0/1) into 32-voxel words.
-    const Extent3 e = buffer.Extent();
-    const uint32_t words = (e.nx + 31) / 32;
-    std::vector<uint32_t> packed(size_t(words) * e.ny * e.nz, 0);
-    const auto* src = reinterpret_cast<const uint8_t*>(canonical.data());
-    for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
-        for (uint32_t i = 0; i < e.nx; ++i)
-            packed[row * words + i / 32] |= uint32_t(src[row * e.nx + i] != 0) << (i % 32);
+    const std::vector<uint32_t> packed = PackBits32(canonical, buffer.Extent());
     return mContext->Upload(Dev(buffer), std::as_bytes(std::span(packed)));
 }
 
@@ -89,12 +82,9 @@ Status BackendVk::Download(const Buffer& buffer, std::span<std::byte> canonical)
     if (canonical.size() != buffer.CanonicalBytes()) return MakeError("vk: download size does not match the buffer");
     if (buffer.Format() != BufferFormat::Bits) return mContext->Download(Dev(buffer), canonical);
     const Extent3 e = buffer.Extent();
-    const uint32_t words = (e.nx + 31) / 32;
-    std::vector<uint32_t> packed(size_t(words) * e.ny * e.nz);
+    std::vector<uint32_t> packed(size_t(CeilDiv(e.nx, 32)) * e.ny * e.nz);
     CB_TRY(mContext->Download(Dev(buffer), std::as_writable_bytes(std::span(packed))));
-    auto* dst = reinterpret_cast<uint8_t*>(canonical.data());
-    for (size_t row = 0; row < size_t(e.ny) * e.nz; ++row)
-        for (uint32_t i = 0; i < e.nx; ++i) dst[row * e.nx + i] = uint8_t((packed[row * words + i / 32] >> (i % 32)) & 1);
+    UnpackBits32(packed, e, canonical);
     return {};
 }
 
@@ -303,7 +293,7 @@ Status BackendVk::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     const Extent3 e = columnSum.Extent();
     auto pipeline = mContext->GetPipeline("shadow", 2);
     if (!pipeline) return std::unexpected(pipeline.error());
-    const Vec3& s = params.sun;
+    const ShadowLookup l = MakeShadowLookup(params.sun, e.nx, e.ny, params.nz, params.sigma, params.voxelSize);
     struct {
         uint32_t nx, ny;
         int32_t bx, by;
@@ -311,18 +301,8 @@ Status BackendVk::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
         uint32_t beer;
         float opticalDepthPerD, kappa;
         uint32_t noSun;
-    } push{e.nx, e.ny, 0, 0, 0, 0, params.form == AttenuationKind::Beer ? 1u : 0u, 0, params.kappa, s[2] <= 0.0f ? 1u : 0u};
-    if (s[2] > 0.0f) {
-        // The same offset arithmetic as the CPU (impl_cpu/ShadeCpu.cpp).
-        const float climb = 0.5f * float(params.nz) / s[2];
-        const float limit = float(e.nx + e.ny) + 2.0f;
-        const float cx = std::clamp(s[0] * climb, -limit, limit), cy = std::clamp(s[1] * climb, -limit, limit);
-        push.bx = int32_t(std::floor(cx));
-        push.by = int32_t(std::floor(cy));
-        push.fx = cx - std::floor(cx);
-        push.fy = cy - std::floor(cy);
-        push.opticalDepthPerD = params.sigma * params.voxelSize / s[2];
-    }
+    } push{e.nx, e.ny, l.baseX, l.baseY, l.fx, l.fy, params.form == AttenuationKind::Beer ? 1u : 0u,
+           l.opticalDepthPerD, params.kappa, l.noSun ? 1u : 0u};
     const DeviceBuffer* buffers[] = {&Dev(columnSum), &Dev(G)};
     return Record("shadow", [&](VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny);
