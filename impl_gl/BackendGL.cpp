@@ -23,6 +23,32 @@ TexelFormat FormatOf(BufferFormat format) {
 
 const BufferGL& Tex(const Buffer& b) { return static_cast<const BufferGL&>(b); }
 
+// Device time from a GL_TIMESTAMP query at construction to one at StopMs(),
+// which waits for the work between them (glFinish).
+class GpuTimer {
+  public:
+    explicit GpuTimer(const Functions& f) : mF(f) {
+        mF.GenQueries(2, mQueries);
+        mF.QueryCounter(mQueries[0], GL_TIMESTAMP);
+    }
+    ~GpuTimer() { mF.DeleteQueries(2, mQueries); }
+    GpuTimer(const GpuTimer&) = delete;
+    GpuTimer& operator=(const GpuTimer&) = delete;
+
+    double StopMs() {
+        mF.QueryCounter(mQueries[1], GL_TIMESTAMP);
+        mF.Finish();
+        GLuint64 t0 = 0, t1 = 0;
+        mF.GetQueryObjectui64v(mQueries[0], GL_QUERY_RESULT, &t0);
+        mF.GetQueryObjectui64v(mQueries[1], GL_QUERY_RESULT, &t1);
+        return double(t1 - t0) * 1e-6;
+    }
+
+  private:
+    const Functions& mF;
+    GLuint mQueries[2] = {};
+};
+
 }  // namespace
 
 Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context) {
@@ -97,9 +123,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
     auto program = mContext->Program("smooth");
     if (!program) return std::unexpected(program.error());
     const Extent3 e = cld.Extent();
-    GLuint queries[2];
-    f.GenQueries(2, queries);
-    f.QueryCounter(queries[0], GL_TIMESTAMP);
+    GpuTimer timer(f);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindTextureUnit(0, Tex(cld).Texture());
@@ -116,13 +140,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
         f.Uniform1i(layerLocation, GLint(k));
         f.DrawArrays(GL_TRIANGLES, 0, 3);
     }
-    f.QueryCounter(queries[1], GL_TIMESTAMP);
-    f.Finish();
-    GLuint64 t0 = 0, t1 = 0;
-    f.GetQueryObjectui64v(queries[0], GL_QUERY_RESULT, &t0);
-    f.GetQueryObjectui64v(queries[1], GL_QUERY_RESULT, &t1);
-    f.DeleteQueries(2, queries);
-    mLastDeviceMs = double(t1 - t0) * 1e-6;
+    mLastDeviceMs = timer.StopMs();
     return mContext->Check("smooth");
 }
 
@@ -142,9 +160,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     const GLuint fb = mContext->Framebuffer();
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
-    GLuint queries[2];
-    f.GenQueries(2, queries);
-    f.QueryCounter(queries[0], GL_TIMESTAMP);
+    GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindFramebuffer(GL_FRAMEBUFFER, fb);
 
@@ -197,18 +213,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.tiles).Texture(), 0, 0);
     f.DrawArrays(GL_TRIANGLES, 0, 3);
 
-    f.QueryCounter(queries[1], GL_TIMESTAMP);
     f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    f.Finish();
+    mLastDeviceMs = timer.StopMs();
     GLuint covered = 0;
     f.GetNamedBufferSubData(counter, 0, sizeof covered, &covered);
     f.DeleteBuffers(1, &counter);
     out.coveredColumns = covered;
-    GLuint64 t0 = 0, t1 = 0;
-    f.GetQueryObjectui64v(queries[0], GL_QUERY_RESULT, &t0);
-    f.GetQueryObjectui64v(queries[1], GL_QUERY_RESULT, &t1);
-    f.DeleteQueries(2, queries);
-    mLastDeviceMs = double(t1 - t0) * 1e-6;
     return mContext->Check("density");
 }
 Status BackendGL::Shade(const ShadeParams&, const Buffer&, Buffer&) { return NotYet("shade"); }
@@ -232,17 +242,9 @@ Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     f.BindFramebuffer(GL_FRAMEBUFFER, fb);
     f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(G).Texture(), 0, 0);
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
-    GLuint queries[2];
-    f.GenQueries(2, queries);
-    f.QueryCounter(queries[0], GL_TIMESTAMP);
+    GpuTimer timer(f);
     f.DrawArrays(GL_TRIANGLES, 0, 3);
-    f.QueryCounter(queries[1], GL_TIMESTAMP);
-    f.Finish();
-    GLuint64 t0 = 0, t1 = 0;
-    f.GetQueryObjectui64v(queries[0], GL_QUERY_RESULT, &t0);
-    f.GetQueryObjectui64v(queries[1], GL_QUERY_RESULT, &t1);
-    f.DeleteQueries(2, queries);
-    mLastDeviceMs = double(t1 - t0) * 1e-6;
+    mLastDeviceMs = timer.StopMs();
     return mContext->Check("shadow");
 }
 Status BackendGL::RenderSplat(const SplatParams&, const SplatInputs&, Buffer&, SplatStats*) { return NotYet("render_splat"); }

@@ -34,6 +34,16 @@ void main() {
 }
 )";
 
+// The info log of a shader or program (getiv/getLog: glGetShaderiv/InfoLog or glGetProgramiv/InfoLog).
+template <typename GetIv, typename GetLog>
+std::string InfoLog(GLuint object, GetIv getiv, GetLog getLog) {
+    GLint length = 0;
+    getiv(object, GL_INFO_LOG_LENGTH, &length);
+    std::string log(size_t(std::max(length, 1)), '\0');
+    getLog(object, length, nullptr, log.data());
+    return log;
+}
+
 Result<GLuint> Compile(const Functions& f, GLenum type, const std::string& source, const std::string& name) {
     GLuint shader = f.CreateShader(type);
     const char* text = source.c_str();
@@ -42,10 +52,7 @@ Result<GLuint> Compile(const Functions& f, GLenum type, const std::string& sourc
     GLint ok = 0;
     f.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
     if (!ok) {
-        GLint length = 0;
-        f.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
-        std::string log(size_t(std::max(length, 1)), '\0');
-        f.GetShaderInfoLog(shader, length, nullptr, log.data());
+        const std::string log = InfoLog(shader, f.GetShaderiv, f.GetShaderInfoLog);
         f.DeleteShader(shader);
         return MakeError("gl: compiling the " + name + " shader failed:\n" + log);
     }
@@ -157,10 +164,7 @@ Result<GLuint> GLContext::Program(const std::string& name) {
     GLint ok = 0;
     mF.GetProgramiv(program, GL_LINK_STATUS, &ok);
     if (!ok) {
-        GLint length = 0;
-        mF.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-        std::string log(size_t(std::max(length, 1)), '\0');
-        mF.GetProgramInfoLog(program, length, nullptr, log.data());
+        const std::string log = InfoLog(program, mF.GetProgramiv, mF.GetProgramInfoLog);
         mF.DeleteProgram(program);
         return MakeError("gl: linking the " + name + " program failed:\n" + log);
     }
