@@ -17,11 +17,13 @@ double Quantile(const std::vector<double>& sorted, double p) {
     return sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - double(lo));
 }
 
-// Post-warm-up samples of one stage.
-std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage) {
+// Post-warm-up samples of one stage: wall time, or device time where the backend measured it.
+std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage, bool device = false) {
     std::vector<double> out;
-    for (const StepRecord& r : run.steps)
-        if (r.step >= scene.warmupSteps && r.stageMs[size_t(stage)]) out.push_back(*r.stageMs[size_t(stage)]);
+    for (const StepRecord& r : run.steps) {
+        const std::optional<double>& sample = device ? r.deviceMs[size_t(stage)] : r.stageMs[size_t(stage)];
+        if (r.step >= scene.warmupSteps && sample) out.push_back(*sample);
+    }
     return out;
 }
 
@@ -72,9 +74,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         for (Stage stage : kAllStages) {
             if (!scene.stages.Has(stage)) continue;
             nlohmann::json entry = SummaryJson(StageSamples(scene, run, stage));
-            std::vector<double> device;
-            for (const StepRecord& r : run.steps)
-                if (r.step >= scene.warmupSteps && r.deviceMs[size_t(stage)]) device.push_back(*r.deviceMs[size_t(stage)]);
+            const std::vector<double> device = StageSamples(scene, run, stage, /*device=*/true);
             if (!device.empty()) entry["device"] = SummaryJson(device);  // GPU timestamps, without submission
             timing[std::string(StageName(stage))] = entry;
         }
@@ -148,10 +148,7 @@ std::string TimingTable(const Scene& scene, const BackendRun& run) {
     };
     for (Stage stage : kAllStages) {
         if (!scene.stages.Has(stage)) continue;
-        std::vector<double> device;
-        for (const StepRecord& r : run.steps)
-            if (r.step >= scene.warmupSteps && r.deviceMs[size_t(stage)]) device.push_back(*r.deviceMs[size_t(stage)]);
-        row(std::string(StageName(stage)), StageSamples(scene, run, stage), device);
+        row(std::string(StageName(stage)), StageSamples(scene, run, stage), StageSamples(scene, run, stage, true));
     }
     if (scene.stages.Has(Stage::RenderSplat)) {
         for (const CameraSettings& camera : scene.render.cameras) {
