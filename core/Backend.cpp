@@ -20,4 +20,13 @@ void UnpackBits32(std::span<const uint32_t> packed, const Extent3& e, std::span<
         for (uint32_t i = 0; i < e.nx; ++i) dst[row * e.nx + i] = uint8_t((packed[row * words + i / 32] >> (i % 32)) & 1);
 }
 
+std::vector<uint8_t> SplatBoxVisibility(const SplatParams& p, const Extent3& e, std::span<const uint8_t> bandsPrev,
+                                        std::span<const uint8_t> bandsCur) {
+    std::vector<uint8_t> boxes(size_t(CeilDiv(e.nx, p.tile)) * CeilDiv(e.ny, p.tile) * CeilDiv(e.nz, p.band), 1);
+    if (p.culling) boxes = FrustumVisibleBoxes(p.camera, e, p.origin, p.voxelSize, p.tile, p.band, p.splatDiameter);
+    if (p.skipping)
+        for (size_t n = 0; n < boxes.size(); ++n) boxes[n] &= uint8_t(bandsPrev[n] | bandsCur[n]);
+    return boxes;
+}
+
 }  // namespace cb

@@ -136,6 +136,12 @@ struct SplatParams {
     uint32_t tile = 32, band = 4;  // of the occupancy maps
 };
 
+// Which tile x band boxes may hold a visible splat (SPEC 8): every box, less
+// those outside the frustum when culling, less those empty in both steps'
+// band occupancy (canonical bytes) when skipping. Index as FrustumVisibleBoxes.
+std::vector<uint8_t> SplatBoxVisibility(const SplatParams& params, const Extent3& grid,
+                                        std::span<const uint8_t> bandsPrev, std::span<const uint8_t> bandsCur);
+
 struct SplatInputs {
     const Buffer* qPrev = nullptr;  // F32 volume
     const Buffer* qCur = nullptr;   // F32 volume
@@ -200,6 +206,7 @@ struct BackendOptions {
     std::string vkDevice;    // Vulkan device index or name substring; "" = the first
     bool vkValidation = false;  // Khronos validation layer (also CLOUDBENCH_VK_VALIDATION=1)
     std::string glContext;   // "osmesa" (default) or "egl"
+    std::string glCaLayout;  // automaton layout: "packed" (default, R32UI) or "rgba8" (the thesis's)
 };
 
 // Creates a backend by name. An unknown name, or one whose device is missing,

@@ -28,7 +28,7 @@ Result<std::unique_ptr<Backend>> CreateBackend(const std::string& name, const Ba
     if (name == "cpu") return std::make_unique<cpu::BackendCpu>(options.cpuThreads);
     if (name == "gl") {
 #if CLOUDBENCH_HAVE_GL
-        auto backend = gl::BackendGL::Create(options.glContext);
+        auto backend = gl::BackendGL::Create(options.glContext, options.glCaLayout);
         if (!backend) return std::unexpected(backend.error());
         return std::unique_ptr<Backend>(std::move(*backend));
 #else

@@ -29,6 +29,7 @@ struct CommonOptions {
     int cpuThreads = 0;
     std::string vkDevice;                 // --vk-device INDEX|NAME
     std::string glContext;                // --gl-context osmesa|egl
+    std::string glCaLayout;               // --gl-ca-layout packed|rgba8
     bool quiet = false;
 
     BackendOptions Backend() const {
@@ -36,6 +37,7 @@ struct CommonOptions {
         b.cpuThreads = cpuThreads;
         b.vkDevice = vkDevice;
         b.glContext = glContext;
+        b.glCaLayout = glCaLayout;
         return b;
     }
 };

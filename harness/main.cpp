@@ -41,6 +41,8 @@ Options:
   --threads N        CPU backend threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
   --gl-context CTX   OpenGL context: osmesa (default, llvmpipe) or egl (GPU or surfaceless)
+  --gl-ca-layout L   OpenGL automaton layout: packed (default; R32UI, 32 voxels a texel)
+                     or rgba8 (the thesis's: one RGBA8 texel a voxel, a channel a bit)
   --quiet            no progress lines
 )";
 
@@ -159,6 +161,11 @@ int main(int argc, char** argv) {
             if (!v || (std::string_view(v) != "osmesa" && std::string_view(v) != "egl"))
                 return Usage("--gl-context needs osmesa or egl", help);
             options.glContext = v;
+        } else if (arg == "--gl-ca-layout") {
+            const char* v = value();
+            if (!v || (std::string_view(v) != "packed" && std::string_view(v) != "rgba8"))
+                return Usage("--gl-ca-layout needs packed or rgba8", help);
+            options.glCaLayout = v;
         } else if (arg == "--vk-device") {
             const char* v = value();
             if (!v) return Usage("--vk-device needs an index or a name", help);

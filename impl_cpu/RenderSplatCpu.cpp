@@ -46,17 +46,13 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
 
     // 1. Which tile x band boxes can contribute.
     const uint32_t tilesX = CeilDiv(e.nx, p.tile), tilesY = CeilDiv(e.ny, p.tile), bandCount = CeilDiv(e.nz, p.band);
-    std::vector<uint8_t> boxVisible(size_t(tilesX) * tilesY * bandCount, 1);
+    const size_t boxCount = size_t(tilesX) * tilesY * bandCount;
+    std::span<const uint8_t> bandsPrev, bandsCur;
     if (p.skipping) {
-        const uint8_t* a = static_cast<const BufferCpu&>(*in.bandsPrev).U8();
-        const uint8_t* b = static_cast<const BufferCpu&>(*in.bandsCur).U8();
-        for (size_t n = 0; n < boxVisible.size(); ++n) boxVisible[n] = a[n] | b[n];
+        bandsPrev = {static_cast<const BufferCpu&>(*in.bandsPrev).U8(), boxCount};
+        bandsCur = {static_cast<const BufferCpu&>(*in.bandsCur).U8(), boxCount};
     }
-    if (p.culling) {
-        const std::vector<uint8_t> inFrustum =
-            FrustumVisibleBoxes(cam, e, p.origin, p.voxelSize, p.tile, p.band, p.splatDiameter);
-        for (size_t n = 0; n < boxVisible.size(); ++n) boxVisible[n] &= inFrustum[n];
-    }
+    const std::vector<uint8_t> boxVisible = SplatBoxVisibility(p, e, bandsPrev, bandsCur);
 
     // 2. Splats in the shared order: task `n` makes those of the n-th outer slice.
     const SplatOrder& order = *p.order;

@@ -51,20 +51,88 @@ class GpuTimer {
 
 }  // namespace
 
-Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context) {
+Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context, const std::string& caLayout) {
     if (!context.empty() && context != "osmesa" && context != "egl")
         return MakeError("gl: unknown context '" + context + "' (osmesa or egl)");
+    if (!caLayout.empty() && caLayout != "packed" && caLayout != "rgba8")
+        return MakeError("gl: unknown automaton layout '" + caLayout + "' (packed or rgba8)");
     auto ctx = GLContext::Create(context == "egl" ? ContextKind::Egl : ContextKind::OSMesa);
     if (!ctx) return std::unexpected(ctx.error());
-    return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx)));
+    std::unique_ptr<BackendGL> backend(new BackendGL(std::move(*ctx), caLayout == "rgba8"));
+    backend->mContext->F().CreateFramebuffers(1, &backend->mTargets);
+    CB_TRY(backend->mContext->Check("creating the multi-target framebuffer"));
+    return backend;
 }
+
+BackendGL::~BackendGL() {
+    const Functions& f = mContext->F();
+    for (ScratchTexture& t : mScratch)
+        if (t.texture) f.DeleteTextures(1, &t.texture);
+    for (auto& [buffer, bytes] : mBuffers)
+        if (buffer) f.DeleteBuffers(1, &buffer);
+    if (mTargets) f.DeleteFramebuffers(1, &mTargets);
+}
+
+std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
 
 bool BackendGL::Supports(Stage stage) const {
-    return stage == Stage::Smooth || stage == Stage::Density || stage == Stage::Shadow;
+    switch (stage) {
+        case Stage::Region:
+        case Stage::Ca:
+        case Stage::Smooth:
+        case Stage::Density:
+        case Stage::Shade:
+        case Stage::Shadow:
+        case Stage::RenderSplat: return true;
+        default: return false;
+    }
 }
 
-Status BackendGL::NotYet(const char* stage) const {
-    return MakeError(std::string("gl: stage '") + stage + "' is not implemented yet (issue 5)");
+GLuint BackendGL::Scratch(ScratchSlot slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
+    const Functions& f = mContext->F();
+    ScratchTexture& t = mScratch[slot];
+    if (t.texture && t.target == target && t.format == format && t.width == width && t.height == height && t.depth == depth)
+        return t.texture;
+    if (t.texture) f.DeleteTextures(1, &t.texture);
+    t = {0, target, format, width, height, depth};
+    f.CreateTextures(target, 1, &t.texture);
+    if (target == GL_TEXTURE_2D) f.TextureStorage2D(t.texture, 1, format, width, height);
+    else f.TextureStorage3D(t.texture, 1, format, width, height, depth);
+    f.TextureParameteri(t.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    f.TextureParameteri(t.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return t.texture;
+}
+
+GLuint BackendGL::ScratchBuffer(BufferSlot slot, size_t bytes) {
+    const Functions& f = mContext->F();
+    auto& [buffer, size] = mBuffers[slot];
+    bytes = std::max<size_t>(bytes, 16);
+    if (buffer && size >= bytes) return buffer;
+    if (buffer) f.DeleteBuffers(1, &buffer);
+    f.CreateBuffers(1, &buffer);
+    f.NamedBufferData(buffer, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_DRAW);
+    size = bytes;
+    return buffer;
+}
+
+Status BackendGL::BindTargets(std::initializer_list<std::pair<GLuint, int>> targets) {
+    const Functions& f = mContext->F();
+    GLenum drawBuffers[4] = {};
+    GLsizei n = 0;
+    for (const auto& [texture, layer] : targets) {
+        const GLenum attachment = GL_COLOR_ATTACHMENT0 + GLenum(n);
+        if (layer < 0) f.NamedFramebufferTexture(mTargets, attachment, texture, 0);
+        else f.NamedFramebufferTextureLayer(mTargets, attachment, texture, 0, layer);
+        drawBuffers[n++] = attachment;
+    }
+    // Detach the rest: attachments of other sizes would clip the render area.
+    for (GLsizei unused = n; unused < 4; ++unused)
+        f.NamedFramebufferTexture(mTargets, GL_COLOR_ATTACHMENT0 + GLenum(unused), 0, 0);
+    f.NamedFramebufferDrawBuffers(mTargets, n, drawBuffers);
+    f.BindFramebuffer(GL_FRAMEBUFFER, mTargets);
+    if (f.CheckNamedFramebufferStatus(mTargets, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return MakeError("gl: a pass's render targets do not make a complete framebuffer");
+    return {};
 }
 
 Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Extent3 extent) {
@@ -94,6 +162,7 @@ Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
     if (b.Format() == BufferFormat::Bits) {
         packed = PackBits32(canonical, e);
         data = packed.data();
+        ++mBitsWrites;
     }
     f.TextureSubImage3D(b.Texture(), 0, 0, 0, 0, GLsizei(b.Width()), GLsizei(e.ny), GLsizei(e.nz), t.format, t.type, data);
     return mContext->Check("uploading a texture");
@@ -144,9 +213,6 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
     return mContext->Check("smooth");
 }
 
-Status BackendGL::Region(std::span<const RasterEllipsoid>, Buffer&) { return NotYet("region"); }
-Status BackendGL::CaInitialize(const CaInitParams&, CaFields) { return NotYet("ca"); }
-Status BackendGL::CaStep(const CaStepParams&, ConstCaFields, const Buffer&, CaFields) { return NotYet("ca"); }
 Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
     const Functions& f = mContext->F();
@@ -221,7 +287,6 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     out.coveredColumns = covered;
     return mContext->Check("density");
 }
-Status BackendGL::Shade(const ShadeParams&, const Buffer&, Buffer&) { return NotYet("shade"); }
 Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) {
     const Functions& f = mContext->F();
     auto program = mContext->Program("shadow");
@@ -247,6 +312,427 @@ Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("shadow");
 }
-Status BackendGL::RenderSplat(const SplatParams&, const SplatInputs&, Buffer&, SplatStats*) { return NotYet("render_splat"); }
+
+
+// region: per slice, one instanced quad per ellipsoid into an R8 UNORM layer
+// with MAX blending (integer targets cannot blend), then one copy into the
+// R8UI volume (the same 8-bit texel class, so the bits carry over).
+Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) {
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("region");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = region.Extent();
+    static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
+    GpuTimer timer(f);
+    const GLuint list = ScratchBuffer(kEllipsoidList, ellipsoids.size_bytes());
+    if (!ellipsoids.empty()) f.NamedBufferSubData(list, 0, GLsizeiptr(ellipsoids.size_bytes()), ellipsoids.data());
+    const GLuint unorm = Scratch(kRegionUnorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    const float zero = 0.0f;
+    f.ClearTexImage(unorm, 0, GL_RED, GL_FLOAT, &zero);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
+    f.Uniform2i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny));
+    const GLint layer = f.GetUniformLocation(*program, "layer");
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_MAX);
+    for (uint32_t k = 0; k < e.nz && !ellipsoids.empty(); ++k) {
+        CB_TRY(BindTargets({{unorm, int(k)}}));
+        f.Uniform1i(layer, GLint(k));
+        f.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(ellipsoids.size()));
+    }
+    f.Disable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.CopyImageSubData(unorm, GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, Tex(region).Texture(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
+                       GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("region");
+}
+
+Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("ca_init");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = out.hum->Extent();
+    GpuTimer timer(f);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Uniform3i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1ui(f.GetUniformLocation(*program, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*program, "qHum0"), params.qHum0);
+    f.Uniform1ui(f.GetUniformLocation(*program, "qAct0"), params.qAct0);
+    const GLint layer = f.GetUniformLocation(*program, "layer");
+    f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), GLsizei(e.ny));
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        CB_TRY(BindTargets({{Tex(*out.hum).Texture(), int(k)}, {Tex(*out.act).Texture(), int(k)}, {Tex(*out.cld).Texture(), int(k)}}));
+        f.Uniform1i(layer, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    ++mBitsWrites;
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca initial state");
+}
+
+Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    if (mRgba8) return CaStepRgba8(params, in, region, out);
+    const Functions& f = mContext->F();
+    auto rules = mContext->Program("ca");
+    if (!rules) return std::unexpected(rules.error());
+    auto advect = mContext->Program("advect");
+    if (!advect) return std::unexpected(advect.error());
+    const Extent3 e = in.hum->Extent();
+    const GLsizei words = GLsizei(CeilDiv(e.nx, 32));
+    const bool wind = !params.shiftX.empty();
+    // With wind the rules write scratch fields that the advection pass shifts into `out`.
+    GLuint next[3] = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
+    if (wind) {
+        next[0] = Scratch(kCaHum, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[1] = Scratch(kCaAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[2] = Scratch(kCaCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+    }
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Viewport(0, 0, words, GLsizei(e.ny));
+    f.UseProgram(*rules);
+    f.BindTextureUnit(0, Tex(*in.hum).Texture());
+    f.BindTextureUnit(1, Tex(*in.act).Texture());
+    f.BindTextureUnit(2, Tex(*in.cld).Texture());
+    f.BindTextureUnit(3, Tex(region).Texture());
+    f.Uniform3i(f.GetUniformLocation(*rules, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1i(f.GetUniformLocation(*rules, "words"), words);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "step"), params.step);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
+    const GLint rulesLayer = f.GetUniformLocation(*rules, "layer");
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        CB_TRY(BindTargets({{next[0], int(k)}, {next[1], int(k)}, {next[2], int(k)}}));
+        f.Uniform1i(rulesLayer, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    if (wind) {
+        f.UseProgram(*advect);
+        for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), next[n]);
+        f.Uniform3i(f.GetUniformLocation(*advect, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        f.Uniform1i(f.GetUniformLocation(*advect, "words"), words);
+        const GLint layer = f.GetUniformLocation(*advect, "layer"), shift = f.GetUniformLocation(*advect, "shift");
+        for (uint32_t k = 0; k < e.nz; ++k) {
+            CB_TRY(BindTargets({{Tex(*out.hum).Texture(), int(k)}, {Tex(*out.act).Texture(), int(k)}, {Tex(*out.cld).Texture(), int(k)}}));
+            f.Uniform1i(layer, GLint(k));
+            f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]);
+            f.DrawArrays(GL_TRIANGLES, 0, 3);
+        }
+    }
+    ++mBitsWrites;
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca");
+}
+
+// The thesis's layout: the step runs on RGBA8UI voxels (kStateA -> kStateB,
+// and back to kStateA through the advection pass when there is wind), then the
+// packed fields the other stages read are written from it. The packing of
+// `in` is skipped when kStateA already holds it (the previous step's result).
+Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    const Functions& f = mContext->F();
+    auto pack = mContext->Program("ca_pack_rgba8");
+    if (!pack) return std::unexpected(pack.error());
+    auto rules = mContext->Program("ca_rgba8");
+    if (!rules) return std::unexpected(rules.error());
+    auto advect = mContext->Program("advect_rgba8");
+    if (!advect) return std::unexpected(advect.error());
+    auto unpack = mContext->Program("ca_unpack_rgba8");
+    if (!unpack) return std::unexpected(unpack.error());
+    const Extent3 e = in.hum->Extent();
+    const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
+    const GLuint stateA = Scratch(kStateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateB = Scratch(kStateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
+    const bool packed = mStateOf == inputs && mStateWrites == mBitsWrites;
+    const bool wind = !params.shiftX.empty();
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Viewport(0, 0, nx, ny);
+    auto perSlice = [&](GLuint program, GLuint target, auto&& setLayer) -> Status {
+        f.UseProgram(program);
+        f.Uniform3i(f.GetUniformLocation(program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        const GLint layer = f.GetUniformLocation(program, "layer");
+        for (uint32_t k = 0; k < e.nz; ++k) {
+            CB_TRY(BindTargets({{target, int(k)}}));
+            f.Uniform1i(layer, GLint(k));
+            setLayer(k);
+            f.DrawArrays(GL_TRIANGLES, 0, 3);
+        }
+        return {};
+    };
+    if (!packed) {
+        for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), inputs[n]);
+        CB_TRY(perSlice(*pack, stateA, [](uint32_t) {}));
+    }
+    f.BindTextureUnit(0, stateA);
+    f.BindTextureUnit(1, Tex(region).Texture());
+    f.UseProgram(*rules);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "step"), params.step);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
+    CB_TRY(perSlice(*rules, stateB, [](uint32_t) {}));
+    GLuint result = stateB;
+    if (wind) {
+        f.BindTextureUnit(0, stateB);
+        const GLint shift = f.GetUniformLocation(*advect, "shift");
+        CB_TRY(perSlice(*advect, stateA, [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
+        result = stateA;
+    }
+    f.BindTextureUnit(0, result);
+    f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), ny);
+    f.UseProgram(*unpack);
+    f.Uniform3i(f.GetUniformLocation(*unpack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    const GLint unpackLayer = f.GetUniformLocation(*unpack, "layer");
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        CB_TRY(BindTargets({{Tex(*out.hum).Texture(), int(k)}, {Tex(*out.act).Texture(), int(k)}, {Tex(*out.cld).Texture(), int(k)}}));
+        f.Uniform1i(unpackLayer, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    ++mBitsWrites;
+    // Without wind the result is in kStateB: swap the slots so kStateA holds it.
+    if (result == stateB) std::swap(mScratch[kStateA], mScratch[kStateB]);
+    mStateOf = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
+    mStateWrites = mBitsWrites;
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca (RGBA8 layout)");
+}
+
+// shade: optional down-sampling pass, then the slice loop from the sun's side
+// (ping-pong between two 2-D textures, each slice also written to layer w of a
+// w-major volume), then one pass that writes the z-layered T, reading the
+// w-major volume trilinearly (exactly, at f = 1).
+Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    const int res = params.resolution;
+    if (res != 1 && res != 2 && res != 4) return MakeError("gl: shade resolution must be 1, 2 or 4");
+    const Functions& f = mContext->F();
+    auto slice = mContext->Program("shade_slice");
+    if (!slice) return std::unexpected(slice.error());
+    auto up = mContext->Program("shade_up");
+    if (!up) return std::unexpected(up.error());
+    auto down = mContext->Program("shade_down");
+    if (!down) return std::unexpected(down.error());
+    const Extent3 e = q.Extent();
+    const int n[3] = {int(CeilDiv(e.nx, uint32_t(res))), int(CeilDiv(e.ny, uint32_t(res))), int(CeilDiv(e.nz, uint32_t(res)))};
+    const ShearWarp g = MakeShearWarp(params.sun, params.filter);
+    const SliceAttenuation a = MakeSliceAttenuation(params.attenuation, params.sigma, params.voxelSize * float(res), g.absSw,
+                                                    params.thesisAr, params.scattering, params.albedo, params.solidAngle,
+                                                    params.phase);
+    const int nu = n[g.u], nv = n[g.v], nw = n[g.w];
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    GLuint shadedQ = Tex(q).Texture();
+    if (res > 1) {
+        shadedQ = Scratch(kShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
+        f.UseProgram(*down);
+        f.BindTextureUnit(0, Tex(q).Texture());
+        f.Uniform3i(f.GetUniformLocation(*down, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        f.Uniform1i(f.GetUniformLocation(*down, "f"), res);
+        const GLint layer = f.GetUniformLocation(*down, "layer");
+        f.Viewport(0, 0, n[0], n[1]);
+        for (int k = 0; k < n[2]; ++k) {
+            CB_TRY(BindTargets({{shadedQ, k}}));
+            f.Uniform1i(layer, k);
+            f.DrawArrays(GL_TRIANGLES, 0, 3);
+        }
+    }
+    const GLuint volume = Scratch(kShadeVolume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
+    GLuint ping = Scratch(kShadePing, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    GLuint pong = Scratch(kShadePong, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    auto unit = [](int axis) {
+        GLint v[3] = {0, 0, 0};
+        v[axis] = 1;
+        return std::array<GLint, 3>{v[0], v[1], v[2]};
+    };
+    const auto eu = unit(g.u), ev = unit(g.v), ew = unit(g.w);
+    f.UseProgram(*slice);
+    f.BindTextureUnit(1, shadedQ);
+    f.Uniform3i(f.GetUniformLocation(*slice, "axisU"), eu[0], eu[1], eu[2]);
+    f.Uniform3i(f.GetUniformLocation(*slice, "axisV"), ev[0], ev[1], ev[2]);
+    f.Uniform2i(f.GetUniformLocation(*slice, "sliceSize"), nu, nv);
+    f.Uniform2i(f.GetUniformLocation(*slice, "tapOffset"), g.u0, g.v0);
+    f.Uniform2f(f.GetUniformLocation(*slice, "tapFraction"), g.fu, g.fv);
+    f.Uniform1i(f.GetUniformLocation(*slice, "beer"), a.kind == AttenuationKind::Beer ? 1 : 0);
+    f.Uniform1f(f.GetUniformLocation(*slice, "depthPerQ"), a.opticalDepthPerQ);
+    f.Uniform1f(f.GetUniformLocation(*slice, "thesisAr"), a.thesisAr);
+    f.Uniform1f(f.GetUniformLocation(*slice, "scatterGain"), a.scatterGain);
+    f.Uniform1ui(f.GetUniformLocation(*slice, "storage"), uint32_t(params.storage));
+    const GLint first = f.GetUniformLocation(*slice, "first"), previousW = f.GetUniformLocation(*slice, "previousW");
+    f.Viewport(0, 0, nu, nv);
+    int previous = 0;
+    for (int m = 0; m < nw; ++m) {
+        const int w = g.sunAbove ? nw - 1 - m : m;
+        CB_TRY(BindTargets({{pong, -1}, {volume, w}}));
+        f.BindTextureUnit(0, ping);
+        f.Uniform1i(first, m == 0 ? 1 : 0);
+        f.Uniform3i(previousW, previous * ew[0], previous * ew[1], previous * ew[2]);
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        std::swap(ping, pong);
+        previous = w;
+    }
+    f.UseProgram(*up);
+    f.BindTextureUnit(0, volume);
+    f.Uniform3i(f.GetUniformLocation(*up, "cells"), n[0], n[1], n[2]);
+    f.Uniform3i(f.GetUniformLocation(*up, "axes"), g.u, g.v, g.w);
+    f.Uniform1i(f.GetUniformLocation(*up, "f"), res);
+    const GLint upLayer = f.GetUniformLocation(*up, "layer");
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        CB_TRY(BindTargets({{Tex(T).Texture(), int(k)}}));
+        f.Uniform1i(upLayer, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("shade");
+}
+
+// render_splat: GL_POINTS in the shared order, one vertex per voxel; culling
+// and skipping become a multi-draw over the runs of ranks whose tile x band
+// box is visible. The RGBA32F target is drawn with row 0 at the top, so one
+// read into a pixel buffer and one upload from it give the canonical (3, W, H) image.
+Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
+    if (!p.order || !in.qPrev || !in.qCur || !in.T) return MakeError("gl: render_splat needs q (both steps), T and an order");
+    if (p.skipping && (!in.bandsPrev || !in.bandsCur)) return MakeError("gl: render_splat with skipping needs both steps' occupancy");
+    if (image.Extent().nx != 3) return MakeError("gl: render_splat image must have extent (3, width, height)");
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("splat");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = in.qCur->Extent();
+    const uint32_t W = image.Extent().ny, H = image.Extent().nz;
+    const CameraFrame& cam = p.camera;
+
+    std::vector<uint8_t> bandsPrev, bandsCur;
+    if (p.skipping) {
+        bandsPrev.resize(in.bandsPrev->CanonicalBytes());
+        bandsCur.resize(in.bandsCur->CanonicalBytes());
+        CB_TRY(Download(*in.bandsPrev, std::as_writable_bytes(std::span(bandsPrev))));
+        CB_TRY(Download(*in.bandsCur, std::as_writable_bytes(std::span(bandsCur))));
+    }
+    const std::vector<uint8_t> boxes = SplatBoxVisibility(p, e, bandsPrev, bandsCur);
+
+    // Runs of consecutive ranks whose box is visible: one draw each.
+    const SplatOrder& order = *p.order;
+    const int outer = order.axes[0], middle = order.axes[1], inner = order.axes[2];
+    const uint32_t tilesX = CeilDiv(e.nx, p.tile), tilesY = CeilDiv(e.ny, p.tile);
+    const uint32_t boxSize[3] = {p.tile, p.tile, p.band};
+    const uint32_t boxStride[3] = {1, tilesX, tilesX * tilesY};
+    std::vector<GLint> firsts;
+    std::vector<GLsizei> counts;
+    uint64_t visited = 0;
+    {
+        const auto& innerIdx = order.indices[inner];
+        std::vector<uint32_t> innerBox(innerIdx.size());
+        for (size_t n = 0; n < innerIdx.size(); ++n) innerBox[n] = (innerIdx[n] / boxSize[inner]) * boxStride[inner];
+        GLint rank = 0;
+        GLint runStart = -1;
+        for (uint32_t o : order.indices[outer])
+            for (uint32_t m : order.indices[middle]) {
+                const uint32_t base = (o / boxSize[outer]) * boxStride[outer] + (m / boxSize[middle]) * boxStride[middle];
+                for (size_t n = 0; n < innerIdx.size(); ++n, ++rank) {
+                    const bool visible = boxes[base + innerBox[n]] != 0;
+                    if (visible && runStart < 0) runStart = rank;
+                    if (!visible && runStart >= 0) {
+                        firsts.push_back(runStart);
+                        counts.push_back(rank - runStart);
+                        runStart = -1;
+                    }
+                }
+            }
+        if (runStart >= 0) {
+            firsts.push_back(runStart);
+            counts.push_back(rank - runStart);
+        }
+        for (GLsizei c : counts) visited += uint64_t(c);
+    }
+
+    std::vector<uint32_t> indices;
+    GLint base[3];
+    for (int level = 0; level < 3; ++level) {
+        base[level] = GLint(indices.size());
+        const auto& axis = order.indices[order.axes[level]];
+        indices.insert(indices.end(), axis.begin(), axis.end());
+    }
+    GLfloat pointRange[2] = {1, 1};
+    f.GetFloatv(GL_POINT_SIZE_RANGE, pointRange);
+    constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
+
+    GpuTimer timer(f);
+    const GLuint orderBuffer = ScratchBuffer(kSplatOrder, indices.size() * 4);
+    f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(indices.size() * 4), indices.data());
+    const GLuint counters = ScratchBuffer(kSplatCounters, 16);
+    const uint32_t zero[4] = {};
+    f.NamedBufferSubData(counters, 0, sizeof zero, zero);
+    const GLuint target = Scratch(kSplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    CB_TRY(BindTargets({{target, -1}}));
+    const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
+    f.ClearNamedFramebufferfv(mTargets, GL_COLOR, 0, background);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, orderBuffer);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counters);
+    f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
+    f.BindTextureUnit(1, Tex(*in.qCur).Texture());
+    f.BindTextureUnit(2, Tex(*in.T).Texture());
+    auto uniform = [&](const char* name) { return f.GetUniformLocation(*program, name); };
+    f.Uniform3i(uniform("grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform3i(uniform("axes"), outer, middle, inner);
+    f.Uniform3i(uniform("orderBase"), base[0], base[1], base[2]);
+    f.Uniform2f(uniform("image"), float(W), float(H));
+    f.Uniform1f(uniform("guard"), kGuard);
+    f.Uniform4f(uniform("eye"), cam.eye[0], cam.eye[1], cam.eye[2], cam.nearPlane);
+    f.Uniform4f(uniform("forward"), cam.forward[0], cam.forward[1], cam.forward[2], cam.focalPx);
+    f.Uniform3f(uniform("right"), cam.right[0], cam.right[1], cam.right[2]);
+    f.Uniform3f(uniform("up"), cam.upVector[0], cam.upVector[1], cam.upVector[2]);
+    f.Uniform4f(uniform("sun"), p.sun[0], p.sun[1], p.sun[2], p.phase.g);
+    f.Uniform4f(uniform("sunRadiance"), p.sunRadiance[0], p.sunRadiance[1], p.sunRadiance[2], float(p.phase.kind));
+    f.Uniform4f(uniform("ambient"), p.ambient[0], p.ambient[1], p.ambient[2], p.qMin);
+    f.Uniform4f(uniform("origin"), p.origin[0], p.origin[1], p.origin[2], p.voxelSize);
+    f.Uniform4f(uniform("misc"), p.splatDiameter, p.alpha, p.opacity, pointRange[1]);
+    f.Enable(GL_PROGRAM_POINT_SIZE);
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    f.Viewport(-GLint(kGuard), -GLint(kGuard), GLsizei(W + 2 * kGuard), GLsizei(H + 2 * kGuard));
+    GLuint fragments = 0;
+    if (stats) {
+        f.GenQueries(1, &fragments);
+        f.BeginQuery(GL_SAMPLES_PASSED, fragments);
+    }
+    if (!firsts.empty()) f.MultiDrawArrays(GL_POINTS, firsts.data(), counts.data(), GLsizei(firsts.size()));
+    if (stats) f.EndQuery(GL_SAMPLES_PASSED);
+    f.Disable(GL_BLEND);
+    f.Disable(GL_PROGRAM_POINT_SIZE);
+    // The image: RGB floats of rows top first are exactly the canonical layout.
+    const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
+    const GLuint copy = ScratchBuffer(kImageCopy, imageBytes);
+    f.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(target, 0, GL_RGB, GL_FLOAT, GLsizei(imageBytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, copy);
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    mLastDeviceMs = timer.StopMs();
+    if (stats) {
+        GLuint64 passed = 0;
+        f.GetQueryObjectui64v(fragments, GL_QUERY_RESULT, &passed);
+        f.DeleteQueries(1, &fragments);
+        uint32_t drawn = 0;
+        f.GetNamedBufferSubData(counters, 0, sizeof drawn, &drawn);
+        stats->splats = drawn;
+        stats->voxelsVisited = visited;
+        stats->fragments = passed;
+    }
+    return mContext->Check("render_splat");
+}
 
 }  // namespace cb::gl

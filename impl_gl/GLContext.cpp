@@ -149,9 +149,10 @@ Status GLContext::Check(const char* what) const {
 
 Result<GLuint> GLContext::Program(const std::string& name) {
     if (auto it = mPrograms.find(name); it != mPrograms.end()) return it->second;
-    const std::string* source = FindFragmentShader(name);
+    const std::string* source = FindShader(name + ".frag");
     if (!source) return MakeError("gl: no shader named '" + name + "'");
-    auto vs = Compile(mF, GL_VERTEX_SHADER, kFullScreenVertex, name + " vertex");
+    const std::string* vertex = FindShader(name + ".vert");
+    auto vs = Compile(mF, GL_VERTEX_SHADER, vertex ? *vertex : std::string(kFullScreenVertex), name + " vertex");
     if (!vs) return std::unexpected(vs.error());
     auto fs = Compile(mF, GL_FRAGMENT_SHADER, *source, name);
     if (!fs) return std::unexpected(fs.error());

@@ -26,8 +26,9 @@ class GLContext {
     std::string Renderer() const;
     // "doing X: GL_INVALID_OPERATION" for a pending GL error; ok otherwise.
     Status Check(const char* what) const;
-    // The linked program of a fragment pass (shaders/<name>.frag with the
-    // full-screen vertex shader); a compile or link failure carries its log.
+    // The linked program of pass `name`: shaders/<name>.frag with
+    // shaders/<name>.vert, or the full-screen triangle where there is none; a
+    // compile or link failure carries its log and the pass's name.
     Result<GLuint> Program(const std::string& name);
     // An empty vertex array for attribute-less draws.
     GLuint EmptyVao() const { return mVao; }

@@ -31,6 +31,7 @@
     X(PFNGLUNIFORM2FPROC, Uniform2f)                                           \
     X(PFNGLCREATETEXTURESPROC, CreateTextures)                                 \
     X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                 \
+    X(PFNGLTEXTURESTORAGE2DPROC, TextureStorage2D)                             \
     X(PFNGLTEXTURESTORAGE3DPROC, TextureStorage3D)                             \
     X(PFNGLTEXTURESUBIMAGE3DPROC, TextureSubImage3D)                           \
     X(PFNGLGETTEXTUREIMAGEPROC, GetTextureImage)                               \
@@ -53,6 +54,7 @@
     X(PFNGLCREATEBUFFERSPROC, CreateBuffers)                                   \
     X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                                   \
     X(PFNGLNAMEDBUFFERDATAPROC, NamedBufferData)                               \
+    X(PFNGLNAMEDBUFFERSUBDATAPROC, NamedBufferSubData)                         \
     X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                 \
     X(PFNGLGETNAMEDBUFFERSUBDATAPROC, GetNamedBufferSubData)                   \
     X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                   \
@@ -62,7 +64,19 @@
     X(PFNGLGENQUERIESPROC, GenQueries)                                         \
     X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                   \
     X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \
-    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
+    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)                       \
+    X(PFNGLBEGINQUERYPROC, BeginQuery)                                         \
+    X(PFNGLENDQUERYPROC, EndQuery)                                             \
+    X(PFNGLDRAWARRAYSINSTANCEDPROC, DrawArraysInstanced)                       \
+    X(PFNGLMULTIDRAWARRAYSPROC, MultiDrawArrays)                               \
+    X(PFNGLCOPYIMAGESUBDATAPROC, CopyImageSubData)                             \
+    X(PFNGLNAMEDFRAMEBUFFERDRAWBUFFERSPROC, NamedFramebufferDrawBuffers)       \
+    X(PFNGLNAMEDFRAMEBUFFERTEXTUREPROC, NamedFramebufferTexture)               \
+    X(PFNGLCLEARNAMEDFRAMEBUFFERFVPROC, ClearNamedFramebufferfv)               \
+    X(PFNGLBINDBUFFERPROC, BindBuffer)                                         \
+    X(PFNGLGETFLOATVPROC, GetFloatv)                                           \
+    X(PFNGLUNIFORM3FPROC, Uniform3f)                                           \
+    X(PFNGLUNIFORM4FPROC, Uniform4f)
 
 namespace cb::gl {
 

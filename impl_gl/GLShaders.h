@@ -7,7 +7,7 @@
 
 namespace cb::gl {
 
-// The fragment shader of pass `name` (shaders/<name>.frag); nullptr if none.
-const std::string* FindFragmentShader(const std::string& name);
+// The source of shaders/<file> (e.g. "smooth.frag"); nullptr if none.
+const std::string* FindShader(const std::string& file);
 
 }  // namespace cb::gl

@@ -319,14 +319,14 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
 
     // Which tile x band boxes can hold a splat: the frustum (host geometry,
     // shared with the CPU) and, when skipping, the two steps' band occupancy.
-    std::vector<uint8_t> boxes(size_t(CeilDiv(e.nx, p.tile)) * CeilDiv(e.ny, p.tile) * CeilDiv(e.nz, p.band), 1);
-    if (p.culling) boxes = FrustumVisibleBoxes(cam, e, p.origin, p.voxelSize, p.tile, p.band, p.splatDiameter);
+    std::vector<uint8_t> a, b;
     if (p.skipping) {
-        std::vector<uint8_t> a(in.bandsPrev->CanonicalBytes()), b(in.bandsCur->CanonicalBytes());
+        a.resize(in.bandsPrev->CanonicalBytes());
+        b.resize(in.bandsCur->CanonicalBytes());
         CB_TRY(Download(*in.bandsPrev, std::as_writable_bytes(std::span(a))));
         CB_TRY(Download(*in.bandsCur, std::as_writable_bytes(std::span(b))));
-        for (size_t n = 0; n < boxes.size(); ++n) boxes[n] &= uint8_t(a[n] | b[n]);
     }
+    const std::vector<uint8_t> boxes = SplatBoxVisibility(p, e, a, b);
     // The shared order, outer axis first.
     const SplatOrder& order = *p.order;
     std::vector<uint32_t> indices;

@@ -1,0 +1,22 @@
+// Stage `ca`, initial state (SPEC 3), packed layout: one fragment per 32-voxel
+// word of slice `layer`, the three fields as three R32UI targets.
+uniform int layer;
+uniform ivec3 size;
+uniform uint seed, qHum0, qAct0;
+layout(location = 0) out uint hum;
+layout(location = 1) out uint act;
+layout(location = 2) out uint cld;
+
+void main() {
+    const uint w = uint(gl_FragCoord.x), row = uint(gl_FragCoord.y) + uint(size.y) * uint(layer);
+    const uint keyHum = StreamKey(seed, 0xFFFFFFFFu, 1u), keyAct = StreamKey(seed, 0xFFFFFFFFu, 2u);
+    const uint i0 = 32u * w, count = min(32u, uint(size.x) - i0), v0 = i0 + uint(size.x) * row;
+    uint h = 0u, a = 0u;
+    for (uint b = 0u; b < count; ++b) {
+        if (Rand24FromKey(keyHum, v0 + b) < qHum0) h |= 1u << b;
+        if (Rand24FromKey(keyAct, v0 + b) < qAct0) a |= 1u << b;
+    }
+    hum = h;
+    act = a;
+    cld = 0u;
+}

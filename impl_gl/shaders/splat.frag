@@ -1,0 +1,17 @@
+// Stage `render_splat`: one fragment of a point sprite. Keeps SPEC 8's
+// coverage (px - s/2 <= x + 0.5 < px + s/2, likewise y) and gives the
+// kernel-weighted alpha; blending (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) composites.
+flat in vec4 colour;
+flat in vec3 splat;
+layout(location = 0) out vec4 result;
+
+void main() {
+    const vec2 pixel = gl_FragCoord.xy;  // (x + 0.5, y + 0.5), y counted from the top
+    precise float halfSize = 0.5 * splat.z;
+    if (!(splat.x - halfSize <= pixel.x && pixel.x < splat.x + halfSize && splat.y - halfSize <= pixel.y &&
+          pixel.y < splat.y + halfSize))
+        discard;
+    precise float a = (pixel.x - splat.x) / splat.z + 0.5;
+    precise float b = (pixel.y - splat.y) / splat.z + 0.5;
+    result = vec4(colour.rgb, clamp(colour.a * SplatKernel(a, b), 0.0, 1.0));
+}
