@@ -149,13 +149,21 @@ Status GLContext::Check(const char* what) const {
 
 Result<GLuint> GLContext::Program(const std::string& name) {
     if (auto it = mPrograms.find(name); it != mPrograms.end()) return it->second;
-    const std::string* source = FindShader(name + ".frag");
-    if (!source) return MakeError("gl: no shader named '" + name + "'");
-    const std::string* vertex = FindShader(name + ".vert");
+    const std::string* fragment = FindShader(name + ".frag");
+    if (!fragment) return MakeError("gl: no shader named '" + name + "'");
+    auto program = LinkProgram(name, FindShader(name + ".vert"), *fragment);
+    if (program) mPrograms[name] = *program;
+    return program;
+}
+
+Result<GLuint> GLContext::LinkProgram(const std::string& name, const std::string* vertex, const std::string& fragment) {
     auto vs = Compile(mF, GL_VERTEX_SHADER, vertex ? *vertex : std::string(kFullScreenVertex), name + " vertex");
     if (!vs) return std::unexpected(vs.error());
-    auto fs = Compile(mF, GL_FRAGMENT_SHADER, *source, name);
-    if (!fs) return std::unexpected(fs.error());
+    auto fs = Compile(mF, GL_FRAGMENT_SHADER, fragment, name + " fragment");
+    if (!fs) {
+        mF.DeleteShader(*vs);
+        return std::unexpected(fs.error());
+    }
     const GLuint program = mF.CreateProgram();
     mF.AttachShader(program, *vs);
     mF.AttachShader(program, *fs);
@@ -169,7 +177,6 @@ Result<GLuint> GLContext::Program(const std::string& name) {
         mF.DeleteProgram(program);
         return MakeError("gl: linking the " + name + " program failed:\n" + log);
     }
-    mPrograms[name] = program;
     return program;
 }
 

@@ -30,6 +30,9 @@ class GLContext {
     // shaders/<name>.vert, or the full-screen triangle where there is none; a
     // compile or link failure carries its log and the pass's name.
     Result<GLuint> Program(const std::string& name);
+    // Compiles and links a program from full sources (vertex: nullptr for the
+    // full-screen triangle); errors name `name` and carry the GL log.
+    Result<GLuint> LinkProgram(const std::string& name, const std::string* vertex, const std::string& fragment);
     // An empty vertex array for attribute-less draws.
     GLuint EmptyVao() const { return mVao; }
     GLuint Framebuffer() const { return mFramebuffer; }
