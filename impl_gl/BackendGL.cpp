@@ -186,28 +186,39 @@ Status BackendGL::Download(const Buffer& buffer, std::span<std::byte> canonical)
     return {};
 }
 
+// smooth: three separable passes, x then y then z, through R16UI sums.
 Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
     if (radius < 0 || radius > 2) return MakeError("gl: smooth radius must be 0, 1 or 2");
     const Functions& f = mContext->F();
-    auto program = mContext->Program("smooth");
-    if (!program) return std::unexpected(program.error());
+    GLuint passes[3];
+    const char* names[3] = {"smooth_x", "smooth_y", "smooth_z"};
+    for (int n = 0; n < 3; ++n) {
+        auto program = mContext->Program(names[n]);
+        if (!program) return std::unexpected(program.error());
+        passes[n] = *program;
+    }
     const Extent3 e = cld.Extent();
+    const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
+    const GLuint sumX = Scratch(kSmoothX, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
+    const GLuint sumXY = Scratch(kSmoothXY, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
+    const GLuint input[3] = {Tex(cld).Texture(), sumX, sumXY};
+    const GLuint output[3] = {sumX, sumXY, Tex(q).Texture()};
     GpuTimer timer(f);
-    f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
-    f.BindTextureUnit(0, Tex(cld).Texture());
-    f.Uniform1i(f.GetUniformLocation(*program, "radius"), radius);
-    f.Uniform1f(f.GetUniformLocation(*program, "invW"), 1.0f / float(SmoothNormaliser(radius)));
-    f.Uniform3i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-    const GLint layerLocation = f.GetUniformLocation(*program, "layer");
-    f.BindFramebuffer(GL_FRAMEBUFFER, mContext->Framebuffer());
-    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        f.NamedFramebufferTextureLayer(mContext->Framebuffer(), GL_COLOR_ATTACHMENT0, Tex(q).Texture(), 0, GLint(k));
-        if (k == 0 && f.CheckNamedFramebufferStatus(mContext->Framebuffer(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            return MakeError("gl: smooth: the R32F slice is not a complete framebuffer");
-        f.Uniform1i(layerLocation, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    f.Viewport(0, 0, nx, ny);
+    for (int n = 0; n < 3; ++n) {
+        const GLuint program = passes[n];
+        f.UseProgram(program);
+        f.BindTextureUnit(0, input[n]);
+        f.Uniform1i(f.GetUniformLocation(program, "radius"), radius);
+        f.Uniform3i(f.GetUniformLocation(program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        if (n == 2) f.Uniform1f(f.GetUniformLocation(program, "invW"), 1.0f / float(SmoothNormaliser(radius)));
+        const GLint layer = f.GetUniformLocation(program, "layer");
+        for (uint32_t k = 0; k < e.nz; ++k) {
+            CB_TRY(BindTargets({{output[n], int(k)}}));
+            f.Uniform1i(layer, GLint(k));
+            f.DrawArrays(GL_TRIANGLES, 0, 3);
+        }
     }
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("smooth");

@@ -60,7 +60,7 @@ class BackendGL final : public Backend {
   private:
     // Scratch textures and buffers, kept between calls and remade when their shape changes.
     enum ScratchSlot : size_t {
-        kRegionUnorm, kCaHum, kCaAct, kCaCld, kStateA, kStateB, kShadeCoarseQ, kShadeVolume, kShadePing,
+        kRegionUnorm, kSmoothX, kSmoothXY, kCaHum, kCaAct, kCaCld, kStateA, kStateB, kShadeCoarseQ, kShadeVolume, kShadePing,
         kShadePong, kSplatTarget, kScratchSlots
     };
     enum BufferSlot : size_t { kEllipsoidList, kSplatOrder, kSplatCounters, kImageCopy, kBufferSlots };

@@ -40,7 +40,7 @@ TEST_F(GLContextTest, LinkErrorNamesThePassAndCarriesTheLog) {
 }
 
 TEST_F(GLContextTest, EveryEmbeddedPassLinks) {
-    for (const char* pass : {"smooth", "density_sum", "density_cover", "occupancy", "shadow", "region", "ca_init", "ca",
+    for (const char* pass : {"smooth_x", "smooth_y", "smooth_z", "density_sum", "density_cover", "occupancy", "shadow", "region", "ca_init", "ca",
                              "advect", "ca_pack_rgba8", "ca_rgba8", "advect_rgba8", "ca_unpack_rgba8", "shade_down",
                              "shade_slice", "shade_up", "splat"}) {
         auto program = mContext->Program(pass);
