@@ -29,4 +29,17 @@ std::vector<uint8_t> SplatBoxVisibility(const SplatParams& p, const Extent3& e, 
     return boxes;
 }
 
+Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const SplatParams& p, const SplatInputs& in) {
+    std::vector<uint8_t> bandsPrev, bandsCur;
+    if (p.skipping) {
+        if (!in.bandsPrev || !in.bandsCur)
+            return MakeError(backend.Name() + ": render_splat with skipping needs both steps' occupancy");
+        bandsPrev.resize(in.bandsPrev->CanonicalBytes());
+        bandsCur.resize(in.bandsCur->CanonicalBytes());
+        CB_TRY(backend.Download(*in.bandsPrev, std::as_writable_bytes(std::span(bandsPrev))));
+        CB_TRY(backend.Download(*in.bandsCur, std::as_writable_bytes(std::span(bandsCur))));
+    }
+    return SplatBoxVisibility(p, in.qCur->Extent(), bandsPrev, bandsCur);
+}
+
 }  // namespace cb

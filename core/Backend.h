@@ -209,6 +209,10 @@ struct BackendOptions {
     std::string glCaLayout;  // automaton layout: "packed" (default, R32UI) or "rgba8" (the thesis's)
 };
 
+// SplatBoxVisibility for a backend whose occupancy lives on a device: reads
+// both steps' bands back through backend.Download when skipping.
+Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const SplatParams& params, const SplatInputs& in);
+
 // Creates a backend by name. An unknown name, or one whose device is missing,
 // comes back as an Error that says why (the harness reports it and goes on).
 Result<std::unique_ptr<Backend>> CreateBackend(const std::string& name, const BackendOptions& options = {});

@@ -610,7 +610,6 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
 // read into a pixel buffer and one upload from it give the canonical (3, W, H) image.
 Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
     if (!p.order || !in.qPrev || !in.qCur || !in.T) return MakeError("gl: render_splat needs q (both steps), T and an order");
-    if (p.skipping && (!in.bandsPrev || !in.bandsCur)) return MakeError("gl: render_splat with skipping needs both steps' occupancy");
     if (image.Extent().nx != 3) return MakeError("gl: render_splat image must have extent (3, width, height)");
     const Functions& f = mContext->F();
     auto program = mContext->Program("splat");
@@ -619,14 +618,9 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
     const CameraFrame& cam = p.camera;
 
-    std::vector<uint8_t> bandsPrev, bandsCur;
-    if (p.skipping) {
-        bandsPrev.resize(in.bandsPrev->CanonicalBytes());
-        bandsCur.resize(in.bandsCur->CanonicalBytes());
-        CB_TRY(Download(*in.bandsPrev, std::as_writable_bytes(std::span(bandsPrev))));
-        CB_TRY(Download(*in.bandsCur, std::as_writable_bytes(std::span(bandsCur))));
-    }
-    const std::vector<uint8_t> boxes = SplatBoxVisibility(p, e, bandsPrev, bandsCur);
+    auto visibility = DownloadSplatBoxVisibility(*this, p, in);
+    if (!visibility) return std::unexpected(visibility.error());
+    const std::vector<uint8_t>& boxes = *visibility;
 
     // Runs of consecutive ranks whose box is visible: one draw each.
     const SplatOrder& order = *p.order;

@@ -311,7 +311,6 @@ Status BackendVk::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
 
 Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
     if (!p.order || !in.qPrev || !in.qCur || !in.T) return MakeError("vk: render_splat needs q (both steps), T and an order");
-    if (p.skipping && (!in.bandsPrev || !in.bandsCur)) return MakeError("vk: render_splat with skipping needs both steps' occupancy");
     const Extent3 e = in.qCur->Extent();
     if (image.Extent().nx != 3) return MakeError("vk: render_splat image must have extent (3, width, height)");
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
@@ -319,14 +318,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
 
     // Which tile x band boxes can hold a splat: the frustum (host geometry,
     // shared with the CPU) and, when skipping, the two steps' band occupancy.
-    std::vector<uint8_t> a, b;
-    if (p.skipping) {
-        a.resize(in.bandsPrev->CanonicalBytes());
-        b.resize(in.bandsCur->CanonicalBytes());
-        CB_TRY(Download(*in.bandsPrev, std::as_writable_bytes(std::span(a))));
-        CB_TRY(Download(*in.bandsCur, std::as_writable_bytes(std::span(b))));
-    }
-    const std::vector<uint8_t> boxes = SplatBoxVisibility(p, e, a, b);
+    auto visibility = DownloadSplatBoxVisibility(*this, p, in);
+    if (!visibility) return std::unexpected(visibility.error());
+    const std::vector<uint8_t>& boxes = *visibility;
     // The shared order, outer axis first.
     const SplatOrder& order = *p.order;
     std::vector<uint32_t> indices;
