@@ -1,6 +1,6 @@
 // Stage `shade`: full-resolution T of slice `layer` from the w-major volume of
 // the shaded grid, read trilinearly at (i + 0.5)/f - 0.5 clamped to the cell
-// centres (f = 1 reads each voxel's own value exactly).
+// centres; at f = 1 each voxel's own value.
 layout(binding = 0) uniform sampler2DArray shaded;  // layer = w index, texel = (u, v)
 uniform int layer;
 uniform ivec3 cells;   // shaded grid size in (x, y, z)
@@ -20,6 +20,10 @@ float At(int x, int y, int z) {
 }
 
 void main() {
+    if (f == 1) {  // the same voxel: a copy (the trilinear weights would all be 0)
+        T = At(int(gl_FragCoord.x), int(gl_FragCoord.y), layer);
+        return;
+    }
     int x0, x1, y0, y1, z0, z1;
     float tx, ty, tz;
     Tap(int(gl_FragCoord.x), cells.x, x0, x1, tx);
