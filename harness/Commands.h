@@ -30,6 +30,13 @@ struct CommonOptions {
     std::string vkDevice;                 // --vk-device INDEX|NAME
     std::string glContext;                // --gl-context osmesa|egl
     bool quiet = false;
+    // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
+    // timed calls per measurement; accuracy --switches; sweep --metric.
+    bool reference = false;
+    std::vector<std::string> vary;
+    int repeats = 5;
+    bool switches = false;
+    std::string metric = "max";
 
     BackendOptions Backend() const {
         BackendOptions b;
@@ -45,6 +52,15 @@ int DumpCommand(const CommonOptions& options);
 // Lists the Vulkan devices (and says which other backends this build has).
 int DevicesCommand();
 int ConformCommand(const CommonOptions& options);
+// Every shade and shadow option's error against the exact reference, per backend.
+int AccuracyCommand(const CommonOptions& options);
+// The cartesian product of --vary values: time and error per point, Pareto front.
+int SweepCommand(const CommonOptions& options);
+
+class Simulation;
+// dump --reference: writes T_ref.npy (with shade) and shadow_ref.npy (with
+// shadow) of the simulation's current step into `dir`.
+Status WriteReferenceDump(const Simulation& simulation, const std::string& dir, int threads);
 
 // scenes/<name>.json for a bare name, the argument itself for a path.
 std::string ResolveScenePath(const std::string& nameOrPath);
