@@ -155,7 +155,7 @@ class Evaluator {
                 std::fprintf(stderr,
                              "reference for %s: %zu boxes built in %.3f s; T_ref %llu rays in %.3f s (%.2f M rays/s), "
                              "G_ref %llu rays in %.3f s\n",
-                             key.c_str(), rec.primitives, rec.buildSeconds, (unsigned long long)rec.tStats.rays,
+                             label.c_str(), rec.primitives, rec.buildSeconds, (unsigned long long)rec.tStats.rays,
                              rec.tStats.seconds, rec.tStats.RaysPerSecond() / 1e6,
                              (unsigned long long)rec.gStats.rays, rec.gStats.seconds);
             mRecords.push_back(rec);
