@@ -320,6 +320,10 @@ std::vector<SwitchCase> SwitchCases(const Scene& scene) {
              std::numbers::pi / 4, false}};
 }
 
+std::string EpsilonText(double eps) {
+    return eps < 1e-2 ? Fmt("%.0e", eps) + " rad" : Fmt("%.3g", eps * 180 / std::numbers::pi) + " deg";
+}
+
 const char* AxisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 
 struct SwitchResult {
@@ -360,7 +364,7 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const std::string& scenePa
                     if (!slot.backend) continue;
                     StageAccuracy a = MeasureShade(*slot.backend, *scene, **in, **reference, 0, true);
                     if (a.status != "ok") continue;
-                    errorRows.push_back({c.name, Fmt("%.0e", eps) + " rad", side == 0 ? "-" : "+",
+                    errorRows.push_back({c.name, EpsilonText(eps), side == 0 ? "-" : "+",
                                          AxisName(axis[side]), slot.name, Err(a.all.max), Err(a.all.mean),
                                          Err(a.all.p99), Err(a.subset.max), Err(a.subset.mean), Err(a.subset.p99)});
                     out.doc.push_back({{"switch", c.name}, {"epsilon_rad", eps}, {"side", side == 0 ? "-" : "+"},
@@ -386,7 +390,7 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const std::string& scenePa
                 double jump = 0;
                 for (size_t v = 0; v < lower.size(); ++v)
                     jump = std::max(jump, std::fabs(double(lower[v]) - double(upper->second[v])));
-                jumpRows.push_back({c.name, Fmt("%.0e", eps) + " rad",
+                jumpRows.push_back({c.name, EpsilonText(eps),
                                     std::string(AxisName(axis[0])) + " -> " + AxisName(axis[1]), name, Err(jump),
                                     Err(refJump), Err(bound)});
                 out.doc.push_back({{"switch", c.name}, {"epsilon_rad", eps}, {"backend", name},
