@@ -48,7 +48,7 @@ def main():
             ax.set_yscale("log")
         ax.set_xlabel("median time of the stage (ms)")
         ax.set_ylabel(f"{metric} |error| against the Embree reference")
-        ax.set_title(f"{doc['scene']}: {stage}, varying {', '.join(varied)}")
+        ax.set_title(f"{doc['scene']}: {stage}\nvarying {', '.join(varied)}", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
