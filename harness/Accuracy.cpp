@@ -143,7 +143,8 @@ StageAccuracy MeasureShade(Backend& backend, const Scene& scene, const LightingI
 
 StageAccuracy MeasureShadow(Backend& backend, const Scene& scene, const LightingInputs& in,
                             const ReferenceResult& reference, int repeats) {
-    if (!backend.Supports(Stage::Shadow)) return Failed("unsupported", backend.Name() + " does not implement shadow yet");
+    if (!backend.Supports(Stage::Shadow))
+        return Failed("unsupported", backend.Name() + " does not implement shadow yet");
     if (in.D.empty()) return Failed("unsupported", "the scene has no density stage, so no D to shadow from");
     const Extent3 columns{in.grid.nx, in.grid.ny, 1};
     auto D = backend.CreateBuffer(BufferFormat::F32, columns);

@@ -8,10 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "core/Npy.h"
 #include "harness/Accuracy.h"
@@ -62,8 +61,8 @@ json StatsJson(const ErrorStats& e) {
     return {{"count", e.count}, {"max", e.max}, {"mean", e.mean}, {"p99", e.p99}, {"worst_index", e.worst}};
 }
 json TimeJson(const Summary& s) {
-    return {{"median_ms", s.median}, {"q1_ms", s.q1}, {"q3_ms", s.q3}, {"min_ms", s.min}, {"max_ms", s.max},
-            {"count", s.count}};
+    return {{"median_ms", s.median}, {"q1_ms", s.q1},   {"q3_ms", s.q3},
+            {"min_ms", s.min},       {"max_ms", s.max}, {"count", s.count}};
 }
 
 Status WriteText(const std::string& path, const std::string& text) {
@@ -86,7 +85,8 @@ std::vector<BackendSlot> OpenBackends(const CommonOptions& options) {
     for (const std::string& name : options.backends.empty() ? BuiltBackends() : options.backends) {
         BackendSlot slot{name, nullptr, ""};
         auto backend = CreateBackend(name, options.Backend());
-        if (backend) slot.backend = std::move(*backend);
+        if (backend)
+            slot.backend = std::move(*backend);
         else {
             slot.error = backend.error().message;
             std::fprintf(stderr, "backend %s unavailable: %s\n", name.c_str(), slot.error.c_str());
@@ -121,10 +121,12 @@ class Evaluator {
             if (!LightingOnly(o.path)) key += o.path + "=" + o.value + ";";
         auto it = mInputs.find(key);
         if (it == mInputs.end()) {
-            if (!mOptions.quiet) std::fprintf(stderr, "simulating %u steps of %s%s%s\n", scene.steps, scene.name.c_str(),
-                                              key.empty() ? "" : " with ", key.c_str());
+            if (!mOptions.quiet)
+                std::fprintf(stderr, "simulating %u steps of %s%s%s\n", scene.steps, scene.name.c_str(),
+                             key.empty() ? "" : " with ", key.c_str());
             auto in = SimulateLightingInputs(scene, mOptions.cpuThreads);
             if (!in) return std::unexpected(in.error());
+            KeepOnlyLast(mInputs, mLastKey);
             it = mInputs.emplace(key, std::move(*in)).first;
         }
         mLastKey = key;
@@ -156,11 +158,13 @@ class Evaluator {
                              "reference for %s: %zu boxes built in %.3f s; T_ref %llu rays in %.3f s (%.2f M rays/s), "
                              "G_ref %llu rays in %.3f s\n",
                              label.c_str(), rec.primitives, rec.buildSeconds, (unsigned long long)rec.tStats.rays,
-                             rec.tStats.seconds, rec.tStats.RaysPerSecond() / 1e6,
-                             (unsigned long long)rec.gStats.rays, rec.gStats.seconds);
+                             rec.tStats.seconds, rec.tStats.RaysPerSecond() / 1e6, (unsigned long long)rec.gStats.rays,
+                             rec.gStats.seconds);
             mRecords.push_back(rec);
+            KeepOnlyLast(mReferences, mLastReference);
             it = mReferences.emplace(key, std::move(*r)).first;
         }
+        mLastReference = key;
         return &it->second;
     }
     Result<const ReferenceResult*> Reference(const Scene& scene, const LightingInputs& in) {
@@ -170,8 +174,19 @@ class Evaluator {
     const std::vector<ReferenceRecord>& Records() const { return mRecords; }
 
   private:
+    // Bounds memory (a thesis-sized reference is about 11 MB): past kKept
+    // entries, all but the last one returned are dropped, so the pointer the
+    // caller still holds from the previous call stays valid.
+    static constexpr size_t kKept = 8;
+    template <typename Map>
+    static void KeepOnlyLast(Map& map, const std::string& last) {
+        if (map.size() < kKept) return;
+        for (auto it = map.begin(); it != map.end();) it = it->first == last ? std::next(it) : map.erase(it);
+    }
+
     const CommonOptions& mOptions;
     ref::RayStart mStart;
+    std::string mLastReference;
     std::map<std::string, LightingInputs> mInputs;
     std::map<std::string, ReferenceResult> mReferences;
     std::vector<ReferenceRecord> mRecords;
@@ -181,14 +196,15 @@ class Evaluator {
 json ReferencesJson(const std::vector<ReferenceRecord>& records, int threads) {
     json out = json::array();
     for (const ReferenceRecord& r : records)
-        out.push_back({{"inputs", r.key},
-                       {"boxes", r.primitives},
-                       {"build_s", r.buildSeconds},
-                       {"threads", threads},
-                       {"T_ref", {{"rays", r.tStats.rays}, {"seconds", r.tStats.seconds},
-                                  {"rays_per_s", r.tStats.RaysPerSecond()}}},
-                       {"G_ref", {{"rays", r.gStats.rays}, {"seconds", r.gStats.seconds},
-                                  {"rays_per_s", r.gStats.RaysPerSecond()}}}});
+        out.push_back(
+            {{"inputs", r.key},
+             {"boxes", r.primitives},
+             {"build_s", r.buildSeconds},
+             {"threads", threads},
+             {"T_ref",
+              {{"rays", r.tStats.rays}, {"seconds", r.tStats.seconds}, {"rays_per_s", r.tStats.RaysPerSecond()}}},
+             {"G_ref",
+              {{"rays", r.gStats.rays}, {"seconds", r.gStats.seconds}, {"rays_per_s", r.gStats.RaysPerSecond()}}}});
     return out;
 }
 
@@ -211,8 +227,8 @@ std::string SettingsLabel(const std::vector<SceneOverride>& settings) {
 json RowJson(const Row& r) {
     json settings = json::object();
     for (const SceneOverride& o : r.settings) settings[o.path] = o.value;
-    json j = {{"settings", settings}, {"backend", r.backend}, {"stage", StageName(r.stage)},
-              {"status", r.result.status}};
+    json j = {
+        {"settings", settings}, {"backend", r.backend}, {"stage", StageName(r.stage)}, {"status", r.result.status}};
     if (!r.result.detail.empty()) j["detail"] = r.result.detail;
     if (r.result.status == "ok") {
         j["time"] = TimeJson(r.result.timeMs);
@@ -238,10 +254,12 @@ Status MeasureSetting(Evaluator& eval, const std::string& scenePath, const Commo
         if (!scene->stages.Has(stage)) continue;
         for (BackendSlot& slot : backends) {
             Row row{setting, slot.name, stage, {}, false};
-            if (!slot.backend) row.result = {"unavailable", slot.error, {}, {}, {}, {}};
+            if (!slot.backend)
+                row.result = {"unavailable", slot.error, {}, {}, {}, {}};
             else if (stage == Stage::Shade)
                 row.result = MeasureShade(*slot.backend, *scene, **in, **reference, options.repeats);
-            else row.result = MeasureShadow(*slot.backend, *scene, **in, **reference, options.repeats);
+            else
+                row.result = MeasureShadow(*slot.backend, *scene, **in, **reference, options.repeats);
             if (row.result.status != "ok" && !options.quiet)
                 std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(stage)).c_str(),
                              SettingsLabel(setting).c_str(), row.result.status.c_str(), row.result.detail.c_str());
@@ -260,8 +278,8 @@ std::vector<std::string> RowCells(const Row& r, bool withLabel) {
         return cells;
     }
     const StageAccuracy& a = r.result;
-    for (const std::string& s : {TimeText(a.timeMs), Err(a.all.max), Err(a.all.mean), Err(a.all.p99),
-                                 Err(a.subset.max), Err(a.subset.mean), Err(a.subset.p99)})
+    for (const std::string& s : {TimeText(a.timeMs), Err(a.all.max), Err(a.all.mean), Err(a.all.p99), Err(a.subset.max),
+                                 Err(a.subset.mean), Err(a.subset.p99)})
         cells.push_back(s);
     return cells;
 }
@@ -279,7 +297,9 @@ std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage
         add("shade.filter", {"bilinear", "nearest"}, s.filter == SampleFilter::Bilinear ? "bilinear" : "nearest");
         add("shade.resolution", {"1", "2", "4"}, std::to_string(s.resolution));
         add("shade.storage", {"fp32", "fp16", "unorm8"},
-            s.storage == StorageFormat::Fp32 ? "fp32" : s.storage == StorageFormat::Fp16 ? "fp16" : "unorm8");
+            s.storage == StorageFormat::Fp32   ? "fp32"
+            : s.storage == StorageFormat::Fp16 ? "fp16"
+                                               : "unorm8");
         add("shade.scattering.enabled", {"false", "true"}, s.scattering ? "true" : "false");
     } else {
         add("shadow.form", {"beer", "thesis"}, scene.shadow.form == AttenuationKind::Beer ? "beer" : "thesis");
@@ -364,11 +384,14 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const std::string& scenePa
                     if (!slot.backend) continue;
                     StageAccuracy a = MeasureShade(*slot.backend, *scene, **in, **reference, 0, true);
                     if (a.status != "ok") continue;
-                    errorRows.push_back({c.name, EpsilonText(eps), side == 0 ? "-" : "+",
-                                         AxisName(axis[side]), slot.name, Err(a.all.max), Err(a.all.mean),
-                                         Err(a.all.p99), Err(a.subset.max), Err(a.subset.mean), Err(a.subset.p99)});
-                    out.doc.push_back({{"switch", c.name}, {"epsilon_rad", eps}, {"side", side == 0 ? "-" : "+"},
-                                       {"axis", AxisName(axis[side])}, {"backend", slot.name},
+                    errorRows.push_back({c.name, EpsilonText(eps), side == 0 ? "-" : "+", AxisName(axis[side]),
+                                         slot.name, Err(a.all.max), Err(a.all.mean), Err(a.all.p99), Err(a.subset.max),
+                                         Err(a.subset.mean), Err(a.subset.p99)});
+                    out.doc.push_back({{"switch", c.name},
+                                       {"epsilon_rad", eps},
+                                       {"side", side == 0 ? "-" : "+"},
+                                       {"axis", AxisName(axis[side])},
+                                       {"backend", slot.name},
                                        {"error", {{"all", StatsJson(a.all)}, {"in_cloud", StatsJson(a.subset)}}}});
                     T[side][slot.name] = std::move(a.output);
                 }
@@ -393,17 +416,21 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const std::string& scenePa
                 jumpRows.push_back({c.name, EpsilonText(eps),
                                     std::string(AxisName(axis[0])) + " -> " + AxisName(axis[1]), name, Err(jump),
                                     Err(refJump), Err(bound)});
-                out.doc.push_back({{"switch", c.name}, {"epsilon_rad", eps}, {"backend", name},
-                                   {"axes", {AxisName(axis[0]), AxisName(axis[1])}}, {"jump", jump},
-                                   {"reference_jump", refJump}, {"bound", bound}});
+                out.doc.push_back({{"switch", c.name},
+                                   {"epsilon_rad", eps},
+                                   {"backend", name},
+                                   {"axes", {AxisName(axis[0]), AxisName(axis[1])}},
+                                   {"jump", jump},
+                                   {"reference_jump", refJump},
+                                   {"bound", bound}});
             }
         }
     }
     out.errorsTable = Table({"switch", "epsilon", "side", "axis", "backend", "max", "mean", "p99", "max (in cloud)",
                              "mean (in cloud)", "p99 (in cloud)"},
                             errorRows);
-    out.jumpTable = Table({"switch", "epsilon", "axes", "backend", "jump max|T+ - T-|", "T_ref jump", "a-priori bound"},
-                          jumpRows);
+    out.jumpTable =
+        Table({"switch", "epsilon", "axes", "backend", "jump max|T+ - T-|", "T_ref jump", "a-priori bound"}, jumpRows);
     return out;
 }
 
@@ -441,9 +468,10 @@ int AccuracyCommand(const CommonOptions& options) {
     Evaluator eval(options, ref::RayStart::VoxelExit);
     std::vector<Row> rows;
     std::string md = "# Accuracy of " + scene->name + "\n\n";
-    std::printf("accuracy of scene %s (%ux%ux%u) at step %u against the exact reference (Embree; T_ref from each "
-                "voxel's exit point toward the sun)\n",
-                scene->name.c_str(), scene->grid.size.nx, scene->grid.size.ny, scene->grid.size.nz, scene->steps - 1);
+    std::printf(
+        "accuracy of scene %s (%ux%ux%u) at step %u against the exact reference (Embree; T_ref from each "
+        "voxel's exit point toward the sun)\n",
+        scene->name.c_str(), scene->grid.size.nx, scene->grid.size.ny, scene->grid.size.nz, scene->steps - 1);
     for (Stage stage : {Stage::Shade, Stage::Shadow}) {
         if (!scene->stages.Has(stage)) continue;
         const Stage only[] = {stage};
@@ -496,8 +524,8 @@ int AccuracyCommand(const CommonOptions& options) {
             if (!slot.backend) continue;
             StageAccuracy a = MeasureShade(*slot.backend, *scene, **in, **centre, 0);
             if (a.status != "ok") continue;
-            cells.push_back({"scene's T vs T_ref(voxel centre)", slot.name, Err(a.all.max), Err(a.all.mean),
-                             Err(a.all.p99)});
+            cells.push_back(
+                {"scene's T vs T_ref(voxel centre)", slot.name, Err(a.all.max), Err(a.all.mean), Err(a.all.p99)});
             doc["voxel_centre_reference"][slot.name] = StatsJson(a.all);
         }
         doc["voxel_exit_vs_centre"] = StatsJson(between);
@@ -512,10 +540,10 @@ int AccuracyCommand(const CommonOptions& options) {
             std::fprintf(stderr, "accuracy: switches: %s\n", sw.error().message.c_str());
             return kExitFailed;
         }
-        std::printf("\nprincipal-axis switches: error on each side\n%s\njump at the switch\n%s", sw->errorsTable.c_str(),
-                    sw->jumpTable.c_str());
-        md += "## Principal-axis switches: error on each side\n\n" + sw->errorsTable +
-              "\n## Jump at the switch\n\n" + sw->jumpTable + "\n";
+        std::printf("\nprincipal-axis switches: error on each side\n%s\njump at the switch\n%s",
+                    sw->errorsTable.c_str(), sw->jumpTable.c_str());
+        md += "## Principal-axis switches: error on each side\n\n" + sw->errorsTable + "\n## Jump at the switch\n\n" +
+              sw->jumpTable + "\n";
         doc["switches"] = sw->doc;
     }
 
@@ -525,9 +553,8 @@ int AccuracyCommand(const CommonOptions& options) {
         speed.push_back({r.key, std::to_string(r.primitives), Fmt("%.3f", r.buildSeconds),
                          std::to_string(r.tStats.rays), Fmt("%.3f", r.tStats.seconds),
                          Fmt("%.2f", r.tStats.RaysPerSecond() / 1e6), Fmt("%.2f", r.gStats.RaysPerSecond() / 1e6)});
-    const std::string speedTable =
-        Table({"reference inputs", "boxes", "build s", "T_ref rays", "T_ref s", "T_ref M rays/s", "G_ref M rays/s"},
-              speed);
+    const std::string speedTable = Table(
+        {"reference inputs", "boxes", "build s", "T_ref rays", "T_ref s", "T_ref M rays/s", "G_ref M rays/s"}, speed);
     std::printf("\nreference speed\n%s", speedTable.c_str());
     md += "## Reference speed\n\n" + speedTable;
 
@@ -552,13 +579,17 @@ std::vector<std::string> SplitValues(const std::string& text) {
     int depth = 0;
     bool quoted = false;
     for (char ch : text) {
-        if (ch == '"') quoted = !quoted;
-        else if (!quoted && (ch == '[' || ch == '{')) ++depth;
-        else if (!quoted && (ch == ']' || ch == '}')) --depth;
+        if (ch == '"')
+            quoted = !quoted;
+        else if (!quoted && (ch == '[' || ch == '{'))
+            ++depth;
+        else if (!quoted && (ch == ']' || ch == '}'))
+            --depth;
         if (ch == ',' && depth == 0 && !quoted) {
             out.push_back(current);
             current.clear();
-        } else current += ch;
+        } else
+            current += ch;
     }
     out.push_back(current);
     return out;
@@ -644,7 +675,8 @@ int SweepCommand(const CommonOptions& options) {
         std::vector<SceneOverride> all = options.overrides;
         all.insert(all.end(), point.begin(), point.end());
         if (auto s = LoadScene(scenePath, all); !s) {
-            std::fprintf(stderr, "sweep: --vary point %s:\n%s\n", SettingsLabel(point).c_str(), s.error().message.c_str());
+            std::fprintf(stderr, "sweep: --vary point %s:\n%s\n", SettingsLabel(point).c_str(),
+                         s.error().message.c_str());
             return kExitBadScene;
         }
     }
@@ -660,9 +692,10 @@ int SweepCommand(const CommonOptions& options) {
     for (const BackendSlot& b : backends) any |= b.backend != nullptr;
     if (!any) return kExitNoBackend;
 
-    std::printf("sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "
-                "%s error\n",
-                scene->name.c_str(), points.size(), backends.size(), options.repeats, options.metric.c_str());
+    std::printf(
+        "sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "
+        "%s error\n",
+        scene->name.c_str(), points.size(), backends.size(), options.repeats, options.metric.c_str());
     Evaluator eval(options, ref::RayStart::VoxelExit);
     std::vector<Row> rows;
     // A stage is left out when every varied field belongs to the other one
@@ -745,8 +778,9 @@ int SweepCommand(const CommonOptions& options) {
     const std::string command = python + " " + quote(script) + " " + quote(jsonPath) + " " + quote(pngPath);
     const bool plotted = !python.empty() && std::system(command.c_str()) == 0;
     if (python.empty())
-        std::fprintf(stderr, "sweep: no plot: python3 with matplotlib was not found (apt-get install "
-                             "python3-matplotlib); %s and %s are written\n",
+        std::fprintf(stderr,
+                     "sweep: no plot: python3 with matplotlib was not found (apt-get install "
+                     "python3-matplotlib); %s and %s are written\n",
                      jsonPath.c_str(), mdPath.c_str());
     else if (!plotted)
         std::fprintf(stderr, "sweep: no plot: '%s' failed; %s and %s are written\n", command.c_str(), jsonPath.c_str(),

@@ -18,6 +18,9 @@
 #include "reference/Reference.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -27,10 +30,6 @@
 #include <mutex>
 #include <string>
 #include <thread>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 namespace cb::ref {
 namespace {
@@ -122,7 +121,8 @@ struct DeviceErrors {
 void OnDeviceError(void* user, RTCError code, const char* text) {
     auto& errors = *static_cast<DeviceErrors*>(user);
     std::lock_guard lock(errors.mutex);
-    if (errors.message.empty()) errors.message = "Embree error " + std::to_string(int(code)) + ": " + (text ? text : "");
+    if (errors.message.empty())
+        errors.message = "Embree error " + std::to_string(int(code)) + ": " + (text ? text : "");
 }
 
 }  // namespace

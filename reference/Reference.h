@@ -36,9 +36,9 @@ enum class RayStart : uint8_t {
 const char* RayStartName(RayStart start);
 
 struct ReferenceParams {
-    Vec3 sun{0, 0, 1};       // unit vector toward the sun (the float s every stage uses)
-    double sigma = 0.02;     // extinction at q = 1, 1/m
-    double voxelSize = 50;   // h, metres
+    Vec3 sun{0, 0, 1};      // unit vector toward the sun (the float s every stage uses)
+    double sigma = 0.02;    // extinction at q = 1, 1/m
+    double voxelSize = 50;  // h, metres
     RayStart start = RayStart::VoxelExit;
 };
 

@@ -113,10 +113,12 @@ TEST(Accuracy, OverheadShadowEqualsReference) {
         auto Db = test::MakeFilled(backend, BufferFormat::F32, {e.nx, e.ny, 1}, D);
         auto G = test::MakeBuffer(backend, BufferFormat::F32, {e.nx, e.ny, 1});
         ASSERT_TRUE(backend.Shadow(p, *Db, *G).has_value());
-        const ErrorStats err = AbsoluteErrors(test::Read<float>(backend, *G),
-                                              (*tracer)->GroundShadow({p.sun, p.sigma, p.voxelSize}));
-        if (elevation == 90.0) EXPECT_LT(err.max, 1e-6);
-        else EXPECT_GT(err.max, 1e-3);
+        const ErrorStats err =
+            AbsoluteErrors(test::Read<float>(backend, *G), (*tracer)->GroundShadow({p.sun, p.sigma, p.voxelSize}));
+        if (elevation == 90.0)
+            EXPECT_LT(err.max, 1e-6);
+        else
+            EXPECT_GT(err.max, 1e-3);
     }
 }
 
@@ -136,9 +138,9 @@ TEST(Accuracy, SwitchJumpWithinBound) {
         double el, az;
         bool alongElevation;
     };
-    const Case cases[] = {{45 * kDeg, 0, true},                                  // z / x
-                          {std::atan(std::sin(60 * kDeg)), 60 * kDeg, true},     // z / y
-                          {25 * kDeg, 45 * kDeg, false},                         // x / y
+    const Case cases[] = {{45 * kDeg, 0, true},                                       // z / x
+                          {std::atan(std::sin(60 * kDeg)), 60 * kDeg, true},          // z / y
+                          {25 * kDeg, 45 * kDeg, false},                              // x / y
                           {std::atan(std::cos(200 * kDeg)) * -1, 200 * kDeg, true}};  // z / -x
     for (const Case& c : cases)
         for (AttenuationKind att : {AttenuationKind::Beer, AttenuationKind::Thesis})

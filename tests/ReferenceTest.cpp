@@ -53,14 +53,17 @@ TEST(Reference, HomogeneousSlabAtSeveralSunAngles) {
             p.sigma = 0.004;
             p.voxelSize = 50;
             const double sz = p.sun[2];
-            const double maxComponent = std::max({double(std::fabs(p.sun[0])), double(std::fabs(p.sun[1])), std::fabs(sz)});
+            const double maxComponent =
+                std::max({double(std::fabs(p.sun[0])), double(std::fabs(p.sun[1])), std::fabs(sz)});
             for (RayStart start : {RayStart::VoxelCentre, RayStart::VoxelExit}) {
                 p.start = start;
                 const std::vector<float> T = tracer->Transmittance(p);
                 for (uint32_t k = 0; k < e.nz; ++k) {
                     double path = 0;  // voxels of slab on the ray, counted from the ray's start
-                    if (k < k0) path = (k1 - k0) / sz;
-                    else if (k < k1) path = (k1 - (k + 0.5)) / sz - (start == RayStart::VoxelExit ? 0.5 / maxComponent : 0.0);
+                    if (k < k0)
+                        path = (k1 - k0) / sz;
+                    else if (k < k1)
+                        path = (k1 - (k + 0.5)) / sz - (start == RayStart::VoxelExit ? 0.5 / maxComponent : 0.0);
                     const double exact = std::exp(-p.sigma * p.voxelSize * c * path);
                     for (uint32_t j = 24; j < 40; j += 5)
                         for (uint32_t i = 24; i < 40; i += 3)
@@ -218,7 +221,8 @@ TEST(Reference, SingleVoxelPathLength) {
         dirs.push_back({float(v[0] / len), float(v[1] / len), float(v[2] / len)});
     }
     for (const Vec3& d : dirs) {
-        const double chord = 1.0 / std::max({std::fabs(double(d[0])), std::fabs(double(d[1])), std::fabs(double(d[2]))});
+        const double chord =
+            1.0 / std::max({std::fabs(double(d[0])), std::fabs(double(d[1])), std::fabs(double(d[2]))});
         // From 4 units behind the centre: 4 is exact in float along any d.
         const std::array<double, 3> behind = {1.5 - 4 * double(d[0]), 1.5 - 4 * double(d[1]), 1.5 - 4 * double(d[2])};
         EXPECT_NEAR(tracer->Integrate(behind, d, 0.0), chord, 1e-5) << d[0] << " " << d[1] << " " << d[2];
@@ -242,9 +246,9 @@ TEST(Reference, RayAlongASharedFaceCountsOnce) {
     q[VoxelIndex(e, 1, 1, 2)] = 1.0f;
     q[VoxelIndex(e, 1, 2, 2)] = 1.0f;
     auto tracer = Trace(e, q);
-    EXPECT_EQ(tracer->Integrate({0.0, 2.0, 1.5}, {1, 0, 0}, 0.0), 1.0);   // face y = 2 between rows j = 1, 2
-    EXPECT_EQ(tracer->Integrate({0.0, 2.0, 2.0}, {1, 0, 0}, 0.0), 1.0);   // edge shared by four voxels
-    EXPECT_EQ(tracer->Integrate({1.5, 2.0, 0.0}, {0, 0, 1}, 0.0), 2.0);   // along z: two slices, once each
+    EXPECT_EQ(tracer->Integrate({0.0, 2.0, 1.5}, {1, 0, 0}, 0.0), 1.0);  // face y = 2 between rows j = 1, 2
+    EXPECT_EQ(tracer->Integrate({0.0, 2.0, 2.0}, {1, 0, 0}, 0.0), 1.0);  // edge shared by four voxels
+    EXPECT_EQ(tracer->Integrate({1.5, 2.0, 0.0}, {0, 0, 1}, 0.0), 2.0);  // along z: two slices, once each
 }
 
 // An independent Amanatides-Woo traversal: sum of q l from `o` (inside the
@@ -290,7 +294,7 @@ TEST(Reference, MatchesIndependentDda) {
     Pcg32 rng(21);
     std::vector<float> q(e.Count());
     for (float& v : q) v = rng.Below(3) == 0 ? float(rng.Below(65)) / 64.0f : 0.0f;
-    std::vector<Vec3> suns = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, Sun(45, 0), Sun(20, 45), Sun(35.26438968, 45),
+    std::vector<Vec3> suns = {{0, 0, 1},    {1, 0, 0},    {0, -1, 0}, Sun(45, 0), Sun(20, 45), Sun(35.26438968, 45),
                               Sun(-30, 70), Sun(1e-4, 10)};
     for (int n = 0; n < 12; ++n) suns.push_back(Sun(rng.NextDouble() * 180 - 90, rng.NextDouble() * 360));
     const double sigma = 0.02, h = 50;

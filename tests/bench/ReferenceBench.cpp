@@ -52,7 +52,8 @@ void Transmittance(benchmark::State& state, const std::string& name) {
     auto tracer = Tracer(in, int(state.range(0)));
     const ref::ReferenceParams p = MakeReferenceParams(scene, ref::RayStart::VoxelExit);
     for (auto _ : state) benchmark::DoNotOptimize(tracer->Transmittance(p));
-    state.counters["rays/s"] = benchmark::Counter(double(in.grid.Count()), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["rays/s"] =
+        benchmark::Counter(double(in.grid.Count()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 void GroundShadow(benchmark::State& state, const std::string& name) {
@@ -66,15 +67,15 @@ void GroundShadow(benchmark::State& state, const std::string& name) {
 }
 
 // Wall time: the tracer runs its own TBB threads.
-#define CB_REFERENCE_BENCH(scene)                                                                   \
-    BENCHMARK_CAPTURE(Build, scene, #scene)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();         \
+#define CB_REFERENCE_BENCH(scene)                                                                                  \
+    BENCHMARK_CAPTURE(Build, scene, #scene)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();                 \
     BENCHMARK_CAPTURE(Transmittance, scene, #scene)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime(); \
     BENCHMARK_CAPTURE(GroundShadow, scene, #scene)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-CB_REFERENCE_BENCH(ci-small)
-CB_REFERENCE_BENCH(thesis-low)
-CB_REFERENCE_BENCH(thesis-medium)
-CB_REFERENCE_BENCH(thesis-high)
+CB_REFERENCE_BENCH(ci - small)
+CB_REFERENCE_BENCH(thesis - low)
+CB_REFERENCE_BENCH(thesis - medium)
+CB_REFERENCE_BENCH(thesis - high)
 
 }  // namespace
 }  // namespace cb
