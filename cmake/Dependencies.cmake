@@ -33,3 +33,8 @@ if(CLOUDBENCH_BUILD_BENCHMARKS)
   find_package(benchmark CONFIG QUIET)
   cloudbench_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
 endif()
+
+# The exact attenuation reference (SPEC 11). Debian's embree-config.cmake defines
+# the imported target `embree`.
+find_package(embree 3 CONFIG QUIET)
+cloudbench_require(embree_FOUND "Embree 3" libembree-dev)

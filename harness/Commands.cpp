@@ -232,6 +232,7 @@ int DumpCommand(const CommonOptions& options) {
         CB_TRY(write(dir, "bands.npy", s.Bands()));
         CB_TRY(write(dir, "T.npy", s.T()));
         CB_TRY(write(dir, "shadow.npy", s.Shadow()));
+        if (options.reference) CB_TRY(WriteReferenceDump(s, dir, options.cpuThreads));
         // frame.exr is the first camera; the others are frame-<camera>.exr.
         for (size_t n = 0; s.Image(n); ++n) {
             auto rgb = DownloadAll<float>(s.GetBackend(), *s.Image(n));

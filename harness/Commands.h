@@ -31,6 +31,13 @@ struct CommonOptions {
     std::string glContext;                // --gl-context osmesa|egl
     std::string glCaLayout;               // --gl-ca-layout packed|rgba8
     bool quiet = false;
+    // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
+    // timed calls per measurement; accuracy --switches; sweep --metric.
+    bool reference = false;
+    std::vector<std::string> vary;
+    int repeats = 5;
+    bool switches = false;
+    std::string metric = "max";
 
     BackendOptions Backend() const {
         BackendOptions b;
@@ -47,6 +54,15 @@ int DumpCommand(const CommonOptions& options);
 // Lists the Vulkan devices (and says which other backends this build has).
 int DevicesCommand();
 int ConformCommand(const CommonOptions& options);
+// Every shade and shadow option's error against the exact reference, per backend.
+int AccuracyCommand(const CommonOptions& options);
+// The cartesian product of --vary values: time and error per point, Pareto front.
+int SweepCommand(const CommonOptions& options);
+
+class Simulation;
+// dump --reference: writes T_ref.npy (with shade) and shadow_ref.npy (with
+// shadow) of the simulation's current step into `dir`.
+Status WriteReferenceDump(const Simulation& simulation, const std::string& dir, int threads);
 
 // scenes/<name>.json for a bare name, the argument itself for a path.
 std::string ResolveScenePath(const std::string& nameOrPath);

@@ -16,6 +16,8 @@ Commands:
   dump     Write each step's canonical stage outputs as NumPy .npy files
   conform  Check every backend's stages against the CPU on a scene
   devices  List the backends of this build and the Vulkan devices
+  accuracy Measure every shade and shadow option against the exact (Embree) reference
+  sweep    Vary scene fields over a cartesian product: time and error, Pareto front, plot
   help   Show help for a command: cloudbench help run
 
 Exit codes: 0 success, 1 a stage failed or an output could not be written,
@@ -56,11 +58,14 @@ Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
   tiles.npy bands.npy      uint8 tile and height-band occupancy of step t
   T.npy                    float32, the transmittance of step t
   shadow.npy               float32 ground shadow, shape (1, ny, nx)
+  T_ref.npy shadow_ref.npy with --reference: the exact references (Embree) for
+                           T and the ground shadow, same shapes
   frame.exr                step t from the first camera (frame-<camera>.exr: others)
 Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
 
 Options:
   --backend NAME     the backend to dump (default: cpu)
+  --reference        also write T_ref.npy and shadow_ref.npy (docs/accuracy.md)
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/dump)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
@@ -87,6 +92,58 @@ Options:
   --vk-device DEV    Vulkan device: index or part of the name
 )";
 
+constexpr const char* kAccuracyHelp = R"(usage: cloudbench accuracy [SCENE] [options]
+
+Simulates SCENE on the CPU to its last step, computes the exact references
+T_ref (every voxel, from the point where the ray toward the sun leaves the
+voxel) and G_ref (every ground cell) with Embree, and measures the shade and
+shadow stages of every backend against them: the scene's settings, then each
+option changed one at a time (shade: attenuation, filter, resolution, storage,
+scattering; shadow: form). Prints per option and backend the median time with
+quartiles and the max, mean and 99th-percentile |error| over all voxels and
+over the voxels in cloud (q > 0) or ground cells under cloud (G_ref < 1), the
+reference's own speed in rays per second, and writes DIR/accuracy.json and
+DIR/accuracy.md.
+
+Options:
+  --backend LIST     backends to measure (default: all built); unavailable ones
+                     are reported, and a stage a backend lacks is listed as unsupported
+  --repeat N         timed calls per measurement, after one warm-up (default 5)
+  --switches         also cross the principal axis's 45-degree switches: error on
+                     each side (1e-6 rad, 1e-3 rad, 1 degree) and the jump in T
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>/accuracy)
+  --set PATH=VALUE   override a scene field (see cloudbench help run)
+  --threads N        CPU backend and reference threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name
+  --quiet            no progress lines
+)";
+
+constexpr const char* kSweepHelp = R"(usage: cloudbench sweep [SCENE] --vary PATH=V1,V2,... [--vary ...] [options]
+
+Runs the cartesian product of the --vary values (dotted scene paths, as for
+--set; a value may be JSON, e.g. --vary grid.size=[32,32,8],[64,64,16]). At
+each point: the CPU simulates the scene to its last step, the Embree
+reference is computed for that q and sun, and every backend's shade and
+shadow stages are timed (median of --repeat calls, with quartiles) and
+compared with it. Marks the Pareto front (no other point as fast and as
+accurate) per stage and writes DIR/sweep.json, DIR/sweep.md and DIR/sweep.png
+(error against time, one series per backend; needs python3 with matplotlib,
+otherwise the plot is skipped with a message).
+
+Options:
+  --vary PATH=V1,... a field and its values; repeat for more fields
+  --backend LIST     backends to measure (default: all built)
+  --metric M         error for the Pareto front: max (default), mean or p99
+  --repeat N         timed calls per point, after one warm-up (default 5)
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>/sweep)
+  --set PATH=VALUE   override a scene field for every point
+  --threads N        CPU backend and reference threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name
+  --quiet            no progress lines
+)";
+
 int Usage(const char* message, const char* help) {
     std::fprintf(stderr, "cloudbench: %s\n\n%s", message, help);
     return cb::kExitUsage;
@@ -106,7 +163,12 @@ int main(int argc, char** argv) {
     }
     if (command == "help") {
         std::string_view topic = argc > 2 ? argv[2] : "";
-        std::fputs(topic == "run" ? kRunHelp : topic == "dump" ? kDumpHelp : topic == "conform" ? kConformHelp : kMainHelp,
+        std::fputs(topic == "run"        ? kRunHelp
+                   : topic == "dump"     ? kDumpHelp
+                   : topic == "conform"  ? kConformHelp
+                   : topic == "accuracy" ? kAccuracyHelp
+                   : topic == "sweep"    ? kSweepHelp
+                                         : kMainHelp,
                    stdout);
         return cb::kExitOk;
     }
@@ -114,12 +176,15 @@ int main(int argc, char** argv) {
     const char* help = command == "run"       ? kRunHelp
                        : command == "dump"    ? kDumpHelp
                        : command == "conform" ? kConformHelp
+                       : command == "accuracy" ? kAccuracyHelp
+                       : command == "sweep"   ? kSweepHelp
                                               : nullptr;
     if (!help) return Usage(("unknown command '" + std::string(command) + "'").c_str(), kMainHelp);
 
     cb::CommonOptions options;
     // A dump has no statistics, so no warm-up to keep below --steps.
-    if (command == "dump" || command == "conform") options.overrides.push_back({"warmup_steps", "0"});
+    if (command != "run") options.overrides.push_back({"warmup_steps", "0"});
+    const bool measures = command == "accuracy" || command == "sweep";
     bool sceneGiven = false;
     for (int n = 2; n < argc; ++n) {
         const std::string_view arg = argv[n];
@@ -172,6 +237,24 @@ int main(int argc, char** argv) {
             options.vkDevice = v;
         } else if (arg == "--quiet") {
             options.quiet = true;
+        } else if (arg == "--reference" && command == "dump") {
+            options.reference = true;
+        } else if (arg == "--switches" && command == "accuracy") {
+            options.switches = true;
+        } else if (arg == "--vary" && command == "sweep") {
+            const char* v = value();
+            if (!v) return Usage("--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4", help);
+            options.vary.push_back(v);
+        } else if (arg == "--metric" && command == "sweep") {
+            const char* v = value();
+            if (!v) return Usage("--metric needs max, mean or p99", help);
+            options.metric = v;
+        } else if (arg == "--repeat" && measures) {
+            const char* v = value();
+            char* end = nullptr;
+            long repeats = v ? std::strtol(v, &end, 10) : -1;
+            if (!v || *end != '\0' || repeats < 1 || repeats > 10000) return Usage("--repeat needs a number from 1", help);
+            options.repeats = int(repeats);
         } else if (arg.starts_with("-")) {
             return Usage(("unknown option '" + std::string(arg) + "'").c_str(), help);
         } else if (!sceneGiven) {
@@ -182,5 +265,7 @@ int main(int argc, char** argv) {
         }
     }
     if (command == "conform") return cb::ConformCommand(options);
+    if (command == "accuracy") return cb::AccuracyCommand(options);
+    if (command == "sweep") return cb::SweepCommand(options);
     return command == "run" ? cb::RunCommand(options) : cb::DumpCommand(options);
 }

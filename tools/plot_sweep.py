@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""Plots a `cloudbench sweep` result: error against time, one series per backend,
+one panel per stage, the Pareto front marked. Usage: plot_sweep.py sweep.json sweep.png"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit("usage: plot_sweep.py SWEEP_JSON OUT_PNG")
+    with open(sys.argv[1]) as f:
+        doc = json.load(f)
+    metric = doc["metric"]
+    rows = [r for r in doc["rows"] if r["status"] == "ok"]
+    stages = [s for s in ("shade", "shadow") if any(r["stage"] == s for r in rows)]
+    if not stages:
+        sys.exit("plot_sweep.py: no measured rows in " + sys.argv[1])
+    fig, axes = plt.subplots(1, len(stages), figsize=(6.5 * len(stages), 5), squeeze=False)
+    varied = [v["path"] for v in doc["vary"]]
+    # One colour per backend in every panel.
+    colours = {b: f"C{n}" for n, b in enumerate(sorted({r["backend"] for r in rows}))}
+    for ax, stage in zip(axes[0], stages):
+        stage_rows = [r for r in rows if r["stage"] == stage]
+        backends = sorted({r["backend"] for r in stage_rows})
+        for backend in backends:
+            mine = [r for r in stage_rows if r["backend"] == backend]
+            t = [r["time"]["median_ms"] for r in mine]
+            e = [r["error"]["all"][metric] for r in mine]
+            lo = [r["time"]["median_ms"] - r["time"]["q1_ms"] for r in mine]
+            hi = [r["time"]["q3_ms"] - r["time"]["median_ms"] for r in mine]
+            ax.errorbar(t, e, xerr=[lo, hi], fmt="o", capsize=2, label=backend, alpha=0.8,
+                        color=colours[backend])
+            if len(varied) <= 2 and len(mine) <= 24:
+                for r, x, y in zip(mine, t, e):
+                    label = ",".join(str(r["settings"].get(p, "")) for p in varied)
+                    ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+        front = sorted((r["time"]["median_ms"], r["error"]["all"][metric]) for r in stage_rows if r.get("pareto"))
+        if front:
+            ax.plot([p[0] for p in front], [p[1] for p in front], "k--", lw=1, label="Pareto front")
+            ax.scatter([p[0] for p in front], [p[1] for p in front], s=120, facecolors="none", edgecolors="k")
+        ax.set_xscale("log")
+        if all(r["error"]["all"][metric] > 0 for r in stage_rows):
+            ax.set_yscale("log")
+        ax.set_xlabel("median time of the stage (ms)")
+        ax.set_ylabel(f"{metric} |error| against the Embree reference")
+        ax.set_title(f"{doc['scene']}: {stage}\nvarying {', '.join(varied)}", fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(sys.argv[2], dpi=110)
+
+
+if __name__ == "__main__":
+    main()
