@@ -71,6 +71,8 @@ Options:
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
+  --gl-context CTX   OpenGL context: osmesa (default) or egl
+  --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8
   --quiet            no progress lines
 )";
 
@@ -90,6 +92,8 @@ Options:
   --out DIR          output folder (default: out/<scene name>/conform)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --vk-device DEV    Vulkan device: index or part of the name
+  --gl-context CTX   OpenGL context: osmesa (default) or egl
+  --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8
 )";
 
 constexpr const char* kAccuracyHelp = R"(usage: cloudbench accuracy [SCENE] [options]
@@ -116,6 +120,7 @@ Options:
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend and reference threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name
+  --gl-context CTX   OpenGL context: osmesa (default) or egl
   --quiet            no progress lines
 )";
 
@@ -141,6 +146,7 @@ Options:
   --set PATH=VALUE   override a scene field for every point
   --threads N        CPU backend and reference threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name
+  --gl-context CTX   OpenGL context: osmesa (default) or egl
   --quiet            no progress lines
 )";
 
