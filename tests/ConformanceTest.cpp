@@ -340,6 +340,7 @@ TEST_P(Conformance, RenderSplat) {
     const DensityParams density{8, 4};
     for (size_t c = 0; c < cameras.size(); ++c) {
         std::vector<float> images[2];
+        SplatStats stats[2];
         for (int n = 0; n < 2; ++n) {
             Backend& b = *backends[n];
             auto qp = test::MakeFilled(b, BufferFormat::F32, e, qPrev);
@@ -371,9 +372,18 @@ TEST_P(Conformance, RenderSplat) {
             auto image = test::MakeBuffer(b, BufferFormat::F32, {3, W, H});
             SplatInputs in{qp.get(), qc.get(), t.get(), occupancy[0][0].get(), occupancy[1][0].get(),
                            occupancy[0][1].get(), occupancy[1][1].get()};
-            Status s = b.RenderSplat(p, in, *image, nullptr);
+            Status s = b.RenderSplat(p, in, *image, &stats[n]);
             ASSERT_TRUE(s.has_value()) << s.error().message;
             images[n] = test::Read<float>(b, *image);
+        }
+        // The same voxels make splats everywhere; Vulkan does not count the
+        // visited voxels or the fragments (docs/pipeline.md), the others must
+        // agree on both (GL: runs of visible boxes, and a fragment query).
+        EXPECT_GT(stats[0].splats, 0u) << "camera " << c << " sees no splat: the test would prove nothing";
+        EXPECT_EQ(stats[1].splats, stats[0].splats) << "camera " << c;
+        if (mBackend->Name() != "vk") {
+            EXPECT_EQ(stats[1].voxelsVisited, stats[0].voxelsVisited) << "camera " << c;
+            EXPECT_EQ(stats[1].fragments, stats[0].fragments) << "camera " << c;
         }
         const ImageComparison cmp = CompareImages(images[0], images[1], W, H);
         if (!cmp.Passes()) {
