@@ -200,16 +200,24 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
 Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q) {
     if (radius < 0 || radius > 2) return MakeError("vk: smooth radius must be 0, 1 or 2");
     const Extent3 e = cld.Extent();
-    auto pipeline = mContext->GetPipeline("smooth", 2);
+    auto pipeline = mContext->GetPipeline("smooth", 4);
     if (!pipeline) return std::unexpected(pipeline.error());
+    auto sumX = Scratch(21, e.Count() * 4);
+    if (!sumX) return std::unexpected(sumX.error());
+    auto sumXY = Scratch(22, e.Count() * 4);
+    if (!sumXY) return std::unexpected(sumXY.error());
     struct {
         uint32_t nx, ny, nz, words;
         int32_t radius;
         float invW;
-    } push{e.nx, e.ny, e.nz, (e.nx + 31) / 32, radius, 1.0f / float(SmoothNormaliser(radius))};
-    const DeviceBuffer* buffers[] = {&Dev(cld), &Dev(q)};
+        uint32_t pass;
+    } push{e.nx, e.ny, e.nz, (e.nx + 31) / 32, radius, 1.0f / float(SmoothNormaliser(radius)), 0};
+    const DeviceBuffer* buffers[] = {&Dev(cld), *sumX, *sumXY, &Dev(q)};
     return Record("smooth", [&](VulkanContext::Recorder& r) {
-        r.Dispatch(**pipeline, buffers, &push, sizeof push, uint32_t(e.Count()));
+        for (push.pass = 0; push.pass < 3; ++push.pass) {
+            if (push.pass > 0) r.Barrier();
+            r.Dispatch(**pipeline, buffers, &push, sizeof push, uint32_t(e.Count()));
+        }
     });
 }
 

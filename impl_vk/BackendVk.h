@@ -65,7 +65,7 @@ class BackendVk final : public Backend {
     // Reused between calls: 0 ellipsoids, 1-3 advection, 4 shifts, 5 cover
     // counter, 6-7 coarse shading grids, 8-18 the splat renderer's buffers.
     // A fixed array, so pointers to one slot stay valid while others grow.
-    std::array<DeviceBuffer, 21> mScratch{};
+    std::array<DeviceBuffer, 23> mScratch{};
 };
 
 }  // namespace cb::vk
