@@ -128,9 +128,12 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
 std::string TimingTable(const Scene& scene, const BackendRun& run) {
     std::string out;
     char line[256];
-    std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, statistics over steps %u..%zu\n", run.name.c_str(),
-                  run.device.c_str(), run.steps.size(), scene.warmupSteps,
-                  run.steps.empty() ? size_t(0) : run.steps.size() - 1);
+    if (run.steps.size() > scene.warmupSteps)
+        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, statistics over steps %u..%zu\n", run.name.c_str(),
+                      run.device.c_str(), run.steps.size(), scene.warmupSteps, run.steps.size() - 1);
+    else
+        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, none after the %u warm-up steps\n",
+                      run.name.c_str(), run.device.c_str(), run.steps.size(), scene.warmupSteps);
     out += line;
     std::snprintf(line, sizeof line, "  %-18s %10s %10s %10s %10s %10s\n", "stage", "median ms", "q1", "q3", "min",
                   "max");  // wall time; "device" follows where the backend measures GPU time

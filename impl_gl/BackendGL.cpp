@@ -139,9 +139,18 @@ Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Ext
     if (extent.Count() == 0) return MakeError("gl: cannot create an empty buffer");
     const Functions& f = mContext->F();
     const TexelFormat t = FormatOf(format);
+    const GLsizei width = GLsizei(format == BufferFormat::Bits ? (extent.nx + 31) / 32 : extent.nx);
+    GLint maxSize = 0, maxLayers = 0;
+    f.GetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+    f.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+    if (width > maxSize || extent.ny > uint32_t(maxSize) || extent.nz > uint32_t(maxLayers))
+        return MakeError("gl: a buffer of extent (" + std::to_string(extent.nx) + ", " + std::to_string(extent.ny) + ", " +
+                         std::to_string(extent.nz) + ") needs a " + std::to_string(width) + " x " +
+                         std::to_string(extent.ny) + " texture with " + std::to_string(extent.nz) +
+                         " layers; this driver allows " + std::to_string(maxSize) + " x " + std::to_string(maxSize) +
+                         " with " + std::to_string(maxLayers) + " layers (an image's height is its layer count)");
     GLuint texture = 0;
     f.CreateTextures(GL_TEXTURE_2D_ARRAY, 1, &texture);
-    const GLsizei width = GLsizei(format == BufferFormat::Bits ? (extent.nx + 31) / 32 : extent.nx);
     f.TextureStorage3D(texture, 1, t.internal, width, GLsizei(extent.ny), GLsizei(extent.nz));
     f.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     f.TextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
