@@ -272,10 +272,10 @@ class Validator {
 
     void MarkOverridden(std::string path) { mOverridden.push_back(std::move(path)); }
 
-    // Adds one error line; fields under a --set path get " (set with --set)".
+    // Adds one error line; fields under an override (--set, --vary) get " (set on the command line)".
     void Fail(std::string_view field, std::string_view reason) {
         std::string line = mLabel + ": " + std::string(field) + ": " + std::string(reason);
-        if (IsOverridden(field)) line += " (set with --set)";
+        if (IsOverridden(field)) line += " (set on the command line)";
         mErrors.push_back(std::move(line));
     }
 

@@ -744,21 +744,21 @@ TEST(SceneTest, OverrideBareWordAndNewSection) {
 // Test that a bad override value is refused and marked as coming from --set.
 TEST(SceneTest, OverrideBadValue) {
     std::string message = ErrorOf(kMinimal, {{"ca.p_ext", "2"}, {"grid", R"({"size": [8, 0, 6]})"}});
-    EXPECT_TRUE(HasLine(message, "test.json: ca.p_ext: must be in [0, 1], got 2 (set with --set)"));
-    EXPECT_TRUE(HasLine(message, "test.json: grid.size[1]: must be in [1, 4294967295], got 0 (set with --set)"));
+    EXPECT_TRUE(HasLine(message, "test.json: ca.p_ext: must be in [0, 1], got 2 (set on the command line)"));
+    EXPECT_TRUE(HasLine(message, "test.json: grid.size[1]: must be in [1, 4294967295], got 0 (set on the command line)"));
 }
 
 // Test that errors outside the overridden paths are not marked as coming from --set.
 TEST(SceneTest, OverrideSuffixOnlyOnOverriddenFields) {
     std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": 0})", {{"step", "3"}});
     EXPECT_TRUE(HasLine(message, "test.json: steps: must be in [1, 10000000], got 0"));
-    EXPECT_TRUE(HasLine(message, R"(test.json: step: unknown field (did you mean "steps"?) (set with --set))"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: step: unknown field (did you mean "steps"?) (set on the command line))"));
 }
 
 // Test that an override of an unknown field is refused by the unknown-field check.
 TEST(SceneTest, OverrideUnknownField) {
     EXPECT_TRUE(HasLine(ErrorOf(kMinimal, {{"ca.sed", "3"}}),
-                        R"(test.json: ca.sed: unknown field (did you mean "seed"?) (set with --set))"));
+                        R"(test.json: ca.sed: unknown field (did you mean "seed"?) (set on the command line))"));
 }
 
 // Test that an override cannot descend into a value that is not an object.
@@ -777,16 +777,16 @@ TEST(SceneTest, OverrideShadeStorage) {
 // Test that --set shade.resolution=3 is refused and marked as coming from --set.
 TEST(SceneTest, OverrideShadeResolutionRefused) {
     EXPECT_TRUE(HasLine(ErrorOf(kMinimal, {{"shade.resolution", "3"}}),
-                        "test.json: shade.resolution: must be 1, 2 or 4, got 3 (set with --set)"));
+                        "test.json: shade.resolution: must be 1, 2 or 4, got 3 (set on the command line)"));
 }
 
 // Test that an override value that overflows to infinity is refused, not used.
 TEST(SceneTest, OverrideNonFinite) {
     std::string message = ErrorOf(kMinimal, {{"grid.voxel_size", "1e999"}, {"grid.origin", "[0, -1e999, 0]"}});
     EXPECT_TRUE(HasLine(message,
-                        "test.json: grid.voxel_size: the number 1e999 is out of range (not finite) (set with --set)"));
+                        "test.json: grid.voxel_size: the number 1e999 is out of range (not finite) (set on the command line)"));
     EXPECT_TRUE(HasLine(message,
-                        "test.json: grid.origin: the number -1e999 is out of range (not finite) (set with --set)"));
+                        "test.json: grid.origin: the number -1e999 is out of range (not finite) (set on the command line)"));
 }
 
 }  // namespace
