@@ -268,14 +268,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Disable(GL_BLEND);
 
     // Cover: an atomic counter over the columns; the column flags land in a scratch R8UI layer.
-    GLuint counter = 0;
-    f.CreateBuffers(1, &counter);
+    const GLuint counter = ScratchBuffer(kCoverCounter, sizeof(GLuint));
     const GLuint initial = 0;
-    f.NamedBufferData(counter, sizeof initial, &initial, GL_DYNAMIC_READ);
+    f.NamedBufferSubData(counter, 0, sizeof initial, &initial);
     f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
-    auto flags = CreateBuffer(BufferFormat::U8, {e.nx, e.ny, 1});
-    if (!flags) return std::unexpected(flags.error());
-    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(**flags).Texture(), 0, 0);
+    const GLuint flags = Scratch(kCoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
+    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, flags, 0, 0);
     f.UseProgram(*cover);
     f.BindTextureUnit(0, Tex(cld).Texture());
     f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
@@ -303,7 +301,6 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     mLastDeviceMs = timer.StopMs();
     GLuint covered = 0;
     f.GetNamedBufferSubData(counter, 0, sizeof covered, &covered);
-    f.DeleteBuffers(1, &counter);
     out.coveredColumns = covered;
     return mContext->Check("density");
 }

@@ -61,9 +61,9 @@ class BackendGL final : public Backend {
     // Scratch textures and buffers, kept between calls and remade when their shape changes.
     enum ScratchSlot : size_t {
         kRegionUnorm, kSmoothX, kSmoothXY, kCaHum, kCaAct, kCaCld, kStateA, kStateB, kShadeCoarseQ, kShadeVolume, kShadePing,
-        kShadePong, kSplatTarget, kScratchSlots
+        kShadePong, kSplatTarget, kCoverFlags, kScratchSlots
     };
-    enum BufferSlot : size_t { kEllipsoidList, kSplatOrder, kSplatCounters, kImageCopy, kBufferSlots };
+    enum BufferSlot : size_t { kCoverCounter, kEllipsoidList, kSplatOrder, kSplatCounters, kImageCopy, kBufferSlots };
     struct ScratchTexture {
         GLuint texture = 0;
         GLenum target = 0, format = 0;
