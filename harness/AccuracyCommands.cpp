@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "core/Npy.h"
@@ -94,6 +95,20 @@ std::vector<BackendSlot> OpenBackends(const CommonOptions& options) {
         slots.push_back(std::move(slot));
     }
     return slots;
+}
+
+// Makes the output folder and opens the backends; the exit code when the
+// folder cannot be made or no backend is available, nullopt to go on.
+std::optional<int> OpenOutputAndBackends(const CommonOptions& options, const std::string& outDir,
+                                         std::vector<BackendSlot>& backends) {
+    if (Status s = MakeOutDir(outDir); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    backends = OpenBackends(options);
+    for (const BackendSlot& b : backends)
+        if (b.backend) return std::nullopt;
+    return kExitNoBackend;
 }
 
 // Paths whose value changes only the lighting stages, not q or D.
@@ -454,16 +469,8 @@ int AccuracyCommand(const CommonOptions& options) {
         return kExitBadScene;
     }
     const std::string outDir = DefaultOut(options, *scene, "accuracy");
-    std::error_code ec;
-    fs::create_directories(outDir, ec);
-    if (ec) {
-        std::fprintf(stderr, "%s: cannot create the output folder: %s\n", outDir.c_str(), ec.message().c_str());
-        return kExitFailed;
-    }
-    std::vector<BackendSlot> backends = OpenBackends(options);
-    bool any = false;
-    for (const BackendSlot& b : backends) any |= b.backend != nullptr;
-    if (!any) return kExitNoBackend;
+    std::vector<BackendSlot> backends;
+    if (std::optional<int> exitCode = OpenOutputAndBackends(options, outDir, backends)) return *exitCode;
 
     Evaluator eval(options, ref::RayStart::VoxelExit);
     std::vector<Row> rows;
@@ -681,16 +688,8 @@ int SweepCommand(const CommonOptions& options) {
         }
     }
     const std::string outDir = DefaultOut(options, *scene, "sweep");
-    std::error_code ec;
-    fs::create_directories(outDir, ec);
-    if (ec) {
-        std::fprintf(stderr, "%s: cannot create the output folder: %s\n", outDir.c_str(), ec.message().c_str());
-        return kExitFailed;
-    }
-    std::vector<BackendSlot> backends = OpenBackends(options);
-    bool any = false;
-    for (const BackendSlot& b : backends) any |= b.backend != nullptr;
-    if (!any) return kExitNoBackend;
+    std::vector<BackendSlot> backends;
+    if (std::optional<int> exitCode = OpenOutputAndBackends(options, outDir, backends)) return *exitCode;
 
     std::printf(
         "sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "

@@ -26,17 +26,17 @@ std::string ResolveScenePath(const std::string& nameOrPath) {
     return (dir / (name + ".json")).string();
 }
 
-namespace {
-
-Result<Scene> Load(const CommonOptions& options) {
-    return LoadScene(ResolveScenePath(options.scene), options.overrides);
-}
-
 Status MakeOutDir(const std::string& dir) {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) return MakeError(dir + ": cannot create the output folder: " + ec.message());
     return {};
+}
+
+namespace {
+
+Result<Scene> Load(const CommonOptions& options) {
+    return LoadScene(ResolveScenePath(options.scene), options.overrides);
 }
 
 // Reads a buffer back in canonical form; adds the time it took to `timesMs` when given.

@@ -49,6 +49,9 @@ struct CommonOptions {
     }
 };
 
+// Creates `dir` and its parents; the error names the folder and the reason.
+Status MakeOutDir(const std::string& dir);
+
 int RunCommand(const CommonOptions& options);
 int DumpCommand(const CommonOptions& options);
 // Lists the Vulkan devices (and says which other backends this build has).
