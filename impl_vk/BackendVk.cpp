@@ -369,7 +369,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         uint32_t grid[4], axes[4], orderBase[4], boxes[4], image[4];
         float eye[4], forward[4], right[4], up[4], sun[4], sunRadiance[4], ambient[4], background[4], origin[4], misc[4];
     } frame{};
-    constexpr uint32_t kVoxelsPerChunk = 1024, kSplatsPerChunk = 256, kTileSize = 16;
+    constexpr uint32_t kVoxelsPerChunk = 1024, kSplatsPerChunk = 256, kTileSize = 8;
     const uint32_t voxels = uint32_t(e.Count());
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
     frame = {{e.nx, e.ny, e.nz, kVoxelsPerChunk},
