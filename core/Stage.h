@@ -42,6 +42,23 @@ constexpr std::string_view StageName(Stage stage) {
     return "?";
 }
 
+// The stages of the thesis's splat pipeline (SPEC 2-8), which every backend
+// implements; render_march and noise are not built yet.
+constexpr bool IsSplatPipelineStage(Stage stage) {
+    switch (stage) {
+        case Stage::Region:
+        case Stage::Ca:
+        case Stage::Smooth:
+        case Stage::Density:
+        case Stage::Shade:
+        case Stage::Shadow:
+        case Stage::RenderSplat: return true;
+        case Stage::RenderMarch:
+        case Stage::Noise: return false;
+    }
+    return false;
+}
+
 constexpr std::optional<Stage> ParseStage(std::string_view name) {
     for (Stage stage : kAllStages) {
         if (StageName(stage) == name) return stage;

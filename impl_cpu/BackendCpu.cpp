@@ -22,18 +22,7 @@ std::string BackendCpu::Device() const {
     return std::to_string(mArena.max_concurrency()) + " threads (TBB), " + CaKernelName();
 }
 
-bool BackendCpu::Supports(Stage stage) const {
-    switch (stage) {
-        case Stage::Region:
-        case Stage::Ca:
-        case Stage::Smooth:
-        case Stage::Density:
-        case Stage::Shade:
-        case Stage::Shadow:
-        case Stage::RenderSplat: return true;
-        default: return false;
-    }
-}
+bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
 
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("cpu: cannot create an empty buffer");

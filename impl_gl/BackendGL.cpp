@@ -75,18 +75,7 @@ BackendGL::~BackendGL() {
 
 std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
 
-bool BackendGL::Supports(Stage stage) const {
-    switch (stage) {
-        case Stage::Region:
-        case Stage::Ca:
-        case Stage::Smooth:
-        case Stage::Density:
-        case Stage::Shade:
-        case Stage::Shadow:
-        case Stage::RenderSplat: return true;
-        default: return false;
-    }
-}
+bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
 
 GLuint BackendGL::Scratch(ScratchSlot slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
     const Functions& f = mContext->F();

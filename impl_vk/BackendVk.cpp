@@ -32,18 +32,7 @@ BackendVk::~BackendVk() {
     for (DeviceBuffer& b : mScratch) mContext->DestroyBuffer(b);
 }
 
-bool BackendVk::Supports(Stage stage) const {
-    switch (stage) {
-        case Stage::Region:
-        case Stage::Ca:
-        case Stage::Smooth:
-        case Stage::Density:
-        case Stage::Shade:
-        case Stage::Shadow:
-        case Stage::RenderSplat: return true;
-        default: return false;
-    }
-}
+bool BackendVk::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
 
 template <typename Fn>
 Status BackendVk::Record(const char* what, Fn&& fn) {

@@ -396,6 +396,17 @@ TEST_P(Conformance, RenderSplat) {
     }
 }
 
+// Every backend implements the thesis's splat pipeline; a lost stage would
+// otherwise only turn its conformance tests into skips.
+TEST_P(Conformance, ImplementsTheSplatPipeline) {
+    if (std::get<1>(GetParam()).size.nx != 64) GTEST_SKIP() << "runs once per backend";
+    for (Stage stage : {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density, Stage::Shade, Stage::Shadow,
+                        Stage::RenderSplat})
+        EXPECT_TRUE(mBackend->Supports(stage)) << mBackend->Name() << " lacks " << StageName(stage);
+    EXPECT_FALSE(mBackend->Supports(Stage::RenderMarch));
+    EXPECT_FALSE(mBackend->Supports(Stage::Noise));
+}
+
 // Test end to end: the simulation stages of ci-small for 15 steps, each backend
 // on its own state. Where the region volumes are identical the automaton
 // states must be identical too, step after step; where a region differs (SPEC
