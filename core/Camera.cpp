@@ -56,6 +56,16 @@ Projected Project(const CameraFrame& f, const Vec3& p) {
     return {px, py, depth};
 }
 
+FlatSplatOrder FlattenSplatOrder(const SplatOrder& order) {
+    FlatSplatOrder flat;
+    for (int level = 0; level < 3; ++level) {
+        flat.base[level] = uint32_t(flat.indices.size());
+        const std::vector<uint32_t>& axis = order.indices[order.axes[level]];
+        flat.indices.insert(flat.indices.end(), axis.begin(), axis.end());
+    }
+    return flat;
+}
+
 SplatOrder MakeSplatOrder(const CameraFrame& frame, const Extent3& grid, const std::array<double, 3>& origin,
                           double voxelSize) {
     SplatOrder order;

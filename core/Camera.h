@@ -59,6 +59,15 @@ struct SplatOrder {
 SplatOrder MakeSplatOrder(const CameraFrame& frame, const Extent3& grid, const std::array<double, 3>& origin,
                           double voxelSize);
 
+// The three axis orders of a SplatOrder in one array, outer axis first, as
+// GPU shaders read them: base[level] is where level's order starts. Rank r
+// is the voxel at outer order r / (nMid nIn), middle (r / nIn) % nMid, inner r % nIn.
+struct FlatSplatOrder {
+    std::vector<uint32_t> indices;
+    std::array<uint32_t, 3> base{};
+};
+FlatSplatOrder FlattenSplatOrder(const SplatOrder& order);
+
 // View-frustum culling of tile x height-band boxes (SPEC 8): 1 where a box of
 // voxel centres may hold a splat that covers a pixel, 0 where it certainly
 // does not (conservative; docs/pipeline.md derives the bound). Index

@@ -652,20 +652,14 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         for (GLsizei c : counts) visited += uint64_t(c);
     }
 
-    std::vector<uint32_t> indices;
-    GLint base[3];
-    for (int level = 0; level < 3; ++level) {
-        base[level] = GLint(indices.size());
-        const auto& axis = order.indices[order.axes[level]];
-        indices.insert(indices.end(), axis.begin(), axis.end());
-    }
+    const FlatSplatOrder flat = FlattenSplatOrder(order);
     GLfloat pointRange[2] = {1, 1};
     f.GetFloatv(GL_POINT_SIZE_RANGE, pointRange);
     constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
 
     GpuTimer timer(f);
-    const GLuint orderBuffer = ScratchBuffer(kSplatOrder, indices.size() * 4);
-    f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(indices.size() * 4), indices.data());
+    const GLuint orderBuffer = ScratchBuffer(kSplatOrder, flat.indices.size() * 4);
+    f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
     const GLuint counters = ScratchBuffer(kSplatCounters, 16);
     const uint32_t zero[4] = {};
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
@@ -683,7 +677,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     auto uniform = [&](const char* name) { return f.GetUniformLocation(*program, name); };
     f.Uniform3i(uniform("grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
     f.Uniform3i(uniform("axes"), outer, middle, inner);
-    f.Uniform3i(uniform("orderBase"), base[0], base[1], base[2]);
+    f.Uniform3i(uniform("orderBase"), GLint(flat.base[0]), GLint(flat.base[1]), GLint(flat.base[2]));
     f.Uniform2f(uniform("image"), float(W), float(H));
     f.Uniform1f(uniform("guard"), kGuard);
     f.Uniform4f(uniform("eye"), cam.eye[0], cam.eye[1], cam.eye[2], cam.nearPlane);

@@ -347,13 +347,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const std::vector<uint8_t>& boxes = *visibility;
     // The shared order, outer axis first.
     const SplatOrder& order = *p.order;
-    std::vector<uint32_t> indices;
-    uint32_t base[3];
-    for (int level = 0; level < 3; ++level) {
-        base[level] = uint32_t(indices.size());
-        const auto& axis = order.indices[order.axes[level]];
-        indices.insert(indices.end(), axis.begin(), axis.end());
-    }
+    const FlatSplatOrder flat = FlattenSplatOrder(order);
     struct alignas(16) Frame {
         uint32_t grid[4], axes[4], orderBase[4], boxes[4], image[4];
         float eye[4], forward[4], right[4], up[4], sun[4], sunRadiance[4], ambient[4], background[4], origin[4], misc[4];
@@ -363,7 +357,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
     frame = {{e.nx, e.ny, e.nz, kVoxelsPerChunk},
              {uint32_t(order.axes[0]), uint32_t(order.axes[1]), uint32_t(order.axes[2]), voxels},
-             {base[0], base[1], base[2], 0},
+             {flat.base[0], flat.base[1], flat.base[2], 0},
              {p.tile, p.band, CeilDiv(e.nx, p.tile), CeilDiv(e.ny, p.tile)},
              {W, H, tilesX, tilesY},
              {cam.eye[0], cam.eye[1], cam.eye[2], cam.nearPlane},
@@ -385,13 +379,13 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         return {};
     };
     CB_TRY(need(8, sizeof frame));
-    CB_TRY(need(9, indices.size() * 4));
+    CB_TRY(need(9, flat.indices.size() * 4));
     CB_TRY(need(10, boxes.size()));
     CB_TRY(need(11, VkDeviceSize(chunks) * 4));
     CB_TRY(need(12, VkDeviceSize(chunks) * 4));
     CB_TRY(need(13, VkDeviceSize(chunks + 1) * 4));
     CB_TRY(mContext->Upload(*slot[8], std::as_bytes(std::span(&frame, 1))));
-    CB_TRY(mContext->Upload(*slot[9], std::as_bytes(std::span(indices))));
+    CB_TRY(mContext->Upload(*slot[9], std::as_bytes(std::span(flat.indices))));
     CB_TRY(mContext->Upload(*slot[10], std::as_bytes(std::span(boxes))));
     Pipeline* pipes[5] = {};
     const char* names[5] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite"};
