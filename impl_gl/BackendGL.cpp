@@ -104,7 +104,7 @@ GLuint BackendGL::ScratchBuffer(BufferSlot slot, size_t bytes) {
     return buffer;
 }
 
-Status BackendGL::BindTargets(std::initializer_list<std::pair<GLuint, int>> targets) {
+Status BackendGL::BindTargets(std::span<const std::pair<GLuint, int>> targets) {
     const Functions& f = mContext->F();
     GLenum drawBuffers[4] = {};
     GLsizei n = 0;
@@ -122,6 +122,28 @@ Status BackendGL::BindTargets(std::initializer_list<std::pair<GLuint, int>> targ
     if (f.CheckNamedFramebufferStatus(mTargets, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return MakeError("gl: a pass's render targets do not make a complete framebuffer");
     return {};
+}
+
+template <typename PerLayer>
+Status BackendGL::DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures,
+                             PerLayer&& perLayer) {
+    const Functions& f = mContext->F();
+    const GLint layerUniform = f.GetUniformLocation(program, "layer");
+    std::array<std::pair<GLuint, int>, 4> targets;
+    if (textures.size() > targets.size()) return MakeError("gl: a pass has more than 4 render targets");
+    for (uint32_t k = 0; k < layers; ++k) {
+        size_t n = 0;
+        for (GLuint texture : textures) targets[n++] = {texture, int(k)};
+        CB_TRY(BindTargets(std::span(targets.data(), n)));
+        f.Uniform1i(layerUniform, GLint(k));
+        perLayer(k);
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    return {};
+}
+
+Status BackendGL::DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures) {
+    return DrawLayers(program, layers, textures, [](uint32_t) {});
 }
 
 Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Extent3 extent) {
@@ -211,12 +233,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
         f.Uniform1i(f.GetUniformLocation(program, "radius"), radius);
         f.Uniform3i(f.GetUniformLocation(program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
         if (n == 2) f.Uniform1f(f.GetUniformLocation(program, "invW"), 1.0f / float(SmoothNormaliser(radius)));
-        const GLint layer = f.GetUniformLocation(program, "layer");
-        for (uint32_t k = 0; k < e.nz; ++k) {
-            CB_TRY(BindTargets({{output[n], int(k)}}));
-            f.Uniform1i(layer, GLint(k));
-            f.DrawArrays(GL_TRIANGLES, 0, 3);
-        }
+        CB_TRY(DrawLayers(program, e.nz, {output[n]}));
     }
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("smooth");
@@ -368,13 +385,8 @@ Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
     f.Uniform1ui(f.GetUniformLocation(*program, "seed"), params.seed);
     f.Uniform1ui(f.GetUniformLocation(*program, "qHum0"), params.qHum0);
     f.Uniform1ui(f.GetUniformLocation(*program, "qAct0"), params.qAct0);
-    const GLint layer = f.GetUniformLocation(*program, "layer");
     f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), GLsizei(e.ny));
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        CB_TRY(BindTargets({{Tex(*out.hum).Texture(), int(k)}, {Tex(*out.act).Texture(), int(k)}, {Tex(*out.cld).Texture(), int(k)}}));
-        f.Uniform1i(layer, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    CB_TRY(DrawLayers(*program, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
     ++mBitsWrites;
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("ca initial state");
@@ -412,24 +424,15 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
     f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
     f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
-    const GLint rulesLayer = f.GetUniformLocation(*rules, "layer");
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        CB_TRY(BindTargets({{next[0], int(k)}, {next[1], int(k)}, {next[2], int(k)}}));
-        f.Uniform1i(rulesLayer, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    CB_TRY(DrawLayers(*rules, e.nz, {next[0], next[1], next[2]}));
     if (wind) {
         f.UseProgram(*advect);
         for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), next[n]);
         f.Uniform3i(f.GetUniformLocation(*advect, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
         f.Uniform1i(f.GetUniformLocation(*advect, "words"), words);
-        const GLint layer = f.GetUniformLocation(*advect, "layer"), shift = f.GetUniformLocation(*advect, "shift");
-        for (uint32_t k = 0; k < e.nz; ++k) {
-            CB_TRY(BindTargets({{Tex(*out.hum).Texture(), int(k)}, {Tex(*out.act).Texture(), int(k)}, {Tex(*out.cld).Texture(), int(k)}}));
-            f.Uniform1i(layer, GLint(k));
-            f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]);
-            f.DrawArrays(GL_TRIANGLES, 0, 3);
-        }
+        const GLint shift = f.GetUniformLocation(*advect, "shift");
+        CB_TRY(DrawLayers(*advect, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()},
+                          [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
     }
     ++mBitsWrites;
     mLastDeviceMs = timer.StopMs();
@@ -463,14 +466,7 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     auto perSlice = [&](GLuint program, GLuint target, auto&& setLayer) -> Status {
         f.UseProgram(program);
         f.Uniform3i(f.GetUniformLocation(program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-        const GLint layer = f.GetUniformLocation(program, "layer");
-        for (uint32_t k = 0; k < e.nz; ++k) {
-            CB_TRY(BindTargets({{target, int(k)}}));
-            f.Uniform1i(layer, GLint(k));
-            setLayer(k);
-            f.DrawArrays(GL_TRIANGLES, 0, 3);
-        }
-        return {};
+        return DrawLayers(program, e.nz, {target}, setLayer);
     };
     if (!packed) {
         for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), inputs[n]);
@@ -496,12 +492,7 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), ny);
     f.UseProgram(*unpack);
     f.Uniform3i(f.GetUniformLocation(*unpack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-    const GLint unpackLayer = f.GetUniformLocation(*unpack, "layer");
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        CB_TRY(BindTargets({{Tex(*out.hum).Texture(), int(k)}, {Tex(*out.act).Texture(), int(k)}, {Tex(*out.cld).Texture(), int(k)}}));
-        f.Uniform1i(unpackLayer, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    CB_TRY(DrawLayers(*unpack, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
     ++mBitsWrites;
     // Without wind the result is in kStateB: swap the slots so kStateA holds it.
     if (result == stateB) std::swap(mScratch[kStateA], mScratch[kStateB]);
@@ -541,13 +532,8 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         f.BindTextureUnit(0, Tex(q).Texture());
         f.Uniform3i(f.GetUniformLocation(*down, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
         f.Uniform1i(f.GetUniformLocation(*down, "f"), res);
-        const GLint layer = f.GetUniformLocation(*down, "layer");
         f.Viewport(0, 0, n[0], n[1]);
-        for (int k = 0; k < n[2]; ++k) {
-            CB_TRY(BindTargets({{shadedQ, k}}));
-            f.Uniform1i(layer, k);
-            f.DrawArrays(GL_TRIANGLES, 0, 3);
-        }
+        CB_TRY(DrawLayers(*down, uint32_t(n[2]), {shadedQ}));
     }
     const GLuint volume = Scratch(kShadeVolume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
     GLuint ping = Scratch(kShadePing, GL_TEXTURE_2D, GL_R32F, nu, nv);
@@ -588,13 +574,8 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     f.Uniform3i(f.GetUniformLocation(*up, "cells"), n[0], n[1], n[2]);
     f.Uniform3i(f.GetUniformLocation(*up, "axes"), g.u, g.v, g.w);
     f.Uniform1i(f.GetUniformLocation(*up, "f"), res);
-    const GLint upLayer = f.GetUniformLocation(*up, "layer");
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        CB_TRY(BindTargets({{Tex(T).Texture(), int(k)}}));
-        f.Uniform1i(upLayer, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    CB_TRY(DrawLayers(*up, e.nz, {Tex(T).Texture()}));
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("shade");
 }

@@ -11,6 +11,7 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -75,7 +76,16 @@ class BackendGL final : public Backend {
     GLuint ScratchBuffer(BufferSlot slot, size_t bytes);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the
     // multi-target framebuffer as colour attachments 0, 1, ... and makes them the draw buffers.
-    Status BindTargets(std::initializer_list<std::pair<GLuint, int>> targets);
+    Status BindTargets(std::span<const std::pair<GLuint, int>> targets);
+    Status BindTargets(std::initializer_list<std::pair<GLuint, int>> targets) {
+        return BindTargets(std::span(targets.begin(), targets.size()));
+    }
+    // Draws the full-screen triangle of `program` (in use, its other uniforms
+    // set) once per layer k < layers: uniform "layer" = k, the render targets
+    // layer k of each of `textures`, and perLayer(k) for whatever else changes with k.
+    template <typename PerLayer>
+    Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer);
+    Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures);
     Status CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
 
     std::unique_ptr<GLContext> mContext;
