@@ -186,6 +186,22 @@ class Evaluator {
         return Reference(scene, in, mStart);
     }
 
+    // The scene at scenePath with `overrides`, its inputs and its reference.
+    struct Point {
+        Scene scene;
+        const LightingInputs* in = nullptr;
+        const ReferenceResult* reference = nullptr;
+    };
+    Result<Point> Load(const std::string& scenePath, const std::vector<SceneOverride>& overrides) {
+        auto scene = LoadScene(scenePath, overrides);
+        if (!scene) return std::unexpected(scene.error());
+        auto in = Inputs(*scene, overrides);
+        if (!in) return std::unexpected(in.error());
+        auto reference = Reference(*scene, **in);
+        if (!reference) return std::unexpected(reference.error());
+        return Point{std::move(*scene), *in, *reference};
+    }
+
     const std::vector<ReferenceRecord>& Records() const { return mRecords; }
 
   private:
@@ -259,22 +275,19 @@ Status MeasureSetting(Evaluator& eval, const std::string& scenePath, const Commo
                       std::vector<BackendSlot>& backends, std::vector<Row>& rows) {
     std::vector<SceneOverride> all = options.overrides;
     all.insert(all.end(), setting.begin(), setting.end());
-    auto scene = LoadScene(scenePath, all);
-    if (!scene) return std::unexpected(scene.error());
-    auto in = eval.Inputs(*scene, all);
-    if (!in) return std::unexpected(in.error());
-    auto reference = eval.Reference(*scene, **in);
-    if (!reference) return std::unexpected(reference.error());
+    auto point = eval.Load(scenePath, all);
+    if (!point) return std::unexpected(point.error());
+    const Scene& scene = point->scene;
     for (Stage stage : stages) {
-        if (!scene->stages.Has(stage)) continue;
+        if (!scene.stages.Has(stage)) continue;
         for (BackendSlot& slot : backends) {
             Row row{setting, slot.name, stage, {}, false};
             if (!slot.backend)
                 row.result = {"unavailable", slot.error, {}, {}, {}, {}};
             else if (stage == Stage::Shade)
-                row.result = MeasureShade(*slot.backend, *scene, **in, **reference, options.repeats);
+                row.result = MeasureShade(*slot.backend, scene, *point->in, *point->reference, options.repeats);
             else
-                row.result = MeasureShadow(*slot.backend, *scene, **in, **reference, options.repeats);
+                row.result = MeasureShadow(*slot.backend, scene, *point->in, *point->reference, options.repeats);
             if (row.result.status != "ok" && !options.quiet)
                 std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(stage)).c_str(),
                              SettingsLabel(setting).c_str(), row.result.status.c_str(), row.result.detail.c_str());
@@ -386,18 +399,14 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const std::string& scenePa
                 std::vector<SceneOverride> all = options.overrides;
                 all.push_back({"sun.elevation_deg", Fmt("%.17g", el / kDeg)});
                 all.push_back({"sun.azimuth_deg", Fmt("%.17g", az / kDeg)});
-                auto scene = LoadScene(scenePath, all);
-                if (!scene) return std::unexpected(scene.error());
-                auto in = eval.Inputs(*scene, all);
-                if (!in) return std::unexpected(in.error());
-                auto reference = eval.Reference(*scene, **in);
-                if (!reference) return std::unexpected(reference.error());
-                sun[side] = scene->sun.Direction();
+                auto point = eval.Load(scenePath, all);
+                if (!point) return std::unexpected(point.error());
+                sun[side] = point->scene.sun.Direction();
                 axis[side] = PrincipalAxis(sun[side]);
-                Tref[side] = (*reference)->T;
+                Tref[side] = point->reference->T;
                 for (BackendSlot& slot : backends) {
                     if (!slot.backend) continue;
-                    StageAccuracy a = MeasureShade(*slot.backend, *scene, **in, **reference, 0, true);
+                    StageAccuracy a = MeasureShade(*slot.backend, point->scene, *point->in, *point->reference, 0, true);
                     if (a.status != "ok") continue;
                     errorRows.push_back({c.name, EpsilonText(eps), side == 0 ? "-" : "+", AxisName(axis[side]),
                                          slot.name, Err(a.all.max), Err(a.all.mean), Err(a.all.p99), Err(a.subset.max),
