@@ -58,10 +58,7 @@ Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context,
         return MakeError("gl: unknown automaton layout '" + caLayout + "' (packed or rgba8)");
     auto ctx = GLContext::Create(context == "egl" ? ContextKind::Egl : ContextKind::OSMesa);
     if (!ctx) return std::unexpected(ctx.error());
-    std::unique_ptr<BackendGL> backend(new BackendGL(std::move(*ctx), caLayout == "rgba8"));
-    backend->mContext->F().CreateFramebuffers(1, &backend->mTargets);
-    CB_TRY(backend->mContext->Check("creating the multi-target framebuffer"));
-    return backend;
+    return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx), caLayout == "rgba8"));
 }
 
 BackendGL::~BackendGL() {
@@ -70,7 +67,6 @@ BackendGL::~BackendGL() {
         if (t.texture) f.DeleteTextures(1, &t.texture);
     for (auto& [buffer, bytes] : mBuffers)
         if (buffer) f.DeleteBuffers(1, &buffer);
-    if (mTargets) f.DeleteFramebuffers(1, &mTargets);
 }
 
 std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
@@ -106,20 +102,21 @@ GLuint BackendGL::ScratchBuffer(BufferSlot slot, size_t bytes) {
 
 Status BackendGL::BindTargets(std::span<const std::pair<GLuint, int>> targets) {
     const Functions& f = mContext->F();
+    const GLuint framebuffer = mContext->Framebuffer();
     GLenum drawBuffers[4] = {};
     GLsizei n = 0;
     for (const auto& [texture, layer] : targets) {
         const GLenum attachment = GL_COLOR_ATTACHMENT0 + GLenum(n);
-        if (layer < 0) f.NamedFramebufferTexture(mTargets, attachment, texture, 0);
-        else f.NamedFramebufferTextureLayer(mTargets, attachment, texture, 0, layer);
+        if (layer < 0) f.NamedFramebufferTexture(framebuffer, attachment, texture, 0);
+        else f.NamedFramebufferTextureLayer(framebuffer, attachment, texture, 0, layer);
         drawBuffers[n++] = attachment;
     }
     // Detach the rest: attachments of other sizes would clip the render area.
     for (GLsizei unused = n; unused < 4; ++unused)
-        f.NamedFramebufferTexture(mTargets, GL_COLOR_ATTACHMENT0 + GLenum(unused), 0, 0);
-    f.NamedFramebufferDrawBuffers(mTargets, n, drawBuffers);
-    f.BindFramebuffer(GL_FRAMEBUFFER, mTargets);
-    if (f.CheckNamedFramebufferStatus(mTargets, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        f.NamedFramebufferTexture(framebuffer, GL_COLOR_ATTACHMENT0 + GLenum(unused), 0, 0);
+    f.NamedFramebufferDrawBuffers(framebuffer, n, drawBuffers);
+    f.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    if (f.CheckNamedFramebufferStatus(framebuffer, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return MakeError("gl: a pass's render targets do not make a complete framebuffer");
     return {};
 }
@@ -249,17 +246,15 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     auto occupancy = mContext->Program("occupancy");
     if (!occupancy) return std::unexpected(occupancy.error());
     const Extent3 e = q.Extent();
-    const GLuint fb = mContext->Framebuffer();
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
     GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
-    f.BindFramebuffer(GL_FRAMEBUFFER, fb);
 
     // D: additive blending of the slices, k ascending.
     const float zero = 0.0f;
     f.ClearTexImage(Tex(*out.columnSum).Texture(), 0, GL_RED, GL_FLOAT, &zero);
-    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.columnSum).Texture(), 0, 0);
+    CB_TRY(BindTargets({{Tex(*out.columnSum).Texture(), 0}}));
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     f.UseProgram(*sum);
     f.BindTextureUnit(0, Tex(q).Texture());
@@ -279,7 +274,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.NamedBufferSubData(counter, 0, sizeof initial, &initial);
     f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
     const GLuint flags = Scratch(kCoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
-    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, flags, 0, 0);
+    CB_TRY(BindTargets({{flags, 0}}));
     f.UseProgram(*cover);
     f.BindTextureUnit(0, Tex(cld).Texture());
     f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
@@ -291,16 +286,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
     f.Uniform3i(f.GetUniformLocation(*occupancy, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
     f.Uniform2i(f.GetUniformLocation(*occupancy, "tileBand"), GLint(params.tile), GLint(params.band));
-    const GLint mode = f.GetUniformLocation(*occupancy, "mode"), layer = f.GetUniformLocation(*occupancy, "layer");
+    const GLint mode = f.GetUniformLocation(*occupancy, "mode");
     f.Viewport(0, 0, GLsizei(tilesX), GLsizei(tilesY));
     f.Uniform1i(mode, 0);
-    for (uint32_t b = 0; b < bandCount; ++b) {
-        f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.bands).Texture(), 0, GLint(b));
-        f.Uniform1i(layer, GLint(b));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    CB_TRY(DrawLayers(*occupancy, bandCount, {Tex(*out.bands).Texture()}));
     f.Uniform1i(mode, 1);
-    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(*out.tiles).Texture(), 0, 0);
+    CB_TRY(BindTargets({{Tex(*out.tiles).Texture(), 0}}));
     f.DrawArrays(GL_TRIANGLES, 0, 3);
 
     f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -326,9 +317,7 @@ Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     f.Uniform1f(f.GetUniformLocation(*program, "opticalDepthPerD"), l.opticalDepthPerD);
     f.Uniform1f(f.GetUniformLocation(*program, "kappa"), params.kappa);
     f.Uniform1i(f.GetUniformLocation(*program, "noSun"), l.noSun ? 1 : 0);
-    const GLuint fb = mContext->Framebuffer();
-    f.BindFramebuffer(GL_FRAMEBUFFER, fb);
-    f.NamedFramebufferTextureLayer(fb, GL_COLOR_ATTACHMENT0, Tex(G).Texture(), 0, 0);
+    CB_TRY(BindTargets({{Tex(G).Texture(), 0}}));
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     GpuTimer timer(f);
     f.DrawArrays(GL_TRIANGLES, 0, 3);
@@ -647,7 +636,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const GLuint target = Scratch(kSplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
     CB_TRY(BindTargets({{target, -1}}));
     const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
-    f.ClearNamedFramebufferfv(mTargets, GL_COLOR, 0, background);
+    f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, orderBuffer);

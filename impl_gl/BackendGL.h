@@ -75,7 +75,8 @@ class BackendGL final : public Backend {
     GLuint Scratch(ScratchSlot slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
     GLuint ScratchBuffer(BufferSlot slot, size_t bytes);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the
-    // multi-target framebuffer as colour attachments 0, 1, ... and makes them the draw buffers.
+    // context's framebuffer as colour attachments 0, 1, ... and makes them the
+    // draw buffers; the other attachments are detached.
     Status BindTargets(std::span<const std::pair<GLuint, int>> targets);
     Status BindTargets(std::initializer_list<std::pair<GLuint, int>> targets) {
         return BindTargets(std::span(targets.begin(), targets.size()));
@@ -91,7 +92,6 @@ class BackendGL final : public Backend {
     std::unique_ptr<GLContext> mContext;
     bool mRgba8 = false;
     std::optional<double> mLastDeviceMs;
-    GLuint mTargets = 0;  // the multi-target framebuffer
     std::array<ScratchTexture, kScratchSlots> mScratch{};
     std::array<std::pair<GLuint, size_t>, kBufferSlots> mBuffers{};
     // Which packed fields the thesis-layout state in kStateA holds: the last

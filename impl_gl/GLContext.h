@@ -35,6 +35,7 @@ class GLContext {
     Result<GLuint> LinkProgram(const std::string& name, const std::string* vertex, const std::string& fragment);
     // An empty vertex array for attribute-less draws.
     GLuint EmptyVao() const { return mVao; }
+    // The framebuffer every pass renders through (BackendGL::BindTargets attaches its targets).
     GLuint Framebuffer() const { return mFramebuffer; }
 
   private:
