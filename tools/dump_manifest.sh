@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# The array-for-array fingerprint of every backend's dumps, for refactors that
+# must change no result (issue 10): sha256 of each .npy, and of each frame's
+# EXR with its capture date blanked (the only field that differs between runs).
+# usage: tools/dump_manifest.sh BUILD_DIR OUT_FILE
+set -euo pipefail
+bin="$1/cloudbench"; out="$2"
+work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT
+for be in cpu vk gl; do
+  "$bin" dump ci-small --backend "$be" --steps 6 --set 'ca.wind_shift=[[1,0]]' --out "$work/ci-$be" --quiet >/dev/null
+done
+"$bin" dump thesis-low --backend cpu --steps 4 --out "$work/low-cpu" --quiet >/dev/null
+( cd "$work"
+  for f in $(find . -name '*.npy' | sort); do echo "$(sha256sum < "$f" | cut -c1-64)  $f"; done
+  for f in $(find . -name '*.exr' | sort); do
+    echo "$(LC_ALL=C sed -E 's/[0-9]{4}:[0-9]{2}:[0-9]{2} [0-9]{2}:[0-9]{2}:[0-9]{2}/DATE/' "$f" | sha256sum | cut -c1-64)  $f"
+  done ) > "$out"
+echo "$(wc -l < "$out") arrays fingerprinted into $out"
