@@ -159,6 +159,33 @@ struct SplatStats {
     uint64_t fragments = 0;       // pixel blends: covered pixels summed over splats, clipped to the image
 };
 
+// The backends' entry points, X(stage, Method, (parameters)): one or more per
+// stage (the automaton has two). Contracts:
+//   Region        R = max-blend of the ellipsoids; region is U8 of the grid size.
+//   CaInitialize  the automaton's state at t = 0.
+//   CaStep        one step t -> t+1; `in` and `out` must be distinct buffers.
+//   Smooth        q (F32) from cld (Bits); radius 0, 1 or 2.
+//   Density       D, this step's tile and band occupancy from q, and cover from cld.
+//   Shade         T (F32, grid size) from q.
+//   Shadow        G (F32, (nx, ny, 1)) from D.
+//   RenderSplat   a linear RGB image, F32 with extent (3, width, height):
+//                 channel fastest, then x, then y, row 0 at the top.
+#define CB_SPLAT_PIPELINE_ENTRIES(X)                                                                     \
+    X(Region, Region, (std::span<const RasterEllipsoid> ellipsoids, Buffer & region))                    \
+    X(Ca, CaInitialize, (const CaInitParams& params, CaFields out))                                      \
+    X(Ca, CaStep, (const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out))     \
+    X(Smooth, Smooth, (int radius, const Buffer& cld, Buffer& q))                                        \
+    X(Density, Density, (const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out)) \
+    X(Shade, Shade, (const ShadeParams& params, const Buffer& q, Buffer& T))                             \
+    X(Shadow, Shadow, (const ShadowParams& params, const Buffer& columnSum, Buffer& G))                  \
+    X(RenderSplat, RenderSplat, (const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats))
+
+// Every entry point; the ray-march path's stages join here (issue 13).
+#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X)
+
+// In a backend's class: declares the override of one entry.
+#define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;
+
 class Backend {
   public:
     virtual ~Backend() = default;
@@ -178,24 +205,22 @@ class Backend {
     virtual Status Upload(Buffer& buffer, std::span<const std::byte> canonical) = 0;
     virtual Status Download(const Buffer& buffer, std::span<std::byte> canonical) = 0;
 
-    // ---- Stages (SPEC names) ----
-    // region: R = max-blend of the ellipsoids; out is U8 of the grid size.
-    virtual Status Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) = 0;
-    // ca (initial state, t = 0).
-    virtual Status CaInitialize(const CaInitParams& params, CaFields out) = 0;
-    // ca: one step; `in` and `out` must be distinct buffers.
-    virtual Status CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) = 0;
-    // smooth: q (F32) from cld (Bits); radius 0, 1 or 2.
-    virtual Status Smooth(int radius, const Buffer& cld, Buffer& q) = 0;
-    // density: D, this step's tile and band occupancy from q, and cover from cld.
-    virtual Status Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) = 0;
-    // shade: T (F32, grid size) from q.
-    virtual Status Shade(const ShadeParams& params, const Buffer& q, Buffer& T) = 0;
-    // shadow: G (F32, (nx, ny, 1)) from D.
-    virtual Status Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) = 0;
-    // render_splat: a linear RGB image, F32 with extent (3, width, height):
-    // channel fastest, then x, then y, row 0 at the top.
-    virtual Status RenderSplat(const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats) = 0;
+    // ---- Stages: one virtual per entry of CB_BACKEND_ENTRIES ----
+    // Each returns "unsupported" here; a backend overrides the entries of the
+    // stages it implements (CB_OVERRIDE_BACKEND_ENTRY) and says so in Supports.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#define CB_DEFAULT_BACKEND_ENTRY(stage, Method, parameters) \
+    virtual Status Method parameters { return Unsupported(Stage::stage); }
+    CB_BACKEND_ENTRIES(CB_DEFAULT_BACKEND_ENTRY)
+#undef CB_DEFAULT_BACKEND_ENTRY
+#pragma GCC diagnostic pop
+
+  protected:
+    // The error of an entry point whose stage this backend does not implement.
+    Status Unsupported(Stage stage) const {
+        return MakeError(Name() + " does not implement stage '" + std::string(StageName(stage)) + "'");
+    }
 };
 
 // The backends compiled into this build, in preference order.

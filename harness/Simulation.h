@@ -26,7 +26,6 @@
 
 namespace cb {
 
-inline constexpr size_t kStageCount = kAllStages.size();
 
 // One rendered image.
 struct FrameRecord {

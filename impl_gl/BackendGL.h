@@ -49,14 +49,7 @@ class BackendGL final : public Backend {
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
     Status Download(const Buffer& buffer, std::span<std::byte> canonical) override;
 
-    Status Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) override;
-    Status CaInitialize(const CaInitParams& params, CaFields out) override;
-    Status CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) override;
-    Status Smooth(int radius, const Buffer& cld, Buffer& q) override;
-    Status Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) override;
-    Status Shade(const ShadeParams& params, const Buffer& q, Buffer& T) override;
-    Status Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) override;
-    Status RenderSplat(const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats) override;
+    CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:
     // Scratch textures and buffers, kept between calls and remade when their shape changes.
