@@ -19,17 +19,17 @@
 #include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
-#include "core/Shading.h"
 #include "core/Rules.h"
+#include "core/Shading.h"
 #include "core/Stage.h"
 
 namespace cb {
 
 // Canonical element types (SPEC 0): bit fields are one byte per voxel (0 or 1).
 enum class BufferFormat : uint8_t {
-    Bits,   // canonical uint8 0/1
-    U8,     // canonical uint8
-    F32,    // canonical float32
+    Bits,  // canonical uint8 0/1
+    U8,    // canonical uint8
+    F32,   // canonical float32
 };
 
 size_t CanonicalElementBytes(BufferFormat format);
@@ -99,13 +99,13 @@ struct DensityParams {
 
 // Inputs of the shade stage (SPEC 6) besides q.
 struct ShadeParams {
-    Vec3 sun{0, 0, 1};          // unit vector toward the sun
+    Vec3 sun{0, 0, 1};  // unit vector toward the sun
     AttenuationKind attenuation = AttenuationKind::Beer;
-    float sigma = 0.02f;        // 1/m at q = 1
-    float voxelSize = 50;       // h, metres
+    float sigma = 0.02f;   // 1/m at q = 1
+    float voxelSize = 50;  // h, metres
     float thesisAr = 0.9f;
     SampleFilter filter = SampleFilter::Bilinear;
-    int resolution = 1;         // 1, 2 or 4
+    int resolution = 1;  // 1, 2 or 4
     StorageFormat storage = StorageFormat::Fp32;
     bool scattering = false;
     float albedo = 0.9f, solidAngle = 0.05f;
@@ -117,7 +117,7 @@ struct ShadowParams {
     Vec3 sun{0, 0, 1};
     AttenuationKind form = AttenuationKind::Beer;
     float sigma = 0.02f, voxelSize = 50, kappa = 0.25f;
-    uint32_t nz = 1;            // grid height in voxels (the volume's mid-height is nz/2)
+    uint32_t nz = 1;  // grid height in voxels (the volume's mid-height is nz/2)
 };
 
 // Inputs of the splat renderer (SPEC 8). The order is computed on the host
@@ -154,9 +154,9 @@ struct SplatInputs {
 };
 
 struct SplatStats {
-    uint64_t splats = 0;          // splats drawn (q_alpha > q_min, in front of the near plane, not culled)
-    uint64_t voxelsVisited = 0;   // voxels the renderer looked at after culling and skipping
-    uint64_t fragments = 0;       // pixel blends: covered pixels summed over splats, clipped to the image
+    uint64_t splats = 0;         // splats drawn (q_alpha > q_min, in front of the near plane, not culled)
+    uint64_t voxelsVisited = 0;  // voxels the renderer looked at after culling and skipping
+    uint64_t fragments = 0;      // pixel blends: covered pixels summed over splats, clipped to the image
 };
 
 // The backends' entry points, X(stage, Method, (parameters)): one or more per
@@ -170,14 +170,14 @@ struct SplatStats {
 //   Shadow        G (F32, (nx, ny, 1)) from D.
 //   RenderSplat   a linear RGB image, F32 with extent (3, width, height):
 //                 channel fastest, then x, then y, row 0 at the top.
-#define CB_SPLAT_PIPELINE_ENTRIES(X)                                                                     \
-    X(Region, Region, (std::span<const RasterEllipsoid> ellipsoids, Buffer & region))                    \
-    X(Ca, CaInitialize, (const CaInitParams& params, CaFields out))                                      \
-    X(Ca, CaStep, (const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out))     \
-    X(Smooth, Smooth, (int radius, const Buffer& cld, Buffer& q))                                        \
+#define CB_SPLAT_PIPELINE_ENTRIES(X)                                                                            \
+    X(Region, Region, (std::span<const RasterEllipsoid> ellipsoids, Buffer & region))                           \
+    X(Ca, CaInitialize, (const CaInitParams& params, CaFields out))                                             \
+    X(Ca, CaStep, (const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out))           \
+    X(Smooth, Smooth, (int radius, const Buffer& cld, Buffer& q))                                               \
     X(Density, Density, (const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out)) \
-    X(Shade, Shade, (const ShadeParams& params, const Buffer& q, Buffer& T))                             \
-    X(Shadow, Shadow, (const ShadowParams& params, const Buffer& columnSum, Buffer& G))                  \
+    X(Shade, Shade, (const ShadeParams& params, const Buffer& q, Buffer& T))                                    \
+    X(Shadow, Shadow, (const ShadowParams& params, const Buffer& columnSum, Buffer& G))                         \
     X(RenderSplat, RenderSplat, (const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats))
 
 // Every entry point; the ray-march path's stages join here (issue 13).
@@ -227,16 +227,17 @@ class Backend {
 std::vector<std::string> BuiltBackends();
 
 struct BackendOptions {
-    int cpuThreads = 0;      // 0: every hardware thread
-    std::string vkDevice;    // Vulkan device index or name substring; "" = the first
+    int cpuThreads = 0;         // 0: every hardware thread
+    std::string vkDevice;       // Vulkan device index or name substring; "" = the first
     bool vkValidation = false;  // Khronos validation layer (also CLOUDBENCH_VK_VALIDATION=1)
-    std::string glContext;   // "osmesa" (default) or "egl"
-    std::string glCaLayout;  // automaton layout: "packed" (default, R32UI) or "rgba8" (the thesis's)
+    std::string glContext;      // "osmesa" (default) or "egl"
+    std::string glCaLayout;     // automaton layout: "packed" (default, R32UI) or "rgba8" (the thesis's)
 };
 
 // SplatBoxVisibility for a backend whose occupancy lives on a device: reads
 // both steps' bands back through backend.Download when skipping.
-Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const SplatParams& params, const SplatInputs& in);
+Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const SplatParams& params,
+                                                        const SplatInputs& in);
 
 // Creates a backend by name. An unknown name, or one whose device is missing,
 // comes back as an Error that says why (the harness reports it and goes on).

@@ -19,16 +19,16 @@ namespace cb {
 
 // X(Enum, "name", "SPEC section", splat pipeline?): a stage of the splat
 // pipeline (SPEC 2-8) is one every backend implements.
-#define CB_STAGES(X)                                                        \
-    X(Region, "region", "2", true)             /* ellipsoids -> uint8 region volume R */          \
-    X(Ca, "ca", "3", true)                     /* cellular automaton on hum/act/cld bit fields */ \
-    X(Smooth, "smooth", "4", true)             /* binomial smoothing cld -> q */                  \
-    X(Density, "density", "5", true)           /* column sums D, tile/band occupancy, cover */    \
-    X(Shade, "shade", "6", true)               /* light attenuation T by inverse shear-warp */    \
-    X(Shadow, "shadow", "7", true)             /* ground shadow G */                              \
-    X(RenderSplat, "render_splat", "8", true)  /* point-sprite splatting */                       \
-    X(RenderMarch, "render_march", "10", false) /* per-pixel ray march */                         \
-    X(Noise, "noise", "10a", false)            /* noise-formed density */
+#define CB_STAGES(X)                                                                               \
+    X(Region, "region", "2", true)              /* ellipsoids -> uint8 region volume R */          \
+    X(Ca, "ca", "3", true)                      /* cellular automaton on hum/act/cld bit fields */ \
+    X(Smooth, "smooth", "4", true)              /* binomial smoothing cld -> q */                  \
+    X(Density, "density", "5", true)            /* column sums D, tile/band occupancy, cover */    \
+    X(Shade, "shade", "6", true)                /* light attenuation T by inverse shear-warp */    \
+    X(Shadow, "shadow", "7", true)              /* ground shadow G */                              \
+    X(RenderSplat, "render_splat", "8", true)   /* point-sprite splatting */                       \
+    X(RenderMarch, "render_march", "10", false) /* per-pixel ray march */                          \
+    X(Noise, "noise", "10a", false)             /* noise-formed density */
 
 enum class Stage : uint8_t {
 #define CB_STAGE_ENUM(name, text, spec, splat) name,
@@ -46,7 +46,8 @@ inline constexpr size_t kStageCount = kAllStages.size();
 constexpr std::string_view StageName(Stage stage) {
     switch (stage) {
 #define CB_STAGE_NAME(name, text, spec, splat) \
-    case Stage::name: return text;
+    case Stage::name:                          \
+        return text;
         CB_STAGES(CB_STAGE_NAME)
 #undef CB_STAGE_NAME
     }
@@ -57,7 +58,8 @@ constexpr std::string_view StageName(Stage stage) {
 constexpr std::string_view StageSpecSection(Stage stage) {
     switch (stage) {
 #define CB_STAGE_SPEC(name, text, spec, splat) \
-    case Stage::name: return spec;
+    case Stage::name:                          \
+        return spec;
         CB_STAGES(CB_STAGE_SPEC)
 #undef CB_STAGE_SPEC
     }
@@ -69,7 +71,8 @@ constexpr std::string_view StageSpecSection(Stage stage) {
 constexpr bool IsSplatPipelineStage(Stage stage) {
     switch (stage) {
 #define CB_STAGE_SPLAT(name, text, spec, splat) \
-    case Stage::name: return splat;
+    case Stage::name:                           \
+        return splat;
         CB_STAGES(CB_STAGE_SPLAT)
 #undef CB_STAGE_SPLAT
     }
