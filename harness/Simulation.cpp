@@ -23,8 +23,8 @@ Status Timed(StepRecord& record, Stage stage, const Backend& backend, Fn&& fn) {
 }  // namespace
 
 Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs)
-    : mScene(scene), mBackend(backend), mEllipsoids(scene.ellipsoids, scene.grid.size),
-      mEveryStepOutputs(everyStepOutputs) {}
+    : mScene(scene), mBackend(backend), mPlan(PlanResources(scene)), mSchedule(ScheduleStages(scene.stages)),
+      mEllipsoids(scene.ellipsoids, scene.grid.size), mEveryStepOutputs(everyStepOutputs) {}
 
 bool Simulation::IsOutputStep(uint32_t step) const {
     if (mEveryStepOutputs || !mScene.stages.Has(Stage::RenderSplat)) return true;
@@ -33,120 +33,109 @@ bool Simulation::IsOutputStep(uint32_t step) const {
     return every > 0 && step >= mScene.warmupSteps && (step - mScene.warmupSteps) % every == 0;
 }
 
+const Buffer* Simulation::Get(Resource resource, size_t n) const {
+    const Slot& slot = mSlots[size_t(resource)];
+    return n < slot.current.size() ? slot.current[n].get() : nullptr;
+}
+
+const Buffer* Simulation::Previous(Resource resource) const { return mSlots[size_t(resource)].previous.get(); }
+
+Buffer& Simulation::Out(Resource resource, size_t n) { return *mSlots[size_t(resource)].current.at(n); }
+
 Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backend& backend, bool everyStepOutputs) {
     for (Stage stage : kAllStages) {
         if (scene.stages.Has(stage) && !backend.Supports(stage))
             return MakeError(backend.Name() + " does not implement stage '" + std::string(StageName(stage)) + "' yet");
     }
     std::unique_ptr<Simulation> sim(new Simulation(scene, backend, everyStepOutputs));
-    const Extent3 grid = scene.grid.size;
-    auto make = [&](std::unique_ptr<Buffer>& slot, BufferFormat format, Extent3 extent) -> Status {
-        auto buffer = backend.CreateBuffer(format, extent);
+    CB_TRY(sim->Allocate());
+    CB_TRY(sim->InitializeState());
+    return sim;
+}
+
+Status Simulation::Allocate() {
+    auto make = [&](std::unique_ptr<Buffer>& slot, Resource r) -> Status {
+        auto buffer = mBackend.CreateBuffer(ResourceFormat(r), ResourceExtent(r, mScene));
         if (!buffer) return std::unexpected(buffer.error());
         slot = std::move(*buffer);
         return {};
     };
-    const StageSet& stages = scene.stages;
-    if (stages.Has(Stage::Region)) CB_TRY(make(sim->mRegion, BufferFormat::U8, grid));
-    if (stages.Has(Stage::Ca)) {
-        // Two states: step t is read while step t+1 is written.
-        for (int s = 0; s < 2; ++s) {
-            CB_TRY(make(sim->mHum[s], BufferFormat::Bits, grid));
-            CB_TRY(make(sim->mAct[s], BufferFormat::Bits, grid));
-            CB_TRY(make(sim->mCld[s], BufferFormat::Bits, grid));
-        }
-        CaInitParams init{scene.ca.seed, QuantizeProbability(scene.ca.hum0), QuantizeProbability(scene.ca.act0)};
-        CB_TRY(backend.CaInitialize(init, {sim->mHum[0].get(), sim->mAct[0].get(), sim->mCld[0].get()}));
-        if (scene.ca.HasWind()) {
-            for (const SliceShift& s : scene.ca.windShift) {
-                sim->mShiftX.push_back(s.sx);
-                sim->mShiftY.push_back(s.sy);
-            }
+    for (Resource r : kAllResources) {
+        const size_t i = size_t(r);
+        if (!mPlan.used[i]) continue;
+        Slot& slot = mSlots[i];
+        slot.current.resize(IsPerCamera(r) ? mScene.render.cameras.size() : 1);
+        for (auto& buffer : slot.current) CB_TRY(make(buffer, r));
+        if (mPlan.doubleBuffered[i]) CB_TRY(make(slot.next, r));
+        if (mPlan.previous[i]) CB_TRY(make(slot.previous, r));
+    }
+    return {};
+}
+
+Status Simulation::InitializeState() {
+    if (!mScene.stages.Has(Stage::Ca)) return {};
+    const CaInitParams init = MakeCaInitParams(mScene);
+    CB_TRY(mBackend.CaInitialize(init, {&Out(Resource::Hum), &Out(Resource::Act), &Out(Resource::Cld)}));
+    if (mScene.ca.HasWind()) {
+        for (const SliceShift& s : mScene.ca.windShift) {
+            mShiftX.push_back(s.sx);
+            mShiftY.push_back(s.sy);
         }
     }
-    if (stages.Has(Stage::Smooth)) CB_TRY(make(sim->mQ, BufferFormat::F32, grid));
-    if (stages.Has(Stage::Density)) {
-        const uint32_t T = scene.density.tile, B = scene.density.band;
-        const Extent3 tiles{CeilDiv(grid.nx, T), CeilDiv(grid.ny, T), 1};
-        CB_TRY(make(sim->mColumnSum, BufferFormat::F32, {grid.nx, grid.ny, 1}));
-        CB_TRY(make(sim->mTiles, BufferFormat::U8, tiles));
-        CB_TRY(make(sim->mBands, BufferFormat::U8, {tiles.nx, tiles.ny, CeilDiv(grid.nz, B)}));
-        if (stages.Has(Stage::RenderSplat) && scene.render.skipping) {
-            CB_TRY(make(sim->mTilesPrev, BufferFormat::U8, tiles));
-            CB_TRY(make(sim->mBandsPrev, BufferFormat::U8, {tiles.nx, tiles.ny, CeilDiv(grid.nz, B)}));
-        }
-    }
-    if (stages.Has(Stage::Shade)) CB_TRY(make(sim->mT, BufferFormat::F32, grid));
-    if (stages.Has(Stage::Shadow)) CB_TRY(make(sim->mShadow, BufferFormat::F32, {grid.nx, grid.ny, 1}));
-    if (stages.Has(Stage::RenderSplat)) {
-        CB_TRY(make(sim->mQPrev, BufferFormat::F32, grid));
-        for (size_t n = 0; n < scene.render.cameras.size(); ++n) {
-            sim->mImages.emplace_back();
-            CB_TRY(make(sim->mImages.back(), BufferFormat::F32, {3, scene.render.width, scene.render.height}));
-        }
-    }
-    return sim;
+    return {};
+}
+
+std::vector<uint64_t> Simulation::InputVersions(Stage stage) const {
+    std::vector<uint64_t> versions;
+    for (Resource r : Describe(stage).reads) versions.push_back(mSlots[size_t(r)].version);
+    return versions;
+}
+
+bool Simulation::InputsChangedSinceLastRun(Stage stage) const {
+    const auto& last = mInputsAtLastRun[size_t(stage)];
+    return !last || *last != InputVersions(stage);
 }
 
 Status Simulation::Step(StepRecord& record, const Observer& observe) {
     record = StepRecord{};
     record.step = mStep;
-    const StageSet& stages = mScene.stages;
-    const int cur = mCurrent, next = 1 - mCurrent;
+    const bool outputStep = IsOutputStep(mStep);
 
-    if (stages.Has(Stage::Region)) {
-        mRaster = mEllipsoids.Raster();
-        CB_TRY(Timed(record, Stage::Region, mBackend, [&] { return mBackend.Region(mRaster, *mRegion); }));
-    }
-    // Keep step t-1's q and occupancy for the renderer (the first step has none: it uses its own).
-    if (mQPrev && mStep > 0) std::swap(mQ, mQPrev);
-    if (mTilesPrev && mStep > 0) {
-        std::swap(mTiles, mTilesPrev);
-        std::swap(mBands, mBandsPrev);
-    }
-    if (stages.Has(Stage::Smooth)) {
-        CB_TRY(Timed(record, Stage::Smooth, mBackend, [&] { return mBackend.Smooth(mScene.smooth.radius, *mCld[cur], *mQ); }));
-        mShadeCurrent = false;
-    }
-    if (stages.Has(Stage::Density)) {
-        DensityOutputs out{mColumnSum.get(), mTiles.get(), mBands.get(), 0};
-        DensityParams params{mScene.density.tile, mScene.density.band};
-        CB_TRY(Timed(record, Stage::Density, mBackend, [&] { return mBackend.Density(params, *mQ, *mCld[cur], out); }));
-        record.coveredColumns = out.coveredColumns;
-    }
-    if (mStep == 0 && mQPrev) {
-        // No previous step yet: interpolate between q_0 and itself.
-        std::vector<std::byte> copy(mQ->CanonicalBytes());
-        CB_TRY(mBackend.Download(*mQ, copy));
-        CB_TRY(mBackend.Upload(*mQPrev, copy));
-        if (mTilesPrev) {
-            copy.resize(mTiles->CanonicalBytes());
-            CB_TRY(mBackend.Download(*mTiles, copy));
-            CB_TRY(mBackend.Upload(*mTilesPrev, copy));
-            copy.resize(mBands->CanonicalBytes());
-            CB_TRY(mBackend.Download(*mBands, copy));
-            CB_TRY(mBackend.Upload(*mBandsPrev, copy));
+    for (Stage stage : mSchedule) {
+        const StageDescriptor& d = Describe(stage);
+        if (d.advancesState || (d.outputStepsOnly && !outputStep)) continue;
+        if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage)) continue;
+        // Keep step t-1's values for the renderer before they are overwritten.
+        for (Resource r : d.writes) {
+            Slot& slot = mSlots[size_t(r)];
+            if (slot.previous && mStep > 0) std::swap(slot.current[0], slot.previous);
+        }
+        CB_TRY(RunStage(stage, record));
+        mInputsAtLastRun[size_t(stage)] = InputVersions(stage);
+        for (Resource r : d.writes) {
+            Slot& slot = mSlots[size_t(r)];
+            ++slot.version;
+            if (slot.previous && mStep == 0) {
+                // No previous step yet: interpolate between step 0 and itself.
+                std::vector<std::byte> copy(slot.previous->CanonicalBytes());
+                CB_TRY(mBackend.Download(*slot.current[0], copy));
+                CB_TRY(mBackend.Upload(*slot.previous, copy));
+            }
         }
     }
-    if (IsOutputStep(mStep)) CB_TRY(RunLighting(record));
     if (observe) CB_TRY(observe(*this));
 
-    if (stages.Has(Stage::Ca)) {
-        CaStepParams params;
-        params.seed = mScene.ca.seed;
-        params.step = mStep;
-        params.qExt = QuantizeProbability(mScene.ca.pExt);
-        params.qHum = QuantizeProbability(mScene.ca.pHum);
-        params.qAct = QuantizeProbability(mScene.ca.pAct);
-        params.shiftX = mShiftX;
-        params.shiftY = mShiftY;
-        CB_TRY(Timed(record, Stage::Ca, mBackend, [&] {
-            return mBackend.CaStep(params, {mHum[cur].get(), mAct[cur].get(), mCld[cur].get()}, *mRegion,
-                                   {mHum[next].get(), mAct[next].get(), mCld[next].get()});
-        }));
-        mCurrent = next;
+    for (Stage stage : mSchedule) {
+        const StageDescriptor& d = Describe(stage);
+        if (!d.advancesState) continue;
+        CB_TRY(RunStage(stage, record));
+        for (Resource r : d.writes) {
+            Slot& slot = mSlots[size_t(r)];
+            std::swap(slot.current[0], slot.next);
+            ++slot.version;
+        }
     }
-    if (stages.Has(Stage::Region)) {
+    if (mScene.stages.Has(Stage::Region)) {
         auto start = std::chrono::steady_clock::now();
         mEllipsoids.Update();
         record.ellipsoidUpdateMs =
@@ -156,40 +145,72 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     return {};
 }
 
-Status Simulation::RunLighting(StepRecord& record) {
+Status Simulation::RunStage(Stage stage, StepRecord& record) {
     const Scene& sc = mScene;
-    if (sc.stages.Has(Stage::Shade) && !mShadeCurrent) {
-        const ShadeParams p = MakeShadeParams(sc);
-        CB_TRY(Timed(record, Stage::Shade, mBackend, [&] { return mBackend.Shade(p, *mQ, *mT); }));
-        mShadeCurrent = true;
-    }
-    if (sc.stages.Has(Stage::Shadow)) {
-        const ShadowParams p = MakeShadowParams(sc);
-        CB_TRY(Timed(record, Stage::Shadow, mBackend, [&] { return mBackend.Shadow(p, *mColumnSum, *mShadow); }));
-    }
-    if (sc.stages.Has(Stage::RenderSplat)) {
-        double total = 0;
-        std::optional<double> deviceTotal;
-        for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
-            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
-            // The order is host work shared by all backends, outside the stage time.
-            const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
-            p.order = &order;
-            SplatInputs in{mQPrev.get(), mQ.get(), mT.get(), mTilesPrev.get(), mTiles.get(), mBandsPrev.get(), mBands.get()};
-            FrameRecord frame;
-            frame.camera = sc.render.cameras[n].name;
-            auto start = std::chrono::steady_clock::now();
-            Status status = mBackend.RenderSplat(p, in, *mImages[n], &frame.stats);
-            frame.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-            if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
-            total += frame.ms;
-            if (auto device = mBackend.LastDeviceMs()) deviceTotal = deviceTotal.value_or(0) + *device;
-            record.frames.push_back(frame);
+    auto timed = [&](auto&& call) { return Timed(record, stage, mBackend, call); };
+    switch (stage) {
+        case Stage::Region:
+            mRaster = mEllipsoids.Raster();
+            return timed([&] { return mBackend.Region(mRaster, Out(Resource::Region)); });
+        case Stage::Ca: {
+            CaStepParams params = MakeCaStepParams(sc, mStep);
+            params.shiftX = mShiftX;
+            params.shiftY = mShiftY;
+            return timed([&] {
+                return mBackend.CaStep(params, {&In(Resource::Hum), &In(Resource::Act), &In(Resource::Cld)},
+                                       In(Resource::Region),
+                                       {&Next(Resource::Hum), &Next(Resource::Act), &Next(Resource::Cld)});
+            });
         }
-        record.stageMs[size_t(Stage::RenderSplat)] = total;
-        record.deviceMs[size_t(Stage::RenderSplat)] = deviceTotal;
-        mLastRendered = mStep;
+        case Stage::Smooth:
+            return timed([&] { return mBackend.Smooth(sc.smooth.radius, In(Resource::Cld), Out(Resource::Q)); });
+        case Stage::Density: {
+            DensityOutputs out{&Out(Resource::ColumnSum), &Out(Resource::Tiles), &Out(Resource::Bands), 0};
+            const DensityParams params = MakeDensityParams(sc);
+            CB_TRY(timed([&] { return mBackend.Density(params, In(Resource::Q), In(Resource::Cld), out); }));
+            record.coveredColumns = out.coveredColumns;
+            return {};
+        }
+        case Stage::Shade: {
+            const ShadeParams p = MakeShadeParams(sc);
+            return timed([&] { return mBackend.Shade(p, In(Resource::Q), Out(Resource::T)); });
+        }
+        case Stage::Shadow: {
+            const ShadowParams p = MakeShadowParams(sc);
+            return timed([&] { return mBackend.Shadow(p, In(Resource::ColumnSum), Out(Resource::Shadow)); });
+        }
+        case Stage::RenderSplat: return RenderSplatFrames(record);
+        case Stage::RenderMarch:
+        case Stage::Noise: break;
     }
+    return MakeError("the simulation cannot run stage '" + std::string(StageName(stage)) + "' yet");
+}
+
+Status Simulation::RenderSplatFrames(StepRecord& record) {
+    const Scene& sc = mScene;
+    double total = 0;
+    std::optional<double> deviceTotal;
+    for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
+        SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
+        // The order is host work shared by all backends, outside the stage time.
+        const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
+        p.order = &order;
+        const SplatInputs in{Previous(Resource::Q), Get(Resource::Q),        Get(Resource::T),
+                             Previous(Resource::Tiles), Get(Resource::Tiles), Previous(Resource::Bands),
+                             Get(Resource::Bands)};
+        FrameRecord frame;
+        frame.camera = sc.render.cameras[n].name;
+        auto start = std::chrono::steady_clock::now();
+        Status status = mBackend.RenderSplat(p, in, Out(Resource::SplatImage, n), &frame.stats);
+        frame.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
+        total += frame.ms;
+        if (auto device = mBackend.LastDeviceMs()) deviceTotal = deviceTotal.value_or(0) + *device;
+        record.frames.push_back(frame);
+    }
+    record.stageMs[size_t(Stage::RenderSplat)] = total;
+    record.deviceMs[size_t(Stage::RenderSplat)] = deviceTotal;
+    mLastRendered = mStep;
     return {};
 }
 

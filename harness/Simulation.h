@@ -1,10 +1,13 @@
-// Runs a scene's enabled stages on one backend, one step at a time. Only the
-// buffers of enabled stages are allocated (SPEC 14).
+// Runs a scene's enabled stages on one backend, one step at a time, scheduled
+// by the resources they read and write (core/StageDescriptors.h): only the
+// buffers the enabled stages write are allocated (SPEC 14), every producer
+// runs before its readers, and a stage that advances the state (the
+// automaton) runs after every reader of that state.
 //
-// Step t, in order:
+// Step t of the splat pipeline, in the resulting order:
 //   region   R_t from the ellipsoid list L_t
 //   smooth   q_t from cld_t
-//   density  D_t, occupancy and cover from q_t and cld_t
+//   density  D_t, occupancy and cover from q_t (and cld_t)
 //   shade    T_t from q_t           } on output steps only, and shade only when
 //   shadow   G_t from D_t           } q changed since it last ran
 //   render   one image per camera from q_{t-1}, q_t (interpolated by alpha), T_t
@@ -23,6 +26,7 @@
 #include "core/Backend.h"
 #include "core/Ellipsoids.h"
 #include "core/Scene.h"
+#include "core/StageDescriptors.h"
 
 namespace cb {
 
@@ -60,49 +64,71 @@ class Simulation {
     const Scene& GetScene() const { return mScene; }
     Backend& GetBackend() const { return mBackend; }
 
-    // Buffers of the current step; nullptr when their stage is not enabled.
-    const Buffer* Hum() const { return mHum[mCurrent].get(); }
-    const Buffer* Act() const { return mAct[mCurrent].get(); }
-    const Buffer* Cld() const { return mCld[mCurrent].get(); }
-    const Buffer* Region() const { return mRegion.get(); }
-    const Buffer* Q() const { return mQ.get(); }
-    const Buffer* ColumnSum() const { return mColumnSum.get(); }
-    const Buffer* Tiles() const { return mTiles.get(); }
-    const Buffer* Bands() const { return mBands.get(); }
-    const Buffer* T() const { return mT.get(); }
-    // The previous step's q and band occupancy (render_splat only).
-    const Buffer* QPrev() const { return mQPrev.get(); }
-    const Buffer* TilesPrev() const { return mTilesPrev.get(); }
-    const Buffer* BandsPrev() const { return mBandsPrev.get(); }
-    const Buffer* Shadow() const { return mShadow.get(); }
-    // The image of camera `n` (F32, extent (3, width, height)); valid after a render step.
-    const Buffer* Image(size_t n) const { return n < mImages.size() ? mImages[n].get() : nullptr; }
+    // The current step's buffer of a resource (camera n of a per-camera one);
+    // nullptr when no enabled stage writes it.
+    const Buffer* Get(Resource resource, size_t n = 0) const;
+    // The previous step's value of a resource an interpolating renderer reads;
+    // nullptr when none is kept.
+    const Buffer* Previous(Resource resource) const;
+
+    const Buffer* Hum() const { return Get(Resource::Hum); }
+    const Buffer* Act() const { return Get(Resource::Act); }
+    const Buffer* Cld() const { return Get(Resource::Cld); }
+    const Buffer* Region() const { return Get(Resource::Region); }
+    const Buffer* Q() const { return Get(Resource::Q); }
+    const Buffer* ColumnSum() const { return Get(Resource::ColumnSum); }
+    const Buffer* Tiles() const { return Get(Resource::Tiles); }
+    const Buffer* Bands() const { return Get(Resource::Bands); }
+    const Buffer* T() const { return Get(Resource::T); }
+    const Buffer* QPrev() const { return Previous(Resource::Q); }
+    const Buffer* TilesPrev() const { return Previous(Resource::Tiles); }
+    const Buffer* BandsPrev() const { return Previous(Resource::Bands); }
+    const Buffer* Shadow() const { return Get(Resource::Shadow); }
+    // The splat image of camera `n` (F32, extent (3, width, height)); valid after a render step.
+    const Buffer* Image(size_t n) const { return Get(Resource::SplatImage, n); }
     // The step whose images are in Image(); nullopt before the first render.
     std::optional<uint32_t> LastRenderedStep() const { return mLastRendered; }
     bool IsOutputStep(uint32_t step) const;
     // The ellipsoids the current step's region came from.
     const std::vector<RasterEllipsoid>& RasterList() const { return mRaster; }
+    // The enabled stages in the order a step runs them.
+    const std::vector<Stage>& Schedule() const { return mSchedule; }
 
   private:
+    // A resource's buffers: this step's (one per camera for images), the next
+    // step's for a state-advancing writer, the previous step's where a
+    // renderer interpolates; and a count of writes, to skip stages whose
+    // inputs did not change.
+    struct Slot {
+        std::vector<std::unique_ptr<Buffer>> current;
+        std::unique_ptr<Buffer> next, previous;
+        uint64_t version = 0;
+    };
+
     Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs);
-    Status RunLighting(StepRecord& record);
+    Status Allocate();
+    Status InitializeState();
+    // Runs one stage on this step's buffers (its writes go to `next` when it advances the state).
+    Status RunStage(Stage stage, StepRecord& record);
+    Status RenderSplatFrames(StepRecord& record);
+    bool InputsChangedSinceLastRun(Stage stage) const;
+    std::vector<uint64_t> InputVersions(Stage stage) const;
+    Buffer& Out(Resource resource, size_t n = 0);
+    Buffer& Next(Resource resource) { return *mSlots[size_t(resource)].next; }
+    const Buffer& In(Resource resource) const { return *mSlots[size_t(resource)].current.at(0); }
 
     const Scene mScene;
     Backend& mBackend;
+    const ResourcePlan mPlan;
+    const std::vector<Stage> mSchedule;
     EllipsoidList mEllipsoids;
     std::vector<RasterEllipsoid> mRaster;  // the list step t's region was rasterised from
     uint32_t mStep = 0;
-    int mCurrent = 0;  // which of the two automaton states is step t
     std::vector<int32_t> mShiftX, mShiftY;
-
-    std::unique_ptr<Buffer> mHum[2], mAct[2], mCld[2];
-    std::unique_ptr<Buffer> mRegion, mQ, mColumnSum, mTiles, mBands;
-    // Previous step's q and occupancy, for interpolation and skipping (render only).
-    std::unique_ptr<Buffer> mQPrev, mTilesPrev, mBandsPrev;
-    std::unique_ptr<Buffer> mT, mShadow;
-    std::vector<std::unique_ptr<Buffer>> mImages;
+    std::array<Slot, kResourceCount> mSlots;
+    // Input versions of each stage when it last ran (skipsUnchangedInputs).
+    std::array<std::optional<std::vector<uint64_t>>, kStageCount> mInputsAtLastRun;
     const bool mEveryStepOutputs;
-    bool mShadeCurrent = false;  // T matches the current q
     std::optional<uint32_t> mLastRendered;
 };
 

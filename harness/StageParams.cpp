@@ -1,6 +1,24 @@
 #include "harness/StageParams.h"
 
+#include "core/Random.h"
+
 namespace cb {
+
+CaInitParams MakeCaInitParams(const Scene& sc) {
+    return {sc.ca.seed, QuantizeProbability(sc.ca.hum0), QuantizeProbability(sc.ca.act0)};
+}
+
+CaStepParams MakeCaStepParams(const Scene& sc, uint32_t step) {
+    CaStepParams p;
+    p.seed = sc.ca.seed;
+    p.step = step;
+    p.qExt = QuantizeProbability(sc.ca.pExt);
+    p.qHum = QuantizeProbability(sc.ca.pHum);
+    p.qAct = QuantizeProbability(sc.ca.pAct);
+    return p;
+}
+
+DensityParams MakeDensityParams(const Scene& sc) { return {sc.density.tile, sc.density.band}; }
 
 ShadeParams MakeShadeParams(const Scene& sc) {
     ShadeParams p;

@@ -1,5 +1,5 @@
-// A scene's settings turned into the parameters of the lighting stages, in
-// one place for the simulation driver, `conform` and the benchmarks.
+// A scene's settings turned into each stage's parameters, in one place for the
+// simulation driver, `conform` and the benchmarks.
 #pragma once
 
 #include "core/Backend.h"
@@ -7,6 +7,10 @@
 
 namespace cb {
 
+CaInitParams MakeCaInitParams(const Scene& scene);
+// Without the wind shifts, which the caller keeps alive and sets.
+CaStepParams MakeCaStepParams(const Scene& scene, uint32_t step);
+DensityParams MakeDensityParams(const Scene& scene);
 ShadeParams MakeShadeParams(const Scene& scene);
 ShadowParams MakeShadowParams(const Scene& scene);
 // Everything but the order, which the caller makes (MakeSplatOrder) and keeps alive.

@@ -1,0 +1,264 @@
+#include "core/StageDescriptors.h"
+
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/Shading.h"
+
+namespace cb {
+
+std::string_view ResourceName(Resource resource) {
+    switch (resource) {
+#define CB_RESOURCE_NAME(name, text, format) \
+    case Resource::name: return text;
+        CB_RESOURCES(CB_RESOURCE_NAME)
+#undef CB_RESOURCE_NAME
+    }
+    return "?";
+}
+
+BufferFormat ResourceFormat(Resource resource) {
+    switch (resource) {
+#define CB_RESOURCE_FORMAT(name, text, format) \
+    case Resource::name: return BufferFormat::format;
+        CB_RESOURCES(CB_RESOURCE_FORMAT)
+#undef CB_RESOURCE_FORMAT
+    }
+    return BufferFormat::F32;
+}
+
+bool IsPerCamera(Resource resource) { return resource == Resource::SplatImage || resource == Resource::MarchImage; }
+
+Extent3 ResourceExtent(Resource resource, const Scene& scene) {
+    const Extent3 grid = scene.grid.size;
+    const uint32_t tile = scene.density.tile, band = scene.density.band;
+    switch (resource) {
+        case Resource::Region:
+        case Resource::Hum:
+        case Resource::Act:
+        case Resource::Cld:
+        case Resource::Q:
+        case Resource::T: return grid;
+        case Resource::ColumnSum:
+        case Resource::Shadow: return {grid.nx, grid.ny, 1};
+        case Resource::Tiles: return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), 1};
+        case Resource::Bands: return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), CeilDiv(grid.nz, band)};
+        case Resource::SplatImage:
+        case Resource::MarchImage: return {3, scene.render.width, scene.render.height};
+    }
+    return grid;
+}
+
+std::string CompareRule::Text(std::string_view symbol) const {
+    char text[96];
+    std::string d = "|d";
+    d.append(symbol).append("|");
+    switch (kind) {
+        case Kind::BitExact: return "bit-exact";
+        case Kind::Absolute: std::snprintf(text, sizeof text, "%s <= %g", d.c_str(), tolerance); break;
+        case Kind::Quantised:
+            std::snprintf(text, sizeof text, "%s <= %g, <= %g %% differ", d.c_str(), tolerance, share * 100);
+            break;
+        case Kind::Image:
+            if (tolerance * 255 == double(int(tolerance * 255)) && limit * 255 == double(int(limit * 255)))
+                std::snprintf(text, sizeof text, "%d/255 on %g %%, %d/255 max", int(tolerance * 255),
+                              100 - share * 100, int(limit * 255));
+            else if (std::isinf(limit))
+                std::snprintf(text, sizeof text, "%g on %g %%", tolerance, 100 - share * 100);
+            else
+                std::snprintf(text, sizeof text, "%g on %g %%, %g max", tolerance, 100 - share * 100, limit);
+            break;
+    }
+    return text;
+}
+
+namespace {
+
+CompareRule BitExact(const Scene&) { return {CompareRule::Kind::BitExact}; }
+
+// SPEC 2: the region weight may round either way at a quantisation boundary.
+CompareRule RegionRule(const Scene&) { return {CompareRule::Kind::Quantised, 1, 0.005}; }
+
+// SPEC 6: 1e-5 in fp32; one storage quantum in the narrower formats.
+CompareRule ShadeRule(const Scene& scene) {
+    const StorageFormat storage = scene.shade.storage;
+    return {CompareRule::Kind::Absolute, storage == StorageFormat::Fp32 ? 1e-5 : double(StorageQuantum(storage))};
+}
+
+CompareRule ShadowRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}; }
+
+// SPEC 8: per channel 2/255 on 99.9 % of pixels, 8/255 everywhere.
+CompareRule SplatImageRule(const Scene&) { return {CompareRule::Kind::Image, 2.0 / 255.0, 0.001, 8.0 / 255.0}; }
+
+// SPEC 10: 1e-4 per linear channel on 99.9 % of pixels.
+CompareRule MarchImageRule(const Scene&) {
+    return {CompareRule::Kind::Image, 1e-4, 0.001, std::numeric_limits<double>::infinity()};
+}
+
+// SPEC 10a.
+CompareRule NoiseRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}; }
+
+// The splat renderer interpolates q between the last two steps, and skips
+// boxes empty in both steps' occupancy.
+std::vector<Resource> SplatPrevious(const Scene& scene) {
+    if (scene.render.skipping) return {Resource::Q, Resource::Tiles, Resource::Bands};
+    return {Resource::Q};
+}
+
+// Fields left out take their defaults (GCC warns about designated initialisers that omit fields).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const std::array<StageDescriptor, kStageCount> kDescriptors = {{
+    {.stage = Stage::Region, .section = "ellipsoids", .writes = {Resource::Region}, .symbol = "R", .rule = RegionRule},
+    {.stage = Stage::Ca,
+     .section = "ca",
+     .reads = {Resource::Region},
+     .writes = {Resource::Hum, Resource::Act, Resource::Cld},
+     .advancesState = true,
+     .symbol = "cld",
+     .rule = BitExact},
+    {.stage = Stage::Smooth,
+     .section = "smooth",
+     .reads = {Resource::Cld},
+     .writes = {Resource::Q},
+     .symbol = "q",
+     .rule = BitExact},
+    {.stage = Stage::Density,
+     .section = "density",
+     .reads = {Resource::Q},
+     .optionalReads = {Resource::Cld},
+     .writes = {Resource::ColumnSum, Resource::Tiles, Resource::Bands},
+     .symbol = "D",
+     .rule = BitExact},
+    {.stage = Stage::Shade,
+     .section = "shade",
+     .reads = {Resource::Q},
+     .writes = {Resource::T},
+     .outputStepsOnly = true,
+     .skipsUnchangedInputs = true,
+     .symbol = "T",
+     .rule = ShadeRule},
+    {.stage = Stage::Shadow,
+     .section = "shadow",
+     .reads = {Resource::ColumnSum},
+     .writes = {Resource::Shadow},
+     .outputStepsOnly = true,
+     .symbol = "G",
+     .rule = ShadowRule},
+    {.stage = Stage::RenderSplat,
+     .section = "render",
+     .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
+     .readsPrevious = SplatPrevious,
+     .writes = {Resource::SplatImage},
+     .outputStepsOnly = true,
+     .renderer = true,
+     .symbol = "image",
+     .rule = SplatImageRule},
+    {.stage = Stage::RenderMarch,
+     .section = "render",
+     .reads = {Resource::Q},
+     .writes = {Resource::MarchImage},
+     .outputStepsOnly = true,
+     .renderer = true,
+     .symbol = "image",
+     .rule = MarchImageRule},
+    {.stage = Stage::Noise, .section = "noise", .writes = {Resource::Q}, .symbol = "q", .rule = NoiseRule},
+}};
+#pragma GCC diagnostic pop
+
+bool Contains(const std::vector<Resource>& list, Resource r) {
+    for (Resource x : list)
+        if (x == r) return true;
+    return false;
+}
+
+}  // namespace
+
+const StageDescriptor& Describe(Stage stage) {
+    const StageDescriptor& d = kDescriptors[size_t(stage)];
+    assert(d.stage == stage && "kDescriptors is in CB_STAGES order");
+    return d;
+}
+
+std::optional<Stage> ProducerOf(Resource resource, const StageSet& enabled) {
+    for (Stage s : kAllStages)
+        if (enabled.Has(s) && Contains(Describe(s).writes, resource)) return s;
+    return std::nullopt;
+}
+
+std::vector<Stage> ScheduleStages(const StageSet& enabled) {
+    // Stage a must run before b when b reads what a writes (a does not advance
+    // the state), or when a reads what b writes and b advances the state.
+    auto before = [&](Stage a, Stage b) {
+        const StageDescriptor &da = Describe(a), &db = Describe(b);
+        for (const std::vector<Resource>* reads : {&db.reads, &db.optionalReads})
+            for (Resource r : *reads)
+                if (!da.advancesState && Contains(da.writes, r)) return true;
+        for (const std::vector<Resource>* reads : {&da.reads, &da.optionalReads})
+            for (Resource r : *reads)
+                if (db.advancesState && Contains(db.writes, r)) return true;
+        return false;
+    };
+    // Kahn's algorithm, taking ready stages in CB_STAGES order so the schedule is stable.
+    std::vector<Stage> pending, order;
+    for (Stage s : kAllStages)
+        if (enabled.Has(s)) pending.push_back(s);
+    while (!pending.empty()) {
+        auto ready = pending.end();
+        for (auto it = pending.begin(); it != pending.end() && ready == pending.end(); ++it) {
+            bool blocked = false;
+            for (Stage other : pending)
+                if (other != *it && before(other, *it)) blocked = true;
+            if (!blocked) ready = it;
+        }
+        assert(ready != pending.end() && "the stage graph has no cycle");
+        if (ready == pending.end()) ready = pending.begin();
+        order.push_back(*ready);
+        pending.erase(ready);
+    }
+    return order;
+}
+
+std::vector<std::string> MissingInputs(const StageSet& enabled) {
+    std::vector<std::string> missing;
+    for (Stage s : kAllStages) {
+        if (!enabled.Has(s)) continue;
+        for (Resource r : Describe(s).reads) {
+            if (ProducerOf(r, enabled)) continue;
+            std::string message = "'";
+            message.append(StageName(s)).append("' needs '").append(ResourceName(r));
+            message.append("', which no enabled stage writes (");
+            bool first = true;
+            for (Stage p : kAllStages) {
+                if (!Contains(Describe(p).writes, r)) continue;
+                message.append(first ? "" : " or ").append(StageName(p));
+                first = false;
+            }
+            missing.push_back(message + ")");
+        }
+    }
+    return missing;
+}
+
+ResourcePlan PlanResources(const Scene& scene) {
+    ResourcePlan plan;
+    for (Stage s : kAllStages) {
+        if (!scene.stages.Has(s)) continue;
+        const StageDescriptor& d = Describe(s);
+        for (Resource r : d.writes) {
+            plan.used[size_t(r)] = true;
+            if (d.advancesState) plan.doubleBuffered[size_t(r)] = true;
+        }
+    }
+    for (Stage s : kAllStages) {
+        const StageDescriptor& d = Describe(s);
+        if (!scene.stages.Has(s) || !d.readsPrevious) continue;
+        for (Resource r : d.readsPrevious(scene))
+            if (plan.used[size_t(r)]) plan.previous[size_t(r)] = true;
+    }
+    return plan;
+}
+
+}  // namespace cb

@@ -1,0 +1,123 @@
+// One descriptor per stage: what it reads and writes, when it runs, and how two
+// implementations of it are compared. The simulation, `conform`, `dump`, the
+// memory plan and the conformance tests walk these instead of naming stages,
+// so a new stage is a CB_STAGES line, a descriptor and its backends' code.
+//
+// Data flows through resources, never from stage to stage: "density needs q",
+// whoever writes q (smooth, or a noise producer).
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/Backend.h"
+#include "core/Scene.h"
+#include "core/Stage.h"
+
+namespace cb {
+
+// X(Enum, "name", format): the buffers that pass between stages (SPEC 0).
+#define CB_RESOURCES(X)                                                    \
+    X(Region, "region", U8)     /* R: region weights, grid */              \
+    X(Hum, "hum", Bits)         /* automaton fields, grid */               \
+    X(Act, "act", Bits)                                                    \
+    X(Cld, "cld", Bits)                                                    \
+    X(Q, "q", F32)              /* density in [0, 1], grid */              \
+    X(ColumnSum, "D", F32)      /* column sums, (nx, ny, 1) */             \
+    X(Tiles, "tiles", U8)       /* tile occupancy, (tx, ty, 1) */          \
+    X(Bands, "bands", U8)       /* tile x band occupancy, (tx, ty, bz) */  \
+    X(T, "T", F32)              /* transmittance toward the sun, grid */   \
+    X(Shadow, "G", F32)         /* ground shadow, (nx, ny, 1) */           \
+    X(SplatImage, "image_splat", F32) /* (3, width, height) per camera */  \
+    X(MarchImage, "image_march", F32)
+
+enum class Resource : uint8_t {
+#define CB_RESOURCE_ENUM(name, text, format) name,
+    CB_RESOURCES(CB_RESOURCE_ENUM)
+#undef CB_RESOURCE_ENUM
+};
+
+inline constexpr std::array kAllResources = {
+#define CB_RESOURCE_VALUE(name, text, format) Resource::name,
+    CB_RESOURCES(CB_RESOURCE_VALUE)
+#undef CB_RESOURCE_VALUE
+};
+inline constexpr size_t kResourceCount = kAllResources.size();
+
+std::string_view ResourceName(Resource resource);
+BufferFormat ResourceFormat(Resource resource);
+// The extent of one buffer of the resource in this scene.
+Extent3 ResourceExtent(Resource resource, const Scene& scene);
+// Images: one buffer per camera; every other resource: one.
+bool IsPerCamera(Resource resource);
+
+// How two implementations of a stage are compared, as data (SPEC's rule for
+// the stage). Integer and boolean outputs are bit-exact; floats within a
+// tolerance; images by SPEC 8's (or SPEC 10's) pixel-share rule.
+struct CompareRule {
+    enum class Kind : uint8_t {
+        BitExact,     // every element equal
+        Absolute,     // |d| <= tolerance everywhere
+        Quantised,    // |d| <= tolerance everywhere, and at most `share` of elements differ at all
+        Image,        // per channel |d| <= tolerance on at least 1 - share of pixels, <= limit everywhere
+    };
+    Kind kind = Kind::BitExact;
+    double tolerance = 0;
+    double share = 0;
+    double limit = 0;
+
+    // As the tables print it, e.g. "bit-exact", "|dT| <= 1e-05"; `symbol` names the compared quantity.
+    std::string Text(std::string_view symbol) const;
+};
+
+struct StageDescriptor {
+    Stage stage;
+    std::string_view section;               // the scene section of its settings ("" for none)
+    std::vector<Resource> reads;            // this step's values
+    // Read when some enabled stage writes them, and not needed otherwise
+    // (density's cover comes from cld with an automaton, from q without).
+    std::vector<Resource> optionalReads;
+    // Inputs whose previous step's value it also reads in this scene
+    // (interpolating renderers); nullptr for none.
+    std::vector<Resource> (*readsPrevious)(const Scene& scene) = nullptr;
+    std::vector<Resource> writes;
+    // Writes step t+1's values of its outputs from step t's (the automaton):
+    // it runs after every stage that reads them, and its outputs are double-buffered.
+    bool advancesState = false;
+    // Runs on output steps only (render steps, or every step when dumping).
+    bool outputStepsOnly = false;
+    // Skipped when none of its inputs changed since it last ran.
+    bool skipsUnchangedInputs = false;
+    // A renderer: writes one image per camera.
+    bool renderer = false;
+    std::string_view symbol;                // the compared quantity in rule texts ("R", "T", ...)
+    // The comparison for this scene (shade's tolerance depends on its storage format).
+    CompareRule (*rule)(const Scene& scene) = nullptr;
+};
+
+const StageDescriptor& Describe(Stage stage);
+
+// The enabled stages in the order a step runs them: every producer before
+// the stages that read its outputs, and stages that advance the state after
+// every reader of that state.
+std::vector<Stage> ScheduleStages(const StageSet& enabled);
+
+// The stage among `enabled` that writes `resource`, if any.
+std::optional<Stage> ProducerOf(Resource resource, const StageSet& enabled);
+
+// Each enabled stage's input that no enabled stage writes, as
+// "'density' needs 'q', which no enabled stage writes (smooth or noise)".
+std::vector<std::string> MissingInputs(const StageSet& enabled);
+
+// The resources a scene's enabled stages write, and which of them are also
+// kept for the previous step (read by an interpolating renderer).
+struct ResourcePlan {
+    std::array<bool, kResourceCount> used{};
+    std::array<bool, kResourceCount> previous{};
+    std::array<bool, kResourceCount> doubleBuffered{};  // written by a stage that advances the state
+};
+ResourcePlan PlanResources(const Scene& scene);
+
+}  // namespace cb
