@@ -73,7 +73,7 @@ std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? 
 
 bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
 
-GLuint BackendGL::Scratch(ScratchSlot slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
+GLuint BackendGL::Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
     const Functions& f = mContext->F();
     ScratchTexture& t = mScratch[slot];
     if (t.texture && t.target == target && t.format == format && t.width == width && t.height == height && t.depth == depth)
@@ -88,7 +88,7 @@ GLuint BackendGL::Scratch(ScratchSlot slot, GLenum target, GLenum format, GLsize
     return t.texture;
 }
 
-GLuint BackendGL::ScratchBuffer(BufferSlot slot, size_t bytes) {
+GLuint BackendGL::ScratchBuffer(GlScratchBuffer slot, size_t bytes) {
     const Functions& f = mContext->F();
     auto& [buffer, size] = mBuffers[slot];
     bytes = std::max<size_t>(bytes, 16);
@@ -216,8 +216,8 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
     }
     const Extent3 e = cld.Extent();
     const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
-    const GLuint sumX = Scratch(kSmoothX, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
-    const GLuint sumXY = Scratch(kSmoothXY, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
+    const GLuint sumX = Scratch(GlScratch::SmoothX, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
+    const GLuint sumXY = Scratch(GlScratch::SmoothXY, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
     const GLuint input[3] = {Tex(cld).Texture(), sumX, sumXY};
     const GLuint output[3] = {sumX, sumXY, Tex(q).Texture()};
     GpuTimer timer(f);
@@ -269,11 +269,11 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Disable(GL_BLEND);
 
     // Cover: an atomic counter over the columns; the column flags land in a scratch R8UI layer.
-    const GLuint counter = ScratchBuffer(kCoverCounter, sizeof(GLuint));
+    const GLuint counter = ScratchBuffer(GlScratchBuffer::CoverCounter, sizeof(GLuint));
     const GLuint initial = 0;
     f.NamedBufferSubData(counter, 0, sizeof initial, &initial);
     f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
-    const GLuint flags = Scratch(kCoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
+    const GLuint flags = Scratch(GlScratch::CoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
     CB_TRY(BindTargets({{flags, 0}}));
     f.UseProgram(*cover);
     f.BindTextureUnit(0, Tex(cld).Texture());
@@ -336,9 +336,10 @@ Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     const Extent3 e = region.Extent();
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
     GpuTimer timer(f);
-    const GLuint list = ScratchBuffer(kEllipsoidList, ellipsoids.size_bytes());
+    const GLuint list = ScratchBuffer(GlScratchBuffer::EllipsoidList, ellipsoids.size_bytes());
     if (!ellipsoids.empty()) f.NamedBufferSubData(list, 0, GLsizeiptr(ellipsoids.size_bytes()), ellipsoids.data());
-    const GLuint unorm = Scratch(kRegionUnorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    const GLuint unorm =
+        Scratch(GlScratch::RegionUnorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
     const float zero = 0.0f;
     f.ClearTexImage(unorm, 0, GL_RED, GL_FLOAT, &zero);
     f.UseProgram(*program);
@@ -394,9 +395,9 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     // With wind the rules write scratch fields that the advection pass shifts into `out`.
     GLuint next[3] = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
     if (wind) {
-        next[0] = Scratch(kCaHum, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
-        next[1] = Scratch(kCaAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
-        next[2] = Scratch(kCaCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[0] = Scratch(GlScratch::CaHum, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[1] = Scratch(GlScratch::CaAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[2] = Scratch(GlScratch::CaCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
     }
     GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
@@ -428,10 +429,10 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     return mContext->Check("ca");
 }
 
-// The thesis's layout: the step runs on RGBA8UI voxels (kStateA -> kStateB,
-// and back to kStateA through the advection pass when there is wind), then the
+// The thesis's layout: the step runs on RGBA8UI voxels (Rgba8StateA -> Rgba8StateB,
+// and back to Rgba8StateA through the advection pass when there is wind), then the
 // packed fields the other stages read are written from it. The packing of
-// `in` is skipped when kStateA already holds it (the previous step's result).
+// `in` is skipped when Rgba8StateA already holds it (the previous step's result).
 Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
     const Functions& f = mContext->F();
     auto pack = mContext->Program("ca_pack_rgba8");
@@ -444,8 +445,8 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     if (!unpack) return std::unexpected(unpack.error());
     const Extent3 e = in.hum->Extent();
     const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
-    const GLuint stateA = Scratch(kStateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
-    const GLuint stateB = Scratch(kStateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateA = Scratch(GlScratch::Rgba8StateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateB = Scratch(GlScratch::Rgba8StateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
     const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
     const bool packed = mStateOf == inputs && mStateWrites == mBitsWrites;
     const bool wind = !params.shiftX.empty();
@@ -483,8 +484,8 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     f.Uniform3i(f.GetUniformLocation(*unpack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
     CB_TRY(DrawLayers(*unpack, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
     ++mBitsWrites;
-    // Without wind the result is in kStateB: swap the slots so kStateA holds it.
-    if (result == stateB) std::swap(mScratch[kStateA], mScratch[kStateB]);
+    // Without wind the result is in Rgba8StateB: swap the slots so Rgba8StateA holds it.
+    if (result == stateB) std::swap(mScratch[GlScratch::Rgba8StateA], mScratch[GlScratch::Rgba8StateB]);
     mStateOf = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
     mStateWrites = mBitsWrites;
     mLastDeviceMs = timer.StopMs();
@@ -516,7 +517,7 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     f.BindVertexArray(mContext->EmptyVao());
     GLuint shadedQ = Tex(q).Texture();
     if (res > 1) {
-        shadedQ = Scratch(kShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
+        shadedQ = Scratch(GlScratch::ShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
         f.UseProgram(*down);
         f.BindTextureUnit(0, Tex(q).Texture());
         f.Uniform3i(f.GetUniformLocation(*down, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
@@ -524,9 +525,9 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         f.Viewport(0, 0, n[0], n[1]);
         CB_TRY(DrawLayers(*down, uint32_t(n[2]), {shadedQ}));
     }
-    const GLuint volume = Scratch(kShadeVolume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
-    GLuint ping = Scratch(kShadePing, GL_TEXTURE_2D, GL_R32F, nu, nv);
-    GLuint pong = Scratch(kShadePong, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    const GLuint volume = Scratch(GlScratch::ShadeVolume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
+    GLuint ping = Scratch(GlScratch::ShadePing, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    GLuint pong = Scratch(GlScratch::ShadePong, GL_TEXTURE_2D, GL_R32F, nu, nv);
     auto unit = [](int axis) {
         GLint v[3] = {0, 0, 0};
         v[axis] = 1;
@@ -628,12 +629,12 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
 
     GpuTimer timer(f);
-    const GLuint orderBuffer = ScratchBuffer(kSplatOrder, flat.indices.size() * 4);
+    const GLuint orderBuffer = ScratchBuffer(GlScratchBuffer::SplatOrder, flat.indices.size() * 4);
     f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
-    const GLuint counters = ScratchBuffer(kSplatCounters, 16);
+    const GLuint counters = ScratchBuffer(GlScratchBuffer::SplatCounters, 16);
     const uint32_t zero[4] = {};
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
-    const GLuint target = Scratch(kSplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    const GLuint target = Scratch(GlScratch::SplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
     CB_TRY(BindTargets({{target, -1}}));
     const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
     f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
@@ -675,7 +676,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.Disable(GL_PROGRAM_POINT_SIZE);
     // The image: RGB floats of rows top first are exactly the canonical layout.
     const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
-    const GLuint copy = ScratchBuffer(kImageCopy, imageBytes);
+    const GLuint copy = ScratchBuffer(GlScratchBuffer::ImageCopy, imageBytes);
     f.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
     f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
     f.PixelStorei(GL_PACK_ALIGNMENT, 1);
