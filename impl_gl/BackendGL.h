@@ -5,6 +5,11 @@
 // automaton can also run in the thesis's layout (one RGBA8UI texel per voxel,
 // a channel per bit), converted to and from the packed fields it shares with
 // the other stages (docs/pipeline.md).
+//
+// Files: the host side of each stage is in its own <Stage>GL.cpp (RegionGL.cpp,
+// CaGL.cpp, ...); BackendGL.cpp holds the context, buffers, transfers and the
+// helpers the stages share (scratch slots, BindTargets, DrawLayers), with the
+// rest of what they share in BackendGLInternal.h.
 #pragma once
 
 #include <array>
@@ -116,7 +121,8 @@ class BackendGL final : public Backend {
     }
     // Draws the full-screen triangle of `program` (in use, its other uniforms
     // set) once per layer k < layers: uniform "layer" = k, the render targets
-    // layer k of each of `textures`, and perLayer(k) for whatever else changes with k.
+    // layer k of each of `textures`, and perLayer(k) for whatever else changes
+    // with k. The template is defined in BackendGLInternal.h.
     template <typename PerLayer>
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer);
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures);
