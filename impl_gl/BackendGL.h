@@ -5,6 +5,11 @@
 // automaton can also run in the thesis's layout (one RGBA8UI texel per voxel,
 // a channel per bit), converted to and from the packed fields it shares with
 // the other stages (docs/pipeline.md).
+//
+// Files: the host side of each stage is in its own <Stage>GL.cpp (RegionGL.cpp,
+// CaGL.cpp, ...); BackendGL.cpp holds the context, buffers, transfers and the
+// helpers the stages share (scratch slots, BindTargets, DrawLayers), with the
+// rest of what they share in BackendGLInternal.h.
 #pragma once
 
 #include <array>
@@ -52,12 +57,45 @@ class BackendGL final : public Backend {
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:
-    // Scratch textures and buffers, kept between calls and remade when their shape changes.
-    enum ScratchSlot : size_t {
-        kRegionUnorm, kSmoothX, kSmoothXY, kCaHum, kCaAct, kCaCld, kStateA, kStateB, kShadeCoarseQ, kShadeVolume, kShadePing,
-        kShadePong, kSplatTarget, kCoverFlags, kScratchSlots
+    // The scratch textures, each used by one stage only (named first), kept
+    // between calls and remade when its target, format or size changes.
+    enum class GlScratch {
+        RegionUnorm,   // Region: the R8 UNORM layers the ellipsoids MAX-blend into
+        CaHum,         // CaStep, with wind: the rules' humidity, before advection
+        CaAct,         // CaStep, with wind: the rules' activation, before advection
+        CaCld,         // CaStep, with wind: the rules' clouds, before advection
+        Rgba8StateA,   // CaStep, RGBA8 layout: the state between steps (see mStateOf)
+        Rgba8StateB,   // CaStep, RGBA8 layout: the rules' output
+        SmoothX,       // Smooth: the R16UI sums along x
+        SmoothXY,      // Smooth: the R16UI sums along x and y
+        CoverFlags,    // Density: the R8UI flags of the covered columns
+        ShadeCoarseQ,  // Shade, resolution > 1: the down-sampled q
+        ShadeVolume,   // Shade: the w-major volume of slices
+        ShadePing,     // Shade: the slice loop's previous slice
+        ShadePong,     // Shade: the slice loop's current slice
+        SplatTarget,   // RenderSplat: the RGBA32F image
+        Count
     };
-    enum BufferSlot : size_t { kCoverCounter, kEllipsoidList, kSplatOrder, kSplatCounters, kImageCopy, kBufferSlots };
+    // The scratch buffer objects, each used by one stage only, grown as needed.
+    enum class GlScratchBuffer {
+        EllipsoidList,  // Region: the ellipsoids, read by the vertex shader
+        CoverCounter,   // Density: the atomic counter of covered columns
+        SplatOrder,     // RenderSplat: the flattened shared order
+        SplatCounters,  // RenderSplat: the shader's counters (splats drawn)
+        ImageCopy,      // RenderSplat: the pixel buffer the image passes through
+        Count
+    };
+    // An array indexed by one slot enum and nothing else.
+    template <typename Slot, typename T>
+    class SlotArray {
+      public:
+        T& operator[](Slot slot) { return mItems[size_t(slot)]; }
+        auto begin() { return mItems.begin(); }
+        auto end() { return mItems.end(); }
+
+      private:
+        std::array<T, size_t(Slot::Count)> mItems{};
+    };
     struct ScratchTexture {
         GLuint texture = 0;
         GLenum target = 0, format = 0;
@@ -65,8 +103,8 @@ class BackendGL final : public Backend {
     };
 
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8) : mContext(std::move(context)), mRgba8(rgba8) {}
-    GLuint Scratch(ScratchSlot slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
-    GLuint ScratchBuffer(BufferSlot slot, size_t bytes);
+    GLuint Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
+    GLuint ScratchBuffer(GlScratchBuffer slot, size_t bytes);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the
     // context's framebuffer as colour attachments 0, 1, ... and makes them the
     // draw buffers; the other attachments are detached.
@@ -76,7 +114,8 @@ class BackendGL final : public Backend {
     }
     // Draws the full-screen triangle of `program` (in use, its other uniforms
     // set) once per layer k < layers: uniform "layer" = k, the render targets
-    // layer k of each of `textures`, and perLayer(k) for whatever else changes with k.
+    // layer k of each of `textures`, and perLayer(k) for whatever else changes
+    // with k. The template is defined in BackendGLInternal.h.
     template <typename PerLayer>
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer);
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures);
@@ -85,9 +124,9 @@ class BackendGL final : public Backend {
     std::unique_ptr<GLContext> mContext;
     bool mRgba8 = false;
     std::optional<double> mLastDeviceMs;
-    std::array<ScratchTexture, kScratchSlots> mScratch{};
-    std::array<std::pair<GLuint, size_t>, kBufferSlots> mBuffers{};
-    // Which packed fields the thesis-layout state in kStateA holds: the last
+    SlotArray<GlScratch, ScratchTexture> mScratch;
+    SlotArray<GlScratchBuffer, std::pair<GLuint, size_t>> mBuffers;  // buffer, bytes
+    // Which packed fields the thesis-layout state in Rgba8StateA holds: the last
     // step's outputs, valid until a bit field is written some other way.
     std::array<GLuint, 3> mStateOf{};
     uint64_t mBitsWrites = 0, mStateWrites = ~uint64_t(0);

@@ -1,0 +1,137 @@
+#include <array>
+#include <utility>
+
+#include "impl_gl/BackendGLInternal.h"
+
+namespace cb::gl {
+
+Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("ca_init");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = out.hum->Extent();
+    GpuTimer timer(f);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Uniform3i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1ui(f.GetUniformLocation(*program, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*program, "qHum0"), params.qHum0);
+    f.Uniform1ui(f.GetUniformLocation(*program, "qAct0"), params.qAct0);
+    f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), GLsizei(e.ny));
+    CB_TRY(DrawLayers(*program, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
+    ++mBitsWrites;
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca initial state");
+}
+
+Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    if (mRgba8) return CaStepRgba8(params, in, region, out);
+    const Functions& f = mContext->F();
+    auto rules = mContext->Program("ca");
+    if (!rules) return std::unexpected(rules.error());
+    auto advect = mContext->Program("advect");
+    if (!advect) return std::unexpected(advect.error());
+    const Extent3 e = in.hum->Extent();
+    const GLsizei words = GLsizei(CeilDiv(e.nx, 32));
+    const bool wind = !params.shiftX.empty();
+    // With wind the rules write scratch fields that the advection pass shifts into `out`.
+    GLuint next[3] = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
+    if (wind) {
+        next[0] = Scratch(GlScratch::CaHum, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[1] = Scratch(GlScratch::CaAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[2] = Scratch(GlScratch::CaCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+    }
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Viewport(0, 0, words, GLsizei(e.ny));
+    f.UseProgram(*rules);
+    f.BindTextureUnit(0, Tex(*in.hum).Texture());
+    f.BindTextureUnit(1, Tex(*in.act).Texture());
+    f.BindTextureUnit(2, Tex(*in.cld).Texture());
+    f.BindTextureUnit(3, Tex(region).Texture());
+    f.Uniform3i(f.GetUniformLocation(*rules, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1i(f.GetUniformLocation(*rules, "words"), words);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "step"), params.step);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
+    CB_TRY(DrawLayers(*rules, e.nz, {next[0], next[1], next[2]}));
+    if (wind) {
+        f.UseProgram(*advect);
+        for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), next[n]);
+        f.Uniform3i(f.GetUniformLocation(*advect, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        f.Uniform1i(f.GetUniformLocation(*advect, "words"), words);
+        const GLint shift = f.GetUniformLocation(*advect, "shift");
+        CB_TRY(DrawLayers(*advect, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()},
+                          [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
+    }
+    ++mBitsWrites;
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca");
+}
+
+// The thesis's layout: the step runs on RGBA8UI voxels (Rgba8StateA -> Rgba8StateB,
+// and back to Rgba8StateA through the advection pass when there is wind), then the
+// packed fields the other stages read are written from it. The packing of
+// `in` is skipped when Rgba8StateA already holds it (the previous step's result).
+Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    const Functions& f = mContext->F();
+    auto pack = mContext->Program("ca_pack_rgba8");
+    if (!pack) return std::unexpected(pack.error());
+    auto rules = mContext->Program("ca_rgba8");
+    if (!rules) return std::unexpected(rules.error());
+    auto advect = mContext->Program("advect_rgba8");
+    if (!advect) return std::unexpected(advect.error());
+    auto unpack = mContext->Program("ca_unpack_rgba8");
+    if (!unpack) return std::unexpected(unpack.error());
+    const Extent3 e = in.hum->Extent();
+    const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
+    const GLuint stateA = Scratch(GlScratch::Rgba8StateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateB = Scratch(GlScratch::Rgba8StateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
+    const bool packed = mStateOf == inputs && mStateWrites == mBitsWrites;
+    const bool wind = !params.shiftX.empty();
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Viewport(0, 0, nx, ny);
+    auto perSlice = [&](GLuint program, GLuint target, auto&& setLayer) -> Status {
+        f.UseProgram(program);
+        f.Uniform3i(f.GetUniformLocation(program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        return DrawLayers(program, e.nz, {target}, setLayer);
+    };
+    if (!packed) {
+        for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), inputs[n]);
+        CB_TRY(perSlice(*pack, stateA, [](uint32_t) {}));
+    }
+    f.BindTextureUnit(0, stateA);
+    f.BindTextureUnit(1, Tex(region).Texture());
+    f.UseProgram(*rules);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "step"), params.step);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
+    CB_TRY(perSlice(*rules, stateB, [](uint32_t) {}));
+    GLuint result = stateB;
+    if (wind) {
+        f.BindTextureUnit(0, stateB);
+        const GLint shift = f.GetUniformLocation(*advect, "shift");
+        CB_TRY(perSlice(*advect, stateA, [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
+        result = stateA;
+    }
+    f.BindTextureUnit(0, result);
+    f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), ny);
+    f.UseProgram(*unpack);
+    f.Uniform3i(f.GetUniformLocation(*unpack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    CB_TRY(DrawLayers(*unpack, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
+    ++mBitsWrites;
+    // Without wind the result is in Rgba8StateB: swap the slots so Rgba8StateA holds it.
+    if (result == stateB) std::swap(mScratch[GlScratch::Rgba8StateA], mScratch[GlScratch::Rgba8StateB]);
+    mStateOf = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
+    mStateWrites = mBitsWrites;
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca (RGBA8 layout)");
+}
+
+}  // namespace cb::gl

@@ -1,0 +1,71 @@
+#include "impl_gl/BackendGLInternal.h"
+
+namespace cb::gl {
+
+Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) {
+    if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
+    const Functions& f = mContext->F();
+    auto sum = mContext->Program("density_sum");
+    if (!sum) return std::unexpected(sum.error());
+    auto cover = mContext->Program("density_cover");
+    if (!cover) return std::unexpected(cover.error());
+    auto occupancy = mContext->Program("occupancy");
+    if (!occupancy) return std::unexpected(occupancy.error());
+    const Extent3 e = q.Extent();
+    const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
+    const uint32_t bandCount = CeilDiv(e.nz, params.band);
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+
+    // D: additive blending of the slices, k ascending.
+    const float zero = 0.0f;
+    f.ClearTexImage(Tex(*out.columnSum).Texture(), 0, GL_RED, GL_FLOAT, &zero);
+    CB_TRY(BindTargets({{Tex(*out.columnSum).Texture(), 0}}));
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    f.UseProgram(*sum);
+    f.BindTextureUnit(0, Tex(q).Texture());
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.BlendFunc(GL_ONE, GL_ONE);
+    const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
+    for (uint32_t k = 0; k < e.nz; ++k) {
+        f.Uniform1i(sumLayer, GLint(k));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    f.Disable(GL_BLEND);
+
+    // Cover: an atomic counter over the columns; the column flags land in a scratch R8UI layer.
+    const GLuint counter = ScratchBuffer(GlScratchBuffer::CoverCounter, sizeof(GLuint));
+    const GLuint initial = 0;
+    f.NamedBufferSubData(counter, 0, sizeof initial, &initial);
+    f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
+    const GLuint flags = Scratch(GlScratch::CoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
+    CB_TRY(BindTargets({{flags, 0}}));
+    f.UseProgram(*cover);
+    f.BindTextureUnit(0, Tex(cld).Texture());
+    f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+
+    // Occupancy: max-downsampling to tiles (from D) and to tile x band (from q).
+    f.UseProgram(*occupancy);
+    f.BindTextureUnit(0, Tex(q).Texture());
+    f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
+    f.Uniform3i(f.GetUniformLocation(*occupancy, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform2i(f.GetUniformLocation(*occupancy, "tileBand"), GLint(params.tile), GLint(params.band));
+    const GLint mode = f.GetUniformLocation(*occupancy, "mode");
+    f.Viewport(0, 0, GLsizei(tilesX), GLsizei(tilesY));
+    f.Uniform1i(mode, 0);
+    CB_TRY(DrawLayers(*occupancy, bandCount, {Tex(*out.bands).Texture()}));
+    f.Uniform1i(mode, 1);
+    CB_TRY(BindTargets({{Tex(*out.tiles).Texture(), 0}}));
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+
+    f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    mLastDeviceMs = timer.StopMs();
+    GLuint covered = 0;
+    f.GetNamedBufferSubData(counter, 0, sizeof covered, &covered);
+    out.coveredColumns = covered;
+    return mContext->Check("density");
+}
+
+}  // namespace cb::gl

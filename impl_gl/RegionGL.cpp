@@ -1,0 +1,42 @@
+#include "impl_gl/BackendGLInternal.h"
+
+namespace cb::gl {
+
+// region: per slice, one instanced quad per ellipsoid into an R8 UNORM layer
+// with MAX blending (integer targets cannot blend), then one copy into the
+// R8UI volume (the same 8-bit texel class, so the bits carry over).
+Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) {
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("region");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = region.Extent();
+    static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
+    GpuTimer timer(f);
+    const GLuint list = ScratchBuffer(GlScratchBuffer::EllipsoidList, ellipsoids.size_bytes());
+    if (!ellipsoids.empty()) f.NamedBufferSubData(list, 0, GLsizeiptr(ellipsoids.size_bytes()), ellipsoids.data());
+    const GLuint unorm =
+        Scratch(GlScratch::RegionUnorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    const float zero = 0.0f;
+    f.ClearTexImage(unorm, 0, GL_RED, GL_FLOAT, &zero);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
+    f.Uniform2i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny));
+    const GLint layer = f.GetUniformLocation(*program, "layer");
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_MAX);
+    for (uint32_t k = 0; k < e.nz && !ellipsoids.empty(); ++k) {
+        CB_TRY(BindTargets({{unorm, int(k)}}));
+        f.Uniform1i(layer, GLint(k));
+        f.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(ellipsoids.size()));
+    }
+    f.Disable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.CopyImageSubData(unorm, GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, Tex(region).Texture(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
+                       GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("region");
+}
+
+}  // namespace cb::gl

@@ -1,0 +1,139 @@
+#include <vector>
+
+#include "impl_gl/BackendGLInternal.h"
+
+namespace cb::gl {
+
+// render_splat: GL_POINTS in the shared order, one vertex per voxel; culling
+// and skipping become a multi-draw over the runs of ranks whose tile x band
+// box is visible. The RGBA32F target is drawn with row 0 at the top, so one
+// read into a pixel buffer and one upload from it give the canonical (3, W, H) image.
+Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
+    if (!p.order || !in.qPrev || !in.qCur || !in.T)
+        return MakeError("gl: render_splat needs q (both steps), T and an order");
+    if (image.Extent().nx != 3) return MakeError("gl: render_splat image must have extent (3, width, height)");
+    const Functions& f = mContext->F();
+    auto program = mContext->Program("splat");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = in.qCur->Extent();
+    const uint32_t W = image.Extent().ny, H = image.Extent().nz;
+    const CameraFrame& cam = p.camera;
+
+    auto visibility = DownloadSplatBoxVisibility(*this, p, in);
+    if (!visibility) return std::unexpected(visibility.error());
+    const std::vector<uint8_t>& boxes = *visibility;
+
+    // Runs of consecutive ranks whose box is visible: one draw each.
+    const SplatOrder& order = *p.order;
+    const int outer = order.axes[0], middle = order.axes[1], inner = order.axes[2];
+    const uint32_t tilesX = CeilDiv(e.nx, p.tile), tilesY = CeilDiv(e.ny, p.tile);
+    const uint32_t boxSize[3] = {p.tile, p.tile, p.band};
+    const uint32_t boxStride[3] = {1, tilesX, tilesX * tilesY};
+    std::vector<GLint> firsts;
+    std::vector<GLsizei> counts;
+    uint64_t visited = 0;
+    {
+        const auto& innerIdx = order.indices[inner];
+        std::vector<uint32_t> innerBox(innerIdx.size());
+        for (size_t n = 0; n < innerIdx.size(); ++n) innerBox[n] = (innerIdx[n] / boxSize[inner]) * boxStride[inner];
+        GLint rank = 0;
+        GLint runStart = -1;
+        for (uint32_t o : order.indices[outer])
+            for (uint32_t m : order.indices[middle]) {
+                const uint32_t base =
+                    (o / boxSize[outer]) * boxStride[outer] + (m / boxSize[middle]) * boxStride[middle];
+                for (size_t n = 0; n < innerIdx.size(); ++n, ++rank) {
+                    const bool visible = boxes[base + innerBox[n]] != 0;
+                    if (visible && runStart < 0) runStart = rank;
+                    if (!visible && runStart >= 0) {
+                        firsts.push_back(runStart);
+                        counts.push_back(rank - runStart);
+                        runStart = -1;
+                    }
+                }
+            }
+        if (runStart >= 0) {
+            firsts.push_back(runStart);
+            counts.push_back(rank - runStart);
+        }
+        for (GLsizei c : counts) visited += uint64_t(c);
+    }
+
+    const FlatSplatOrder flat = FlattenSplatOrder(order);
+    GLfloat pointRange[2] = {1, 1};
+    f.GetFloatv(GL_POINT_SIZE_RANGE, pointRange);
+    constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
+
+    GpuTimer timer(f);
+    const GLuint orderBuffer = ScratchBuffer(GlScratchBuffer::SplatOrder, flat.indices.size() * 4);
+    f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
+    const GLuint counters = ScratchBuffer(GlScratchBuffer::SplatCounters, 16);
+    const uint32_t zero[4] = {};
+    f.NamedBufferSubData(counters, 0, sizeof zero, zero);
+    const GLuint target = Scratch(GlScratch::SplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    CB_TRY(BindTargets({{target, -1}}));
+    const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
+    f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
+    f.UseProgram(*program);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, orderBuffer);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counters);
+    f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
+    f.BindTextureUnit(1, Tex(*in.qCur).Texture());
+    f.BindTextureUnit(2, Tex(*in.T).Texture());
+    auto uniform = [&](const char* name) { return f.GetUniformLocation(*program, name); };
+    f.Uniform3i(uniform("grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform3i(uniform("axes"), outer, middle, inner);
+    f.Uniform3i(uniform("orderBase"), GLint(flat.base[0]), GLint(flat.base[1]), GLint(flat.base[2]));
+    f.Uniform2f(uniform("image"), float(W), float(H));
+    f.Uniform1f(uniform("guard"), kGuard);
+    f.Uniform4f(uniform("eye"), cam.eye[0], cam.eye[1], cam.eye[2], cam.nearPlane);
+    f.Uniform4f(uniform("forward"), cam.forward[0], cam.forward[1], cam.forward[2], cam.focalPx);
+    f.Uniform3f(uniform("right"), cam.right[0], cam.right[1], cam.right[2]);
+    f.Uniform3f(uniform("up"), cam.upVector[0], cam.upVector[1], cam.upVector[2]);
+    f.Uniform4f(uniform("sun"), p.sun[0], p.sun[1], p.sun[2], p.phase.g);
+    f.Uniform4f(uniform("sunRadiance"), p.sunRadiance[0], p.sunRadiance[1], p.sunRadiance[2], float(p.phase.kind));
+    f.Uniform4f(uniform("ambient"), p.ambient[0], p.ambient[1], p.ambient[2], p.qMin);
+    f.Uniform4f(uniform("origin"), p.origin[0], p.origin[1], p.origin[2], p.voxelSize);
+    f.Uniform4f(uniform("misc"), p.splatDiameter, p.alpha, p.opacity, pointRange[1]);
+    f.Enable(GL_PROGRAM_POINT_SIZE);
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    f.Viewport(-GLint(kGuard), -GLint(kGuard), GLsizei(W + 2 * kGuard), GLsizei(H + 2 * kGuard));
+    GLuint fragments = 0;
+    if (stats) {
+        f.GenQueries(1, &fragments);
+        f.BeginQuery(GL_SAMPLES_PASSED, fragments);
+    }
+    if (!firsts.empty()) f.MultiDrawArrays(GL_POINTS, firsts.data(), counts.data(), GLsizei(firsts.size()));
+    if (stats) f.EndQuery(GL_SAMPLES_PASSED);
+    f.Disable(GL_BLEND);
+    f.Disable(GL_PROGRAM_POINT_SIZE);
+    // The image: RGB floats of rows top first are exactly the canonical layout.
+    const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
+    const GLuint copy = ScratchBuffer(GlScratchBuffer::ImageCopy, imageBytes);
+    f.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(target, 0, GL_RGB, GL_FLOAT, GLsizei(imageBytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, copy);
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    mLastDeviceMs = timer.StopMs();
+    if (stats) {
+        GLuint64 passed = 0;
+        f.GetQueryObjectui64v(fragments, GL_QUERY_RESULT, &passed);
+        f.DeleteQueries(1, &fragments);
+        uint32_t drawn = 0;
+        f.GetNamedBufferSubData(counters, 0, sizeof drawn, &drawn);
+        stats->splats = drawn;
+        stats->voxelsVisited = visited;
+        stats->fragments = passed;
+    }
+    return mContext->Check("render_splat");
+}
+
+}  // namespace cb::gl

@@ -1,0 +1,87 @@
+#include <array>
+#include <utility>
+
+#include "impl_gl/BackendGLInternal.h"
+
+namespace cb::gl {
+
+// shade: optional down-sampling pass, then the slice loop from the sun's side
+// (ping-pong between two 2-D textures, each slice also written to layer w of a
+// w-major volume), then one pass that writes the z-layered T, reading the
+// w-major volume trilinearly (exactly, at f = 1).
+Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    const int res = params.resolution;
+    if (res != 1 && res != 2 && res != 4) return MakeError("gl: shade resolution must be 1, 2 or 4");
+    const Functions& f = mContext->F();
+    auto slice = mContext->Program("shade_slice");
+    if (!slice) return std::unexpected(slice.error());
+    auto up = mContext->Program("shade_up");
+    if (!up) return std::unexpected(up.error());
+    auto down = mContext->Program("shade_down");
+    if (!down) return std::unexpected(down.error());
+    const Extent3 e = q.Extent();
+    const int n[3] = {int(CeilDiv(e.nx, uint32_t(res))), int(CeilDiv(e.ny, uint32_t(res))),
+                      int(CeilDiv(e.nz, uint32_t(res)))};
+    const ShearWarp g = MakeShearWarp(params.sun, params.filter);
+    const SliceAttenuation a =
+        MakeSliceAttenuation(params.attenuation, params.sigma, params.voxelSize * float(res), g.absSw, params.thesisAr,
+                             params.scattering, params.albedo, params.solidAngle, params.phase);
+    const int nu = n[g.u], nv = n[g.v], nw = n[g.w];
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    GLuint shadedQ = Tex(q).Texture();
+    if (res > 1) {
+        shadedQ = Scratch(GlScratch::ShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
+        f.UseProgram(*down);
+        f.BindTextureUnit(0, Tex(q).Texture());
+        f.Uniform3i(f.GetUniformLocation(*down, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        f.Uniform1i(f.GetUniformLocation(*down, "f"), res);
+        f.Viewport(0, 0, n[0], n[1]);
+        CB_TRY(DrawLayers(*down, uint32_t(n[2]), {shadedQ}));
+    }
+    const GLuint volume = Scratch(GlScratch::ShadeVolume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
+    GLuint ping = Scratch(GlScratch::ShadePing, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    GLuint pong = Scratch(GlScratch::ShadePong, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    auto unit = [](int axis) {
+        GLint v[3] = {0, 0, 0};
+        v[axis] = 1;
+        return std::array<GLint, 3>{v[0], v[1], v[2]};
+    };
+    const auto eu = unit(g.u), ev = unit(g.v), ew = unit(g.w);
+    f.UseProgram(*slice);
+    f.BindTextureUnit(1, shadedQ);
+    f.Uniform3i(f.GetUniformLocation(*slice, "axisU"), eu[0], eu[1], eu[2]);
+    f.Uniform3i(f.GetUniformLocation(*slice, "axisV"), ev[0], ev[1], ev[2]);
+    f.Uniform2i(f.GetUniformLocation(*slice, "sliceSize"), nu, nv);
+    f.Uniform2i(f.GetUniformLocation(*slice, "tapOffset"), g.u0, g.v0);
+    f.Uniform2f(f.GetUniformLocation(*slice, "tapFraction"), g.fu, g.fv);
+    f.Uniform1i(f.GetUniformLocation(*slice, "beer"), a.kind == AttenuationKind::Beer ? 1 : 0);
+    f.Uniform1f(f.GetUniformLocation(*slice, "depthPerQ"), a.opticalDepthPerQ);
+    f.Uniform1f(f.GetUniformLocation(*slice, "thesisAr"), a.thesisAr);
+    f.Uniform1f(f.GetUniformLocation(*slice, "scatterGain"), a.scatterGain);
+    f.Uniform1ui(f.GetUniformLocation(*slice, "storage"), uint32_t(params.storage));
+    const GLint first = f.GetUniformLocation(*slice, "first"), previousW = f.GetUniformLocation(*slice, "previousW");
+    f.Viewport(0, 0, nu, nv);
+    int previous = 0;
+    for (int m = 0; m < nw; ++m) {
+        const int w = g.sunAbove ? nw - 1 - m : m;
+        CB_TRY(BindTargets({{pong, -1}, {volume, w}}));
+        f.BindTextureUnit(0, ping);
+        f.Uniform1i(first, m == 0 ? 1 : 0);
+        f.Uniform3i(previousW, previous * ew[0], previous * ew[1], previous * ew[2]);
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        std::swap(ping, pong);
+        previous = w;
+    }
+    f.UseProgram(*up);
+    f.BindTextureUnit(0, volume);
+    f.Uniform3i(f.GetUniformLocation(*up, "cells"), n[0], n[1], n[2]);
+    f.Uniform3i(f.GetUniformLocation(*up, "axes"), g.u, g.v, g.w);
+    f.Uniform1i(f.GetUniformLocation(*up, "f"), res);
+    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    CB_TRY(DrawLayers(*up, e.nz, {Tex(T).Texture()}));
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("shade");
+}
+
+}  // namespace cb::gl
