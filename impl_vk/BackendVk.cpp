@@ -1,14 +1,22 @@
 #include "impl_vk/BackendVk.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
-#include <cstring>
+#include <iterator>
 #include <vector>
 
 namespace cb::vk {
 namespace {
 
 const DeviceBuffer& Dev(const Buffer& b) { return static_cast<const BufferVk&>(b).Device(); }
+
+// The scratch slot that holds field `field` (0 hum, 1 act, 2 cld, as in CaFields) of the rules' output.
+VkScratch CaRulesOutputSlot(size_t field) {
+    constexpr VkScratch kSlots[] = {VkScratch::CaRulesHum, VkScratch::CaRulesAct, VkScratch::CaRulesCld};
+    assert(field < std::size(kSlots));
+    return kSlots[field];
+}
 
 // Bytes a buffer takes on the device.
 VkDeviceSize DeviceBytes(BufferFormat format, const Extent3& e) {
@@ -42,8 +50,8 @@ Status BackendVk::Record(const char* what, Fn&& fn) {
     return {};
 }
 
-Result<DeviceBuffer*> BackendVk::Scratch(size_t slot, VkDeviceSize size) {
-    DeviceBuffer& b = mScratch.at(slot);
+Result<DeviceBuffer*> BackendVk::Scratch(VkScratch slot, VkDeviceSize size) {
+    DeviceBuffer& b = mScratch.at(size_t(slot));
     if (b.size < size) {
         mContext->DestroyBuffer(b);
         auto created = mContext->CreateBuffer(size);
@@ -80,7 +88,7 @@ Status BackendVk::Download(const Buffer& buffer, std::span<std::byte> canonical)
 Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) {
     const Extent3 e = region.Extent();
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
-    auto list = Scratch(0, std::max<VkDeviceSize>(32, ellipsoids.size_bytes()));
+    auto list = Scratch(VkScratch::EllipsoidList, std::max<VkDeviceSize>(32, ellipsoids.size_bytes()));
     if (!list) return std::unexpected(list.error());
     CB_TRY(mContext->Upload(**list, std::as_bytes(ellipsoids)));
     // Per 16x16 tile of each slice, the ellipsoids whose bounding box (the
@@ -104,10 +112,10 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
                 }
                 tileStart[tile + 1] = uint32_t(tileList.size());
             }
-    auto starts = Scratch(19, tileStart.size() * 4);
+    auto starts = Scratch(VkScratch::RegionTileStarts, tileStart.size() * 4);
     if (!starts) return std::unexpected(starts.error());
     CB_TRY(mContext->Upload(**starts, std::as_bytes(std::span(tileStart))));
-    auto entries = Scratch(20, std::max<size_t>(16, tileList.size() * 4));
+    auto entries = Scratch(VkScratch::RegionTileEntries, std::max<size_t>(16, tileList.size() * 4));
     if (!entries) return std::unexpected(entries.error());
     if (!tileList.empty()) CB_TRY(mContext->Upload(**entries, std::as_bytes(std::span(tileList))));
     auto pipeline = mContext->GetPipeline("region", 4);
@@ -153,7 +161,7 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     if (wind) {
         // The rules write into scratch; advection moves the result into `out`.
         for (size_t f = 0; f < 3; ++f) {
-            auto s = Scratch(1 + f, VkDeviceSize(count) * 4);
+            auto s = Scratch(CaRulesOutputSlot(f), VkDeviceSize(count) * 4);
             if (!s) return std::unexpected(s.error());
             targets[f] = *s;
         }
@@ -162,7 +170,7 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
             packed.push_back(params.shiftX[k]);
             packed.push_back(params.shiftY[k]);
         }
-        auto s = Scratch(4, packed.size() * 4);
+        auto s = Scratch(VkScratch::CaWindShifts, packed.size() * 4);
         if (!s) return std::unexpected(s.error());
         shifts = *s;
         CB_TRY(mContext->Upload(*shifts, std::as_bytes(std::span(packed))));
@@ -191,9 +199,9 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q) {
     const Extent3 e = cld.Extent();
     auto pipeline = mContext->GetPipeline("smooth", 4);
     if (!pipeline) return std::unexpected(pipeline.error());
-    auto sumX = Scratch(21, e.Count() * 4);
+    auto sumX = Scratch(VkScratch::SmoothSumX, e.Count() * 4);
     if (!sumX) return std::unexpected(sumX.error());
-    auto sumXY = Scratch(22, e.Count() * 4);
+    auto sumXY = Scratch(VkScratch::SmoothSumXY, e.Count() * 4);
     if (!sumXY) return std::unexpected(sumXY.error());
     struct {
         uint32_t nx, ny, nz, words;
@@ -217,7 +225,7 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     if (!columns) return std::unexpected(columns.error());
     auto occupancy = mContext->GetPipeline("occupancy", 4);
     if (!occupancy) return std::unexpected(occupancy.error());
-    auto counter = Scratch(5, 4);
+    auto counter = Scratch(VkScratch::CoverCounter, 4);
     if (!counter) return std::unexpected(counter.error());
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
@@ -253,9 +261,9 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const DeviceBuffer* shadeQ = &Dev(q);
     const DeviceBuffer* shadeT = &Dev(T);
     if (f > 1) {
-        auto cq = Scratch(6, coarseBytes);
+        auto cq = Scratch(VkScratch::ShadeCoarseQ, coarseBytes);
         if (!cq) return std::unexpected(cq.error());
-        auto ct = Scratch(7, coarseBytes);
+        auto ct = Scratch(VkScratch::ShadeCoarseT, coarseBytes);
         if (!ct) return std::unexpected(ct.error());
         shadeQ = *cq;
         shadeT = *ct;
@@ -371,22 +379,27 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
              {p.origin[0], p.origin[1], p.origin[2], p.voxelSize},
              {p.splatDiameter, p.alpha, 0, 0}};
     const uint32_t chunks = CeilDiv(voxels, kVoxelsPerChunk);
-    DeviceBuffer* slot[20] = {};
-    auto need = [&](size_t n, VkDeviceSize bytes) -> Status {
-        auto b = Scratch(n, std::max<VkDeviceSize>(bytes, 16));
+    // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
+    struct {
+        DeviceBuffer *frame, *order, *boxes, *chunkSplats, *chunkVisited, *chunkOffsets;
+        DeviceBuffer *splats, *binCounts, *tileTotals, *tileBases, *tileList;
+    } scratch{};
+    // At least 16 bytes: a binding needs a buffer even when nothing is in it.
+    auto need = [&](DeviceBuffer*& buffer, VkScratch slot, VkDeviceSize bytes) -> Status {
+        auto b = Scratch(slot, std::max<VkDeviceSize>(bytes, 16));
         if (!b) return std::unexpected(b.error());
-        slot[n] = *b;
+        buffer = *b;
         return {};
     };
-    CB_TRY(need(8, sizeof frame));
-    CB_TRY(need(9, flat.indices.size() * 4));
-    CB_TRY(need(10, boxes.size()));
-    CB_TRY(need(11, VkDeviceSize(chunks) * 4));
-    CB_TRY(need(12, VkDeviceSize(chunks) * 4));
-    CB_TRY(need(13, VkDeviceSize(chunks + 1) * 4));
-    CB_TRY(mContext->Upload(*slot[8], std::as_bytes(std::span(&frame, 1))));
-    CB_TRY(mContext->Upload(*slot[9], std::as_bytes(std::span(flat.indices))));
-    CB_TRY(mContext->Upload(*slot[10], std::as_bytes(std::span(boxes))));
+    CB_TRY(need(scratch.frame, VkScratch::SplatFrame, sizeof frame));
+    CB_TRY(need(scratch.order, VkScratch::SplatOrder, flat.indices.size() * 4));
+    CB_TRY(need(scratch.boxes, VkScratch::SplatBoxes, boxes.size()));
+    CB_TRY(need(scratch.chunkSplats, VkScratch::SplatChunkSplats, VkDeviceSize(chunks) * 4));
+    CB_TRY(need(scratch.chunkVisited, VkScratch::SplatChunkVisited, VkDeviceSize(chunks) * 4));
+    CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
+    CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
+    CB_TRY(mContext->Upload(*scratch.order, std::as_bytes(std::span(flat.indices))));
+    CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
     Pipeline* pipes[5] = {};
     const char* names[5] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite"};
     const uint32_t bindings[5] = {8, 2, 8, 5, 4};
@@ -395,7 +408,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         if (!pipe) return std::unexpected(pipe.error());
         pipes[n] = *pipe;
     }
-    const DeviceBuffer* common[6] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), slot[9], slot[10], slot[8]};
+    const DeviceBuffer* common[6] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), scratch.order, scratch.boxes, scratch.frame};
     double deviceMs = 0;
     auto run = [&](const char* what, auto&& record) -> Status {
         CB_TRY(Record(what, record));
@@ -404,31 +417,32 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     };
     // 1. Splats per chunk of ranks, and their offsets.
     const uint32_t chunkPush = chunks;
-    const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2], common[3], common[4], common[5], slot[11], slot[12]};
-    const DeviceBuffer* scanChunks[] = {slot[11], slot[13]};
+    const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2], common[3], common[4], common[5], scratch.chunkSplats, scratch.chunkVisited};
+    const DeviceBuffer* scanChunks[] = {scratch.chunkSplats, scratch.chunkOffsets};
     CB_TRY(run("render_splat: counting splats", [&](VulkanContext::Recorder& r) {
         r.Dispatch(*pipes[0], countBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
         r.Dispatch(*pipes[1], scanChunks, &chunkPush, sizeof chunkPush, 1);
     }));
     std::vector<uint32_t> chunkOffsets(chunks + 1);
-    CB_TRY(mContext->Download(*slot[13], std::as_writable_bytes(std::span(chunkOffsets))));
+    CB_TRY(mContext->Download(*scratch.chunkOffsets, std::as_writable_bytes(std::span(chunkOffsets))));
     const uint32_t splatCount = chunkOffsets[chunks];
 
     // 2. Write the splats in order; bin them by screen tile, keeping the order.
     const uint32_t splatChunks = std::max(1u, CeilDiv(splatCount, kSplatsPerChunk));
-    CB_TRY(need(14, VkDeviceSize(splatCount) * 48));
-    CB_TRY(need(15, VkDeviceSize(splatChunks) * screenTiles * 4));
-    CB_TRY(need(16, VkDeviceSize(screenTiles) * 4));
-    CB_TRY(need(17, VkDeviceSize(screenTiles + 1) * 4));
+    CB_TRY(need(scratch.splats, VkScratch::Splats, VkDeviceSize(splatCount) * 48));
+    CB_TRY(need(scratch.binCounts, VkScratch::SplatBinCounts, VkDeviceSize(splatChunks) * screenTiles * 4));
+    CB_TRY(need(scratch.tileTotals, VkScratch::SplatTileTotals, VkDeviceSize(screenTiles) * 4));
+    CB_TRY(need(scratch.tileBases, VkScratch::SplatTileBases, VkDeviceSize(screenTiles + 1) * 4));
     struct {
         uint32_t mode, splatCount, chunkSize, chunks, tilesX, tilesY, tileSize;
     } bin{0, splatCount, kSplatsPerChunk, splatChunks, tilesX, tilesY, kTileSize};
-    const DeviceBuffer* writeBuffers[] = {common[0], common[1], common[2], common[3], common[4], common[5], slot[13], slot[14]};
+    const DeviceBuffer* writeBuffers[] = {common[0], common[1], common[2], common[3], common[4], common[5], scratch.chunkOffsets, scratch.splats};
     const uint32_t tilesPush = screenTiles;
-    const DeviceBuffer* scanTiles[] = {slot[16], slot[17]};
-    CB_TRY(need(18, 16));  // the list is sized below; binding 4 needs a buffer in the first passes
-    const DeviceBuffer* binBuffers[] = {slot[14], slot[15], slot[16], slot[17], slot[18]};
+    const DeviceBuffer* scanTiles[] = {scratch.tileTotals, scratch.tileBases};
+    // The list is sized in step 3; splat_bin's binding 4 needs a buffer in the first passes.
+    CB_TRY(need(scratch.tileList, VkScratch::SplatTileList, 16));
+    const DeviceBuffer* binBuffers[] = {scratch.splats, scratch.binCounts, scratch.tileTotals, scratch.tileBases, scratch.tileList};
     CB_TRY(run("render_splat: binning", [&](VulkanContext::Recorder& r) {
         r.Dispatch(*pipes[2], writeBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
@@ -441,16 +455,16 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         r.Dispatch(*pipes[1], scanTiles, &tilesPush, sizeof tilesPush, 1);
     }));
     std::vector<uint32_t> bases(screenTiles + 1);
-    CB_TRY(mContext->Download(*slot[17], std::as_writable_bytes(std::span(bases))));
+    CB_TRY(mContext->Download(*scratch.tileBases, std::as_writable_bytes(std::span(bases))));
 
     // 3. Fill the tile lists; composite every pixel.
-    CB_TRY(need(18, VkDeviceSize(bases[screenTiles]) * 4));
-    const DeviceBuffer* fillBuffers[] = {slot[14], slot[15], slot[16], slot[17], slot[18]};
+    CB_TRY(need(scratch.tileList, VkScratch::SplatTileList, VkDeviceSize(bases[screenTiles]) * 4));
+    const DeviceBuffer* fillBuffers[] = {scratch.splats, scratch.binCounts, scratch.tileTotals, scratch.tileBases, scratch.tileList};
     struct {
         uint32_t width, height, tilesX, tileSize;
         float background[4];
     } composite{W, H, tilesX, kTileSize, {p.background[0], p.background[1], p.background[2], 0}};
-    const DeviceBuffer* compositeBuffers[] = {slot[14], slot[17], slot[18], &Dev(image)};
+    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.tileList, &Dev(image)};
     CB_TRY(run("render_splat: compositing", [&](VulkanContext::Recorder& r) {
         bin.mode = 2;
         r.Dispatch(*pipes[3], fillBuffers, &bin, sizeof bin, splatChunks);
