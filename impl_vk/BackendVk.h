@@ -86,7 +86,7 @@ class BackendVk final : public Backend {
 
   private:
     explicit BackendVk(std::unique_ptr<VulkanContext> context) : mContext(std::move(context)) {}
-    // Records with `fn`, submits, waits and keeps the device time.
+    // Records with `fn`, submits, waits and keeps the device time (defined in StageVk.h).
     template <typename Fn>
     Status Record(const char* what, Fn&& fn);
     // The slot's buffer, grown to at least `size` bytes; its contents are undefined.
