@@ -26,6 +26,36 @@ class BufferVk final : public Buffer {
     DeviceBuffer mBuffer;
 };
 
+// The backend's reusable device buffers (BackendVk::Scratch). Each slot belongs
+// to one stage, keeps its contents only within a call and grows to the largest
+// size asked of it.
+enum class VkScratch {
+    EllipsoidList,      // region: the ellipsoids, 32 bytes each
+    RegionTileStarts,   // region: first RegionTileEntries index per 16x16 tile of a slice, and one past the end
+    RegionTileEntries,  // region: ellipsoid indices, tile by tile
+    CaRulesHum,         // ca: the rules' hum before advection (only with wind)
+    CaRulesAct,         // ca: the rules' act before advection (only with wind)
+    CaRulesCld,         // ca: the rules' cld before advection (only with wind)
+    CaWindShifts,       // ca: (shiftX, shiftY) per slice (only with wind)
+    SmoothSumX,         // smooth: the bit field summed along x
+    SmoothSumXY,        // smooth: those sums summed along y
+    CoverCounter,       // density: covered columns, one uint
+    ShadeCoarseQ,       // shade: q on the coarse grid (resolution 2 or 4)
+    ShadeCoarseT,       // shade: T on the coarse grid (resolution 2 or 4)
+    SplatFrame,         // render_splat: grid, camera and light (the shaders' Frame)
+    SplatOrder,         // render_splat: the flattened shared order
+    SplatBoxes,         // render_splat: visibility of each tile x band box, one byte each
+    SplatChunkSplats,   // render_splat: splats per chunk of ranks
+    SplatChunkVisited,  // render_splat: voxels visited per chunk of ranks
+    SplatChunkOffsets,  // render_splat: SplatChunkSplats scanned, and the total
+    Splats,             // render_splat: the splats in the shared order, 48 bytes each
+    SplatBinCounts,     // render_splat: splats per chunk x screen tile
+    SplatTileTotals,    // render_splat: splats per screen tile
+    SplatTileBases,     // render_splat: SplatTileTotals scanned, and the total
+    SplatTileList,      // render_splat: splat indices, screen tile by screen tile
+    Count
+};
+
 class BackendVk final : public Backend {
   public:
     // device: index, name substring or "" (first device); validation: Khronos layer on.
@@ -49,16 +79,17 @@ class BackendVk final : public Backend {
 
   private:
     explicit BackendVk(std::unique_ptr<VulkanContext> context) : mContext(std::move(context)) {}
+    // Records with `fn`, submits, waits and keeps the device time (defined in StageVk.h).
     template <typename Fn>
     Status Record(const char* what, Fn&& fn);
-    Result<DeviceBuffer*> Scratch(size_t slot, VkDeviceSize size);
+    // The slot's buffer, grown to at least `size` bytes; its contents are undefined.
+    Result<DeviceBuffer*> Scratch(VkScratch slot, VkDeviceSize size);
 
     std::unique_ptr<VulkanContext> mContext;
     std::optional<double> mLastDeviceMs;
-    // Reused between calls: 0 ellipsoids, 1-3 advection, 4 shifts, 5 cover
-    // counter, 6-7 coarse shading grids, 8-18 the splat renderer's buffers.
-    // A fixed array, so pointers to one slot stay valid while others grow.
-    std::array<DeviceBuffer, 23> mScratch{};
+    // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
+    // while others grow.
+    std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};
 };
 
 }  // namespace cb::vk

@@ -1,0 +1,86 @@
+// Stage `ca` (SPEC 3) on Vulkan: the initial state (ca_init.comp) and a step
+// (ca.comp, then advect.comp when any slice has wind).
+#include <cassert>
+#include <iterator>
+#include <vector>
+
+#include "impl_vk/StageVk.h"
+
+namespace cb::vk {
+namespace {
+
+// The scratch slot that holds field `field` (0 hum, 1 act, 2 cld, as in CaFields) of the rules' output.
+VkScratch CaRulesOutputSlot(size_t field) {
+    constexpr VkScratch kSlots[] = {VkScratch::CaRulesHum, VkScratch::CaRulesAct, VkScratch::CaRulesCld};
+    assert(field < std::size(kSlots));
+    return kSlots[field];
+}
+
+}  // namespace
+
+Status BackendVk::CaInitialize(const CaInitParams& params, CaFields out) {
+    const Extent3 e = out.hum->Extent();
+    auto pipeline = mContext->GetPipeline("ca_init", 3);
+    if (!pipeline) return std::unexpected(pipeline.error());
+    const uint32_t words = (e.nx + 31) / 32;
+    struct {
+        uint32_t nx, ny, nz, words, seed, qHum0, qAct0;
+    } push{e.nx, e.ny, e.nz, words, params.seed, params.qHum0, params.qAct0};
+    const DeviceBuffer* buffers[] = {&Dev(*out.hum), &Dev(*out.act), &Dev(*out.cld)};
+    return Record("ca initial state", [&](VulkanContext::Recorder& r) {
+        r.Dispatch(**pipeline, buffers, &push, sizeof push, words * e.ny * e.nz);
+    });
+}
+
+Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    const Extent3 e = in.hum->Extent();
+    const uint32_t words = (e.nx + 31) / 32;
+    const uint32_t count = words * e.ny * e.nz;
+    auto rules = mContext->GetPipeline("ca", 7);
+    if (!rules) return std::unexpected(rules.error());
+    bool wind = false;
+    for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
+
+    struct {
+        uint32_t nx, ny, nz, words, seed, step, qExt, qHum, qAct;
+    } push{e.nx, e.ny, e.nz, words, params.seed, params.step, params.qExt, params.qHum, params.qAct};
+    const DeviceBuffer* targets[3] = {&Dev(*out.hum), &Dev(*out.act), &Dev(*out.cld)};
+    Pipeline* advect = nullptr;
+    DeviceBuffer* shifts = nullptr;
+    if (wind) {
+        // The rules write into scratch; advection moves the result into `out`.
+        for (size_t f = 0; f < 3; ++f) {
+            auto s = Scratch(CaRulesOutputSlot(f), VkDeviceSize(count) * 4);
+            if (!s) return std::unexpected(s.error());
+            targets[f] = *s;
+        }
+        std::vector<int32_t> packed;
+        for (size_t k = 0; k < params.shiftX.size(); ++k) {
+            packed.push_back(params.shiftX[k]);
+            packed.push_back(params.shiftY[k]);
+        }
+        auto s = Scratch(VkScratch::CaWindShifts, packed.size() * 4);
+        if (!s) return std::unexpected(s.error());
+        shifts = *s;
+        CB_TRY(mContext->Upload(*shifts, std::as_bytes(std::span(packed))));
+        auto p = mContext->GetPipeline("advect", 7);
+        if (!p) return std::unexpected(p.error());
+        advect = *p;
+    }
+    const DeviceBuffer* buffers[] = {&Dev(*in.hum), &Dev(*in.act), &Dev(*in.cld), &Dev(region),
+                                     targets[0],    targets[1],    targets[2]};
+    return Record("ca step", [&](VulkanContext::Recorder& r) {
+        r.Dispatch(**rules, buffers, &push, sizeof push, count);
+        if (advect) {
+            r.Barrier();
+            struct {
+                uint32_t nx, ny, nz, words;
+            } advectPush{e.nx, e.ny, e.nz, words};
+            const DeviceBuffer* advectBuffers[] = {targets[0],     targets[1],     targets[2], &Dev(*out.hum),
+                                                   &Dev(*out.act), &Dev(*out.cld), shifts};
+            r.Dispatch(*advect, advectBuffers, &advectPush, sizeof advectPush, count);
+        }
+    });
+}
+
+}  // namespace cb::vk

@@ -1,0 +1,34 @@
+// Stage `shadow` (SPEC 7) on Vulkan: shadow.comp, one invocation per column.
+#include "impl_vk/StageVk.h"
+
+namespace cb::vk {
+
+Status BackendVk::Shadow(const ShadowParams& params, const Buffer& columnSum, Buffer& G) {
+    const Extent3 e = columnSum.Extent();
+    auto pipeline = mContext->GetPipeline("shadow", 2);
+    if (!pipeline) return std::unexpected(pipeline.error());
+    const ShadowLookup l = MakeShadowLookup(params.sun, e.nx, e.ny, params.nz, params.sigma, params.voxelSize);
+    struct {
+        uint32_t nx, ny;
+        int32_t bx, by;
+        float fx, fy;
+        uint32_t beer;
+        float opticalDepthPerD, kappa;
+        uint32_t noSun;
+    } push{e.nx,
+           e.ny,
+           l.baseX,
+           l.baseY,
+           l.fx,
+           l.fy,
+           params.form == AttenuationKind::Beer ? 1u : 0u,
+           l.opticalDepthPerD,
+           params.kappa,
+           l.noSun ? 1u : 0u};
+    const DeviceBuffer* buffers[] = {&Dev(columnSum), &Dev(G)};
+    return Record("shadow", [&](VulkanContext::Recorder& r) {
+        r.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny);
+    });
+}
+
+}  // namespace cb::vk
