@@ -18,8 +18,7 @@
 #include <string_view>
 #include <utility>
 
-#include <nlohmann/json.hpp>
-
+#include "core/JsonDom.h"
 #include "core/SceneMemory.h"
 
 namespace cb {
@@ -27,8 +26,10 @@ namespace {
 
 using scene_io::PhysicalMemoryBytes;
 
-// ordered_json keeps the file's key order, so errors come out in reading order.
-using Json = nlohmann::ordered_json;
+using scene_io::IndexField;
+using scene_io::JoinField;
+using scene_io::Json;
+using scene_io::JsonDom;
 
 constexpr int64_t kU32Max = std::numeric_limits<uint32_t>::max();
 constexpr int64_t kI32Min = std::numeric_limits<int32_t>::min();
@@ -73,15 +74,6 @@ std::string Quote(std::string_view text) {
     quoted.reserve(text.size() + 2);
     quoted.append(1, '"').append(text).append(1, '"');
     return quoted;
-}
-
-std::string JoinField(std::string_view parent, std::string_view key) {
-    if (parent.empty()) return std::string(key);
-    return std::string(parent) + "." + std::string(key);
-}
-
-std::string IndexField(std::string_view parent, size_t index) {
-    return std::string(parent) + "[" + std::to_string(index) + "]";
 }
 
 // Case-insensitive edit distance, for "did you mean" suggestions.
@@ -134,115 +126,6 @@ std::string FormatGiB(uint64_t bytes) {
     char buffer[64];
     std::snprintf(buffer, sizeof(buffer), "%.1f", double(bytes) / double(uint64_t(1) << 30));
     return buffer;
-}
-
-// ---- JSON parsing --------------------------------------------------------------------------------------------
-
-// Builds the document like nlohmann's own DOM parser, but keeps the byte
-// position of a failure (also for number overflow, which json::parse reports
-// without one) and refuses duplicate keys instead of silently keeping the last.
-class DomBuilder final : public nlohmann::json_sax<Json> {
-  public:
-    explicit DomBuilder(Json& root) : mRoot(root) {}
-
-    bool null() override { return Put(nullptr); }
-    bool boolean(bool value) override { return Put(value); }
-    bool number_integer(number_integer_t value) override { return Put(value); }
-    bool number_unsigned(number_unsigned_t value) override { return Put(value); }
-    bool number_float(number_float_t value, const string_t&) override { return Put(value); }
-    bool string(string_t& value) override { return Put(std::move(value)); }
-    bool binary(binary_t& value) override { return Put(Json::binary(std::move(value))); }
-    bool start_object(std::size_t) override { return Open(Json::object()); }
-    bool start_array(std::size_t) override { return Open(Json::array()); }
-    bool end_object() override { return Close(); }
-    bool end_array() override { return Close(); }
-
-    bool key(string_t& name) override {
-        Frame& top = mStack.back();
-        if (top.node->contains(name)) mDuplicates.push_back(JoinField(top.field, name));
-        top.key = std::move(name);
-        return true;
-    }
-
-    bool parse_error(std::size_t position, const std::string& lastToken, const Json::exception& error) override {
-        mErrorPosition = position;
-        mErrorToken = lastToken;
-        mErrorId = error.id;
-        mErrorText = error.what();
-        return false;
-    }
-
-    // Set after a failed parse: byte count read when it failed (1-based), nlohmann's id and text.
-    size_t mErrorPosition = 0;
-    std::string mErrorToken;
-    int mErrorId = 0;
-    std::string mErrorText;
-    std::vector<std::string> mDuplicates;  // dotted fields of repeated keys
-
-  private:
-    struct Frame {
-        Json* node;
-        std::string field;  // dotted path of `node`
-        std::string key;    // last key read, when `node` is an object
-    };
-
-    // Stores `value` at the current position; returns its place and field path.
-    std::pair<Json*, std::string> Place(Json value) {
-        if (mStack.empty()) {
-            mRoot = std::move(value);
-            return {&mRoot, ""};
-        }
-        Frame& top = mStack.back();
-        if (top.node->is_array()) {
-            top.node->push_back(std::move(value));
-            return {&top.node->back(), IndexField(top.field, top.node->size() - 1)};
-        }
-        Json& slot = (*top.node)[top.key];
-        slot = std::move(value);
-        return {&slot, JoinField(top.field, top.key)};
-    }
-
-    bool Put(Json value) {
-        Place(std::move(value));
-        return true;
-    }
-
-    bool Open(Json container) {
-        auto [node, field] = Place(std::move(container));
-        mStack.push_back(Frame{node, std::move(field), {}});
-        return true;
-    }
-
-    bool Close() {
-        mStack.pop_back();
-        return true;
-    }
-
-    Json& mRoot;
-    std::vector<Frame> mStack;
-};
-
-// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix.
-std::string ShortReason(const std::string& what) {
-    std::string text = what;
-    if (size_t p = text.find("] "); p != std::string::npos) text = text.substr(p + 2);
-    if (text.starts_with("parse error")) {
-        if (size_t p = text.find(": "); p != std::string::npos) text = text.substr(p + 2);
-    }
-    return text;
-}
-
-// "line L, column C" (1-based) of the character at byte `position` - 1 of `text`.
-std::string LineColumn(std::string_view text, size_t position) {
-    const size_t offset = std::min(position == 0 ? 0 : position - 1, text.size());
-    size_t line = 1, lineStart = 0;
-    for (size_t i = 0; i < offset; ++i) {
-        if (text[i] == '\n') {
-            ++line;
-            lineStart = i + 1;
-        }
-    }
-    return "line " + std::to_string(line) + ", column " + std::to_string(offset - lineStart + 1);
 }
 
 // ---- Validation ----------------------------------------------------------------------------------------------
@@ -503,16 +386,14 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
     }
 
     // The value is JSON text; anything that does not parse is taken as a string.
-    Json value;
-    DomBuilder builder(value);
-    const bool parsed = Json::sax_parse(item.value, &builder);
-    if (!parsed && builder.mErrorId == 406) {
+    JsonDom parsed = scene_io::ParseJsonDom(item.value);
+    if (parsed.failure && parsed.failure->IsNumberOverflow()) {
         // Number overflow (1e999) is a number, not a bare word: refuse it rather than take it as a string.
         check.MarkOverridden(item.path);
-        check.Fail(item.path, "the number " + builder.mErrorToken + " is out of range (not finite)");
+        check.Fail(item.path, "the number " + parsed.failure->token + " is out of range (not finite)");
         return;
     }
-    if (!parsed) value = item.value;
+    Json value = parsed.failure ? Json(item.value) : std::move(parsed.root);
 
     Json* node = &root;
     std::string prefix;
@@ -530,8 +411,8 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
     }
     (*node)[keys.back()] = std::move(value);
     check.MarkOverridden(item.path);
-    if (parsed) {
-        for (const std::string& duplicate : builder.mDuplicates)
+    if (!parsed.failure) {
+        for (const std::string& duplicate : parsed.duplicates)
             check.Fail(JoinField(item.path, duplicate), "duplicate field");
     }
 }
@@ -1116,22 +997,13 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
 Result<Scene> ParseSceneChecked(const std::string& text, const std::string& label,
                                 const std::vector<SceneOverride>& overrides) {
     Validator check(label);
-    Json root;
-    DomBuilder builder(root);
-    if (!Json::sax_parse(text, &builder)) {
-        if (builder.mErrorId == 406) {
-            // Number overflow: the position is the token's last character; point at its first.
-            const size_t length = builder.mErrorToken.size();
-            const size_t start = builder.mErrorPosition > length ? builder.mErrorPosition - length + 1 : 1;
-            check.FailWhole(LineColumn(text, start) + ": the number " + builder.mErrorToken +
-                            " is out of range (not finite)");
-        } else {
-            check.FailWhole(LineColumn(text, builder.mErrorPosition) + ": malformed JSON: " +
-                            ShortReason(builder.mErrorText));
-        }
+    JsonDom dom = scene_io::ParseJsonDom(text);
+    if (dom.failure) {
+        check.FailWhole(scene_io::DescribeParseFailure(text, *dom.failure));
         return MakeError(check.Message());
     }
-    for (const std::string& duplicate : builder.mDuplicates) check.Fail(duplicate, "duplicate field");
+    Json& root = dom.root;
+    for (const std::string& duplicate : dom.duplicates) check.Fail(duplicate, "duplicate field");
     if (!root.is_object()) {
         check.FailWhole("expected a JSON object at the top level, got " + Describe(root));
         return MakeError(check.Message());
