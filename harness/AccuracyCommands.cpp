@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/Npy.h"
+#include "core/SceneNames.h"
 #include "harness/Accuracy.h"
 #include "harness/Commands.h"
 #include "harness/Simulation.h"
@@ -319,18 +320,20 @@ std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage
         for (const char* v : values)
             if (current != v) out.push_back({{path, v}});
     };
+    // A choice's names come from the scene's own table (core/SceneNames.h), in its order.
+    auto addNames = [&](const char* path, const auto& names, auto current) {
+        for (const auto& [name, value] : names)
+            if (value != current) out.push_back({{path, std::string(name)}});
+    };
     if (stage == Stage::Shade) {
         const ShadeSettings& s = scene.shade;
-        add("shade.attenuation", {"beer", "thesis"}, s.attenuation == AttenuationKind::Beer ? "beer" : "thesis");
-        add("shade.filter", {"bilinear", "nearest"}, s.filter == SampleFilter::Bilinear ? "bilinear" : "nearest");
+        addNames("shade.attenuation", kAttenuationKindNames, s.attenuation);
+        addNames("shade.filter", kSampleFilterNames, s.filter);
         add("shade.resolution", {"1", "2", "4"}, std::to_string(s.resolution));
-        add("shade.storage", {"fp32", "fp16", "unorm8"},
-            s.storage == StorageFormat::Fp32   ? "fp32"
-            : s.storage == StorageFormat::Fp16 ? "fp16"
-                                               : "unorm8");
+        addNames("shade.storage", kStorageFormatNames, s.storage);
         add("shade.scattering.enabled", {"false", "true"}, s.scattering ? "true" : "false");
     } else {
-        add("shadow.form", {"beer", "thesis"}, scene.shadow.form == AttenuationKind::Beer ? "beer" : "thesis");
+        addNames("shadow.form", kAttenuationKindNames, scene.shadow.form);
     }
     return out;
 }

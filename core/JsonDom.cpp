@@ -1,0 +1,134 @@
+#include "core/JsonDom.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace cb::scene_io {
+namespace {
+
+// Builds the document like nlohmann's own DOM parser, recording each value's
+// field path (for duplicate keys) and the details of a failure.
+class DomBuilder final : public nlohmann::json_sax<Json> {
+  public:
+    explicit DomBuilder(JsonDom& dom) : mDom(dom) {}
+
+    bool null() override { return Put(nullptr); }
+    bool boolean(bool value) override { return Put(value); }
+    bool number_integer(number_integer_t value) override { return Put(value); }
+    bool number_unsigned(number_unsigned_t value) override { return Put(value); }
+    bool number_float(number_float_t value, const string_t&) override { return Put(value); }
+    bool string(string_t& value) override { return Put(std::move(value)); }
+    bool binary(binary_t& value) override { return Put(Json::binary(std::move(value))); }
+    bool start_object(std::size_t) override { return Open(Json::object()); }
+    bool start_array(std::size_t) override { return Open(Json::array()); }
+    bool end_object() override { return Close(); }
+    bool end_array() override { return Close(); }
+
+    bool key(string_t& name) override {
+        Frame& top = mStack.back();
+        if (top.node->contains(name)) mDom.duplicates.push_back(JoinField(top.field, name));
+        top.key = std::move(name);
+        return true;
+    }
+
+    bool parse_error(std::size_t position, const std::string& lastToken, const Json::exception& error) override {
+        mDom.failure = JsonParseFailure{position, lastToken, error.id, error.what()};
+        return false;
+    }
+
+  private:
+    struct Frame {
+        Json* node;
+        std::string field;  // dotted path of `node`
+        std::string key;    // last key read, when `node` is an object
+    };
+
+    // Stores `value` at the current position; returns its place and field path.
+    std::pair<Json*, std::string> Place(Json value) {
+        if (mStack.empty()) {
+            mDom.root = std::move(value);
+            return {&mDom.root, ""};
+        }
+        Frame& top = mStack.back();
+        if (top.node->is_array()) {
+            top.node->push_back(std::move(value));
+            return {&top.node->back(), IndexField(top.field, top.node->size() - 1)};
+        }
+        Json& slot = (*top.node)[top.key];
+        slot = std::move(value);
+        return {&slot, JoinField(top.field, top.key)};
+    }
+
+    bool Put(Json value) {
+        Place(std::move(value));
+        return true;
+    }
+
+    bool Open(Json container) {
+        auto [node, field] = Place(std::move(container));
+        mStack.push_back(Frame{node, std::move(field), {}});
+        return true;
+    }
+
+    bool Close() {
+        mStack.pop_back();
+        return true;
+    }
+
+    JsonDom& mDom;
+    std::vector<Frame> mStack;
+};
+
+// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix.
+std::string ShortReason(const std::string& what) {
+    std::string text = what;
+    if (size_t p = text.find("] "); p != std::string::npos) text = text.substr(p + 2);
+    if (text.starts_with("parse error")) {
+        if (size_t p = text.find(": "); p != std::string::npos) text = text.substr(p + 2);
+    }
+    return text;
+}
+
+// "line L, column C" (1-based) of the character at byte `position` - 1 of `text`.
+std::string LineColumn(std::string_view text, size_t position) {
+    const size_t offset = std::min(position == 0 ? 0 : position - 1, text.size());
+    size_t line = 1, lineStart = 0;
+    for (size_t i = 0; i < offset; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            lineStart = i + 1;
+        }
+    }
+    return "line " + std::to_string(line) + ", column " + std::to_string(offset - lineStart + 1);
+}
+
+}  // namespace
+
+std::string JoinField(std::string_view parent, std::string_view key) {
+    if (parent.empty()) return std::string(key);
+    return std::string(parent) + "." + std::string(key);
+}
+
+std::string IndexField(std::string_view parent, size_t index) {
+    return std::string(parent) + "[" + std::to_string(index) + "]";
+}
+
+JsonDom ParseJsonDom(const std::string& text) {
+    JsonDom dom;
+    DomBuilder builder(dom);
+    // Every refusal goes through parse_error; the fallback only keeps "not JSON" from reading as success.
+    if (!Json::sax_parse(text, &builder) && !dom.failure) dom.failure = JsonParseFailure{};
+    return dom;
+}
+
+std::string DescribeParseFailure(std::string_view text, const JsonParseFailure& failure) {
+    if (failure.IsNumberOverflow()) {
+        // nlohmann's position is the token's last character; point at its first.
+        const size_t length = failure.token.size();
+        const size_t start = failure.position > length ? failure.position - length + 1 : 1;
+        return LineColumn(text, start) + ": the number " + failure.token + " is out of range (not finite)";
+    }
+    return LineColumn(text, failure.position) + ": malformed JSON: " + ShortReason(failure.what);
+}
+
+}  // namespace cb::scene_io

@@ -1,0 +1,47 @@
+// JSON text -> document, for the scene loader. Unlike json::parse it keeps
+// where a failure happened (also for number overflow, which json::parse reports
+// without a position) and refuses duplicate keys instead of silently keeping the
+// last one. Internal to core: it exposes nlohmann, which core links privately.
+#pragma once
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cb::scene_io {
+
+// ordered_json keeps the file's key order, so errors come out in reading order.
+using Json = nlohmann::ordered_json;
+
+// Dotted field paths as errors spell them: JoinField("ca", "seed") is "ca.seed"
+// (just "seed" under an empty parent), IndexField("stages", 2) is "stages[2]".
+std::string JoinField(std::string_view parent, std::string_view key);
+std::string IndexField(std::string_view parent, size_t index);
+
+// Why the text is not JSON, as nlohmann's parser reported it.
+struct JsonParseFailure {
+    size_t position = 0;  // bytes read when it failed (1-based)
+    std::string token;    // the last token read
+    int id = 0;           // nlohmann's error id
+    std::string what;     // nlohmann's message
+
+    // A number beyond the range of a double, such as 1e999.
+    bool IsNumberOverflow() const { return id == 406; }
+};
+
+struct JsonDom {
+    Json root;                                // partial when `failure` is set
+    std::optional<JsonParseFailure> failure;  // set when the text is not JSON
+    std::vector<std::string> duplicates;      // dotted fields of repeated keys, in reading order
+};
+
+JsonDom ParseJsonDom(const std::string& text);
+
+// "line L, column C: reason" for a failure of ParseJsonDom(text); an overflowing
+// number is pointed at by its first character.
+std::string DescribeParseFailure(std::string_view text, const JsonParseFailure& failure);
+
+}  // namespace cb::scene_io

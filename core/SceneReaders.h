@@ -1,0 +1,44 @@
+// One reader per section of a scene file (docs/scenes.md). Each reads its
+// section from the document root into its settings, which hold the defaults on
+// entry; a field that is wrong is reported into `check` and leaves its default.
+// Internal to core (see core/JsonDom.h).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "core/Scene.h"
+#include "core/SceneValidator.h"
+
+namespace cb::scene_io {
+
+inline constexpr int64_t kU32Max = std::numeric_limits<uint32_t>::max();
+
+// The whole scene after parsing and overrides: every section, then the size checks.
+void ReadScene(const Json& root, const std::string& label, Validator& check, Scene& scene);
+
+// Simulation sections (core/SceneReaders.cpp).
+
+// Returns true when grid.size is present and valid.
+bool ReadGrid(const Json& root, Validator& check, GridSettings& grid);
+// The default stage list when absent; dependencies are checked only on a clean list.
+void ReadStages(const Json& root, Validator& check, StageSet& stages);
+// `nz` is the grid's when known; the wind shift stays as written (one pair or nz pairs).
+void ReadCa(const Json& root, Validator& check, std::optional<uint32_t> nz, CaSettings& ca);
+void ReadEllipsoids(const Json& root, Validator& check, EllipsoidSettings& ellipsoids);
+void ReadSmooth(const Json& root, Validator& check, SmoothSettings& smooth);
+void ReadDensity(const Json& root, Validator& check, DensitySettings& density);
+
+// Lighting and rendering sections (core/SceneRenderReaders.cpp).
+
+void ReadSun(const Json& root, Validator& check, SunSettings& sun);
+void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting);
+void ReadPhase(const Json& root, Validator& check, PhaseParams& phase);
+void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
+void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow);
+// Returns false when render.cameras was given but is wrong (so "needs a camera" is not piled on).
+bool ReadRender(const Json& root, Validator& check, RenderSettings& render);
+
+}  // namespace cb::scene_io

@@ -1,0 +1,260 @@
+// Readers of the lighting and rendering sections (sun, lighting, phase, shade,
+// shadow, render with its cameras).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string_view>
+#include <utility>
+
+#include "core/SceneNames.h"
+#include "core/SceneReaders.h"
+
+namespace cb::scene_io {
+namespace {
+
+constexpr std::string_view kSunKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
+constexpr std::string_view kPhaseKeys[] = {"function", "g"};
+constexpr std::string_view kShadeKeys[] = {"attenuation", "sigma",   "thesis_ar", "filter",
+                                           "resolution",  "storage", "scattering"};
+constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angle"};
+constexpr std::string_view kShadowKeys[] = {"form", "kappa"};
+constexpr std::string_view kRenderKeys[] = {"width", "height",  "q_min",    "splat_scale", "opacity",
+                                            "alpha", "culling", "skipping", "every_steps", "cameras"};
+constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
+
+constexpr int64_t kShadeResolutions[] = {1, 2, 4};
+constexpr int64_t kMaxImageEdge = 16384;
+
+// One entry of render.cameras; nullopt when anything in it is wrong (all of it reported).
+std::optional<CameraSettings> ReadCamera(const Json& value, const std::string& field, size_t index, Validator& check) {
+    if (!value.is_object()) {
+        check.Fail(field, "expected a camera object, got " + Describe(value));
+        return std::nullopt;
+    }
+    const size_t errorsBefore = check.ErrorCount();
+    check.CheckKeys(value, field, kCameraKeys);
+    auto find = [&](std::string_view key) { return Validator::Find(value, key); };
+    auto sub = [&](std::string_view key) { return JoinField(field, key); };
+
+    CameraSettings camera;
+    camera.name = "view" + std::to_string(index);
+    if (const Json* v = find("name")) {
+        if (auto s = check.String(*v, sub("name"))) {
+            if (s->empty())
+                check.Fail(sub("name"), "must not be empty");
+            else
+                camera.name = *s;
+        }
+    }
+    std::optional<std::array<double, 3>> eye, target;
+    if (const Json* v = find("eye")) {
+        eye = check.Numbers<3>(*v, sub("eye"), kFinite);
+    } else {
+        check.Fail(sub("eye"), "required field is missing");
+    }
+    if (const Json* v = find("target")) {
+        target = check.Numbers<3>(*v, sub("target"), kFinite);
+    } else {
+        check.Fail(sub("target"), "required field is missing");
+    }
+    if (eye && target && *eye == *target) check.Fail(sub("target"), "must differ from eye");
+    if (eye) camera.eye = *eye;
+    if (target) camera.target = *target;
+    if (const Json* v = find("up")) {
+        if (auto a = check.Numbers<3>(*v, sub("up"), kFinite)) {
+            if ((*a)[0] == 0 && (*a)[1] == 0 && (*a)[2] == 0)
+                check.Fail(sub("up"), "must not be all zero, got " + Describe(*v));
+            else
+                camera.up = *a;
+        }
+    }
+    if (const Json* v = find("fov_deg")) {
+        const Range fov{.lo = 0, .loOpen = true, .hi = 180, .hiOpen = true};
+        if (auto d = check.Number(*v, sub("fov_deg"), fov)) camera.fovDeg = *d;
+    }
+    // far must exceed near; the message names whichever of the two the file gave (far when both).
+    bool nearOk = true, farOk = true;
+    if (const Json* v = find("near")) {
+        auto d = check.Number(*v, sub("near"), kPositive);
+        if (d) camera.nearPlane = *d;
+        nearOk = d.has_value();
+    }
+    const Json* far = find("far");
+    if (far) {
+        auto d = check.Number(*far, sub("far"), kFinite);
+        if (d) camera.farPlane = *d;
+        farOk = d.has_value();
+    }
+    if (nearOk && farOk && camera.farPlane <= camera.nearPlane) {
+        if (far)
+            check.Fail(sub("far"),
+                       "must be > near (" + FormatNumber(camera.nearPlane) + "), got " + FormatNumber(camera.farPlane));
+        else
+            check.Fail(sub("near"),
+                       "must be < far (" + FormatNumber(camera.farPlane) + "), got " + FormatNumber(camera.nearPlane));
+    }
+    if (check.ErrorCount() != errorsBefore) return std::nullopt;
+    return camera;
+}
+
+}  // namespace
+
+void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
+    const Json* section = check.Section(root, "", "sun", kSunKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "elevation_deg")) {
+        if (auto d = check.Number(*v, "sun.elevation_deg", Range{.lo = -90, .hi = 90})) sun.elevationDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "azimuth_deg")) {
+        if (auto d = check.Number(*v, "sun.azimuth_deg", kFinite)) sun.azimuthDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "color")) {
+        if (auto a = check.Numbers<3>(*v, "sun.color", kNonNegative)) sun.color = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "intensity")) {
+        if (auto d = check.Number(*v, "sun.intensity", kNonNegative)) sun.intensity = *d;
+    }
+}
+
+void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting) {
+    const Json* section = check.Section(root, "", "lighting", kLightingKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "ambient")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.ambient", kNonNegative)) lighting.ambient = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "background")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.background", kNonNegative)) lighting.background = *a;
+    }
+}
+
+void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
+    const Json* section = check.Section(root, "", "phase", kPhaseKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "function")) {
+        if (auto kind = check.Choice(*v, "phase.function", kPhaseKindNames)) phase.kind = *kind;
+    }
+    if (const Json* v = Validator::Find(*section, "g")) {
+        if (auto d = check.Number(*v, "phase.g", Range{.lo = -1, .loOpen = true, .hi = 1, .hiOpen = true})) {
+            // g is kept as a float: a value within 2^-25 of +-1 would become +-1 there.
+            if (std::fabs(float(*d)) >= 1.0f)
+                check.Fail("phase.g", "must be in (-1, 1) in single precision, got " + Describe(*v));
+            else
+                phase.g = float(*d);
+        }
+    }
+}
+
+void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
+    const Json* section = check.Section(root, "", "shade", kShadeKeys);
+    if (!section) return;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    if (const Json* v = find("attenuation")) {
+        if (auto kind = check.Choice(*v, "shade.attenuation", kAttenuationKindNames)) shade.attenuation = *kind;
+    }
+    if (const Json* v = find("sigma")) {
+        if (auto d = check.Number(*v, "shade.sigma", kNonNegative)) shade.sigma = *d;
+    }
+    if (const Json* v = find("thesis_ar")) {
+        if (auto d = check.Number(*v, "shade.thesis_ar", kProbability)) shade.thesisAr = *d;
+    }
+    if (const Json* v = find("filter")) {
+        if (auto filter = check.Choice(*v, "shade.filter", kSampleFilterNames)) shade.filter = *filter;
+    }
+    if (const Json* v = find("resolution")) {
+        if (auto n = check.IntegerChoice(*v, "shade.resolution", kShadeResolutions, "1, 2 or 4"))
+            shade.resolution = int(*n);
+    }
+    if (const Json* v = find("storage")) {
+        if (auto format = check.Choice(*v, "shade.storage", kStorageFormatNames)) shade.storage = *format;
+    }
+    const Json* scattering = check.Section(*section, "shade", "scattering", kScatteringKeys);
+    if (!scattering) return;
+    if (const Json* v = Validator::Find(*scattering, "enabled")) {
+        if (auto b = check.Boolean(*v, "shade.scattering.enabled")) shade.scattering = *b;
+    }
+    if (const Json* v = Validator::Find(*scattering, "albedo")) {
+        if (auto d = check.Number(*v, "shade.scattering.albedo", kProbability)) shade.albedo = *d;
+    }
+    if (const Json* v = Validator::Find(*scattering, "solid_angle")) {
+        const Range solidAngle{.lo = 0, .loOpen = true, .hi = 4 * std::numbers::pi};
+        if (auto d = check.Number(*v, "shade.scattering.solid_angle", solidAngle)) shade.solidAngle = *d;
+    }
+}
+
+void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
+    const Json* section = check.Section(root, "", "shadow", kShadowKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "form")) {
+        if (auto kind = check.Choice(*v, "shadow.form", kAttenuationKindNames)) shadow.form = *kind;
+    }
+    if (const Json* v = Validator::Find(*section, "kappa")) {
+        if (auto d = check.Number(*v, "shadow.kappa", kNonNegative)) shadow.kappa = *d;
+    }
+}
+
+bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
+    const Json* section = check.Section(root, "", "render", kRenderKeys);
+    if (!section) return true;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    auto field = [](std::string_view key) { return JoinField("render", key); };
+
+    if (const Json* v = find("width")) {
+        if (auto n = check.Integer(*v, field("width"), 1, kMaxImageEdge)) render.width = uint32_t(*n);
+    }
+    if (const Json* v = find("height")) {
+        if (auto n = check.Integer(*v, field("height"), 1, kMaxImageEdge)) render.height = uint32_t(*n);
+    }
+    if (const Json* v = find("q_min")) {
+        if (auto d = check.Number(*v, field("q_min"), kNonNegative)) render.qMin = *d;
+    }
+    if (const Json* v = find("splat_scale")) {
+        if (auto d = check.Number(*v, field("splat_scale"), kPositive)) render.splatScale = *d;
+    }
+    if (const Json* v = find("opacity")) {
+        if (auto d = check.Number(*v, field("opacity"), kProbability)) render.opacity = *d;
+    }
+    if (const Json* v = find("alpha")) {
+        if (auto d = check.Number(*v, field("alpha"), kProbability)) render.alpha = *d;
+    }
+    if (const Json* v = find("culling")) {
+        if (auto b = check.Boolean(*v, field("culling"))) render.culling = *b;
+    }
+    if (const Json* v = find("skipping")) {
+        if (auto b = check.Boolean(*v, field("skipping"))) render.skipping = *b;
+    }
+    if (const Json* v = find("every_steps")) {
+        if (auto n = check.Integer(*v, field("every_steps"), 0, kU32Max)) render.everySteps = uint32_t(*n);
+    }
+
+    const Json* cameras = find("cameras");
+    if (!cameras) return true;
+    if (!cameras->is_array()) {
+        check.Fail(field("cameras"), "expected an array of camera objects, got " + Describe(*cameras));
+        return false;
+    }
+    bool allOk = true;
+    render.cameras.clear();
+    for (size_t i = 0; i < cameras->size(); ++i) {
+        const std::string cameraField = IndexField(field("cameras"), i);
+        std::optional<CameraSettings> camera = ReadCamera((*cameras)[i], cameraField, i, check);
+        if (!camera) {
+            allOk = false;
+            continue;
+        }
+        const bool duplicate = std::any_of(render.cameras.begin(), render.cameras.end(),
+                                           [&](const CameraSettings& c) { return c.name == camera->name; });
+        if (duplicate) {
+            // A defaulted name ("view1") can clash with a name given earlier; say so, since the file has no name here.
+            const bool given = Validator::Find((*cameras)[i], "name") != nullptr;
+            check.Fail(JoinField(cameraField, "name"),
+                       "duplicate camera name " + Quote(camera->name) + (given ? "" : " (its default name)"));
+            allOk = false;
+            continue;
+        }
+        render.cameras.push_back(std::move(*camera));
+    }
+    return allOk;
+}
+
+}  // namespace cb::scene_io

@@ -1,0 +1,290 @@
+#include "core/SceneValidator.h"
+
+#include <charconv>
+#include <cmath>
+#include <system_error>
+
+namespace cb::scene_io {
+namespace {
+
+constexpr size_t kMaxShownChars = 60;  // longest value text quoted in an error
+
+// Case-insensitive edit distance, for "did you mean" suggestions.
+size_t EditDistance(std::string_view a, std::string_view b) {
+    auto lower = [](char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; };
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const size_t above = row[j];
+            const size_t substitute = diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
+            row[j] = std::min({above + 1, row[j - 1] + 1, substitute});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+}  // namespace
+
+std::string FormatNumber(double value) {
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char buffer[64];
+    // Whole numbers below 1e15 are written out ("100000", not the shorter "1e+05").
+    const bool whole = value == std::floor(value) && std::fabs(value) < 1e15;
+    auto [end, ec] = whole ? std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::fixed)
+                           : std::to_chars(buffer, buffer + sizeof(buffer), value);
+    if (ec != std::errc()) return "?";
+    return std::string(buffer, end);
+}
+
+std::string Describe(const Json& value) {
+    std::string text;
+    if (value.is_number_float()) {
+        text = FormatNumber(value.get<double>());
+    } else {
+        text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
+    }
+    if (text.size() > kMaxShownChars) text = text.substr(0, kMaxShownChars - 3) + "...";
+    return text;
+}
+
+std::string Quote(std::string_view text) {
+    // Built with append rather than operator+: GCC 12 raises a false -Wrestrict
+    // on "literal" + std::string (GCC bug 105651).
+    std::string quoted;
+    quoted.reserve(text.size() + 2);
+    quoted.append(1, '"').append(text).append(1, '"');
+    return quoted;
+}
+
+std::string Suggestion(std::string_view name, std::span<const std::string_view> known) {
+    // A name that one known name starts with ("fov" for "fov_deg") is a shortening, not a misspelling.
+    if (name.size() >= 3) {
+        std::string_view extended;
+        size_t matches = 0;
+        for (std::string_view candidate : known) {
+            if (candidate.size() > name.size() && EditDistance(candidate.substr(0, name.size()), name) == 0) {
+                extended = candidate;
+                ++matches;
+            }
+        }
+        if (matches == 1) return " (did you mean " + Quote(extended) + "?)";
+    }
+    std::string_view best;
+    size_t bestDistance = std::numeric_limits<size_t>::max();
+    for (std::string_view candidate : known) {
+        const size_t d = EditDistance(name, candidate);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = candidate;
+        }
+    }
+    // Close means at most two edits, and fewer edits than the shorter name has letters.
+    if (best.empty() || bestDistance > 2 || bestDistance >= std::min(name.size(), best.size())) return "";
+    return " (did you mean " + Quote(best) + "?)";
+}
+
+// ---- Validator ------------------------------------------------------------------------------------------------
+
+void Validator::Fail(std::string_view field, std::string_view reason) {
+    std::string line = mLabel + ": " + std::string(field) + ": " + std::string(reason);
+    if (IsOverridden(field)) line += " (set on the command line)";
+    mErrors.push_back(std::move(line));
+}
+
+std::string Validator::Message() const {
+    std::string message;
+    for (const std::string& line : mErrors) {
+        if (!message.empty()) message += '\n';
+        message += line;
+    }
+    return message;
+}
+
+void Validator::CheckKeys(const Json& object, std::string_view field, std::span<const std::string_view> known) {
+    for (const auto& [key, value] : object.items()) {
+        if (std::find(known.begin(), known.end(), key) == known.end())
+            Fail(JoinField(field, key), "unknown field" + Suggestion(key, known));
+    }
+}
+
+const Json* Validator::Find(const Json& object, std::string_view key) {
+    auto it = object.find(std::string(key));
+    return it == object.end() ? nullptr : &*it;
+}
+
+const Json* Validator::Section(const Json& parent, std::string_view parentField, std::string_view key,
+                               std::span<const std::string_view> known) {
+    const Json* section = Find(parent, key);
+    if (!section) return nullptr;
+    const std::string field = JoinField(parentField, key);
+    if (!section->is_object()) {
+        Fail(field, "expected an object, got " + Describe(*section));
+        return nullptr;
+    }
+    CheckKeys(*section, field, known);
+    return section;
+}
+
+std::optional<int64_t> Validator::Integer(const Json& value, std::string_view field, int64_t lo, int64_t hi) {
+    int64_t result = 0;
+    bool inRange = true;
+    if (value.is_number_unsigned()) {
+        const uint64_t u = value.get<uint64_t>();
+        inRange = u <= uint64_t(std::numeric_limits<int64_t>::max());
+        result = inRange ? int64_t(u) : 0;
+    } else if (value.is_number_integer()) {
+        result = value.get<int64_t>();
+    } else if (value.is_number_float()) {
+        const double d = value.get<double>();
+        if (!std::isfinite(d)) {
+            Fail(field, "must be a finite integer, got " + Describe(value));
+            return std::nullopt;
+        }
+        if (d != std::floor(d)) {
+            Fail(field, "expected an integer, got " + Describe(value));
+            return std::nullopt;
+        }
+        inRange = d >= -9.2e18 && d <= 9.2e18;
+        result = inRange ? int64_t(d) : 0;
+    } else {
+        Fail(field, "expected an integer, got " + Describe(value));
+        return std::nullopt;
+    }
+    if (!inRange || result < lo || result > hi) {
+        Fail(field, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + Describe(value));
+        return std::nullopt;
+    }
+    return result;
+}
+
+std::optional<double> Validator::Number(const Json& value, std::string_view field, Range range) {
+    if (!value.is_number()) {
+        Fail(field, "expected a number, got " + Describe(value));
+        return std::nullopt;
+    }
+    const double d = value.get<double>();
+    if (!std::isfinite(d)) {
+        Fail(field, "must be a finite number, got " + Describe(value));
+        return std::nullopt;
+    }
+    const bool loOk = range.loOpen ? d > range.lo : d >= range.lo;
+    const bool hiOk = range.hiOpen ? d < range.hi : d <= range.hi;
+    if (loOk && hiOk) return d;
+    std::string reason;
+    if (std::isinf(range.hi)) {
+        reason = std::string("must be ") + (range.loOpen ? "> " : ">= ") + FormatNumber(range.lo);
+    } else if (std::isinf(range.lo)) {
+        reason = std::string("must be ") + (range.hiOpen ? "< " : "<= ") + FormatNumber(range.hi);
+    } else {
+        reason = std::string("must be in ") + (range.loOpen ? "(" : "[") + FormatNumber(range.lo) + ", " +
+                 FormatNumber(range.hi) + (range.hiOpen ? ")" : "]");
+    }
+    Fail(field, reason + ", got " + Describe(value));
+    return std::nullopt;
+}
+
+std::optional<std::string> Validator::String(const Json& value, std::string_view field) {
+    if (!value.is_string()) {
+        Fail(field, "expected a string, got " + Describe(value));
+        return std::nullopt;
+    }
+    return value.get<std::string>();
+}
+
+std::optional<bool> Validator::Boolean(const Json& value, std::string_view field) {
+    if (!value.is_boolean()) {
+        Fail(field, "expected true or false, got " + Describe(value));
+        return std::nullopt;
+    }
+    return value.get<bool>();
+}
+
+void Validator::FailChoice(const Json& value, std::string_view field, std::span<const std::string_view> names) {
+    std::string list;
+    for (size_t i = 0; i < names.size(); ++i) list += (i == 0 ? "" : ", ") + Quote(names[i]);
+    std::string reason = "must be one of " + list + ", got " + Describe(value);
+    if (value.is_string()) reason += Suggestion(value.get_ref<const std::string&>(), names);
+    Fail(field, reason);
+}
+
+std::optional<int64_t> Validator::IntegerChoice(const Json& value, std::string_view field,
+                                                std::span<const int64_t> allowed, std::string_view allowedText) {
+    // Whole numbers beyond int64 are simply not in the list (rather than outside int64's range).
+    const bool huge =
+        (value.is_number_unsigned() && value.get<uint64_t>() > uint64_t(std::numeric_limits<int64_t>::max())) ||
+        (value.is_number_float() && std::isfinite(value.get<double>()) &&
+         value.get<double>() == std::floor(value.get<double>()) && std::fabs(value.get<double>()) > 9.2e18);
+    std::optional<int64_t> n;
+    if (!huge) {
+        n = Integer(value, field, std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max());
+        if (!n) return std::nullopt;  // not an integer: already reported
+        if (std::find(allowed.begin(), allowed.end(), *n) != allowed.end()) return n;
+    }
+    Fail(field, "must be " + std::string(allowedText) + ", got " + Describe(value));
+    return std::nullopt;
+}
+
+bool Validator::IsOverridden(std::string_view field) const {
+    for (const std::string& path : mOverridden) {
+        if (!field.starts_with(path)) continue;
+        if (field.size() == path.size() || field[path.size()] == '.' || field[path.size()] == '[') return true;
+    }
+    return false;
+}
+
+// ---- --set ----------------------------------------------------------------------------------------------------
+
+void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
+    const std::string where = "--set " + item.path;
+    std::vector<std::string> keys;
+    for (size_t start = 0;;) {
+        const size_t dot = item.path.find('.', start);
+        keys.push_back(item.path.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+        if (dot == std::string::npos) break;
+        start = dot + 1;
+    }
+    for (const std::string& key : keys) {
+        if (key.empty()) {
+            check.Fail(where, "expected a dotted field path such as ca.seed");
+            return;
+        }
+    }
+
+    // The value is JSON text; anything that does not parse is taken as a string.
+    JsonDom parsed = ParseJsonDom(item.value);
+    if (parsed.failure && parsed.failure->IsNumberOverflow()) {
+        // Number overflow (1e999) is a number, not a bare word: refuse it rather than take it as a string.
+        check.MarkOverridden(item.path);
+        check.Fail(item.path, "the number " + parsed.failure->token + " is out of range (not finite)");
+        return;
+    }
+    Json value = parsed.failure ? Json(item.value) : std::move(parsed.root);
+
+    Json* node = &root;
+    std::string prefix;
+    for (size_t i = 0; i + 1 < keys.size(); ++i) {
+        prefix = JoinField(prefix, keys[i]);
+        auto it = node->find(keys[i]);
+        if (it == node->end()) {
+            node = &((*node)[keys[i]] = Json::object());
+        } else if (it->is_object()) {
+            node = &*it;
+        } else {
+            check.Fail(where, Quote(prefix) + " is not an object");
+            return;
+        }
+    }
+    (*node)[keys.back()] = std::move(value);
+    check.MarkOverridden(item.path);
+    if (!parsed.failure) {
+        for (const std::string& duplicate : parsed.duplicates)
+            check.Fail(JoinField(item.path, duplicate), "duplicate field");
+    }
+}
+
+}  // namespace cb::scene_io
