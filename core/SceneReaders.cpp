@@ -2,6 +2,8 @@
 // density) and of the whole scene.
 #include "core/SceneReaders.h"
 
+#include "core/StageDescriptors.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -151,13 +153,20 @@ void ReadStages(const Json& root, Validator& check, StageSet& stages) {
     }
     // Dependencies are checked only on a clean list, so one typo does not cascade.
     if (!allOk) return;
-    constexpr std::pair<Stage, Stage> kNeeds[] = {
-        {Stage::Ca, Stage::Region},          {Stage::Smooth, Stage::Ca},      {Stage::Density, Stage::Smooth},
-        {Stage::Shade, Stage::Smooth},       {Stage::Shadow, Stage::Density}, {Stage::RenderSplat, Stage::Shade},
-        {Stage::RenderSplat, Stage::Density}};
-    for (auto [stage, needed] : kNeeds) {
-        if (stages.Has(stage) && !stages.Has(needed))
-            check.Fail("stages", Quote(StageName(stage)) + " needs " + Quote(StageName(needed)));
+    // Stages depend on resources, not on each other (core/StageDescriptors.h);
+    // one line per stage and set of stages that could write what it lacks.
+    const std::vector<MissingInput> missing = MissingInputs(stages);
+    for (size_t n = 0; n < missing.size();) {
+        std::string resources, producers;
+        size_t end = n;
+        for (; end < missing.size() && missing[end].stage == missing[n].stage &&
+               missing[end].producers == missing[n].producers;
+             ++end)
+            resources += (resources.empty() ? "" : " and ") + Quote(ResourceName(missing[end].resource));
+        for (Stage p : missing[n].producers) producers += (producers.empty() ? "" : " or ") + Quote(StageName(p));
+        check.Fail("stages", Quote(StageName(missing[n].stage)) + " needs " + resources +
+                                 ", which no enabled stage writes (enable " + producers + ")");
+        n = end;
     }
 }
 

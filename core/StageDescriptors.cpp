@@ -221,22 +221,16 @@ std::vector<Stage> ScheduleStages(const StageSet& enabled) {
     return order;
 }
 
-std::vector<std::string> MissingInputs(const StageSet& enabled) {
-    std::vector<std::string> missing;
+std::vector<MissingInput> MissingInputs(const StageSet& enabled) {
+    std::vector<MissingInput> missing;
     for (Stage s : kAllStages) {
         if (!enabled.Has(s)) continue;
         for (Resource r : Describe(s).reads) {
             if (ProducerOf(r, enabled)) continue;
-            std::string message = "'";
-            message.append(StageName(s)).append("' needs '").append(ResourceName(r));
-            message.append("', which no enabled stage writes (");
-            bool first = true;
-            for (Stage p : kAllStages) {
-                if (!Contains(Describe(p).writes, r)) continue;
-                message.append(first ? "" : " or ").append(StageName(p));
-                first = false;
-            }
-            missing.push_back(message + ")");
+            MissingInput m{s, r, {}};
+            for (Stage p : kAllStages)
+                if (Contains(Describe(p).writes, r)) m.producers.push_back(p);
+            missing.push_back(std::move(m));
         }
     }
     return missing;

@@ -107,9 +107,13 @@ std::vector<Stage> ScheduleStages(const StageSet& enabled);
 // The stage among `enabled` that writes `resource`, if any.
 std::optional<Stage> ProducerOf(Resource resource, const StageSet& enabled);
 
-// Each enabled stage's input that no enabled stage writes, as
-// "'density' needs 'q', which no enabled stage writes (smooth or noise)".
-std::vector<std::string> MissingInputs(const StageSet& enabled);
+// An enabled stage's input that no enabled stage writes, and the stages that could.
+struct MissingInput {
+    Stage stage;
+    Resource resource;
+    std::vector<Stage> producers;
+};
+std::vector<MissingInput> MissingInputs(const StageSet& enabled);
 
 // The resources a scene's enabled stages write, and which of them are also
 // kept for the previous step (read by an interpolating renderer).

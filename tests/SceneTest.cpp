@@ -402,12 +402,12 @@ TEST(SceneTest, UnknownStage) {
                                     "test.json: stages: must name at least one stage"));
 }
 
-// Test that a stage without the stage it reads is refused.
+// Test that a stage whose input no enabled stage writes is refused, naming the resource and its producers.
 TEST(SceneTest, StageDependency) {
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["region", "ca", "density"]})"),
-                        R"(test.json: stages: "density" needs "smooth")"));
+                        R"(test.json: stages: "density" needs "q", which no enabled stage writes (enable "smooth" or "noise"))"));
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["ca"]})"),
-                        R"(test.json: stages: "ca" needs "region")"));
+                        R"(test.json: stages: "ca" needs "region", which no enabled stage writes (enable "region"))"));
 }
 
 // Test that wind_shift must have one pair or nz pairs, each two integers.
@@ -522,19 +522,19 @@ TEST(SceneTest, RenderSplatWithoutCameras) {
                         R"(test.json: render.cameras: "render_splat" needs at least one camera)"));
 }
 
-// Test each dependency of the lighting stages: shade needs smooth, shadow density, render_splat shade and density.
+// Test each input of the lighting stages: shade needs q, shadow D, render_splat T and the occupancy.
 TEST(SceneTest, LightingStageDependencies) {
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["shade"]})"),
-                        R"(test.json: stages: "shade" needs "smooth")"));
+                        R"(test.json: stages: "shade" needs "q", which no enabled stage writes (enable "smooth" or "noise"))"));
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["region", "ca", "smooth", "shadow"]})"),
-                        R"(test.json: stages: "shadow" needs "density")"));
+                        R"(test.json: stages: "shadow" needs "D", which no enabled stage writes (enable "density"))"));
     const std::string camera = R"("render": {"cameras": [{"eye": [0, 0, 0], "target": [1, 0, 0]}]})";
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + camera +
                                 R"(, "stages": ["region", "ca", "smooth", "density", "render_splat"]})"),
-                        R"(test.json: stages: "render_splat" needs "shade")"));
+                        R"(test.json: stages: "render_splat" needs "T", which no enabled stage writes (enable "shade"))"));
     std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + camera +
                                   R"(, "stages": ["region", "ca", "smooth", "shade", "render_splat"]})");
-    EXPECT_TRUE(HasLine(message, R"(test.json: stages: "render_splat" needs "density")"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: stages: "render_splat" needs "tiles" and "bands", which no enabled stage writes (enable "density"))"));
     EXPECT_EQ(SplitLines(message).size(), 1u) << message;
 }
 
