@@ -16,9 +16,7 @@ namespace {
 
 template <typename T>
 Result<std::vector<T>> Read(Backend& backend, const Buffer& buffer) {
-    std::vector<T> data(buffer.CanonicalBytes() / sizeof(T));
-    CB_TRY(backend.Download(buffer, std::as_writable_bytes(std::span(data))));
-    return data;
+    return Download<T>(backend, buffer);
 }
 
 template <typename T>
@@ -98,35 +96,30 @@ class Tally {
 
 }  // namespace
 
-Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::vector<std::string>& backends,
-                                               const BackendOptions& options) {
+Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
+                                               std::span<const OpenedBackend> others) {
     Tally tally;
-    auto cpuBackend = CreateBackend("cpu", options);
-    if (!cpuBackend) return std::unexpected(cpuBackend.error());
-    Backend& cpu = **cpuBackend;
     auto sim = Simulation::Create(scene, cpu, /*everyStepOutputs=*/true);
     if (!sim) return std::unexpected(sim.error());
     const Extent3 e = scene.grid.size;
 
     struct Candidate {
         std::string name;
-        std::unique_ptr<Backend> backend;
+        Backend* backend;
     };
-    std::vector<Candidate> others;
+    std::vector<Candidate> candidates;
     std::vector<ConformRow> unavailable;
-    for (const std::string& name : backends) {
-        if (name == "cpu") continue;
-        auto b = CreateBackend(name, options);
-        if (!b) {
-            ConformRow row;
-            row.stage = "(all)";
-            row.backend = name;
-            row.status = "skipped";
-            row.detail = b.error().message;
-            unavailable.push_back(row);
+    for (const OpenedBackend& other : others) {
+        if (other.backend) {
+            candidates.push_back({other.name, other.backend.get()});
             continue;
         }
-        others.push_back({name, std::move(*b)});
+        ConformRow row;
+        row.stage = "(all)";
+        row.backend = other.name;
+        row.status = "skipped";
+        row.detail = other.reason;
+        unavailable.push_back(row);
     }
 
     // The CPU's state before the step (the automaton's input) is read before stepping.
@@ -142,7 +135,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
         }
         Status checks;
         auto observe = [&](const Simulation& s) -> Status {
-            for (Candidate& c : others) {
+            for (Candidate& c : candidates) {
                 Backend& b = *c.backend;
                 const StageSet& st = scene.stages;
                 auto skip = [&](Stage stage) {
@@ -246,7 +239,8 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
                     auto tc = copy(s.Tiles(), BufferFormat::U8);
                     auto bp = copy(s.BandsPrev(), BufferFormat::U8);
                     auto bc = copy(s.Bands(), BufferFormat::U8);
-                    if (!qp || !qc || !T || !tp || !tc || !bp || !bc) return MakeError("render_splat: copying inputs failed");
+                    if (!qp || !qc || !T || !tp || !tc || !bp || !bc)
+                        return MakeError("render_splat: copying inputs failed");
                     const RenderSettings& rs = scene.render;
                     for (size_t n = 0; n < rs.cameras.size(); ++n) {
                         SplatParams p = MakeSplatParams(scene, rs.cameras[n]);
@@ -283,7 +277,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
             const Buffer* fields[3] = {(*sim)->Hum(), (*sim)->Act(), (*sim)->Cld()};
             for (int f = 0; f < 3; ++f) after[f] = *Read<uint8_t>(cpu, *fields[f]);
             const std::vector<uint8_t> region = *Read<uint8_t>(cpu, *(*sim)->Region());
-            for (Candidate& c : others) {
+            for (Candidate& c : candidates) {
                 Backend& b = *c.backend;
                 if (!b.Supports(Stage::Ca)) {
                     ConformRow& row = tally.Row("ca", c.name, "", 0);
@@ -316,17 +310,14 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::ve
     return rows;
 }
 
-std::string ConformTable(const std::vector<ConformRow>& rows) {
-    std::string out;
-    char line[512];
-    std::snprintf(line, sizeof line, "  %-13s %-8s %-8s %-28s %12s  %s\n", "stage", "backend", "result", "rule", "worst", "where");
-    out += line;
-    for (const ConformRow& r : rows) {
-        std::snprintf(line, sizeof line, "  %-13s %-8s %-8s %-28s %12.4g  %s\n", r.stage.c_str(), r.backend.c_str(),
-                      r.status.c_str(), r.rule.c_str(), r.worst, r.detail.c_str());
-        out += line;
-    }
-    return out;
+report::Table ConformTable(const std::vector<ConformRow>& rows) {
+    using report::Column;
+    report::Table table({Column("stage").Width(13).Separator("  "), Column("backend").Width(8),
+                         Column("result").Width(8), Column("rule").Width(28),
+                         Column("worst").Real("%.4g").Width(12).AlignRight(), Column("where").Separator("  ")},
+                        report::TextLayout::Columns);
+    for (const ConformRow& r : rows) table.rows.push_back({r.stage, r.backend, r.status, r.rule, r.worst, r.detail});
+    return table;
 }
 
 nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& rows) {

@@ -3,13 +3,15 @@
 // that step and their outputs are compared by SPEC's rule for the stage.
 #pragma once
 
+#include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/Backend.h"
 #include "core/Scene.h"
+#include "harness/ReportModel.h"
+#include "harness/Session.h"
 
 namespace cb {
 
@@ -22,11 +24,12 @@ struct ConformRow {
     std::string detail;           // worst place and both values, or why it was skipped
 };
 
-// Compares every backend in `backends` (other than cpu) against the CPU over the scene's steps.
-Result<std::vector<ConformRow>> RunConformance(const Scene& scene, const std::vector<std::string>& backends,
-                                               const BackendOptions& options);
+// Compares every available backend in `others` against `cpu` over the scene's
+// steps; one that did not open is a row "(all)" skipped with the reason.
+Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others);
 
-std::string ConformTable(const std::vector<ConformRow>& rows);
+// stage x backend: result, rule, worst error and where, as `conform` prints it.
+report::Table ConformTable(const std::vector<ConformRow>& rows);
 nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& rows);
 
 }  // namespace cb

@@ -1,5 +1,7 @@
 #include "harness/Report.h"
 
+#include "harness/Session.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -125,33 +127,47 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
     return doc;
 }
 
-std::string TimingTable(const Scene& scene, const BackendRun& run) {
-    std::string out;
+namespace {
+
+// The timing table's columns: stage, median, q1, q3, min, max (ms), then two
+// notes without a title: the device median and a camera's frame summary.
+std::vector<report::Column> TimingColumns() {
+    using report::Column;
+    std::vector<Column> columns = {Column("stage").Width(18).Separator("  ")};
+    for (const char* title : {"median ms", "q1", "q3", "min", "max"})
+        columns.push_back(Column(title).Real("%.3f").Unit("ms").Width(10).AlignRight());
+    columns.push_back(Column("device median").Real("%.3f").Unit("ms").Separator("   ").Prefix("device ").NoTextTitle());
+    columns.push_back(Column("frames").Separator("  ").NoTextTitle());
+    return columns;
+}
+
+std::vector<report::Cell> TimingRow(const std::string& name, const std::vector<double>& samples,
+                                    const std::vector<double>& device, std::string note = "") {
+    const Summary s = Summarize(samples);
+    std::vector<report::Cell> row = {name, s.median, s.q1, s.q3, s.min, s.max};
+    row.push_back(device.empty() ? report::Cell() : report::Cell(Summarize(device).median));
+    row.push_back(note.empty() ? report::Cell() : report::Cell(std::move(note)));
+    return row;
+}
+
+}  // namespace
+
+report::Section TimingSection(const Scene& scene, const BackendRun& run) {
+    report::Section section;
     char line[256];
     if (run.steps.size() > scene.warmupSteps)
-        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, statistics over steps %u..%zu\n", run.name.c_str(),
+        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, statistics over steps %u..%zu", run.name.c_str(),
                       run.device.c_str(), run.steps.size(), scene.warmupSteps, run.steps.size() - 1);
     else
-        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, none after the %u warm-up steps\n",
+        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, none after the %u warm-up steps",
                       run.name.c_str(), run.device.c_str(), run.steps.size(), scene.warmupSteps);
-    out += line;
-    std::snprintf(line, sizeof line, "  %-18s %10s %10s %10s %10s %10s\n", "stage", "median ms", "q1", "q3", "min",
-                  "max");  // wall time; "device" follows where the backend measures GPU time
-    out += line;
-    auto row = [&](const std::string& name, const std::vector<double>& samples, const std::vector<double>& device) {
-        Summary s = Summarize(samples);
-        std::snprintf(line, sizeof line, "  %-18s %10.3f %10.3f %10.3f %10.3f %10.3f", name.c_str(), s.median, s.q1,
-                      s.q3, s.min, s.max);
-        out += line;
-        if (!device.empty()) {
-            std::snprintf(line, sizeof line, "   device %.3f", Summarize(device).median);
-            out += line;
-        }
-        out += "\n";
-    };
+    section.title = line;
+    // Wall time; "device" follows where the backend measures GPU time.
+    report::Table table(TimingColumns(), report::TextLayout::Columns);
     for (Stage stage : kAllStages) {
         if (!scene.stages.Has(stage)) continue;
-        row(std::string(StageName(stage)), StageSamples(scene, run, stage), StageSamples(scene, run, stage, true));
+        table.rows.push_back(TimingRow(std::string(StageName(stage)), StageSamples(scene, run, stage),
+                                       StageSamples(scene, run, stage, true)));
     }
     if (scene.stages.Has(Stage::RenderSplat)) {
         for (const CameraSettings& camera : scene.render.cameras) {
@@ -163,32 +179,44 @@ std::string TimingTable(const Scene& scene, const BackendRun& run) {
                         ms.push_back(f.ms);
                         lastSplats = f.stats.splats;
                     }
-            Summary s = Summarize(ms);
-            std::snprintf(line, sizeof line, "  %-18s %10.3f %10.3f %10.3f %10.3f %10.3f  %zu frames, %.1f fps, %llu splats\n",
-                          ("  frame " + camera.name).substr(0, 18).c_str(), s.median, s.q1, s.q3, s.min, s.max, s.count,
+            const Summary s = Summarize(ms);
+            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu splats", s.count,
                           s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(lastSplats));
-            out += line;
+            table.rows.push_back(TimingRow(("  frame " + camera.name).substr(0, 18), ms, {}, line));
         }
     }
     if (scene.stages.Has(Stage::Region)) {
         std::vector<double> host;
         for (const StepRecord& r : run.steps)
             if (r.step >= scene.warmupSteps) host.push_back(r.ellipsoidUpdateMs);
-        row("(host) ellipsoids", host, {});
+        table.rows.push_back(TimingRow("(host) ellipsoids", host, {}));
     }
-    if (!run.downloadMs.empty()) row("(transfer) download", run.downloadMs, {});
+    if (!run.downloadMs.empty()) table.rows.push_back(TimingRow("(transfer) download", run.downloadMs, {}));
+    section.blocks.push_back(std::move(table));
     if (scene.stages.Has(Stage::Density) && !run.steps.empty()) {
         std::vector<double> after;
         for (const StepRecord& r : run.steps)
             if (r.step >= scene.warmupSteps && r.coveredColumns) after.push_back(CoverFraction(scene, *r.coveredColumns));
-        Summary s = Summarize(after);
+        const Summary s = Summarize(after);
         const StepRecord& last = run.steps.back();
-        std::snprintf(line, sizeof line, "  cloud cover: last step %.1f %%, median %.1f %% (min %.1f, max %.1f)\n",
+        std::snprintf(line, sizeof line, "  cloud cover: last step %.1f %%, median %.1f %% (min %.1f, max %.1f)",
                       last.coveredColumns ? 100.0 * CoverFraction(scene, *last.coveredColumns) : 0.0, 100 * s.median,
                       100 * s.min, 100 * s.max);
-        out += line;
+        section.blocks.push_back(report::Paragraph{line});
     }
-    return out;
+    return section;
+}
+
+std::string_view RendererFileName(Stage renderer) {
+    switch (renderer) {
+        case Stage::RenderSplat: return "splat";
+        case Stage::RenderMarch: return "march";
+        default: return StageName(renderer);
+    }
+}
+
+std::string FrameFileStem(Stage renderer, const std::string& camera, const std::string& backend) {
+    return "frame-" + std::string(RendererFileName(renderer)) + "-" + camera + (backend.empty() ? "" : "-" + backend);
 }
 
 Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz) {
@@ -203,8 +231,10 @@ Status WriteTopView(const std::string& path, const std::vector<float>& columnSum
             image.setpixel(int(i), int(y), &v, 1);
         }
     }
-    if (!image.write(path)) return MakeError(path + ": cannot write the PNG: " + image.geterror());
-    return {};
+    return Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
+        if (!image.write(temp)) return MakeError(path + ": cannot write the PNG: " + image.geterror());
+        return {};
+    });
 }
 
 ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
@@ -229,8 +259,10 @@ Status WriteDifferenceImage(const std::string& path, const std::vector<float>& r
     OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
     OIIO::ImageBuf a(spec, const_cast<float*>(reference.data())), b(spec, const_cast<float*>(candidate.data()));
     OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(a, b);
-    if (!diff.write(path)) return MakeError(path + ": cannot write: " + diff.geterror());
-    return {};
+    return Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
+        if (!diff.write(temp)) return MakeError(path + ": cannot write: " + diff.geterror());
+        return {};
+    });
 }
 
 Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
@@ -239,7 +271,10 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
     OIIO::ImageBuf linear(spec, const_cast<float*>(rgb.data()));  // wraps, does not copy
     std::vector<std::string> written;
     const std::string exr = stem + ".exr";
-    if (!linear.write(exr)) return MakeError(exr + ": cannot write: " + linear.geterror());
+    CB_TRY(Session::WriteAtomically(exr, [&](const std::string& temp) -> Status {
+        if (!linear.write(temp)) return MakeError(exr + ": cannot write: " + linear.geterror());
+        return {};
+    }));
     written.push_back(exr);
     if (png) {
         OIIO::ImageBuf srgb;
@@ -247,7 +282,10 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
             return MakeError(stem + ".png: colour conversion failed: " + srgb.geterror());
         const std::string path = stem + ".png";
         srgb.set_write_format(OIIO::TypeDesc::UINT8);
-        if (!srgb.write(path)) return MakeError(path + ": cannot write: " + srgb.geterror());
+        CB_TRY(Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
+            if (!srgb.write(temp)) return MakeError(path + ": cannot write: " + srgb.geterror());
+            return {};
+        }));
         written.push_back(path);
     }
     return written;

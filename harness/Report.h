@@ -1,5 +1,6 @@
 // What a run reports: per-stage timing statistics, cover, results.json
-// (format in docs/results.md) and the top-view PNG of the density map.
+// (format in docs/results.md), the frames and the top-view PNG of the density
+// map. Every file is written atomically (Session::WriteAtomically).
 #pragma once
 
 #include <optional>
@@ -10,6 +11,7 @@
 
 #include "core/Backend.h"
 #include "core/Scene.h"
+#include "harness/ReportModel.h"
 #include "harness/Simulation.h"
 
 namespace cb {
@@ -36,8 +38,9 @@ struct BackendRun {
 
 nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs);
 
-// The per-stage timing table and the cover line, as printed by `run`.
-std::string TimingTable(const Scene& scene, const BackendRun& run);
+// One backend's section of `run`'s report: its device and steps, the
+// per-stage timing table (with each camera's frames) and the cover line.
+report::Section TimingSection(const Scene& scene, const BackendRun& run);
 
 // Writes D as a grey top view (x right, y up, white = densest column), 8-bit
 // PNG through OpenImageIO. `columnSum` is canonical D, nx*ny floats.
@@ -58,6 +61,11 @@ ImageComparison CompareImages(const std::vector<float>& reference, const std::ve
 // Writes |reference - candidate| as an EXR (for a failed comparison).
 Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
                             const std::vector<float>& candidate, uint32_t width, uint32_t height);
+
+// The short name of a renderer stage in file names: "splat" for render_splat.
+std::string_view RendererFileName(Stage renderer);
+// "frame-<renderer>-<camera>", with "-<backend>" when `backend` is not empty.
+std::string FrameFileStem(Stage renderer, const std::string& camera, const std::string& backend = "");
 
 // Writes a linear RGB float image (3 floats a pixel, row 0 at the top) as
 // `stem`.exr (float, linear) and, with png = true, `stem`.png (8-bit sRGB),

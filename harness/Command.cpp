@@ -1,0 +1,152 @@
+#include "harness/Command.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <map>
+
+namespace cb {
+namespace {
+
+std::map<std::string_view, Command>& Registry() {
+    static std::map<std::string_view, Command> registry;
+    return registry;
+}
+
+// A positive integer in [1, max], or nullopt.
+std::optional<int> PositiveInt(const char* text, long max) {
+    if (!text) return std::nullopt;
+    char* end = nullptr;
+    const long value = std::strtol(text, &end, 10);
+    if (*end != '\0' || value < 1 || value > max) return std::nullopt;
+    return int(value);
+}
+
+// An option whose value must be one of `allowed`, stored in `field`.
+OptionSpec Choice(std::string_view name, std::string CommonOptions::*field, const char* a, const char* b,
+                  std::string message) {
+    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                if (!v || (std::strcmp(v, a) != 0 && std::strcmp(v, b) != 0)) return message;
+                o.*field = v;
+                return std::nullopt;
+            }};
+}
+
+// Function-local statics: commands in other files read them during static initialisation.
+std::vector<OptionSpec> MakeSceneCommandOptions() {
+    return {
+        {"--backend", "--backends", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             if (!v) return "--backend needs a list, e.g. --backend cpu";
+             const std::string list = v;
+             for (size_t start = 0; start <= list.size();) {
+                 size_t comma = list.find(',', start);
+                 if (comma == std::string::npos) comma = list.size();
+                 if (comma > start) o.backends.push_back(list.substr(start, comma - start));
+                 start = comma + 1;
+             }
+             return std::nullopt;
+         }},
+        {"--steps", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             if (!v) return "--steps needs a number";
+             o.overrides.push_back({"steps", v});
+             return std::nullopt;
+         }},
+        TextOption("--out", &CommonOptions::outDir, "--out needs a folder"),
+        {"--set", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             const char* eq = v ? std::strchr(v, '=') : nullptr;
+             if (!eq || eq == v) return "--set needs PATH=VALUE, e.g. --set ca.seed=42";
+             o.overrides.push_back({std::string(v, eq), std::string(eq + 1)});
+             return std::nullopt;
+         }},
+        {"--threads", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             const std::optional<int> threads = PositiveInt(v, 1024);
+             if (!threads) return "--threads needs a number from 1";
+             o.cpuThreads = *threads;
+             return std::nullopt;
+         }},
+        Choice("--gl-context", &CommonOptions::glContext, "osmesa", "egl", "--gl-context needs osmesa or egl"),
+        Choice("--gl-ca-layout", &CommonOptions::glCaLayout, "packed", "rgba8", "--gl-ca-layout needs packed or rgba8"),
+        TextOption("--vk-device", &CommonOptions::vkDevice, "--vk-device needs an index or a name"),
+        FlagOption("--quiet", &CommonOptions::quiet),
+    };
+}
+
+}  // namespace
+
+OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field) {
+    return {name, "", false, [=](CommonOptions& o, const char*) -> std::optional<std::string> {
+                o.*field = true;
+                return std::nullopt;
+            }};
+}
+
+OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing) {
+    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                if (!v) return missing;
+                o.*field = v;
+                return std::nullopt;
+            }};
+}
+
+OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOptions::*field, std::string missing) {
+    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                if (!v) return missing;
+                (o.*field).push_back(v);
+                return std::nullopt;
+            }};
+}
+
+BackendOptions CommonOptions::Backend() const {
+    BackendOptions b;
+    b.cpuThreads = cpuThreads;
+    b.vkDevice = vkDevice;
+    b.glContext = glContext;
+    b.glCaLayout = glCaLayout;
+    return b;
+}
+
+std::span<const OptionSpec> SceneCommandOptions() {
+    static const std::vector<OptionSpec> options = MakeSceneCommandOptions();
+    return options;
+}
+
+OptionSpec RepeatOption() {
+    return {"--repeat", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                const std::optional<int> repeats = PositiveInt(v, 10000);
+                if (!repeats) return "--repeat needs a number from 1";
+                o.repeats = *repeats;
+                return std::nullopt;
+            }};
+}
+
+CommandRegistration::CommandRegistration(Command command) {
+    const std::string_view name = command.name;
+    Registry().emplace(name, std::move(command));
+}
+
+std::vector<const Command*> RegisteredCommands() {
+    std::vector<const Command*> out;
+    for (const auto& [name, command] : Registry()) out.push_back(&command);
+    std::ranges::stable_sort(out, {}, &Command::helpOrder);
+    return out;
+}
+
+const Command* FindCommand(std::string_view name) {
+    auto it = Registry().find(name);
+    return it == Registry().end() ? nullptr : &it->second;
+}
+
+std::string ResolveScenePath(const std::string& nameOrPath) {
+    const std::string& name = nameOrPath.empty() ? std::string(kDefaultScene) : nameOrPath;
+    if (name.find('/') != std::string::npos || name.ends_with(".json")) return name;
+    const char* env = std::getenv("CLOUDBENCH_SCENES");
+    const std::filesystem::path dir = env ? std::filesystem::path(env) : std::filesystem::path(CLOUDBENCH_SCENES_DIR);
+    return (dir / (name + ".json")).string();
+}
+
+}  // namespace cb

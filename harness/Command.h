@@ -1,0 +1,100 @@
+// The `cloudbench` commands: what one command declares (name, help, options,
+// run function) and the registry that main() walks. Each command lives in its
+// own file under harness/commands/ and registers itself with a
+// CommandRegistration; docs/cli.md and CONTRIBUTING.md describe them.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/Backend.h"
+#include "core/Scene.h"
+
+namespace cb {
+
+// The process exit codes (docs/cli.md).
+enum ExitCode : int {
+    kExitOk = 0,
+    kExitFailed = 1,  // a stage failed, or an output could not be written
+    kExitUsage = 2,   // bad command line
+    kExitBadScene = 3,
+    kExitNoBackend = 4,  // none of the requested backends is available
+    kExitNonConformant = 5,
+};
+
+// What the command line sets; every command reads the fields its options fill.
+struct CommonOptions {
+    std::string scene;                     // name in scenes/ or a path; "" = default scene
+    std::vector<std::string> backends;     // empty = the command's default
+    std::vector<SceneOverride> overrides;  // --set, and --steps as "steps"
+    std::string outDir;                    // "" = the command's default under out/<scene name>
+    int cpuThreads = 0;
+    std::string vkDevice;    // --vk-device INDEX|NAME
+    std::string glContext;   // --gl-context osmesa|egl
+    std::string glCaLayout;  // --gl-ca-layout packed|rgba8
+    bool quiet = false;
+    // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
+    // timed calls per measurement; accuracy --switches; sweep --metric.
+    bool reference = false;
+    std::vector<std::string> vary;
+    int repeats = 5;
+    bool switches = false;
+    std::string metric = "max";
+    // argv as given, for the provenance of the outputs.
+    std::vector<std::string> commandLine;
+
+    BackendOptions Backend() const;
+};
+
+// One command-line option. `apply` stores the value (nullptr for a flag) and
+// returns a usage message when the value is missing or wrong.
+struct OptionSpec {
+    std::string_view name;
+    std::string_view alias;  // "" = none
+    bool takesValue = false;
+    std::function<std::optional<std::string>(CommonOptions&, const char* value)> apply;
+};
+
+// A flag that sets `field`.
+OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field);
+// An option whose value is stored in `field` (appended, for a list); `missing`
+// is the usage message when the value is missing.
+OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing);
+OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOptions::*field, std::string missing);
+
+// The options every scene command accepts: --backend, --steps, --out, --set,
+// --threads, --gl-context, --gl-ca-layout, --vk-device, --quiet.
+std::span<const OptionSpec> SceneCommandOptions();
+// --repeat N, shared by accuracy and sweep.
+OptionSpec RepeatOption();
+
+struct Command {
+    std::string_view name;
+    std::string_view summary;  // one line in `cloudbench --help`
+    std::string_view help;     // `cloudbench help NAME`
+    int helpOrder = 0;         // position in `cloudbench --help`
+    // Whether the command takes a scene and the scene options; devices does not.
+    bool takesScene = true;
+    // Whether the scene's warm-up steps are kept (run times them; the others set them to 0).
+    bool keepsWarmup = false;
+    std::vector<OptionSpec> extraOptions = {};  // besides SceneCommandOptions()
+    std::function<int(const CommonOptions&)> run;
+};
+
+// Adds a command to the registry at static initialisation.
+struct CommandRegistration {
+    explicit CommandRegistration(Command command);
+};
+
+// The registered commands in help order.
+std::vector<const Command*> RegisteredCommands();
+const Command* FindCommand(std::string_view name);
+
+// scenes/<name>.json for a bare name, the argument itself for a path.
+std::string ResolveScenePath(const std::string& nameOrPath);
+inline constexpr const char* kDefaultScene = "thesis-medium";
+
+}  // namespace cb

@@ -1,0 +1,109 @@
+// The work every command shares: the resolved scene, the output folder,
+// atomic output files (each written under a temporary name in its folder,
+// then renamed), the backends opened with their status, canonical read-backs
+// and the provenance block of the JSON outputs (docs/results.md).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/Backend.h"
+#include "core/Scene.h"
+#include "harness/Command.h"
+#include "harness/Provenance.h"
+
+namespace cb {
+
+enum class BackendStatus { Available, Unavailable, Unsupported };
+std::string_view BackendStatusName(BackendStatus status);  // "available", "unavailable", "unsupported"
+
+// One requested backend; `backend` is set only when it is available.
+struct OpenedBackend {
+    std::string name;
+    std::unique_ptr<Backend> backend;
+    BackendStatus status = BackendStatus::Unavailable;
+    std::string reason;  // why it is unavailable or unsupported
+};
+
+class Session {
+  public:
+    // Resolves options.scene and loads it with options.overrides. On a bad
+    // scene prints the loader's "file: field: reason" and returns kExitBadScene.
+    // The output folder defaults to out/<scene name>[/<outSubfolder>].
+    static std::expected<std::unique_ptr<Session>, int> Open(const CommonOptions& options,
+                                                             std::string_view outSubfolder);
+
+    const CommonOptions& Options() const { return mOptions; }
+    const Scene& GetScene() const { return mScene; }
+    const std::string& ScenePath() const { return mScenePath; }
+    const std::string& OutDir() const { return mOutDir; }
+
+    // The same scene file with options.overrides followed by `extra`.
+    Result<Scene> LoadVariant(std::span<const SceneOverride> extra) const;
+
+    // Creates OutDir(); prints the reason and returns false when it cannot.
+    bool MakeOutDir() const;
+
+    // options.backends, or `defaults` when none were given.
+    std::vector<std::string> RequestedBackends(const std::vector<std::string>& defaults) const;
+    // Opens `names` and records them for the provenance. With `scene`, a
+    // backend that lacks one of its stages is Unsupported. With `report`,
+    // each backend not available is named on stderr with the reason.
+    std::vector<OpenedBackend> OpenBackends(const std::vector<std::string>& names, const Scene* scene = nullptr,
+                                            bool report = true);
+
+    // Writes `path` through `write`, which is given a temporary name in the
+    // same folder with the same extension; renamed to `path` on success.
+    static Status WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write);
+    static Status WriteText(const std::string& path, const std::string& text);
+    // Writes `doc` with a "provenance" block added.
+    Status WriteJson(const std::string& path, nlohmann::json doc) const;
+    // Reads `buffer` back and writes it as .npy shaped (nz, ny, nx).
+    static Status WriteNpy(const std::string& path, Backend& backend, const Buffer& buffer);
+
+    // The provenance of this run: build, machine, backends opened so far, scene, command line.
+    nlohmann::json Provenance() const;
+
+  private:
+    Session(const CommonOptions& options, std::string scenePath, Scene scene, std::string outDir);
+
+    const CommonOptions& mOptions;
+    std::string mScenePath;
+    Scene mScene;
+    std::string mOutDir;
+    std::vector<BackendProvenance> mBackends;
+};
+
+// Creates `dir` and its parents; the error names the folder and the reason.
+Status MakeFolder(const std::string& dir);
+
+// Reads a buffer back in canonical form; adds the time it took to `timesMs` when given.
+template <typename T>
+Result<std::vector<T>> Download(Backend& backend, const Buffer& buffer, std::vector<double>* timesMs = nullptr) {
+    std::vector<T> data(buffer.CanonicalBytes() / sizeof(T));
+    const auto start = std::chrono::steady_clock::now();
+    CB_TRY(backend.Download(buffer, std::as_writable_bytes(std::span(data))));
+    if (timesMs)
+        timesMs->push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    return data;
+}
+
+// Progress on stderr: a self-rewriting line on a terminal, a line per 10 % otherwise.
+class Progress {
+  public:
+    Progress(std::string label, uint32_t total, bool quiet);
+    void Update(uint32_t done);
+
+  private:
+    std::string mLabel;
+    uint32_t mTotal;
+    bool mQuiet, mTty;
+};
+
+}  // namespace cb

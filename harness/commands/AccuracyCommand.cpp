@@ -1,0 +1,314 @@
+// `cloudbench accuracy` (docs/accuracy.md): every shade and shadow option of
+// every backend measured against the exact (Embree) reference; writes
+// accuracy.json and accuracy.md.
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "harness/Measurement.h"
+#include "harness/StageParams.h"
+
+namespace cb {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kHelp = R"(usage: cloudbench accuracy [SCENE] [options]
+
+Simulates SCENE on the CPU to its last step, computes the exact references
+T_ref (every voxel, from the point where the ray toward the sun leaves the
+voxel) and G_ref (every ground cell) with Embree, and measures the shade and
+shadow stages of every backend against them: the scene's settings, then each
+option changed one at a time (shade: attenuation, filter, resolution, storage,
+scattering; shadow: form). Prints per option and backend the median time with
+quartiles and the max, mean and 99th-percentile |error| over all voxels and
+over the voxels in cloud (q > 0) or ground cells under cloud (G_ref < 1), the
+reference's own speed in rays per second, and writes DIR/accuracy.json and
+DIR/accuracy.md.
+
+Options:
+  --backend LIST     backends to measure (default: all built); unavailable ones
+                     are reported, and a stage a backend lacks is listed as unsupported
+  --repeat N         timed calls per measurement, after one warm-up (default 5)
+  --switches         also cross the principal axis's 45-degree switches: error on
+                     each side (1e-6 rad, 1e-3 rad, 1 degree) and the jump in T
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>/accuracy)
+  --set PATH=VALUE   override a scene field (see cloudbench help run)
+  --threads N        CPU backend and reference threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name
+  --gl-context CTX   OpenGL context: osmesa (default) or egl
+  --quiet            no progress lines
+)";
+
+// Values of each shade and shadow option that differ from the scene's.
+std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage stage) {
+    std::vector<std::vector<SceneOverride>> out;
+    auto add = [&](const char* path, std::initializer_list<const char*> values, const std::string& current) {
+        for (const char* v : values)
+            if (current != v) out.push_back({{path, v}});
+    };
+    // A choice's names come from the scene's own table (core/SceneNames.h), in its order.
+    auto addNames = [&](const char* path, const auto& names, auto current) {
+        for (const auto& [name, value] : names)
+            if (value != current) out.push_back({{path, std::string(name)}});
+    };
+    if (stage == Stage::Shade) {
+        const ShadeSettings& s = scene.shade;
+        addNames("shade.attenuation", kAttenuationKindNames, s.attenuation);
+        addNames("shade.filter", kSampleFilterNames, s.filter);
+        add("shade.resolution", {"1", "2", "4"}, std::to_string(s.resolution));
+        addNames("shade.storage", kStorageFormatNames, s.storage);
+        add("shade.scattering.enabled", {"false", "true"}, s.scattering ? "true" : "false");
+    } else {
+        addNames("shadow.form", kAttenuationKindNames, scene.shadow.form);
+    }
+    return out;
+}
+
+// Principal-axis switches.
+
+struct SwitchCase {
+    std::string name;
+    double tieElevation, tieAzimuth;  // radians
+    bool alongElevation;              // the angle that moves across the switch
+};
+
+// The z switch at the scene's azimuth (tan el = max(|cos az|, |sin az|)) and
+// the x/y switch at azimuth 45 degrees and an elevation below the z switch.
+std::vector<SwitchCase> SwitchCases(const Scene& scene) {
+    constexpr double kDeg = std::numbers::pi / 180;
+    const double az = scene.sun.azimuthDeg * kDeg;
+    const double zTie = std::atan(std::max(std::fabs(std::cos(az)), std::fabs(std::sin(az))));
+    const double xyElevation = std::min(scene.sun.elevationDeg * kDeg, 25 * kDeg);
+    return {{"z / horizontal (elevation " + Fmt("%.4f", zTie / kDeg) + " deg at azimuth " +
+                 Fmt("%.1f", scene.sun.azimuthDeg) + ")",
+             zTie, az, true},
+            {"x / y (azimuth 45 deg at elevation " + Fmt("%.1f", xyElevation / kDeg) + ")", xyElevation,
+             std::numbers::pi / 4, false}};
+}
+
+std::string EpsilonText(double eps) {
+    return eps < 1e-2 ? Fmt("%.0e", eps) + " rad" : Fmt("%.3g", eps * 180 / std::numbers::pi) + " deg";
+}
+
+const char* AxisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+
+struct SwitchResult {
+    json doc = json::array();
+    report::Table errors, jumps;
+};
+
+Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, std::span<const OpenedBackend> backends) {
+    constexpr double kDeg = std::numbers::pi / 180;
+    const CommonOptions& options = session.Options();
+    const Scene& base = session.GetScene();
+    SwitchResult out;
+    out.errors = TextTable({"switch", "epsilon", "side", "axis", "backend"});
+    for (auto& c : StatsColumns()) out.errors.columns.push_back(c);
+    for (auto& c : StatsColumns(" (in cloud)")) out.errors.columns.push_back(c);
+    out.jumps = TextTable({"switch", "epsilon", "axes", "backend"});
+    for (const char* title : {"jump max|T+ - T-|", "T_ref jump", "a-priori bound"})
+        out.jumps.columns.push_back(report::Column(title).Real("%.3g"));
+    for (const SwitchCase& c : SwitchCases(base)) {
+        for (double eps : {1e-6, 1e-3, 1.0 * kDeg}) {
+            std::map<std::string, std::vector<float>> T[2];  // per side, per backend
+            std::vector<float> Tref[2];
+            Vec3 sun[2];
+            int axis[2];
+            for (int side = 0; side < 2; ++side) {
+                const double sign = side == 0 ? -1 : 1;
+                const double el = c.alongElevation ? c.tieElevation + sign * eps : c.tieElevation;
+                const double az = c.alongElevation ? c.tieAzimuth : c.tieAzimuth + sign * eps;
+                const SceneOverride sunAt[] = {{"sun.elevation_deg", Fmt("%.17g", el / kDeg)},
+                                               {"sun.azimuth_deg", Fmt("%.17g", az / kDeg)}};
+                auto point = eval.Load(sunAt);
+                if (!point) return std::unexpected(point.error());
+                sun[side] = point->scene.sun.Direction();
+                axis[side] = PrincipalAxis(sun[side]);
+                Tref[side] = point->reference->T;
+                for (const OpenedBackend& slot : backends) {
+                    if (!slot.backend) continue;
+                    StageAccuracy a = MeasureShade(*slot.backend, point->scene, *point->in, *point->reference, 0, true);
+                    if (a.status != "ok") continue;
+                    std::vector<report::Cell> cells = {c.name, EpsilonText(eps), side == 0 ? "-" : "+",
+                                                       AxisName(axis[side]), slot.name};
+                    for (auto& cell : StatsCells(a.all)) cells.push_back(cell);
+                    for (auto& cell : StatsCells(a.subset)) cells.push_back(cell);
+                    out.errors.rows.push_back(std::move(cells));
+                    out.doc.push_back({{"switch", c.name},
+                                       {"epsilon_rad", eps},
+                                       {"side", side == 0 ? "-" : "+"},
+                                       {"axis", AxisName(axis[side])},
+                                       {"backend", slot.name},
+                                       {"error", {{"all", StatsJson(a.all)}, {"in_cloud", StatsJson(a.subset)}}}});
+                    T[side][slot.name] = std::move(a.output);
+                }
+            }
+            // The jump between the two sides, and its a-priori bound from the tie direction.
+            const Vec3 tie = SunDirection(c.tieElevation, c.tieAzimuth);
+            float qMax = 0;
+            if (auto in = eval.Inputs(base, options.overrides))
+                for (float v : (*in)->q) qMax = std::max(qMax, v);
+            const ShadeParams params = MakeShadeParams(base);
+            const double bound = SwitchSideBound(params, base.grid.size, sun[0], tie, axis[0], qMax) +
+                                 SwitchSideBound(params, base.grid.size, sun[1], tie, axis[1], qMax);
+            double refJump = 0;
+            for (size_t v = 0; v < Tref[0].size(); ++v)
+                refJump = std::max(refJump, std::fabs(double(Tref[0][v]) - double(Tref[1][v])));
+            for (const auto& [name, lower] : T[0]) {
+                auto upper = T[1].find(name);
+                if (upper == T[1].end()) continue;
+                double jump = 0;
+                for (size_t v = 0; v < lower.size(); ++v)
+                    jump = std::max(jump, std::fabs(double(lower[v]) - double(upper->second[v])));
+                out.jumps.rows.push_back({c.name, EpsilonText(eps),
+                                          std::string(AxisName(axis[0])) + " -> " + AxisName(axis[1]), name, jump,
+                                          refJump, bound});
+                out.doc.push_back({{"switch", c.name},
+                                   {"epsilon_rad", eps},
+                                   {"backend", name},
+                                   {"axes", {AxisName(axis[0]), AxisName(axis[1])}},
+                                   {"jump", jump},
+                                   {"reference_jump", refJump},
+                                   {"bound", bound}});
+            }
+        }
+    }
+    return out;
+}
+
+// The scene's own shading against the reference counted from the voxel
+// centre: how much the choice of the ray start matters.
+Result<report::Section> RayStartSection(Evaluator& eval, const Scene& scene, std::span<const OpenedBackend> backends,
+                                        json& doc) {
+    auto in = eval.Inputs(scene, eval.Options().overrides);
+    if (!in) return std::unexpected(in.error());
+    auto exit = eval.Reference(scene, **in);
+    if (!exit) return std::unexpected(exit.error());
+    auto centre = eval.Reference(scene, **in, ref::RayStart::VoxelCentre);
+    if (!centre) return std::unexpected(centre.error());
+    const ErrorStats between = AbsoluteErrors((*exit)->T, (*centre)->T);
+    report::Table table = TextTable({"comparison", "backend"});
+    for (auto& c : StatsColumns()) table.columns.push_back(c);
+    auto row = [](std::string comparison, std::string backend, const ErrorStats& e) {
+        std::vector<report::Cell> cells = {std::move(comparison), std::move(backend)};
+        for (auto& cell : StatsCells(e)) cells.push_back(cell);
+        return cells;
+    };
+    table.rows.push_back(row("T_ref(voxel exit) vs T_ref(voxel centre)", "", between));
+    for (const OpenedBackend& slot : backends) {
+        if (!slot.backend) continue;
+        StageAccuracy a = MeasureShade(*slot.backend, scene, **in, **centre, 0);
+        if (a.status != "ok") continue;
+        table.rows.push_back(row("scene's T vs T_ref(voxel centre)", slot.name, a.all));
+        doc["voxel_centre_reference"][slot.name] = StatsJson(a.all);
+    }
+    doc["voxel_exit_vs_centre"] = StatsJson(between);
+    return report::Section{"Reference ray start: voxel exit (default) vs voxel centre", {std::move(table)}};
+}
+
+// Prints a section as it is done (after a blank line) and keeps it for accuracy.md.
+void Emit(report::Report& report, report::Section section) {
+    std::printf("\n%s", report::RenderText(section).c_str());
+    report.sections.push_back(std::move(section));
+}
+
+int Accuracy(const CommonOptions& options) {
+    auto session = Session::Open(options, "accuracy");
+    if (!session) return session.error();
+    const Scene& scene = (*session)->GetScene();
+    if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow)) {
+        std::fprintf(stderr, "%s: stages: accuracy needs \"shade\" or \"shadow\"\n", scene.path.c_str());
+        return kExitBadScene;
+    }
+    if (!(*session)->MakeOutDir()) return kExitFailed;
+    const std::vector<OpenedBackend> backends =
+        (*session)->OpenBackends((*session)->RequestedBackends(BuiltBackends()));
+    if (std::ranges::none_of(backends, [](const OpenedBackend& b) { return b.backend != nullptr; }))
+        return kExitNoBackend;
+
+    Evaluator eval(**session, ref::RayStart::VoxelExit);
+    std::vector<Row> rows;
+    std::printf(
+        "accuracy of scene %s (%ux%ux%u) at step %u against the exact reference (Embree; T_ref from each "
+        "voxel's exit point toward the sun)\n",
+        scene.name.c_str(), scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps - 1);
+    for (Stage stage : {Stage::Shade, Stage::Shadow}) {
+        if (!scene.stages.Has(stage)) continue;
+        const Stage only[] = {stage};
+        std::vector<std::vector<SceneOverride>> settings = {{}};
+        for (auto& v : OptionVariants(scene, stage)) settings.push_back(v);
+        for (const auto& setting : settings)
+            if (Status s = MeasureSetting(eval, setting, only, backends, rows); !s) {
+                std::fprintf(stderr, "accuracy: %s: %s\n", SettingsLabel(setting).c_str(), s.error().message.c_str());
+                return kExitFailed;
+            }
+    }
+    json doc = {{"format", "cloudbench-accuracy/1"},
+                {"scene", scene.name},
+                {"grid", {scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz}},
+                {"step", scene.steps - 1},
+                {"reference_start", "voxel-exit"},
+                {"repeats", options.repeats},
+                {"rows", json::array()}};
+    report::Report report("Accuracy of " + scene.name);
+    for (Stage stage : {Stage::Shade, Stage::Shadow}) {
+        report::Table table(ErrorColumns({"option"}, stage));
+        for (const Row& r : rows)
+            if (r.stage == stage) {
+                std::vector<report::Cell> cells = {SettingsLabel(r.settings)};
+                for (auto& cell : RowCells(r)) cells.push_back(std::move(cell));
+                table.rows.push_back(std::move(cells));
+                doc["rows"].push_back(RowJson(r));
+            }
+        if (table.rows.empty()) continue;
+        Emit(report, {stage == Stage::Shade ? "shade: |T - T_ref| over all voxels and voxels with q > 0"
+                                            : "shadow: |G - G_ref| over all ground cells and cells with G_ref < 1",
+                      {std::move(table)}});
+    }
+    if (scene.stages.Has(Stage::Shade)) {
+        auto section = RayStartSection(eval, scene, backends, doc);
+        if (!section) {
+            std::fprintf(stderr, "accuracy: %s\n", section.error().message.c_str());
+            return kExitFailed;
+        }
+        Emit(report, std::move(*section));
+    }
+    if (options.switches && scene.stages.Has(Stage::Shade)) {
+        auto sw = MeasureSwitches(eval, **session, backends);
+        if (!sw) {
+            std::fprintf(stderr, "accuracy: switches: %s\n", sw.error().message.c_str());
+            return kExitFailed;
+        }
+        Emit(report, {"Principal-axis switches: error on each side", {std::move(sw->errors)}});
+        Emit(report, {"Jump at the switch", {std::move(sw->jumps)}});
+        doc["switches"] = sw->doc;
+    }
+    doc["references"] = ReferencesJson(eval.Records(), options.cpuThreads);
+    Emit(report, {"Reference speed", {ReferenceSpeedTable(eval.Records())}});
+    doc["report"] = report::RenderJson(report);
+
+    const std::string jsonPath = (*session)->OutDir() + "/accuracy.json";
+    const std::string mdPath = (*session)->OutDir() + "/accuracy.md";
+    Status written = (*session)->WriteJson(jsonPath, doc);
+    if (written) written = Session::WriteText(mdPath, report::RenderMarkdown(report));
+    if (!written) {
+        std::fprintf(stderr, "%s\n", written.error().message.c_str());
+        return kExitFailed;
+    }
+    std::printf("results: %s %s\n", jsonPath.c_str(), mdPath.c_str());
+    return kExitOk;
+}
+
+const CommandRegistration kRegistration({
+    .name = "accuracy",
+    .summary = "Measure every shade and shadow option against the exact (Embree) reference",
+    .help = kHelp,
+    .helpOrder = 4,
+    .extraOptions = {RepeatOption(), FlagOption("--switches", &CommonOptions::switches)},
+    .run = Accuracy,
+});
+
+}  // namespace
+}  // namespace cb

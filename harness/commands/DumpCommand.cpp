@@ -1,0 +1,134 @@
+// `cloudbench dump`: every step's canonical stage outputs as NumPy .npy files
+// (docs/results.md#dumps), and with --reference the exact references.
+#include <cstdio>
+
+#include "core/Npy.h"
+#include "harness/Accuracy.h"
+#include "harness/Report.h"
+#include "harness/Session.h"
+#include "harness/Simulation.h"
+
+namespace cb {
+namespace {
+
+constexpr const char* kHelp = R"(usage: cloudbench dump [SCENE] [options]
+
+Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
+  hum.npy act.npy cld.npy  uint8 0/1, the automaton state at step t
+  region.npy               uint8, the region volume used for step t -> t+1
+  q.npy                    float32, smoothed from cld at step t
+  density.npy              float32 D, shape (1, ny, nx)
+  tiles.npy bands.npy      uint8 tile and height-band occupancy of step t
+  T.npy                    float32, the transmittance of step t
+  shadow.npy               float32 ground shadow, shape (1, ny, nx)
+  T_ref.npy shadow_ref.npy with --reference: the exact references (Embree) for
+                           T and the ground shadow, same shapes
+  frame-splat-<camera>.exr step t from each camera
+Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
+
+Options:
+  --backend NAME     the backend to dump (default: cpu)
+  --reference        also write T_ref.npy and shadow_ref.npy (docs/accuracy.md)
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>/dump)
+  --set PATH=VALUE   override a scene field (see cloudbench help run)
+  --threads N        CPU backend threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
+  --gl-context CTX   OpenGL context: osmesa (default) or egl
+  --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8
+  --quiet            no progress lines
+)";
+
+// dump --reference: T_ref.npy (with shade) and shadow_ref.npy (with shadow)
+// of the simulation's current step, computed from its q.
+Status WriteReferenceDump(const Simulation& sim, const std::string& dir, int threads) {
+    const Scene& scene = sim.GetScene();
+    const bool wantT = scene.stages.Has(Stage::Shade), wantG = scene.stages.Has(Stage::Shadow);
+    if ((!wantT && !wantG) || !sim.Q()) return {};
+    auto q = Download<float>(sim.GetBackend(), *sim.Q());
+    if (!q) return std::unexpected(q.error());
+    const Extent3 e = scene.grid.size;
+    auto tracer = ref::OpticalDepthTracer::Create(e, *q, threads);
+    if (!tracer) return std::unexpected(tracer.error());
+    const ref::ReferenceParams p = MakeReferenceParams(scene, ref::RayStart::VoxelExit);
+    auto write = [&](const std::string& path, const uint64_t(&shape)[3], const std::vector<float>& values) {
+        return Session::WriteAtomically(path, [&](const std::string& temp) {
+            return WriteNpy(temp, NpyType::F32, shape, std::as_bytes(std::span(values)));
+        });
+    };
+    if (wantT) CB_TRY(write(dir + "/T_ref.npy", {e.nz, e.ny, e.nx}, (*tracer)->Transmittance(p)));
+    if (wantG) CB_TRY(write(dir + "/shadow_ref.npy", {1, e.ny, e.nx}, (*tracer)->GroundShadow(p)));
+    return {};
+}
+
+// Writes every output of the simulation's current step into DIR/step_tttt/.
+Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOptions& options) {
+    char folder[32];
+    std::snprintf(folder, sizeof folder, "/step_%04u", s.CurrentStep());
+    const std::string dir = outDir + folder;
+    CB_TRY(MakeFolder(dir));
+    const std::pair<const char*, const Buffer*> arrays[] = {
+        {"hum.npy", s.Hum()}, {"act.npy", s.Act()},           {"cld.npy", s.Cld()},     {"region.npy", s.Region()},
+        {"q.npy", s.Q()},     {"density.npy", s.ColumnSum()}, {"tiles.npy", s.Tiles()}, {"bands.npy", s.Bands()},
+        {"T.npy", s.T()},     {"shadow.npy", s.Shadow()},
+    };
+    for (const auto& [file, buffer] : arrays)
+        if (buffer) CB_TRY(Session::WriteNpy(dir + "/" + file, s.GetBackend(), *buffer));
+    if (options.reference) CB_TRY(WriteReferenceDump(s, dir, options.cpuThreads));
+    const Scene& scene = s.GetScene();
+    for (size_t n = 0; s.Image(n); ++n) {
+        auto rgb = Download<float>(s.GetBackend(), *s.Image(n));
+        if (!rgb) return std::unexpected(rgb.error());
+        const std::string stem = dir + "/" + FrameFileStem(Stage::RenderSplat, scene.render.cameras[n].name);
+        auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, /*png=*/false);
+        if (!paths) return std::unexpected(paths.error());
+    }
+    return {};
+}
+
+int Dump(const CommonOptions& options) {
+    auto session = Session::Open(options, "dump");
+    if (!session) return session.error();
+    const Scene& scene = (*session)->GetScene();
+    if (options.backends.size() > 1) {
+        std::fprintf(stderr, "dump: --backend takes one backend, got %zu\n", options.backends.size());
+        return kExitUsage;
+    }
+    std::vector<OpenedBackend> opened = (*session)->OpenBackends((*session)->RequestedBackends({"cpu"}));
+    Backend* backend = opened[0].backend.get();
+    if (!backend) return kExitNoBackend;
+    const std::string& name = opened[0].name;
+    const std::string& outDir = (*session)->OutDir();
+    auto sim = Simulation::Create(scene, *backend, /*everyStepOutputs=*/true);
+    if (!sim) {
+        std::fprintf(stderr, "%s\n", sim.error().message.c_str());
+        return kExitFailed;
+    }
+    auto observe = [&](const Simulation& s) { return WriteStep(s, outDir, options); };
+    Progress progress("dump " + name, scene.steps, options.quiet);
+    for (uint32_t t = 0; t < scene.steps; ++t) {
+        StepRecord record;
+        if (Status s = (*sim)->Step(record, observe); !s) {
+            std::fprintf(stderr, "dump stopped at step %u: %s (steps before it are in %s)\n", t,
+                         s.error().message.c_str(), outDir.c_str());
+            return kExitFailed;
+        }
+        progress.Update(t + 1);
+    }
+    const Extent3 g = scene.grid.size;
+    std::printf("dumped %u steps of scene %s (%ux%ux%u, backend %s) to %s/step_0000 .. step_%04u\n", scene.steps,
+                scene.name.c_str(), g.nx, g.ny, g.nz, name.c_str(), outDir.c_str(), scene.steps - 1);
+    return kExitOk;
+}
+
+const CommandRegistration kRegistration({
+    .name = "dump",
+    .summary = "Write each step's canonical stage outputs as NumPy .npy files",
+    .help = kHelp,
+    .helpOrder = 1,
+    .extraOptions = {FlagOption("--reference", &CommonOptions::reference)},
+    .run = Dump,
+});
+
+}  // namespace
+}  // namespace cb

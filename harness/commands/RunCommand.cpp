@@ -1,0 +1,155 @@
+// `cloudbench run`: runs a scene on each backend, times every stage, writes
+// results.json, the last frame of each camera and a top view of the density map.
+#include <cstdio>
+
+#include "harness/Report.h"
+#include "harness/Session.h"
+#include "harness/Simulation.h"
+
+namespace cb {
+namespace {
+
+constexpr const char* kHelp = R"(usage: cloudbench run [SCENE] [options]
+
+Runs SCENE (a name in scenes/ or a path to a .json file; default: thesis-medium)
+on each backend, prints a per-stage timing table (median and spread over the
+steps after warm-up), each camera's frame rate and the cloud cover, and writes
+DIR/results.json, the last frame of each camera (DIR/frame-splat-<camera>-<backend>
+.exr and .png) and a top view of the last density map, DIR/topview-<backend>.png.
+
+Options:
+  --backend LIST     comma-separated backends (cpu, gl, vk); default: all built.
+                     An unavailable backend is reported and the others still run.
+  --steps N          number of steps (same as --set steps=N)
+  --out DIR          output folder (default: out/<scene name>)
+  --set PATH=VALUE   override a scene field by its dotted path, validated like
+                     the file: --set ca.seed=42 --set grid.size=[64,16,64]
+  --threads N        CPU backend threads (default: all)
+  --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
+  --gl-context CTX   OpenGL context: osmesa (default, llvmpipe) or egl (GPU or surfaceless)
+  --gl-ca-layout L   OpenGL automaton layout: packed (default; R32UI, 32 voxels a texel)
+                     or rgba8 (the thesis's: one RGBA8 texel a voxel, a channel a bit)
+  --quiet            no progress lines
+)";
+
+// Steps the simulation to the end, then writes the last frame of each camera
+// and the top view; whatever fails is recorded in `run` and the rest goes on.
+// Returns false when an output could not be written.
+bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::vector<std::string>& written) {
+    const Scene& scene = session.GetScene();
+    const std::string& outDir = session.OutDir();
+    auto sim = Simulation::Create(scene, backend);
+    if (!sim) {
+        run.status = "failed";
+        run.error = sim.error().message;
+        return true;
+    }
+    Progress progress(run.name, scene.steps, session.Options().quiet);
+    for (uint32_t t = 0; t < scene.steps; ++t) {
+        StepRecord record;
+        if (Status status = (*sim)->Step(record); !status) {
+            run.status = "failed";
+            run.error = "step " + std::to_string(t) + ": " + status.error().message;
+            break;
+        }
+        run.steps.push_back(record);
+        progress.Update(t + 1);
+    }
+    bool allWritten = true;
+    auto failed = [&](const Error& error) {
+        std::fprintf(stderr, "%s\n", error.message.c_str());
+        allWritten = false;
+    };
+    if ((*sim)->LastRenderedStep()) {
+        for (size_t n = 0; n < scene.render.cameras.size(); ++n) {
+            auto rgb = Download<float>(backend, *(*sim)->Image(n), &run.downloadMs);
+            if (!rgb) {
+                failed(rgb.error());
+                continue;
+            }
+            const std::string stem =
+                outDir + "/" + FrameFileStem(Stage::RenderSplat, scene.render.cameras[n].name, run.name);
+            auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height);
+            if (paths)
+                written.insert(written.end(), paths->begin(), paths->end());
+            else
+                failed(paths.error());
+        }
+    }
+    // The density map of the last step, seen from above.
+    if (const Buffer* columnSum = (*sim)->ColumnSum(); columnSum && !run.steps.empty()) {
+        auto d = Download<float>(backend, *columnSum, &run.downloadMs);
+        const std::string png = outDir + "/topview-" + run.name + ".png";
+        Status s = d ? WriteTopView(png, *d, scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz)
+                     : Status(std::unexpected(d.error()));
+        if (s)
+            written.push_back(png);
+        else
+            failed(s.error());
+    }
+    return allWritten;
+}
+
+int Run(const CommonOptions& options) {
+    auto session = Session::Open(options, "");
+    if (!session) return session.error();
+    const Scene& scene = (*session)->GetScene();
+    if (!(*session)->MakeOutDir()) return kExitFailed;
+    std::printf("scene %s: %ux%ux%u voxels, %u steps (%u warm-up)\n", scene.name.c_str(), scene.grid.size.nx,
+                scene.grid.size.ny, scene.grid.size.nz, scene.steps, scene.warmupSteps);
+
+    std::vector<OpenedBackend> backends =
+        (*session)->OpenBackends((*session)->RequestedBackends(BuiltBackends()), &scene);
+    std::vector<BackendRun> runs;
+    std::vector<std::string> written;
+    bool anyAvailable = false, anyFailed = false;
+    for (OpenedBackend& opened : backends) {
+        BackendRun run;
+        run.name = opened.name;
+        if (!opened.backend) {
+            run.status = std::string(BackendStatusName(opened.status));
+            run.error = opened.reason;
+            runs.push_back(std::move(run));
+            continue;
+        }
+        anyAvailable = true;
+        run.device = opened.backend->Device();
+        anyFailed |= !RunBackend(**session, *opened.backend, run, written);
+        opened.backend.reset();  // its memory goes back before the next backend runs
+        if (run.status == "failed") {
+            anyFailed = true;
+            std::fprintf(stderr, "backend %s failed: %s\n", run.name.c_str(), run.error.c_str());
+        }
+        std::printf("%s", report::RenderText(TimingSection(scene, run)).c_str());
+        runs.push_back(std::move(run));
+    }
+
+    report::Report timing("Run of " + scene.name);
+    for (const BackendRun& run : runs)
+        if (run.status == "ok" || run.status == "failed") timing.sections.push_back(TimingSection(scene, run));
+    nlohmann::json doc = ResultsJson(scene, runs);
+    doc["report"] = report::RenderJson(timing);
+    const std::string resultsPath = (*session)->OutDir() + "/results.json";
+    if (Status s = (*session)->WriteJson(resultsPath, doc); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    written.insert(written.begin(), resultsPath);
+    std::printf("results:");
+    for (const std::string& path : written) std::printf(" %s", path.c_str());
+    std::printf("\n");
+    if (!anyAvailable) return kExitNoBackend;
+    return anyFailed ? kExitFailed : kExitOk;
+}
+
+const CommandRegistration kRegistration({
+    .name = "run",
+    .summary = "Run a scene on one or more backends, time every stage, write results.json",
+    .help = kHelp,
+    .helpOrder = 0,
+    .keepsWarmup = true,
+    .run = Run,
+});
+
+}  // namespace
+}  // namespace cb
