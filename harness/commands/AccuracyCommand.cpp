@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "core/SceneNames.h"
 #include "harness/Measurement.h"
 #include "harness/StageParams.h"
 
