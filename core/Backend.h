@@ -89,12 +89,18 @@ struct DensityOutputs {
     Buffer* columnSum = nullptr;  // F32, (nx, ny, 1): D
     Buffer* tiles = nullptr;      // U8, (ceil(nx/T), ceil(ny/T), 1): 1 iff D > 0 in the tile
     Buffer* bands = nullptr;      // U8, (ceil(nx/T), ceil(ny/T), ceil(nz/B)): 1 iff q > 0 in tile x band
-    uint32_t coveredColumns = 0;  // columns (i, j) with any cld = 1
+    uint32_t coveredColumns = 0;  // columns (i, j) with any cld = 1; without cld, with D > 0
 };
 
 struct DensityParams {
     uint32_t tile = 32;
     uint32_t band = 4;
+};
+
+// Inputs of the noise producer of q (SPEC 10a). The noise settings themselves
+// arrive with the stage (issue 13); a step index is its time coordinate.
+struct NoiseParams {
+    uint32_t step = 0;
 };
 
 // Inputs of the shade stage (SPEC 6) besides q.
@@ -165,7 +171,9 @@ struct SplatStats {
 //   CaInitialize  the automaton's state at t = 0.
 //   CaStep        one step t -> t+1; `in` and `out` must be distinct buffers.
 //   Smooth        q (F32) from cld (Bits); radius 0, 1 or 2.
-//   Density       D, this step's tile and band occupancy from q, and cover from cld.
+//   Density       D, this step's tile and band occupancy from q, and the cover:
+//                 columns with any cld = 1, or without an automaton (cld null)
+//                 columns with D > 0.
 //   Shade         T (F32, grid size) from q.
 //   Shadow        G (F32, (nx, ny, 1)) from D.
 //   RenderSplat   a linear RGB image, F32 with extent (3, width, height):
@@ -175,13 +183,17 @@ struct SplatStats {
     X(Ca, CaInitialize, (const CaInitParams& params, CaFields out))                                             \
     X(Ca, CaStep, (const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out))           \
     X(Smooth, Smooth, (int radius, const Buffer& cld, Buffer& q))                                               \
-    X(Density, Density, (const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out)) \
+    X(Density, Density, (const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out)) \
     X(Shade, Shade, (const ShadeParams& params, const Buffer& q, Buffer& T))                                    \
     X(Shadow, Shadow, (const ShadowParams& params, const Buffer& columnSum, Buffer& G))                         \
     X(RenderSplat, RenderSplat, (const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats))
 
-// Every entry point; the ray-march path's stages join here (issue 13).
-#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X)
+// The producers of q other than the automaton and smoothing. Noise  q (F32,
+// grid size) formed from noise (SPEC 10a); no backend implements it yet.
+#define CB_NOISE_ENTRIES(X) X(Noise, Noise, (const NoiseParams& params, Buffer& q))
+
+// Every entry point; the ray marcher joins here (issue 13).
+#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X) CB_NOISE_ENTRIES(X)
 
 // In a backend's class: declares the override of one entry.
 #define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;

@@ -12,7 +12,8 @@ namespace cb {
 std::string_view ResourceName(Resource resource) {
     switch (resource) {
 #define CB_RESOURCE_NAME(name, text, format) \
-    case Resource::name: return text;
+    case Resource::name:                     \
+        return text;
         CB_RESOURCES(CB_RESOURCE_NAME)
 #undef CB_RESOURCE_NAME
     }
@@ -22,7 +23,8 @@ std::string_view ResourceName(Resource resource) {
 BufferFormat ResourceFormat(Resource resource) {
     switch (resource) {
 #define CB_RESOURCE_FORMAT(name, text, format) \
-    case Resource::name: return BufferFormat::format;
+    case Resource::name:                       \
+        return BufferFormat::format;
         CB_RESOURCES(CB_RESOURCE_FORMAT)
 #undef CB_RESOURCE_FORMAT
     }
@@ -40,13 +42,18 @@ Extent3 ResourceExtent(Resource resource, const Scene& scene) {
         case Resource::Act:
         case Resource::Cld:
         case Resource::Q:
-        case Resource::T: return grid;
+        case Resource::T:
+            return grid;
         case Resource::ColumnSum:
-        case Resource::Shadow: return {grid.nx, grid.ny, 1};
-        case Resource::Tiles: return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), 1};
-        case Resource::Bands: return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), CeilDiv(grid.nz, band)};
+        case Resource::Shadow:
+            return {grid.nx, grid.ny, 1};
+        case Resource::Tiles:
+            return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), 1};
+        case Resource::Bands:
+            return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), CeilDiv(grid.nz, band)};
         case Resource::SplatImage:
-        case Resource::MarchImage: return {3, scene.render.width, scene.render.height};
+        case Resource::MarchImage:
+            return {3, scene.render.width, scene.render.height};
     }
     return grid;
 }
@@ -56,15 +63,18 @@ std::string CompareRule::Text(std::string_view symbol) const {
     std::string d = "|d";
     d.append(symbol).append("|");
     switch (kind) {
-        case Kind::BitExact: return "bit-exact";
-        case Kind::Absolute: std::snprintf(text, sizeof text, "%s <= %g", d.c_str(), tolerance); break;
+        case Kind::BitExact:
+            return "bit-exact";
+        case Kind::Absolute:
+            std::snprintf(text, sizeof text, "%s <= %g", d.c_str(), tolerance);
+            break;
         case Kind::Quantised:
             std::snprintf(text, sizeof text, "%s <= %g, <= %g %% differ", d.c_str(), tolerance, share * 100);
             break;
         case Kind::Image:
             if (tolerance * 255 == double(int(tolerance * 255)) && limit * 255 == double(int(limit * 255)))
-                std::snprintf(text, sizeof text, "%d/255 on %g %%, %d/255 max", int(tolerance * 255),
-                              100 - share * 100, int(limit * 255));
+                std::snprintf(text, sizeof text, "%d/255 on %g %%, %d/255 max", int(tolerance * 255), 100 - share * 100,
+                              int(limit * 255));
             else if (std::isinf(limit))
                 std::snprintf(text, sizeof text, "%g on %g %%", tolerance, 100 - share * 100);
             else

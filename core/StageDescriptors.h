@@ -19,18 +19,18 @@
 namespace cb {
 
 // X(Enum, "name", format): the buffers that pass between stages (SPEC 0).
-#define CB_RESOURCES(X)                                                    \
-    X(Region, "region", U8)     /* R: region weights, grid */              \
-    X(Hum, "hum", Bits)         /* automaton fields, grid */               \
-    X(Act, "act", Bits)                                                    \
-    X(Cld, "cld", Bits)                                                    \
-    X(Q, "q", F32)              /* density in [0, 1], grid */              \
-    X(ColumnSum, "D", F32)      /* column sums, (nx, ny, 1) */             \
-    X(Tiles, "tiles", U8)       /* tile occupancy, (tx, ty, 1) */          \
-    X(Bands, "bands", U8)       /* tile x band occupancy, (tx, ty, bz) */  \
-    X(T, "T", F32)              /* transmittance toward the sun, grid */   \
-    X(Shadow, "G", F32)         /* ground shadow, (nx, ny, 1) */           \
-    X(SplatImage, "image_splat", F32) /* (3, width, height) per camera */  \
+#define CB_RESOURCES(X)                                                         \
+    X(Region, "region", U8) /* R: region weights, grid */                       \
+    X(Hum, "hum", Bits)     /* automaton fields, grid */                        \
+    X(Act, "act", Bits)                                                         \
+    X(Cld, "cld", Bits)                                                         \
+    X(Q, "q", F32)                    /* density in [0, 1], grid */             \
+    X(ColumnSum, "D", F32)            /* column sums, (nx, ny, 1) */            \
+    X(Tiles, "tiles", U8)             /* tile occupancy, (tx, ty, 1) */         \
+    X(Bands, "bands", U8)             /* tile x band occupancy, (tx, ty, bz) */ \
+    X(T, "T", F32)                    /* transmittance toward the sun, grid */  \
+    X(Shadow, "G", F32)               /* ground shadow, (nx, ny, 1) */          \
+    X(SplatImage, "image_splat", F32) /* (3, width, height) per camera */       \
     X(MarchImage, "image_march", F32)
 
 enum class Resource : uint8_t {
@@ -58,10 +58,10 @@ bool IsPerCamera(Resource resource);
 // tolerance; images by SPEC 8's (or SPEC 10's) pixel-share rule.
 struct CompareRule {
     enum class Kind : uint8_t {
-        BitExact,     // every element equal
-        Absolute,     // |d| <= tolerance everywhere
-        Quantised,    // |d| <= tolerance everywhere, and at most `share` of elements differ at all
-        Image,        // per channel |d| <= tolerance on at least 1 - share of pixels, <= limit everywhere
+        BitExact,   // every element equal
+        Absolute,   // |d| <= tolerance everywhere
+        Quantised,  // |d| <= tolerance everywhere, and at most `share` of elements differ at all
+        Image,      // per channel |d| <= tolerance on at least 1 - share of pixels, <= limit everywhere
     };
     Kind kind = Kind::BitExact;
     double tolerance = 0;
@@ -74,8 +74,8 @@ struct CompareRule {
 
 struct StageDescriptor {
     Stage stage;
-    std::string_view section;               // the scene section of its settings ("" for none)
-    std::vector<Resource> reads;            // this step's values
+    std::string_view section;     // the scene section of its settings ("" for none)
+    std::vector<Resource> reads;  // this step's values
     // Read when some enabled stage writes them, and not needed otherwise
     // (density's cover comes from cld with an automaton, from q without).
     std::vector<Resource> optionalReads;
@@ -92,7 +92,7 @@ struct StageDescriptor {
     bool skipsUnchangedInputs = false;
     // A renderer: writes one image per camera.
     bool renderer = false;
-    std::string_view symbol;                // the compared quantity in rule texts ("R", "T", ...)
+    std::string_view symbol;  // the compared quantity in rule texts ("R", "T", ...)
     // The comparison for this scene (shade's tolerance depends on its storage format).
     CompareRule (*rule)(const Scene& scene) = nullptr;
 };

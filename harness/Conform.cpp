@@ -188,7 +188,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
                     auto bands = b.CreateBuffer(BufferFormat::U8, s.Bands()->Extent());
                     if (!q || !cld || !D || !tiles || !bands) return MakeError("density: allocation failed");
                     DensityOutputs out{D->get(), tiles->get(), bands->get(), 0};
-                    CB_TRY(b.Density({scene.density.tile, scene.density.band}, **q, **cld, out));
+                    CB_TRY(b.Density({scene.density.tile, scene.density.band}, **q, cld->get(), out));
                     tally.Exact("density", c.name, t, s.ColumnSum()->Extent(), *Read<float>(cpu, *s.ColumnSum()),
                                 *Read<float>(b, **D));
                     tally.Exact("density", c.name, t, s.Tiles()->Extent(), *Read<uint8_t>(cpu, *s.Tiles()),

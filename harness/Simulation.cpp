@@ -23,8 +23,12 @@ Status Timed(StepRecord& record, Stage stage, const Backend& backend, Fn&& fn) {
 }  // namespace
 
 Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs)
-    : mScene(scene), mBackend(backend), mPlan(PlanResources(scene)), mSchedule(ScheduleStages(scene.stages)),
-      mEllipsoids(scene.ellipsoids, scene.grid.size), mEveryStepOutputs(everyStepOutputs) {}
+    : mScene(scene),
+      mBackend(backend),
+      mPlan(PlanResources(scene)),
+      mSchedule(ScheduleStages(scene.stages)),
+      mEllipsoids(scene.ellipsoids, scene.grid.size),
+      mEveryStepOutputs(everyStepOutputs) {}
 
 bool Simulation::IsOutputStep(uint32_t step) const {
     if (mEveryStepOutputs || !mScene.stages.Has(Stage::RenderSplat)) return true;
@@ -167,7 +171,7 @@ Status Simulation::RunStage(Stage stage, StepRecord& record) {
         case Stage::Density: {
             DensityOutputs out{&Out(Resource::ColumnSum), &Out(Resource::Tiles), &Out(Resource::Bands), 0};
             const DensityParams params = MakeDensityParams(sc);
-            CB_TRY(timed([&] { return mBackend.Density(params, In(Resource::Q), In(Resource::Cld), out); }));
+            CB_TRY(timed([&] { return mBackend.Density(params, In(Resource::Q), Get(Resource::Cld), out); }));
             record.coveredColumns = out.coveredColumns;
             return {};
         }
@@ -179,9 +183,14 @@ Status Simulation::RunStage(Stage stage, StepRecord& record) {
             const ShadowParams p = MakeShadowParams(sc);
             return timed([&] { return mBackend.Shadow(p, In(Resource::ColumnSum), Out(Resource::Shadow)); });
         }
-        case Stage::RenderSplat: return RenderSplatFrames(record);
+        case Stage::RenderSplat:
+            return RenderSplatFrames(record);
+        case Stage::Noise: {
+            const NoiseParams p{mStep};
+            return timed([&] { return mBackend.Noise(p, Out(Resource::Q)); });
+        }
         case Stage::RenderMarch:
-        case Stage::Noise: break;
+            break;
     }
     return MakeError("the simulation cannot run stage '" + std::string(StageName(stage)) + "' yet");
 }
@@ -195,7 +204,7 @@ Status Simulation::RenderSplatFrames(StepRecord& record) {
         // The order is host work shared by all backends, outside the stage time.
         const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
         p.order = &order;
-        const SplatInputs in{Previous(Resource::Q), Get(Resource::Q),        Get(Resource::T),
+        const SplatInputs in{Previous(Resource::Q),     Get(Resource::Q),     Get(Resource::T),
                              Previous(Resource::Tiles), Get(Resource::Tiles), Previous(Resource::Bands),
                              Get(Resource::Bands)};
         FrameRecord frame;

@@ -30,7 +30,6 @@
 
 namespace cb {
 
-
 // One rendered image.
 struct FrameRecord {
     std::string camera;
@@ -44,7 +43,7 @@ struct StepRecord {
     std::array<std::optional<double>, kStageCount> stageMs{};
     // Device time of each stage in ms, where the backend measures it.
     std::array<std::optional<double>, kStageCount> deviceMs{};
-    double ellipsoidUpdateMs = 0;           // host-side list update
+    double ellipsoidUpdateMs = 0;            // host-side list update
     std::optional<uint32_t> coveredColumns;  // from the density stage
     std::vector<FrameRecord> frames;         // render_splat, one per camera
 };

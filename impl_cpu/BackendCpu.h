@@ -33,7 +33,8 @@ class BufferCpu final : public Buffer {
     std::vector<float> mF32;
 };
 
-class BackendCpu final : public Backend {
+// Not final: tests derive test-only stages from it (a producer of q other than smooth).
+class BackendCpu : public Backend {
   public:
     // threads = 0: all hardware threads.
     explicit BackendCpu(int threads = 0);

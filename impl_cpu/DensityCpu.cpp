@@ -1,12 +1,12 @@
 // Stage `density` on the CPU (SPEC 5): column sums, tile and band occupancy,
 // and cloud cover. Work is split by rows of tiles, so each task owns its
 // outputs and no two tasks write the same byte.
-#include <algorithm>
-#include <bit>
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <bit>
 
 #include "impl_cpu/BackendCpu.h"
 
@@ -31,13 +31,36 @@ void TileFlags(const float* values, uint32_t nx, uint32_t rows, uint32_t T, std:
     }
 }
 
+// Columns (i, j) with any cld = 1: the OR of a column's slices, counted a word at a time.
+uint32_t CoveredColumns(const BitField& cld, const Extent3& e) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<uint32_t>(0, e.ny, 8), 0u,
+        [&](const tbb::blocked_range<uint32_t>& rows, uint32_t count) {
+            std::vector<uint64_t> columns(cld.WordsPerRow());
+            for (uint32_t j = rows.begin(); j != rows.end(); ++j) {
+                std::fill(columns.begin(), columns.end(), 0);
+                for (uint32_t k = 0; k < e.nz; ++k) {
+                    const uint64_t* row = cld.Row(j, k);
+                    for (uint32_t w = 0; w < cld.WordsPerRow(); ++w) columns[w] |= row[w];
+                }
+                for (uint64_t word : columns) count += uint32_t(std::popcount(word));
+            }
+            return count;
+        },
+        [](uint32_t a, uint32_t b) { return a + b; });
+}
+
+// Columns with D > 0 (the cover of a scene without an automaton).
+uint32_t ColumnsAboveZero(const float* D, size_t columns) {
+    return uint32_t(std::count_if(D, D + columns, [](float d) { return d > 0.0f; }));
+}
+
 }  // namespace
 
-Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer& cldBuffer,
+Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer* cldBuffer,
                            DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("cpu: density tile and band must be positive");
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
-    const BitField& cld = static_cast<const BufferCpu&>(cldBuffer).Bits();
     float* D = static_cast<BufferCpu&>(*out.columnSum).F32();
     uint8_t* tiles = static_cast<BufferCpu&>(*out.tiles).U8();
     uint8_t* bands = static_cast<BufferCpu&>(*out.bands).U8();
@@ -47,62 +70,50 @@ Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, c
     const size_t sliceSize = size_t(e.nx) * e.ny;
 
     mArena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, tilesY, 1), [&](const tbb::blocked_range<uint32_t>& tileRows) {
-            // The columns of one row of tiles are contiguous in D and in each
-            // slice of q, so every inner loop runs over T*nx consecutive floats.
-            std::vector<float> bandMax;  // per column: the largest q within the current band
-            std::vector<float> columnMax;
-            for (uint32_t ty = tileRows.begin(); ty != tileRows.end(); ++ty) {
-                const uint32_t j0 = ty * T, j1 = std::min(e.ny, j0 + T);
-                const size_t count = size_t(j1 - j0) * e.nx;
-                float* d = D + size_t(e.nx) * j0;
-                std::fill(d, d + count, 0.0f);
-                bandMax.resize(count);
-                for (uint32_t b = 0; b < bandCount; ++b) {
-                    std::fill(bandMax.begin(), bandMax.end(), 0.0f);
-                    const uint32_t kEnd = std::min(e.nz, (b + 1) * B);
-                    // k ascending, the order every backend sums in; four slices per
-                    // pass so that d and bandMax are loaded and stored once per four.
-                    uint32_t k = b * B;
-                    for (; k + 4 <= kEnd; k += 4) {
-                        const float* s0 = q + sliceSize * k + size_t(e.nx) * j0;
-                        const float *s1 = s0 + sliceSize, *s2 = s1 + sliceSize, *s3 = s2 + sliceSize;
-                        float* m = bandMax.data();
-                        for (size_t n = 0; n < count; ++n) {
-                            d[n] = (((d[n] + s0[n]) + s1[n]) + s2[n]) + s3[n];
-                            m[n] = std::max(std::max(m[n], s0[n]), std::max(s1[n], std::max(s2[n], s3[n])));
+        tbb::parallel_for(
+            tbb::blocked_range<uint32_t>(0, tilesY, 1), [&](const tbb::blocked_range<uint32_t>& tileRows) {
+                // The columns of one row of tiles are contiguous in D and in each
+                // slice of q, so every inner loop runs over T*nx consecutive floats.
+                std::vector<float> bandMax;  // per column: the largest q within the current band
+                std::vector<float> columnMax;
+                for (uint32_t ty = tileRows.begin(); ty != tileRows.end(); ++ty) {
+                    const uint32_t j0 = ty * T, j1 = std::min(e.ny, j0 + T);
+                    const size_t count = size_t(j1 - j0) * e.nx;
+                    float* d = D + size_t(e.nx) * j0;
+                    std::fill(d, d + count, 0.0f);
+                    bandMax.resize(count);
+                    for (uint32_t b = 0; b < bandCount; ++b) {
+                        std::fill(bandMax.begin(), bandMax.end(), 0.0f);
+                        const uint32_t kEnd = std::min(e.nz, (b + 1) * B);
+                        // k ascending, the order every backend sums in; four slices per
+                        // pass so that d and bandMax are loaded and stored once per four.
+                        uint32_t k = b * B;
+                        for (; k + 4 <= kEnd; k += 4) {
+                            const float* s0 = q + sliceSize * k + size_t(e.nx) * j0;
+                            const float *s1 = s0 + sliceSize, *s2 = s1 + sliceSize, *s3 = s2 + sliceSize;
+                            float* m = bandMax.data();
+                            for (size_t n = 0; n < count; ++n) {
+                                d[n] = (((d[n] + s0[n]) + s1[n]) + s2[n]) + s3[n];
+                                m[n] = std::max(std::max(m[n], s0[n]), std::max(s1[n], std::max(s2[n], s3[n])));
+                            }
                         }
-                    }
-                    for (; k < kEnd; ++k) {
-                        const float* slice = q + sliceSize * k + size_t(e.nx) * j0;
-                        for (size_t n = 0; n < count; ++n) {
-                            d[n] += slice[n];
-                            bandMax[n] = std::max(bandMax[n], slice[n]);
+                        for (; k < kEnd; ++k) {
+                            const float* slice = q + sliceSize * k + size_t(e.nx) * j0;
+                            for (size_t n = 0; n < count; ++n) {
+                                d[n] += slice[n];
+                                bandMax[n] = std::max(bandMax[n], slice[n]);
+                            }
                         }
+                        uint8_t* bandRow = bands + tilesX * (ty + size_t(tilesY) * b);
+                        TileFlags(bandMax.data(), e.nx, j1 - j0, T, columnMax, bandRow);
                     }
-                    uint8_t* bandRow = bands + tilesX * (ty + size_t(tilesY) * b);
-                    TileFlags(bandMax.data(), e.nx, j1 - j0, T, columnMax, bandRow);
+                    uint8_t* tileRow = tiles + size_t(tilesX) * ty;
+                    TileFlags(d, e.nx, j1 - j0, T, columnMax, tileRow);
                 }
-                uint8_t* tileRow = tiles + size_t(tilesX) * ty;
-                TileFlags(d, e.nx, j1 - j0, T, columnMax, tileRow);
-            }
-        });
+            });
 
-        out.coveredColumns = tbb::parallel_reduce(
-            tbb::blocked_range<uint32_t>(0, e.ny, 8), 0u,
-            [&](const tbb::blocked_range<uint32_t>& rows, uint32_t count) {
-                std::vector<uint64_t> columns(cld.WordsPerRow());
-                for (uint32_t j = rows.begin(); j != rows.end(); ++j) {
-                    std::fill(columns.begin(), columns.end(), 0);
-                    for (uint32_t k = 0; k < e.nz; ++k) {
-                        const uint64_t* row = cld.Row(j, k);
-                        for (uint32_t w = 0; w < cld.WordsPerRow(); ++w) columns[w] |= row[w];
-                    }
-                    for (uint64_t word : columns) count += uint32_t(std::popcount(word));
-                }
-                return count;
-            },
-            [](uint32_t a, uint32_t b) { return a + b; });
+        out.coveredColumns = cldBuffer ? CoveredColumns(static_cast<const BufferCpu&>(*cldBuffer).Bits(), e)
+                                       : ColumnsAboveZero(D, size_t(e.nx) * e.ny);
     });
     return {};
 }

@@ -2,7 +2,7 @@
 
 namespace cb::gl {
 
-Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) {
+Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
     const Functions& f = mContext->F();
     auto sum = mContext->Program("density_sum");
@@ -42,7 +42,10 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     const GLuint flags = Scratch(GlScratch::CoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
     CB_TRY(BindTargets({{flags, 0}}));
     f.UseProgram(*cover);
-    f.BindTextureUnit(0, Tex(cld).Texture());
+    // Without cld the cover counts columns with D > 0 and leaves the cld unit unbound.
+    f.BindTextureUnit(0, cld ? Tex(*cld).Texture() : 0);
+    f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
+    f.Uniform1i(f.GetUniformLocation(*cover, "fromCld"), cld ? 1 : 0);
     f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
     f.DrawArrays(GL_TRIANGLES, 0, 3);
 

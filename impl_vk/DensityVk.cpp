@@ -4,7 +4,7 @@
 
 namespace cb::vk {
 
-Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Buffer& cld, DensityOutputs& out) {
+Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("vk: density tile and band must be positive");
     const Extent3 e = q.Extent();
     auto columns = mContext->GetPipeline("density", 4);
@@ -16,12 +16,13 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
     struct {
-        uint32_t nx, ny, nz, words;
-    } columnPush{e.nx, e.ny, e.nz, (e.nx + 31) / 32};
+        uint32_t nx, ny, nz, words, fromCld;
+    } columnPush{e.nx, e.ny, e.nz, (e.nx + 31) / 32, cld ? 1u : 0u};
     struct {
         uint32_t nx, ny, nz, tile, band, tilesX, tilesY, bandCount;
     } occupancyPush{e.nx, e.ny, e.nz, params.tile, params.band, tilesX, tilesY, bandCount};
-    const DeviceBuffer* columnBuffers[] = {&Dev(q), &Dev(cld), &Dev(*out.columnSum), *counter};
+    // Without cld the cover counts columns with D > 0; q stands in at the unused binding.
+    const DeviceBuffer* columnBuffers[] = {&Dev(q), &Dev(cld ? *cld : q), &Dev(*out.columnSum), *counter};
     const DeviceBuffer* occupancyBuffers[] = {&Dev(q), &Dev(*out.columnSum), &Dev(*out.tiles), &Dev(*out.bands)};
     CB_TRY(Record("density", [&](VulkanContext::Recorder& r) {
         r.Fill(**counter, 0);

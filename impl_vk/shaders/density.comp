@@ -1,12 +1,13 @@
 #version 450
 // Stage `density` (SPEC 5), columns: D = sum of q over k ascending (the order
-// every backend sums in), and the cover count from cld.
+// every backend sums in), and the cover count: columns with any cld = 1, or
+// with D > 0 when the scene has no automaton (fromCld = 0; cld is then unused).
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Q { float q[]; };
 layout(std430, binding = 1) readonly buffer Cld { uint cld[]; };
 layout(std430, binding = 2) writeonly buffer D { float d[]; };
 layout(std430, binding = 3) buffer Cover { uint covered; };
-layout(push_constant) uniform Params { uint nx, ny, nz, words; } pc;
+layout(push_constant) uniform Params { uint nx, ny, nz, words, fromCld; } pc;
 
 void main() {
     const uint column = gl_GlobalInvocationID.x;
@@ -16,8 +17,9 @@ void main() {
     uint any = 0u;
     for (uint k = 0u; k < pc.nz; ++k) {
         sum += q[column + pc.nx * pc.ny * k];
-        any |= (cld[(i >> 5) + pc.words * (j + pc.ny * k)] >> (i & 31u)) & 1u;
+        if (pc.fromCld != 0u) any |= (cld[(i >> 5) + pc.words * (j + pc.ny * k)] >> (i & 31u)) & 1u;
     }
+    if (pc.fromCld == 0u) any = sum > 0.0 ? 1u : 0u;
     d[column] = sum;
     if (any != 0u) atomicAdd(covered, 1u);
 }
