@@ -2,25 +2,9 @@
 
 #include <chrono>
 
-#include "core/Random.h"
 #include "harness/StageParams.h"
 
 namespace cb {
-namespace {
-
-// Runs one stage call and records its wall time.
-template <typename Fn>
-Status Timed(StepRecord& record, Stage stage, const Backend& backend, Fn&& fn) {
-    auto start = std::chrono::steady_clock::now();
-    Status status = fn();
-    std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
-    record.stageMs[size_t(stage)] = elapsed.count();
-    record.deviceMs[size_t(stage)] = backend.LastDeviceMs();
-    if (!status) return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
-    return {};
-}
-
-}  // namespace
 
 Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs)
     : mScene(scene),
@@ -80,12 +64,6 @@ Status Simulation::InitializeState() {
     if (!mScene.stages.Has(Stage::Ca)) return {};
     const CaInitParams init = MakeCaInitParams(mScene);
     CB_TRY(mBackend.CaInitialize(init, {&Out(Resource::Hum), &Out(Resource::Act), &Out(Resource::Cld)}));
-    if (mScene.ca.HasWind()) {
-        for (const SliceShift& s : mScene.ca.windShift) {
-            mShiftX.push_back(s.sx);
-            mShiftY.push_back(s.sy);
-        }
-    }
     return {};
 }
 
@@ -149,77 +127,26 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     return {};
 }
 
-Status Simulation::RunStage(Stage stage, StepRecord& record) {
-    const Scene& sc = mScene;
-    auto timed = [&](auto&& call) { return Timed(record, stage, mBackend, call); };
-    switch (stage) {
-        case Stage::Region:
-            mRaster = mEllipsoids.Raster();
-            return timed([&] { return mBackend.Region(mRaster, Out(Resource::Region)); });
-        case Stage::Ca: {
-            CaStepParams params = MakeCaStepParams(sc, mStep);
-            params.shiftX = mShiftX;
-            params.shiftY = mShiftY;
-            return timed([&] {
-                return mBackend.CaStep(params, {&In(Resource::Hum), &In(Resource::Act), &In(Resource::Cld)},
-                                       In(Resource::Region),
-                                       {&Next(Resource::Hum), &Next(Resource::Act), &Next(Resource::Cld)});
-            });
-        }
-        case Stage::Smooth:
-            return timed([&] { return mBackend.Smooth(sc.smooth.radius, In(Resource::Cld), Out(Resource::Q)); });
-        case Stage::Density: {
-            DensityOutputs out{&Out(Resource::ColumnSum), &Out(Resource::Tiles), &Out(Resource::Bands), 0};
-            const DensityParams params = MakeDensityParams(sc);
-            CB_TRY(timed([&] { return mBackend.Density(params, In(Resource::Q), Get(Resource::Cld), out); }));
-            record.coveredColumns = out.coveredColumns;
-            return {};
-        }
-        case Stage::Shade: {
-            const ShadeParams p = MakeShadeParams(sc);
-            return timed([&] { return mBackend.Shade(p, In(Resource::Q), Out(Resource::T)); });
-        }
-        case Stage::Shadow: {
-            const ShadowParams p = MakeShadowParams(sc);
-            return timed([&] { return mBackend.Shadow(p, In(Resource::ColumnSum), Out(Resource::Shadow)); });
-        }
-        case Stage::RenderSplat:
-            return RenderSplatFrames(record);
-        case Stage::Noise: {
-            const NoiseParams p{mStep};
-            return timed([&] { return mBackend.Noise(p, Out(Resource::Q)); });
-        }
-        case Stage::RenderMarch:
-            break;
+StageBuffers Simulation::Buffers() {
+    StageBuffers buffers;
+    for (Resource r : kAllResources) {
+        Slot& slot = mSlots[size_t(r)];
+        for (auto& b : slot.current) buffers.current[size_t(r)].push_back(b.get());
+        buffers.previous[size_t(r)] = slot.previous.get();
+        buffers.next[size_t(r)] = slot.next.get();
     }
-    return MakeError("the simulation cannot run stage '" + std::string(StageName(stage)) + "' yet");
+    return buffers;
 }
 
-Status Simulation::RenderSplatFrames(StepRecord& record) {
-    const Scene& sc = mScene;
-    double total = 0;
-    std::optional<double> deviceTotal;
-    for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
-        SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
-        // The order is host work shared by all backends, outside the stage time.
-        const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
-        p.order = &order;
-        const SplatInputs in{Previous(Resource::Q),     Get(Resource::Q),     Get(Resource::T),
-                             Previous(Resource::Tiles), Get(Resource::Tiles), Previous(Resource::Bands),
-                             Get(Resource::Bands)};
-        FrameRecord frame;
-        frame.camera = sc.render.cameras[n].name;
-        auto start = std::chrono::steady_clock::now();
-        Status status = mBackend.RenderSplat(p, in, Out(Resource::SplatImage, n), &frame.stats);
-        frame.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
-        total += frame.ms;
-        if (auto device = mBackend.LastDeviceMs()) deviceTotal = deviceTotal.value_or(0) + *device;
-        record.frames.push_back(frame);
-    }
-    record.stageMs[size_t(Stage::RenderSplat)] = total;
-    record.deviceMs[size_t(Stage::RenderSplat)] = deviceTotal;
-    mLastRendered = mStep;
+Status Simulation::RunStage(Stage stage, StepRecord& record) {
+    if (stage == Stage::Region) mRaster = mEllipsoids.Raster();
+    StageCallRecord call;
+    CB_TRY(CallStage(stage, mBackend, mScene, {mStep, mRaster}, Buffers(), call));
+    record.stageMs[size_t(stage)] = call.ms;
+    record.deviceMs[size_t(stage)] = call.deviceMs;
+    if (call.coveredColumns) record.coveredColumns = call.coveredColumns;
+    for (FrameRecord& frame : call.frames) record.frames.push_back(std::move(frame));
+    if (Describe(stage).renderer) mLastRendered = mStep;
     return {};
 }
 

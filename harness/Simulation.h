@@ -27,15 +27,9 @@
 #include "core/Ellipsoids.h"
 #include "core/Scene.h"
 #include "core/StageDescriptors.h"
+#include "harness/StageCall.h"
 
 namespace cb {
-
-// One rendered image.
-struct FrameRecord {
-    std::string camera;
-    double ms = 0;
-    SplatStats stats;
-};
 
 struct StepRecord {
     uint32_t step = 0;
@@ -109,12 +103,10 @@ class Simulation {
     Status InitializeState();
     // Runs one stage on this step's buffers (its writes go to `next` when it advances the state).
     Status RunStage(Stage stage, StepRecord& record);
-    Status RenderSplatFrames(StepRecord& record);
+    StageBuffers Buffers();
     bool InputsChangedSinceLastRun(Stage stage) const;
     std::vector<uint64_t> InputVersions(Stage stage) const;
     Buffer& Out(Resource resource, size_t n = 0);
-    Buffer& Next(Resource resource) { return *mSlots[size_t(resource)].next; }
-    const Buffer& In(Resource resource) const { return *mSlots[size_t(resource)].current.at(0); }
 
     const Scene mScene;
     Backend& mBackend;
@@ -123,7 +115,6 @@ class Simulation {
     EllipsoidList mEllipsoids;
     std::vector<RasterEllipsoid> mRaster;  // the list step t's region was rasterised from
     uint32_t mStep = 0;
-    std::vector<int32_t> mShiftX, mShiftY;
     std::array<Slot, kResourceCount> mSlots;
     // Input versions of each stage when it last ran (skipsUnchangedInputs).
     std::array<std::optional<std::vector<uint64_t>>, kStageCount> mInputsAtLastRun;

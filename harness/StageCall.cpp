@@ -1,0 +1,104 @@
+#include "harness/StageCall.h"
+
+#include <chrono>
+
+#include "harness/StageParams.h"
+
+namespace cb {
+namespace {
+
+// Runs one backend call, adding its wall and device time to the record.
+template <typename Fn>
+Status Timed(Backend& backend, StageCallRecord& record, Fn&& call) {
+    const auto start = std::chrono::steady_clock::now();
+    Status status = call();
+    record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (auto device = backend.LastDeviceMs()) record.deviceMs = record.deviceMs.value_or(0) + *device;
+    return status;
+}
+
+Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageBuffers& io, StageCallRecord& record) {
+    for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
+        SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
+        // The order is host work shared by all backends, outside the stage time.
+        const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
+        p.order = &order;
+        // Without a previous step (step 0, or no history kept) the renderer interpolates a step with itself.
+        auto previousOr = [&](Resource r) { return io.Previous(r) ? io.Previous(r) : io.Current(r); };
+        const SplatInputs in{previousOr(Resource::Q),      io.Current(Resource::Q),     io.Current(Resource::T),
+                             io.Previous(Resource::Tiles), io.Current(Resource::Tiles), io.Previous(Resource::Bands),
+                             io.Current(Resource::Bands)};
+        FrameRecord frame;
+        frame.camera = sc.render.cameras[n].name;
+        const double before = record.ms;
+        Status status = Timed(backend, record, [&] {
+            return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats);
+        });
+        frame.ms = record.ms - before;
+        if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
+        record.frames.push_back(frame);
+    }
+    return {};
+}
+
+Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+            StageCallRecord& record) {
+    auto timed = [&](auto&& call) { return Timed(backend, record, call); };
+    switch (stage) {
+        case Stage::Region:
+            return timed([&] { return backend.Region(host.raster, *io.Current(Resource::Region)); });
+        case Stage::Ca: {
+            CaStepParams params = MakeCaStepParams(sc, host.step);
+            std::vector<int32_t> shiftX, shiftY;
+            if (sc.ca.HasWind())
+                for (const SliceShift& s : sc.ca.windShift) shiftX.push_back(s.sx), shiftY.push_back(s.sy);
+            params.shiftX = shiftX;
+            params.shiftY = shiftY;
+            const ConstCaFields in{io.Current(Resource::Hum), io.Current(Resource::Act), io.Current(Resource::Cld)};
+            const CaFields out{io.Next(Resource::Hum), io.Next(Resource::Act), io.Next(Resource::Cld)};
+            return timed([&] { return backend.CaStep(params, in, *io.Current(Resource::Region), out); });
+        }
+        case Stage::Smooth:
+            return timed(
+                [&] { return backend.Smooth(sc.smooth.radius, *io.Current(Resource::Cld), *io.Current(Resource::Q)); });
+        case Stage::Density: {
+            DensityOutputs out{io.Current(Resource::ColumnSum), io.Current(Resource::Tiles),
+                               io.Current(Resource::Bands), 0};
+            const DensityParams params = MakeDensityParams(sc);
+            CB_TRY(timed(
+                [&] { return backend.Density(params, *io.Current(Resource::Q), io.Current(Resource::Cld), out); }));
+            record.coveredColumns = out.coveredColumns;
+            return {};
+        }
+        case Stage::Shade: {
+            const ShadeParams p = MakeShadeParams(sc);
+            return timed([&] { return backend.Shade(p, *io.Current(Resource::Q), *io.Current(Resource::T)); });
+        }
+        case Stage::Shadow: {
+            const ShadowParams p = MakeShadowParams(sc);
+            return timed(
+                [&] { return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow)); });
+        }
+        case Stage::RenderSplat:
+            return RenderSplatFrames(backend, sc, io, record);
+        case Stage::Noise: {
+            const NoiseParams p{host.step};
+            return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });
+        }
+        case Stage::RenderMarch:
+            break;
+    }
+    return MakeError("the harness cannot call stage '" + std::string(StageName(stage)) + "' yet");
+}
+
+}  // namespace
+
+Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
+                 const StageBuffers& buffers, StageCallRecord& record) {
+    Status status = Call(stage, backend, scene, host, buffers, record);
+    if (!status && stage != Stage::RenderSplat)
+        return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
+    return status;
+}
+
+}  // namespace cb

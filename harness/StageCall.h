@@ -1,0 +1,63 @@
+// One stage's call on a backend, from the buffers of its resources: what the
+// simulation runs every step, and what `conform` runs on another backend with
+// the CPU's inputs. Each stage's call (its parameters, its entry point, its
+// host-side work) is written here once.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/Backend.h"
+#include "core/Ellipsoids.h"
+#include "core/Scene.h"
+#include "core/StageDescriptors.h"
+
+namespace cb {
+
+// The buffers of one call, by resource (core/StageDescriptors.h): inputs are
+// `current` (and `previous` for an interpolating renderer); outputs go to
+// `current`, or to `next` for a stage that advances the state. Images hold
+// one buffer per camera.
+struct StageBuffers {
+    std::array<std::vector<Buffer*>, kResourceCount> current;
+    std::array<Buffer*, kResourceCount> previous{};
+    std::array<Buffer*, kResourceCount> next{};
+
+    Buffer* Current(Resource r, size_t n = 0) const {
+        const auto& list = current[size_t(r)];
+        return n < list.size() ? list[n] : nullptr;
+    }
+    Buffer* Previous(Resource r) const { return previous[size_t(r)]; }
+    Buffer* Next(Resource r) const { return next[size_t(r)]; }
+};
+
+// What a stage reads from the host rather than from a resource.
+struct StageHostInputs {
+    uint32_t step = 0;
+    std::span<const RasterEllipsoid> raster;  // region: step t's ellipsoids
+};
+
+// One rendered image.
+struct FrameRecord {
+    std::string camera;
+    double ms = 0;
+    SplatStats stats;
+};
+
+// What one call measured and returned besides its buffers.
+struct StageCallRecord {
+    double ms = 0;                           // wall time of the backend's calls
+    std::optional<double> deviceMs;          // where the backend measures it
+    std::optional<uint32_t> coveredColumns;  // density
+    std::vector<FrameRecord> frames;         // renderers, one per camera
+};
+
+// Runs `stage` on `backend`. The buffers must hold every resource the stage's
+// descriptor reads and writes in this scene; an error names the stage.
+Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
+                 const StageBuffers& buffers, StageCallRecord& record);
+
+}  // namespace cb
