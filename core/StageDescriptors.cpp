@@ -124,7 +124,7 @@ const std::array<StageDescriptor, kStageCount> kDescriptors = {{
     {.stage = Stage::Region, .section = "ellipsoids", .writes = {Resource::Region}, .symbol = "R", .rule = RegionRule},
     {.stage = Stage::Ca,
      .section = "ca",
-     .reads = {Resource::Region},
+     .reads = {Resource::Region, Resource::Hum, Resource::Act, Resource::Cld},
      .writes = {Resource::Hum, Resource::Act, Resource::Cld},
      .advancesState = true,
      .symbol = "cld",

@@ -75,7 +75,7 @@ struct CompareRule {
 struct StageDescriptor {
     Stage stage;
     std::string_view section;     // the scene section of its settings ("" for none)
-    std::vector<Resource> reads;  // this step's values
+    std::vector<Resource> reads;  // this step's values (a stage that advances the state reads its own)
     // Read when some enabled stage writes them, and not needed otherwise
     // (density's cover comes from cld with an automaton, from q without).
     std::vector<Resource> optionalReads;

@@ -6,10 +6,10 @@
 #include <map>
 #include <sstream>
 
-#include "core/Random.h"
+#include "core/StageDescriptors.h"
 #include "harness/Report.h"
 #include "harness/Simulation.h"
-#include "harness/StageParams.h"
+#include "harness/StageCall.h"
 
 namespace cb {
 namespace {
@@ -20,7 +20,8 @@ Result<std::vector<T>> Read(Backend& backend, const Buffer& buffer) {
 }
 
 template <typename T>
-Result<std::unique_ptr<Buffer>> Filled(Backend& backend, BufferFormat format, Extent3 extent, const std::vector<T>& data) {
+Result<std::unique_ptr<Buffer>> Filled(Backend& backend, BufferFormat format, Extent3 extent,
+                                       const std::vector<T>& data) {
     auto buffer = backend.CreateBuffer(format, extent);
     if (!buffer) return std::unexpected(buffer.error());
     CB_TRY(backend.Upload(**buffer, std::as_bytes(std::span(data))));
@@ -59,15 +60,16 @@ class Tally {
         if (double(differ) > row.worst) {
             row.worst = double(differ);
             std::ostringstream d;
-            d << differ << " differ at step " << step << ", first " << Where(e, first) << ": cpu " << +ref[first] << ", "
-              << backend << " " << +got[first];
+            d << differ << " differ at step " << step << ", first " << Where(e, first) << ": cpu " << +ref[first]
+              << ", " << backend << " " << +got[first];
             row.detail = d.str();
         }
         if (differ) row.status = "fail";
     }
     // |a - b| <= tolerance everywhere.
     void Within(const std::string& stage, const std::string& backend, uint32_t step, const Extent3& e,
-                const std::vector<float>& ref, const std::vector<float>& got, double tolerance, const std::string& rule) {
+                const std::vector<float>& ref, const std::vector<float>& got, double tolerance,
+                const std::string& rule) {
         ConformRow& row = Row(stage, backend, rule, tolerance);
         double worst = 0;
         size_t at = 0;
@@ -96,12 +98,97 @@ class Tally {
 
 }  // namespace
 
+namespace {
+
+// A stage of one backend that advances the state (the automaton): its outputs
+// are step t+1's, compared after the CPU has stepped.
+struct PendingState {
+    Stage stage;
+    std::string backend;
+    Backend* owner;
+    std::vector<std::pair<Resource, std::unique_ptr<Buffer>>> outputs;
+};
+
+// Compares one output buffer of `stage` with the CPU's by the stage's rule.
+Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::string& name, uint32_t t, Backend& cpu,
+                     const Buffer& ref, Backend& b, const Buffer& got, const std::string& camera) {
+    const StageDescriptor& d = Describe(stage);
+    const CompareRule rule = d.rule(scene);
+    const std::string stageName(StageName(stage));
+    const Extent3 e = ref.Extent();
+    if (ref.Format() != BufferFormat::F32) {
+        auto r = Read<uint8_t>(cpu, ref);
+        auto g = Read<uint8_t>(b, got);
+        if (!r || !g) return MakeError(stageName + ": download failed");
+        if (rule.kind == CompareRule::Kind::BitExact) {
+            tally.Exact(stageName, name, t, e, *r, *g);
+            return {};
+        }
+        // Quantised: |d| <= tolerance everywhere, and at most `share` of the elements differ.
+        ConformRow& row = tally.Row(stageName, name, rule.Text(d.symbol), rule.tolerance);
+        size_t differ = 0, at = 0;
+        int worst = 0;
+        for (size_t v = 0; v < r->size(); ++v) {
+            const int diff = std::abs(int((*r)[v]) - int((*g)[v]));
+            differ += diff != 0;
+            if (diff > worst) worst = diff, at = v;
+        }
+        if (worst > row.worst) {
+            row.worst = worst;
+            row.detail = "step " + std::to_string(t) + " at " + Where(e, at) + ": cpu " + std::to_string((*r)[at]) +
+                         ", " + name + " " + std::to_string((*g)[at]);
+        }
+        if (worst > rule.tolerance || double(differ) > rule.share * double(r->size())) row.status = "fail";
+        return {};
+    }
+    auto r = Read<float>(cpu, ref);
+    auto g = Read<float>(b, got);
+    if (!r || !g) return MakeError(stageName + ": download failed");
+    switch (rule.kind) {
+        case CompareRule::Kind::BitExact:
+            tally.Exact(stageName, name, t, e, *r, *g);
+            break;
+        case CompareRule::Kind::Absolute:
+        case CompareRule::Kind::Quantised:
+            tally.Within(stageName, name, t, e, *r, *g, rule.tolerance, rule.Text(d.symbol));
+            break;
+        case CompareRule::Kind::Image: {
+            const uint32_t width = e.ny, height = e.nz;  // images are (3, width, height)
+            const ImageComparison cmp = CompareImages(*r, *g, width, height, rule);
+            ConformRow& row = tally.Row(stageName, name, rule.Text(d.symbol), rule.limit);
+            if (!(cmp.maxError <= row.worst)) {
+                row.worst = cmp.maxError;
+                char detail[256];
+                std::snprintf(detail, sizeof detail,
+                              "step %u camera %s: worst pixel (%d, %d), %zu pixels over %s, PSNR %.1f dB", t,
+                              camera.c_str(), cmp.worstX, cmp.worstY, cmp.pixelsOverTolerance,
+                              rule.tolerance * 255 == 2 ? "2/255" : std::to_string(rule.tolerance).c_str(), cmp.psnr);
+                row.detail = detail;
+            }
+            if (!cmp.Passes()) row.status = "fail";
+            break;
+        }
+    }
+    return {};
+}
+
+// A copy of a CPU buffer on backend b, through the canonical layout.
+Result<std::unique_ptr<Buffer>> CopyTo(Backend& cpu, const Buffer& from, Backend& b) {
+    std::vector<std::byte> data(from.CanonicalBytes());
+    CB_TRY(cpu.Download(from, data));
+    auto to = b.CreateBuffer(from.Format(), from.Extent());
+    if (!to) return std::unexpected(to.error());
+    CB_TRY(b.Upload(**to, data));
+    return std::move(*to);
+}
+
+}  // namespace
+
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
                                                std::span<const OpenedBackend> others) {
     Tally tally;
     auto sim = Simulation::Create(scene, cpu, /*everyStepOutputs=*/true);
     if (!sim) return std::unexpected(sim.error());
-    const Extent3 e = scene.grid.size;
 
     struct Candidate {
         std::string name;
@@ -122,187 +209,92 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
         unavailable.push_back(row);
     }
 
-    // The CPU's state before the step (the automaton's input) is read before stepping.
     for (uint32_t t = 0; t < scene.steps; ++t) {
-        std::vector<uint8_t> stateBefore[3];
-        if (scene.stages.Has(Stage::Ca)) {
-            const Buffer* fields[3] = {(*sim)->Hum(), (*sim)->Act(), (*sim)->Cld()};
-            for (int f = 0; f < 3; ++f) {
-                auto d = Read<uint8_t>(cpu, *fields[f]);
-                if (!d) return std::unexpected(d.error());
-                stateBefore[f] = std::move(*d);
-            }
-        }
-        Status checks;
+        std::vector<PendingState> pending;
+        // At the observer every stage of step t has run on the CPU, and the
+        // state is still step t's: each backend's stages get the CPU's inputs.
         auto observe = [&](const Simulation& s) -> Status {
             for (Candidate& c : candidates) {
                 Backend& b = *c.backend;
-                const StageSet& st = scene.stages;
-                auto skip = [&](Stage stage) {
-                    if (b.Supports(stage)) return false;
-                    ConformRow& row = tally.Row(std::string(StageName(stage)), c.name, "", 0);
-                    row.status = "skipped";
-                    row.detail = c.name + " does not implement it yet";
-                    return true;
-                };
-                if (st.Has(Stage::Region) && !skip(Stage::Region)) {
-                    auto out = b.CreateBuffer(BufferFormat::U8, e);
-                    if (!out) return std::unexpected(out.error());
-                    CB_TRY(b.Region(s.RasterList(), **out));
-                    auto ref = Read<uint8_t>(cpu, *s.Region());
-                    auto got = Read<uint8_t>(b, **out);
-                    if (!ref || !got) return MakeError("region: download failed");
-                    // |dR| <= 1 everywhere and at most 0.5 % of voxels differ.
-                    ConformRow& row = tally.Row("region", c.name, "|dR| <= 1, <= 0.5 % differ", 1);
-                    size_t differ = 0, at = 0;
-                    int worst = 0;
-                    for (size_t v = 0; v < ref->size(); ++v) {
-                        const int d = std::abs(int((*ref)[v]) - int((*got)[v]));
-                        differ += d != 0;
-                        if (d > worst) worst = d, at = v;
-                    }
-                    if (worst > row.worst) {
-                        row.worst = worst;
-                        row.detail = "step " + std::to_string(t) + " at " + Where(e, at) + ": cpu " +
-                                     std::to_string((*ref)[at]) + ", " + c.name + " " + std::to_string((*got)[at]);
-                    }
-                    if (worst > 1 || double(differ) > 0.005 * double(ref->size())) row.status = "fail";
-                }
-                if (st.Has(Stage::Smooth) && !skip(Stage::Smooth)) {
-                    auto cld = Filled(b, BufferFormat::Bits, e, stateBefore[2]);
-                    auto q = b.CreateBuffer(BufferFormat::F32, e);
-                    if (!cld || !q) return MakeError("smooth: allocation failed");
-                    CB_TRY(b.Smooth(scene.smooth.radius, **cld, **q));
-                    auto ref = Read<float>(cpu, *s.Q());
-                    auto got = Read<float>(b, **q);
-                    if (!ref || !got) return MakeError("smooth: download failed");
-                    tally.Exact("smooth", c.name, t, e, *ref, *got);
-                }
-                if (st.Has(Stage::Density) && !skip(Stage::Density)) {
-                    auto qData = Read<float>(cpu, *s.Q());
-                    if (!qData) return std::unexpected(qData.error());
-                    auto q = Filled(b, BufferFormat::F32, e, *qData);
-                    auto cld = Filled(b, BufferFormat::Bits, e, stateBefore[2]);
-                    auto D = b.CreateBuffer(BufferFormat::F32, s.ColumnSum()->Extent());
-                    auto tiles = b.CreateBuffer(BufferFormat::U8, s.Tiles()->Extent());
-                    auto bands = b.CreateBuffer(BufferFormat::U8, s.Bands()->Extent());
-                    if (!q || !cld || !D || !tiles || !bands) return MakeError("density: allocation failed");
-                    DensityOutputs out{D->get(), tiles->get(), bands->get(), 0};
-                    CB_TRY(b.Density({scene.density.tile, scene.density.band}, **q, cld->get(), out));
-                    tally.Exact("density", c.name, t, s.ColumnSum()->Extent(), *Read<float>(cpu, *s.ColumnSum()),
-                                *Read<float>(b, **D));
-                    tally.Exact("density", c.name, t, s.Tiles()->Extent(), *Read<uint8_t>(cpu, *s.Tiles()),
-                                *Read<uint8_t>(b, **tiles));
-                    tally.Exact("density", c.name, t, s.Bands()->Extent(), *Read<uint8_t>(cpu, *s.Bands()),
-                                *Read<uint8_t>(b, **bands));
-                }
-                if (st.Has(Stage::Shade) && !skip(Stage::Shade) && s.T()) {
-                    auto qData = Read<float>(cpu, *s.Q());
-                    if (!qData) return std::unexpected(qData.error());
-                    auto q = Filled(b, BufferFormat::F32, e, *qData);
-                    auto T = b.CreateBuffer(BufferFormat::F32, e);
-                    if (!q || !T) return MakeError("shade: allocation failed");
-                    const ShadeParams p = MakeShadeParams(scene);
-                    CB_TRY(b.Shade(p, **q, **T));
-                    const double tolerance = p.storage == StorageFormat::Fp32 ? 1e-5 : StorageQuantum(p.storage);
-                    char rule[64];
-                    std::snprintf(rule, sizeof rule, "|dT| <= %g", tolerance);
-                    tally.Within("shade", c.name, t, e, *Read<float>(cpu, *s.T()), *Read<float>(b, **T), tolerance, rule);
-                }
-                if (st.Has(Stage::Shadow) && !skip(Stage::Shadow) && s.Shadow()) {
-                    auto dData = Read<float>(cpu, *s.ColumnSum());
-                    if (!dData) return std::unexpected(dData.error());
-                    const Extent3 map = s.ColumnSum()->Extent();
-                    auto D = Filled(b, BufferFormat::F32, map, *dData);
-                    auto G = b.CreateBuffer(BufferFormat::F32, map);
-                    if (!D || !G) return MakeError("shadow: allocation failed");
-                    const ShadowParams p = MakeShadowParams(scene);
-                    CB_TRY(b.Shadow(p, **D, **G));
-                    tally.Within("shadow", c.name, t, map, *Read<float>(cpu, *s.Shadow()), *Read<float>(b, **G), 1e-5,
-                                 "|dG| <= 1e-05");
-                }
-                if (st.Has(Stage::RenderSplat) && !skip(Stage::RenderSplat) && s.Image(0)) {
-                    // Feed the CPU's q of both steps, T and occupancy; render every camera.
-                    auto copy = [&](const Buffer* from, BufferFormat format) -> Result<std::unique_ptr<Buffer>> {
-                        if (!from) return std::unique_ptr<Buffer>();
-                        std::vector<std::byte> data(from->CanonicalBytes());
-                        CB_TRY(cpu.Download(*from, data));
-                        auto to = b.CreateBuffer(format, from->Extent());
-                        if (!to) return std::unexpected(to.error());
-                        CB_TRY(b.Upload(**to, data));
-                        return std::move(*to);
-                    };
-                    auto qp = copy(s.QPrev(), BufferFormat::F32);
-                    auto qc = copy(s.Q(), BufferFormat::F32);
-                    auto T = copy(s.T(), BufferFormat::F32);
-                    auto tp = copy(s.TilesPrev(), BufferFormat::U8);
-                    auto tc = copy(s.Tiles(), BufferFormat::U8);
-                    auto bp = copy(s.BandsPrev(), BufferFormat::U8);
-                    auto bc = copy(s.Bands(), BufferFormat::U8);
-                    if (!qp || !qc || !T || !tp || !tc || !bp || !bc)
-                        return MakeError("render_splat: copying inputs failed");
-                    const RenderSettings& rs = scene.render;
-                    for (size_t n = 0; n < rs.cameras.size(); ++n) {
-                        SplatParams p = MakeSplatParams(scene, rs.cameras[n]);
-                        const SplatOrder order = MakeSplatOrder(p.camera, e, scene.grid.origin, scene.grid.voxelSize);
-                        p.order = &order;
-                        auto image = b.CreateBuffer(BufferFormat::F32, {3, rs.width, rs.height});
-                        if (!image) return std::unexpected(image.error());
-                        SplatInputs in{qp->get(), qc->get(), T->get(), tp->get(), tc->get(), bp->get(), bc->get()};
-                        CB_TRY(b.RenderSplat(p, in, **image, nullptr));
-                        auto ref = Read<float>(cpu, *s.Image(n));
-                        auto got = Read<float>(b, **image);
-                        if (!ref || !got) return MakeError("render_splat: download failed");
-                        const ImageComparison cmp = CompareImages(*ref, *got, rs.width, rs.height);
-                        ConformRow& row = tally.Row("render_splat", c.name, "2/255 on 99.9 %, 8/255 max", 8.0 / 255.0);
-                        if (!(cmp.maxError <= row.worst)) {
-                            row.worst = cmp.maxError;
-                            char detail[256];
-                            std::snprintf(detail, sizeof detail,
-                                          "step %u camera %s: worst pixel (%d, %d), %zu pixels over 2/255, PSNR %.1f dB",
-                                          t, rs.cameras[n].name.c_str(), cmp.worstX, cmp.worstY, cmp.pixelsOver2, cmp.psnr);
-                            row.detail = detail;
+                for (Stage stage : s.Schedule()) {
+                    const StageDescriptor& d = Describe(stage);
+                    if (!b.Supports(stage)) {
+                        // Rows of state-advancing stages come after the others, as they are compared later.
+                        if (!d.advancesState) {
+                            ConformRow& row = tally.Row(std::string(StageName(stage)), c.name, "", 0);
+                            row.status = "skipped";
+                            row.detail = c.name + " does not implement it yet";
+                        } else {
+                            pending.push_back({stage, c.name, nullptr, {}});
                         }
-                        if (!cmp.Passes()) row.status = "fail";
+                        continue;
                     }
+                    std::vector<std::unique_ptr<Buffer>> owned;
+                    StageBuffers io;
+                    auto hold = [&](Result<std::unique_ptr<Buffer>> made) -> Result<Buffer*> {
+                        if (!made) return std::unexpected(made.error());
+                        owned.push_back(std::move(*made));
+                        return owned.back().get();
+                    };
+                    // Inputs: the CPU's buffers of this step (and the previous one where kept).
+                    std::vector<Resource> inputs = d.reads;
+                    inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
+                    for (Resource r : inputs) {
+                        if (!s.Get(r) || !io.current[size_t(r)].empty()) continue;
+                        auto copy = hold(CopyTo(cpu, *s.Get(r), b));
+                        if (!copy) return std::unexpected(copy.error());
+                        io.current[size_t(r)].push_back(*copy);
+                    }
+                    if (d.readsPrevious)
+                        for (Resource r : d.readsPrevious(scene)) {
+                            if (!s.Previous(r)) continue;
+                            auto copy = hold(CopyTo(cpu, *s.Previous(r), b));
+                            if (!copy) return std::unexpected(copy.error());
+                            io.previous[size_t(r)] = *copy;
+                        }
+                    // Outputs: fresh buffers of the resource's shape.
+                    PendingState state{stage, c.name, &b, {}};
+                    for (Resource r : d.writes) {
+                        const size_t count = IsPerCamera(r) ? scene.render.cameras.size() : 1;
+                        if (!d.advancesState) io.current[size_t(r)].clear();
+                        for (size_t n = 0; n < count; ++n) {
+                            auto made = b.CreateBuffer(ResourceFormat(r), ResourceExtent(r, scene));
+                            if (!made) return std::unexpected(made.error());
+                            if (d.advancesState) {
+                                io.next[size_t(r)] = made->get();
+                                state.outputs.emplace_back(r, std::move(*made));
+                            } else {
+                                io.current[size_t(r)].push_back(*hold(std::move(*made)));
+                            }
+                        }
+                    }
+                    StageCallRecord record;
+                    CB_TRY(CallStage(stage, b, scene, {t, s.RasterList()}, io, record));
+                    if (d.advancesState) {
+                        pending.push_back(std::move(state));
+                        continue;
+                    }
+                    for (Resource r : d.writes)
+                        for (size_t n = 0; n < io.current[size_t(r)].size(); ++n)
+                            CB_TRY(CompareOutput(tally, scene, stage, c.name, t, cpu, *s.Get(r, n), b,
+                                                 *io.current[size_t(r)][n],
+                                                 IsPerCamera(r) ? scene.render.cameras[n].name : ""));
                 }
             }
             return {};
         };
         StepRecord record;
         if (Status s = (*sim)->Step(record, observe); !s) return std::unexpected(s.error());
-        // The automaton: each backend steps from the CPU's state t with R_t; compare with the CPU's t+1.
-        if (scene.stages.Has(Stage::Ca)) {
-            std::vector<uint8_t> after[3];
-            const Buffer* fields[3] = {(*sim)->Hum(), (*sim)->Act(), (*sim)->Cld()};
-            for (int f = 0; f < 3; ++f) after[f] = *Read<uint8_t>(cpu, *fields[f]);
-            const std::vector<uint8_t> region = *Read<uint8_t>(cpu, *(*sim)->Region());
-            for (Candidate& c : candidates) {
-                Backend& b = *c.backend;
-                if (!b.Supports(Stage::Ca)) {
-                    ConformRow& row = tally.Row("ca", c.name, "", 0);
-                    row.status = "skipped";
-                    row.detail = c.name + " does not implement it yet";
-                    continue;
-                }
-                std::unique_ptr<Buffer> in[3], out[3];
-                for (int f = 0; f < 3; ++f) {
-                    auto buffer = Filled(b, BufferFormat::Bits, e, stateBefore[f]);
-                    auto o = b.CreateBuffer(BufferFormat::Bits, e);
-                    if (!buffer || !o) return MakeError("ca: allocation failed");
-                    in[f] = std::move(*buffer);
-                    out[f] = std::move(*o);
-                }
-                auto r = Filled(b, BufferFormat::U8, e, region);
-                if (!r) return std::unexpected(r.error());
-                std::vector<int32_t> sx, sy;
-                if (scene.ca.HasWind())
-                    for (const SliceShift& shift : scene.ca.windShift) sx.push_back(shift.sx), sy.push_back(shift.sy);
-                CaStepParams p{scene.ca.seed, t, QuantizeProbability(scene.ca.pExt), QuantizeProbability(scene.ca.pHum),
-                               QuantizeProbability(scene.ca.pAct), sx, sy};
-                CB_TRY(b.CaStep(p, {in[0].get(), in[1].get(), in[2].get()}, **r, {out[0].get(), out[1].get(), out[2].get()}));
-                for (int f = 0; f < 3; ++f) tally.Exact("ca", c.name, t, e, after[f], *Read<uint8_t>(b, *out[f]));
+        // Stages that advance the state: each backend stepped from the CPU's state t; compare with the CPU's t+1.
+        for (PendingState& p : pending) {
+            if (!p.owner) {
+                ConformRow& row = tally.Row(std::string(StageName(p.stage)), p.backend, "", 0);
+                row.status = "skipped";
+                row.detail = p.backend + " does not implement it yet";
+                continue;
             }
+            for (auto& [r, buffer] : p.outputs)
+                CB_TRY(CompareOutput(tally, scene, p.stage, p.backend, t, cpu, *(*sim)->Get(r), *p.owner, *buffer, ""));
         }
     }
     std::vector<ConformRow> rows = tally.Rows();
@@ -323,8 +315,13 @@ report::Table ConformTable(const std::vector<ConformRow>& rows) {
 nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& rows) {
     nlohmann::json list = nlohmann::json::array();
     for (const ConformRow& r : rows)
-        list.push_back({{"stage", r.stage}, {"backend", r.backend}, {"status", r.status}, {"rule", r.rule},
-                        {"worst", r.worst}, {"tolerance", r.tolerance}, {"detail", r.detail}});
+        list.push_back({{"stage", r.stage},
+                        {"backend", r.backend},
+                        {"status", r.status},
+                        {"rule", r.rule},
+                        {"worst", r.worst},
+                        {"tolerance", r.tolerance},
+                        {"detail", r.detail}});
     return {{"format", "cloudbench-conform/1"}, {"scene", scene.name}, {"steps", scene.steps}, {"results", list}};
 }
 

@@ -1,13 +1,14 @@
 #include "harness/Report.h"
 
-#include "harness/Session.h"
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include "harness/Session.h"
 
 namespace cb {
 namespace {
@@ -35,8 +36,8 @@ double CoverFraction(const Scene& scene, uint32_t columns) {
 
 nlohmann::json SummaryJson(const std::vector<double>& samples) {
     Summary s = Summarize(samples);
-    return {{"samples_ms", samples}, {"median_ms", s.median}, {"q1_ms", s.q1}, {"q3_ms", s.q3},
-            {"min_ms", s.min}, {"max_ms", s.max}, {"count", s.count}};
+    return {{"samples_ms", samples}, {"median_ms", s.median}, {"q1_ms", s.q1},   {"q3_ms", s.q3},
+            {"min_ms", s.min},       {"max_ms", s.max},       {"count", s.count}};
 }
 
 }  // namespace
@@ -83,7 +84,8 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         b["stages"] = timing;
         std::vector<double> hostSamples;
         for (const StepRecord& r : run.steps)
-            if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region)) hostSamples.push_back(r.ellipsoidUpdateMs);
+            if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region))
+                hostSamples.push_back(r.ellipsoidUpdateMs);
         b["host"] = {{"ellipsoid_update", SummaryJson(hostSamples)}};
         b["transfers"] = {{"download", SummaryJson(run.downloadMs)}};
         if (scene.stages.Has(Stage::RenderSplat)) {
@@ -120,7 +122,9 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             double mean = 0;
             for (double c : after) mean += c;
             b["cover_summary"] = {{"mean", after.empty() ? 0.0 : mean / double(after.size())},
-                                  {"median", s.median}, {"min", s.min}, {"max", s.max}};
+                                  {"median", s.median},
+                                  {"min", s.min},
+                                  {"max", s.max}};
         }
         doc["backends"][run.name] = b;
     }
@@ -196,7 +200,8 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
     if (scene.stages.Has(Stage::Density) && !run.steps.empty()) {
         std::vector<double> after;
         for (const StepRecord& r : run.steps)
-            if (r.step >= scene.warmupSteps && r.coveredColumns) after.push_back(CoverFraction(scene, *r.coveredColumns));
+            if (r.step >= scene.warmupSteps && r.coveredColumns)
+                after.push_back(CoverFraction(scene, *r.coveredColumns));
         const Summary s = Summarize(after);
         const StepRecord& last = run.steps.back();
         std::snprintf(line, sizeof line, "  cloud cover: last step %.1f %%, median %.1f %% (min %.1f, max %.1f)",
@@ -209,9 +214,12 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
 
 std::string_view RendererFileName(Stage renderer) {
     switch (renderer) {
-        case Stage::RenderSplat: return "splat";
-        case Stage::RenderMarch: return "march";
-        default: return StageName(renderer);
+        case Stage::RenderSplat:
+            return "splat";
+        case Stage::RenderMarch:
+            return "march";
+        default:
+            return StageName(renderer);
     }
 }
 
@@ -219,7 +227,8 @@ std::string FrameFileStem(Stage renderer, const std::string& camera, const std::
     return "frame-" + std::string(RendererFileName(renderer)) + "-" + camera + (backend.empty() ? "" : "-" + backend);
 }
 
-Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz) {
+Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny,
+                    uint32_t nz) {
     OIIO::ImageSpec spec(int(nx), int(ny), 1, OIIO::TypeDesc::UINT8);
     OIIO::ImageBuf image(spec);
     // Optical-depth look: brightness 1 - exp(-D / 4); a column of 4 full voxels is ~63 % white.
@@ -238,16 +247,18 @@ Status WriteTopView(const std::string& path, const std::vector<float>& columnSum
 }
 
 ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
-                              uint32_t height) {
+                              uint32_t height, const CompareRule& rule) {
     OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
     OIIO::ImageBuf a(spec, const_cast<float*>(reference.data())), b(spec, const_cast<float*>(candidate.data()));
-    // failthresh 8/255, warnthresh 2/255: a pixel counts once, as a failure or a warning.
-    const auto result = OIIO::ImageBufAlgo::compare(a, b, 8.0f / 255.0f, 2.0f / 255.0f);
+    // failthresh: the limit; warnthresh: the tolerance. A pixel counts once, as a failure or a warning.
+    const float limit = std::isinf(rule.limit) ? std::numeric_limits<float>::max() : float(rule.limit);
+    const auto result = OIIO::ImageBufAlgo::compare(a, b, limit, float(rule.tolerance));
     ImageComparison c;
+    c.rule = rule;
     c.maxError = result.maxerror;
     c.meanError = result.meanerror;
     c.psnr = result.PSNR;
-    c.pixelsOver2 = size_t(result.nfail + result.nwarn);  // compare counts pixels over warn (2/255) and fail (8/255) apart
+    c.pixelsOverTolerance = size_t(result.nfail + result.nwarn);
     c.pixels = size_t(width) * height;
     c.worstX = result.maxx;
     c.worstY = result.maxy;

@@ -3,14 +3,14 @@
 // map. Every file is written atomically (Session::WriteAtomically).
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/Backend.h"
 #include "core/Scene.h"
+#include "core/StageDescriptors.h"
 #include "harness/ReportModel.h"
 #include "harness/Simulation.h"
 
@@ -44,20 +44,22 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run);
 
 // Writes D as a grey top view (x right, y up, white = densest column), 8-bit
 // PNG through OpenImageIO. `columnSum` is canonical D, nx*ny floats.
-Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny, uint32_t nz);
+Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny,
+                    uint32_t nz);
 
-// SPEC 8's image rule: per channel |d| <= 2/255 on at least 99.9 % of pixels
-// and <= 8/255 everywhere; with PSNR and mean absolute error, from
-// OpenImageIO's ImageBufAlgo::compare.
+// An image comparison by a CompareRule of kind Image (default: SPEC 8's, per
+// channel |d| <= 2/255 on at least 99.9 % of pixels and <= 8/255 everywhere),
+// with PSNR and mean absolute error, from OpenImageIO's ImageBufAlgo::compare.
 struct ImageComparison {
+    CompareRule rule;
     double maxError = 0, meanError = 0, psnr = 0;
-    size_t pixelsOver2 = 0;   // pixels with a channel off by more than 2/255
+    size_t pixelsOverTolerance = 0;  // pixels with a channel off by more than rule.tolerance
     size_t pixels = 0;
     int worstX = 0, worstY = 0;
-    bool Passes() const { return maxError <= 8.0 / 255.0 && double(pixelsOver2) <= 0.001 * double(pixels); }
+    bool Passes() const { return maxError <= rule.limit && double(pixelsOverTolerance) <= rule.share * double(pixels); }
 };
 ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
-                              uint32_t height);
+                              uint32_t height, const CompareRule& rule = Describe(Stage::RenderSplat).rule(Scene{}));
 // Writes |reference - candidate| as an EXR (for a failed comparison).
 Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
                             const std::vector<float>& candidate, uint32_t width, uint32_t height);

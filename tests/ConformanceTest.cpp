@@ -397,7 +397,7 @@ TEST_P(Conformance, RenderSplat) {
             const std::string path = ::testing::TempDir() + "/render_diff_" + mBackend->Name() + "_" + std::to_string(c) + ".exr";
             (void)WriteDifferenceImage(path, images[0], images[1], W, H);
             ADD_FAILURE() << "camera " << c << ": max error " << cmp.maxError << " at (" << cmp.worstX << ", " << cmp.worstY
-                          << "), " << cmp.pixelsOver2 << " of " << cmp.pixels << " pixels over 2/255, PSNR " << cmp.psnr
+                          << "), " << cmp.pixelsOverTolerance << " of " << cmp.pixels << " pixels over 2/255, PSNR " << cmp.psnr
                           << "; difference image: " << path;
         }
     }

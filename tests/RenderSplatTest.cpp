@@ -248,7 +248,7 @@ TEST(ImageRule, ThresholdsAndCounts) {
     b = a;
     for (uint32_t n = 0; n < 5; ++n) b[3 * n] += 2.5f / 255.0f;  // 5 of 10000 pixels
     c = CompareImages(a, b, W, H);
-    EXPECT_EQ(c.pixelsOver2, 5u);
+    EXPECT_EQ(c.pixelsOverTolerance, 5u);
     EXPECT_TRUE(c.Passes());
     for (uint32_t n = 5; n < 20; ++n) b[3 * n] += 2.5f / 255.0f;  // 20 of 10000
     EXPECT_FALSE(CompareImages(a, b, W, H).Passes());
