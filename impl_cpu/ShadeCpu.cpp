@@ -31,12 +31,8 @@ void ShadeRowT(const SliceAttenuation& att, const float* __restrict t0, const fl
     for (uint32_t a = 0; a < n; ++a) {
         const float t = Bilinear(t0[a], t0[a + 1], t1[a], t1[a + 1], fu, fv);
         const float qs = Bilinear(q0[a], q0[a + 1], q1[a], q1[a + 1], fu, fv);
-        // SliceAttenuation::Factor with the kind fixed.
-        const float tau = depthPerQ * qs;
-        float factor = kAttenuation == AttenuationKind::Beer ? ExpNonPositive(-tau) : 1.0f - (1.0f - ar) * qs;
-        factor = std::clamp(factor + gain * tau, 0.0f, 1.0f);
-        const float value = RoundToStorage(kStorage, t * factor);
-        out[a] = value < kTransmittanceFloor ? 0.0f : value;
+        const float factor = SliceFactor(kAttenuation == AttenuationKind::Beer, depthPerQ, ar, gain, qs);
+        out[a] = StoreTransmittance(kStorage, t, factor);
     }
 }
 
@@ -150,7 +146,7 @@ void UpsampleRowT(const float* __restrict b, uint32_t cells, const uint32_t* x0,
     // Cells I with 1 <= I and I + 1 <= cells - 1 have every phase in the interior.
     const uint32_t firstI = 1, lastI = cells >= 2 ? cells - 2 : 0;
     const uint32_t interiorBegin = F * firstI, interiorEnd = cells >= 3 ? std::min(n, F * (lastI + 1)) : 0;
-    for (uint32_t i = 0; i < std::min(n, interiorBegin); ++i) out[i] = b[x0[i]] * (1.0f - fx[i]) + b[x1[i]] * fx[i];
+    for (uint32_t i = 0; i < std::min(n, interiorBegin); ++i) out[i] = Lerp(b[x0[i]], b[x1[i]], fx[i]);
     if (interiorEnd > interiorBegin) {
         for (int p = 0; p < F; ++p) {
             const uint32_t i = interiorBegin + uint32_t(p);
@@ -159,11 +155,11 @@ void UpsampleRowT(const float* __restrict b, uint32_t cells, const uint32_t* x0,
             const float* lo = b + int(firstI) + offset;
             float* o = out + interiorBegin + p;
             const uint32_t count = (interiorEnd - interiorBegin) / F;
-            for (uint32_t I = 0; I < count; ++I) o[F * I] = lo[I] * (1.0f - t) + lo[I + 1] * t;
+            for (uint32_t I = 0; I < count; ++I) o[F * I] = Lerp(lo[I], lo[I + 1], t);
         }
     }
     for (uint32_t i = std::max(interiorEnd, std::min(n, interiorBegin)); i < n; ++i)
-        out[i] = b[x0[i]] * (1.0f - fx[i]) + b[x1[i]] * fx[i];
+        out[i] = Lerp(b[x0[i]], b[x1[i]], fx[i]);
 }
 
 void UpsampleRow(const float* b, uint32_t cells, int f, const uint32_t* x0, const uint32_t* x1, const float* fx,
@@ -228,10 +224,10 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
     auto taps = [&](uint32_t n, uint32_t cells) {
         Taps out{std::vector<uint32_t>(n), std::vector<uint32_t>(n), std::vector<float>(n)};
         for (uint32_t i = 0; i < n; ++i) {
-            const float x = std::clamp((float(i) + 0.5f) / float(f) - 0.5f, 0.0f, float(cells - 1));
-            out.i0[i] = uint32_t(x);
-            out.i1[i] = std::min(out.i0[i] + 1, cells - 1);
-            out.t[i] = x - float(out.i0[i]);
+            const UpsampleTaps tap = UpsampleTap(i, f, cells);
+            out.i0[i] = tap.i0;
+            out.i1[i] = tap.i1;
+            out.t[i] = tap.w;
         }
         return out;
     };
@@ -270,6 +266,7 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
         std::fill(G, G + size_t(e.nx) * e.ny, 1.0f);
         return {};
     }
+    const bool beer = params.form == AttenuationKind::Beer;
     auto tap = [&](int64_t i, int64_t j) -> float {
         return (i < 0 || j < 0 || i >= e.nx || j >= e.ny) ? 0.0f : D[size_t(i) + size_t(e.nx) * size_t(j)];
     };
@@ -279,9 +276,7 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
                 for (uint32_t i = 0; i < e.nx; ++i) {
                     const int64_t x = int64_t(i) + l.baseX, y = int64_t(j) + l.baseY;
                     const float d = Bilinear(tap(x, y), tap(x + 1, y), tap(x, y + 1), tap(x + 1, y + 1), l.fx, l.fy);
-                    G[i + size_t(e.nx) * j] = params.form == AttenuationKind::Beer
-                                                  ? ExpNonPositive(-l.opticalDepthPerD * d)
-                                                  : 1.0f - std::clamp(params.kappa * d, 0.0f, 1.0f);
+                    G[i + size_t(e.nx) * j] = GroundShadow(beer, l.opticalDepthPerD, params.kappa, d);
                 }
         });
     });
