@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
@@ -53,22 +54,13 @@ void ShadeRow(const ShadeKernel& k, const float* t0, const float* t1, const floa
     }
 }
 
-// A volume with explicit sizes, for the shading grid (full or coarse).
-struct Grid3 {
-    uint32_t n[3];
-    const float* q;
-    float* T;
-};
-
-// Shades `grid` with voxels of edge `cellSize` metres.
-void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::task_arena& arena) {
-    const ShearWarp g = MakeShearWarp(p.sun, p.filter);
+// Shades the plan's grid (full or coarse): Q in, T out, both of plan.cells.
+void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena) {
+    const ShearWarp& g = plan.geometry;
     const int w = g.w, u = g.u, v = g.v;
-    const uint32_t nu = grid.n[u], nv = grid.n[v], nw = grid.n[w];
-    const size_t stride[3] = {1, grid.n[0], size_t(grid.n[0]) * grid.n[1]};
-    const SliceAttenuation attenuation = MakeSliceAttenuation(p.attenuation, p.sigma, cellSize, g.absSw, p.thesisAr,
-                                                              p.scattering, p.albedo, p.solidAngle, p.phase);
-    const ShadeKernel kernel{attenuation, p.storage};
+    const uint32_t nu = plan.nu, nv = plan.nv, nw = plan.nw;
+    const size_t stride[3] = {1, plan.cells[0], size_t(plan.cells[0]) * plan.cells[1]};
+    const ShadeKernel kernel{plan.attenuation, storage};
     const int u0 = g.u0, v0 = g.v0;
     const float fu = g.fu, fv = g.fv;
 
@@ -78,19 +70,18 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
     std::vector<float> prevT(size_t(pitch) * (nv + 3), 1.0f), prevQ(size_t(pitch) * (nv + 3), 0.0f);
     auto padded = [&](int64_t a, int64_t b) { return size_t(a + 1) + size_t(pitch) * size_t(b + 1); };
 
-    const bool sunAbove = g.sunAbove;
     for (uint32_t m = 0; m < nw; ++m) {
-        const uint32_t wIndex = sunAbove ? nw - 1 - m : m;
+        const uint32_t wIndex = plan.SliceW(m);
         const size_t sliceBase = stride[w] * wIndex;
         if (m == 0) {
             for (uint32_t b = 0; b < nv; ++b)
-                for (uint32_t a = 0; a < nu; ++a) grid.T[sliceBase + stride[u] * a + stride[v] * b] = 1.0f;
+                for (uint32_t a = 0; a < nu; ++a) T[sliceBase + stride[u] * a + stride[v] * b] = 1.0f;
         } else {
             auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
                 for (uint32_t b = range.begin(); b != range.end(); ++b) {
                     const float* t0 = prevT.data() + padded(u0, int64_t(b) + v0);
                     const float* q0 = prevQ.data() + padded(u0, int64_t(b) + v0);
-                    float* out = grid.T + sliceBase + stride[v] * b;
+                    float* out = T + sliceBase + stride[v] * b;
                     if (stride[u] == 1) ShadeRow(kernel, t0, t0 + pitch, q0, q0 + pitch, fu, fv, out, nu);
                     else {
                         // u is not x: shade into a contiguous row, then scatter.
@@ -111,8 +102,8 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
         for (uint32_t b = 0; b < nv; ++b) {
             float* pt = prevT.data() + padded(0, b);
             float* pq = prevQ.data() + padded(0, b);
-            const float* t = grid.T + sliceBase + stride[v] * b;
-            const float* q = grid.q + sliceBase + stride[v] * b;
+            const float* t = T + sliceBase + stride[v] * b;
+            const float* q = Q + sliceBase + stride[v] * b;
             for (uint32_t a = 0; a < nu; ++a) {
                 pt[a] = t[stride[u] * a];
                 pq[a] = q[stride[u] * a];
@@ -181,13 +172,14 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* T = static_cast<BufferCpu&>(TBuffer).F32();
     const Extent3 e = qBuffer.Extent();
+    const ShadePlan plan = MakeShadePlan(params, e);
     if (f == 1) {
-        ShadeGrid(params, params.voxelSize, {{e.nx, e.ny, e.nz}, q, T}, mArena);
+        ShadeGrid(plan, params.storage, q, T, mArena);
         return {};
     }
 
     // Coarse grid: the mean of each f^3 block (partial blocks: of the voxels present).
-    const uint32_t c[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+    const uint32_t* c = plan.cells;
     const size_t coarseSlice = size_t(c[0]) * c[1];
     mShadeCoarseQ.assign(coarseSlice * c[2], 0.0f);
     mShadeCoarseT.assign(coarseSlice * c[2], 1.0f);
@@ -210,7 +202,7 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
             }
         });
     });
-    ShadeGrid(params, params.voxelSize * float(f), {{c[0], c[1], c[2]}, cq, mShadeCoarseT.data()}, mArena);
+    ShadeGrid(plan, params.storage, cq, mShadeCoarseT.data(), mArena);
 
     // Full resolution, trilinear from the coarse grid: full voxel i sits at coarse
     // coordinate (i + 0.5)/f - 0.5, clamped to the coarse grid's centres. Per fine

@@ -6,7 +6,8 @@
 // The in-row part of the growth neighbourhood: act at i-1, i+1, i-2, i+2 for
 // every bit of word a, with prev and next the row's neighbouring words (0 outside).
 uint CaRowNeighbours(uint a, uint prev, uint next) {
-    return ((a << 1) | (prev >> 31)) | ((a >> 1) | (next << 31)) | ((a << 2) | (prev >> 30)) | ((a >> 2) | (next << 30));
+    return ((a << 1) | (prev >> 31)) | ((a >> 1) | (next << 31)) | ((a << 2) | (prev >> 30)) |
+           ((a >> 2) | (next << 30));
 }
 
 // Growth on (hum, act, cld) words or 0/1 voxels: hum & !act, !act & hum & f, cld | act.

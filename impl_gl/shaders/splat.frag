@@ -11,5 +11,6 @@ void main() {
     if (!(splat.x - halfSize <= pixel.x && pixel.x < splat.x + halfSize && splat.y - halfSize <= pixel.y &&
           pixel.y < splat.y + halfSize))
         discard;
-    result = vec4(colour.rgb, SplatAlpha(colour.a, SplatCoord(pixel.x, splat.x, splat.z), SplatCoord(pixel.y, splat.y, splat.z)));
+    const float a = SplatCoord(pixel.x, splat.x, splat.z), b = SplatCoord(pixel.y, splat.y, splat.z);
+    result = vec4(colour.rgb, SplatAlpha(colour.a, a, b));
 }
