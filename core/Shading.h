@@ -143,21 +143,56 @@ struct SliceAttenuation {
     float thesisAr = 0.9f;       // a_r of the thesis form
     float scatterGain = 0;       // albedo * P^(0) * gamma / (4 pi); 0 = no multiple scattering
 
-    // The factor by which light is multiplied crossing a slice of density q,
-    // clamped to [0, 1] (forward scattering may otherwise exceed 1).
-    float Factor(float q) const {
-        const float tau = opticalDepthPerQ * q;
-        float a = kind == AttenuationKind::Beer ? ExpNonPositive(-tau) : 1.0f - (1.0f - thesisAr) * q;
-        a += scatterGain * tau;
-        return std::clamp(a, 0.0f, 1.0f);
-    }
+    float Factor(float q) const;
 };
 
+// The factor by which light is multiplied crossing a slice of density q,
+// clamped to [0, 1] (forward scattering may otherwise exceed 1). Free of the
+// struct so that a loop with `beer` fixed at compile time vectorises.
+// GLSL twin: shading.glsl SliceFactor.
+inline float SliceFactor(bool beer, float depthPerQ, float thesisAr, float scatterGain, float q) {
+    const float tau = depthPerQ * q;
+    const float a = beer ? ExpNonPositive(-tau) : 1.0f - (1.0f - thesisAr) * q;
+    return std::clamp(a + scatterGain * tau, 0.0f, 1.0f);
+}
+
+inline float SliceAttenuation::Factor(float q) const {
+    return SliceFactor(kind == AttenuationKind::Beer, opticalDepthPerQ, thesisAr, scatterGain, q);
+}
+
+// T of a slice as stored: previousT * factor rounded to the storage format, and
+// 0 below kTransmittanceFloor. GLSL twin: shading.glsl StoreTransmittance.
+inline float StoreTransmittance(StorageFormat storage, float previousT, float factor) {
+    const float value = RoundToStorage(storage, previousT * factor);
+    return value < kTransmittanceFloor ? 0.0f : value;
+}
+
+// Ground shadow G from the column sum d (SPEC 7): exp(-opticalDepthPerD d) for
+// the beer form, 1 - clamp(kappa d) for the thesis form. GLSL twin: shading.glsl GroundShadow.
+inline float GroundShadow(bool beer, float opticalDepthPerD, float kappa, float d) {
+    return beer ? ExpNonPositive(-opticalDepthPerD * d) : 1.0f - std::clamp(kappa * d, 0.0f, 1.0f);
+}
+
+// Trilinear read-back of a shade grid at resolution f (SPEC 6): fine voxel i
+// sits at coarse coordinate (i + 0.5)/f - 0.5, clamped to the cell centres;
+// taps i0, i1 = min(i0 + 1, cells - 1), weight w. GLSL twin: shading.glsl UpsampleTap.
+struct UpsampleTaps {
+    uint32_t i0, i1;
+    float w;
+};
+inline UpsampleTaps UpsampleTap(uint32_t i, int f, uint32_t cells) {
+    const float x = std::clamp((float(i) + 0.5f) / float(f) - 0.5f, 0.0f, float(cells - 1));
+    const uint32_t i0 = uint32_t(x);
+    return {i0, std::min(i0 + 1, cells - 1), x - float(i0)};
+}
+
+// a (1 - t) + b t (the build never fuses it into an FMA). GLSL twin: shading.glsl Lerp.
+inline float Lerp(float a, float b, float t) { return a * (1.0f - t) + b * t; }
+
 // Bilinear blend of four taps: t00 at (0,0), t10 at (1,0), t01 at (0,1), t11 at (1,1).
+// GLSL twin: shading.glsl Bilinear.
 inline float Bilinear(float t00, float t10, float t01, float t11, float fu, float fv) {
-    const float a = t00 * (1.0f - fu) + t10 * fu;
-    const float b = t01 * (1.0f - fu) + t11 * fu;
-    return a * (1.0f - fv) + b * fv;
+    return Lerp(Lerp(t00, t10, fu), Lerp(t01, t11, fu), fv);
 }
 
 // The geometry of one shear-warp pass (SPEC 6), shared by every backend:

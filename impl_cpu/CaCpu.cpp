@@ -3,7 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "core/Random.h"
+#include "core/Automaton.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/CaKernels.h"
 
@@ -49,6 +49,7 @@ Status BackendCpu::CaInitialize(const CaInitParams& params, CaFields out) {
     const Extent3 e = hum.Extent();
     const uint32_t keyHum = StreamKey(params.seed, kInitialStateStep, kStreamHumidity);
     const uint32_t keyAct = StreamKey(params.seed, kInitialStateStep, kStreamActivation);
+    const uint32_t qHum0 = params.qHum0, qAct0 = params.qAct0;
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
             for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
@@ -59,9 +60,10 @@ Status BackendCpu::CaInitialize(const CaInitParams& params, CaFields out) {
                 uint32_t base = VoxelIndex(e, 0, j, k);
                 for (uint32_t w = 0; w < hum.WordsPerRow(); ++w) h[w] = a[w] = c[w] = 0;
                 for (uint32_t i = 0; i < e.nx; ++i) {
-                    uint64_t bit = 1ull << (i & 63);
-                    if (Rand24FromKey(keyHum, base + i) < params.qHum0) h[i >> 6] |= bit;
-                    if (Rand24FromKey(keyAct, base + i) < params.qAct0) a[i >> 6] |= bit;
+                    const CaBits<uint32_t> s = CaInitialVoxel(keyHum, keyAct, qHum0, qAct0, base + i);
+                    h[i >> 6] |= uint64_t(s.hum) << (i & 63);
+                    a[i >> 6] |= uint64_t(s.act) << (i & 63);
+                    c[i >> 6] |= uint64_t(s.cld) << (i & 63);
                 }
             }
         });
@@ -90,9 +92,7 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
         for (int f = 0; f < 3; ++f) dst[f] = &mAdvectScratch[f];
     }
 
-    const uint32_t keyExt = StreamKey(params.seed, params.step, kStreamExtinction);
-    const uint32_t keyHum = StreamKey(params.seed, params.step, kStreamHumidity);
-    const uint32_t keyAct = StreamKey(params.seed, params.step, kStreamActivation);
+    const CaEvents events = MakeCaEvents(params.seed, params.step, params.qExt, params.qHum, params.qAct);
 
     auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
         for (uint32_t r = range.begin(); r != range.end(); ++r) {
@@ -115,42 +115,15 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
                 const uint64_t aw = a[w];
                 const uint64_t prev = w > 0 ? a[w - 1] : 0;
                 const uint64_t next = w + 1 < words ? a[w + 1] : 0;
-                // f(i) reads act(i-1), act(i+1), act(i-2), act(i+2) within the row.
-                uint64_t f = (aw << 1 | prev >> 63) | (aw >> 1 | next << 63) | (aw << 2 | prev >> 62) |
-                             (aw >> 2 | next << 62);
+                uint64_t f = CaRowNeighbours(aw, prev, next);
                 for (const uint64_t* n : across)
                     if (n) f |= n[w];
-
-                // 1. Growth.
-                const uint64_t hum1 = h[w] & ~aw;
-                const uint64_t cld1 = c[w] | aw;
-                const uint64_t act1 = ~aw & h[w] & f;  // h has no bits past nx, so neither has act1
-
-                // 2-3. Region-scaled events. Where R = 0 no event can change the
-                // result (P_hum = P_act = 0 and cld is cleared), so only voxels
-                // with R > 0 that an event could flip draw random numbers.
                 const uint32_t i0 = 64 * w;
-                const uint8_t* rWord = rRow + i0;
-                uint64_t inRegion = NonZeroMaskVector(rWord);
-                if (w == words - 1) inRegion &= lastMask;
-                const uint32_t v0 = rowBase + i0;
-
-                uint64_t cld2 = cld1 & inRegion;
-                const uint64_t extCandidates = cld2;
-                if (extCandidates && params.qExt)
-                    cld2 &= ~(EventBitsVector(keyExt, v0, rWord, params.qExt, /*invert=*/true) & extCandidates);
-                uint64_t hum2 = hum1;
-                const uint64_t humCandidates = ~hum1 & inRegion;
-                if (humCandidates && params.qHum)
-                    hum2 |= EventBitsVector(keyHum, v0, rWord, params.qHum, false) & humCandidates;
-                uint64_t act2 = act1;
-                const uint64_t actCandidates = ~act1 & inRegion;
-                if (actCandidates && params.qAct)
-                    act2 |= EventBitsVector(keyAct, v0, rWord, params.qAct, false) & actCandidates;
-
-                hOut[w] = hum2;
-                aOut[w] = act2;
-                cOut[w] = cld2;
+                const CaBits<uint64_t> s = CaStepWord({h[w], aw, c[w]}, f, rRow + i0, w == words - 1 ? lastMask : ~0ull,
+                                                      rowBase + i0, events);
+                hOut[w] = s.hum;
+                aOut[w] = s.act;
+                cOut[w] = s.cld;
             }
         }
     };

@@ -14,17 +14,11 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/Splat.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
 namespace {
-
-struct Splat {
-    float px, py, size;  // centre in pixels, edge length in pixels
-    float alphaScale;    // q_alpha * opacity
-    float color[3];
-    int32_t x0, x1, y0, y1;  // covered pixels, inclusive (x0 > x1 when none)
-};
 
 constexpr uint32_t kRowsPerBand = 8;
 
@@ -42,7 +36,6 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const float* qCur = static_cast<const BufferCpu&>(*in.qCur).F32();
     const float* T = static_cast<const BufferCpu&>(*in.T).F32();
     float* image = static_cast<BufferCpu&>(imageBuffer).F32();
-    const CameraFrame& cam = p.camera;
 
     // 1. Which tile x band boxes can contribute.
     const uint32_t tilesX = CeilDiv(e.nx, p.tile), tilesY = CeilDiv(e.ny, p.tile), bandCount = CeilDiv(e.nz, p.band);
@@ -60,7 +53,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const std::vector<uint32_t>& outerIdx = order.indices[outer];
     std::vector<std::vector<Splat>> perSlice(outerIdx.size());
     std::vector<uint64_t> visitedPerSlice(outerIdx.size(), 0);
-    const float sunR[3] = {p.sunRadiance[0], p.sunRadiance[1], p.sunRadiance[2]};
+    const SplatFrame frame = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) {
             for (size_t n = range.begin(); n != range.end(); ++n) {
@@ -76,30 +69,8 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                             continue;
                         ++visitedPerSlice[n];
                         const uint32_t v = VoxelIndex(e, i, j, k);
-                        const float qa = qPrev[v] + p.alpha * (qCur[v] - qPrev[v]);
-                        if (!(qa > p.qMin)) continue;
-                        const Vec3 centre{p.origin[0] + (float(i) + 0.5f) * p.voxelSize,
-                                          p.origin[1] + (float(j) + 0.5f) * p.voxelSize,
-                                          p.origin[2] + (float(k) + 0.5f) * p.voxelSize};
-                        const Projected pr = Project(cam, centre);
-                        if (!(pr.depth > cam.nearPlane)) continue;
                         Splat s;
-                        s.px = pr.px;
-                        s.py = pr.py;
-                        s.size = std::clamp(p.splatDiameter * cam.focalPx / pr.depth, 1.0f, 255.0f);
-                        s.alphaScale = qa * p.opacity;
-                        const float vx = centre[0] - cam.eye[0], vy = centre[1] - cam.eye[1], vz = centre[2] - cam.eye[2];
-                        const float len = std::sqrt(vx * vx + vy * vy + vz * vz);
-                        const float cosTheta = (p.sun[0] * vx + p.sun[1] * vy + p.sun[2] * vz) / len;
-                        const float light = T[v] * PhaseValue(p.phase, cosTheta);
-                        for (int c = 0; c < 3; ++c) s.color[c] = sunR[c] * light + p.ambient[c];
-                        // Covered pixels: px - s/2 <= x + 0.5 < px + s/2.
-                        const float half = 0.5f * s.size;
-                        s.x0 = int32_t(std::max(0.0f, std::ceil(s.px - half - 0.5f)));
-                        s.x1 = int32_t(std::min(float(W) - 1.0f, std::ceil(s.px + half - 0.5f) - 1.0f));
-                        s.y0 = int32_t(std::max(0.0f, std::ceil(s.py - half - 0.5f)));
-                        s.y1 = int32_t(std::min(float(H) - 1.0f, std::ceil(s.py + half - 0.5f) - 1.0f));
-                        out.push_back(s);
+                        if (MakeSplat(frame, i, j, k, SplatQ(qPrev[v], qCur[v], p.alpha), T[v], s)) out.push_back(s);
                     }
                 }
             }
@@ -174,7 +145,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                     const int32_t y0 = std::max<int32_t>(s.y0, int32_t(rowLo)), y1 = std::min<int32_t>(s.y1, int32_t(rowHi));
                     if (y0 > y1) continue;
                     const int32_t width = s.x1 - s.x0 + 1;
-                    const float r = s.color[0], g = s.color[1], bl = s.color[2];
+                    const float r = s.colour[0], g = s.colour[1], bl = s.colour[2];
                     for (int32_t i = 0; i < width; ++i) {
                         colours[3 * i] = r;
                         colours[3 * i + 1] = g;
@@ -183,17 +154,17 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                     const float px = s.px, size = s.size, alphaScale = s.alphaScale;
                     const int32_t x0 = s.x0;
                     for (int32_t y = y0; y <= y1; ++y) {
-                        const float bCoord = (float(y) + 0.5f - s.py) / size + 0.5f;
+                        const float bCoord = SplatCoord(float(y) + 0.5f, s.py, size);
                         for (int32_t i = 0; i < width; ++i) {
-                            const float aCoord = (float(x0 + i) + 0.5f - px) / size + 0.5f;
-                            const float alpha = std::clamp(alphaScale * SplatKernel(aCoord, bCoord), 0.0f, 1.0f);
+                            const float alpha =
+                                SplatAlpha(alphaScale, SplatCoord(float(x0 + i) + 0.5f, px, size), bCoord);
                             alphas[3 * i] = alpha;
                             alphas[3 * i + 1] = alpha;
                             alphas[3 * i + 2] = alpha;
                         }
                         float* run = image + size_t(3) * (size_t(W) * uint32_t(y) + uint32_t(x0));
                         for (int32_t j = 0; j < 3 * width; ++j)
-                            run[j] = alphas[j] * colours[j] + (1.0f - alphas[j]) * run[j];
+                            run[j] = Lerp(run[j], colours[j], alphas[j]);
                     }
                 }
             }

@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
@@ -31,12 +32,8 @@ void ShadeRowT(const SliceAttenuation& att, const float* __restrict t0, const fl
     for (uint32_t a = 0; a < n; ++a) {
         const float t = Bilinear(t0[a], t0[a + 1], t1[a], t1[a + 1], fu, fv);
         const float qs = Bilinear(q0[a], q0[a + 1], q1[a], q1[a + 1], fu, fv);
-        // SliceAttenuation::Factor with the kind fixed.
-        const float tau = depthPerQ * qs;
-        float factor = kAttenuation == AttenuationKind::Beer ? ExpNonPositive(-tau) : 1.0f - (1.0f - ar) * qs;
-        factor = std::clamp(factor + gain * tau, 0.0f, 1.0f);
-        const float value = RoundToStorage(kStorage, t * factor);
-        out[a] = value < kTransmittanceFloor ? 0.0f : value;
+        const float factor = SliceFactor(kAttenuation == AttenuationKind::Beer, depthPerQ, ar, gain, qs);
+        out[a] = StoreTransmittance(kStorage, t, factor);
     }
 }
 
@@ -57,22 +54,13 @@ void ShadeRow(const ShadeKernel& k, const float* t0, const float* t1, const floa
     }
 }
 
-// A volume with explicit sizes, for the shading grid (full or coarse).
-struct Grid3 {
-    uint32_t n[3];
-    const float* q;
-    float* T;
-};
-
-// Shades `grid` with voxels of edge `cellSize` metres.
-void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::task_arena& arena) {
-    const ShearWarp g = MakeShearWarp(p.sun, p.filter);
+// Shades the plan's grid (full or coarse): Q in, T out, both of plan.cells.
+void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena) {
+    const ShearWarp& g = plan.geometry;
     const int w = g.w, u = g.u, v = g.v;
-    const uint32_t nu = grid.n[u], nv = grid.n[v], nw = grid.n[w];
-    const size_t stride[3] = {1, grid.n[0], size_t(grid.n[0]) * grid.n[1]};
-    const SliceAttenuation attenuation = MakeSliceAttenuation(p.attenuation, p.sigma, cellSize, g.absSw, p.thesisAr,
-                                                              p.scattering, p.albedo, p.solidAngle, p.phase);
-    const ShadeKernel kernel{attenuation, p.storage};
+    const uint32_t nu = plan.nu, nv = plan.nv, nw = plan.nw;
+    const size_t stride[3] = {1, plan.cells[0], size_t(plan.cells[0]) * plan.cells[1]};
+    const ShadeKernel kernel{plan.attenuation, storage};
     const int u0 = g.u0, v0 = g.v0;
     const float fu = g.fu, fv = g.fv;
 
@@ -82,19 +70,18 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
     std::vector<float> prevT(size_t(pitch) * (nv + 3), 1.0f), prevQ(size_t(pitch) * (nv + 3), 0.0f);
     auto padded = [&](int64_t a, int64_t b) { return size_t(a + 1) + size_t(pitch) * size_t(b + 1); };
 
-    const bool sunAbove = g.sunAbove;
     for (uint32_t m = 0; m < nw; ++m) {
-        const uint32_t wIndex = sunAbove ? nw - 1 - m : m;
+        const uint32_t wIndex = plan.SliceW(m);
         const size_t sliceBase = stride[w] * wIndex;
         if (m == 0) {
             for (uint32_t b = 0; b < nv; ++b)
-                for (uint32_t a = 0; a < nu; ++a) grid.T[sliceBase + stride[u] * a + stride[v] * b] = 1.0f;
+                for (uint32_t a = 0; a < nu; ++a) T[sliceBase + stride[u] * a + stride[v] * b] = 1.0f;
         } else {
             auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
                 for (uint32_t b = range.begin(); b != range.end(); ++b) {
                     const float* t0 = prevT.data() + padded(u0, int64_t(b) + v0);
                     const float* q0 = prevQ.data() + padded(u0, int64_t(b) + v0);
-                    float* out = grid.T + sliceBase + stride[v] * b;
+                    float* out = T + sliceBase + stride[v] * b;
                     if (stride[u] == 1) ShadeRow(kernel, t0, t0 + pitch, q0, q0 + pitch, fu, fv, out, nu);
                     else {
                         // u is not x: shade into a contiguous row, then scatter.
@@ -115,8 +102,8 @@ void ShadeGrid(const ShadeParams& p, float cellSize, const Grid3& grid, tbb::tas
         for (uint32_t b = 0; b < nv; ++b) {
             float* pt = prevT.data() + padded(0, b);
             float* pq = prevQ.data() + padded(0, b);
-            const float* t = grid.T + sliceBase + stride[v] * b;
-            const float* q = grid.q + sliceBase + stride[v] * b;
+            const float* t = T + sliceBase + stride[v] * b;
+            const float* q = Q + sliceBase + stride[v] * b;
             for (uint32_t a = 0; a < nu; ++a) {
                 pt[a] = t[stride[u] * a];
                 pq[a] = q[stride[u] * a];
@@ -150,7 +137,7 @@ void UpsampleRowT(const float* __restrict b, uint32_t cells, const uint32_t* x0,
     // Cells I with 1 <= I and I + 1 <= cells - 1 have every phase in the interior.
     const uint32_t firstI = 1, lastI = cells >= 2 ? cells - 2 : 0;
     const uint32_t interiorBegin = F * firstI, interiorEnd = cells >= 3 ? std::min(n, F * (lastI + 1)) : 0;
-    for (uint32_t i = 0; i < std::min(n, interiorBegin); ++i) out[i] = b[x0[i]] * (1.0f - fx[i]) + b[x1[i]] * fx[i];
+    for (uint32_t i = 0; i < std::min(n, interiorBegin); ++i) out[i] = Lerp(b[x0[i]], b[x1[i]], fx[i]);
     if (interiorEnd > interiorBegin) {
         for (int p = 0; p < F; ++p) {
             const uint32_t i = interiorBegin + uint32_t(p);
@@ -159,11 +146,11 @@ void UpsampleRowT(const float* __restrict b, uint32_t cells, const uint32_t* x0,
             const float* lo = b + int(firstI) + offset;
             float* o = out + interiorBegin + p;
             const uint32_t count = (interiorEnd - interiorBegin) / F;
-            for (uint32_t I = 0; I < count; ++I) o[F * I] = lo[I] * (1.0f - t) + lo[I + 1] * t;
+            for (uint32_t I = 0; I < count; ++I) o[F * I] = Lerp(lo[I], lo[I + 1], t);
         }
     }
     for (uint32_t i = std::max(interiorEnd, std::min(n, interiorBegin)); i < n; ++i)
-        out[i] = b[x0[i]] * (1.0f - fx[i]) + b[x1[i]] * fx[i];
+        out[i] = Lerp(b[x0[i]], b[x1[i]], fx[i]);
 }
 
 void UpsampleRow(const float* b, uint32_t cells, int f, const uint32_t* x0, const uint32_t* x1, const float* fx,
@@ -185,13 +172,14 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* T = static_cast<BufferCpu&>(TBuffer).F32();
     const Extent3 e = qBuffer.Extent();
+    const ShadePlan plan = MakeShadePlan(params, e);
     if (f == 1) {
-        ShadeGrid(params, params.voxelSize, {{e.nx, e.ny, e.nz}, q, T}, mArena);
+        ShadeGrid(plan, params.storage, q, T, mArena);
         return {};
     }
 
     // Coarse grid: the mean of each f^3 block (partial blocks: of the voxels present).
-    const uint32_t c[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+    const uint32_t* c = plan.cells;
     const size_t coarseSlice = size_t(c[0]) * c[1];
     mShadeCoarseQ.assign(coarseSlice * c[2], 0.0f);
     mShadeCoarseT.assign(coarseSlice * c[2], 1.0f);
@@ -214,7 +202,7 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
             }
         });
     });
-    ShadeGrid(params, params.voxelSize * float(f), {{c[0], c[1], c[2]}, cq, mShadeCoarseT.data()}, mArena);
+    ShadeGrid(plan, params.storage, cq, mShadeCoarseT.data(), mArena);
 
     // Full resolution, trilinear from the coarse grid: full voxel i sits at coarse
     // coordinate (i + 0.5)/f - 0.5, clamped to the coarse grid's centres. Per fine
@@ -228,10 +216,10 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
     auto taps = [&](uint32_t n, uint32_t cells) {
         Taps out{std::vector<uint32_t>(n), std::vector<uint32_t>(n), std::vector<float>(n)};
         for (uint32_t i = 0; i < n; ++i) {
-            const float x = std::clamp((float(i) + 0.5f) / float(f) - 0.5f, 0.0f, float(cells - 1));
-            out.i0[i] = uint32_t(x);
-            out.i1[i] = std::min(out.i0[i] + 1, cells - 1);
-            out.t[i] = x - float(out.i0[i]);
+            const UpsampleTaps tap = UpsampleTap(i, f, cells);
+            out.i0[i] = tap.i0;
+            out.i1[i] = tap.i1;
+            out.t[i] = tap.w;
         }
         return out;
     };
@@ -270,6 +258,7 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
         std::fill(G, G + size_t(e.nx) * e.ny, 1.0f);
         return {};
     }
+    const bool beer = params.form == AttenuationKind::Beer;
     auto tap = [&](int64_t i, int64_t j) -> float {
         return (i < 0 || j < 0 || i >= e.nx || j >= e.ny) ? 0.0f : D[size_t(i) + size_t(e.nx) * size_t(j)];
     };
@@ -279,9 +268,7 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
                 for (uint32_t i = 0; i < e.nx; ++i) {
                     const int64_t x = int64_t(i) + l.baseX, y = int64_t(j) + l.baseY;
                     const float d = Bilinear(tap(x, y), tap(x + 1, y), tap(x, y + 1), tap(x + 1, y + 1), l.fx, l.fy);
-                    G[i + size_t(e.nx) * j] = params.form == AttenuationKind::Beer
-                                                  ? ExpNonPositive(-l.opticalDepthPerD * d)
-                                                  : 1.0f - std::clamp(params.kappa * d, 0.0f, 1.0f);
+                    G[i + size_t(e.nx) * j] = GroundShadow(beer, l.opticalDepthPerD, params.kappa, d);
                 }
         });
     });

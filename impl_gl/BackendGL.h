@@ -81,6 +81,7 @@ class BackendGL final : public Backend {
         EllipsoidList,  // Region: the ellipsoids, read by the vertex shader
         CoverCounter,   // Density: the atomic counter of covered columns
         SplatOrder,     // RenderSplat: the flattened shared order
+        SplatFrame,     // RenderSplat: the shared frame block (core/Splat.h)
         SplatCounters,  // RenderSplat: the shader's counters (splats drawn)
         ImageCopy,      // RenderSplat: the pixel buffer the image passes through
         Count

@@ -1,5 +1,6 @@
 #include <vector>
 
+#include "core/Splat.h"
 #include "impl_gl/BackendGLInternal.h"
 
 namespace cb::gl {
@@ -17,7 +18,6 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (!program) return std::unexpected(program.error());
     const Extent3 e = in.qCur->Extent();
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
-    const CameraFrame& cam = p.camera;
 
     auto visibility = DownloadSplatBoxVisibility(*this, p, in);
     if (!visibility) return std::unexpected(visibility.error());
@@ -67,6 +67,11 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     GpuTimer timer(f);
     const GLuint orderBuffer = ScratchBuffer(GlScratchBuffer::SplatOrder, flat.indices.size() * 4);
     f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
+    // The shared frame; this backend's lane: the largest point size.
+    SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
+    frame.misc[2] = pointRange[1];
+    const GLuint frameBuffer = ScratchBuffer(GlScratchBuffer::SplatFrame, sizeof frame);
+    f.NamedBufferSubData(frameBuffer, 0, sizeof frame, &frame);
     const GLuint counters = ScratchBuffer(GlScratchBuffer::SplatCounters, 16);
     const uint32_t zero[4] = {};
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
@@ -78,24 +83,11 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindVertexArray(mContext->EmptyVao());
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, orderBuffer);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counters);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, frameBuffer);
     f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());
     f.BindTextureUnit(2, Tex(*in.T).Texture());
-    auto uniform = [&](const char* name) { return f.GetUniformLocation(*program, name); };
-    f.Uniform3i(uniform("grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-    f.Uniform3i(uniform("axes"), outer, middle, inner);
-    f.Uniform3i(uniform("orderBase"), GLint(flat.base[0]), GLint(flat.base[1]), GLint(flat.base[2]));
-    f.Uniform2f(uniform("image"), float(W), float(H));
-    f.Uniform1f(uniform("guard"), kGuard);
-    f.Uniform4f(uniform("eye"), cam.eye[0], cam.eye[1], cam.eye[2], cam.nearPlane);
-    f.Uniform4f(uniform("forward"), cam.forward[0], cam.forward[1], cam.forward[2], cam.focalPx);
-    f.Uniform3f(uniform("right"), cam.right[0], cam.right[1], cam.right[2]);
-    f.Uniform3f(uniform("up"), cam.upVector[0], cam.upVector[1], cam.upVector[2]);
-    f.Uniform4f(uniform("sun"), p.sun[0], p.sun[1], p.sun[2], p.phase.g);
-    f.Uniform4f(uniform("sunRadiance"), p.sunRadiance[0], p.sunRadiance[1], p.sunRadiance[2], float(p.phase.kind));
-    f.Uniform4f(uniform("ambient"), p.ambient[0], p.ambient[1], p.ambient[2], p.qMin);
-    f.Uniform4f(uniform("origin"), p.origin[0], p.origin[1], p.origin[2], p.voxelSize);
-    f.Uniform4f(uniform("misc"), p.splatDiameter, p.alpha, p.opacity, pointRange[1]);
+    f.Uniform1f(f.GetUniformLocation(*program, "guard"), kGuard);
     f.Enable(GL_PROGRAM_POINT_SIZE);
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);

@@ -1,6 +1,7 @@
 #include <array>
 #include <utility>
 
+#include "core/ShadePlan.h"
 #include "impl_gl/BackendGLInternal.h"
 
 namespace cb::gl {
@@ -20,13 +21,11 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     auto down = mContext->Program("shade_down");
     if (!down) return std::unexpected(down.error());
     const Extent3 e = q.Extent();
-    const int n[3] = {int(CeilDiv(e.nx, uint32_t(res))), int(CeilDiv(e.ny, uint32_t(res))),
-                      int(CeilDiv(e.nz, uint32_t(res)))};
-    const ShearWarp g = MakeShearWarp(params.sun, params.filter);
-    const SliceAttenuation a =
-        MakeSliceAttenuation(params.attenuation, params.sigma, params.voxelSize * float(res), g.absSw, params.thesisAr,
-                             params.scattering, params.albedo, params.solidAngle, params.phase);
-    const int nu = n[g.u], nv = n[g.v], nw = n[g.w];
+    const ShadePlan plan = MakeShadePlan(params, e);
+    const int n[3] = {int(plan.cells[0]), int(plan.cells[1]), int(plan.cells[2])};
+    const ShearWarp& g = plan.geometry;
+    const SliceAttenuation& a = plan.attenuation;
+    const int nu = int(plan.nu), nv = int(plan.nv), nw = int(plan.nw);
     GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
     GLuint shadedQ = Tex(q).Texture();
@@ -64,7 +63,7 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     f.Viewport(0, 0, nu, nv);
     int previous = 0;
     for (int m = 0; m < nw; ++m) {
-        const int w = g.sunAbove ? nw - 1 - m : m;
+        const int w = int(plan.SliceW(uint32_t(m)));
         CB_TRY(BindTargets({{pong, -1}, {volume, w}}));
         f.BindTextureUnit(0, ping);
         f.Uniform1i(first, m == 0 ? 1 : 0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/Splat.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
@@ -13,7 +14,6 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const Extent3 e = in.qCur->Extent();
     if (image.Extent().nx != 3) return MakeError("vk: render_splat image must have extent (3, width, height)");
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
-    const CameraFrame& cam = p.camera;
 
     // Which tile x band boxes can hold a splat: the frustum (host geometry,
     // shared with the CPU) and, when skipping, the two steps' band occupancy.
@@ -23,29 +23,14 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // The shared order, outer axis first.
     const SplatOrder& order = *p.order;
     const FlatSplatOrder flat = FlattenSplatOrder(order);
-    struct alignas(16) Frame {
-        uint32_t grid[4], axes[4], orderBase[4], boxes[4], image[4];
-        float eye[4], forward[4], right[4], up[4], sun[4], sunRadiance[4], ambient[4], background[4], origin[4],
-            misc[4];
-    } frame{};
     constexpr uint32_t kVoxelsPerChunk = 1024, kSplatsPerChunk = 256, kTileSize = 8;
     const uint32_t voxels = uint32_t(e.Count());
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
-    frame = {{e.nx, e.ny, e.nz, kVoxelsPerChunk},
-             {uint32_t(order.axes[0]), uint32_t(order.axes[1]), uint32_t(order.axes[2]), voxels},
-             {flat.base[0], flat.base[1], flat.base[2], 0},
-             {p.tile, p.band, CeilDiv(e.nx, p.tile), CeilDiv(e.ny, p.tile)},
-             {W, H, tilesX, tilesY},
-             {cam.eye[0], cam.eye[1], cam.eye[2], cam.nearPlane},
-             {cam.forward[0], cam.forward[1], cam.forward[2], cam.focalPx},
-             {cam.right[0], cam.right[1], cam.right[2], 0},
-             {cam.upVector[0], cam.upVector[1], cam.upVector[2], 0},
-             {p.sun[0], p.sun[1], p.sun[2], p.phase.g},
-             {p.sunRadiance[0], p.sunRadiance[1], p.sunRadiance[2], float(p.phase.kind)},
-             {p.ambient[0], p.ambient[1], p.ambient[2], p.qMin},
-             {p.background[0], p.background[1], p.background[2], p.opacity},
-             {p.origin[0], p.origin[1], p.origin[2], p.voxelSize},
-             {p.splatDiameter, p.alpha, 0, 0}};
+    // The shared frame; this backend's lanes: voxels per chunk of ranks, screen tiles.
+    SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
+    frame.grid[3] = kVoxelsPerChunk;
+    frame.image[2] = tilesX;
+    frame.image[3] = tilesY;
     const uint32_t chunks = CeilDiv(voxels, kVoxelsPerChunk);
     // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
     struct {
@@ -100,7 +85,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
 
     // 2. Write the splats in order; bin them by screen tile, keeping the order.
     const uint32_t splatChunks = std::max(1u, CeilDiv(splatCount, kSplatsPerChunk));
-    CB_TRY(need(scratch.splats, VkScratch::Splats, VkDeviceSize(splatCount) * 48));
+    CB_TRY(need(scratch.splats, VkScratch::Splats, VkDeviceSize(splatCount) * sizeof(Splat)));
     CB_TRY(need(scratch.binCounts, VkScratch::SplatBinCounts, VkDeviceSize(splatChunks) * screenTiles * 4));
     CB_TRY(need(scratch.tileTotals, VkScratch::SplatTileTotals, VkDeviceSize(screenTiles) * 4));
     CB_TRY(need(scratch.tileBases, VkScratch::SplatTileBases, VkDeviceSize(screenTiles + 1) * 4));

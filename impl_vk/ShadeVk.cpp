@@ -1,6 +1,7 @@
 // Stage `shade` (SPEC 6) on Vulkan: inverse shear-warp, one shade_slice.comp
 // dispatch per slice; at resolution 2 or 4 on a coarse grid (shade_down.comp,
 // shade_up.comp).
+#include "core/ShadePlan.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
@@ -9,8 +10,8 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const int f = params.resolution;
     if (f != 1 && f != 2 && f != 4) return MakeError("vk: shade resolution must be 1, 2 or 4");
     const Extent3 e = q.Extent();
-    const uint32_t n[3] = {f == 1 ? e.nx : CeilDiv(e.nx, f), f == 1 ? e.ny : CeilDiv(e.ny, f),
-                           f == 1 ? e.nz : CeilDiv(e.nz, f)};
+    const ShadePlan plan = MakeShadePlan(params, e);
+    const uint32_t* n = plan.cells;
     const VkDeviceSize coarseBytes = VkDeviceSize(n[0]) * n[1] * n[2] * 4;
     const DeviceBuffer* shadeQ = &Dev(q);
     const DeviceBuffer* shadeT = &Dev(T);
@@ -34,10 +35,8 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         down = *d;
         up = *u;
     }
-    const ShearWarp g = MakeShearWarp(params.sun, params.filter);
-    const SliceAttenuation a =
-        MakeSliceAttenuation(params.attenuation, params.sigma, params.voxelSize * float(f), g.absSw, params.thesisAr,
-                             params.scattering, params.albedo, params.solidAngle, params.phase);
+    const ShearWarp& g = plan.geometry;
+    const SliceAttenuation& a = plan.attenuation;
     const uint32_t stride[3] = {1, n[0], n[0] * n[1]};
     struct {
         uint32_t nu, nv, strideU, strideV, sliceBase, prevBase;
@@ -68,7 +67,7 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const DeviceBuffer* sliceBuffers[] = {shadeQ, shadeT};
     const DeviceBuffer* downBuffers[] = {&Dev(q), shadeQ};
     const DeviceBuffer* upBuffers[] = {shadeT, &Dev(T)};
-    const uint32_t nw = n[g.w];
+    const uint32_t nw = plan.nw;
     return Record("shade", [&](VulkanContext::Recorder& r) {
         if (down) {
             r.Dispatch(*down, downBuffers, &resample, sizeof resample, n[0] * n[1] * n[2]);
@@ -76,7 +75,7 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         }
         uint32_t previous = 0;
         for (uint32_t m = 0; m < nw; ++m) {
-            const uint32_t wIndex = g.sunAbove ? nw - 1 - m : m;
+            const uint32_t wIndex = plan.SliceW(m);
             push.first = m == 0 ? 1u : 0u;
             push.sliceBase = wIndex * stride[g.w];
             push.prevBase = previous * stride[g.w];

@@ -315,6 +315,12 @@ Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t b
     if (auto it = mPipelines.find(name); it != mPipelines.end()) return &it->second;
     std::span<const uint32_t> spirv = FindShader(name);
     if (spirv.empty()) return MakeError("no compiled shader named '" + name + "'");
+    return GetPipeline(name, bindings, spirv);
+}
+
+Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings,
+                                             std::span<const uint32_t> spirv) {
+    if (auto it = mPipelines.find(name); it != mPipelines.end()) return &it->second;
     Pipeline p;
     p.bindings = bindings;
     std::vector<VkDescriptorSetLayoutBinding> b(bindings);

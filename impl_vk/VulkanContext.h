@@ -65,6 +65,8 @@ class VulkanContext {
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
     Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings);
+    // The pipeline of SPIR-V compiled elsewhere (tests), cached under `name`.
+    Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv);
 
     // Records with `record`, submits, waits; returns the device time between
     // the first and last timestamp in ms.

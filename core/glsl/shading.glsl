@@ -48,11 +48,49 @@ float RoundToStorage(uint storage, float value) {
     return value;
 }
 
-float Bilinear(float t00, float t10, float t01, float t11, float fu, float fv) {
-    precise float a = t00 * (1.0 - fu) + t10 * fu;
-    precise float b = t01 * (1.0 - fu) + t11 * fu;
-    precise float result = a * (1.0 - fv) + b * fv;
+// a (1 - t) + b t, unfused (core/Shading.h Lerp).
+float Lerp(float a, float b, float t) {
+    precise float result = a * (1.0 - t) + b * t;
     return result;
+}
+
+// t00 at (0,0), t10 at (1,0), t01 at (0,1), t11 at (1,1) (core/Shading.h Bilinear).
+float Bilinear(float t00, float t10, float t01, float t11, float fu, float fv) {
+    return Lerp(Lerp(t00, t10, fu), Lerp(t01, t11, fu), fv);
+}
+
+// The factor by which light is multiplied crossing a slice of density q (SPEC 6),
+// clamped to [0, 1] (core/Shading.h SliceFactor). beer: 1 beer, 0 thesis.
+float SliceFactor(uint beer, float depthPerQ, float thesisAr, float scatterGain, float q) {
+    precise float tau = depthPerQ * q;
+    precise float a = beer != 0u ? ExpNonPositive(-tau) : 1.0 - (1.0 - thesisAr) * q;
+    precise float result = clamp(a + scatterGain * tau, 0.0, 1.0);
+    return result;
+}
+
+// T of a slice as stored: the product rounded to its storage, and 0 below the
+// floor (core/Shading.h StoreTransmittance).
+float StoreTransmittance(uint storage, float previousT, float factor) {
+    precise float product = previousT * factor;
+    const float value = RoundToStorage(storage, product);
+    return value < kTransmittanceFloor ? 0.0 : value;
+}
+
+// Ground shadow G from the column sum D along the sun (SPEC 7, core/Shading.h GroundShadow).
+float GroundShadow(uint beer, float opticalDepthPerD, float kappa, float d) {
+    precise float depth = -opticalDepthPerD * d;
+    precise float thesis = 1.0 - clamp(kappa * d, 0.0, 1.0);
+    return beer != 0u ? ExpNonPositive(depth) : thesis;
+}
+
+// Where fine voxel i reads a grid of `cells` coarse cells (f fine voxels each):
+// coordinate (i + 0.5)/f - 0.5 clamped to the centres, taps i0 and i1, weight w
+// (core/Shading.h UpsampleTap).
+void UpsampleTap(int i, int f, int cells, out int i0, out int i1, out float w) {
+    precise float x = clamp((float(i) + 0.5) / float(f) - 0.5, 0.0, float(cells - 1));
+    i0 = int(x);
+    i1 = min(i0 + 1, cells - 1);
+    w = x - float(i0);
 }
 
 // phase kind: 0 none, 1 Henyey-Greenstein, 2 Cornette-Shanks. Returns 4 pi p.

@@ -11,12 +11,9 @@ void main() {
     const uint w = uint(gl_FragCoord.x), row = uint(gl_FragCoord.y) + uint(size.y) * uint(layer);
     const uint keyHum = StreamKey(seed, 0xFFFFFFFFu, 1u), keyAct = StreamKey(seed, 0xFFFFFFFFu, 2u);
     const uint i0 = 32u * w, count = min(32u, uint(size.x) - i0), v0 = i0 + uint(size.x) * row;
-    uint h = 0u, a = 0u;
-    for (uint b = 0u; b < count; ++b) {
-        if (Rand24FromKey(keyHum, v0 + b) < qHum0) h |= 1u << b;
-        if (Rand24FromKey(keyAct, v0 + b) < qAct0) a |= 1u << b;
-    }
-    hum = h;
-    act = a;
-    cld = 0u;
+    uvec3 s = uvec3(0u);
+    for (uint b = 0u; b < count; ++b) s |= CaInitialVoxel(keyHum, keyAct, qHum0, qAct0, v0 + b) << b;
+    hum = s.x;
+    act = s.y;
+    cld = s.z;
 }

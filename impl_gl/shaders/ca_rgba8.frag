@@ -15,21 +15,11 @@ uint Act(int i, int j, int k) {
 
 void main() {
     const int i = int(gl_FragCoord.x), j = int(gl_FragCoord.y), k = layer;
-    const uvec4 s = texelFetch(state, ivec3(i, j, k), 0);
-    const uint h = s.r, a = s.g, c = s.b;
     const uint f = Act(i + 1, j, k) | Act(i - 1, j, k) | Act(i + 2, j, k) | Act(i - 2, j, k) | Act(i, j + 1, k) |
                    Act(i, j - 1, k) | Act(i, j + 2, k) | Act(i, j - 2, k) | Act(i, j, k + 1) | Act(i, j, k - 1) |
                    Act(i, j, k - 2);
-    uint hum = h & (1u - a), cld = c | a, act = (1u - a) & h & f;
+    const uvec3 grown = CaGrowth(texelFetch(state, ivec3(i, j, k), 0).rgb, f);
     const uint r = texelFetch(region, ivec3(i, j, k), 0).r;
-    if (r == 0u) {
-        cld = 0u;  // P_hum = P_act = 0 and cld is cleared: nothing to draw
-    } else {
-        const uint v = uint(i) + uint(size.x) * (uint(j) + uint(size.y) * uint(k));
-        if (cld != 0u && qExt != 0u && RegionEventFires(Rand24FromKey(StreamKey(seed, step, 0u), v), 255u - r, qExt))
-            cld = 0u;
-        if (hum == 0u && qHum != 0u && RegionEventFires(Rand24FromKey(StreamKey(seed, step, 1u), v), r, qHum)) hum = 1u;
-        if (act == 0u && qAct != 0u && RegionEventFires(Rand24FromKey(StreamKey(seed, step, 2u), v), r, qAct)) act = 1u;
-    }
-    next = uvec4(hum, act, cld, 0u);
+    const uint v = uint(i) + uint(size.x) * (uint(j) + uint(size.y) * uint(k));
+    next = uvec4(CaVoxelEvents(grown, r, v, MakeCaEvents(seed, step, qExt, qHum, qAct)), 0u);
 }

@@ -35,11 +35,6 @@ void main() {
     const float fu = tapFraction.x, fv = tapFraction.y;
     const float tt = Bilinear(TapT(ua, vb), TapT(ua + 1, vb), TapT(ua, vb + 1), TapT(ua + 1, vb + 1), fu, fv);
     const float qs = Bilinear(TapQ(ua, vb), TapQ(ua + 1, vb), TapQ(ua, vb + 1), TapQ(ua + 1, vb + 1), fu, fv);
-    precise float tau = depthPerQ * qs;
-    precise float factor = beer != 0 ? ExpNonPositive(-tau) : 1.0 - (1.0 - thesisAr) * qs;
-    factor = clamp(factor + scatterGain * tau, 0.0, 1.0);
-    precise float product = tt * factor;
-    const float value = RoundToStorage(storage, product);
-    nextT = value < kTransmittanceFloor ? 0.0 : value;
+    nextT = StoreTransmittance(storage, tt, SliceFactor(uint(beer), depthPerQ, thesisAr, scatterGain, qs));
     volumeT = nextT;
 }

@@ -8,12 +8,6 @@ uniform ivec3 axes;    // u, v, w as axis numbers (0 x, 1 y, 2 z)
 uniform int f;
 layout(location = 0) out float T;
 
-void Tap(int i, int n, out int i0, out int i1, out float w) {
-    const float x = clamp((float(i) + 0.5) / float(f) - 0.5, 0.0, float(n - 1));
-    i0 = int(x);
-    i1 = min(i0 + 1, n - 1);
-    w = x - float(i0);
-}
 float At(int x, int y, int z) {
     const int c[3] = int[3](x, y, z);
     return texelFetch(shaded, ivec3(c[axes.x], c[axes.y], c[axes.z]), 0).r;
@@ -26,11 +20,10 @@ void main() {
     }
     int x0, x1, y0, y1, z0, z1;
     float tx, ty, tz;
-    Tap(int(gl_FragCoord.x), cells.x, x0, x1, tx);
-    Tap(int(gl_FragCoord.y), cells.y, y0, y1, ty);
-    Tap(layer, cells.z, z0, z1, tz);
+    UpsampleTap(int(gl_FragCoord.x), f, cells.x, x0, x1, tx);
+    UpsampleTap(int(gl_FragCoord.y), f, cells.y, y0, y1, ty);
+    UpsampleTap(layer, f, cells.z, z0, z1, tz);
     const float b0 = Bilinear(At(x0, y0, z0), At(x0, y1, z0), At(x0, y0, z1), At(x0, y1, z1), ty, tz);
     const float b1 = Bilinear(At(x1, y0, z0), At(x1, y1, z0), At(x1, y0, z1), At(x1, y1, z1), ty, tz);
-    precise float value = b0 * (1.0 - tx) + b1 * tx;
-    T = value;
+    T = Lerp(b0, b1, tx);
 }

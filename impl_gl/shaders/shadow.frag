@@ -23,5 +23,5 @@ void main() {
     const ivec2 p = ivec2(gl_FragCoord.xy) + base;
     const float dd = Bilinear(TapD(p.x, p.y), TapD(p.x + 1, p.y), TapD(p.x, p.y + 1), TapD(p.x + 1, p.y + 1), fraction.x,
                               fraction.y);
-    g = beer != 0 ? ExpNonPositive(-opticalDepthPerD * dd) : 1.0 - clamp(kappa * dd, 0.0, 1.0);
+    g = GroundShadow(uint(beer), opticalDepthPerD, kappa, dd);
 }

@@ -11,7 +11,6 @@ void main() {
     if (!(splat.x - halfSize <= pixel.x && pixel.x < splat.x + halfSize && splat.y - halfSize <= pixel.y &&
           pixel.y < splat.y + halfSize))
         discard;
-    precise float a = (pixel.x - splat.x) / splat.z + 0.5;
-    precise float b = (pixel.y - splat.y) / splat.z + 0.5;
-    result = vec4(colour.rgb, clamp(colour.a * SplatKernel(a, b), 0.0, 1.0));
+    const float a = SplatCoord(pixel.x, splat.x, splat.z), b = SplatCoord(pixel.y, splat.y, splat.z);
+    result = vec4(colour.rgb, SplatAlpha(colour.a, a, b));
 }

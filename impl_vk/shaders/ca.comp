@@ -4,6 +4,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_8bit_storage : require
 #include "random.glsl"
+#include "automaton.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer HumIn { uint humIn[]; };
@@ -29,28 +30,17 @@ void main() {
     const uint a = actIn[id];
     const uint prev = w > 0u ? actIn[id - 1u] : 0u;
     const uint next = w + 1u < pc.words ? actIn[id + 1u] : 0u;
-    uint f = ((a << 1) | (prev >> 31)) | ((a >> 1) | (next << 31)) | ((a << 2) | (prev >> 30)) | ((a >> 2) | (next << 30));
+    uint f = CaRowNeighbours(a, prev, next);
     f |= ActRow(w, j + 1, k) | ActRow(w, j - 1, k) | ActRow(w, j + 2, k) | ActRow(w, j - 2, k);
     f |= ActRow(w, j, k + 1) | ActRow(w, j, k - 1) | ActRow(w, j, k - 2);
 
-    const uint h = humIn[id], c = cldIn[id];
-    const uint hum1 = h & ~a, cld1 = c | a, act1 = ~a & h & f;
+    const uvec3 grown = CaGrowth(uvec3(humIn[id], a, cldIn[id]), f);
 
-    const uint keyExt = StreamKey(pc.seed, pc.step, 0u);
-    const uint keyHum = StreamKey(pc.seed, pc.step, 1u);
-    const uint keyAct = StreamKey(pc.seed, pc.step, 2u);
+    const CaEvents events = MakeCaEvents(pc.seed, pc.step, pc.qExt, pc.qHum, pc.qAct);
     const uint i0 = 32u * w, count = min(32u, pc.nx - i0), v0 = i0 + pc.nx * row;
-    uint inRegion = 0u, ext = 0u, hum = 0u, act = 0u;
-    for (uint b = 0u; b < count; ++b) {
-        const uint r = uint(region[v0 + b]);
-        if (r == 0u) continue;  // P_hum = P_act = 0 and cld is cleared: nothing to draw
-        const uint bit = 1u << b;
-        inRegion |= bit;
-        if ((cld1 & bit) != 0u && pc.qExt != 0u && RegionEventFires(Rand24FromKey(keyExt, v0 + b), 255u - r, pc.qExt)) ext |= bit;
-        if ((hum1 & bit) == 0u && pc.qHum != 0u && RegionEventFires(Rand24FromKey(keyHum, v0 + b), r, pc.qHum)) hum |= bit;
-        if ((act1 & bit) == 0u && pc.qAct != 0u && RegionEventFires(Rand24FromKey(keyAct, v0 + b), r, pc.qAct)) act |= bit;
-    }
-    humOut[id] = hum1 | hum;
-    actOut[id] = act1 | act;
-    cldOut[id] = cld1 & inRegion & ~ext;
+    uvec3 s = uvec3(0u);  // bits past nx stay 0
+    for (uint b = 0u; b < count; ++b) s |= CaVoxelEvents((grown >> b) & 1u, uint(region[v0 + b]), v0 + b, events) << b;
+    humOut[id] = s.x;
+    actOut[id] = s.y;
+    cldOut[id] = s.z;
 }

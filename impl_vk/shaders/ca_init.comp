@@ -2,6 +2,7 @@
 // Stage `ca`, initial state (SPEC 3): one invocation per 32-voxel word.
 #extension GL_GOOGLE_include_directive : require
 #include "random.glsl"
+#include "automaton.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) writeonly buffer Hum { uint hum[]; };
@@ -15,12 +16,9 @@ void main() {
     const uint w = id % pc.words, row = id / pc.words;
     const uint keyHum = StreamKey(pc.seed, 0xFFFFFFFFu, 1u), keyAct = StreamKey(pc.seed, 0xFFFFFFFFu, 2u);
     const uint i0 = 32u * w, count = min(32u, pc.nx - i0), v0 = i0 + pc.nx * row;
-    uint h = 0u, a = 0u;
-    for (uint b = 0u; b < count; ++b) {
-        if (Rand24FromKey(keyHum, v0 + b) < pc.qHum0) h |= 1u << b;
-        if (Rand24FromKey(keyAct, v0 + b) < pc.qAct0) a |= 1u << b;
-    }
-    hum[id] = h;
-    act[id] = a;
-    cld[id] = 0u;
+    uvec3 s = uvec3(0u);
+    for (uint b = 0u; b < count; ++b) s |= CaInitialVoxel(keyHum, keyAct, pc.qHum0, pc.qAct0, v0 + b) << b;
+    hum[id] = s.x;
+    act[id] = s.y;
+    cld[id] = s.z;
 }

@@ -41,10 +41,5 @@ void main() {
     const int ua = int(a) + pc.u0, vb = int(b) + pc.v0;
     const float tt = Bilinear(TapT(ua, vb), TapT(ua + 1, vb), TapT(ua, vb + 1), TapT(ua + 1, vb + 1), pc.fu, pc.fv);
     const float qs = Bilinear(TapQ(ua, vb), TapQ(ua + 1, vb), TapQ(ua, vb + 1), TapQ(ua + 1, vb + 1), pc.fu, pc.fv);
-    precise float tau = pc.depthPerQ * qs;
-    precise float factor = pc.beer != 0u ? ExpNonPositive(-tau) : 1.0 - (1.0 - pc.thesisAr) * qs;
-    factor = clamp(factor + pc.scatterGain * tau, 0.0, 1.0);
-    precise float product = tt * factor;
-    const float value = RoundToStorage(pc.storage, product);
-    t[target] = value < kTransmittanceFloor ? 0.0 : value;
+    t[target] = StoreTransmittance(pc.storage, tt, SliceFactor(pc.beer, pc.depthPerQ, pc.thesisAr, pc.scatterGain, qs));
 }

@@ -30,5 +30,5 @@ void main() {
     }
     const int x = int(id % pc.nx) + pc.bx, y = int(id / pc.nx) + pc.by;
     const float dd = Bilinear(TapD(x, y), TapD(x + 1, y), TapD(x, y + 1), TapD(x + 1, y + 1), pc.fx, pc.fy);
-    g[id] = pc.beer != 0u ? ExpNonPositive(-pc.opticalDepthPerD * dd) : 1.0 - clamp(pc.kappa * dd, 0.0, 1.0);
+    g[id] = GroundShadow(pc.beer, pc.opticalDepthPerD, pc.kappa, dd);
 }

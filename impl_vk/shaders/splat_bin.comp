@@ -5,12 +5,10 @@
 // its total; mode 2: per chunk, write splat indices at tileBase[tile] + offset,
 // in order. Every write is owned by one invocation, so no atomics and the
 // result does not depend on scheduling.
+#extension GL_GOOGLE_include_directive : require
+#include "shading.glsl"
+#include "splat.glsl"
 layout(local_size_x = 64) in;
-struct Splat {
-    float px, py, size, alphaScale;
-    float r, g, b, pad;
-    int x0, x1, y0, y1;
-};
 layout(std430, binding = 0) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 1) buffer Counts { uint counts[]; };   // chunks x tiles
 layout(std430, binding = 2) buffer Totals { uint totals[]; };   // per tile (mode 1 writes)

@@ -3,12 +3,8 @@
 // in the shared back-to-front order: C <- alpha c + (1 - alpha) C.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
+#include "splat.glsl"
 layout(local_size_x = 64) in;
-struct Splat {
-    float px, py, size, alphaScale;
-    float r, g, b, pad;
-    int x0, x1, y0, y1;
-};
 layout(std430, binding = 0) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 1) readonly buffer Bases { uint bases[]; };
 layout(std430, binding = 2) readonly buffer List { uint list[]; };
@@ -24,11 +20,9 @@ void main() {
     for (uint n = bases[tile]; n < bases[tile + 1u]; ++n) {
         const Splat s = splats[list[n]];
         if (x < s.x0 || x > s.x1 || y < s.y0 || y > s.y1) continue;
-        precise float a = (float(x) + 0.5 - s.px) / s.size + 0.5;
-        precise float b = (float(y) + 0.5 - s.py) / s.size + 0.5;
-        precise float alpha = clamp(s.alphaScale * SplatKernel(a, b), 0.0, 1.0);
-        precise vec3 blended = alpha * vec3(s.r, s.g, s.b) + (1.0 - alpha) * c;
-        c = blended;
+        const float a = SplatCoord(float(x) + 0.5, s.px, s.size), b = SplatCoord(float(y) + 0.5, s.py, s.size);
+        const float alpha = SplatAlpha(s.alphaScale, a, b);
+        c = vec3(Lerp(c.r, s.r, alpha), Lerp(c.g, s.g, alpha), Lerp(c.b, s.b, alpha));
     }
     image[3u * id] = c.r;
     image[3u * id + 1u] = c.g;

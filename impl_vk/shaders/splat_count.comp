@@ -2,7 +2,7 @@
 // Splat pass 1: per chunk of ranks, how many splats it makes and how many
 // voxels it visits (boxes not culled or skipped).
 #extension GL_GOOGLE_include_directive : require
-#include "splat.glsl"
+#include "splat_ranks.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 6) writeonly buffer Counts { uint chunkSplats[]; };
 layout(std430, binding = 7) writeonly buffer Visited { uint chunkVisited[]; };
@@ -15,7 +15,7 @@ void main() {
     uint splats = 0u;
     for (uint r = first; r < last; ++r) {
         Splat s;
-        if (MakeSplat(r, s)) ++splats;
+        if (MakeRankSplat(r, s)) ++splats;
     }
     chunkSplats[c] = splats;
     chunkVisited[c] = 0u;

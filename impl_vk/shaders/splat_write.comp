@@ -1,7 +1,7 @@
 #version 450
 // Splat pass 3: per chunk of ranks, write its splats at the chunk's offset, in order.
 #extension GL_GOOGLE_include_directive : require
-#include "splat.glsl"
+#include "splat_ranks.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 6) readonly buffer Offsets { uint chunkOffset[]; };
 layout(std430, binding = 7) writeonly buffer Splats { Splat splats[]; };
@@ -14,6 +14,6 @@ void main() {
     uint slot = chunkOffset[c];
     for (uint r = first; r < last; ++r) {
         Splat s;
-        if (MakeSplat(r, s)) splats[slot++] = s;
+        if (MakeRankSplat(r, s)) splats[slot++] = s;
     }
 }

@@ -1,0 +1,113 @@
+#version 450
+// The GLSL twins of core/glsl, one function per `fn` (tests/GlslTwinTest.cpp
+// lists them): element n reads 16 words at in[16 n] and writes 16 at out[16 n];
+// floats travel as their bits.
+#extension GL_GOOGLE_include_directive : require
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "splat.glsl"
+
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer In { uint inWords[]; };
+layout(std430, binding = 1) writeonly buffer Out { uint outWords[]; };
+layout(std430, binding = 2) readonly buffer Frame { SplatFrame frame; };
+layout(push_constant) uniform Params { uint fn, count; } pc;
+
+uint base;
+uint U(uint k) { return inWords[base + k]; }
+float F(uint k) { return uintBitsToFloat(inWords[base + k]); }
+int I(uint k) { return int(inWords[base + k]); }
+void PutU(uint k, uint v) { outWords[base + k] = v; }
+void PutF(uint k, float v) { outWords[base + k] = floatBitsToUint(v); }
+void PutI(uint k, int v) { outWords[base + k] = uint(v); }
+
+void main() {
+    const uint n = gl_GlobalInvocationID.x;
+    if (n >= pc.count) return;
+    base = 16u * n;
+    switch (pc.fn) {
+        case 0u: PutU(0u, LowBias32(U(0u))); break;
+        case 1u: PutU(0u, StreamKey(U(0u), U(1u), U(2u))); break;
+        case 2u: PutU(0u, Rand24FromKey(U(0u), U(1u))); break;
+        case 3u: PutU(0u, RegionEventFires(U(0u), U(1u), U(2u)) ? 1u : 0u); break;
+        case 4u: PutF(0u, EllipsoidWeight(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), F(6u), F(7u),
+                                          vec3(F(8u), F(9u), F(10u)))); break;
+        case 5u: PutU(0u, QuantizeRegion(F(0u))); break;
+        case 6u: PutI(0u, SmoothWeight(I(0u), I(1u))); break;
+        case 7u: PutF(0u, ExpNonPositive(F(0u))); break;
+        case 8u: PutF(0u, RoundToHalf(F(0u))); break;
+        case 9u: PutF(0u, RoundToUnorm8(F(0u))); break;
+        case 10u: PutF(0u, RoundToStorage(U(0u), F(1u))); break;
+        case 11u: PutF(0u, Lerp(F(0u), F(1u), F(2u))); break;
+        case 12u: PutF(0u, Bilinear(F(0u), F(1u), F(2u), F(3u), F(4u), F(5u))); break;
+        case 13u: PutF(0u, PhaseValue(U(0u), F(1u), F(2u))); break;
+        case 14u: PutF(0u, SplatKernel(F(0u), F(1u))); break;
+        case 15u: PutF(0u, SliceFactor(U(0u), F(1u), F(2u), F(3u), F(4u))); break;
+        case 16u: PutF(0u, StoreTransmittance(U(0u), F(1u), F(2u))); break;
+        case 17u: PutF(0u, GroundShadow(U(0u), F(1u), F(2u), F(3u))); break;
+        case 18u: {
+            int i0, i1;
+            float w;
+            UpsampleTap(I(0u), I(1u), I(2u), i0, i1, w);
+            PutI(0u, i0);
+            PutI(1u, i1);
+            PutF(2u, w);
+            break;
+        }
+        case 19u: PutU(0u, CaRowNeighbours(U(0u), U(1u), U(2u))); break;
+        case 20u: {
+            const uvec3 s = CaGrowth(uvec3(U(0u), U(1u), U(2u)), U(3u));
+            PutU(0u, s.x);
+            PutU(1u, s.y);
+            PutU(2u, s.z);
+            break;
+        }
+        case 21u: {
+            const CaEvents e = CaEvents(U(5u), U(6u), U(7u), U(8u), U(9u), U(10u));
+            const uvec3 s = CaVoxelEvents(uvec3(U(0u), U(1u), U(2u)), U(3u), U(4u), e);
+            PutU(0u, s.x);
+            PutU(1u, s.y);
+            PutU(2u, s.z);
+            break;
+        }
+        case 22u: {
+            const uvec3 s = CaInitialVoxel(U(0u), U(1u), U(2u), U(3u), U(4u));
+            PutU(0u, s.x);
+            PutU(1u, s.y);
+            PutU(2u, s.z);
+            break;
+        }
+        case 23u: {
+            const CaEvents e = MakeCaEvents(U(0u), U(1u), U(2u), U(3u), U(4u));
+            PutU(0u, e.keyExt);
+            PutU(1u, e.keyHum);
+            PutU(2u, e.keyAct);
+            PutU(3u, e.qExt);
+            PutU(4u, e.qHum);
+            PutU(5u, e.qAct);
+            break;
+        }
+        case 24u: PutF(0u, SplatQ(F(0u), F(1u), F(2u))); break;
+        case 25u: PutF(0u, SplatCoord(F(0u), F(1u), F(2u))); break;
+        case 26u: PutF(0u, SplatAlpha(F(0u), F(1u), F(2u))); break;
+        case 27u: {
+            Splat s;
+            const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), s);
+            PutU(0u, made ? 1u : 0u);
+            PutF(1u, s.px);
+            PutF(2u, s.py);
+            PutF(3u, s.size);
+            PutF(4u, s.alphaScale);
+            PutF(5u, s.r);
+            PutF(6u, s.g);
+            PutF(7u, s.b);
+            PutI(8u, s.x0);
+            PutI(9u, s.x1);
+            PutI(10u, s.y0);
+            PutI(11u, s.y1);
+            break;
+        }
+    }
+}
