@@ -10,10 +10,9 @@
 
 #include "core/Error.h"
 #include "impl_gl/GLFunctions.h"
+#include "impl_gl/GLOptions.h"
 
 namespace cb::gl {
-
-enum class ContextKind { OSMesa, Egl };
 
 class GLContext {
   public:

@@ -1,8 +1,8 @@
-// The backend registry: which backends this build has, and how to make one.
+#include "registry/Registry.h"
+
 #include <cstdlib>
 #include <cstring>
 
-#include "core/Backend.h"
 #include "impl_cpu/BackendCpu.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/BackendVk.h"
