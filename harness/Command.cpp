@@ -37,6 +37,18 @@ OptionSpec Choice(std::string_view name, Enum CommonOptions::*field, const std::
             }};
 }
 
+// The table's names as a choice, the first marked as the default: "a (default) or b".
+template <typename Enum, size_t N>
+std::string DefaultFirst(const std::array<NamedValue<Enum>, N>& table) {
+    std::string out;
+    for (size_t i = 0; i < N; ++i) {
+        if (i > 0) out += i + 1 == N ? " or " : ", ";
+        out += table[i].name;
+        if (i == 0) out += " (default)";
+    }
+    return out;
+}
+
 // Function-local statics: commands in other files read them during static initialisation.
 std::vector<OptionSpec> MakeSceneCommandOptions() {
     return {
@@ -117,6 +129,11 @@ BackendOptions CommonOptions::Backend() const {
 std::span<const OptionSpec> SceneCommandOptions() {
     static const std::vector<OptionSpec> options = MakeSceneCommandOptions();
     return options;
+}
+
+std::string GlOptionsHelp() {
+    return "  --gl-context CTX   OpenGL context: " + DefaultFirst(gl::kContextKindNames) +
+           "\n  --gl-ca-layout L   OpenGL automaton layout: " + DefaultFirst(gl::kCaLayoutNames) + "\n";
 }
 
 OptionSpec RepeatOption() {

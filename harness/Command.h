@@ -69,6 +69,9 @@ OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOpti
 // The options every scene command accepts: --backend, --steps, --out, --set,
 // --threads, --gl-context, --gl-ca-layout, --vk-device, --quiet.
 std::span<const OptionSpec> SceneCommandOptions();
+// The help lines of --gl-context and --gl-ca-layout, their values listed from
+// the options' name tables, the default first.
+std::string GlOptionsHelp();
 // --repeat N, shared by accuracy and sweep.
 OptionSpec RepeatOption();
 
