@@ -1,6 +1,6 @@
 // The backend-neutral interface: one entry per SPEC stage. impl_cpu, impl_gl and
-// impl_vk each implement it in their own library; the harness links whichever
-// were built and picks them by name (CreateBackend).
+// impl_vk each implement it in their own library; the registry (registry/) links
+// whichever were built and makes them by name (CreateBackend).
 //
 // Data lives in backend-owned Buffers whose internal layout is the backend's
 // business (the CPU packs bit fields 64 voxels to a word). Upload and Download
@@ -235,24 +235,9 @@ class Backend {
     }
 };
 
-// The backends compiled into this build, in preference order.
-std::vector<std::string> BuiltBackends();
-
-struct BackendOptions {
-    int cpuThreads = 0;         // 0: every hardware thread
-    std::string vkDevice;       // Vulkan device index or name substring; "" = the first
-    bool vkValidation = false;  // Khronos validation layer (also CLOUDBENCH_VK_VALIDATION=1)
-    std::string glContext;      // "osmesa" (default) or "egl"
-    std::string glCaLayout;     // automaton layout: "packed" (default, R32UI) or "rgba8" (the thesis's)
-};
-
 // SplatBoxVisibility for a backend whose occupancy lives on a device: reads
 // both steps' bands back through backend.Download when skipping.
 Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const SplatParams& params,
                                                         const SplatInputs& in);
-
-// Creates a backend by name. An unknown name, or one whose device is missing,
-// comes back as an Error that says why (the harness reports it and goes on).
-Result<std::unique_ptr<Backend>> CreateBackend(const std::string& name, const BackendOptions& options = {});
 
 }  // namespace cb

@@ -7,6 +7,7 @@
 
 #include "harness/Simulation.h"
 #include "harness/StageParams.h"
+#include "registry/Registry.h"
 
 namespace cb {
 

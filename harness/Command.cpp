@@ -1,6 +1,7 @@
 #include "harness/Command.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -23,14 +24,29 @@ std::optional<int> PositiveInt(const char* text, long max) {
     return int(value);
 }
 
-// An option whose value must be one of `allowed`, stored in `field`.
-OptionSpec Choice(std::string_view name, std::string CommonOptions::*field, const char* a, const char* b,
-                  std::string message) {
-    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                if (!v || (std::strcmp(v, a) != 0 && std::strcmp(v, b) != 0)) return message;
-                o.*field = v;
+// An option whose value is one of `table`'s names, stored in `field` as its
+// value; otherwise the usage message lists the names: "--x needs a or b".
+template <typename Enum, size_t N>
+OptionSpec Choice(std::string_view name, Enum CommonOptions::*field, const std::array<NamedValue<Enum>, N>& table) {
+    const std::string message = std::string(name) + " needs " + ChoiceOf(table);
+    return {name, "", true, [=, &table](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                const std::optional<Enum> value = v ? ValueNamed(table, v) : std::nullopt;
+                if (!value) return message;
+                o.*field = *value;
                 return std::nullopt;
             }};
+}
+
+// The table's names as a choice, the first marked as the default: "a (default) or b".
+template <typename Enum, size_t N>
+std::string DefaultFirst(const std::array<NamedValue<Enum>, N>& table) {
+    std::string out;
+    for (size_t i = 0; i < N; ++i) {
+        if (i > 0) out += i + 1 == N ? " or " : ", ";
+        out += table[i].name;
+        if (i == 0) out += " (default)";
+    }
+    return out;
 }
 
 // Function-local statics: commands in other files read them during static initialisation.
@@ -69,8 +85,8 @@ std::vector<OptionSpec> MakeSceneCommandOptions() {
              o.cpuThreads = *threads;
              return std::nullopt;
          }},
-        Choice("--gl-context", &CommonOptions::glContext, "osmesa", "egl", "--gl-context needs osmesa or egl"),
-        Choice("--gl-ca-layout", &CommonOptions::glCaLayout, "packed", "rgba8", "--gl-ca-layout needs packed or rgba8"),
+        Choice("--gl-context", &CommonOptions::glContext, gl::kContextKindNames),
+        Choice("--gl-ca-layout", &CommonOptions::glCaLayout, gl::kCaLayoutNames),
         TextOption("--vk-device", &CommonOptions::vkDevice, "--vk-device needs an index or a name"),
         FlagOption("--quiet", &CommonOptions::quiet),
     };
@@ -113,6 +129,11 @@ BackendOptions CommonOptions::Backend() const {
 std::span<const OptionSpec> SceneCommandOptions() {
     static const std::vector<OptionSpec> options = MakeSceneCommandOptions();
     return options;
+}
+
+std::string GlOptionsHelp() {
+    return "  --gl-context CTX   OpenGL context: " + DefaultFirst(gl::kContextKindNames) +
+           "\n  --gl-ca-layout L   OpenGL automaton layout: " + DefaultFirst(gl::kCaLayoutNames) + "\n";
 }
 
 OptionSpec RepeatOption() {

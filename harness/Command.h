@@ -12,6 +12,7 @@
 
 #include "core/Backend.h"
 #include "core/Scene.h"
+#include "registry/Registry.h"
 
 namespace cb {
 
@@ -32,9 +33,9 @@ struct CommonOptions {
     std::vector<SceneOverride> overrides;  // --set, and --steps as "steps"
     std::string outDir;                    // "" = the command's default under out/<scene name>
     int cpuThreads = 0;
-    std::string vkDevice;    // --vk-device INDEX|NAME
-    std::string glContext;   // --gl-context osmesa|egl
-    std::string glCaLayout;  // --gl-ca-layout packed|rgba8
+    std::string vkDevice;                                 // --vk-device INDEX|NAME
+    gl::ContextKind glContext = gl::ContextKind::OSMesa;  // --gl-context, gl::kContextKindNames
+    gl::CaLayout glCaLayout = gl::CaLayout::Packed;       // --gl-ca-layout, gl::kCaLayoutNames
     bool quiet = false;
     // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
     // timed calls per measurement; accuracy --switches; sweep --metric.
@@ -68,6 +69,9 @@ OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOpti
 // The options every scene command accepts: --backend, --steps, --out, --set,
 // --threads, --gl-context, --gl-ca-layout, --vk-device, --quiet.
 std::span<const OptionSpec> SceneCommandOptions();
+// The help lines of --gl-context and --gl-ca-layout, their values listed from
+// the options' name tables, the default first.
+std::string GlOptionsHelp();
 // --repeat N, shared by accuracy and sweep.
 OptionSpec RepeatOption();
 

@@ -26,14 +26,10 @@ TexelFormat FormatOf(BufferFormat format) {
 
 }  // namespace
 
-Result<std::unique_ptr<BackendGL>> BackendGL::Create(const std::string& context, const std::string& caLayout) {
-    if (!context.empty() && context != "osmesa" && context != "egl")
-        return MakeError("gl: unknown context '" + context + "' (osmesa or egl)");
-    if (!caLayout.empty() && caLayout != "packed" && caLayout != "rgba8")
-        return MakeError("gl: unknown automaton layout '" + caLayout + "' (packed or rgba8)");
-    auto ctx = GLContext::Create(context == "egl" ? ContextKind::Egl : ContextKind::OSMesa);
+Result<std::unique_ptr<BackendGL>> BackendGL::Create(ContextKind context, CaLayout caLayout) {
+    auto ctx = GLContext::Create(context);
     if (!ctx) return std::unexpected(ctx.error());
-    return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx), caLayout == "rgba8"));
+    return std::unique_ptr<BackendGL>(new BackendGL(std::move(*ctx), caLayout == CaLayout::Rgba8));
 }
 
 BackendGL::~BackendGL() {

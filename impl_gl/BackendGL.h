@@ -41,8 +41,9 @@ class BufferGL final : public Buffer {
 
 class BackendGL final : public Backend {
   public:
-    // context: "osmesa" (default) or "egl"; caLayout: "packed" (default) or "rgba8".
-    static Result<std::unique_ptr<BackendGL>> Create(const std::string& context, const std::string& caLayout = "");
+    // An Error says why the context cannot be made here.
+    static Result<std::unique_ptr<BackendGL>> Create(ContextKind context = ContextKind::OSMesa,
+                                                     CaLayout caLayout = CaLayout::Packed);
     ~BackendGL() override;
 
     std::string Name() const override { return "gl"; }

@@ -137,8 +137,12 @@ GLContext::~GLContext() {
 }
 
 std::string GLContext::Renderer() const {
-    const char* renderer = reinterpret_cast<const char*>(mF.GetString(GL_RENDERER));
-    return std::string(renderer ? renderer : "?") + (mKind == ContextKind::OSMesa ? " (OSMesa)" : " (EGL)");
+    return String(GL_RENDERER) + (mKind == ContextKind::OSMesa ? " (OSMesa)" : " (EGL)");
+}
+
+std::string GLContext::String(GLenum name) const {
+    const char* text = reinterpret_cast<const char*>(mF.GetString(name));
+    return text ? text : "?";
 }
 
 Status GLContext::Check(const char* what) const {

@@ -10,10 +10,9 @@
 
 #include "core/Error.h"
 #include "impl_gl/GLFunctions.h"
+#include "impl_gl/GLOptions.h"
 
 namespace cb::gl {
-
-enum class ContextKind { OSMesa, Egl };
 
 class GLContext {
   public:
@@ -23,7 +22,10 @@ class GLContext {
     GLContext& operator=(const GLContext&) = delete;
 
     const Functions& F() const { return mF; }
+    // GL_RENDERER, then the context kind: "llvmpipe (...) (OSMesa)".
     std::string Renderer() const;
+    // glGetString(name) as the driver spells it; "?" when it returns null.
+    std::string String(GLenum name) const;
     // "doing X: GL_INVALID_OPERATION" for a pending GL error; ok otherwise.
     Status Check(const char* what) const;
     // The linked program of pass `name`: shaders/<name>.frag with

@@ -87,7 +87,17 @@ Result<std::vector<DeviceInfo>> ListDevices() {
     for (uint32_t n = 0; n < count; ++n) {
         VkPhysicalDeviceProperties p;
         vkGetPhysicalDeviceProperties(devices[n], &p);
-        out.push_back({n, p.deviceName, DeviceTypeName(p.deviceType), p.apiVersion});
+        // The driver properties are core from Vulkan 1.2 only.
+        std::string driver = "?";
+        if (p.apiVersion >= VK_API_VERSION_1_2) {
+            VkPhysicalDeviceDriverProperties driverProperties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+            VkPhysicalDeviceProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+            properties.pNext = &driverProperties;
+            vkGetPhysicalDeviceProperties2(devices[n], &properties);
+            driver = driverProperties.driverName;
+            if (driverProperties.driverInfo[0] != '\0') driver += std::string(" ") + driverProperties.driverInfo;
+        }
+        out.push_back({n, p.deviceName, DeviceTypeName(p.deviceType), p.apiVersion, driver});
     }
     vkDestroyInstance(*instance, nullptr);
     if (out.empty()) return MakeError("no Vulkan device found (install mesa-vulkan-drivers for lavapipe)");

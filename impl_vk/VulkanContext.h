@@ -25,6 +25,7 @@ struct DeviceInfo {
     std::string name;
     std::string type;  // "cpu", "integrated GPU", "discrete GPU", ...
     uint32_t apiVersion;
+    std::string driver;  // driver name and version info ("llvmpipe Mesa 22.3.6"); "?" before Vulkan 1.2
 };
 
 // The Vulkan devices on this machine; an Error says why there are none.

@@ -15,6 +15,7 @@
 #include "core/Scene.h"
 #include "harness/Report.h"
 #include "harness/Simulation.h"
+#include "registry/Registry.h"
 #include "core/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
@@ -31,20 +32,28 @@ struct SizeCase {
 };
 void PrintTo(const SizeCase& c, std::ostream* os) { *os << c.name; }
 
-using Param = std::tuple<std::string, SizeCase>;
+// A backend under test: its name and the options it is made with.
+struct BackendVariant {
+    std::string backend;
+    BackendOptions options;
+    // The name in test names: the backend, then any non-default automaton layout ("gl_rgba8").
+    std::string Label() const {
+        if (options.glCaLayout == gl::CaLayout::Packed) return backend;
+        return backend + "_" + std::string(gl::CaLayoutName(options.glCaLayout));
+    }
+};
+void PrintTo(const BackendVariant& v, std::ostream* os) { *os << v.Label(); }
+
+using Param = std::tuple<BackendVariant, SizeCase>;
 
 class Conformance : public ::testing::TestWithParam<Param> {
   protected:
     void SetUp() override {
-        BackendOptions options;
+        const BackendVariant& variant = std::get<0>(GetParam());
+        BackendOptions options = variant.options;
         options.vkValidation = true;  // the tests run with the Khronos layer and expect no message
-        std::string name = std::get<0>(GetParam());
-        if (name == "gl-rgba8") {
-            name = "gl";
-            options.glCaLayout = "rgba8";
-            mAutomatonOnly = true;
-        }
-        auto backend = CreateBackend(name, options);
+        mAutomatonOnly = options.glCaLayout != gl::CaLayout::Packed;
+        auto backend = CreateBackend(variant.backend, options);
         if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
         mBackend = std::move(*backend);
     }
@@ -57,7 +66,7 @@ class Conformance : public ::testing::TestWithParam<Param> {
     }
     Extent3 Size() const { return std::get<1>(GetParam()).size; }
     // Why the test of `stage` is skipped on this backend; nullopt when it runs.
-    // The gl-rgba8 variant differs from gl in the automaton only.
+    // A variant with another automaton layout differs from its backend in the ca stage only.
     std::optional<std::string> SkipReason(Stage stage) const {
         if (!mBackend->Supports(stage)) return "not implemented yet: " + mBackend->Name() + " has no " + std::string(StageName(stage)) + " stage";
         if (mAutomatonOnly && stage != Stage::Ca) return std::string("the RGBA8 automaton layout changes only the ca stage (tested as gl)");
@@ -452,7 +461,11 @@ TEST_P(Conformance, EndToEndSimulation) {
     }
 }
 
-std::vector<std::string> AllBackends() { return {"cpu", "vk", "gl", "gl-rgba8"}; }
+std::vector<BackendVariant> AllBackends() {
+    BackendOptions rgba8;
+    rgba8.glCaLayout = gl::CaLayout::Rgba8;
+    return {{"cpu", {}}, {"vk", {}}, {"gl", {}}, {"gl", rgba8}};
+}
 
 INSTANTIATE_TEST_SUITE_P(
     Stages, Conformance,
@@ -460,9 +473,7 @@ INSTANTIATE_TEST_SUITE_P(
                        ::testing::Values(SizeCase{"Small64x64x16", {64, 64, 16}}, SizeCase{"Odd70x33x17", {70, 33, 17}},
                                          SizeCase{"Thin1x1x9", {1, 1, 9}})),
     [](const ::testing::TestParamInfo<Param>& info) {
-        std::string backend = std::get<0>(info.param);
-        std::replace(backend.begin(), backend.end(), '-', '_');
-        return std::string(std::get<1>(info.param).name) + "_" + backend;
+        return std::string(std::get<1>(info.param).name) + "_" + std::get<0>(info.param).Label();
     });
 
 }  // namespace

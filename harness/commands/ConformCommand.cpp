@@ -8,7 +8,7 @@
 namespace cb {
 namespace {
 
-constexpr const char* kHelp = R"(usage: cloudbench conform [SCENE] [options]
+constexpr const char* kHelpHead = R"(usage: cloudbench conform [SCENE] [options]
 
 Runs SCENE on the CPU and, at every step, feeds each other backend's stages
 the CPU's inputs of that step (stage-isolated conformance), comparing by
@@ -24,9 +24,8 @@ Options:
   --out DIR          output folder (default: out/<scene name>/conform)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --vk-device DEV    Vulkan device: index or part of the name
-  --gl-context CTX   OpenGL context: osmesa (default) or egl
-  --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8
 )";
+const std::string kHelp = kHelpHead + GlOptionsHelp();
 
 int Conform(const CommonOptions& options) {
     auto session = Session::Open(options, "conform");

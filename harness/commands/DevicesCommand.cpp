@@ -1,43 +1,65 @@
-// `cloudbench devices`: the backends of this build and the Vulkan devices.
+// `cloudbench devices`: the backends of this build, the Vulkan devices and the
+// OpenGL contexts, as the registry lists them.
+#include <algorithm>
 #include <cstdio>
 
 #include "harness/Command.h"
-#if CLOUDBENCH_HAVE_VK
-#include "impl_vk/VulkanContext.h"
-#endif
+#include "registry/Registry.h"
 
 namespace cb {
 namespace {
 
 constexpr const char* kHelp = R"(usage: cloudbench devices
 
-Lists the backends of this build and the Vulkan devices, with the index and
-name that --vk-device takes.
+Lists the backends of this build, the Vulkan devices with the index and name
+that --vk-device takes, and the OpenGL contexts that --gl-context takes, each
+tried here: its GL_RENDERER and GL_VERSION, or why it cannot be created.
+Exits 4 when the Vulkan backend is built but finds no device.
 )";
+
+// Returns false when Vulkan is built and has no device.
+bool PrintVulkanDevices() {
+    auto devices = ListVulkanDevices();
+    if (!devices) {
+        std::printf("vk: %s\n", devices.error().message.c_str());
+        const std::vector<std::string> built = BuiltBackends();
+        return std::ranges::find(built, "vk") == built.end();
+    }
+    std::printf("Vulkan devices (--vk-device INDEX or a part of the name):\n");
+    for (const VulkanDeviceInfo& d : *devices)
+        std::printf("  %u  %s: %s, Vulkan %s, driver %s\n", d.index, d.name.c_str(), d.type.c_str(), d.api.c_str(),
+                    d.driver.c_str());
+    return true;
+}
+
+void PrintGLContexts() {
+    auto contexts = ListGLContexts();
+    if (!contexts) {
+        std::printf("gl: %s\n", contexts.error().message.c_str());
+        return;
+    }
+    std::printf("OpenGL contexts (--gl-context NAME):\n");
+    for (const GLContextInfo& c : *contexts) {
+        const std::string name(gl::ContextKindName(c.kind));
+        if (c.available)
+            std::printf("  %-7s %s: OpenGL %s\n", name.c_str(), c.renderer.c_str(), c.version.c_str());
+        else
+            std::printf("  %-7s unavailable: %s\n", name.c_str(), c.reason.c_str());
+    }
+}
 
 int Devices(const CommonOptions&) {
     std::printf("backends in this build:");
     for (const std::string& name : BuiltBackends()) std::printf(" %s", name.c_str());
     std::printf("\n");
-#if CLOUDBENCH_HAVE_VK
-    auto devices = vk::ListDevices();
-    if (!devices) {
-        std::printf("vk: %s\n", devices.error().message.c_str());
-        return kExitNoBackend;
-    }
-    std::printf("Vulkan devices (--vk-device INDEX or a part of the name):\n");
-    for (const vk::DeviceInfo& d : *devices)
-        std::printf("  %u  %s (%s, Vulkan %u.%u)\n", d.index, d.name.c_str(), d.type.c_str(),
-                    VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion));
-#else
-    std::printf("vk: not built in this build\n");
-#endif
-    return kExitOk;
+    const bool vulkanOk = PrintVulkanDevices();
+    PrintGLContexts();
+    return vulkanOk ? kExitOk : kExitNoBackend;
 }
 
 const CommandRegistration kRegistration({
     .name = "devices",
-    .summary = "List the backends of this build and the Vulkan devices",
+    .summary = "List the backends of this build, the Vulkan devices and the OpenGL contexts",
     .help = kHelp,
     .helpOrder = 3,
     .takesScene = false,

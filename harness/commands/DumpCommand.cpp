@@ -11,7 +11,7 @@
 namespace cb {
 namespace {
 
-constexpr const char* kHelp = R"(usage: cloudbench dump [SCENE] [options]
+constexpr const char* kHelpHead = R"(usage: cloudbench dump [SCENE] [options]
 
 Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
   hum.npy act.npy cld.npy  uint8 0/1, the automaton state at step t
@@ -34,10 +34,10 @@ Options:
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
-  --gl-context CTX   OpenGL context: osmesa (default) or egl
-  --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8
-  --quiet            no progress lines
 )";
+constexpr const char* kHelpTail = R"(  --quiet            no progress lines
+)";
+const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail;
 
 // dump --reference: T_ref.npy (with shade) and shadow_ref.npy (with shadow)
 // of the simulation's current step, computed from its q.

@@ -9,7 +9,7 @@
 namespace cb {
 namespace {
 
-constexpr const char* kHelp = R"(usage: cloudbench run [SCENE] [options]
+constexpr const char* kHelpHead = R"(usage: cloudbench run [SCENE] [options]
 
 Runs SCENE (a name in scenes/ or a path to a .json file; default: thesis-medium)
 on each backend, prints a per-stage timing table (median and spread over the
@@ -26,11 +26,11 @@ Options:
                      the file: --set ca.seed=42 --set grid.size=[64,16,64]
   --threads N        CPU backend threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
-  --gl-context CTX   OpenGL context: osmesa (default, llvmpipe) or egl (GPU or surfaceless)
-  --gl-ca-layout L   OpenGL automaton layout: packed (default; R32UI, 32 voxels a texel)
-                     or rgba8 (the thesis's: one RGBA8 texel a voxel, a channel a bit)
+)";
+constexpr const char* kHelpTail = R"(                     (the contexts and layouts: docs/cli.md; cloudbench devices)
   --quiet            no progress lines
 )";
+const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail;
 
 // Steps the simulation to the end, then writes the last frame of each camera
 // and the top view; whatever fails is recorded in `run` and the rest goes on.

@@ -1,14 +1,16 @@
-// The backend registry: which backends this build has, and how to make one.
+#include "registry/Registry.h"
+
 #include <cstdlib>
 #include <cstring>
 
-#include "core/Backend.h"
 #include "impl_cpu/BackendCpu.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/VulkanContext.h"
 #endif
 #if CLOUDBENCH_HAVE_GL
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/GLContext.h"
 #endif
 
 namespace cb {
@@ -47,6 +49,43 @@ Result<std::unique_ptr<Backend>> CreateBackend(const std::string& name, const Ba
 #endif
     }
     return MakeError(name + ": unknown backend (known: cpu, gl, vk)");
+}
+
+Result<std::vector<VulkanDeviceInfo>> ListVulkanDevices() {
+#if CLOUDBENCH_HAVE_VK
+    auto devices = vk::ListDevices();
+    if (!devices) return std::unexpected(devices.error());
+    std::vector<VulkanDeviceInfo> out;
+    for (const vk::DeviceInfo& d : *devices)
+        out.push_back({d.index, d.name, d.type,
+                       std::to_string(VK_API_VERSION_MAJOR(d.apiVersion)) + "." +
+                           std::to_string(VK_API_VERSION_MINOR(d.apiVersion)),
+                       d.driver});
+    return out;
+#else
+    return MakeError("not built in this build (configure with CLOUDBENCH_WITH_VK=ON)");
+#endif
+}
+
+Result<std::vector<GLContextInfo>> ListGLContexts() {
+#if CLOUDBENCH_HAVE_GL
+    std::vector<GLContextInfo> out;
+    for (const NamedValue<gl::ContextKind>& entry : gl::kContextKindNames) {
+        GLContextInfo info;
+        info.kind = entry.value;
+        if (auto context = gl::GLContext::Create(entry.value)) {
+            info.available = true;
+            info.renderer = (*context)->String(GL_RENDERER);
+            info.version = (*context)->String(GL_VERSION);
+        } else {
+            info.reason = context.error().message;
+        }
+        out.push_back(std::move(info));
+    }
+    return out;
+#else
+    return MakeError("not built in this build (configure with CLOUDBENCH_WITH_GL=ON)");
+#endif
 }
 
 }  // namespace cb
