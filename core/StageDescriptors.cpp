@@ -11,8 +11,8 @@ namespace cb {
 
 std::string_view ResourceName(Resource resource) {
     switch (resource) {
-#define CB_RESOURCE_NAME(name, text, format) \
-    case Resource::name:                     \
+#define CB_RESOURCE_NAME(name, text, format, file) \
+    case Resource::name:                           \
         return text;
         CB_RESOURCES(CB_RESOURCE_NAME)
 #undef CB_RESOURCE_NAME
@@ -20,10 +20,21 @@ std::string_view ResourceName(Resource resource) {
     return "?";
 }
 
+std::string_view ResourceDumpStem(Resource resource) {
+    switch (resource) {
+#define CB_RESOURCE_STEM(name, text, format, file) \
+    case Resource::name:                           \
+        return file;
+        CB_RESOURCES(CB_RESOURCE_STEM)
+#undef CB_RESOURCE_STEM
+    }
+    return "";
+}
+
 BufferFormat ResourceFormat(Resource resource) {
     switch (resource) {
-#define CB_RESOURCE_FORMAT(name, text, format) \
-    case Resource::name:                       \
+#define CB_RESOURCE_FORMAT(name, text, format, file) \
+    case Resource::name:                             \
         return BufferFormat::format;
         CB_RESOURCES(CB_RESOURCE_FORMAT)
 #undef CB_RESOURCE_FORMAT

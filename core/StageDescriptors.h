@@ -18,35 +18,39 @@
 
 namespace cb {
 
-// X(Enum, "name", format): the buffers that pass between stages (SPEC 0).
-#define CB_RESOURCES(X)                                                         \
-    X(Region, "region", U8) /* R: region weights, grid */                       \
-    X(Hum, "hum", Bits)     /* automaton fields, grid */                        \
-    X(Act, "act", Bits)                                                         \
-    X(Cld, "cld", Bits)                                                         \
-    X(Q, "q", F32)                    /* density in [0, 1], grid */             \
-    X(ColumnSum, "D", F32)            /* column sums, (nx, ny, 1) */            \
-    X(Tiles, "tiles", U8)             /* tile occupancy, (tx, ty, 1) */         \
-    X(Bands, "bands", U8)             /* tile x band occupancy, (tx, ty, bz) */ \
-    X(T, "T", F32)                    /* transmittance toward the sun, grid */  \
-    X(Shadow, "G", F32)               /* ground shadow, (nx, ny, 1) */          \
-    X(SplatImage, "image_splat", F32) /* (3, width, height) per camera */       \
-    X(MarchImage, "image_march", F32)
+// X(Enum, "name", format, "dump file stem"): the buffers that pass between
+// stages (SPEC 0). Images have no dump array; they are written as frames.
+#define CB_RESOURCES(X)                                                             \
+    X(Region, "region", U8, "region") /* R: region weights, grid */                 \
+    X(Hum, "hum", Bits, "hum")        /* automaton fields, grid */                  \
+    X(Act, "act", Bits, "act")                                                      \
+    X(Cld, "cld", Bits, "cld")                                                      \
+    X(Q, "q", F32, "q")                   /* density in [0, 1], grid */             \
+    X(ColumnSum, "D", F32, "density")     /* column sums, (nx, ny, 1) */            \
+    X(Tiles, "tiles", U8, "tiles")        /* tile occupancy, (tx, ty, 1) */         \
+    X(Bands, "bands", U8, "bands")        /* tile x band occupancy, (tx, ty, bz) */ \
+    X(T, "T", F32, "T")                   /* transmittance toward the sun, grid */  \
+    X(Shadow, "G", F32, "shadow")         /* ground shadow, (nx, ny, 1) */          \
+    X(SplatImage, "image_splat", F32, "") /* (3, width, height) per camera */       \
+    X(MarchImage, "image_march", F32, "")
 
 enum class Resource : uint8_t {
-#define CB_RESOURCE_ENUM(name, text, format) name,
+#define CB_RESOURCE_ENUM(name, text, format, file) name,
     CB_RESOURCES(CB_RESOURCE_ENUM)
 #undef CB_RESOURCE_ENUM
 };
 
 inline constexpr std::array kAllResources = {
-#define CB_RESOURCE_VALUE(name, text, format) Resource::name,
+#define CB_RESOURCE_VALUE(name, text, format, file) Resource::name,
     CB_RESOURCES(CB_RESOURCE_VALUE)
 #undef CB_RESOURCE_VALUE
 };
 inline constexpr size_t kResourceCount = kAllResources.size();
 
 std::string_view ResourceName(Resource resource);
+// The stem of the resource's array in a dump (`dump`: DIR/step_tttt/<stem>.npy);
+// "" for images, which are written as frames.
+std::string_view ResourceDumpStem(Resource resource);
 BufferFormat ResourceFormat(Resource resource);
 // The extent of one buffer of the resource in this scene.
 Extent3 ResourceExtent(Resource resource, const Scene& scene);

@@ -67,22 +67,24 @@ Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOpt
     std::snprintf(folder, sizeof folder, "/step_%04u", s.CurrentStep());
     const std::string dir = outDir + folder;
     CB_TRY(MakeFolder(dir));
-    const std::pair<const char*, const Buffer*> arrays[] = {
-        {"hum.npy", s.Hum()}, {"act.npy", s.Act()},           {"cld.npy", s.Cld()},     {"region.npy", s.Region()},
-        {"q.npy", s.Q()},     {"density.npy", s.ColumnSum()}, {"tiles.npy", s.Tiles()}, {"bands.npy", s.Bands()},
-        {"T.npy", s.T()},     {"shadow.npy", s.Shadow()},
-    };
-    for (const auto& [file, buffer] : arrays)
-        if (buffer) CB_TRY(Session::WriteNpy(dir + "/" + file, s.GetBackend(), *buffer));
-    if (options.reference) CB_TRY(WriteReferenceDump(s, dir, options.cpuThreads));
+    // Every resource the enabled stages write: arrays, and each renderer's image per camera as a frame.
     const Scene& scene = s.GetScene();
-    for (size_t n = 0; s.Image(n); ++n) {
-        auto rgb = Download<float>(s.GetBackend(), *s.Image(n));
-        if (!rgb) return std::unexpected(rgb.error());
-        const std::string stem = dir + "/" + FrameFileStem(Stage::RenderSplat, scene.render.cameras[n].name);
-        auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, /*png=*/false);
-        if (!paths) return std::unexpected(paths.error());
+    for (Resource r : kAllResources) {
+        if (!s.Get(r)) continue;
+        if (!IsPerCamera(r)) {
+            CB_TRY(Session::WriteNpy(dir + "/" + std::string(ResourceDumpStem(r)) + ".npy", s.GetBackend(), *s.Get(r)));
+            continue;
+        }
+        const Stage renderer = *ProducerOf(r, scene.stages);
+        for (size_t n = 0; s.Get(r, n); ++n) {
+            auto rgb = Download<float>(s.GetBackend(), *s.Get(r, n));
+            if (!rgb) return std::unexpected(rgb.error());
+            const std::string stem = dir + "/" + FrameFileStem(renderer, scene.render.cameras[n].name);
+            auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, /*png=*/false);
+            if (!paths) return std::unexpected(paths.error());
+        }
     }
+    if (options.reference) CB_TRY(WriteReferenceDump(s, dir, options.cpuThreads));
     return {};
 }
 
