@@ -128,65 +128,75 @@ std::vector<Resource> SplatPrevious(const Scene& scene) {
     return {Resource::Q};
 }
 
+// The table, made on first use: commands describe stages in their help text
+// during static initialisation, before a namespace-scope table would exist.
 // Fields left out take their defaults (GCC warns about designated initialisers that omit fields).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-const std::array<StageDescriptor, kStageCount> kDescriptors = {{
-    {.stage = Stage::Region, .section = "ellipsoids", .writes = {Resource::Region}, .symbol = "R", .rule = RegionRule},
-    {.stage = Stage::Ca,
-     .section = "ca",
-     .reads = {Resource::Region, Resource::Hum, Resource::Act, Resource::Cld},
-     .writes = {Resource::Hum, Resource::Act, Resource::Cld},
-     .advancesState = true,
-     .symbol = "cld",
-     .rule = BitExact},
-    {.stage = Stage::Smooth,
-     .section = "smooth",
-     .reads = {Resource::Cld},
-     .writes = {Resource::Q},
-     .symbol = "q",
-     .rule = BitExact},
-    {.stage = Stage::Density,
-     .section = "density",
-     .reads = {Resource::Q},
-     .optionalReads = {Resource::Cld},
-     .writes = {Resource::ColumnSum, Resource::Tiles, Resource::Bands},
-     .symbol = "D",
-     .rule = BitExact},
-    {.stage = Stage::Shade,
-     .section = "shade",
-     .reads = {Resource::Q},
-     .writes = {Resource::T},
-     .outputStepsOnly = true,
-     .skipsUnchangedInputs = true,
-     .symbol = "T",
-     .rule = ShadeRule},
-    {.stage = Stage::Shadow,
-     .section = "shadow",
-     .reads = {Resource::ColumnSum},
-     .writes = {Resource::Shadow},
-     .outputStepsOnly = true,
-     .symbol = "G",
-     .rule = ShadowRule},
-    {.stage = Stage::RenderSplat,
-     .section = "render",
-     .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
-     .readsPrevious = SplatPrevious,
-     .writes = {Resource::SplatImage},
-     .outputStepsOnly = true,
-     .renderer = true,
-     .symbol = "image",
-     .rule = SplatImageRule},
-    {.stage = Stage::RenderMarch,
-     .section = "render",
-     .reads = {Resource::Q},
-     .writes = {Resource::MarchImage},
-     .outputStepsOnly = true,
-     .renderer = true,
-     .symbol = "image",
-     .rule = MarchImageRule},
-    {.stage = Stage::Noise, .section = "noise", .writes = {Resource::Q}, .symbol = "q", .rule = NoiseRule},
-}};
+const std::array<StageDescriptor, kStageCount>& Descriptors() {
+    static const std::array<StageDescriptor, kStageCount> table = {{
+        {.stage = Stage::Region,
+         .section = "ellipsoids",
+         .writes = {Resource::Region},
+         .symbol = "R",
+         .rule = RegionRule},
+        {.stage = Stage::Ca,
+         .section = "ca",
+         .reads = {Resource::Region, Resource::Hum, Resource::Act, Resource::Cld},
+         .writes = {Resource::Hum, Resource::Act, Resource::Cld},
+         .advancesState = true,
+         .symbol = "cld",
+         .rule = BitExact},
+        {.stage = Stage::Smooth,
+         .section = "smooth",
+         .reads = {Resource::Cld},
+         .writes = {Resource::Q},
+         .symbol = "q",
+         .rule = BitExact},
+        {.stage = Stage::Density,
+         .section = "density",
+         .reads = {Resource::Q},
+         .optionalReads = {Resource::Cld},
+         .writes = {Resource::ColumnSum, Resource::Tiles, Resource::Bands},
+         .symbol = "D",
+         .rule = BitExact},
+        {.stage = Stage::Shade,
+         .section = "shade",
+         .reads = {Resource::Q},
+         .writes = {Resource::T},
+         .outputStepsOnly = true,
+         .skipsUnchangedInputs = true,
+         .symbol = "T",
+         .rule = ShadeRule,
+         .ruleNote = "one storage quantum with fp16 or unorm8 storage"},
+        {.stage = Stage::Shadow,
+         .section = "shadow",
+         .reads = {Resource::ColumnSum},
+         .writes = {Resource::Shadow},
+         .outputStepsOnly = true,
+         .symbol = "G",
+         .rule = ShadowRule},
+        {.stage = Stage::RenderSplat,
+         .section = "render",
+         .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
+         .readsPrevious = SplatPrevious,
+         .writes = {Resource::SplatImage},
+         .outputStepsOnly = true,
+         .renderer = true,
+         .symbol = "image",
+         .rule = SplatImageRule},
+        {.stage = Stage::RenderMarch,
+         .section = "render",
+         .reads = {Resource::Q},
+         .writes = {Resource::MarchImage},
+         .outputStepsOnly = true,
+         .renderer = true,
+         .symbol = "image",
+         .rule = MarchImageRule},
+        {.stage = Stage::Noise, .section = "noise", .writes = {Resource::Q}, .symbol = "q", .rule = NoiseRule},
+    }};
+    return table;
+}
 #pragma GCC diagnostic pop
 
 bool Contains(const std::vector<Resource>& list, Resource r) {
@@ -198,8 +208,8 @@ bool Contains(const std::vector<Resource>& list, Resource r) {
 }  // namespace
 
 const StageDescriptor& Describe(Stage stage) {
-    const StageDescriptor& d = kDescriptors[size_t(stage)];
-    assert(d.stage == stage && "kDescriptors is in CB_STAGES order");
+    const StageDescriptor& d = Descriptors()[size_t(stage)];
+    assert(d.stage == stage && "the descriptors are in CB_STAGES order");
     return d;
 }
 

@@ -99,6 +99,7 @@ struct StageDescriptor {
     std::string_view symbol;  // the compared quantity in rule texts ("R", "T", ...)
     // The comparison for this scene (shade's tolerance depends on its storage format).
     CompareRule (*rule)(const Scene& scene) = nullptr;
+    std::string_view ruleNote;  // how the rule depends on the scene, for the help ("" if it does not)
 };
 
 const StageDescriptor& Describe(Stage stage);

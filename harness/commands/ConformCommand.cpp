@@ -2,21 +2,22 @@
 // the CPU on a scene (harness/Conform.h); writes conform.json, exits 5 on a failure.
 #include <cstdio>
 
+#include "core/StageDescriptors.h"
 #include "harness/Conform.h"
 #include "harness/Session.h"
 
 namespace cb {
 namespace {
 
-constexpr const char* kHelpHead = R"(usage: cloudbench conform [SCENE] [options]
+constexpr const char* kHelpIntro = R"(usage: cloudbench conform [SCENE] [options]
 
 Runs SCENE on the CPU and, at every step, feeds each other backend's stages
-the CPU's inputs of that step (stage-isolated conformance), comparing by
-SPEC's rule for the stage: region |dR| <= 1 on all but 0.5 % of voxels;
-ca, smooth, density bit-exact; shade |dT| <= 1e-5 (one storage quantum for
-fp16/unorm8); shadow |dG| <= 1e-5. Prints stage x backend with the result,
-the rule and the worst error with where it is, writes DIR/conform.json, and
-exits 5 if any check fails. Stages a backend lacks are listed as skipped.
+the CPU's inputs of that step (stage-isolated conformance), and compares their
+outputs by SPEC's rule for the stage (core/StageDescriptors.cpp):
+)";
+constexpr const char* kHelpOptions = R"(Prints stage x backend with the result, the rule and the worst error with where
+it is, writes DIR/conform.json, and exits 5 if any check fails. Stages a
+backend lacks are listed as skipped.
 
 Options:
   --backend LIST     backends to check (default: all built; cpu is the reference)
@@ -25,7 +26,23 @@ Options:
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --vk-device DEV    Vulkan device: index or part of the name
 )";
-const std::string kHelp = kHelpHead + GlOptionsHelp();
+
+// One line per stage: its rule in a default scene, and what changes it.
+std::string RulesHelp() {
+    std::string text;
+    const Scene defaults;
+    for (Stage stage : kAllStages) {
+        const StageDescriptor& d = Describe(stage);
+        std::string line = "  " + std::string(StageName(stage));
+        line.resize(16, ' ');
+        line += d.rule(defaults).Text(d.symbol);
+        if (!d.ruleNote.empty()) line += " (" + std::string(d.ruleNote) + ")";
+        text += line + "\n";
+    }
+    return text + "\n";
+}
+
+const std::string kHelp = kHelpIntro + RulesHelp() + kHelpOptions + GlOptionsHelp();
 
 int Conform(const CommonOptions& options) {
     auto session = Session::Open(options, "conform");
