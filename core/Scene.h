@@ -18,8 +18,8 @@ namespace cb {
 
 struct GridSettings {
     Extent3 size{64, 16, 64};
-    double voxelSize = 50.0;                 // metres per voxel edge (h)
-    std::array<double, 3> origin{0, 0, 0};   // world position of voxel corner (0,0,0), metres
+    double voxelSize = 50.0;                // metres per voxel edge (h)
+    std::array<double, 3> origin{0, 0, 0};  // world position of voxel corner (0,0,0), metres
 };
 
 // Per-slice integer wind shift for Dobashi advection, in voxels per step.
@@ -49,8 +49,8 @@ struct CaSettings {
 // a grid of vectors spread over the region bounds and looked up bilinearly.
 struct EllipsoidWind {
     std::array<double, 2> vector{0, 0};
-    uint32_t gridNx = 0, gridNy = 0;            // 0: use `vector`
-    std::vector<std::array<double, 2>> grid;    // gridNx*gridNy, x fastest
+    uint32_t gridNx = 0, gridNy = 0;          // 0: use `vector`
+    std::vector<std::array<double, 2>> grid;  // gridNx*gridNy, x fastest
 };
 
 struct EllipsoidSettings {
@@ -62,10 +62,10 @@ struct EllipsoidSettings {
     double lifetimeMean = 400;                    // steps
     double lifetimeVariance = 100;
     uint32_t shrinkSteps = 40;
-    double margin = 16;                           // voxels added around the grid (region bounds)
-    std::array<double, 2> heightRange{0.25, 0.5}; // centre height, fraction of nz
+    double margin = 16;                            // voxels added around the grid (region bounds)
+    std::array<double, 2> heightRange{0.25, 0.5};  // centre height, fraction of nz
     EllipsoidWind wind;
-    double jitter = 0.05;                         // uniform +- per axis per step, voxels
+    double jitter = 0.05;  // uniform +- per axis per step, voxels
 };
 
 struct SmoothSettings {
@@ -79,10 +79,10 @@ struct DensitySettings {
 
 // The sun (SPEC 0): direction from elevation and azimuth, and its radiance.
 struct SunSettings {
-    double elevationDeg = 40;   // above the horizon, degrees
-    double azimuthDeg = 30;     // from +x toward +y, degrees
+    double elevationDeg = 40;                     // above the horizon, degrees
+    double azimuthDeg = 30;                       // from +x toward +y, degrees
     std::array<double, 3> color{1.0, 0.96, 0.9};  // linear RGB
-    double intensity = 1.0;     // multiplies color
+    double intensity = 1.0;                       // multiplies color
 
     // Unit vector toward the sun.
     Vec3 Direction() const {
@@ -96,40 +96,46 @@ struct SunSettings {
 };
 
 struct LightingSettings {
-    std::array<double, 3> ambient{0.25, 0.3, 0.38};    // linear RGB, added to every splat
-    std::array<double, 3> background{0.45, 0.6, 0.85}; // linear RGB behind the clouds
+    std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
+    std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
 };
 
 // Stage `shade` (SPEC 6).
 struct ShadeSettings {
     AttenuationKind attenuation = AttenuationKind::Beer;
-    double sigma = 0.02;        // extinction coefficient at q = 1, 1/m (beer, and tau for scattering)
-    double thesisAr = 0.9;      // a_r of the thesis's linear form
+    double sigma = 0.02;    // extinction coefficient at q = 1, 1/m (beer, and tau for scattering)
+    double thesisAr = 0.9;  // a_r of the thesis's linear form
     SampleFilter filter = SampleFilter::Bilinear;
-    int resolution = 1;         // 1, 2 or 4
+    int resolution = 1;  // 1, 2 or 4
     StorageFormat storage = StorageFormat::Fp32;
-    bool scattering = false;    // multiple forward scattering (seed 002 eq. 5-7)
-    double albedo = 0.9;        // alpha_s
-    double solidAngle = 0.05;   // gamma, steradians
+    bool scattering = false;   // multiple forward scattering (seed 002 eq. 5-7)
+    double albedo = 0.9;       // alpha_s
+    double solidAngle = 0.05;  // gamma, steradians
 };
 
 // Stage `shadow` (SPEC 7).
 struct ShadowSettings {
     AttenuationKind form = AttenuationKind::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D)
-    double kappa = 0.25;        // thesis form: shadow per unit of D
+    double kappa = 0.25;                           // thesis form: shadow per unit of D
 };
 
-// Stage `render_splat` (SPEC 8).
+// What every renderer shares (section `render`): the image, the cameras,
+// when to render and where between two steps.
 struct RenderSettings {
     uint32_t width = 320, height = 240;
-    double qMin = 0.3;          // a voxel makes a splat iff q_alpha > q_min
-    double splatScale = 1.5;    // splat diameter d = splatScale * voxel size
+    double alpha = 0.5;                   // interpolation between the previous and the current step
+    uint32_t everySteps = 0;              // render every N steps after warm-up (and the last); 0 = last step only
+    std::vector<CameraSettings> cameras;  // at least one when a renderer runs
+};
+
+// Stage `render_splat` (SPEC 8): the splat renderer's own settings. In scene
+// files they sit in the `render` section beside the shared ones (docs/scenes.md).
+struct SplatSettings {
+    double qMin = 0.3;        // a voxel makes a splat iff q_alpha > q_min
+    double splatScale = 1.5;  // splat diameter d = splatScale * voxel size
     double opacity = 0.6;
-    double alpha = 0.5;         // interpolation between the previous and the current step
-    bool culling = true;        // view-frustum culling of tile-band boxes
-    bool skipping = true;       // empty-space skipping from the density map
-    uint32_t everySteps = 0;    // render every N steps after warm-up (and the last); 0 = last step only
-    std::vector<CameraSettings> cameras;  // at least one when render_splat runs
+    bool culling = true;   // view-frustum culling of tile-band boxes
+    bool skipping = true;  // empty-space skipping from the density map
 };
 
 struct Scene {
@@ -145,10 +151,11 @@ struct Scene {
     DensitySettings density;
     SunSettings sun;
     LightingSettings lighting;
-    PhaseParams phase;          // used by shade (scattering) and render_splat
+    PhaseParams phase;  // used by shade (scattering) and render_splat
     ShadeSettings shade;
     ShadowSettings shadow;
     RenderSettings render;
+    SplatSettings splat;
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

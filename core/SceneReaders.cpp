@@ -347,6 +347,7 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
     ReadShade(root, check, scene.shade);
     ReadShadow(root, check, scene.shadow);
     const bool camerasOk = ReadRender(root, check, scene.render);
+    ReadSplat(root, check, scene.splat);
     if (scene.stages.Has(Stage::RenderSplat) && camerasOk && scene.render.cameras.empty())
         check.Fail("render.cameras", Quote(StageName(Stage::RenderSplat)) + " needs at least one camera");
 

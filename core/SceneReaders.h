@@ -40,5 +40,6 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
 void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow);
 // Returns false when render.cameras was given but is wrong (so "needs a camera" is not piled on).
 bool ReadRender(const Json& root, Validator& check, RenderSettings& render);
+void ReadSplat(const Json& root, Validator& check, SplatSettings& splat);
 
 }  // namespace cb::scene_io

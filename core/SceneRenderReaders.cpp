@@ -193,6 +193,29 @@ void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
     }
 }
 
+// The splat renderer's fields of the `render` section (its keys are checked by ReadRender).
+void ReadSplat(const Json& root, Validator& check, SplatSettings& splat) {
+    const Json* section = Validator::Find(root, "render");
+    if (!section || !section->is_object()) return;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    auto field = [](std::string_view key) { return JoinField("render", key); };
+    if (const Json* v = find("q_min")) {
+        if (auto d = check.Number(*v, field("q_min"), kNonNegative)) splat.qMin = *d;
+    }
+    if (const Json* v = find("splat_scale")) {
+        if (auto d = check.Number(*v, field("splat_scale"), kPositive)) splat.splatScale = *d;
+    }
+    if (const Json* v = find("opacity")) {
+        if (auto d = check.Number(*v, field("opacity"), kProbability)) splat.opacity = *d;
+    }
+    if (const Json* v = find("culling")) {
+        if (auto b = check.Boolean(*v, field("culling"))) splat.culling = *b;
+    }
+    if (const Json* v = find("skipping")) {
+        if (auto b = check.Boolean(*v, field("skipping"))) splat.skipping = *b;
+    }
+}
+
 bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
     const Json* section = check.Section(root, "", "render", kRenderKeys);
     if (!section) return true;
@@ -205,23 +228,8 @@ bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
     if (const Json* v = find("height")) {
         if (auto n = check.Integer(*v, field("height"), 1, kMaxImageEdge)) render.height = uint32_t(*n);
     }
-    if (const Json* v = find("q_min")) {
-        if (auto d = check.Number(*v, field("q_min"), kNonNegative)) render.qMin = *d;
-    }
-    if (const Json* v = find("splat_scale")) {
-        if (auto d = check.Number(*v, field("splat_scale"), kPositive)) render.splatScale = *d;
-    }
-    if (const Json* v = find("opacity")) {
-        if (auto d = check.Number(*v, field("opacity"), kProbability)) render.opacity = *d;
-    }
     if (const Json* v = find("alpha")) {
         if (auto d = check.Number(*v, field("alpha"), kProbability)) render.alpha = *d;
-    }
-    if (const Json* v = find("culling")) {
-        if (auto b = check.Boolean(*v, field("culling"))) render.culling = *b;
-    }
-    if (const Json* v = find("skipping")) {
-        if (auto b = check.Boolean(*v, field("skipping"))) render.skipping = *b;
     }
     if (const Json* v = find("every_steps")) {
         if (auto n = check.Integer(*v, field("every_steps"), 0, kU32Max)) render.everySteps = uint32_t(*n);

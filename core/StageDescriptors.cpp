@@ -124,7 +124,7 @@ CompareRule NoiseRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}
 // The splat renderer interpolates q between the last two steps, and skips
 // boxes empty in both steps' occupancy.
 std::vector<Resource> SplatPrevious(const Scene& scene) {
-    if (scene.render.skipping) return {Resource::Q, Resource::Tiles, Resource::Bands};
+    if (scene.splat.skipping) return {Resource::Q, Resource::Tiles, Resource::Bands};
     return {Resource::Q};
 }
 

@@ -58,14 +58,14 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
         p.background[c] = float(sc.lighting.background[c]);
     }
     p.phase = sc.phase;
-    p.qMin = float(sc.render.qMin);
-    p.splatDiameter = float(sc.render.splatScale * sc.grid.voxelSize);
-    p.opacity = float(sc.render.opacity);
+    p.qMin = float(sc.splat.qMin);
+    p.splatDiameter = float(sc.splat.splatScale * sc.grid.voxelSize);
+    p.opacity = float(sc.splat.opacity);
     p.alpha = float(sc.render.alpha);
     p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
     p.voxelSize = float(sc.grid.voxelSize);
-    p.culling = sc.render.culling;
-    p.skipping = sc.render.skipping;
+    p.culling = sc.splat.culling;
+    p.skipping = sc.splat.skipping;
     p.tile = sc.density.tile;
     p.band = sc.density.band;
     return p;

@@ -67,7 +67,7 @@ TEST(SceneTest, OverrideThroughNonObject) {
 TEST(SceneTest, OverrideShadeStorage) {
     Scene scene = Parsed(kMinimal, {{"shade.storage", "fp16"}, {"render.culling", "false"}});
     EXPECT_EQ(scene.shade.storage, StorageFormat::Fp16);
-    EXPECT_FALSE(scene.render.culling);
+    EXPECT_FALSE(scene.splat.culling);
 }
 
 // Test that --set shade.resolution=3 is refused and marked as coming from --set.

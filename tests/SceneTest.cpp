@@ -176,12 +176,12 @@ TEST(SceneTest, LightingSectionsDefaults) {
     EXPECT_EQ(scene.shadow.kappa, 0.25);
     EXPECT_EQ(scene.render.width, 320u);
     EXPECT_EQ(scene.render.height, 240u);
-    EXPECT_EQ(scene.render.qMin, 0.3);
-    EXPECT_EQ(scene.render.splatScale, 1.5);
-    EXPECT_EQ(scene.render.opacity, 0.6);
+    EXPECT_EQ(scene.splat.qMin, 0.3);
+    EXPECT_EQ(scene.splat.splatScale, 1.5);
+    EXPECT_EQ(scene.splat.opacity, 0.6);
     EXPECT_EQ(scene.render.alpha, 0.5);
-    EXPECT_TRUE(scene.render.culling);
-    EXPECT_TRUE(scene.render.skipping);
+    EXPECT_TRUE(scene.splat.culling);
+    EXPECT_TRUE(scene.splat.skipping);
     EXPECT_EQ(scene.render.everySteps, 0u);
     EXPECT_TRUE(scene.render.cameras.empty());
 }
@@ -245,12 +245,12 @@ TEST(SceneTest, FullSceneParsesEveryLightingField) {
     EXPECT_EQ(scene.shadow.kappa, 0.0);
     EXPECT_EQ(scene.render.width, 16384u);
     EXPECT_EQ(scene.render.height, 1u);
-    EXPECT_EQ(scene.render.qMin, 0.0);
-    EXPECT_EQ(scene.render.splatScale, 0.25);
-    EXPECT_EQ(scene.render.opacity, 1.0);
+    EXPECT_EQ(scene.splat.qMin, 0.0);
+    EXPECT_EQ(scene.splat.splatScale, 0.25);
+    EXPECT_EQ(scene.splat.opacity, 1.0);
     EXPECT_EQ(scene.render.alpha, 0.0);
-    EXPECT_FALSE(scene.render.culling);
-    EXPECT_FALSE(scene.render.skipping);
+    EXPECT_FALSE(scene.splat.culling);
+    EXPECT_FALSE(scene.splat.skipping);
     EXPECT_EQ(scene.render.everySteps, 5u);
     ASSERT_EQ(scene.render.cameras.size(), 2u);
     const CameraSettings& top = scene.render.cameras[0];
