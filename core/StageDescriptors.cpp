@@ -232,17 +232,22 @@ std::vector<Stage> ScheduleStages(const StageSet& enabled) {
                 if (db.advancesState && Contains(db.writes, r)) return true;
         return false;
     };
-    // Kahn's algorithm, taking ready stages in CB_STAGES order so the schedule is stable.
+    // Kahn's algorithm, taking ready stages in CB_STAGES order so the schedule
+    // is stable, and stages that advance the state only when nothing else is
+    // ready: they end the step, after the observer has seen step t whole.
     std::vector<Stage> pending, order;
     for (Stage s : kAllStages)
         if (enabled.Has(s)) pending.push_back(s);
     while (!pending.empty()) {
         auto ready = pending.end();
-        for (auto it = pending.begin(); it != pending.end() && ready == pending.end(); ++it) {
-            bool blocked = false;
-            for (Stage other : pending)
-                if (other != *it && before(other, *it)) blocked = true;
-            if (!blocked) ready = it;
+        for (bool advancing : {false, true}) {
+            for (auto it = pending.begin(); it != pending.end() && ready == pending.end(); ++it) {
+                if (Describe(*it).advancesState != advancing) continue;
+                bool blocked = false;
+                for (Stage other : pending)
+                    if (other != *it && before(other, *it)) blocked = true;
+                if (!blocked) ready = it;
+            }
         }
         assert(ready != pending.end() && "the stage graph has no cycle");
         if (ready == pending.end()) ready = pending.begin();

@@ -106,7 +106,7 @@ const StageDescriptor& Describe(Stage stage);
 
 // The enabled stages in the order a step runs them: every producer before
 // the stages that read its outputs, and stages that advance the state after
-// every reader of that state.
+// every other stage (they end the step).
 std::vector<Stage> ScheduleStages(const StageSet& enabled);
 
 // The stage among `enabled` that writes `resource`, if any.
