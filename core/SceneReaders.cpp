@@ -348,8 +348,10 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
     ReadShadow(root, check, scene.shadow);
     const bool camerasOk = ReadRender(root, check, scene.render);
     ReadSplat(root, check, scene.splat);
-    if (scene.stages.Has(Stage::RenderSplat) && camerasOk && scene.render.cameras.empty())
-        check.Fail("render.cameras", Quote(StageName(Stage::RenderSplat)) + " needs at least one camera");
+    // Every renderer draws one image per camera.
+    for (Stage stage : kAllStages)
+        if (Describe(stage).renderer && scene.stages.Has(stage) && camerasOk && scene.render.cameras.empty())
+            check.Fail("render.cameras", Quote(StageName(stage)) + " needs at least one camera");
 
     // Size checks, before anything grid-sized exists.
     if (!sizeOk) return;
