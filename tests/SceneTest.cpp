@@ -16,6 +16,8 @@
 namespace cb {
 namespace {
 
+using test::ErrorOf;
+using test::HasLine;
 using test::kMinimal;
 using test::Parsed;
 using test::Stages;
@@ -146,10 +148,15 @@ TEST(SceneTest, IntegralFloatIsAnInteger) {
     EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "steps": 1e3})").steps, 1000u);
 }
 
-// Test that the stages without dependency rules (render_march, noise) are accepted on their own.
-TEST(SceneTest, OtherKnownStagesNeedNothing) {
-    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "stages": ["render_march", "noise"]})").stages,
+// Test that the ray-march path's stages load when their inputs are written:
+// noise alone, and render_march on noise's q with a camera (a renderer needs one).
+TEST(SceneTest, OtherKnownStagesNeedTheirInputs) {
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "stages": ["noise"]})").stages, Stages({Stage::Noise}));
+    const std::string camera = R"("render": {"cameras": [{"eye": [0, 0, 0], "target": [1, 0, 0]}]})";
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, )" + camera + R"(, "stages": ["render_march", "noise"]})").stages,
               Stages({Stage::RenderMarch, Stage::Noise}));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["render_march", "noise"]})"),
+                        R"(test.json: render.cameras: "render_march" needs at least one camera)"));
 }
 
 // Test that a scene with none of the lighting sections gets every documented default for them.
