@@ -4,6 +4,14 @@ namespace cb {
 
 size_t CanonicalElementBytes(BufferFormat format) { return format == BufferFormat::F32 ? 4 : 1; }
 
+uint64_t CanonicalBufferBytes(BufferFormat format, const Extent3& extent) {
+    uint64_t count, bytes;
+    if (__builtin_mul_overflow(uint64_t(extent.nx) * extent.ny, uint64_t(extent.nz), &count) ||
+        __builtin_mul_overflow(count, uint64_t(CanonicalElementBytes(format)), &bytes))
+        return UINT64_MAX;
+    return bytes;
+}
+
 std::vector<uint32_t> PackBits32(std::span<const std::byte> canonical, const Extent3& e) {
     const uint32_t words = CeilDiv(e.nx, 32);
     std::vector<uint32_t> packed(size_t(words) * e.ny * e.nz, 0);

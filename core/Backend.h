@@ -25,6 +25,8 @@
 
 namespace cb {
 
+struct Scene;  // core/Scene.h
+
 // Canonical element types (SPEC 0): bit fields are one byte per voxel (0 or 1).
 enum class BufferFormat : uint8_t {
     Bits,  // canonical uint8 0/1
@@ -33,6 +35,8 @@ enum class BufferFormat : uint8_t {
 };
 
 size_t CanonicalElementBytes(BufferFormat format);
+// Bytes of a buffer in the canonical layout: one element per voxel (saturates at UINT64_MAX).
+uint64_t CanonicalBufferBytes(BufferFormat format, const Extent3& extent);
 
 // Canonical bit fields (one byte, 0 or 1, per voxel) to 32 voxels per uint32
 // along x, rows of ceil(nx/32) words, and back: the GPU backends' layout.
@@ -216,6 +220,18 @@ class Backend {
     // `canonical` must hold exactly buffer.CanonicalBytes().
     virtual Status Upload(Buffer& buffer, std::span<const std::byte> canonical) = 0;
     virtual Status Download(const Buffer& buffer, std::span<std::byte> canonical) = 0;
+
+    // ---- Memory (core/MemoryPlan.h prices a scene's buffer plan with these) ----
+    // Bytes one buffer takes in this backend's own layout; here the canonical bytes.
+    virtual uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const {
+        return CanonicalBufferBytes(format, extent);
+    }
+    // Bytes of the stage scratch this backend keeps while it runs `scene`, besides
+    // the planned buffers; here none.
+    virtual uint64_t ScratchBytes(const Scene& /*scene*/) const { return 0; }
+    // The memory its buffers and scratch can take (physical memory, a device
+    // heap); nullopt when the backend cannot tell.
+    virtual std::optional<uint64_t> AvailableBytes() const { return std::nullopt; }
 
     // ---- Stages: one virtual per entry of CB_BACKEND_ENTRIES ----
     // Each returns "unsupported" here; a backend overrides the entries of the

@@ -172,7 +172,8 @@ Result<Scene> LoadScene(const std::string& path, const std::vector<SceneOverride
 Result<Scene> ParseScene(const std::string& text, const std::string& label,
                          const std::vector<SceneOverride>& overrides = {});
 
-// Bytes the scene's enabled stages allocate on the CPU backend (for the memory check).
+// Bytes the scene's planned buffers take in the host layout, plus the host
+// staging buffer (the loader's memory check; core/MemoryPlan.h).
 uint64_t EstimateSceneBytes(const Scene& scene);
 
 }  // namespace cb

@@ -2,8 +2,6 @@
 // density) and of the whole scene.
 #include "core/SceneReaders.h"
 
-#include "core/StageDescriptors.h"
-
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -11,7 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/SceneMemory.h"
+#include "core/MemoryPlan.h"
+#include "core/StageDescriptors.h"
 
 namespace cb::scene_io {
 namespace {
@@ -35,12 +34,6 @@ constexpr std::string_view kEllipsoidKeys[] = {
 constexpr std::string_view kWindGridKeys[] = {"grid", "vectors"};
 constexpr std::string_view kSmoothKeys[] = {"radius"};
 constexpr std::string_view kDensityKeys[] = {"tile", "band"};
-
-std::string FormatGiB(uint64_t bytes) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "%.1f", double(bytes) / double(uint64_t(1) << 30));
-    return buffer;
-}
 
 void ReadWind(const Json& value, Validator& check, EllipsoidWind& wind) {
     const std::string field = "ellipsoids.wind";

@@ -291,4 +291,32 @@ ResourcePlan PlanResources(const Scene& scene) {
     return plan;
 }
 
+std::string_view BufferRoleName(BufferRole role) {
+    switch (role) {
+        case BufferRole::Current:
+            return "current";
+        case BufferRole::Next:
+            return "next";
+        case BufferRole::Previous:
+            return "previous";
+    }
+    return "?";
+}
+
+std::vector<PlannedBuffer> PlanBuffers(const Scene& scene) {
+    const ResourcePlan plan = PlanResources(scene);
+    std::vector<PlannedBuffer> buffers;
+    for (Resource r : kAllResources) {
+        const size_t i = size_t(r);
+        if (!plan.used[i]) continue;
+        const BufferFormat format = ResourceFormat(r);
+        const Extent3 extent = ResourceExtent(r, scene);
+        const size_t copies = IsPerCamera(r) ? scene.render.cameras.size() : 1;
+        for (size_t n = 0; n < copies; ++n) buffers.push_back({r, BufferRole::Current, uint32_t(n), format, extent});
+        if (plan.doubleBuffered[i]) buffers.push_back({r, BufferRole::Next, 0, format, extent});
+        if (plan.previous[i]) buffers.push_back({r, BufferRole::Previous, 0, format, extent});
+    }
+    return buffers;
+}
+
 }  // namespace cb

@@ -129,4 +129,23 @@ struct ResourcePlan {
 };
 ResourcePlan PlanResources(const Scene& scene);
 
+// Which copy of a resource a buffer holds: this step's, the next step's (a
+// state-advancing writer's output), or the previous step's (an interpolating renderer's input).
+enum class BufferRole : uint8_t { Current, Next, Previous };
+std::string_view BufferRoleName(BufferRole role);  // "current", "next", "previous"
+
+struct PlannedBuffer {
+    Resource resource;
+    BufferRole role = BufferRole::Current;
+    uint32_t camera = 0;  // per-camera resources: the camera's index; 0 otherwise
+    BufferFormat format = BufferFormat::F32;
+    Extent3 extent;
+    bool operator==(const PlannedBuffer&) const = default;
+};
+
+// Every buffer a simulation of `scene` allocates, in allocation order: per
+// resource its current buffers (one per camera for images), then its next, then its
+// previous. Simulation::Allocate allocates exactly these; the memory plan prices them.
+std::vector<PlannedBuffer> PlanBuffers(const Scene& scene);
+
 }  // namespace cb

@@ -73,6 +73,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
     for (const BackendRun& run : runs) {
         nlohmann::json b = {{"status", run.status}, {"device", run.device}, {"steps_completed", run.steps.size()}};
         if (!run.error.empty()) b["error"] = run.error;
+        if (run.plannedBytes) b["planned_bytes"] = *run.plannedBytes;
         nlohmann::json timing = nlohmann::json::object();
         for (Stage stage : kAllStages) {
             if (!scene.stages.Has(stage)) continue;

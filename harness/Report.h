@@ -31,6 +31,7 @@ struct BackendRun {
     std::string device;
     std::string status = "ok";  // "ok", "unavailable" or "failed"
     std::string error;
+    std::optional<uint64_t> plannedBytes;  // the scene's buffers and scratch on this backend (PlannedBytes)
     std::vector<StepRecord> steps;
     // Read-backs of outputs (frames, density map), timed apart from the stages.
     std::vector<double> downloadMs;

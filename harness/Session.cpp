@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/MemoryPlan.h"
 #include "core/Npy.h"
 
 namespace cb {
@@ -68,7 +69,7 @@ std::vector<OpenedBackend> Session::OpenBackends(const std::vector<std::string>&
                                                  bool report) {
     std::vector<OpenedBackend> out;
     for (const std::string& name : names) {
-        OpenedBackend opened{name, nullptr, BackendStatus::Unavailable, ""};
+        OpenedBackend opened{name, nullptr, BackendStatus::Unavailable, "", std::nullopt};
         BackendProvenance record{name, "", "", ""};
         auto backend = CreateBackend(name, mOptions.Backend());
         if (!backend) {
@@ -81,9 +82,17 @@ std::vector<OpenedBackend> Session::OpenBackends(const std::vector<std::string>&
             for (Stage stage : kAllStages)
                 if (scene && scene->stages.Has(stage) && !(*backend)->Supports(stage))
                     missing += (missing.empty() ? "" : ", ") + std::string(StageName(stage));
-            if (missing.empty()) {
+            Status fits;
+            if (scene) {
+                opened.plannedBytes = PlannedBytes(*scene, **backend);
+                fits = CheckPlannedBytesFit(*scene, **backend);
+            }
+            if (missing.empty() && fits) {
                 opened.status = BackendStatus::Available;
                 opened.backend = std::move(*backend);
+            } else if (missing.empty()) {
+                opened.reason = fits.error().message;
+                if (report) std::fprintf(stderr, "backend %s unavailable: %s\n", name.c_str(), opened.reason.c_str());
             } else {
                 opened.status = BackendStatus::Unsupported;
                 opened.reason = name + " does not implement " + missing + " yet";

@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,6 +30,8 @@ struct OpenedBackend {
     std::unique_ptr<Backend> backend;
     BackendStatus status = BackendStatus::Unavailable;
     std::string reason;  // why it is unavailable or unsupported
+    // PlannedBytes of the scene on this backend, when it was opened for a scene.
+    std::optional<uint64_t> plannedBytes;
 };
 
 class Session {
@@ -53,7 +56,8 @@ class Session {
     // options.backends, or `defaults` when none were given.
     std::vector<std::string> RequestedBackends(const std::vector<std::string>& defaults) const;
     // Opens `names` and records them for the provenance. With `scene`, a
-    // backend that lacks one of its stages is Unsupported. With `report`,
+    // backend that lacks one of its stages is Unsupported, and one whose
+    // available memory the scene's planned bytes exceed is Unavailable. With `report`,
     // each backend not available is named on stderr with the reason.
     std::vector<OpenedBackend> OpenBackends(const std::vector<std::string>& names, const Scene* scene = nullptr,
                                             bool report = true);

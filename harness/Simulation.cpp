@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "core/MemoryPlan.h"
 #include "harness/StageParams.h"
 
 namespace cb {
@@ -9,7 +10,6 @@ namespace cb {
 Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs)
     : mScene(scene),
       mBackend(backend),
-      mPlan(PlanResources(scene)),
       mSchedule(ScheduleStages(scene.stages)),
       mEllipsoids(scene.ellipsoids, scene.grid.size),
       mEveryStepOutputs(everyStepOutputs) {}
@@ -35,6 +35,7 @@ Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backe
         if (scene.stages.Has(stage) && !backend.Supports(stage))
             return MakeError(backend.Name() + " does not implement stage '" + std::string(StageName(stage)) + "' yet");
     }
+    CB_TRY(CheckPlannedBytesFit(scene, backend));
     std::unique_ptr<Simulation> sim(new Simulation(scene, backend, everyStepOutputs));
     CB_TRY(sim->Allocate());
     CB_TRY(sim->InitializeState());
@@ -42,20 +43,22 @@ Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backe
 }
 
 Status Simulation::Allocate() {
-    auto make = [&](std::unique_ptr<Buffer>& slot, Resource r) -> Status {
-        auto buffer = mBackend.CreateBuffer(ResourceFormat(r), ResourceExtent(r, mScene));
+    for (const PlannedBuffer& planned : PlanBuffers(mScene)) {
+        auto buffer = mBackend.CreateBuffer(planned.format, planned.extent);
         if (!buffer) return std::unexpected(buffer.error());
-        slot = std::move(*buffer);
-        return {};
-    };
-    for (Resource r : kAllResources) {
-        const size_t i = size_t(r);
-        if (!mPlan.used[i]) continue;
-        Slot& slot = mSlots[i];
-        slot.current.resize(IsPerCamera(r) ? mScene.render.cameras.size() : 1);
-        for (auto& buffer : slot.current) CB_TRY(make(buffer, r));
-        if (mPlan.doubleBuffered[i]) CB_TRY(make(slot.next, r));
-        if (mPlan.previous[i]) CB_TRY(make(slot.previous, r));
+        Slot& slot = mSlots[size_t(planned.resource)];
+        switch (planned.role) {
+            case BufferRole::Current:
+                if (slot.current.size() <= planned.camera) slot.current.resize(planned.camera + 1);
+                slot.current[planned.camera] = std::move(*buffer);
+                break;
+            case BufferRole::Next:
+                slot.next = std::move(*buffer);
+                break;
+            case BufferRole::Previous:
+                slot.previous = std::move(*buffer);
+                break;
+        }
     }
     return {};
 }

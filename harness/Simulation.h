@@ -45,6 +45,8 @@ struct StepRecord {
 class Simulation {
   public:
     // Allocates the enabled stages' buffers and computes the initial state.
+    // Refuses a backend that lacks an enabled stage, or whose available memory
+    // the planned buffers and scratch exceed (CheckPlannedBytesFit).
     // everyStepOutputs: shade, shadow and render on every step (for dumps).
     static Result<std::unique_ptr<Simulation>> Create(const Scene& scene, Backend& backend,
                                                       bool everyStepOutputs = false);
@@ -99,6 +101,7 @@ class Simulation {
     };
 
     Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs);
+    // Allocates exactly PlanBuffers(scene), so the memory plan prices what is allocated.
     Status Allocate();
     Status InitializeState();
     // Runs one stage on this step's buffers (its writes go to `next` when it advances the state).
@@ -110,7 +113,6 @@ class Simulation {
 
     const Scene mScene;
     Backend& mBackend;
-    const ResourcePlan mPlan;
     const std::vector<Stage> mSchedule;
     EllipsoidList mEllipsoids;
     std::vector<RasterEllipsoid> mRaster;  // the list step t's region was rasterised from

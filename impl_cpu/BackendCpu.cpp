@@ -1,8 +1,10 @@
 #include "impl_cpu/BackendCpu.h"
 
+#include <algorithm>
 #include <cstring>
 #include <thread>
 
+#include "core/Scene.h"
 #include "impl_cpu/CaKernels.h"
 
 namespace cb::cpu {
@@ -27,6 +29,39 @@ bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("cpu: cannot create an empty buffer");
     return std::make_unique<BufferCpu>(format, extent);
+}
+
+uint64_t BackendCpu::BufferBytes(BufferFormat format, const Extent3& extent) const {
+    return HostBufferBytes(format, extent);
+}
+
+uint64_t BackendCpu::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint64_t slice = uint64_t(e.nx) * e.ny;
+    uint64_t bytes = 0;
+    // ca with wind: the rules write three fields that advection then moves into the output (CaCpu.cpp).
+    if (scene.stages.Has(Stage::Ca) && scene.ca.HasWind())
+        bytes = SaturatingAdd(bytes, SaturatingMul(HostBufferBytes(BufferFormat::Bits, e), 3));
+    // smooth at radius r > 0: each run of slices (one per thread, at most nz) keeps a ring of 2r + 1 slices of
+    // numerators (1 byte each at r = 1, 2 at r = 2), a slice of x sums and two rows (SmoothCpu.cpp).
+    if (const int r = scene.smooth.radius; scene.stages.Has(Stage::Smooth) && r > 0) {
+        const uint64_t runs = std::min<uint64_t>(e.nz, uint64_t(std::max(Threads(), 1)));
+        const uint64_t numeratorBytes = r == 1 ? 1 : 2;
+        const uint64_t perRun = SaturatingAdd(SaturatingMul(slice, (2 * r + 1) * numeratorBytes + 1),
+                                              uint64_t(e.nx) + 2 * r + 8 + 4 * uint64_t(e.nx));
+        bytes = SaturatingAdd(bytes, SaturatingMul(runs, perRun));
+    }
+    if (scene.stages.Has(Stage::Shade)) {
+        // The shaded grid: ceil(n / f) cells per axis (ShadePlan). Below full resolution the coarse q and T
+        // (ShadeCpu.cpp); at any resolution the slice loop's padded previous T and q slices, (nu + 3) x (nv + 3)
+        // floats each, counted for the two longest axes (u and v depend on the sun).
+        const uint64_t f = uint64_t(std::max(scene.shade.resolution, 1));
+        uint64_t cells[3] = {CeilDiv(e.nx, uint32_t(f)), CeilDiv(e.ny, uint32_t(f)), CeilDiv(e.nz, uint32_t(f))};
+        if (f > 1) bytes = SaturatingAdd(bytes, SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4));
+        std::sort(cells, cells + 3);
+        bytes = SaturatingAdd(bytes, 2 * 4 * (cells[1] + 3) * (cells[2] + 3));
+    }
+    return bytes;
 }
 
 Status BackendCpu::Upload(Buffer& buffer, std::span<const std::byte> canonical) {

@@ -8,15 +8,17 @@
 #include <tbb/task_arena.h>
 
 #include "core/Backend.h"
+#include "core/MemoryPlan.h"
 #include "impl_cpu/BitField.h"
 
 namespace cb::cpu {
 
-// Buffer storage on the CPU. U8 volumes carry kPadding spare zero bytes at the
-// end so that kernels may read a full 64-voxel word past a row's end.
+// Buffer storage on the CPU, in the host layout (core/MemoryPlan.h). U8 volumes
+// carry kPadding spare zero bytes at the end so that kernels may read a full
+// 64-voxel word past a row's end.
 class BufferCpu final : public Buffer {
   public:
-    static constexpr size_t kPadding = 64;
+    static constexpr size_t kPadding = kHostU8Padding;
 
     BufferCpu(BufferFormat format, Extent3 extent);
 
@@ -46,6 +48,15 @@ class BackendCpu : public Backend {
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
     Status Download(const Buffer& buffer, std::span<std::byte> canonical) override;
+
+    // The host layout (HostBufferBytes).
+    uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
+    // The automaton's advection fields with wind, each thread's smoothing ring,
+    // shade's coarse grids and slice buffers; per-call rows and the renderer's
+    // splat lists (which depend on the clouds) are not counted.
+    uint64_t ScratchBytes(const Scene& scene) const override;
+    // The machine's physical memory.
+    std::optional<uint64_t> AvailableBytes() const override { return PhysicalMemoryBytes(); }
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/Scene.h"
 #include "impl_gl/BackendGLInternal.h"
 
 namespace cb::gl {
@@ -123,6 +124,36 @@ Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Ext
     auto buffer = std::make_unique<BufferGL>(format, extent, f, texture);
     CB_TRY(mContext->Check("creating a texture"));
     return std::unique_ptr<Buffer>(std::move(buffer));
+}
+
+uint64_t BackendGL::BufferBytes(BufferFormat format, const Extent3& extent) const {
+    if (format == BufferFormat::Bits) return Extent3{CeilDiv(extent.nx, 32), extent.ny, extent.nz}.Count() * 4;
+    return CanonicalBufferBytes(format, extent);
+}
+
+uint64_t BackendGL::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint64_t voxels = e.Count();
+    uint64_t bytes = 0;
+    if (scene.stages.Has(Stage::Region)) bytes += voxels;  // RegionUnorm: R8
+    if (scene.stages.Has(Stage::Ca)) {
+        if (scene.ca.HasWind()) bytes += 3 * BufferBytes(BufferFormat::Bits, e);  // CaHum, CaAct, CaCld
+        if (mRgba8) bytes += 2 * voxels * 4;                                      // Rgba8StateA, Rgba8StateB
+    }
+    if (scene.stages.Has(Stage::Smooth)) bytes += 2 * voxels * 2;          // SmoothX, SmoothXY: R16UI
+    if (scene.stages.Has(Stage::Density)) bytes += uint64_t(e.nx) * e.ny;  // CoverFlags: R8UI
+    if (scene.stages.Has(Stage::Shade)) {
+        // ShadeCoarseQ below full resolution and ShadeVolume: R32F on the shaded grid, ceil(n / f) cells per
+        // axis; ShadePing and ShadePong: R32F slices of nu x nv cells, counted for the two longest axes.
+        const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
+        uint64_t cells[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+        const uint64_t grid = cells[0] * cells[1] * cells[2] * 4;
+        std::sort(cells, cells + 3);
+        bytes += (f > 1 ? 2 : 1) * grid + 2 * cells[1] * cells[2] * 4;
+    }
+    if (scene.stages.Has(Stage::RenderSplat))
+        bytes += uint64_t(scene.render.width) * scene.render.height * 16;  // SplatTarget: RGBA32F
+    return bytes;
 }
 
 Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {

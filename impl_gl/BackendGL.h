@@ -55,6 +55,15 @@ class BackendGL final : public Backend {
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
     Status Download(const Buffer& buffer, std::span<std::byte> canonical) override;
 
+    // Texture bytes: bit fields as R32UI, ceil(nx/32) texels per row; bytes R8UI; floats R32F.
+    uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
+    // The scratch textures whose size the scene fixes (GlScratch): region's R8
+    // layers, the automaton's rule outputs with wind (and its RGBA8 state),
+    // smooth's R16UI sums, density's cover flags, shade's volumes and slices
+    // (counted for the two longest axes), the splat target. Buffer objects
+    // (lists, counters) are not counted. GL does not report available memory.
+    uint64_t ScratchBytes(const Scene& scene) const override;
+
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:

@@ -4,18 +4,20 @@
 // DensityVk.cpp, ShadeVk.cpp, ShadowVk.cpp, RenderSplatVk.cpp.
 #include "impl_vk/BackendVk.h"
 
+#include <algorithm>
 #include <vector>
 
+#include "core/Scene.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
 namespace {
 
-// Bytes a buffer takes on the device.
+// Bytes of a buffer's contents on the device.
 VkDeviceSize DeviceBytes(BufferFormat format, const Extent3& e) {
     switch (format) {
         case BufferFormat::Bits:
-            return VkDeviceSize((e.nx + 31) / 32) * e.ny * e.nz * 4;
+            return VkDeviceSize(CeilDiv(e.nx, 32)) * e.ny * e.nz * 4;
         case BufferFormat::U8:
             return VkDeviceSize(e.Count());
         case BufferFormat::F32:
@@ -54,6 +56,23 @@ Result<std::unique_ptr<Buffer>> BackendVk::CreateBuffer(BufferFormat format, Ext
     auto device = mContext->CreateBuffer(DeviceBytes(format, extent));
     if (!device) return std::unexpected(Error{"vk: " + device.error().message});
     return std::make_unique<BufferVk>(format, extent, *mContext, *device);
+}
+
+uint64_t BackendVk::BufferBytes(BufferFormat format, const Extent3& extent) const {
+    return VulkanContext::StorageBufferBytes(DeviceBytes(format, extent));
+}
+
+uint64_t BackendVk::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    uint64_t bytes = 0;
+    // ca with wind: the rules' three outputs before advection (CaVk.cpp).
+    if (scene.stages.Has(Stage::Ca) && scene.ca.HasWind()) bytes += 3 * BufferBytes(BufferFormat::Bits, e);
+    // smooth: the sums along x and along x and y, a uint per voxel each (SmoothVk.cpp).
+    if (scene.stages.Has(Stage::Smooth)) bytes += 2 * e.Count() * 4;
+    // shade below full resolution: q and T on the coarse grid, ceil(n / f) cells per axis (ShadeVk.cpp).
+    if (const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1)); scene.stages.Has(Stage::Shade) && f > 1)
+        bytes += 2 * Extent3{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)}.Count() * 4;
+    return bytes;
 }
 
 Status BackendVk::Upload(Buffer& buffer, std::span<const std::byte> canonical) {

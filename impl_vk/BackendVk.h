@@ -71,6 +71,16 @@ class BackendVk final : public Backend {
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
     Status Download(const Buffer& buffer, std::span<std::byte> canonical) override;
 
+    // Bit fields as rows of ceil(nx/32) 32-bit words, bytes as bytes, floats as
+    // floats, each buffer padded to a multiple of 4 bytes.
+    uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
+    // The automaton's rule outputs with wind, smooth's two sum volumes, shade's
+    // coarse q and T below full resolution; the region's and the renderer's
+    // lists (which depend on the ellipsoids and the clouds) are not counted.
+    uint64_t ScratchBytes(const Scene& scene) const override;
+    // The largest device-local heap.
+    std::optional<uint64_t> AvailableBytes() const override { return mContext->LargestDeviceLocalHeap(); }
+
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     // Device time of the last stage call (timestamp queries), in ms.

@@ -1,5 +1,6 @@
 #include "impl_vk/VulkanContext.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "impl_vk/Shaders.h"
@@ -272,10 +273,17 @@ Result<DeviceBuffer> VulkanContext::CreateRawBuffer(VkDeviceSize size, VkBufferU
 }
 
 Result<DeviceBuffer> VulkanContext::CreateBuffer(VkDeviceSize size) {
-    // Storage buffers are padded to a multiple of 4 bytes (uint8 volumes are read as bytes).
-    size = (size + 3) & ~VkDeviceSize(3);
+    size = StorageBufferBytes(size);
     return CreateRawBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                            VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+}
+
+VkDeviceSize VulkanContext::LargestDeviceLocalHeap() const {
+    VkDeviceSize largest = 0;
+    for (uint32_t n = 0; n < mMemory.memoryHeapCount; ++n)
+        if (mMemory.memoryHeaps[n].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            largest = std::max(largest, mMemory.memoryHeaps[n].size);
+    return largest;
 }
 
 void VulkanContext::DestroyBuffer(DeviceBuffer& buffer) {

@@ -59,7 +59,13 @@ class VulkanContext {
     const std::string& DeviceName() const { return mDeviceName; }
     uint32_t ValidationMessages() const { return mValidationMessages; }
 
+    // A device-local storage buffer of StorageBufferBytes(size) bytes.
     Result<DeviceBuffer> CreateBuffer(VkDeviceSize size);
+    // The size CreateBuffer allocates for `size` bytes: padded to a multiple of 4
+    // (uint8 volumes are read as bytes).
+    static VkDeviceSize StorageBufferBytes(VkDeviceSize size) { return (size + 3) & ~VkDeviceSize(3); }
+    // The size of the largest device-local memory heap.
+    VkDeviceSize LargestDeviceLocalHeap() const;
     void DestroyBuffer(DeviceBuffer& buffer);
     Status Upload(const DeviceBuffer& buffer, std::span<const std::byte> data);
     Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);

@@ -106,6 +106,7 @@ int Run(const CommonOptions& options) {
     for (OpenedBackend& opened : backends) {
         BackendRun run;
         run.name = opened.name;
+        run.plannedBytes = opened.plannedBytes;
         if (!opened.backend) {
             run.status = std::string(BackendStatusName(opened.status));
             run.error = opened.reason;
