@@ -15,7 +15,9 @@ Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutpu
       mEveryStepOutputs(everyStepOutputs) {}
 
 bool Simulation::IsOutputStep(uint32_t step) const {
-    if (mEveryStepOutputs || !mScene.stages.Has(Stage::RenderSplat)) return true;
+    bool renders = false;
+    for (Stage stage : mSchedule) renders |= Describe(stage).renderer;
+    if (mEveryStepOutputs || !renders) return true;
     if (step + 1 == mScene.steps) return true;
     const uint32_t every = mScene.render.everySteps;
     return every > 0 && step >= mScene.warmupSteps && (step - mScene.warmupSteps) % every == 0;

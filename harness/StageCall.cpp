@@ -29,6 +29,7 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageBuffers& 
                              io.Previous(Resource::Tiles), io.Current(Resource::Tiles), io.Previous(Resource::Bands),
                              io.Current(Resource::Bands)};
         FrameRecord frame;
+        frame.renderer = Stage::RenderSplat;
         frame.camera = sc.render.cameras[n].name;
         const double before = record.ms;
         Status status = Timed(backend, record, [&] {

@@ -42,6 +42,7 @@ struct StageHostInputs {
 
 // One rendered image.
 struct FrameRecord {
+    Stage renderer = Stage::RenderSplat;
     std::string camera;
     double ms = 0;
     SplatStats stats;

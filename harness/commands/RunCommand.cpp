@@ -60,15 +60,17 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
         std::fprintf(stderr, "%s\n", error.message.c_str());
         allWritten = false;
     };
-    if ((*sim)->LastRenderedStep()) {
+    // The last frame of each renderer and camera.
+    for (Resource image : kAllResources) {
+        if (!IsPerCamera(image) || !(*sim)->Get(image) || !(*sim)->LastRenderedStep()) continue;
+        const Stage renderer = *ProducerOf(image, scene.stages);
         for (size_t n = 0; n < scene.render.cameras.size(); ++n) {
-            auto rgb = Download<float>(backend, *(*sim)->Image(n), &run.downloadMs);
+            auto rgb = Download<float>(backend, *(*sim)->Get(image, n), &run.downloadMs);
             if (!rgb) {
                 failed(rgb.error());
                 continue;
             }
-            const std::string stem =
-                outDir + "/" + FrameFileStem(Stage::RenderSplat, scene.render.cameras[n].name, run.name);
+            const std::string stem = outDir + "/" + FrameFileStem(renderer, scene.render.cameras[n].name, run.name);
             auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height);
             if (paths)
                 written.insert(written.end(), paths->begin(), paths->end());
