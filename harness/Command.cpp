@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -22,6 +24,42 @@ std::optional<int> PositiveInt(const char* text, long max) {
     const long value = std::strtol(text, &end, 10);
     if (*end != '\0' || value < 1 || value > max) return std::nullopt;
     return int(value);
+}
+
+// A name as a message shows it: control and non-ASCII bytes as \xNN, cut after 40 bytes.
+std::string Shown(std::string_view name) {
+    constexpr size_t kMax = 40;
+    std::string out;
+    for (size_t i = 0; i < name.size() && i < kMax; ++i) {
+        const unsigned char c = static_cast<unsigned char>(name[i]);
+        if (c >= 0x20 && c < 0x7f) {
+            out += char(c);
+        } else {
+            char hex[5];
+            std::snprintf(hex, sizeof hex, "\\x%02x", c);
+            out += hex;
+        }
+    }
+    if (name.size() > kMax) out += "...";
+    return out;
+}
+
+// Levenshtein distance, ASCII case ignored; only called on short names.
+size_t EditDistance(std::string_view a, std::string_view b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                              std::tolower(static_cast<unsigned char>(b[j - 1]));
+            const size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+            diagonal = row[j];
+            row[j] = next;
+        }
+    }
+    return row[b.size()];
 }
 
 // An option whose value is one of `table`'s names, stored in `field` as its
@@ -55,14 +93,7 @@ std::vector<OptionSpec> MakeSceneCommandOptions() {
         {"--backend", "--backends", true,
          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
              if (!v) return "--backend needs a list, e.g. --backend cpu";
-             const std::string list = v;
-             for (size_t start = 0; start <= list.size();) {
-                 size_t comma = list.find(',', start);
-                 if (comma == std::string::npos) comma = list.size();
-                 if (comma > start) o.backends.push_back(list.substr(start, comma - start));
-                 start = comma + 1;
-             }
-             return std::nullopt;
+             return ParseBackendList(v, o.backends);
          }},
         {"--steps", "", true,
          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
@@ -104,6 +135,7 @@ OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field) {
 OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing) {
     return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
                 if (!v) return missing;
+                if (!*v) return std::string(name) + ": must not be empty";
                 o.*field = v;
                 return std::nullopt;
             }};
@@ -115,6 +147,45 @@ OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOpti
                 (o.*field).push_back(v);
                 return std::nullopt;
             }};
+}
+
+std::span<const std::string_view> KnownBackends() {
+    // The names registry/Registry.cpp's CreateBackend knows (BackendOptionsTest checks them against it).
+    static constexpr std::array<std::string_view, 3> kKnown = {"cpu", "gl", "vk"};
+    return kKnown;
+}
+
+std::optional<std::string> ParseBackendList(std::string_view list, std::vector<std::string>& backends) {
+    const std::span<const std::string_view> known = KnownBackends();
+    std::string knownList;
+    for (std::string_view name : known) knownList += (knownList.empty() ? "" : ", ") + std::string(name);
+    if (list.empty()) return "--backend: empty list (known: " + knownList + ")";
+    std::vector<std::string> names;
+    for (size_t start = 0; start <= list.size();) {
+        const size_t comma = std::min(list.find(',', start), list.size());
+        const std::string_view name = list.substr(start, comma - start);
+        start = comma + 1;
+        if (name.empty()) return "--backend: empty backend name in '" + Shown(list) + "'";
+        if (std::ranges::find(known, name) == known.end()) {
+            std::string message = "--backend: unknown backend '" + Shown(name) + "' (known: " + knownList + ")";
+            // Close: at most two edits, and fewer than the known name has letters ("cpuu", "CPU", "gk").
+            std::string_view best;
+            size_t bestDistance = 3;
+            if (name.size() <= 16)
+                for (std::string_view candidate : known)
+                    if (const size_t d = EditDistance(name, candidate); d < bestDistance && d < candidate.size()) {
+                        best = candidate;
+                        bestDistance = d;
+                    }
+            if (!best.empty()) message += "; did you mean '" + std::string(best) + "'?";
+            return message;
+        }
+        if (std::ranges::find(names, name) != names.end() || std::ranges::find(backends, name) != backends.end())
+            return "--backend: " + std::string(name) + " named twice";
+        names.emplace_back(name);
+    }
+    backends.insert(backends.end(), names.begin(), names.end());
+    return std::nullopt;
 }
 
 BackendOptions CommonOptions::Backend() const {

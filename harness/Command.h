@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/Backend.h"
@@ -28,7 +29,7 @@ enum ExitCode : int {
 
 // What the command line sets; every command reads the fields its options fill.
 struct CommonOptions {
-    std::string scene;                     // name in scenes/ or a path; "" = default scene
+    std::optional<std::string> scene;      // name in scenes/ or a path; none = kDefaultScene; "" is refused
     std::vector<std::string> backends;     // empty = the command's default
     std::vector<SceneOverride> overrides;  // --set, and --steps as "steps"
     std::string outDir;                    // "" = the command's default under out/<scene name>
@@ -62,9 +63,17 @@ struct OptionSpec {
 // A flag that sets `field`.
 OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field);
 // An option whose value is stored in `field` (appended, for a list); `missing`
-// is the usage message when the value is missing.
+// is the usage message when the value is missing. TextOption refuses an empty
+// value: "--x: must not be empty".
 OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing);
 OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOptions::*field, std::string missing);
+
+// Every backend name the registry knows, built in this build or not, sorted: cpu, gl, vk.
+std::span<const std::string_view> KnownBackends();
+// Appends the names of one --backend LIST to `backends`. Returns the usage
+// message, and appends nothing, for an empty list or item, a name given twice
+// (in `list` or already in `backends`), or a name not in KnownBackends().
+std::optional<std::string> ParseBackendList(std::string_view list, std::vector<std::string>& backends);
 
 // The options every scene command accepts: --backend, --steps, --out, --set,
 // --threads, --gl-context, --gl-ca-layout, --vk-device, --quiet.

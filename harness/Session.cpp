@@ -36,7 +36,12 @@ Session::Session(const CommonOptions& options, std::string scenePath, Scene scen
 
 std::expected<std::unique_ptr<Session>, int> Session::Open(const CommonOptions& options,
                                                            std::string_view outSubfolder) {
-    std::string path = ResolveScenePath(options.scene);
+    // The one command-line check left to here: main() stores the SCENE argument unchecked.
+    if (options.scene && options.scene->empty()) {
+        std::fprintf(stderr, "cloudbench: SCENE: must not be empty (leave it out for %s)\n", kDefaultScene);
+        return std::unexpected(kExitUsage);
+    }
+    std::string path = ResolveScenePath(options.scene.value_or(kDefaultScene));
     Result<Scene> scene = LoadScene(path, options.overrides);
     if (!scene) {
         std::fprintf(stderr, "%s\n", scene.error().message.c_str());

@@ -37,7 +37,8 @@ struct OpenedBackend {
 class Session {
   public:
     // Resolves options.scene and loads it with options.overrides. On a bad
-    // scene prints the loader's "file: field: reason" and returns kExitBadScene.
+    // scene prints the loader's "file: field: reason" and returns kExitBadScene;
+    // an empty SCENE argument is refused first with kExitUsage.
     // The output folder defaults to out/<scene name>[/<outSubfolder>].
     static std::expected<std::unique_ptr<Session>, int> Open(const CommonOptions& options,
                                                              std::string_view outSubfolder);
