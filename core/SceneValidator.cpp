@@ -73,7 +73,15 @@ std::string QuoteShown(std::string_view text) {
         const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
         const unsigned char c = byte(0);
         // Length of the well-formed UTF-8 sequence starting here; 0 when there is none.
-        size_t length = c < 0x80 ? 1 : (c >= 0xC2 && c <= 0xDF) ? 2 : (c & 0xF0) == 0xE0 ? 3 : (c >= 0xF0 && c <= 0xF4) ? 4 : 0;
+        size_t length = 0;
+        if (c < 0x80)
+            length = 1;
+        else if (c >= 0xC2 && c <= 0xDF)
+            length = 2;
+        else if ((c & 0xF0) == 0xE0)
+            length = 3;
+        else if (c >= 0xF0 && c <= 0xF4)
+            length = 4;
         if (i + length > text.size()) length = 0;
         for (size_t k = 1; k < length; ++k)
             if ((byte(k) & 0xC0) != 0x80) length = 0;

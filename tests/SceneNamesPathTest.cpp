@@ -103,8 +103,7 @@ TEST(SceneNamesPathTest, CameraNameRefused) {
     EXPECT_TRUE(HasLine(ErrorOf(WithCamera(R"("")")), NameLine("render.cameras[0].name", R"("")")));
     EXPECT_TRUE(HasLine(ErrorOf(WithCamera(R"("..")")), NameLine("render.cameras[0].name", R"("..")")));
     EXPECT_TRUE(HasLine(ErrorOf(WithCamera(R"(".hidden")")), NameLine("render.cameras[0].name", R"(".hidden")")));
-    EXPECT_TRUE(
-        HasLine(ErrorOf(WithCamera(R"("a\u001bb")")), NameLine("render.cameras[0].name", R"("a\u001bb")")));
+    EXPECT_TRUE(HasLine(ErrorOf(WithCamera(R"("a\u001bb")")), NameLine("render.cameras[0].name", R"("a\u001bb")")));
     const std::string a65(65, 'a');
     EXPECT_TRUE(HasLine(ErrorOf(WithCamera('"' + a65 + '"')),
                         NameLine("render.cameras[0].name", '"' + a65.substr(0, 57) + "...\"")));
