@@ -296,14 +296,14 @@ void ReadDensity(const Json& root, Validator& check, DensitySettings& density) {
 void ReadScene(const Json& root, const std::string& label, Validator& check, Scene& scene) {
     check.CheckKeys(root, "", kTopKeys);
 
-    scene.name = std::filesystem::path(label).stem().string();
+    // The name becomes the folder out/<name>: it follows kPathNameRule, and so must the file stem it defaults to.
     if (const Json* v = Validator::Find(root, "name")) {
-        if (auto s = check.String(*v, "name")) {
-            if (s->empty())
-                check.Fail("name", "must not be empty");
-            else
-                scene.name = *s;
-        }
+        if (auto s = check.PathName(*v, "name")) scene.name = *s;
+    } else {
+        scene.name = std::filesystem::path(label).stem().string();
+        if (!IsPathName(scene.name))
+            check.Fail("name", "the default name " + QuoteShown(scene.name) + " (the file name) " +
+                                   std::string(kPathNameRule) + "; set \"name\" in the file");
     }
     if (const Json* v = Validator::Find(root, "description")) check.String(*v, "description");
 

@@ -38,14 +38,10 @@ std::optional<CameraSettings> ReadCamera(const Json& value, const std::string& f
     auto sub = [&](std::string_view key) { return JoinField(field, key); };
 
     CameraSettings camera;
+    // The name becomes part of frame file names (frame-<renderer>-<camera>-<backend>.png): kPathNameRule.
     camera.name = "view" + std::to_string(index);
     if (const Json* v = find("name")) {
-        if (auto s = check.String(*v, sub("name"))) {
-            if (s->empty())
-                check.Fail(sub("name"), "must not be empty");
-            else
-                camera.name = *s;
-        }
+        if (auto s = check.PathName(*v, sub("name"))) camera.name = *s;
     }
     std::optional<std::array<double, 3>> eye, target;
     if (const Json* v = find("eye")) {

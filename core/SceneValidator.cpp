@@ -61,6 +61,59 @@ std::string Quote(std::string_view text) {
     return quoted;
 }
 
+std::string QuoteShown(std::string_view text) {
+    auto hex = [](unsigned value) {
+        constexpr char kDigits[] = "0123456789abcdef";
+        return std::string{kDigits[(value >> 4) & 15], kDigits[value & 15]};
+    };
+    // One shown character (or escape) per piece; reading stops once the text is known to be too long.
+    std::vector<std::string> pieces;
+    size_t i = 0;
+    while (i < text.size() && pieces.size() <= kMaxShownChars) {
+        const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
+        const unsigned char c = byte(0);
+        // Length of the well-formed UTF-8 sequence starting here; 0 when there is none.
+        size_t length = 0;
+        if (c < 0x80)
+            length = 1;
+        else if (c >= 0xC2 && c <= 0xDF)
+            length = 2;
+        else if ((c & 0xF0) == 0xE0)
+            length = 3;
+        else if (c >= 0xF0 && c <= 0xF4)
+            length = 4;
+        if (i + length > text.size()) length = 0;
+        for (size_t k = 1; k < length; ++k)
+            if ((byte(k) & 0xC0) != 0x80) length = 0;
+        if (length == 0) {
+            pieces.push_back("\\x" + hex(c));
+            length = 1;
+        } else if (c < 0x20 || c == 0x7F || (c == 0xC2 && byte(1) < 0xA0)) {
+            pieces.push_back("\\u00" + hex(c == 0xC2 ? byte(1) : c));
+        } else if (c == '"' || c == '\\') {
+            pieces.push_back(std::string{'\\', char(c)});
+        } else {
+            pieces.emplace_back(text.substr(i, length));
+        }
+        i += length;
+    }
+    if (pieces.size() > kMaxShownChars) {
+        pieces.resize(kMaxShownChars - 3);
+        pieces.emplace_back("...");
+    }
+    std::string shown;
+    for (const std::string& piece : pieces) shown += piece;
+    return Quote(shown);
+}
+
+bool IsPathName(std::string_view name) {
+    if (name.empty() || name.size() > kMaxPathNameLength || name.front() == '.') return false;
+    return std::all_of(name.begin(), name.end(), [](char c) {
+        return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
+               c == '-';
+    });
+}
+
 std::string Suggestion(std::string_view name, std::span<const std::string_view> known) {
     // A name that one known name starts with ("fov" for "fov_deg") is a shortening, not a misspelling.
     if (name.size() >= 3) {
@@ -194,6 +247,19 @@ std::optional<std::string> Validator::String(const Json& value, std::string_view
         return std::nullopt;
     }
     return value.get<std::string>();
+}
+
+std::optional<std::string> Validator::PathName(const Json& value, std::string_view field) {
+    if (!value.is_string()) {
+        Fail(field, "expected a string, got " + Describe(value));
+        return std::nullopt;
+    }
+    const std::string& name = value.get_ref<const std::string&>();
+    if (!IsPathName(name)) {
+        Fail(field, std::string(kPathNameRule) + ", got " + QuoteShown(name));
+        return std::nullopt;
+    }
+    return name;
 }
 
 std::optional<bool> Validator::Boolean(const Json& value, std::string_view field) {

@@ -30,6 +30,18 @@ std::string Describe(const Json& value);
 // `text` in double quotes, as errors show names.
 std::string Quote(std::string_view text);
 
+// Untrusted text in double quotes, safe to print: control characters (C0, DEL, C1) escaped as \u00XX and bytes
+// that are not UTF-8 as \xHH, cut to about 60 characters with "..." (only the start of a long text is read).
+std::string QuoteShown(std::string_view text);
+
+// The rule for names that become a path component (the scene's out/<name>, frame files named after cameras).
+inline constexpr size_t kMaxPathNameLength = 64;
+inline constexpr std::string_view kPathNameRule =
+    "must be 1 to 64 of the characters A-Z a-z 0-9 . _ - and not start with '.'";
+
+// True when `name` follows kPathNameRule: never "", ".", "..", a separator or a hidden file.
+bool IsPathName(std::string_view name);
+
 // " (did you mean "x"?)" when one known name is close to `name` (or extends it), else "".
 std::string Suggestion(std::string_view name, std::span<const std::string_view> known);
 
@@ -78,6 +90,9 @@ class Validator {
     std::optional<double> Number(const Json& value, std::string_view field, Range range);
 
     std::optional<std::string> String(const Json& value, std::string_view field);
+
+    // A string that follows kPathNameRule, as names that become file or folder names must.
+    std::optional<std::string> PathName(const Json& value, std::string_view field);
 
     // A JSON true or false; numbers and strings such as 1 or "true" are refused.
     std::optional<bool> Boolean(const Json& value, std::string_view field);
