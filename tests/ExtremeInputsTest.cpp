@@ -101,8 +101,12 @@ TEST(ExtremeInputs, MakeSplatCoversOnlyTheImageAtExtremeFocalLengths) {
                     Splat s;
                     if (!MakeSplat(F, i, j, k, 0.9f, 1.0f, s)) continue;
                     ASSERT_TRUE(std::isfinite(s.px) && std::isfinite(s.py) && std::isfinite(s.size)) << i << j << k;
-                    if (s.x0 <= s.x1) ASSERT_TRUE(s.x0 >= 0 && s.x1 < 64) << s.x0 << " " << s.x1;
-                    if (s.y0 <= s.y1) ASSERT_TRUE(s.y0 >= 0 && s.y1 < 48) << s.y0 << " " << s.y1;
+                    if (s.x0 <= s.x1) {
+                        ASSERT_TRUE(s.x0 >= 0 && s.x1 < 64) << s.x0 << " " << s.x1;
+                    }
+                    if (s.y0 <= s.y1) {
+                        ASSERT_TRUE(s.y0 >= 0 && s.y1 < 48) << s.y0 << " " << s.y1;
+                    }
                 }
     }
 }
