@@ -54,7 +54,10 @@ static_assert(sizeof(Splat) == 48);
 inline float SplatQ(float qPrev, float qCur, float alpha) { return qPrev + alpha * (qCur - qPrev); }
 
 // The splat of voxel (i, j, k) with q_alpha qa and transmittance t. False, and
-// no splat, when qa <= q_min or the voxel centre is not beyond the near plane.
+// no splat, when qa <= q_min, the voxel centre is not beyond the near plane, or
+// the centre or size in pixels is not finite (an extreme focal length). The
+// covered pixels are clamped in float before the conversion to int, so a splat
+// far outside the image gets an empty range (x0 > x1 or y0 > y1), never a wrap.
 inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, float qa, float t, Splat& s) {
     s = Splat{0, 0, 0, 0, {0, 0, 0}, 0, 0, -1, 0, -1};
     if (!(qa > F.ambient[3])) return false;
@@ -67,9 +70,13 @@ inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, f
     const float depth = dx * F.forward[0] + dy * F.forward[1] + dz * F.forward[2];
     if (!(depth > F.eye[3])) return false;
     const float focal = F.forward[3];
-    s.px = 0.5f * float(F.image[0]) + x * focal / depth;
-    s.py = 0.5f * float(F.image[1]) - y * focal / depth;
-    s.size = std::clamp(F.misc[0] * focal / depth, 1.0f, 255.0f);
+    const float px = 0.5f * float(F.image[0]) + x * focal / depth;
+    const float py = 0.5f * float(F.image[1]) - y * focal / depth;
+    const float size = std::clamp(F.misc[0] * focal / depth, 1.0f, 255.0f);
+    if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(size)) return false;
+    s.px = px;
+    s.py = py;
+    s.size = size;
     const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float cosTheta = (F.sun[0] * dx + F.sun[1] * dy + F.sun[2] * dz) / len;
     const PhaseParams phase{PhaseKind(uint8_t(F.sunRadiance[3])), F.sun[3]};
@@ -77,11 +84,12 @@ inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, f
     s.alphaScale = qa * F.background[3];
     for (int c = 0; c < 3; ++c) s.colour[c] = F.sunRadiance[c] * light + F.ambient[c];
     // Covered pixels: px - s/2 <= x + 0.5 < px + s/2.
-    const float half = 0.5f * s.size;
-    s.x0 = int32_t(std::max(0.0f, std::ceil(s.px - half - 0.5f)));
-    s.x1 = int32_t(std::min(float(F.image[0]) - 1.0f, std::ceil(s.px + half - 0.5f) - 1.0f));
-    s.y0 = int32_t(std::max(0.0f, std::ceil(s.py - half - 0.5f)));
-    s.y1 = int32_t(std::min(float(F.image[1]) - 1.0f, std::ceil(s.py + half - 0.5f) - 1.0f));
+    // Clamped to [0, image] and [-1, image - 1] in float, so the ints cannot overflow.
+    const float half = 0.5f * s.size, imageW = float(F.image[0]), imageH = float(F.image[1]);
+    s.x0 = int32_t(std::min(std::max(0.0f, std::ceil(s.px - half - 0.5f)), imageW));
+    s.x1 = int32_t(std::max(std::min(imageW - 1.0f, std::ceil(s.px + half - 0.5f) - 1.0f), -1.0f));
+    s.y0 = int32_t(std::min(std::max(0.0f, std::ceil(s.py - half - 0.5f)), imageH));
+    s.y1 = int32_t(std::max(std::min(imageH - 1.0f, std::ceil(s.py + half - 0.5f) - 1.0f), -1.0f));
     return true;
 }
 

@@ -92,13 +92,15 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
                     const double root = std::sqrt(disc);
                     const double u0 = (-quadB - root) * b.inv2A;
                     const double u1 = (-quadB + root) * b.inv2A;
-                    const double iLo = std::ceil(el.center[0] + u0 - 0.5) - 1;
-                    const double iHi = std::floor(el.center[0] + u1 - 0.5) + 1;
-                    const int64_t i0 = std::max<int64_t>(0, int64_t(iLo));
-                    const int64_t i1 = std::min<int64_t>(int64_t(nx) - 1, int64_t(iHi));
+                    // The span is clamped to [0, nx - 1] in double, and only then narrowed:
+                    // a huge ellipsoid's bounds exceed every integer type (issue 11).
+                    const double iLo = std::max(0.0, std::ceil(el.center[0] + u0 - 0.5) - 1);
+                    const double iHi = std::min(double(nx) - 1, std::floor(el.center[0] + u1 - 0.5) + 1);
+                    if (!(iLo <= iHi)) continue;  // off the row, or NaN
+                    const uint32_t i0 = uint32_t(iLo), i1 = uint32_t(iHi);
                     const RasterEllipsoid local = el;
                     const float fy = float(py), fz = float(pz);
-                    for (int32_t i = int32_t(i0); i <= int32_t(i1); ++i)
+                    for (uint32_t i = i0; i <= i1; ++i)
                         w[i] = std::max(w[i], EllipsoidWeight(local, float(i) + 0.5f, fy, fz));
                 }
                 for (uint32_t i = 0; i < nx; ++i) row[i] = uint8_t(QuantizeRegion(w[i]));

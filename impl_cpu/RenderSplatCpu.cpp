@@ -144,7 +144,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                     const Splat& s = splats[binned[n]];
                     const int32_t y0 = std::max<int32_t>(s.y0, int32_t(rowLo)), y1 = std::min<int32_t>(s.y1, int32_t(rowHi));
                     if (y0 > y1) continue;
-                    const int32_t width = s.x1 - s.x0 + 1;
+                    const int32_t width = s.x1 - s.x0 + 1;  // <= W: MakeSplat clamps the range to the image
                     const float r = s.colour[0], g = s.colour[1], bl = s.colour[2];
                     for (int32_t i = 0; i < width; ++i) {
                         colours[3 * i] = r;

@@ -34,7 +34,11 @@ float SplatQ(float qPrev, float qCur, float alpha) {
     return qa;
 }
 
-// The splat of voxel idx with q_alpha qa and transmittance t; false when it makes none.
+// std::isfinite.
+bool SplatFinite(float v) { return !isnan(v) && !isinf(v); }
+
+// The splat of voxel idx with q_alpha qa and transmittance t; false when it makes none
+// (also when px, py or size is not finite). Covered pixels are clamped before int().
 bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
     s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
     if (!(qa > F.ambient.w)) return false;
@@ -50,6 +54,7 @@ bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
     precise float px = 0.5 * float(F.image.x) + x * focal / depth;
     precise float py = 0.5 * float(F.image.y) - y * focal / depth;
     precise float size = clamp(F.misc.x * focal / depth, 1.0, 255.0);
+    if (!SplatFinite(px) || !SplatFinite(py) || !SplatFinite(size)) return false;
     precise float len = sqrt(dx * dx + dy * dy + dz * dz);
     precise float cosTheta = (F.sun.x * dx + F.sun.y * dy + F.sun.z * dz) / len;
     precise float light = t * PhaseValue(uint(F.sunRadiance.w), F.sun.w, cosTheta);
@@ -61,10 +66,11 @@ bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
     s.g = F.sunRadiance.y * light + F.ambient.y;
     s.b = F.sunRadiance.z * light + F.ambient.z;
     precise float halfSize = 0.5 * size;
-    s.x0 = int(max(0.0, ceil(px - halfSize - 0.5)));
-    s.x1 = int(min(float(F.image.x) - 1.0, ceil(px + halfSize - 0.5) - 1.0));
-    s.y0 = int(max(0.0, ceil(py - halfSize - 0.5)));
-    s.y1 = int(min(float(F.image.y) - 1.0, ceil(py + halfSize - 0.5) - 1.0));
+    const float imageW = float(F.image.x), imageH = float(F.image.y);
+    s.x0 = int(min(max(0.0, ceil(px - halfSize - 0.5)), imageW));
+    s.x1 = int(max(min(imageW - 1.0, ceil(px + halfSize - 0.5) - 1.0), -1.0));
+    s.y0 = int(min(max(0.0, ceil(py - halfSize - 0.5)), imageH));
+    s.y1 = int(max(min(imageH - 1.0, ceil(py + halfSize - 0.5) - 1.0), -1.0));
     return true;
 }
 
