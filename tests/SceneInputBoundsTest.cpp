@@ -88,5 +88,34 @@ TEST(SceneInputBoundsTest, MissingFileNamesReason) {
     EXPECT_EQ(LoadError("/nonexistent/scene.json"), "/nonexistent/scene.json: cannot read the file: No such file or directory");
 }
 
+// Test that 100,000 nested arrays are refused at the 65th level, quickly and without memory growing with depth.
+TEST(SceneInputBoundsTest, DeepNestingRefused) {
+    const std::string text = R"({"grid": )" + std::string(100000, '[') + std::string(100000, ']') + "}";
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = ErrorOf(text);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Level 1 is the top object, so the 64th '[' (column 10 + 63) opens level 65.
+    EXPECT_EQ(message, "test.json: line 1, column 73: nested deeper than 64 levels");
+    EXPECT_LT(seconds, 0.5);
+
+    // 64 levels are read (and then refused for what they hold, not for their depth).
+    const std::string deepest = R"({"grid": )" + std::string(63, '[') + std::string(63, ']') + "}";
+    EXPECT_EQ(ErrorOf(deepest).find("nested deeper"), std::string::npos);
+
+    // Objects count too, and the same bound holds for a --set value.
+    std::string objects;
+    for (int i = 0; i < 70; ++i) objects += R"({"a": )";
+    objects += "1" + std::string(70, '}');
+    EXPECT_EQ(ErrorOf(objects), "test.json: line 1, column 385: nested deeper than 64 levels");
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}})", {{"ca.seed", std::string(100, '[')}}),
+                        "test.json: ca.seed: nested deeper than 64 levels (set on the command line)"));
+}
+
+// Test that a duplicate key deep in the document is still named by its whole path.
+TEST(SceneInputBoundsTest, DuplicateKeyPathKept) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "x": [0, {"a": 1, "a": 2}]})"),
+                        "test.json: x[1].a: duplicate field"));
+}
+
 }  // namespace
 }  // namespace cb
