@@ -117,5 +117,40 @@ TEST(SceneInputBoundsTest, DuplicateKeyPathKept) {
                         "test.json: x[1].a: duplicate field"));
 }
 
+// Test that a key with control bytes is shown escaped in its field path, never as raw bytes.
+TEST(SceneInputBoundsTest, ControlBytesInKeyEscaped) {
+    const std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "a\u001b[31m\u0007": 1})");
+    EXPECT_EQ(message, "test.json: a\\u001b[31m\\u0007: unknown field");
+    EXPECT_EQ(message.find('\x1b'), std::string::npos);
+    EXPECT_EQ(message.find('\x07'), std::string::npos);
+}
+
+// Test that a string value with control bytes is shown escaped, inside arrays too.
+TEST(SceneInputBoundsTest, ControlBytesInValueEscaped) {
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": "\u001b[2J"})"),
+              R"(test.json: steps: expected an integer, got "\u001b[2J")");
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": ["\u001b\u009b"]})"),
+              R"(test.json: steps: expected an integer, got ["\u001b\u009b"])");
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["region", "x\u0007"]})").find('\x07'),
+              std::string::npos);
+}
+
+// Test that a 50 MB key is shown cut to 60 characters, quickly, with no "did you mean" computed on it.
+TEST(SceneInputBoundsTest, HugeKeyCutShort) {
+    const std::string key(50'000'000, 'k');
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, ")" + key + R"(": 1})");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(message, "test.json: " + std::string(57, 'k') + "...: unknown field");
+    EXPECT_LT(seconds, 2.0);
+
+    // A long value is cut the same way.
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": ")" + key + R"("})"),
+              "test.json: steps: expected an integer, got \"" + std::string(57, 'k') + "...\"");
+    // Near misses of normal length still get their suggestion.
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stpes": 1})"),
+              R"(test.json: stpes: unknown field (did you mean "steps"?))");
+}
+
 }  // namespace
 }  // namespace cb
