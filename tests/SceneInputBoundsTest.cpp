@@ -152,5 +152,21 @@ TEST(SceneInputBoundsTest, HugeKeyCutShort) {
               R"(test.json: stpes: unknown field (did you mean "steps"?))");
 }
 
+// Test that a tile or band whose count would wrap 32 bits (CeilDiv adds edge - 1) is refused at the grid's edge.
+TEST(SceneInputBoundsTest, TileAndBandBoundedByGrid) {
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [16, 8, 6]}, "density": {"tile": 4294967295}})"),
+              "test.json: density.tile: must be at most 4294967280 (2^32 - the grid's longer horizontal edge 16, so "
+              "the count fits 32 bits), got 4294967295");
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [16, 8, 6]}, "density": {"band": 4294967295}})"),
+              "test.json: density.band: must be at most 4294967290 (2^32 - the grid's height 6, so the count fits 32 "
+              "bits), got 4294967295");
+    // At the bound, and far past the grid's edge but below it, the value is kept: one tile, one band.
+    const Scene scene = Parsed(R"({"grid": {"size": [16, 8, 6]}, "density": {"tile": 4294967280, "band": 1000}})");
+    EXPECT_EQ(scene.density.tile, 4294967280u);
+    EXPECT_EQ(scene.density.band, 1000u);
+    const uint32_t tile = scene.density.tile;
+    EXPECT_EQ((16u + tile - 1) / tile, 1u);
+}
+
 }  // namespace
 }  // namespace cb
