@@ -77,12 +77,17 @@ constexpr uint64_t kMaxSceneBytes = uint64_t(16) << 20;
 std::string KindOf(std::filesystem::file_type type) {
     using std::filesystem::file_type;
     switch (type) {
-    case file_type::fifo: return "a FIFO";
-    case file_type::block:
-    case file_type::character: return "a device";
-    case file_type::directory: return "a folder";
-    case file_type::socket: return "a socket";
-    default: return "not a file";
+        case file_type::fifo:
+            return "a FIFO";
+        case file_type::block:
+        case file_type::character:
+            return "a device";
+        case file_type::directory:
+            return "a folder";
+        case file_type::socket:
+            return "a socket";
+        default:
+            return "not a file";
     }
 }
 
@@ -110,7 +115,7 @@ Result<std::string> ReadSceneText(const std::string& path) {
     struct stat info {};
     if (::fstat(fd, &info) != 0) return MakeError(path + ": cannot read the file: " + std::strerror(errno));
     if (!S_ISREG(info.st_mode)) {
-        const auto type = S_ISFIFO(info.st_mode)                            ? std::filesystem::file_type::fifo
+        const auto type = S_ISFIFO(info.st_mode)                           ? std::filesystem::file_type::fifo
                           : S_ISCHR(info.st_mode) || S_ISBLK(info.st_mode) ? std::filesystem::file_type::character
                           : S_ISDIR(info.st_mode)                          ? std::filesystem::file_type::directory
                                                                            : std::filesystem::file_type::unknown;

@@ -7,7 +7,7 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr size_t kMaxShownChars = 60;     // longest value text quoted in an error
+constexpr size_t kMaxShownChars = 60;      // longest value text quoted in an error
 constexpr size_t kMaxSuggestedChars = 64;  // longest name given a "did you mean" (the edit distance is quadratic)
 
 // Case-insensitive edit distance, for "did you mean" suggestions.
@@ -111,8 +111,8 @@ std::string ShownField(std::string_view field) {
     std::string shown;
     for (size_t start = 0;;) {
         const size_t dot = field.find('.', start);
-        shown += ShownText(field.substr(start, dot == std::string_view::npos ? std::string_view::npos : dot - start),
-                           false);
+        shown +=
+            ShownText(field.substr(start, dot == std::string_view::npos ? std::string_view::npos : dot - start), false);
         if (dot == std::string_view::npos) return shown;
         shown += '.';
         start = dot + 1;

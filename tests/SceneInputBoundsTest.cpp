@@ -85,7 +85,8 @@ TEST(SceneInputBoundsTest, LargeFileRefused) {
 
 // Test that a missing file still names the reason.
 TEST(SceneInputBoundsTest, MissingFileNamesReason) {
-    EXPECT_EQ(LoadError("/nonexistent/scene.json"), "/nonexistent/scene.json: cannot read the file: No such file or directory");
+    EXPECT_EQ(LoadError("/nonexistent/scene.json"),
+              "/nonexistent/scene.json: cannot read the file: No such file or directory");
 }
 
 // Test that 100,000 nested arrays are refused at the 65th level, quickly and without memory growing with depth.
