@@ -6,8 +6,9 @@
 namespace cb::scene_io {
 namespace {
 
-// Builds the document like nlohmann's own DOM parser, recording each value's
-// field path (for duplicate keys) and the details of a failure.
+// Builds the document like nlohmann's own DOM parser, recording the field paths of duplicate keys and the
+// details of a failure. Each level keeps only its own key or index: a full path is built only for a duplicate, so
+// memory stays linear in the depth, which kMaxJsonDepth bounds anyway.
 class DomBuilder final : public nlohmann::json_sax<Json> {
   public:
     explicit DomBuilder(JsonDom& dom) : mDom(dom) {}
@@ -26,7 +27,7 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
 
     bool key(string_t& name) override {
         Frame& top = mStack.back();
-        if (top.node->contains(name)) mDom.duplicates.push_back(JoinField(top.field, name));
+        if (top.node->contains(name)) mDom.duplicates.push_back(JoinField(FieldOf(mStack.size()), name));
         top.key = std::move(name);
         return true;
     }
@@ -36,27 +37,39 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
         return false;
     }
 
+    // True when the parse stopped because a container opened deeper than kMaxJsonDepth.
+    bool TooDeep() const { return mTooDeep; }
+
   private:
     struct Frame {
         Json* node;
-        std::string field;  // dotted path of `node`
-        std::string key;    // last key read, when `node` is an object
+        std::string key;  // last key read, when `node` is an object
     };
 
-    // Stores `value` at the current position; returns its place and field path.
-    std::pair<Json*, std::string> Place(Json value) {
+    // Dotted path of the container at level `depth` (1 is the root), built from the levels above it.
+    std::string FieldOf(size_t depth) const {
+        std::string field;
+        for (size_t level = 1; level < depth; ++level) {
+            const Frame& parent = mStack[level - 1];
+            field = parent.node->is_array() ? IndexField(field, parent.node->size() - 1) : JoinField(field, parent.key);
+        }
+        return field;
+    }
+
+    // Stores `value` at the current position; returns its place.
+    Json* Place(Json value) {
         if (mStack.empty()) {
             mDom.root = std::move(value);
-            return {&mDom.root, ""};
+            return &mDom.root;
         }
         Frame& top = mStack.back();
         if (top.node->is_array()) {
             top.node->push_back(std::move(value));
-            return {&top.node->back(), IndexField(top.field, top.node->size() - 1)};
+            return &top.node->back();
         }
         Json& slot = (*top.node)[top.key];
         slot = std::move(value);
-        return {&slot, JoinField(top.field, top.key)};
+        return &slot;
     }
 
     bool Put(Json value) {
@@ -65,8 +78,12 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
     }
 
     bool Open(Json container) {
-        auto [node, field] = Place(std::move(container));
-        mStack.push_back(Frame{node, std::move(field), {}});
+        if (mStack.size() >= kMaxJsonDepth) {
+            mTooDeep = true;
+            return false;  // ends the parse; ParseJsonDom finds where
+        }
+        Json* node = Place(std::move(container));
+        mStack.push_back(Frame{node, {}});
         return true;
     }
 
@@ -77,7 +94,31 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
 
     JsonDom& mDom;
     std::vector<Frame> mStack;
+    bool mTooDeep = false;
 };
+
+// 1-based byte position of the bracket that opens level kMaxJsonDepth + 1 of `text`, which the parser read as
+// valid JSON up to there (so strings need only their quotes and escapes followed).
+size_t TooDeepPosition(std::string_view text) {
+    size_t depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth) return i + 1;
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return text.size();
+}
 
 // nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix.
 std::string ShortReason(const std::string& what) {
@@ -116,8 +157,14 @@ std::string IndexField(std::string_view parent, size_t index) {
 JsonDom ParseJsonDom(const std::string& text) {
     JsonDom dom;
     DomBuilder builder(dom);
-    // Every refusal goes through parse_error; the fallback only keeps "not JSON" from reading as success.
-    if (!Json::sax_parse(text, &builder) && !dom.failure) dom.failure = JsonParseFailure{};
+    // Every other refusal goes through parse_error; the fallback only keeps "not JSON" from reading as success.
+    if (!Json::sax_parse(text, &builder) && !dom.failure) {
+        dom.failure = JsonParseFailure{};
+        if (builder.TooDeep()) {
+            dom.failure->position = TooDeepPosition(text);
+            dom.failure->id = JsonParseFailure::kTooDeepId;
+        }
+    }
     return dom;
 }
 
@@ -128,6 +175,8 @@ std::string DescribeParseFailure(std::string_view text, const JsonParseFailure& 
         const size_t start = failure.position > length ? failure.position - length + 1 : 1;
         return LineColumn(text, start) + ": the number " + failure.token + " is out of range (not finite)";
     }
+    if (failure.IsTooDeep())
+        return LineColumn(text, failure.position) + ": nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";
     return LineColumn(text, failure.position) + ": malformed JSON: " + ShortReason(failure.what);
 }
 

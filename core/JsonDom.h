@@ -21,6 +21,9 @@ using Json = nlohmann::ordered_json;
 std::string JoinField(std::string_view parent, std::string_view key);
 std::string IndexField(std::string_view parent, size_t index);
 
+// Deepest nesting of arrays and objects accepted; a scene needs 4 levels.
+inline constexpr size_t kMaxJsonDepth = 64;
+
 // Why the text is not JSON, as nlohmann's parser reported it.
 struct JsonParseFailure {
     size_t position = 0;  // bytes read when it failed (1-based)
@@ -30,6 +33,10 @@ struct JsonParseFailure {
 
     // A number beyond the range of a double, such as 1e999.
     bool IsNumberOverflow() const { return id == 406; }
+
+    // Arrays or objects nested deeper than kMaxJsonDepth (an id nlohmann does not use).
+    static constexpr int kTooDeepId = -1;
+    bool IsTooDeep() const { return id == kTooDeepId; }
 };
 
 struct JsonDom {

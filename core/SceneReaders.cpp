@@ -282,15 +282,27 @@ void ReadSmooth(const Json& root, Validator& check, SmoothSettings& smooth) {
     }
 }
 
-void ReadDensity(const Json& root, Validator& check, DensitySettings& density) {
+// `grid` is the grid's size when it was valid. Tile and band counts are CeilDiv(edge, tile), computed in 32 bits as
+// (edge + tile - 1) / tile: tile + edge - 1 must fit, so tile is at most 2^32 - the edge it divides.
+void ReadDensity(const Json& root, Validator& check, DensitySettings& density, const Extent3* grid) {
     const Json* section = check.Section(root, "", "density", kDensityKeys);
     if (!section) return;
-    if (const Json* v = Validator::Find(*section, "tile")) {
-        if (auto n = check.Integer(*v, "density.tile", 1, kU32Max)) density.tile = uint32_t(*n);
-    }
-    if (const Json* v = Validator::Find(*section, "band")) {
-        if (auto n = check.Integer(*v, "density.band", 1, kU32Max)) density.band = uint32_t(*n);
-    }
+    auto read = [&](std::string_view key, uint32_t edge, std::string_view edgeText, uint32_t& target) {
+        const Json* v = Validator::Find(*section, key);
+        if (!v) return;
+        const std::string field = JoinField("density", key);
+        auto n = check.Integer(*v, field, 1, kU32Max);
+        if (!n) return;
+        const int64_t most = kU32Max + 1 - int64_t(edge);
+        if (*n > most) {
+            check.Fail(field, "must be at most " + std::to_string(most) + " (2^32 - " + std::string(edgeText) + " " +
+                                  std::to_string(edge) + ", so the count fits 32 bits), got " + Describe(*v));
+            return;
+        }
+        target = uint32_t(*n);
+    };
+    read("tile", grid ? std::max(grid->nx, grid->ny) : 1, "the grid's longer horizontal edge", density.tile);
+    read("band", grid ? grid->nz : 1, "the grid's height", density.band);
 }
 
 void ReadScene(const Json& root, const std::string& label, Validator& check, Scene& scene) {
@@ -332,7 +344,7 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
     ReadEllipsoids(root, check, scene.ellipsoids);
 
     ReadSmooth(root, check, scene.smooth);
-    ReadDensity(root, check, scene.density);
+    ReadDensity(root, check, scene.density, sizeOk ? &scene.grid.size : nullptr);
 
     ReadSun(root, check, scene.sun);
     ReadLighting(root, check, scene.lighting);

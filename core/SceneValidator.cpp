@@ -7,7 +7,8 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr size_t kMaxShownChars = 60;  // longest value text quoted in an error
+constexpr size_t kMaxShownChars = 60;      // longest value text quoted in an error
+constexpr size_t kMaxSuggestedChars = 64;  // longest name given a "did you mean" (the edit distance is quadratic)
 
 // Case-insensitive edit distance, for "did you mean" suggestions.
 size_t EditDistance(std::string_view a, std::string_view b) {
@@ -42,26 +43,25 @@ std::string FormatNumber(double value) {
 }
 
 std::string Describe(const Json& value) {
+    if (value.is_string()) return QuoteShown(value.get_ref<const std::string&>());
     std::string text;
     if (value.is_number_float()) {
         text = FormatNumber(value.get<double>());
     } else {
-        text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
+        // ensure_ascii: control characters (C0, DEL, C1) inside arrays and objects come out as \u00XX.
+        text = value.dump(-1, ' ', true, Json::error_handler_t::replace);
     }
     if (text.size() > kMaxShownChars) text = text.substr(0, kMaxShownChars - 3) + "...";
     return text;
 }
 
-std::string Quote(std::string_view text) {
-    // Built with append rather than operator+: GCC 12 raises a false -Wrestrict
-    // on "literal" + std::string (GCC bug 105651).
-    std::string quoted;
-    quoted.reserve(text.size() + 2);
-    quoted.append(1, '"').append(text).append(1, '"');
-    return quoted;
-}
+std::string Quote(std::string_view text) { return QuoteShown(text); }
 
-std::string QuoteShown(std::string_view text) {
+namespace {
+
+// `text` safe to print, without quotes: control characters escaped as \u00XX, bytes that are not UTF-8 as \xHH,
+// '"' and '\\' escaped when `escapeQuotes`, cut to kMaxShownChars with "..." (only the start of `text` is read).
+std::string ShownText(std::string_view text, bool escapeQuotes) {
     auto hex = [](unsigned value) {
         constexpr char kDigits[] = "0123456789abcdef";
         return std::string{kDigits[(value >> 4) & 15], kDigits[value & 15]};
@@ -90,7 +90,7 @@ std::string QuoteShown(std::string_view text) {
             length = 1;
         } else if (c < 0x20 || c == 0x7F || (c == 0xC2 && byte(1) < 0xA0)) {
             pieces.push_back("\\u00" + hex(c == 0xC2 ? byte(1) : c));
-        } else if (c == '"' || c == '\\') {
+        } else if (escapeQuotes && (c == '"' || c == '\\')) {
             pieces.push_back(std::string{'\\', char(c)});
         } else {
             pieces.emplace_back(text.substr(i, length));
@@ -103,7 +103,32 @@ std::string QuoteShown(std::string_view text) {
     }
     std::string shown;
     for (const std::string& piece : pieces) shown += piece;
-    return Quote(shown);
+    return shown;
+}
+
+// A dotted field path safe to print: each part between dots as ShownText shows it (keys come from the file).
+std::string ShownField(std::string_view field) {
+    std::string shown;
+    for (size_t start = 0;;) {
+        const size_t dot = field.find('.', start);
+        shown +=
+            ShownText(field.substr(start, dot == std::string_view::npos ? std::string_view::npos : dot - start), false);
+        if (dot == std::string_view::npos) return shown;
+        shown += '.';
+        start = dot + 1;
+    }
+}
+
+}  // namespace
+
+std::string QuoteShown(std::string_view text) {
+    // Built with append rather than operator+: GCC 12 raises a false -Wrestrict
+    // on "literal" + std::string (GCC bug 105651).
+    const std::string shown = ShownText(text, true);
+    std::string quoted;
+    quoted.reserve(shown.size() + 2);
+    quoted.append(1, '"').append(shown).append(1, '"');
+    return quoted;
 }
 
 bool IsPathName(std::string_view name) {
@@ -115,6 +140,7 @@ bool IsPathName(std::string_view name) {
 }
 
 std::string Suggestion(std::string_view name, std::span<const std::string_view> known) {
+    if (name.size() > kMaxSuggestedChars) return "";  // no known name is that long
     // A name that one known name starts with ("fov" for "fov_deg") is a shortening, not a misspelling.
     if (name.size() >= 3) {
         std::string_view extended;
@@ -144,7 +170,7 @@ std::string Suggestion(std::string_view name, std::span<const std::string_view> 
 // ---- Validator ------------------------------------------------------------------------------------------------
 
 void Validator::Fail(std::string_view field, std::string_view reason) {
-    std::string line = mLabel + ": " + std::string(field) + ": " + std::string(reason);
+    std::string line = mLabel + ": " + ShownField(field) + ": " + std::string(reason);
     if (IsOverridden(field)) line += " (set on the command line)";
     mErrors.push_back(std::move(line));
 }
@@ -327,6 +353,11 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
         // Number overflow (1e999) is a number, not a bare word: refuse it rather than take it as a string.
         check.MarkOverridden(item.path);
         check.Fail(item.path, "the number " + parsed.failure->token + " is out of range (not finite)");
+        return;
+    }
+    if (parsed.failure && parsed.failure->IsTooDeep()) {
+        check.MarkOverridden(item.path);
+        check.Fail(item.path, "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
         return;
     }
     Json value = parsed.failure ? Json(item.value) : std::move(parsed.root);

@@ -24,10 +24,11 @@ namespace cb::scene_io {
 // Shortest text that reads back as the same double ("0.35", "400", "100000", "1e+20", "inf").
 std::string FormatNumber(double value);
 
-// A JSON value as it appears in an error: strings quoted, long values cut short.
+// A JSON value as it appears in an error: strings as QuoteShown shows them, control characters escaped, long
+// values cut short.
 std::string Describe(const Json& value);
 
-// `text` in double quotes, as errors show names.
+// `text` in double quotes, as errors show names; the same as QuoteShown, since some names come from the file.
 std::string Quote(std::string_view text);
 
 // Untrusted text in double quotes, safe to print: control characters (C0, DEL, C1) escaped as \u00XX and bytes
@@ -42,7 +43,8 @@ inline constexpr std::string_view kPathNameRule =
 // True when `name` follows kPathNameRule: never "", ".", "..", a separator or a hidden file.
 bool IsPathName(std::string_view name);
 
-// " (did you mean "x"?)" when one known name is close to `name` (or extends it), else "".
+// " (did you mean "x"?)" when one known name is close to `name` (or extends it), else ""; always "" for a name
+// longer than 64 characters, so a huge key costs no quadratic edit distance.
 std::string Suggestion(std::string_view name, std::span<const std::string_view> known);
 
 // Collects error lines "label: field: reason" and reads typed values out of the document.
@@ -54,7 +56,8 @@ class Validator {
     // Marks `path` (and everything under it) as given on the command line.
     void MarkOverridden(std::string path) { mOverridden.push_back(std::move(path)); }
 
-    // Adds one error line; fields under an override (--set, --vary) get " (set on the command line)".
+    // Adds one error line; fields under an override (--set, --vary) get " (set on the command line)". Each part of
+    // `field` is shown as QuoteShown shows text (unquoted): keys come from the file.
     void Fail(std::string_view field, std::string_view reason);
 
     // An error with no field (malformed JSON, unreadable file).

@@ -1,0 +1,173 @@
+// Bounded input (issue 11, "Every bad input refused clearly"): scene files that are not regular files or are too
+// large, JSON nested too deep, echoed text kept short and free of control bytes, and derived sizes that must not wrap.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "SceneTestUtil.h"
+#include "core/Scene.h"
+
+namespace cb {
+namespace {
+
+using test::ErrorOf;
+using test::HasLine;
+using test::Parsed;
+using test::SplitLines;
+
+namespace fs = std::filesystem;
+
+// A fresh folder of this test process, removed at the end.
+class TempFolder {
+  public:
+    TempFolder() : mPath(fs::temp_directory_path() / ("cloudbench-inputbounds-" + std::to_string(getpid()))) {
+        fs::remove_all(mPath);
+        fs::create_directories(mPath);
+    }
+    ~TempFolder() {
+        std::error_code ec;
+        fs::remove_all(mPath, ec);
+    }
+    const fs::path& Path() const { return mPath; }
+
+  private:
+    fs::path mPath;
+};
+
+std::string LoadError(const std::string& path) {
+    Result<Scene> scene = LoadScene(path);
+    if (scene) {
+        ADD_FAILURE() << path << " was accepted";
+        return "";
+    }
+    return scene.error().message;
+}
+
+// Test that a FIFO is refused without being opened (opening one with no writer would block forever).
+TEST(SceneInputBoundsTest, FifoRefused) {
+    TempFolder folder;
+    const std::string path = (folder.Path() / "scene.json").string();
+    ASSERT_EQ(mkfifo(path.c_str(), 0600), 0);
+    EXPECT_EQ(LoadError(path), path + ": not a regular file (a FIFO)");
+}
+
+// Test that a device is refused rather than read until memory runs out.
+TEST(SceneInputBoundsTest, DeviceRefused) {
+    EXPECT_EQ(LoadError("/dev/zero"), "/dev/zero: not a regular file (a device)");
+}
+
+// Test that a folder is refused by kind.
+TEST(SceneInputBoundsTest, FolderRefused) {
+    TempFolder folder;
+    const std::string path = folder.Path().string();
+    EXPECT_EQ(LoadError(path), path + ": not a regular file (a folder)");
+}
+
+// Test that a file over 16 MiB is refused with its size, and one of exactly 16 MiB is read.
+TEST(SceneInputBoundsTest, LargeFileRefused) {
+    TempFolder folder;
+    const std::string path = (folder.Path() / "big.json").string();
+    {
+        std::ofstream file(path);
+        file << "{}" << std::string(20971520 - 2, ' ');
+    }
+    EXPECT_EQ(LoadError(path), path + ": 20971520 bytes, more than the 16 MiB a scene may have");
+
+    fs::resize_file(path, 16 << 20);  // at the limit: read, then refused for what it holds, not for its size
+    EXPECT_EQ(LoadError(path), path + ": grid.size: required field is missing");
+}
+
+// Test that a missing file still names the reason.
+TEST(SceneInputBoundsTest, MissingFileNamesReason) {
+    EXPECT_EQ(LoadError("/nonexistent/scene.json"),
+              "/nonexistent/scene.json: cannot read the file: No such file or directory");
+}
+
+// Test that 100,000 nested arrays are refused at the 65th level, quickly and without memory growing with depth.
+TEST(SceneInputBoundsTest, DeepNestingRefused) {
+    const std::string text = R"({"grid": )" + std::string(100000, '[') + std::string(100000, ']') + "}";
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = ErrorOf(text);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Level 1 is the top object, so the 64th '[' (column 10 + 63) opens level 65.
+    EXPECT_EQ(message, "test.json: line 1, column 73: nested deeper than 64 levels");
+    EXPECT_LT(seconds, 0.5);
+
+    // 64 levels are read (and then refused for what they hold, not for their depth).
+    const std::string deepest = R"({"grid": )" + std::string(63, '[') + std::string(63, ']') + "}";
+    EXPECT_EQ(ErrorOf(deepest).find("nested deeper"), std::string::npos);
+
+    // Objects count too, and the same bound holds for a --set value.
+    std::string objects;
+    for (int i = 0; i < 70; ++i) objects += R"({"a": )";
+    objects += "1" + std::string(70, '}');
+    EXPECT_EQ(ErrorOf(objects), "test.json: line 1, column 385: nested deeper than 64 levels");
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}})", {{"ca.seed", std::string(100, '[')}}),
+                        "test.json: ca.seed: nested deeper than 64 levels (set on the command line)"));
+}
+
+// Test that a duplicate key deep in the document is still named by its whole path.
+TEST(SceneInputBoundsTest, DuplicateKeyPathKept) {
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "x": [0, {"a": 1, "a": 2}]})"),
+                        "test.json: x[1].a: duplicate field"));
+}
+
+// Test that a key with control bytes is shown escaped in its field path, never as raw bytes.
+TEST(SceneInputBoundsTest, ControlBytesInKeyEscaped) {
+    const std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "a\u001b[31m\u0007": 1})");
+    EXPECT_EQ(message, "test.json: a\\u001b[31m\\u0007: unknown field");
+    EXPECT_EQ(message.find('\x1b'), std::string::npos);
+    EXPECT_EQ(message.find('\x07'), std::string::npos);
+}
+
+// Test that a string value with control bytes is shown escaped, inside arrays too.
+TEST(SceneInputBoundsTest, ControlBytesInValueEscaped) {
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": "\u001b[2J"})"),
+              R"(test.json: steps: expected an integer, got "\u001b[2J")");
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": ["\u001b\u009b"]})"),
+              R"(test.json: steps: expected an integer, got ["\u001b\u009b"])");
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["region", "x\u0007"]})").find('\x07'),
+              std::string::npos);
+}
+
+// Test that a 50 MB key is shown cut to 60 characters, quickly, with no "did you mean" computed on it.
+TEST(SceneInputBoundsTest, HugeKeyCutShort) {
+    const std::string key(50'000'000, 'k');
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, ")" + key + R"(": 1})");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(message, "test.json: " + std::string(57, 'k') + "...: unknown field");
+    EXPECT_LT(seconds, 2.0);
+
+    // A long value is cut the same way.
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": ")" + key + R"("})"),
+              "test.json: steps: expected an integer, got \"" + std::string(57, 'k') + "...\"");
+    // Near misses of normal length still get their suggestion.
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stpes": 1})"),
+              R"(test.json: stpes: unknown field (did you mean "steps"?))");
+}
+
+// Test that a tile or band whose count would wrap 32 bits (CeilDiv adds edge - 1) is refused at the grid's edge.
+TEST(SceneInputBoundsTest, TileAndBandBoundedByGrid) {
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [16, 8, 6]}, "density": {"tile": 4294967295}})"),
+              "test.json: density.tile: must be at most 4294967280 (2^32 - the grid's longer horizontal edge 16, so "
+              "the count fits 32 bits), got 4294967295");
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [16, 8, 6]}, "density": {"band": 4294967295}})"),
+              "test.json: density.band: must be at most 4294967290 (2^32 - the grid's height 6, so the count fits 32 "
+              "bits), got 4294967295");
+    // At the bound, and far past the grid's edge but below it, the value is kept: one tile, one band.
+    const Scene scene = Parsed(R"({"grid": {"size": [16, 8, 6]}, "density": {"tile": 4294967280, "band": 1000}})");
+    EXPECT_EQ(scene.density.tile, 4294967280u);
+    EXPECT_EQ(scene.density.band, 1000u);
+    const uint32_t tile = scene.density.tile;
+    EXPECT_EQ((16u + tile - 1) / tile, 1u);
+}
+
+}  // namespace
+}  // namespace cb
