@@ -106,7 +106,8 @@ TEST(SceneInputBoundsTest, DeepNestingRefused) {
     // Objects count too, and the same bound holds for a --set value.
     std::string objects;
     for (int i = 0; i < 70; ++i) objects += R"({"a": )";
-    objects += "1" + std::string(70, '}');
+    objects += '1';
+    objects.append(70, '}');
     EXPECT_EQ(ErrorOf(objects), "test.json: line 1, column 385: nested deeper than 64 levels");
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}})", {{"ca.seed", std::string(100, '[')}}),
                         "test.json: ca.seed: nested deeper than 64 levels (set on the command line)"));
