@@ -1,8 +1,11 @@
 #include "harness/Session.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -58,8 +61,26 @@ Result<Scene> Session::LoadVariant(std::span<const SceneOverride> extra) const {
     return LoadScene(mScenePath, all);
 }
 
+Status CheckWritableFolder(const std::string& dir) {
+    auto cannot = [&](int error) { return MakeError(dir + ": cannot write: " + std::strerror(error)); };
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return cannot(ec.value());
+    // A probe file proves that files can be created, written and removed here.
+    const std::string probe = dir + "/.cloudbench-probe-" + std::to_string(getpid());
+    const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return cannot(errno);
+    const char byte = 0;
+    const bool wrote = write(fd, &byte, 1) == 1;
+    int error = wrote ? 0 : errno;
+    if (close(fd) != 0 && error == 0) error = errno;
+    if (unlink(probe.c_str()) != 0 && error == 0) error = errno;
+    if (error != 0) return cannot(error);
+    return {};
+}
+
 bool Session::MakeOutDir() const {
-    if (Status s = MakeFolder(mOutDir); !s) {
+    if (Status s = CheckWritableFolder(mOutDir); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return false;
     }

@@ -51,7 +51,9 @@ class Session {
     // The same scene file with options.overrides followed by `extra`.
     Result<Scene> LoadVariant(std::span<const SceneOverride> extra) const;
 
-    // Creates OutDir(); prints the reason and returns false when it cannot.
+    // Creates OutDir() and proves it writable with a probe file (CheckWritableFolder);
+    // prints "DIR: cannot write: <reason>" and returns false when it is not.
+    // Every writing command calls it before opening backends or computing anything.
     bool MakeOutDir() const;
 
     // options.backends, or `defaults` when none were given.
@@ -87,6 +89,9 @@ class Session {
 
 // Creates `dir` and its parents; the error names the folder and the reason.
 Status MakeFolder(const std::string& dir);
+// Creates `dir` and its parents, then creates, writes and removes a probe file
+// in it; the error reads "DIR: cannot write: <strerror(errno)>".
+Status CheckWritableFolder(const std::string& dir);
 
 // Reads a buffer back in canonical form; adds the time it took to `timesMs` when given.
 template <typename T>
