@@ -66,8 +66,13 @@ class Session {
                                             bool report = true);
 
     // Writes `path` through `write`, which is given a temporary name in the
-    // same folder with the same extension; renamed to `path` on success.
+    // same folder with the same extension (".<stem>.partial<ext>"). The
+    // finished file is checked (a regular file, fsync'ed; a .npy reads back
+    // whole) and renamed to `path`. On any failure the temporary file is
+    // removed, `path` keeps its old contents, and the error names `path` (never
+    // the temporary name) and the system's reason (strerror of errno).
     static Status WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write);
+    // Errors read "PATH: cannot write: <strerror(errno)>".
     static Status WriteText(const std::string& path, const std::string& text);
     // Writes `doc` with a "provenance" block added.
     Status WriteJson(const std::string& path, nlohmann::json doc) const;
