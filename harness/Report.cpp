@@ -2,10 +2,12 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 
 #include "harness/Session.h"
@@ -228,6 +230,32 @@ std::string FrameFileStem(Stage renderer, const std::string& camera, const std::
     return "frame-" + std::string(RendererFileName(renderer)) + "-" + camera + (backend.empty() ? "" : "-" + backend);
 }
 
+namespace {
+
+// Writes `image` to `path` atomically. OIIO's PNG writer can report success on
+// a full disk, so the temporary file is read back whole before it is renamed.
+// Errors read "PATH: cannot write: <reason>"; Session::WriteAtomically adds the errno.
+Status WriteImage(const std::string& path, const OIIO::ImageBuf& image) {
+    return Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
+        if (!image.write(temp)) return MakeError(path + ": cannot write: " + image.geterror());
+        // Only a regular file is read back (a device could read forever); WriteAtomically refuses the rest.
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(temp, ec)) return {};
+        // ImageInput, not ImageBuf: the shared image cache could answer with an earlier file of the same name.
+        auto in = OIIO::ImageInput::open(temp);
+        const OIIO::ImageSpec& want = image.spec();
+        std::vector<float> pixels(size_t(want.width) * size_t(want.height) * size_t(want.nchannels));
+        const bool whole = in && in->spec().width == want.width && in->spec().height == want.height &&
+                           in->spec().nchannels == want.nchannels &&
+                           in->read_image(0, 0, 0, want.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+        const std::string why = in ? in->geterror() : OIIO::geterror();
+        if (!whole) return MakeError(path + ": cannot write: it does not read back whole (" + why + ")");
+        return {};
+    });
+}
+
+}  // namespace
+
 Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny,
                     uint32_t nz) {
     OIIO::ImageSpec spec(int(nx), int(ny), 1, OIIO::TypeDesc::UINT8);
@@ -241,10 +269,7 @@ Status WriteTopView(const std::string& path, const std::vector<float>& columnSum
             image.setpixel(int(i), int(y), &v, 1);
         }
     }
-    return Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
-        if (!image.write(temp)) return MakeError(path + ": cannot write the PNG: " + image.geterror());
-        return {};
-    });
+    return WriteImage(path, image);
 }
 
 ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
@@ -271,10 +296,7 @@ Status WriteDifferenceImage(const std::string& path, const std::vector<float>& r
     OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
     OIIO::ImageBuf a(spec, const_cast<float*>(reference.data())), b(spec, const_cast<float*>(candidate.data()));
     OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(a, b);
-    return Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
-        if (!diff.write(temp)) return MakeError(path + ": cannot write: " + diff.geterror());
-        return {};
-    });
+    return WriteImage(path, diff);
 }
 
 Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
@@ -283,10 +305,7 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
     OIIO::ImageBuf linear(spec, const_cast<float*>(rgb.data()));  // wraps, does not copy
     std::vector<std::string> written;
     const std::string exr = stem + ".exr";
-    CB_TRY(Session::WriteAtomically(exr, [&](const std::string& temp) -> Status {
-        if (!linear.write(temp)) return MakeError(exr + ": cannot write: " + linear.geterror());
-        return {};
-    }));
+    CB_TRY(WriteImage(exr, linear));
     written.push_back(exr);
     if (png) {
         OIIO::ImageBuf srgb;
@@ -294,10 +313,7 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
             return MakeError(stem + ".png: colour conversion failed: " + srgb.geterror());
         const std::string path = stem + ".png";
         srgb.set_write_format(OIIO::TypeDesc::UINT8);
-        CB_TRY(Session::WriteAtomically(path, [&](const std::string& temp) -> Status {
-            if (!srgb.write(temp)) return MakeError(path + ": cannot write: " + srgb.geterror());
-            return {};
-        }));
+        CB_TRY(WriteImage(path, srgb));
         written.push_back(path);
     }
     return written;

@@ -1,10 +1,13 @@
 #include "harness/Session.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 
 #include "core/MemoryPlan.h"
 #include "core/Npy.h"
@@ -58,8 +61,26 @@ Result<Scene> Session::LoadVariant(std::span<const SceneOverride> extra) const {
     return LoadScene(mScenePath, all);
 }
 
+Status CheckWritableFolder(const std::string& dir) {
+    auto cannot = [&](int error) { return MakeError(dir + ": cannot write: " + std::strerror(error)); };
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return cannot(ec.value());
+    // A probe file proves that files can be created, written and removed here.
+    const std::string probe = dir + "/.cloudbench-probe-" + std::to_string(getpid());
+    const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return cannot(errno);
+    const char byte = 0;
+    const bool wrote = write(fd, &byte, 1) == 1;
+    int error = wrote ? 0 : errno;
+    if (close(fd) != 0 && error == 0) error = errno;
+    if (unlink(probe.c_str()) != 0 && error == 0) error = errno;
+    if (error != 0) return cannot(error);
+    return {};
+}
+
 bool Session::MakeOutDir() const {
-    if (Status s = MakeFolder(mOutDir); !s) {
+    if (Status s = CheckWritableFolder(mOutDir); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return false;
     }
@@ -112,28 +133,77 @@ std::vector<OpenedBackend> Session::OpenBackends(const std::vector<std::string>&
     return out;
 }
 
+namespace {
+
+// Replaces every occurrence of `from` in `text` with `to`.
+std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
+    for (size_t at = text.find(from); !from.empty() && at != std::string::npos; at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+    return text;
+}
+
+// Checks a finished temporary file before it is renamed into place: it must be
+// a regular file whose data reach the disk (fsync), and a .npy must read back
+// whole, which catches a write lost in a stream's final flush. Errors name `path`.
+Status CheckFinished(const std::string& temp, const std::string& path) {
+    auto cannot = [&](const std::string& why) { return MakeError(path + ": cannot write: " + why); };
+    const int fd = open(temp.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return cannot(std::strerror(errno));
+    struct stat info {};
+    int error = fstat(fd, &info) != 0 ? errno : 0;
+    const bool regular = error == 0 && S_ISREG(info.st_mode);
+    if (regular && fsync(fd) != 0) error = errno;
+    close(fd);
+    if (error != 0) return cannot(std::strerror(error));
+    if (!regular) return cannot("the temporary file is not a regular file");
+    if (fs::path(path).extension() == ".npy")
+        if (auto back = ReadNpy(temp); !back)
+            return cannot("it does not read back whole (" + ReplaceAll(back.error().message, temp, path) + ")");
+    return {};
+}
+
+}  // namespace
+
 Status Session::WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write) {
     const fs::path target(path);
     // Same folder (so the rename cannot cross file systems), same extension (image writers go by it).
-    const fs::path temp =
-        target.parent_path() / ("." + target.stem().string() + ".partial" + target.extension().string());
-    Status written = write(temp.string());
+    const std::string temp =
+        (target.parent_path() / ("." + target.stem().string() + ".partial" + target.extension().string())).string();
+    errno = 0;
+    Status written = write(temp);
+    const int writeErrno = errno;  // what the failed system call said, when the writer does not say it
+    if (written) written = CheckFinished(temp, path);
     std::error_code ec;
-    if (written) fs::rename(temp, target, ec);
-    if (!written || ec) {
-        fs::remove(temp, ec);
-        if (!written) return written;
-        return MakeError(path + ": cannot move the finished file into place: " + ec.message());
+    if (written) {
+        fs::rename(temp, target, ec);
+        if (ec) written = MakeError(path + ": cannot move the finished file into place: " + ec.message());
+    }
+    if (!written) {
+        fs::remove(temp, ec);  // the old file, if any, stays as it was
+        std::string message = ReplaceAll(written.error().message, temp, path);
+        if (writeErrno != 0 && message.find(std::strerror(writeErrno)) == std::string::npos)
+            message += std::string(": ") + std::strerror(writeErrno);
+        return MakeError(message);
     }
     return {};
 }
 
 Status Session::WriteText(const std::string& path, const std::string& text) {
     return WriteAtomically(path, [&](const std::string& temp) -> Status {
-        std::ofstream file(temp);
-        file << text;
-        file.close();
-        if (!file) return MakeError(path + ": cannot write");
+        auto cannot = [&](int error) { return MakeError(path + ": cannot write: " + std::strerror(error)); };
+        const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0) return cannot(errno);
+        for (size_t done = 0; done < text.size();) {
+            const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                const int error = n < 0 ? errno : EIO;
+                close(fd);
+                return cannot(error);
+            }
+            done += size_t(n);
+        }
+        if (close(fd) != 0) return cannot(errno);
         return {};
     });
 }

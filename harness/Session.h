@@ -51,7 +51,9 @@ class Session {
     // The same scene file with options.overrides followed by `extra`.
     Result<Scene> LoadVariant(std::span<const SceneOverride> extra) const;
 
-    // Creates OutDir(); prints the reason and returns false when it cannot.
+    // Creates OutDir() and proves it writable with a probe file (CheckWritableFolder);
+    // prints "DIR: cannot write: <reason>" and returns false when it is not.
+    // Every writing command calls it before opening backends or computing anything.
     bool MakeOutDir() const;
 
     // options.backends, or `defaults` when none were given.
@@ -64,8 +66,13 @@ class Session {
                                             bool report = true);
 
     // Writes `path` through `write`, which is given a temporary name in the
-    // same folder with the same extension; renamed to `path` on success.
+    // same folder with the same extension (".<stem>.partial<ext>"). The
+    // finished file is checked (a regular file, fsync'ed; a .npy reads back
+    // whole) and renamed to `path`. On any failure the temporary file is
+    // removed, `path` keeps its old contents, and the error names `path` (never
+    // the temporary name) and the system's reason (strerror of errno).
     static Status WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write);
+    // Errors read "PATH: cannot write: <strerror(errno)>".
     static Status WriteText(const std::string& path, const std::string& text);
     // Writes `doc` with a "provenance" block added.
     Status WriteJson(const std::string& path, nlohmann::json doc) const;
@@ -87,6 +94,9 @@ class Session {
 
 // Creates `dir` and its parents; the error names the folder and the reason.
 Status MakeFolder(const std::string& dir);
+// Creates `dir` and its parents, then creates, writes and removes a probe file
+// in it; the error reads "DIR: cannot write: <strerror(errno)>".
+Status CheckWritableFolder(const std::string& dir);
 
 // Reads a buffer back in canonical form; adds the time it took to `timesMs` when given.
 template <typename T>

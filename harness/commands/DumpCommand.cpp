@@ -96,6 +96,7 @@ int Dump(const CommonOptions& options) {
         std::fprintf(stderr, "dump: --backend takes one backend, got %zu\n", options.backends.size());
         return kExitUsage;
     }
+    if (!(*session)->MakeOutDir()) return kExitFailed;
     std::vector<OpenedBackend> opened = (*session)->OpenBackends((*session)->RequestedBackends({"cpu"}));
     Backend* backend = opened[0].backend.get();
     if (!backend) return kExitNoBackend;

@@ -105,7 +105,26 @@ int Run(const CommonOptions& options) {
     std::vector<BackendRun> runs;
     std::vector<std::string> written;
     bool anyAvailable = false, anyFailed = false;
-    for (OpenedBackend& opened : backends) {
+    // results.json is rewritten (atomically) before the first backend and after each one, so that it always
+    // holds every backend finished so far, names the ones still "pending" and says whether the run is
+    // "complete"; a run killed part-way leaves what was done, never a previous run's results.
+    const std::string resultsPath = (*session)->OutDir() + "/results.json";
+    auto writeResults = [&](size_t finished) {
+        report::Report timing("Run of " + scene.name);
+        for (const BackendRun& run : runs)
+            if (run.status == "ok" || run.status == "failed") timing.sections.push_back(TimingSection(scene, run));
+        nlohmann::json doc = ResultsJson(scene, runs);
+        doc["pending"] = nlohmann::json::array();
+        for (size_t i = finished; i < backends.size(); ++i) doc["pending"].push_back(backends[i].name);
+        doc["complete"] = finished == backends.size();
+        doc["report"] = report::RenderJson(timing);
+        Status s = (*session)->WriteJson(resultsPath, doc);
+        if (!s) std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return bool(s);
+    };
+    anyFailed |= !writeResults(0);
+    for (size_t i = 0; i < backends.size(); ++i) {
+        OpenedBackend& opened = backends[i];
         BackendRun run;
         run.name = opened.name;
         run.plannedBytes = opened.plannedBytes;
@@ -125,18 +144,9 @@ int Run(const CommonOptions& options) {
         }
         std::printf("%s", report::RenderText(TimingSection(scene, run)).c_str());
         runs.push_back(std::move(run));
+        if (i + 1 < backends.size()) anyFailed |= !writeResults(i + 1);
     }
-
-    report::Report timing("Run of " + scene.name);
-    for (const BackendRun& run : runs)
-        if (run.status == "ok" || run.status == "failed") timing.sections.push_back(TimingSection(scene, run));
-    nlohmann::json doc = ResultsJson(scene, runs);
-    doc["report"] = report::RenderJson(timing);
-    const std::string resultsPath = (*session)->OutDir() + "/results.json";
-    if (Status s = (*session)->WriteJson(resultsPath, doc); !s) {
-        std::fprintf(stderr, "%s\n", s.error().message.c_str());
-        return kExitFailed;
-    }
+    if (!writeResults(backends.size())) return kExitFailed;
     written.insert(written.begin(), resultsPath);
     std::printf("results:");
     for (const std::string& path : written) std::printf(" %s", path.c_str());
