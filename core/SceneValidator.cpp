@@ -4,29 +4,13 @@
 #include <cmath>
 #include <system_error>
 
+#include "core/NamedValues.h"
+
 namespace cb::scene_io {
 namespace {
 
 constexpr size_t kMaxShownChars = 60;      // longest value text quoted in an error
 constexpr size_t kMaxSuggestedChars = 64;  // longest name given a "did you mean" (the edit distance is quadratic)
-
-// Case-insensitive edit distance, for "did you mean" suggestions.
-size_t EditDistance(std::string_view a, std::string_view b) {
-    auto lower = [](char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; };
-    std::vector<size_t> row(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-        size_t diagonal = row[0];
-        row[0] = i;
-        for (size_t j = 1; j <= b.size(); ++j) {
-            const size_t above = row[j];
-            const size_t substitute = diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
-            row[j] = std::min({above + 1, row[j - 1] + 1, substitute});
-            diagonal = above;
-        }
-    }
-    return row[b.size()];
-}
 
 }  // namespace
 

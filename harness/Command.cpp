@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <map>
 
+#include "core/NamedValues.h"
+
 namespace cb {
 namespace {
 
@@ -44,23 +46,6 @@ std::string Shown(std::string_view name) {
     return out;
 }
 
-// Levenshtein distance, ASCII case ignored; only called on short names.
-size_t EditDistance(std::string_view a, std::string_view b) {
-    std::vector<size_t> row(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-        size_t diagonal = row[0];
-        row[0] = i;
-        for (size_t j = 1; j <= b.size(); ++j) {
-            const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                              std::tolower(static_cast<unsigned char>(b[j - 1]));
-            const size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
-            diagonal = row[j];
-            row[j] = next;
-        }
-    }
-    return row[b.size()];
-}
 
 // An option whose value is one of `table`'s names, stored in `field` as its
 // value; otherwise the usage message lists the names: "--x needs a or b".
