@@ -10,6 +10,7 @@
 #include "core/Ellipsoids.h"
 #include "core/Splat.h"
 #include "impl_cpu/BackendCpu.h"
+#include "tests/RegionReference.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
@@ -17,15 +18,7 @@ namespace {
 
 // The CPU region of `list` against brute force over every voxel.
 void ExpectRegionEqualsBruteForce(const Extent3& e, const std::vector<RasterEllipsoid>& list) {
-    std::vector<uint8_t> expected(e.Count(), 0);
-    for (uint32_t k = 0; k < e.nz; ++k)
-        for (uint32_t j = 0; j < e.ny; ++j)
-            for (uint32_t i = 0; i < e.nx; ++i) {
-                uint8_t best = 0;
-                for (const RasterEllipsoid& el : list)
-                    best = uint8_t(std::max<int>(best, QuantizeRegion(EllipsoidWeight(el, i + 0.5f, j + 0.5f, k + 0.5f))));
-                expected[VoxelIndex(e, i, j, k)] = best;
-            }
+    const std::vector<uint8_t> expected = test::BruteForceRegion(e, list);
     cpu::BackendCpu backend(1);
     auto region = test::MakeBuffer(backend, BufferFormat::U8, e);
     ASSERT_TRUE(backend.Region(list, *region).has_value());

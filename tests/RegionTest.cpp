@@ -7,6 +7,7 @@
 #include "core/Ellipsoids.h"
 #include "core/Random.h"
 #include "impl_cpu/BackendCpu.h"
+#include "tests/RegionReference.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
@@ -67,15 +68,7 @@ TEST(Region, EqualsBruteForceOnRandomEllipsoids) {
                         {float(rng.Uniform(0.3, 20)), float(rng.Uniform(0.3, 12)), float(rng.Uniform(0.3, 6))},
                         std::cos(yaw), std::sin(yaw)});
     }
-    std::vector<uint8_t> expected(e.Count(), 0);
-    for (uint32_t k = 0; k < e.nz; ++k)
-        for (uint32_t j = 0; j < e.ny; ++j)
-            for (uint32_t i = 0; i < e.nx; ++i) {
-                uint8_t best = 0;
-                for (const RasterEllipsoid& el : list)
-                    best = uint8_t(std::max<int>(best, QuantizeRegion(EllipsoidWeight(el, i + 0.5f, j + 0.5f, k + 0.5f))));
-                expected[VoxelIndex(e, i, j, k)] = best;
-            }
+    const std::vector<uint8_t> expected = test::BruteForceRegion(e, list);
     for (int threads : {1, 2}) {
         std::vector<uint8_t> got = Rasterise(e, list, threads);
         size_t nonzero = 0;
