@@ -69,6 +69,27 @@ Extent3 ResourceExtent(Resource resource, const Scene& scene) {
     return grid;
 }
 
+namespace {
+
+// A pixel value as rules state it: "2/255" where it is a whole number of 8-bit steps, "%g" otherwise.
+std::string PixelValueText(double value) {
+    char text[32];
+    if (value * 255 == double(int(value * 255)))
+        std::snprintf(text, sizeof text, "%d/255", int(value * 255));
+    else
+        std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+}  // namespace
+
+std::string CompareRule::ToleranceText() const {
+    if (kind == Kind::Image) return PixelValueText(tolerance);
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", tolerance);
+    return text;
+}
+
 std::string CompareRule::Text(std::string_view symbol) const {
     char text[96];
     std::string d = "|d";
@@ -83,13 +104,8 @@ std::string CompareRule::Text(std::string_view symbol) const {
             std::snprintf(text, sizeof text, "%s <= %g, <= %g %% differ", d.c_str(), tolerance, share * 100);
             break;
         case Kind::Image:
-            if (tolerance * 255 == double(int(tolerance * 255)) && limit * 255 == double(int(limit * 255)))
-                std::snprintf(text, sizeof text, "%d/255 on %g %%, %d/255 max", int(tolerance * 255), 100 - share * 100,
-                              int(limit * 255));
-            else if (std::isinf(limit))
-                std::snprintf(text, sizeof text, "%g on %g %%", tolerance, 100 - share * 100);
-            else
-                std::snprintf(text, sizeof text, "%g on %g %%, %g max", tolerance, 100 - share * 100, limit);
+            std::snprintf(text, sizeof text, "%s on %g %%%s", ToleranceText().c_str(), 100 - share * 100,
+                          std::isinf(limit) ? "" : (", " + PixelValueText(limit) + " max").c_str());
             break;
     }
     return text;

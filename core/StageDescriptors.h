@@ -74,6 +74,8 @@ struct CompareRule {
 
     // As the tables print it, e.g. "bit-exact", "|dT| <= 1e-05"; `symbol` names the compared quantity.
     std::string Text(std::string_view symbol) const;
+    // The tolerance alone, as Text writes it ("2/255" for an image rule's 8-bit steps, "%g" otherwise).
+    std::string ToleranceText() const;
 };
 
 struct StageDescriptor {

@@ -162,7 +162,7 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
                 std::snprintf(detail, sizeof detail,
                               "step %u camera %s: worst pixel (%d, %d), %zu pixels over %s, PSNR %.1f dB", t,
                               camera.c_str(), cmp.worstX, cmp.worstY, cmp.pixelsOverTolerance,
-                              rule.tolerance * 255 == 2 ? "2/255" : std::to_string(rule.tolerance).c_str(), cmp.psnr);
+                              rule.ToleranceText().c_str(), cmp.psnr);
                 row.detail = detail;
             }
             if (!cmp.Passes()) row.status = "fail";
