@@ -19,6 +19,7 @@ constexpr uint32_t VoxelIndex(const Extent3& e, uint32_t i, uint32_t j, uint32_t
     return i + e.nx * (j + e.ny * k);
 }
 
-constexpr uint32_t CeilDiv(uint32_t a, uint32_t b) { return (a + b - 1) / b; }
+// ceil(a / b) for b > 0, without the wrap of (a + b - 1) / b when a + b - 1 passes 2^32.
+constexpr uint32_t CeilDiv(uint32_t a, uint32_t b) { return a / b + (a % b != 0 ? 1u : 0u); }
 
 }  // namespace cb

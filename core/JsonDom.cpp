@@ -1,5 +1,7 @@
 #include "core/JsonDom.h"
 
+#include "core/ShownText.h"
+
 #include <algorithm>
 #include <utility>
 
@@ -120,14 +122,24 @@ size_t TooDeepPosition(std::string_view text) {
     return text.size();
 }
 
-// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix.
+// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix. The token in
+// "last read: '...'" comes from the file: shown as ShownText shows it (escaped, cut short).
 std::string ShortReason(const std::string& what) {
     std::string text = what;
     if (size_t p = text.find("] "); p != std::string::npos) text = text.substr(p + 2);
     if (text.starts_with("parse error")) {
         if (size_t p = text.find(": "); p != std::string::npos) text = text.substr(p + 2);
     }
-    return text;
+    constexpr std::string_view kLastRead = "last read: '";
+    const size_t start = text.find(kLastRead);
+    if (start == std::string::npos) return ShownText(text, false, std::string::npos);
+    const size_t tokenStart = start + kLastRead.size();
+    size_t tokenEnd = text.rfind("'; expected");
+    if (tokenEnd == std::string::npos || tokenEnd < tokenStart) tokenEnd = text.rfind('\'');
+    if (tokenEnd == std::string::npos || tokenEnd < tokenStart) tokenEnd = text.size();
+    return ShownText(std::string_view(text).substr(0, tokenStart), false, std::string::npos) +
+           ShownText(std::string_view(text).substr(tokenStart, tokenEnd - tokenStart)) +
+           ShownText(std::string_view(text).substr(tokenEnd), false, std::string::npos);
 }
 
 // "line L, column C" (1-based) of the character at byte `position` - 1 of `text`.
@@ -173,7 +185,7 @@ std::string DescribeParseFailure(std::string_view text, const JsonParseFailure& 
         // nlohmann's position is the token's last character; point at its first.
         const size_t length = failure.token.size();
         const size_t start = failure.position > length ? failure.position - length + 1 : 1;
-        return LineColumn(text, start) + ": the number " + failure.token + " is out of range (not finite)";
+        return LineColumn(text, start) + ": the number " + ShownText(failure.token) + " is out of range (not finite)";
     }
     if (failure.IsTooDeep())
         return LineColumn(text, failure.position) + ": nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";

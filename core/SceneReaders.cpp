@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/MemoryPlan.h"
+#include "core/ProcessMemory.h"
 #include "core/StageDescriptors.h"
 
 namespace cb::scene_io {
@@ -98,7 +99,7 @@ bool ReadGrid(const Json& root, Validator& check, GridSettings& grid) {
         check.Fail("grid.size", "required field is missing");
     }
     if (const Json* v = Validator::Find(*section, "voxel_size")) {
-        if (auto d = check.Number(*v, "grid.voxel_size", kPositive)) grid.voxelSize = *d;
+        if (auto d = check.Number(*v, "grid.voxel_size", kSinglePositive)) grid.voxelSize = *d;
     }
     if (const Json* v = Validator::Find(*section, "origin")) {
         if (auto a = check.Numbers<3>(*v, "grid.origin", kFinite)) grid.origin = *a;
@@ -305,6 +306,28 @@ void ReadDensity(const Json& root, Validator& check, DensitySettings& density, c
     read("band", grid ? grid->nz : 1, "the grid's height", density.band);
 }
 
+namespace {
+
+// The optical depths the stages derive from sigma, the voxel size and the sun (core/Shading.h), checked here in
+// double where the single-precision kernels would overflow to infinity and turn 0 * inf into NaN: one shaded cell
+// at q = 1, sigma h f (|s_w| >= 1/sqrt(3) divides it), and the beer shadow's factor sigma h / s_z.
+void CheckOpticalDepths(const Scene& scene, Validator& check) {
+    const double perCell = scene.shade.sigma * scene.grid.voxelSize * scene.shade.resolution;
+    if (perCell > kMaxSingle) {
+        check.Fail("shade.sigma", "sigma * grid.voxel_size * shade.resolution (the optical depth of one cell) must be "
+                                  "at most 1e+30, got " + FormatNumber(perCell));
+        return;
+    }
+    const float sz = scene.sun.Direction()[2];
+    if (sz <= 0.0f) return;  // no sun, no shadow factor
+    const double perD = scene.shade.sigma * scene.grid.voxelSize / double(sz);
+    if (perD > kMaxSingle)
+        check.Fail("shade.sigma", "sigma * grid.voxel_size / sin(sun.elevation_deg) (the ground shadow's optical "
+                                  "depth per unit of D) must be at most 1e+30, got " + FormatNumber(perD));
+}
+
+}  // namespace
+
 void ReadScene(const Json& root, const std::string& label, Validator& check, Scene& scene) {
     check.CheckKeys(root, "", kTopKeys);
 
@@ -358,6 +381,8 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
         if (Describe(stage).renderer && scene.stages.Has(stage) && camerasOk && scene.render.cameras.empty())
             check.Fail("render.cameras", Quote(StageName(stage)) + " needs at least one camera");
 
+    CheckOpticalDepths(scene, check);
+
     // Size checks, before anything grid-sized exists.
     if (!sizeOk) return;
     const Extent3& size = scene.grid.size;
@@ -368,10 +393,13 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
                                     " voxels; the voxel index is 32-bit, so at most " + std::to_string(kU32Max));
         return;
     }
+    // Against the fixed ceiling (machine, cgroup, RLIMIT_AS), not what happens to be free now: the backends check that.
     const uint64_t needed = EstimateSceneBytes(scene);
-    if (std::optional<uint64_t> physical = PhysicalMemoryBytes(); physical && needed > *physical) {
-        check.Fail("grid.size", "the enabled stages need " + FormatGiB(needed) + " GiB, more than this machine's " +
-                                    FormatGiB(*physical) + " GiB");
+    if (std::optional<MemoryFigure> limit = ProcessMemoryLimit(); limit && needed > limit->bytes) {
+        const std::string most = limit->source == "physical memory"
+                                     ? "this machine's " + FormatGiB(limit->bytes) + " GiB"
+                                     : "the " + FormatGiB(limit->bytes) + " GiB this process may use (" + limit->source + ")";
+        check.Fail("grid.size", "the enabled stages need " + FormatGiB(needed) + " GiB, more than " + most);
     }
 }
 

@@ -106,21 +106,26 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
         if (auto d = check.Number(*v, "sun.azimuth_deg", kFinite)) sun.azimuthDeg = *d;
     }
     if (const Json* v = Validator::Find(*section, "color")) {
-        if (auto a = check.Numbers<3>(*v, "sun.color", kNonNegative)) sun.color = *a;
+        if (auto a = check.Numbers<3>(*v, "sun.color", kSingleNonNegative)) sun.color = *a;
     }
     if (const Json* v = Validator::Find(*section, "intensity")) {
-        if (auto d = check.Number(*v, "sun.intensity", kNonNegative)) sun.intensity = *d;
+        if (auto d = check.Number(*v, "sun.intensity", kSingleNonNegative)) sun.intensity = *d;
     }
+    // The radiance color * intensity is what the renderers use, in single precision.
+    const double brightest = std::max({sun.color[0], sun.color[1], sun.color[2]}) * sun.intensity;
+    if (brightest > kMaxSingle)
+        check.Fail("sun.intensity", "color * intensity (the sun's radiance) must be at most 1e+30 in each channel, got " +
+                                        FormatNumber(brightest));
 }
 
 void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting) {
     const Json* section = check.Section(root, "", "lighting", kLightingKeys);
     if (!section) return;
     if (const Json* v = Validator::Find(*section, "ambient")) {
-        if (auto a = check.Numbers<3>(*v, "lighting.ambient", kNonNegative)) lighting.ambient = *a;
+        if (auto a = check.Numbers<3>(*v, "lighting.ambient", kSingleNonNegative)) lighting.ambient = *a;
     }
     if (const Json* v = Validator::Find(*section, "background")) {
-        if (auto a = check.Numbers<3>(*v, "lighting.background", kNonNegative)) lighting.background = *a;
+        if (auto a = check.Numbers<3>(*v, "lighting.background", kSingleNonNegative)) lighting.background = *a;
     }
 }
 
@@ -149,7 +154,7 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
         if (auto kind = check.Choice(*v, "shade.attenuation", kAttenuationKindNames)) shade.attenuation = *kind;
     }
     if (const Json* v = find("sigma")) {
-        if (auto d = check.Number(*v, "shade.sigma", kNonNegative)) shade.sigma = *d;
+        if (auto d = check.Number(*v, "shade.sigma", kSingleNonNegative)) shade.sigma = *d;
     }
     if (const Json* v = find("thesis_ar")) {
         if (auto d = check.Number(*v, "shade.thesis_ar", kProbability)) shade.thesisAr = *d;
@@ -185,7 +190,7 @@ void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
         if (auto kind = check.Choice(*v, "shadow.form", kAttenuationKindNames)) shadow.form = *kind;
     }
     if (const Json* v = Validator::Find(*section, "kappa")) {
-        if (auto d = check.Number(*v, "shadow.kappa", kNonNegative)) shadow.kappa = *d;
+        if (auto d = check.Number(*v, "shadow.kappa", kSingleNonNegative)) shadow.kappa = *d;
     }
 }
 

@@ -9,7 +9,6 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr size_t kMaxShownChars = 60;      // longest value text quoted in an error
 constexpr size_t kMaxSuggestedChars = 64;  // longest name given a "did you mean" (the edit distance is quadratic)
 
 }  // namespace
@@ -43,53 +42,6 @@ std::string Quote(std::string_view text) { return QuoteShown(text); }
 
 namespace {
 
-// `text` safe to print, without quotes: control characters escaped as \u00XX, bytes that are not UTF-8 as \xHH,
-// '"' and '\\' escaped when `escapeQuotes`, cut to kMaxShownChars with "..." (only the start of `text` is read).
-std::string ShownText(std::string_view text, bool escapeQuotes) {
-    auto hex = [](unsigned value) {
-        constexpr char kDigits[] = "0123456789abcdef";
-        return std::string{kDigits[(value >> 4) & 15], kDigits[value & 15]};
-    };
-    // One shown character (or escape) per piece; reading stops once the text is known to be too long.
-    std::vector<std::string> pieces;
-    size_t i = 0;
-    while (i < text.size() && pieces.size() <= kMaxShownChars) {
-        const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
-        const unsigned char c = byte(0);
-        // Length of the well-formed UTF-8 sequence starting here; 0 when there is none.
-        size_t length = 0;
-        if (c < 0x80)
-            length = 1;
-        else if (c >= 0xC2 && c <= 0xDF)
-            length = 2;
-        else if ((c & 0xF0) == 0xE0)
-            length = 3;
-        else if (c >= 0xF0 && c <= 0xF4)
-            length = 4;
-        if (i + length > text.size()) length = 0;
-        for (size_t k = 1; k < length; ++k)
-            if ((byte(k) & 0xC0) != 0x80) length = 0;
-        if (length == 0) {
-            pieces.push_back("\\x" + hex(c));
-            length = 1;
-        } else if (c < 0x20 || c == 0x7F || (c == 0xC2 && byte(1) < 0xA0)) {
-            pieces.push_back("\\u00" + hex(c == 0xC2 ? byte(1) : c));
-        } else if (escapeQuotes && (c == '"' || c == '\\')) {
-            pieces.push_back(std::string{'\\', char(c)});
-        } else {
-            pieces.emplace_back(text.substr(i, length));
-        }
-        i += length;
-    }
-    if (pieces.size() > kMaxShownChars) {
-        pieces.resize(kMaxShownChars - 3);
-        pieces.emplace_back("...");
-    }
-    std::string shown;
-    for (const std::string& piece : pieces) shown += piece;
-    return shown;
-}
-
 // A dotted field path safe to print: each part between dots as ShownText shows it (keys come from the file).
 std::string ShownField(std::string_view field) {
     std::string shown;
@@ -104,16 +56,6 @@ std::string ShownField(std::string_view field) {
 }
 
 }  // namespace
-
-std::string QuoteShown(std::string_view text) {
-    // Built with append rather than operator+: GCC 12 raises a false -Wrestrict
-    // on "literal" + std::string (GCC bug 105651).
-    const std::string shown = ShownText(text, true);
-    std::string quoted;
-    quoted.reserve(shown.size() + 2);
-    quoted.append(1, '"').append(shown).append(1, '"');
-    return quoted;
-}
 
 bool IsPathName(std::string_view name) {
     if (name.empty() || name.size() > kMaxPathNameLength || name.front() == '.') return false;
@@ -336,7 +278,7 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
     if (parsed.failure && parsed.failure->IsNumberOverflow()) {
         // Number overflow (1e999) is a number, not a bare word: refuse it rather than take it as a string.
         check.MarkOverridden(item.path);
-        check.Fail(item.path, "the number " + parsed.failure->token + " is out of range (not finite)");
+        check.Fail(item.path, "the number " + ShownText(parsed.failure->token) + " is out of range (not finite)");
         return;
     }
     if (parsed.failure && parsed.failure->IsTooDeep()) {
@@ -352,6 +294,8 @@ void ApplyOverride(Json& root, const SceneOverride& item, Validator& check) {
         prefix = JoinField(prefix, keys[i]);
         auto it = node->find(keys[i]);
         if (it == node->end()) {
+            // The object is the command line's, so an error on it (an unknown section) says so.
+            check.MarkOverridden(prefix);
             node = &((*node)[keys[i]] = Json::object());
         } else if (it->is_object()) {
             node = &*it;

@@ -18,6 +18,7 @@
 #include "core/JsonDom.h"
 #include "core/Scene.h"
 #include "core/SceneNames.h"
+#include "core/ShownText.h"
 
 namespace cb::scene_io {
 
@@ -31,9 +32,9 @@ std::string Describe(const Json& value);
 // `text` in double quotes, as errors show names; the same as QuoteShown, since some names come from the file.
 std::string Quote(std::string_view text);
 
-// Untrusted text in double quotes, safe to print: control characters (C0, DEL, C1) escaped as \u00XX and bytes
-// that are not UTF-8 as \xHH, cut to about 60 characters with "..." (only the start of a long text is read).
-std::string QuoteShown(std::string_view text);
+// Untrusted text in double quotes, safe to print (core/ShownText.h).
+using cb::QuoteShown;
+using cb::ShownText;
 
 // The rule for names that become a path component (the scene's out/<name>, frame files named after cameras).
 inline constexpr size_t kMaxPathNameLength = 64;
@@ -166,6 +167,11 @@ inline constexpr Range kFinite{};
 inline constexpr Range kPositive{.lo = 0, .loOpen = true};
 inline constexpr Range kNonNegative{.lo = 0};
 inline constexpr Range kProbability{.lo = 0, .hi = 1};
+// Quantities the stages compute in single precision (lengths, extinction, radiance) are at most kMaxSingle, so
+// that their products with each other and with grid counts stay finite (float's largest is about 3.4e38).
+inline constexpr double kMaxSingle = 1e30;
+inline constexpr Range kSinglePositive{.lo = 0, .loOpen = true, .hi = kMaxSingle};
+inline constexpr Range kSingleNonNegative{.lo = 0, .hi = kMaxSingle};
 
 // Applies one --set to the document, reporting into `check`. Missing objects along
 // the path are created; a value that is not JSON is taken as a string.

@@ -10,6 +10,7 @@
 #include <map>
 
 #include "core/NamedValues.h"
+#include "core/ShownText.h"
 
 namespace cb {
 namespace {
@@ -28,24 +29,8 @@ std::optional<int> PositiveInt(const char* text, long max) {
     return int(value);
 }
 
-// A name as a message shows it: control and non-ASCII bytes as \xNN, cut after 40 bytes.
-std::string Shown(std::string_view name) {
-    constexpr size_t kMax = 40;
-    std::string out;
-    for (size_t i = 0; i < name.size() && i < kMax; ++i) {
-        const unsigned char c = static_cast<unsigned char>(name[i]);
-        if (c >= 0x20 && c < 0x7f) {
-            out += char(c);
-        } else {
-            char hex[5];
-            std::snprintf(hex, sizeof hex, "\\x%02x", c);
-            out += hex;
-        }
-    }
-    if (name.size() > kMax) out += "...";
-    return out;
-}
-
+// A name from the command line as a message shows it (core/ShownText.h): control characters escaped, cut short.
+std::string Shown(std::string_view name) { return ShownText(name); }
 
 // An option whose value is one of `table`'s names, stored in `field` as its
 // value; otherwise the usage message lists the names: "--x needs a or b".

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <thread>
 
+#include "core/ProcessMemory.h"
 #include "core/Scene.h"
 #include "impl_cpu/CaKernels.h"
 
@@ -29,6 +30,11 @@ bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("cpu: cannot create an empty buffer");
     return std::make_unique<BufferCpu>(format, extent);
+}
+
+std::optional<uint64_t> BackendCpu::AvailableBytes() const {
+    const std::optional<MemoryFigure> available = ProcessAvailableMemory();
+    return available ? std::optional(available->bytes) : std::nullopt;
 }
 
 uint64_t BackendCpu::BufferBytes(BufferFormat format, const Extent3& extent) const {

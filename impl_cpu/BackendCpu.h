@@ -55,8 +55,8 @@ class BackendCpu : public Backend {
     // shade's coarse grids and slice buffers; per-call rows and the renderer's
     // splat lists (which depend on the clouds) are not counted.
     uint64_t ScratchBytes(const Scene& scene) const override;
-    // The machine's physical memory.
-    std::optional<uint64_t> AvailableBytes() const override { return PhysicalMemoryBytes(); }
+    // What this process may still allocate: available memory, cgroup and RLIMIT_AS (core/ProcessMemory.h).
+    std::optional<uint64_t> AvailableBytes() const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 

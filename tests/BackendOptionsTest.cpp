@@ -106,11 +106,11 @@ TEST(BackendOptions, BackendListRefusesUnknownNamesWithASuggestion) {
 TEST(BackendOptions, BackendListShowsNamesSafely) {
     std::vector<std::string> backends;
     EXPECT_EQ(ParseBackendList("c\x1b[2Jpu", backends),
-              "--backend: unknown backend 'c\\x1b[2Jpu' (known: cpu, gl, vk)");  // no raw ESC reaches the terminal
+              "--backend: unknown backend 'c\\u001b[2Jpu' (known: cpu, gl, vk)");  // no raw ESC reaches the terminal
     const std::string huge(1'000'000, 'a');
     const std::optional<std::string> message = ParseBackendList(huge, backends);
     ASSERT_TRUE(message);
-    EXPECT_EQ(*message, "--backend: unknown backend '" + std::string(40, 'a') + "...' (known: cpu, gl, vk)");
+    EXPECT_EQ(*message, "--backend: unknown backend '" + std::string(57, 'a') + "...' (known: cpu, gl, vk)");
 }
 
 // KnownBackends() is the registry's list: every built backend is in it, and

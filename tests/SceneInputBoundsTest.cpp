@@ -1,7 +1,9 @@
 // Bounded input (issue 11, "Every bad input refused clearly"): scene files that are not regular files or are too
 // large, JSON nested too deep, echoed text kept short and free of control bytes, and derived sizes that must not wrap.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -11,6 +13,8 @@
 #include <string>
 
 #include "SceneTestUtil.h"
+#include "core/Grid.h"
+#include "core/ProcessMemory.h"
 #include "core/Scene.h"
 
 namespace cb {
@@ -168,6 +172,67 @@ TEST(SceneInputBoundsTest, TileAndBandBoundedByGrid) {
     EXPECT_EQ(scene.density.band, 1000u);
     const uint32_t tile = scene.density.tile;
     EXPECT_EQ((16u + tile - 1) / tile, 1u);
+}
+
+// Test that CeilDiv is exact up to the top of uint32: (a + b - 1) / b wrapped there and gave 0.
+TEST(SceneInputBoundsTest, CeilDivDoesNotWrap) {
+    constexpr uint32_t kMax = 4294967295u;
+    EXPECT_EQ(CeilDiv(kMax, kMax), 1u);
+    EXPECT_EQ(CeilDiv(1, kMax), 1u);
+    EXPECT_EQ(CeilDiv(kMax, 2), 2147483648u);
+    EXPECT_EQ(CeilDiv(kMax - 1, 2), 2147483647u);
+    EXPECT_EQ(CeilDiv(0, 7), 0u);
+    EXPECT_EQ(CeilDiv(64, 64), 1u);
+    EXPECT_EQ(CeilDiv(65, 64), 2u);
+}
+
+// Test that optical depths formed from in-range fields are checked where they are formed: sigma 1e28 and a voxel of
+// 1 km give 1e31 per cell (T was NaN in single precision), and a grazing sun divides sigma h by ~1e-42.
+TEST(SceneInputBoundsTest, DerivedOpticalDepthBounded) {
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 8, 8], "voxel_size": 1000}, "shade": {"sigma": 1e28}})"),
+              "test.json: shade.sigma: sigma * grid.voxel_size * shade.resolution (the optical depth of one cell) "
+              "must be at most 1e+30, got 1e+31");
+    EXPECT_NE(ErrorOf(R"({"grid": {"size": [8, 8, 8]}, "sun": {"elevation_deg": 1e-40}})")
+                  .find("test.json: shade.sigma: sigma * grid.voxel_size / sin(sun.elevation_deg)"),
+              std::string::npos);
+    EXPECT_EQ(ErrorOf(R"({"grid": {"size": [8, 8, 8], "voxel_size": 1e300}})"),
+              "test.json: grid.voxel_size: must be in (0, 1e+30], got 1e+300");
+    // At the bounds the scene is kept.
+    const Scene scene = Parsed(R"({"grid": {"size": [8, 8, 8], "voxel_size": 1e30}, "shade": {"sigma": 0}})");
+    EXPECT_EQ(scene.grid.voxelSize, 1e30);
+}
+
+// Test that an object --set creates is the command line's: an unknown section it names says so.
+TEST(SceneInputBoundsTest, SetCreatedSectionMarkedAsCommandLine) {
+    auto scene = ParseScene(R"({"grid": {"size": [8, 8, 8]}})", "test.json", {{"foo.bar", "1"}});
+    ASSERT_FALSE(scene);
+    EXPECT_EQ(scene.error().message, "test.json: foo: unknown field (set on the command line)");
+}
+
+// Test that the memory limit counts RLIMIT_AS: in a child under a limit of its VmSize + 256 MiB, the fixed limit is
+// RLIMIT_AS itself and what is still available is at most the 256 MiB left.
+TEST(SceneInputBoundsTest, ProcessMemoryCountsAddressSpaceLimit) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        std::ifstream status("/proc/self/status");
+        std::string line;
+        uint64_t vmKb = 0;
+        while (std::getline(status, line))
+            if (line.starts_with("VmSize:")) vmKb = std::stoull(line.substr(7));
+        const uint64_t limit = vmKb * 1024 + (uint64_t(256) << 20);
+        const rlimit r{limit, limit};
+        if (vmKb == 0 || setrlimit(RLIMIT_AS, &r) != 0) _exit(2);
+        const std::optional<MemoryFigure> fixed = ProcessMemoryLimit();
+        const std::optional<MemoryFigure> now = ProcessAvailableMemory();
+        if (!fixed || fixed->bytes != limit || fixed->source != "RLIMIT_AS") _exit(3);
+        if (!now || now->bytes > (uint64_t(256) << 20)) _exit(4);
+        _exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "2: no VmSize or setrlimit failed, 3: fixed limit, 4: available now";
 }
 
 }  // namespace
