@@ -8,6 +8,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 
 namespace cb {
@@ -232,7 +233,11 @@ inline SliceAttenuation MakeSliceAttenuation(AttenuationKind kind, float sigma, 
                                              const PhaseParams& phase) {
     SliceAttenuation a;
     a.kind = kind;
-    a.opticalDepthPerQ = sigma * cellSize / absSw;
+    // Finite even when sigma h overflows float (sigma 1e39, h 1e300: valid
+    // scenes): an infinite depth would make 0 * inf = NaN where q = 0 (GPUs
+    // then read exp(NaN) as 0). FLT_MAX * q stays finite for q <= 1, and
+    // sigma = 0 gives 0 whatever the slice thickness.
+    a.opticalDepthPerQ = sigma > 0 ? std::min(sigma * cellSize / absSw, std::numeric_limits<float>::max()) : 0.0f;
     a.thesisAr = thesisAr;
     if (scattering) a.scatterGain = albedo * PhaseValue(phase, 1.0f) * solidAngle / (4.0f * std::numbers::pi_v<float>);
     return a;
@@ -262,7 +267,8 @@ inline ShadowLookup MakeShadowLookup(const Vec3& s, uint32_t nx, uint32_t ny, ui
     l.baseY = int32_t(std::floor(cy));
     l.fx = cx - std::floor(cx);
     l.fy = cy - std::floor(cy);
-    l.opticalDepthPerD = sigma * voxelSize / s[2];
+    // Finite, like opticalDepthPerQ: D = 0 then gives exp(-0) = 1, not NaN.
+    l.opticalDepthPerD = sigma > 0 ? std::min(sigma * voxelSize / s[2], std::numeric_limits<float>::max()) : 0.0f;
     return l;
 }
 
