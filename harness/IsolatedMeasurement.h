@@ -30,14 +30,13 @@ struct BackendMeasurement {
     std::string status, reason;          // as opened: "available", "unavailable" or "unsupported", and why
     std::vector<std::vector<Row>> rows;  // per plan item
     std::vector<ReferenceRecord> records;
-    nlohmann::json extra;                // what `more` returned
-    std::optional<ChildFailure> failure; // the process gave no result
+    nlohmann::json extra;                 // what `more` returned
+    std::optional<ChildFailure> failure;  // the process gave no result
 };
 
 // Work after the plan, in the child, on the opened backend (one slot); its
 // JSON comes back as BackendMeasurement::extra.
-using MoreMeasurements =
-    std::function<Result<nlohmann::json>(Evaluator& eval, std::span<const OpenedBackend> backend)>;
+using MoreMeasurements = std::function<Result<nlohmann::json>(Evaluator& eval, std::span<const OpenedBackend> backend)>;
 
 // Measures `plan` on each of `names`, each in its own process. An error in the
 // measurement itself (not the backend's crash: the reference or the inputs)

@@ -1,7 +1,5 @@
 #include "harness/Isolation.h"
 
-#include "core/Stage.h"
-
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -21,6 +19,8 @@
 #include <thread>
 #include <variant>
 
+#include "core/Stage.h"
+
 namespace cb {
 namespace {
 
@@ -33,8 +33,8 @@ struct PhaseBoard {
     uint32_t hasStep;
 };
 
-PhaseBoard gLocalBoard{};          // without isolation, and in a process that runs no child
-PhaseBoard* gBoard = &gLocalBoard; // the board MarkPhase writes
+PhaseBoard gLocalBoard{};           // without isolation, and in a process that runs no child
+PhaseBoard* gBoard = &gLocalBoard;  // the board MarkPhase writes
 
 std::string Seconds(double s) {
     char text[32];
@@ -44,18 +44,30 @@ std::string Seconds(double s) {
 
 std::string SignalName(int sig) {
     switch (sig) {
-        case SIGSEGV: return "SIGSEGV";
-        case SIGABRT: return "SIGABRT";
-        case SIGBUS: return "SIGBUS";
-        case SIGFPE: return "SIGFPE";
-        case SIGILL: return "SIGILL";
-        case SIGKILL: return "SIGKILL";
-        case SIGTERM: return "SIGTERM";
-        case SIGINT: return "SIGINT";
-        case SIGPIPE: return "SIGPIPE";
-        case SIGTRAP: return "SIGTRAP";
-        case SIGSYS: return "SIGSYS";
-        default: return "signal " + std::to_string(sig);
+        case SIGSEGV:
+            return "SIGSEGV";
+        case SIGABRT:
+            return "SIGABRT";
+        case SIGBUS:
+            return "SIGBUS";
+        case SIGFPE:
+            return "SIGFPE";
+        case SIGILL:
+            return "SIGILL";
+        case SIGKILL:
+            return "SIGKILL";
+        case SIGTERM:
+            return "SIGTERM";
+        case SIGINT:
+            return "SIGINT";
+        case SIGPIPE:
+            return "SIGPIPE";
+        case SIGTRAP:
+            return "SIGTRAP";
+        case SIGSYS:
+            return "SIGSYS";
+        default:
+            return "signal " + std::to_string(sig);
     }
 }
 
@@ -147,9 +159,7 @@ nlohmann::json ChildFailure::Json() const {
     return j;
 }
 
-IsolationSettings IsolationFrom(const CommonOptions& options) {
-    return {!options.noIsolation, options.backendTimeout};
-}
+IsolationSettings IsolationFrom(const CommonOptions& options) { return {!options.noIsolation, options.backendTimeout}; }
 
 void MarkPhase(std::string_view phase, std::optional<uint32_t> step) {
     PhaseBoard& b = *gBoard;
@@ -299,7 +309,8 @@ IsolatedOutcome RunIsolated(std::string_view label, const IsolationSettings& set
 
     if (timedOut) {
         failure.status = "timed out";
-        failure.message = std::string(label) + " ran past " + Seconds(settings.timeoutSeconds) + " s (--backend-timeout)";
+        failure.message =
+            std::string(label) + " ran past " + Seconds(settings.timeoutSeconds) + " s (--backend-timeout)";
         out.failure = failure;
         return out;
     }
@@ -322,9 +333,9 @@ IsolatedOutcome RunIsolated(std::string_view label, const IsolationSettings& set
         }
     }
     failure.status = "failed";
-    failure.message = WIFEXITED(status) ? "exited with status " + std::to_string(WEXITSTATUS(status)) +
-                                              " without a result"
-                                        : "ended without a result";
+    failure.message = WIFEXITED(status)
+                          ? "exited with status " + std::to_string(WEXITSTATUS(status)) + " without a result"
+                          : "ended without a result";
     out.failure = failure;
     return out;
 }

@@ -43,8 +43,8 @@ struct IsolatedOutcome {
 };
 
 struct IsolationSettings {
-    bool enabled = true;          // false: run in this process (--no-isolation)
-    double timeoutSeconds = 3600; // 0 = no timeout; not applied without isolation
+    bool enabled = true;           // false: run in this process (--no-isolation)
+    double timeoutSeconds = 3600;  // 0 = no timeout; not applied without isolation
 };
 IsolationSettings IsolationFrom(const CommonOptions& options);
 

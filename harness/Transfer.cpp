@@ -32,19 +32,20 @@ std::optional<T> OptionalFrom(const json& j) {
 }
 
 json ToJson(const Summary& s) {
-    return {{"count", s.count}, {"median", D(s.median)}, {"q1", D(s.q1)}, {"q3", D(s.q3)}, {"min", D(s.min)}, {"max", D(s.max)}};
+    return {{"count", s.count}, {"median", D(s.median)}, {"q1", D(s.q1)},
+            {"q3", D(s.q3)},    {"min", D(s.min)},       {"max", D(s.max)}};
 }
 Summary SummaryFromJson(const json& j) {
-    return {j.at("count").get<size_t>(),  FromD(j.at("median")), FromD(j.at("q1")),
-            FromD(j.at("q3")),     FromD(j.at("min")),    FromD(j.at("max"))};
+    return {j.at("count").get<size_t>(), FromD(j.at("median")), FromD(j.at("q1")),
+            FromD(j.at("q3")),           FromD(j.at("min")),    FromD(j.at("max"))};
 }
 
 json ToJson(const ErrorStats& e) {
     return {{"count", e.count}, {"max", D(e.max)}, {"mean", D(e.mean)}, {"p99", D(e.p99)}, {"worst", e.worst}};
 }
 ErrorStats ErrorStatsFromJson(const json& j) {
-    return {j.at("count").get<uint64_t>(), FromD(j.at("max")), FromD(j.at("mean")),
-            FromD(j.at("p99")), j.at("worst").get<uint64_t>()};
+    return {j.at("count").get<uint64_t>(), FromD(j.at("max")), FromD(j.at("mean")), FromD(j.at("p99")),
+            j.at("worst").get<uint64_t>()};
 }
 
 }  // namespace
@@ -100,8 +101,8 @@ BackendProvenance ProvenanceFromJson(const json& j) {
 }
 
 json ToJson(const ConformRow& r) {
-    return {{"stage", r.stage},   {"backend", r.backend},     {"status", r.status}, {"rule", r.rule},
-            {"worst", D(r.worst)},   {"tolerance", D(r.tolerance)}, {"detail", r.detail}};
+    return {{"stage", r.stage},    {"backend", r.backend},        {"status", r.status}, {"rule", r.rule},
+            {"worst", D(r.worst)}, {"tolerance", D(r.tolerance)}, {"detail", r.detail}};
 }
 ConformRow ConformRowFromJson(const json& j) {
     ConformRow r;
@@ -118,19 +119,16 @@ ConformRow ConformRowFromJson(const json& j) {
 json ToJson(const Row& r) {
     json settings = json::array();
     for (const SceneOverride& o : r.settings) settings.push_back({o.path, o.value});
-    return {{"settings", settings},
-            {"backend", r.backend},
-            {"stage", StageName(r.stage)},
-            {"status", r.result.status},
-            {"detail", r.result.detail},
-            {"time", ToJson(r.result.timeMs)},
-            {"all", ToJson(r.result.all)},
-            {"subset", ToJson(r.result.subset)},
+    return {{"settings", settings},        {"backend", r.backend},
+            {"stage", StageName(r.stage)}, {"status", r.result.status},
+            {"detail", r.result.detail},   {"time", ToJson(r.result.timeMs)},
+            {"all", ToJson(r.result.all)}, {"subset", ToJson(r.result.subset)},
             {"pareto", r.pareto}};
 }
 Row RowFromJson(const json& j) {
     Row r;
-    for (const json& o : j.at("settings")) r.settings.push_back({o.at(0).get<std::string>(), o.at(1).get<std::string>()});
+    for (const json& o : j.at("settings"))
+        r.settings.push_back({o.at(0).get<std::string>(), o.at(1).get<std::string>()});
     r.backend = j.at("backend").get<std::string>();
     r.stage = ParseStage(j.at("stage").get<std::string>()).value_or(Stage::Shade);
     r.result.status = j.at("status").get<std::string>();
@@ -164,10 +162,18 @@ ReferenceRecord ReferenceRecordFromJson(const json& j) {
 json ToJson(const std::vector<report::Cell>& cells) {
     json out = json::array();
     for (const report::Cell& c : cells) switch (c.kind) {
-            case report::Cell::Kind::Empty: out.push_back(nullptr); break;
-            case report::Cell::Kind::Text: out.push_back({{"text", c.text}}); break;
-            case report::Cell::Kind::Real: out.push_back({{"real", D(c.real)}}); break;
-            case report::Cell::Kind::Integer: out.push_back({{"integer", c.integer}}); break;
+            case report::Cell::Kind::Empty:
+                out.push_back(nullptr);
+                break;
+            case report::Cell::Kind::Text:
+                out.push_back({{"text", c.text}});
+                break;
+            case report::Cell::Kind::Real:
+                out.push_back({{"real", D(c.real)}});
+                break;
+            case report::Cell::Kind::Integer:
+                out.push_back({{"integer", c.integer}});
+                break;
         }
     return out;
 }

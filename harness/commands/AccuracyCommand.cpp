@@ -293,7 +293,8 @@ int Accuracy(const CommonOptions& options) {
         return kExitFailed;
     }
     if (std::ranges::none_of(*parts, [](const BackendMeasurement& p) { return p.available; })) return kExitNoBackend;
-    const bool anyCrashed = std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
+    const bool anyCrashed =
+        std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
     std::vector<Row> rows = MergeRows(scene, plan, *parts);
 
     json doc = {{"format", "cloudbench-accuracy/1"},
@@ -332,8 +333,7 @@ int Accuracy(const CommonOptions& options) {
         if (!anyRayStart) doc["voxel_exit_vs_centre"] = r["doc"]["voxel_exit_vs_centre"];
         anyRayStart = true;
     }
-    if (anyRayStart)
-        Emit(report, {"Reference ray start: voxel exit (default) vs voxel centre", {std::move(rayStart)}});
+    if (anyRayStart) Emit(report, {"Reference ray start: voxel exit (default) vs voxel centre", {std::move(rayStart)}});
     if (options.switches && scene.stages.Has(Stage::Shade)) {
         // Rows by key, then by backend (the parts' order): a stable sort of the parts' rows in turn.
         SwitchResult sw = EmptySwitchResult();

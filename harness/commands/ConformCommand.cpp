@@ -94,8 +94,8 @@ int Conform(const CommonOptions& options) {
         if (!outcome.result) {
             const ChildFailure& failure = *outcome.failure;
             std::fprintf(stderr, "backend %s %s\n", name.c_str(), failure.Describe().c_str());
-            (*session)->AddBackendRecord({name, failure.stage == "opening backend" ? "unavailable" : "available", "",
-                                          failure.Describe()});
+            (*session)->AddBackendRecord(
+                {name, failure.stage == "opening backend" ? "unavailable" : "available", "", failure.Describe()});
             rows.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe()});
             anyCrashed = true;
             continue;

@@ -214,7 +214,8 @@ int Sweep(const CommonOptions& options) {
         return kExitFailed;
     }
     if (std::ranges::none_of(*parts, [](const BackendMeasurement& p) { return p.available; })) return kExitNoBackend;
-    const bool anyCrashed = std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
+    const bool anyCrashed =
+        std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
     std::vector<Row> rows = MergeRows(scene, plan, *parts);
     MarkPareto(rows, options.metric);
 
@@ -276,9 +277,9 @@ const CommandRegistration kRegistration({
     .summary = "Vary scene fields over a cartesian product: time and error, Pareto front, plot",
     .help = kHelp,
     .helpOrder = 5,
-    .extraOptions = WithIsolationOptions({ListOption("--vary", &CommonOptions::vary,
-                                "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
-                     TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"), RepeatOption()}),
+    .extraOptions = WithIsolationOptions(
+        {ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
+         TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"), RepeatOption()}),
     .run = Sweep,
 });
 
