@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "harness/Isolation.h"
 #include "harness/Simulation.h"
 #include "harness/StageParams.h"
 #include "registry/Registry.h"
@@ -129,6 +130,8 @@ StageAccuracy MeasureShade(Backend& backend, const Scene& scene, const LightingI
     if (!q || !T) return Failed("failed", (!q ? q.error() : T.error()).message);
     if (Status s = backend.Upload(**q, std::as_bytes(std::span(in.q))); !s) return Failed("failed", s.error().message);
     const ShadeParams params = MakeShadeParams(scene);
+    MarkPhase("shade", in.step);  // for a crash report, as CallStage marks it
+    InjectTestFault(backend.Name(), "shade");
     auto time = TimeRepeated(repeats, [&] { return backend.Shade(params, **q, **T); });
     if (!time) return Failed("failed", "shade: " + time.error().message);
     StageAccuracy a;
@@ -153,6 +156,8 @@ StageAccuracy MeasureShadow(Backend& backend, const Scene& scene, const Lighting
     if (!D || !G) return Failed("failed", (!D ? D.error() : G.error()).message);
     if (Status s = backend.Upload(**D, std::as_bytes(std::span(in.D))); !s) return Failed("failed", s.error().message);
     const ShadowParams params = MakeShadowParams(scene);
+    MarkPhase("shadow", in.step);
+    InjectTestFault(backend.Name(), "shadow");
     auto time = TimeRepeated(repeats, [&] { return backend.Shadow(params, **D, **G); });
     if (!time) return Failed("failed", "shadow: " + time.error().message);
     StageAccuracy a;

@@ -38,6 +38,9 @@ struct CommonOptions {
     gl::ContextKind glContext = gl::ContextKind::OSMesa;  // --gl-context, gl::kContextKindNames
     gl::CaLayout glCaLayout = gl::CaLayout::Packed;       // --gl-ca-layout, gl::kCaLayoutNames
     bool quiet = false;
+    // Crash isolation (harness/Isolation.h): --no-isolation, --backend-timeout SECONDS (0 = none).
+    bool noIsolation = false;
+    double backendTimeout = 3600;
     // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
     // timed calls per measurement; accuracy --switches; sweep --metric.
     bool reference = false;

@@ -133,6 +133,12 @@ std::vector<OpenedBackend> Session::OpenBackends(const std::vector<std::string>&
     return out;
 }
 
+void Session::AddBackendRecord(BackendProvenance record) {
+    for (const BackendProvenance& known : mBackends)
+        if (known.name == record.name) return;
+    mBackends.push_back(std::move(record));
+}
+
 namespace {
 
 // Replaces every occurrence of `from` in `text` with `to`.

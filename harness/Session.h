@@ -79,6 +79,11 @@ class Session {
     // Reads `buffer` back and writes it as .npy shaped (nz, ny, nx).
     static Status WriteNpy(const std::string& path, Backend& backend, const Buffer& buffer);
 
+    // The backends opened so far, for the provenance.
+    const std::vector<BackendProvenance>& BackendRecords() const { return mBackends; }
+    // Records a backend opened elsewhere (in an isolated child); one already recorded by name is kept.
+    void AddBackendRecord(BackendProvenance record);
+
     // The provenance of this run: build, machine, backends opened so far, scene, command line.
     nlohmann::json Provenance() const;
 

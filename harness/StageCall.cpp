@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "harness/Isolation.h"
 #include "harness/StageParams.h"
 
 namespace cb {
@@ -96,6 +97,9 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
 
 Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
                  const StageBuffers& buffers, StageCallRecord& record) {
+    // Where a crash happens, for the parent of an isolated backend (harness/Isolation.h).
+    MarkPhase(StageName(stage), host.step);
+    InjectTestFault(backend.Name(), StageName(stage));
     Status status = Call(stage, backend, scene, host, buffers, record);
     if (!status && stage != Stage::RenderSplat)
         return MakeError(std::string(StageName(stage)) + ": " + status.error().message);

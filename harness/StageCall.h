@@ -58,6 +58,8 @@ struct StageCallRecord {
 
 // Runs `stage` on `backend`. The buffers must hold every resource the stage's
 // descriptor reads and writes in this scene; an error names the stage.
+// Marks the stage and step for crash reports (MarkPhase) and honours the
+// test-only fault switch (InjectTestFault) before the call.
 Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
                  const StageBuffers& buffers, StageCallRecord& record);
 

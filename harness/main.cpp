@@ -3,10 +3,12 @@
 // (harness/commands/), parses its options, prints help, runs it. docs/cli.md
 // describes the commands.
 #include <cstdio>
+#include <new>
 #include <string>
 #include <string_view>
 
 #include "harness/Command.h"
+#include "harness/Isolation.h"
 
 namespace {
 
@@ -86,5 +88,15 @@ int main(int argc, char** argv) {
             return Usage("unexpected argument '" + std::string(arg) + "' (one scene at a time)", command->help);
         }
     }
-    return command->run(options);
+    // An allocation that fails anywhere outside an isolated backend's process
+    // (which reports its own) ends the command with a message, not an abort.
+    try {
+        return command->run(options);
+    } catch (const std::bad_alloc& e) {
+        const std::string phase = cb::CurrentPhase();
+        std::fflush(stdout);
+        std::fprintf(stderr, "cloudbench: out of memory%s%s: %s\n", phase.empty() ? "" : " in ", phase.c_str(),
+                     e.what());
+        return cb::kExitFailed;
+    }
 }

@@ -6,15 +6,17 @@
 #include <numbers>
 
 #include "core/SceneNames.h"
+#include "harness/IsolatedMeasurement.h"
 #include "harness/Measurement.h"
 #include "harness/StageParams.h"
+#include "harness/Transfer.h"
 
 namespace cb {
 namespace {
 
 using nlohmann::json;
 
-constexpr const char* kHelp = R"(usage: cloudbench accuracy [SCENE] [options]
+constexpr const char* kHelpText = R"(usage: cloudbench accuracy [SCENE] [options]
 
 Simulates SCENE on the CPU to its last step, computes the exact references
 T_ref (every voxel, from the point where the ray toward the sun leaves the
@@ -41,6 +43,7 @@ Options:
   --gl-context CTX   OpenGL context: osmesa (default) or egl
   --quiet            no progress lines
 )";
+const std::string kHelp = kHelpText + IsolationOptionsHelp();
 
 // Values of each shade and shadow option that differ from the scene's.
 std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage stage) {
@@ -95,15 +98,16 @@ std::string EpsilonText(double eps) {
 
 const char* AxisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 
+// Each row and doc item has a key, its place in the order of one process
+// measuring every backend: 3 per (switch, epsilon), side 0, side 1, jump.
 struct SwitchResult {
     json doc = json::array();
     report::Table errors, jumps;
+    std::vector<int> errorKeys, jumpKeys, docKeys;
 };
 
-Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, std::span<const OpenedBackend> backends) {
-    constexpr double kDeg = std::numbers::pi / 180;
-    const CommonOptions& options = session.Options();
-    const Scene& base = session.GetScene();
+// The tables' columns, without rows.
+SwitchResult EmptySwitchResult() {
     SwitchResult out;
     out.errors = TextTable({"switch", "epsilon", "side", "axis", "backend"});
     for (auto& c : StatsColumns()) out.errors.columns.push_back(c);
@@ -111,8 +115,18 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, st
     out.jumps = TextTable({"switch", "epsilon", "axes", "backend"});
     for (const char* title : {"jump max|T+ - T-|", "T_ref jump", "a-priori bound"})
         out.jumps.columns.push_back(report::Column(title).Real("%.3g"));
+    return out;
+}
+
+Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, std::span<const OpenedBackend> backends) {
+    constexpr double kDeg = std::numbers::pi / 180;
+    const CommonOptions& options = session.Options();
+    const Scene& base = session.GetScene();
+    SwitchResult out = EmptySwitchResult();
+    int key = 0;
     for (const SwitchCase& c : SwitchCases(base)) {
         for (double eps : {1e-6, 1e-3, 1.0 * kDeg}) {
+            key += 3;
             std::map<std::string, std::vector<float>> T[2];  // per side, per backend
             std::vector<float> Tref[2];
             Vec3 sun[2];
@@ -137,6 +151,8 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, st
                     for (auto& cell : StatsCells(a.all)) cells.push_back(cell);
                     for (auto& cell : StatsCells(a.subset)) cells.push_back(cell);
                     out.errors.rows.push_back(std::move(cells));
+                    out.errorKeys.push_back(key + side);
+                    out.docKeys.push_back(key + side);
                     out.doc.push_back({{"switch", c.name},
                                        {"epsilon_rad", eps},
                                        {"side", side == 0 ? "-" : "+"},
@@ -166,6 +182,8 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, st
                 out.jumps.rows.push_back({c.name, EpsilonText(eps),
                                           std::string(AxisName(axis[0])) + " -> " + AxisName(axis[1]), name, jump,
                                           refJump, bound});
+                out.jumpKeys.push_back(key + 2);
+                out.docKeys.push_back(key + 2);
                 out.doc.push_back({{"switch", c.name},
                                    {"epsilon_rad", eps},
                                    {"backend", name},
@@ -179,6 +197,13 @@ Result<SwitchResult> MeasureSwitches(Evaluator& eval, const Session& session, st
     return out;
 }
 
+// The ray-start comparison's columns, without rows.
+report::Table RayStartTable() {
+    report::Table table = TextTable({"comparison", "backend"});
+    for (auto& c : StatsColumns()) table.columns.push_back(c);
+    return table;
+}
+
 // The scene's own shading against the reference counted from the voxel
 // centre: how much the choice of the ray start matters.
 Result<report::Section> RayStartSection(Evaluator& eval, const Scene& scene, std::span<const OpenedBackend> backends,
@@ -190,8 +215,7 @@ Result<report::Section> RayStartSection(Evaluator& eval, const Scene& scene, std
     auto centre = eval.Reference(scene, **in, ref::RayStart::VoxelCentre);
     if (!centre) return std::unexpected(centre.error());
     const ErrorStats between = AbsoluteErrors((*exit)->T, (*centre)->T);
-    report::Table table = TextTable({"comparison", "backend"});
-    for (auto& c : StatsColumns()) table.columns.push_back(c);
+    report::Table table = RayStartTable();
     auto row = [](std::string comparison, std::string backend, const ErrorStats& e) {
         std::vector<report::Cell> cells = {std::move(comparison), std::move(backend)};
         for (auto& cell : StatsCells(e)) cells.push_back(cell);
@@ -224,28 +248,55 @@ int Accuracy(const CommonOptions& options) {
         return kExitBadScene;
     }
     if (!(*session)->MakeOutDir()) return kExitFailed;
-    const std::vector<OpenedBackend> backends =
-        (*session)->OpenBackends((*session)->RequestedBackends(BuiltBackends()));
-    if (std::ranges::none_of(backends, [](const OpenedBackend& b) { return b.backend != nullptr; }))
-        return kExitNoBackend;
+    const std::vector<std::string> names = (*session)->RequestedBackends(BuiltBackends());
 
-    Evaluator eval(**session, ref::RayStart::VoxelExit);
-    std::vector<Row> rows;
     std::printf(
         "accuracy of scene %s (%ux%ux%u) at step %u against the exact reference (Embree; T_ref from each "
         "voxel's exit point toward the sun)\n",
         scene.name.c_str(), scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps - 1);
+    // Each backend measures every setting, the ray start and the switches in a
+    // process of its own (harness/IsolatedMeasurement.h); the parent merges.
+    std::vector<PlannedSetting> plan;
     for (Stage stage : {Stage::Shade, Stage::Shadow}) {
         if (!scene.stages.Has(stage)) continue;
-        const Stage only[] = {stage};
         std::vector<std::vector<SceneOverride>> settings = {{}};
         for (auto& v : OptionVariants(scene, stage)) settings.push_back(v);
-        for (const auto& setting : settings)
-            if (Status s = MeasureSetting(eval, setting, only, backends, rows); !s) {
-                std::fprintf(stderr, "accuracy: %s: %s\n", SettingsLabel(setting).c_str(), s.error().message.c_str());
-                return kExitFailed;
-            }
+        for (const auto& setting : settings) plan.push_back({setting, {stage}});
     }
+    auto more = [&](Evaluator& eval, std::span<const OpenedBackend> backends) -> Result<json> {
+        json extra = json::object();
+        if (scene.stages.Has(Stage::Shade)) {
+            json doc = json::object();
+            auto section = RayStartSection(eval, scene, backends, doc);
+            if (!section) return std::unexpected(section.error());
+            json rows = json::array();
+            for (const auto& cells : std::get<report::Table>(section->blocks[0]).rows)
+                rows.push_back(transfer::ToJson(cells));
+            extra["ray_start"] = {{"rows", rows}, {"doc", doc}};
+        }
+        if (options.switches && scene.stages.Has(Stage::Shade)) {
+            auto sw = MeasureSwitches(eval, **session, backends);
+            if (!sw) return MakeError("switches: " + sw.error().message);
+            json errors = json::array(), jumps = json::array(), items = json::array();
+            for (size_t n = 0; n < sw->errors.rows.size(); ++n)
+                errors.push_back({sw->errorKeys[n], transfer::ToJson(sw->errors.rows[n])});
+            for (size_t n = 0; n < sw->jumps.rows.size(); ++n)
+                jumps.push_back({sw->jumpKeys[n], transfer::ToJson(sw->jumps.rows[n])});
+            for (size_t n = 0; n < sw->doc.size(); ++n) items.push_back({sw->docKeys[n], sw->doc[n]});
+            extra["switches"] = {{"errors", errors}, {"jumps", jumps}, {"doc", items}};
+        }
+        return extra;
+    };
+    auto parts = MeasureEachBackend(**session, names, plan, more);
+    if (!parts) {
+        std::fprintf(stderr, "accuracy: %s\n", parts.error().message.c_str());
+        return kExitFailed;
+    }
+    if (std::ranges::none_of(*parts, [](const BackendMeasurement& p) { return p.available; })) return kExitNoBackend;
+    const bool anyCrashed =
+        std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
+    std::vector<Row> rows = MergeRows(scene, plan, *parts);
+
     json doc = {{"format", "cloudbench-accuracy/1"},
                 {"scene", scene.name},
                 {"grid", {scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz}},
@@ -268,26 +319,42 @@ int Accuracy(const CommonOptions& options) {
                                             : "shadow: |G - G_ref| over all ground cells and cells with G_ref < 1",
                       {std::move(table)}});
     }
-    if (scene.stages.Has(Stage::Shade)) {
-        auto section = RayStartSection(eval, scene, backends, doc);
-        if (!section) {
-            std::fprintf(stderr, "accuracy: %s\n", section.error().message.c_str());
-            return kExitFailed;
-        }
-        Emit(report, std::move(*section));
+    // The ray start: the reference-against-reference row once, then each backend's.
+    report::Table rayStart = RayStartTable();
+    bool anyRayStart = false;
+    for (const BackendMeasurement& part : *parts) {
+        if (!part.extra.contains("ray_start")) continue;
+        const json& r = part.extra["ray_start"];
+        for (size_t n = anyRayStart ? 1 : 0; n < r["rows"].size(); ++n)
+            rayStart.rows.push_back(transfer::CellsFromJson(r["rows"][n]));
+        if (r["doc"].contains("voxel_centre_reference"))
+            for (const auto& [name, stats] : r["doc"]["voxel_centre_reference"].items())
+                doc["voxel_centre_reference"][name] = stats;
+        if (!anyRayStart) doc["voxel_exit_vs_centre"] = r["doc"]["voxel_exit_vs_centre"];
+        anyRayStart = true;
     }
+    if (anyRayStart) Emit(report, {"Reference ray start: voxel exit (default) vs voxel centre", {std::move(rayStart)}});
     if (options.switches && scene.stages.Has(Stage::Shade)) {
-        auto sw = MeasureSwitches(eval, **session, backends);
-        if (!sw) {
-            std::fprintf(stderr, "accuracy: switches: %s\n", sw.error().message.c_str());
-            return kExitFailed;
-        }
-        Emit(report, {"Principal-axis switches: error on each side", {std::move(sw->errors)}});
-        Emit(report, {"Jump at the switch", {std::move(sw->jumps)}});
-        doc["switches"] = sw->doc;
+        // Rows by key, then by backend (the parts' order): a stable sort of the parts' rows in turn.
+        SwitchResult sw = EmptySwitchResult();
+        auto merged = [&](const char* name) {
+            std::vector<std::pair<int, json>> items;
+            for (const BackendMeasurement& part : *parts)
+                if (part.extra.contains("switches"))
+                    for (const json& item : part.extra["switches"][name])
+                        items.emplace_back(item[0].get<int>(), item[1]);
+            std::ranges::stable_sort(items, {}, &std::pair<int, json>::first);
+            return items;
+        };
+        for (auto& [key, cells] : merged("errors")) sw.errors.rows.push_back(transfer::CellsFromJson(cells));
+        for (auto& [key, cells] : merged("jumps")) sw.jumps.rows.push_back(transfer::CellsFromJson(cells));
+        for (auto& [key, item] : merged("doc")) sw.doc.push_back(item);
+        Emit(report, {"Principal-axis switches: error on each side", {std::move(sw.errors)}});
+        Emit(report, {"Jump at the switch", {std::move(sw.jumps)}});
+        doc["switches"] = sw.doc;
     }
-    doc["references"] = ReferencesJson(eval.Records(), options.cpuThreads);
-    Emit(report, {"Reference speed", {ReferenceSpeedTable(eval.Records())}});
+    doc["references"] = ReferencesJson(FirstRecords(*parts), options.cpuThreads);
+    Emit(report, {"Reference speed", {ReferenceSpeedTable(FirstRecords(*parts))}});
     doc["report"] = report::RenderJson(report);
 
     const std::string jsonPath = (*session)->OutDir() + "/accuracy.json";
@@ -299,7 +366,7 @@ int Accuracy(const CommonOptions& options) {
         return kExitFailed;
     }
     std::printf("results: %s %s\n", jsonPath.c_str(), mdPath.c_str());
-    return kExitOk;
+    return anyCrashed ? kExitFailed : kExitOk;
 }
 
 const CommandRegistration kRegistration({
@@ -307,7 +374,7 @@ const CommandRegistration kRegistration({
     .summary = "Measure every shade and shadow option against the exact (Embree) reference",
     .help = kHelp,
     .helpOrder = 4,
-    .extraOptions = {RepeatOption(), FlagOption("--switches", &CommonOptions::switches)},
+    .extraOptions = WithIsolationOptions({RepeatOption(), FlagOption("--switches", &CommonOptions::switches)}),
     .run = Accuracy,
 });
 

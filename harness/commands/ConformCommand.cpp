@@ -4,7 +4,9 @@
 
 #include "core/StageDescriptors.h"
 #include "harness/Conform.h"
+#include "harness/Isolation.h"
 #include "harness/Session.h"
+#include "harness/Transfer.h"
 
 namespace cb {
 namespace {
@@ -42,7 +44,27 @@ std::string RulesHelp() {
     return text + "\n";
 }
 
-const std::string kHelp = kHelpIntro + RulesHelp() + kHelpOptions + GlOptionsHelp();
+const std::string kHelp = kHelpIntro + RulesHelp() + kHelpOptions + GlOptionsHelp() + IsolationOptionsHelp();
+
+// One backend's conformance against the CPU, in its own process when isolated:
+// both are opened there. Returns {"rows": [...], "backends": [provenance...]},
+// or {"error": ...} when the CPU reference cannot be opened.
+nlohmann::json IsolatedConformance(Session& session, const std::string& name) {
+    MarkPhase("opening backend");
+    std::vector<OpenedBackend> cpu = session.OpenBackends({"cpu"}, nullptr, /*report=*/false);
+    std::vector<OpenedBackend> other = session.OpenBackends({name}, nullptr, /*report=*/false);
+    nlohmann::json backends = nlohmann::json::array();
+    for (const BackendProvenance& record : session.BackendRecords()) backends.push_back(transfer::ToJson(record));
+    if (!cpu[0].backend) return {{"error", cpu[0].reason}, {"backends", backends}};
+    auto rows = RunConformance(session.GetScene(), *cpu[0].backend, other);
+    nlohmann::json list = nlohmann::json::array();
+    if (rows)
+        for (const ConformRow& row : *rows) list.push_back(transfer::ToJson(row));
+    else
+        list.push_back(transfer::ToJson(ConformRow{"(all)", name, "failed", "", 0, 0, rows.error().message}));
+    MarkPhase("closing backends");
+    return {{"rows", list}, {"backends", backends}};
+}
 
 int Conform(const CommonOptions& options) {
     auto session = Session::Open(options, "conform");
@@ -51,25 +73,46 @@ int Conform(const CommonOptions& options) {
     if (!(*session)->MakeOutDir()) return kExitFailed;
     std::printf("conformance of scene %s (%ux%ux%u, %u steps) against the cpu backend\n", scene.name.c_str(),
                 scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps);
-    // The CPU is the reference; the others are opened as asked, less the CPU.
+    // The CPU is the reference; the others are opened as asked, less the CPU,
+    // each in a process of its own with a CPU reference of its own.
     std::vector<std::string> names;
     for (const std::string& name : (*session)->RequestedBackends(BuiltBackends()))
         if (name != "cpu") names.push_back(name);
-    std::vector<OpenedBackend> cpu = (*session)->OpenBackends({"cpu"}, nullptr, /*report=*/false);
-    std::vector<OpenedBackend> others = (*session)->OpenBackends(names, nullptr, /*report=*/false);
-    if (!cpu[0].backend) {
-        std::fprintf(stderr, "conform: %s\n", cpu[0].reason.c_str());
-        return kExitFailed;
+    std::vector<ConformRow> rows;
+    bool anyCrashed = false;
+    if (names.empty()) {
+        // Nothing to compare; the CPU is still opened (in a child) for the provenance.
+        IsolatedOutcome outcome = RunIsolated("backend cpu", IsolationFrom(options), [&](const SendMessage&) {
+            (*session)->OpenBackends({"cpu"}, nullptr, /*report=*/false);
+            return transfer::ToJson((*session)->BackendRecords().back());
+        });
+        if (outcome.result) (*session)->AddBackendRecord(transfer::ProvenanceFromJson(*outcome.result));
     }
-    auto rows = RunConformance(scene, *cpu[0].backend, others);
-    if (!rows) {
-        std::fprintf(stderr, "conform: %s\n", rows.error().message.c_str());
-        return kExitFailed;
+    for (const std::string& name : names) {
+        IsolatedOutcome outcome = RunIsolated("backend " + name, IsolationFrom(options),
+                                              [&](const SendMessage&) { return IsolatedConformance(**session, name); });
+        if (!outcome.result) {
+            const ChildFailure& failure = *outcome.failure;
+            std::fprintf(stderr, "backend %s %s\n", name.c_str(), failure.Describe().c_str());
+            (*session)->AddBackendRecord(
+                {name, failure.stage == "opening backend" ? "unavailable" : "available", "", failure.Describe()});
+            rows.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe()});
+            anyCrashed = true;
+            continue;
+        }
+        const nlohmann::json& r = *outcome.result;
+        for (const nlohmann::json& record : r["backends"])
+            (*session)->AddBackendRecord(transfer::ProvenanceFromJson(record));
+        if (r.contains("error")) {
+            std::fprintf(stderr, "conform: %s\n", r["error"].get<std::string>().c_str());
+            return kExitFailed;
+        }
+        for (const nlohmann::json& row : r["rows"]) rows.push_back(transfer::ConformRowFromJson(row));
     }
     report::Report report("Conformance of " + scene.name);
-    report.sections.push_back({"", {ConformTable(*rows)}});
+    report.sections.push_back({"", {ConformTable(rows)}});
     std::printf("%s", report::RenderText(report.sections[0]).c_str());
-    nlohmann::json doc = ConformJson(scene, *rows);
+    nlohmann::json doc = ConformJson(scene, rows);
     doc["report"] = report::RenderJson(report);
     const std::string path = (*session)->OutDir() + "/conform.json";
     if (Status s = (*session)->WriteJson(path, doc); !s) {
@@ -77,11 +120,14 @@ int Conform(const CommonOptions& options) {
         return kExitFailed;
     }
     std::printf("results: %s\n", path.c_str());
-    bool failed = false, compared = false;
-    for (const ConformRow& r : *rows) {
+    bool failed = false, compared = false, broken = anyCrashed;
+    for (const ConformRow& r : rows) {
         failed |= r.status == "fail";
+        broken |= r.status == "failed";
         compared |= r.status != "skipped";
     }
+    // A backend that crashed or could not run its stages is a failure (1), before a check that failed (5).
+    if (broken) return kExitFailed;
     if (failed) return kExitNonConformant;
     return compared ? kExitOk : kExitNoBackend;
 }
@@ -91,6 +137,7 @@ const CommandRegistration kRegistration({
     .summary = "Check every backend's stages against the CPU on a scene",
     .help = kHelp,
     .helpOrder = 2,
+    .extraOptions = IsolationOptions(),
     .run = Conform,
 });
 

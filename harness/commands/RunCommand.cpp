@@ -1,10 +1,13 @@
 // `cloudbench run`: runs a scene on each backend, times every stage, writes
 // results.json, the last frame of each camera and a top view of the density map.
 #include <cstdio>
+#include <map>
 
+#include "harness/Isolation.h"
 #include "harness/Report.h"
 #include "harness/Session.h"
 #include "harness/Simulation.h"
+#include "harness/Transfer.h"
 
 namespace cb {
 namespace {
@@ -30,14 +33,17 @@ Options:
 constexpr const char* kHelpTail = R"(                     (the contexts and layouts: docs/cli.md; cloudbench devices)
   --quiet            no progress lines
 )";
-const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail;
+const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail + IsolationOptionsHelp();
 
 // Steps the simulation to the end, then writes the last frame of each camera
 // and the top view; whatever fails is recorded in `run` and the rest goes on.
+// Each step's record is sent (to the parent, when isolated) as it is done.
 // Returns false when an output could not be written.
-bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::vector<std::string>& written) {
+bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::vector<std::string>& written,
+                const SendMessage& send) {
     const Scene& scene = session.GetScene();
     const std::string& outDir = session.OutDir();
+    MarkPhase("creating the simulation");
     auto sim = Simulation::Create(scene, backend);
     if (!sim) {
         run.status = "failed";
@@ -52,9 +58,11 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
             run.error = "step " + std::to_string(t) + ": " + status.error().message;
             break;
         }
+        send({{"step", transfer::ToJson(record)}});
         run.steps.push_back(record);
         progress.Update(t + 1);
     }
+    MarkPhase("writing frames");
     bool allWritten = true;
     auto failed = [&](const Error& error) {
         std::fprintf(stderr, "%s\n", error.message.c_str());
@@ -79,6 +87,7 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
         }
     }
     // The density map of the last step, seen from above.
+    MarkPhase("writing the top view");
     if (const Buffer* columnSum = (*sim)->ColumnSum(); columnSum && !run.steps.empty()) {
         auto d = Download<float>(backend, *columnSum, &run.downloadMs);
         const std::string png = outDir + "/topview-" + run.name + ".png";
@@ -92,6 +101,38 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
     return allWritten;
 }
 
+// One backend's whole run, in its own process when isolated: opens it (so no
+// GL, Vulkan or TBB state exists in the parent), runs it, writes its frames.
+// Sends {"opened": ...} and each {"step": ...}; returns the rest.
+nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, const SendMessage& send) {
+    MarkPhase("opening backend");
+    std::vector<OpenedBackend> opened = session.OpenBackends({name}, &session.GetScene());
+    OpenedBackend& slot = opened[0];
+    BackendRun run;
+    run.name = name;
+    run.status = slot.backend ? "ok" : std::string(BackendStatusName(slot.status));
+    run.error = slot.reason;
+    if (slot.backend) run.device = slot.backend->Device();
+    nlohmann::json planned = slot.plannedBytes ? nlohmann::json(*slot.plannedBytes) : nlohmann::json(nullptr);
+    send({{"opened",
+           {{"provenance", transfer::ToJson(session.BackendRecords().back())},
+            {"available", slot.backend != nullptr},
+            {"status", run.status},
+            {"error", run.error},
+            {"device", run.device},
+            {"planned_bytes", planned}}}});
+    std::vector<std::string> written;
+    bool allWritten = true;
+    if (slot.backend) allWritten = RunBackend(session, *slot.backend, run, written, send);
+    MarkPhase("closing backend");
+    slot.backend.reset();
+    return {{"status", run.status},
+            {"error", run.error},
+            {"download_ms", run.downloadMs},
+            {"written", written},
+            {"all_written", allWritten}};
+}
+
 int Run(const CommonOptions& options) {
     auto session = Session::Open(options, "");
     if (!session) return session.error();
@@ -100,9 +141,9 @@ int Run(const CommonOptions& options) {
     std::printf("scene %s: %ux%ux%u voxels, %u steps (%u warm-up)\n", scene.name.c_str(), scene.grid.size.nx,
                 scene.grid.size.ny, scene.grid.size.nz, scene.steps, scene.warmupSteps);
 
-    std::vector<OpenedBackend> backends =
-        (*session)->OpenBackends((*session)->RequestedBackends(BuiltBackends()), &scene);
+    const std::vector<std::string> names = (*session)->RequestedBackends(BuiltBackends());
     std::vector<BackendRun> runs;
+    std::map<std::string, nlohmann::json> failures;  // by backend: why its process gave no result
     std::vector<std::string> written;
     bool anyAvailable = false, anyFailed = false;
     // results.json is rewritten (atomically) before the first backend and after each one, so that it always
@@ -112,41 +153,69 @@ int Run(const CommonOptions& options) {
     auto writeResults = [&](size_t finished) {
         report::Report timing("Run of " + scene.name);
         for (const BackendRun& run : runs)
-            if (run.status == "ok" || run.status == "failed") timing.sections.push_back(TimingSection(scene, run));
+            if (run.status != "unavailable" && run.status != "unsupported")
+                timing.sections.push_back(TimingSection(scene, run));
         nlohmann::json doc = ResultsJson(scene, runs);
+        for (const auto& [name, failure] : failures) doc["backends"][name]["failure"] = failure;
         doc["pending"] = nlohmann::json::array();
-        for (size_t i = finished; i < backends.size(); ++i) doc["pending"].push_back(backends[i].name);
-        doc["complete"] = finished == backends.size();
+        for (size_t i = finished; i < names.size(); ++i) doc["pending"].push_back(names[i]);
+        doc["complete"] = finished == names.size();
         doc["report"] = report::RenderJson(timing);
         Status s = (*session)->WriteJson(resultsPath, doc);
         if (!s) std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return bool(s);
     };
     anyFailed |= !writeResults(0);
-    for (size_t i = 0; i < backends.size(); ++i) {
-        OpenedBackend& opened = backends[i];
+    const IsolationSettings isolation = IsolationFrom(options);
+    for (size_t i = 0; i < names.size(); ++i) {
+        IsolatedOutcome outcome = RunIsolated("backend " + names[i], isolation, [&](const SendMessage& send) {
+            return IsolatedBackendRun(**session, names[i], send);
+        });
+        // What the backend's process sent before it ended is kept, whatever became of it.
         BackendRun run;
-        run.name = opened.name;
-        run.plannedBytes = opened.plannedBytes;
-        if (!opened.backend) {
-            run.status = std::string(BackendStatusName(opened.status));
-            run.error = opened.reason;
-            runs.push_back(std::move(run));
-            continue;
+        run.name = names[i];
+        bool available = false;
+        for (const nlohmann::json& m : outcome.messages) {
+            if (m.contains("opened")) {
+                const nlohmann::json& o = m["opened"];
+                (*session)->AddBackendRecord(transfer::ProvenanceFromJson(o["provenance"]));
+                available = o["available"].get<bool>();
+                run.status = o["status"].get<std::string>();
+                run.error = o["error"].get<std::string>();
+                run.device = o["device"].get<std::string>();
+                if (!o["planned_bytes"].is_null()) run.plannedBytes = o["planned_bytes"].get<uint64_t>();
+            } else if (m.contains("step")) {
+                run.steps.push_back(transfer::StepFromJson(m["step"]));
+            }
         }
-        anyAvailable = true;
-        run.device = opened.backend->Device();
-        anyFailed |= !RunBackend(**session, *opened.backend, run, written);
-        opened.backend.reset();  // its memory goes back before the next backend runs
-        if (run.status == "failed") {
+        if (outcome.result) {
+            const nlohmann::json& r = *outcome.result;
+            run.status = r["status"].get<std::string>();
+            run.error = r["error"].get<std::string>();
+            run.downloadMs = r["download_ms"].get<std::vector<double>>();
+            for (const nlohmann::json& path : r["written"]) written.push_back(path.get<std::string>());
+            anyFailed |= !r["all_written"].get<bool>();
+        } else {
+            const ChildFailure& failure = *outcome.failure;
+            if (!available) (*session)->AddBackendRecord({names[i], "unavailable", "", failure.Describe()});
+            available = true;  // it was asked for and did not finish: a failure, not "no backend"
+            run.status = failure.status;
+            run.error = failure.Describe();
+            failures[run.name] = failure.Json();
+        }
+        anyAvailable |= available;
+        if (run.status != "ok" && available) {
             anyFailed = true;
-            std::fprintf(stderr, "backend %s failed: %s\n", run.name.c_str(), run.error.c_str());
+            if (outcome.failure)
+                std::fprintf(stderr, "backend %s %s\n", run.name.c_str(), run.error.c_str());
+            else
+                std::fprintf(stderr, "backend %s failed: %s\n", run.name.c_str(), run.error.c_str());
         }
-        std::printf("%s", report::RenderText(TimingSection(scene, run)).c_str());
+        if (available) std::printf("%s", report::RenderText(TimingSection(scene, run)).c_str());
         runs.push_back(std::move(run));
-        if (i + 1 < backends.size()) anyFailed |= !writeResults(i + 1);
+        if (i + 1 < names.size()) anyFailed |= !writeResults(i + 1);
     }
-    if (!writeResults(backends.size())) return kExitFailed;
+    if (!writeResults(names.size())) return kExitFailed;
     written.insert(written.begin(), resultsPath);
     std::printf("results:");
     for (const std::string& path : written) std::printf(" %s", path.c_str());
@@ -161,6 +230,7 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 0,
     .keepsWarmup = true,
+    .extraOptions = IsolationOptions(),
     .run = Run,
 });
 

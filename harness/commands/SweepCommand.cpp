@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <expected>
 
+#include "harness/IsolatedMeasurement.h"
 #include "harness/Measurement.h"
 
 namespace cb {
@@ -13,7 +14,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* kHelp = R"(usage: cloudbench sweep [SCENE] --vary PATH=V1,V2,... [--vary ...] [options]
+constexpr const char* kHelpText = R"(usage: cloudbench sweep [SCENE] --vary PATH=V1,V2,... [--vary ...] [options]
 
 Runs the cartesian product of the --vary values (dotted scene paths, as for
 --set; a value may be JSON, e.g. --vary grid.size=[32,32,8],[64,64,16]). At
@@ -38,6 +39,7 @@ Options:
   --gl-context CTX   OpenGL context: osmesa (default) or egl
   --quiet            no progress lines
 )";
+const std::string kHelp = kHelpText + IsolationOptionsHelp();
 
 // Splits "V1,V2,..." at commas outside brackets, braces and quotes.
 std::vector<std::string> SplitValues(const std::string& text) {
@@ -185,17 +187,12 @@ int Sweep(const CommonOptions& options) {
     auto points = Points(**session, *axes);
     if (!points) return points.error();
     if (!(*session)->MakeOutDir()) return kExitFailed;
-    const std::vector<OpenedBackend> backends =
-        (*session)->OpenBackends((*session)->RequestedBackends(BuiltBackends()));
-    if (std::ranges::none_of(backends, [](const OpenedBackend& b) { return b.backend != nullptr; }))
-        return kExitNoBackend;
+    const std::vector<std::string> names = (*session)->RequestedBackends(BuiltBackends());
 
     std::printf(
         "sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "
         "%s error\n",
-        scene.name.c_str(), points->size(), backends.size(), options.repeats, options.metric.c_str());
-    Evaluator eval(**session, ref::RayStart::VoxelExit);
-    std::vector<Row> rows;
+        scene.name.c_str(), points->size(), names.size(), options.repeats, options.metric.c_str());
     // A stage is left out when every varied field belongs to the other one
     // (shadow's beer form reads shade.sigma, so that one counts for both).
     bool onlyShade = true, onlyShadow = true;
@@ -206,13 +203,20 @@ int Sweep(const CommonOptions& options) {
     std::vector<Stage> stages;
     if (!onlyShadow) stages.push_back(Stage::Shade);
     if (!onlyShade) stages.push_back(Stage::Shadow);
-    for (size_t n = 0; n < points->size(); ++n) {
-        if (Status s = MeasureSetting(eval, (*points)[n], stages, backends, rows); !s) {
-            std::fprintf(stderr, "sweep: %s: %s\n", SettingsLabel((*points)[n]).c_str(), s.error().message.c_str());
-            return kExitFailed;
-        }
+    // Each backend measures every point in a process of its own (harness/IsolatedMeasurement.h).
+    std::vector<PlannedSetting> plan;
+    for (const auto& point : *points) plan.push_back({point, stages});
+    auto parts = MeasureEachBackend(**session, names, plan, {}, [&](size_t n) {
         if (!options.quiet) std::fprintf(stderr, "sweep: point %zu/%zu done\n", n + 1, points->size());
+    });
+    if (!parts) {
+        std::fprintf(stderr, "sweep: %s\n", parts.error().message.c_str());
+        return kExitFailed;
     }
+    if (std::ranges::none_of(*parts, [](const BackendMeasurement& p) { return p.available; })) return kExitNoBackend;
+    const bool anyCrashed =
+        std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
+    std::vector<Row> rows = MergeRows(scene, plan, *parts);
     MarkPareto(rows, options.metric);
 
     json doc = {{"format", "cloudbench-sweep/1"},
@@ -249,7 +253,7 @@ int Sweep(const CommonOptions& options) {
         std::printf("\n%s", report::RenderText(section).c_str());
         report.sections.push_back(std::move(section));
     }
-    doc["references"] = ReferencesJson(eval.Records(), options.cpuThreads);
+    doc["references"] = ReferencesJson(FirstRecords(*parts), options.cpuThreads);
     doc["report"] = report::RenderJson(report);
 
     const std::string& outDir = (*session)->OutDir();
@@ -265,7 +269,7 @@ int Sweep(const CommonOptions& options) {
         return kExitFailed;
     }
     std::printf("results: %s %s%s\n", jsonPath.c_str(), mdPath.c_str(), plotted ? (" " + pngPath).c_str() : "");
-    return kExitOk;
+    return anyCrashed ? kExitFailed : kExitOk;
 }
 
 const CommandRegistration kRegistration({
@@ -273,9 +277,9 @@ const CommandRegistration kRegistration({
     .summary = "Vary scene fields over a cartesian product: time and error, Pareto front, plot",
     .help = kHelp,
     .helpOrder = 5,
-    .extraOptions = {ListOption("--vary", &CommonOptions::vary,
-                                "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
-                     TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"), RepeatOption()},
+    .extraOptions = WithIsolationOptions(
+        {ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
+         TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"), RepeatOption()}),
     .run = Sweep,
 });
 
