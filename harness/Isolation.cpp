@@ -35,6 +35,7 @@ struct PhaseBoard {
 
 PhaseBoard gLocalBoard{};           // without isolation, and in a process that runs no child
 PhaseBoard* gBoard = &gLocalBoard;  // the board MarkPhase writes
+void* volatile gFaultAllocation = nullptr;  // the test-only "oom" fault's allocation, never reached
 
 std::string Seconds(double s) {
     char text[32];
@@ -201,11 +202,10 @@ void InjectTestFault(std::string_view backend, std::string_view stage) {
         for (;;) pause();
     if (kind == "exit") _exit(3);
     if (kind == "oom") {
-        // A real allocation failure: more than any address space holds.
-        // (kept in a global, so that the compiler cannot elide it).
-        static void* volatile sink = nullptr;
+        // A real allocation failure: more than any address space holds
+        // (stored in a global, so that the compiler cannot elide the call).
         volatile size_t bytes = size_t(1) << 62;
-        sink = ::operator new(bytes);
+        gFaultAllocation = ::operator new(bytes);
     }
     std::fprintf(stderr, "CLOUDBENCH_TEST_FAULT: unknown kind '%s' (abort, segv, hang, oom, exit)\n", kind.c_str());
 }
