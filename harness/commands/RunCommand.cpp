@@ -2,6 +2,7 @@
 // results.json, the last frame of each camera and a top view of the density map.
 #include <cstdio>
 
+#include "harness/OutputFolder.h"
 #include "harness/Report.h"
 #include "harness/Session.h"
 #include "harness/Simulation.h"
@@ -117,6 +118,7 @@ int Run(const CommonOptions& options) {
         doc["pending"] = nlohmann::json::array();
         for (size_t i = finished; i < backends.size(); ++i) doc["pending"].push_back(backends[i].name);
         doc["complete"] = finished == backends.size();
+        doc["files"] = WrittenOutputs((*session)->OutDir(), "results.json");  // every output in place so far
         doc["report"] = report::RenderJson(timing);
         Status s = (*session)->WriteJson(resultsPath, doc);
         if (!s) std::fprintf(stderr, "%s\n", s.error().message.c_str());
