@@ -122,7 +122,8 @@ Status RemovePreviousOutputs(const std::string& dir, const std::vector<JournalEn
     std::set<std::string, std::greater<>> folders;  // deepest first
     for (const std::string& relative : temporaries) {
         CB_TRY(RemoveIfPresent(TemporaryNameOf(dir + "/" + relative)));
-        for (fs::path parent = fs::path(relative).parent_path(); !parent.empty(); parent = parent.parent_path())
+        for (fs::path parent = fs::path(relative).parent_path(); parent.has_relative_path();
+             parent = parent.parent_path())
             folders.insert(parent.generic_string());
     }
     for (const std::string& folder : folders) rmdir((dir + "/" + folder).c_str());  // only when empty
