@@ -11,6 +11,7 @@
 
 #include "core/MemoryPlan.h"
 #include "core/Npy.h"
+#include "harness/OutputFolder.h"
 
 namespace cb {
 namespace fs = std::filesystem;
@@ -80,7 +81,11 @@ Status CheckWritableFolder(const std::string& dir) {
 }
 
 bool Session::MakeOutDir() const {
-    if (Status s = CheckWritableFolder(mOutDir); !s) {
+    // The command's name is argv[1] (main.cpp); it names the journal of the files it writes.
+    const std::string command = mOptions.commandLine.size() > 1 ? mOptions.commandLine[1] : "command";
+    Status s = CheckWritableFolder(mOutDir);
+    if (s) s = ClaimOutputFolder(mOutDir, command);
+    if (!s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return false;
     }
@@ -173,16 +178,20 @@ Status CheckFinished(const std::string& temp, const std::string& path) {
 Status Session::WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write) {
     const fs::path target(path);
     // Same folder (so the rename cannot cross file systems), same extension (image writers go by it).
-    const std::string temp =
-        (target.parent_path() / ("." + target.stem().string() + ".partial" + target.extension().string())).string();
+    const std::string temp = TemporaryNameOf(path);
+    CB_TRY(RecordOutput(path, OutputEvent::Writing));  // the output folder's journal (harness/OutputFolder.h)
     errno = 0;
     Status written = write(temp);
     const int writeErrno = errno;  // what the failed system call said, when the writer does not say it
     if (written) written = CheckFinished(temp, path);
     std::error_code ec;
+    if (written) written = RecordOutput(path, OutputEvent::Placing);
     if (written) {
         fs::rename(temp, target, ec);
-        if (ec) written = MakeError(path + ": cannot move the finished file into place: " + ec.message());
+        if (ec) {
+            (void)RecordOutput(path, OutputEvent::NotPlaced);
+            written = MakeError(path + ": cannot move the finished file into place: " + ec.message());
+        }
     }
     if (!written) {
         fs::remove(temp, ec);  // the old file, if any, stays as it was

@@ -51,8 +51,10 @@ class Session {
     // The same scene file with options.overrides followed by `extra`.
     Result<Scene> LoadVariant(std::span<const SceneOverride> extra) const;
 
-    // Creates OutDir() and proves it writable with a probe file (CheckWritableFolder);
-    // prints "DIR: cannot write: <reason>" and returns false when it is not.
+    // Creates OutDir(), proves it writable with a probe file (CheckWritableFolder), then
+    // locks it for this command and removes the previous run's outputs of the same command
+    // (ClaimOutputFolder, harness/OutputFolder.h). Prints "DIR: cannot write: <reason>" or
+    // "DIR: in use by another cloudbench command (pid N, COMMAND)" and returns false on failure.
     // Every writing command calls it before opening backends or computing anything.
     bool MakeOutDir() const;
 

@@ -4,6 +4,7 @@
 #include <map>
 
 #include "harness/Isolation.h"
+#include "harness/OutputFolder.h"
 #include "harness/Report.h"
 #include "harness/Session.h"
 #include "harness/Simulation.h"
@@ -160,6 +161,7 @@ int Run(const CommonOptions& options) {
         doc["pending"] = nlohmann::json::array();
         for (size_t i = finished; i < names.size(); ++i) doc["pending"].push_back(names[i]);
         doc["complete"] = finished == names.size();
+        doc["files"] = WrittenOutputs((*session)->OutDir(), "results.json");  // every output in place so far
         doc["report"] = report::RenderJson(timing);
         Status s = (*session)->WriteJson(resultsPath, doc);
         if (!s) std::fprintf(stderr, "%s\n", s.error().message.c_str());

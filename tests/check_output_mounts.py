@@ -1,0 +1,167 @@
+#!/usr/bin/python3
+"""Output folders on a full and on a read-only file system (issue 11), each a
+small tmpfs mounted in a private mount namespace (`unshare -rm`, or `unshare -m`
+as root); exits 77 (skipped) where neither may mount.
+
+usage: check_output_mounts.py CLOUDBENCH DIR full|readonly
+
+full: (1) a run that fits into a 256 KiB tmpfs, with tiny frames; the disk is
+  then filled, leaving 32 KiB; a run with the scene's real frames must exit 1
+  naming a file and "No space left on device", and leave results.json absent or
+  whole and coherent (every file it names whole; no file of run (1) beside a
+  new results.json; no temporary file). (2) A results.json that no cloudbench
+  run wrote into the folder, on a disk with room for the lock and the journal
+  but not for a new results.json: exit 1 naming results.json and the errno,
+  and the file is kept byte for byte.
+readonly: a folder holding a results.json, then remounted read-only: a run into
+  it, and into a new folder under it, exits 1 at once with
+  "DIR: cannot write: Read-only file system"; the results.json is kept.
+"""
+import os
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import output_checks  # noqa: E402
+
+SKIP = 77
+INSIDE = "CLOUDBENCH_OUTPUTS_IN_NAMESPACE"
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def reexec_in_namespace():
+    for flags in (["-rm"], ["-m"]):
+        if subprocess.run(["unshare"] + flags + ["true"], capture_output=True).returncode == 0:
+            env = dict(os.environ, **{INSIDE: "1"})
+            sys.exit(subprocess.run(["unshare"] + flags + [sys.executable] + sys.argv, env=env).returncode)
+    print("skipped: neither unshare -rm nor unshare -m may create a mount namespace here")
+    sys.exit(SKIP)
+
+
+def mount_tmpfs(path, size):
+    os.makedirs(path, exist_ok=True)
+    result = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=%s" % size, "cloudbench-test", path],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        print("skipped: cannot mount a tmpfs: " + result.stderr.strip())
+        sys.exit(SKIP)
+
+
+def fill(folder, leave_bytes):
+    """Fills the file system of `folder` so that about `leave_bytes` stay free: a filler file
+    written until the disk is full, then a spacer of `leave_bytes` removed."""
+    spacer = os.path.join(folder, "spacer")
+    with open(spacer, "wb") as f:
+        f.write(b"\0" * leave_bytes)
+    try:
+        with open(os.path.join(folder, "filler"), "wb") as f:
+            while True:
+                f.write(b"\0" * 4096)
+                f.flush()
+    except OSError:
+        pass
+    os.remove(spacer)
+
+
+def run(cli, folder, *extra):
+    return subprocess.run([cli, "run", "ci-small", "--backend", "cpu", "--steps", "12", "--threads", "2", "--quiet",
+                           "--out", folder] + list(extra), capture_output=True, text=True, timeout=120)
+
+
+def full(cli, work):
+    mount = os.path.join(work, "full")
+    mount_tmpfs(mount, "256k")
+    folder = os.path.join(mount, "out")
+    tiny = ["--set", "render.width=16", "--set", "render.height=12", "--set", "grid.size=[16,16,8]"]
+    first = run(cli, folder, *tiny)
+    if first.returncode != 0:
+        fail("the first run, which fits, exited %d: %s" % (first.returncode, first.stderr))
+    before = output_checks.visible_files(folder)
+    fill(mount, 32 * 1024)
+    second = run(cli, folder)
+    print("run on a full disk: exit %d\n%s" % (second.returncode, second.stderr.strip()))
+    if second.returncode != 1:
+        fail("exit %d on a full disk, expected 1" % second.returncode)
+    named = [line for line in second.stderr.splitlines()
+             if line.startswith(folder + "/") and ": cannot write: " in line and "No space left on device" in line]
+    if not named:
+        fail("no line 'FILE: cannot write: ... No space left on device' naming a file in %s" % folder)
+    output_checks.FRAME_SIZE = output_checks.TOPVIEW_SIZE = None  # either run's images may be named
+    problems = output_checks.results_problems(folder)
+    after = output_checks.visible_files(folder)
+    survivors = [name for name, identity in after.items() if before.get(name) == identity]
+    if "results.json" in after and after["results.json"] != before.get("results.json") and survivors:
+        problems.append("the first run's files survive beside the new results.json: %s" % survivors)
+    if "results.json" in after and after["results.json"] == before.get("results.json") and after != before:
+        problems.append("the first run's results.json kept, but its files changed")
+    if output_checks.temporary_files(folder):
+        problems.append("temporary files left: %s" % output_checks.temporary_files(folder))
+    if problems:
+        fail("; ".join(problems))
+    state = ("absent" if "results.json" not in after else
+             "kept" if after["results.json"] == before.get("results.json") else "replaced whole")
+    print("results.json %s; the folder is coherent" % state)
+
+    # A results.json that this folder's journal does not list: never removed, and kept when it cannot be replaced.
+    os.remove(os.path.join(mount, "filler"))
+    shutil.rmtree(folder)
+    os.makedirs(folder)
+    seeded = os.path.join(folder, "results.json")
+    with open(seeded, "w") as f:
+        f.write('{"format": "cloudbench-results/1", "seeded": true}\n' + " " * 9000 + "\n")
+    original = open(seeded, "rb").read()
+    fill(mount, 2 * 4096)  # a page for the probe and then the lock holder's line, one for the journal
+    third = run(cli, folder)
+    print("run with room for the journal only: exit %d\n%s" % (third.returncode, third.stderr.strip()))
+    if third.returncode != 1:
+        fail("exit %d, expected 1" % third.returncode)
+    if "%s: cannot write: No space left on device" % seeded not in third.stderr:
+        fail("no message naming %s and 'No space left on device'" % seeded)
+    if open(seeded, "rb").read() != original:
+        fail("the seeded results.json was changed")
+    if output_checks.temporary_files(folder):
+        fail("temporary files left: %s" % output_checks.temporary_files(folder))
+    print("the seeded results.json is kept byte for byte")
+
+
+def readonly(cli, work):
+    mount = os.path.join(work, "readonly")
+    mount_tmpfs(mount, "64k")
+    folder = os.path.join(mount, "out")
+    os.makedirs(folder)
+    kept = os.path.join(folder, "results.json")
+    with open(kept, "w") as f:
+        f.write('{"seeded": true}\n')
+    result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
+    if result.returncode != 0:
+        print("skipped: cannot remount read-only: " + result.stderr.strip())
+        sys.exit(SKIP)
+    for target in (folder, os.path.join(folder, "sub")):
+        outcome = run(cli, target)
+        expected = "%s: cannot write: Read-only file system\n" % target
+        if outcome.returncode != 1 or outcome.stderr != expected:
+            fail("--out %s: exit %d, stderr %r; expected exit 1 and %r"
+                 % (target, outcome.returncode, outcome.stderr, expected))
+        print("refused: " + outcome.stderr.strip())
+    if open(kept).read() != '{"seeded": true}\n':
+        fail("results.json changed on a read-only file system")
+
+
+def main():
+    if len(sys.argv) != 4 or sys.argv[3] not in ("full", "readonly"):
+        sys.exit(__doc__)
+    if not os.environ.get(INSIDE):
+        reexec_in_namespace()
+    cli, work = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    os.makedirs(work, exist_ok=True)
+    {"full": full, "readonly": readonly}[sys.argv[3]](cli, work)
+    print("ok")
+
+
+if __name__ == "__main__":
+    main()
