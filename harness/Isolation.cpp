@@ -1,4 +1,5 @@
 #include "harness/Isolation.h"
+#include "harness/PosixIo.h"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -96,16 +97,6 @@ std::variant<nlohmann::json, ChildFailure> RunCaught(const IsolatedWork& work, c
     } catch (const std::exception& e) {
         return FailureHere("failed", std::string("uncaught exception: ") + e.what());
     }
-}
-
-bool WriteAll(int fd, const std::string& text) {
-    for (size_t done = 0; done < text.size();) {
-        const ssize_t n = write(fd, text.data() + done, text.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        done += size_t(n);
-    }
-    return true;
 }
 
 // The child: runs the work and sends every message and the result as lines

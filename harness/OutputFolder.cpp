@@ -1,4 +1,5 @@
 #include "harness/OutputFolder.h"
+#include "harness/PosixIo.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -142,19 +143,6 @@ std::string DescribeHolder(int lockFd) {
     if (!std::all_of(command.begin(), command.end(), [](char c) { return (c >= 'a' && c <= 'z') || c == '-'; }))
         return "";
     return " (pid " + pid + ", " + command + ")";
-}
-
-bool WriteAll(int fd, const std::string& text) {
-    for (size_t done = 0; done < text.size();) {
-        const ssize_t n = write(fd, text.data() + done, text.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            if (n == 0) errno = EIO;
-            return false;
-        }
-        done += size_t(n);
-    }
-    return true;
 }
 
 }  // namespace
