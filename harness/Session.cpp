@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -173,6 +174,12 @@ Status CheckFinished(const std::string& temp, const std::string& path) {
     return {};
 }
 
+// Whether the file system holding `folder` has no block left for an unprivileged writer.
+bool FileSystemFull(const fs::path& folder) {
+    struct statvfs info {};
+    return statvfs((folder.empty() ? fs::path(".") : folder).c_str(), &info) == 0 && info.f_bavail == 0;
+}
+
 }  // namespace
 
 Status Session::WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write) {
@@ -196,8 +203,11 @@ Status Session::WriteAtomically(const std::string& path, const std::function<Sta
     if (!written) {
         fs::remove(temp, ec);  // the old file, if any, stays as it was
         std::string message = ReplaceAll(written.error().message, temp, path);
-        if (writeErrno != 0 && message.find(std::strerror(writeErrno)) == std::string::npos)
-            message += std::string(": ") + std::strerror(writeErrno);
+        // A library writer (OIIO) may fail without saying why, and leave a stale errno from
+        // an unrelated call: a full file system is checked first, and named as such.
+        const int reason = FileSystemFull(target.parent_path()) ? ENOSPC : writeErrno;
+        if (reason != 0 && message.find(std::strerror(reason)) == std::string::npos)
+            message += std::string(": ") + std::strerror(reason);
         return MakeError(message);
     }
     return {};

@@ -91,6 +91,11 @@ def full(cli, work):
              if line.startswith(folder + "/") and ": cannot write: " in line and "No space left on device" in line]
     if not named:
         fail("no line 'FILE: cannot write: ... No space left on device' naming a file in %s" % folder)
+    # Every failed write on the full disk says so, not a stale errno left by an image library.
+    misnamed = [line for line in second.stderr.splitlines()
+                if ": cannot write: " in line and "No space left on device" not in line]
+    if misnamed:
+        fail("failed writes on a full disk that do not say 'No space left on device': %s" % misnamed)
     output_checks.FRAME_SIZE = output_checks.TOPVIEW_SIZE = None  # either run's images may be named
     problems = output_checks.results_problems(folder)
     after = output_checks.visible_files(folder)
