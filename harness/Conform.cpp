@@ -184,8 +184,8 @@ Result<std::unique_ptr<Buffer>> CopyTo(Backend& cpu, const Buffer& from, Backend
 
 }  // namespace
 
-Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
-                                               std::span<const OpenedBackend> others) {
+Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
+                                               const ConformProgress& afterStep) {
     Tally tally;
     auto sim = Simulation::Create(scene, cpu, /*everyStepOutputs=*/true);
     if (!sim) return std::unexpected(sim.error());
@@ -296,6 +296,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
             for (auto& [r, buffer] : p.outputs)
                 CB_TRY(CompareOutput(tally, scene, p.stage, p.backend, t, cpu, *(*sim)->Get(r), *p.owner, *buffer, ""));
         }
+        if (afterStep) afterStep(t, tally.Rows());
     }
     std::vector<ConformRow> rows = tally.Rows();
     rows.insert(rows.end(), unavailable.begin(), unavailable.end());

@@ -3,6 +3,7 @@
 // that step and their outputs are compared by SPEC's rule for the stage.
 #pragma once
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -24,9 +25,13 @@ struct ConformRow {
     std::string detail;           // worst place and both values, or why it was skipped
 };
 
+// Called after each step's comparisons with the rows so far (each row's worst over steps 0..step).
+using ConformProgress = std::function<void(uint32_t step, const std::vector<ConformRow>& rows)>;
+
 // Compares every available backend in `others` against `cpu` over the scene's
 // steps; one that did not open is a row "(all)" skipped with the reason.
-Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others);
+Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
+                                               const ConformProgress& afterStep = {});
 
 // stage x backend: result, rule, worst error and where, as `conform` prints it.
 report::Table ConformTable(const std::vector<ConformRow>& rows);

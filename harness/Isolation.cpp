@@ -19,6 +19,7 @@
 #include <new>
 #include <thread>
 #include <variant>
+#include <vector>
 
 #include "core/Stage.h"
 
@@ -170,20 +171,39 @@ std::string CurrentPhase() {
 }
 
 void InjectTestFault(std::string_view backend, std::string_view stage) {
-    // Parsed once: "<backend>:<stage>:<kind>".
-    static const std::optional<std::array<std::string, 3>> fault = []() -> std::optional<std::array<std::string, 3>> {
+    // Parsed once: "<backend>:<stage>:<kind>[:<step>]"; with a step, it fires at that step only.
+    struct Fault {
+        std::string backend, stage, kind;
+        std::optional<uint32_t> step;
+    };
+    static const std::optional<Fault> fault = []() -> std::optional<Fault> {
         const char* value = std::getenv("CLOUDBENCH_TEST_FAULT");
         if (!value || !*value) return std::nullopt;
-        const std::string text = value;
-        const size_t a = text.find(':'), b = a == std::string::npos ? a : text.find(':', a + 1);
-        if (b == std::string::npos) {
-            std::fprintf(stderr, "CLOUDBENCH_TEST_FAULT: ignored, expected <backend>:<stage>:<kind>\n");
+        std::vector<std::string> parts(1);
+        for (const char* c = value; *c; ++c)
+            if (*c == ':')
+                parts.emplace_back();
+            else
+                parts.back().push_back(*c);
+        Fault f;
+        if (parts.size() == 3 || parts.size() == 4) {
+            f = {parts[0], parts[1], parts[2], std::nullopt};
+            if (parts.size() == 4) {
+                char* end = nullptr;
+                const unsigned long step = std::strtoul(parts[3].c_str(), &end, 10);
+                if (parts[3].empty() || *end != '\0') parts.clear();
+                f.step = uint32_t(step);
+            }
+        }
+        if (parts.size() != 3 && parts.size() != 4) {
+            std::fprintf(stderr, "CLOUDBENCH_TEST_FAULT: ignored, expected <backend>:<stage>:<kind>[:<step>]\n");
             return std::nullopt;
         }
-        return std::array<std::string, 3>{text.substr(0, a), text.substr(a + 1, b - a - 1), text.substr(b + 1)};
+        return f;
     }();
-    if (!fault || (*fault)[0] != backend || (*fault)[1] != stage) return;
-    const std::string& kind = (*fault)[2];
+    if (!fault || fault->backend != backend || fault->stage != stage) return;
+    if (fault->step && !(gBoard->hasStep && gBoard->step == *fault->step)) return;
+    const std::string& kind = fault->kind;
     std::fprintf(stderr, "CLOUDBENCH_TEST_FAULT: %s in %.*s stage %.*s\n", kind.c_str(), int(backend.size()),
                  backend.data(), int(stage.size()), stage.data());
     std::fflush(stderr);

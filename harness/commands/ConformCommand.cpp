@@ -49,14 +49,21 @@ const std::string kHelp = kHelpIntro + RulesHelp() + kHelpOptions + GlOptionsHel
 // One backend's conformance against the CPU, in its own process when isolated:
 // both are opened there. Returns {"rows": [...], "backends": [provenance...]},
 // or {"error": ...} when the CPU reference cannot be opened.
-nlohmann::json IsolatedConformance(Session& session, const std::string& name) {
+// After each step it sends {"step": t, "rows": [...]}, the rows so far, so that a
+// backend whose process dies later keeps the comparisons it finished.
+nlohmann::json IsolatedConformance(Session& session, const std::string& name, const SendMessage& send) {
     MarkPhase("opening backend");
     std::vector<OpenedBackend> cpu = session.OpenBackends({"cpu"}, nullptr, /*report=*/false);
     std::vector<OpenedBackend> other = session.OpenBackends({name}, nullptr, /*report=*/false);
     nlohmann::json backends = nlohmann::json::array();
     for (const BackendProvenance& record : session.BackendRecords()) backends.push_back(transfer::ToJson(record));
     if (!cpu[0].backend) return {{"error", cpu[0].reason}, {"backends", backends}};
-    auto rows = RunConformance(session.GetScene(), *cpu[0].backend, other);
+    auto rows = RunConformance(session.GetScene(), *cpu[0].backend, other,
+                               [&](uint32_t step, const std::vector<ConformRow>& so_far) {
+                                   nlohmann::json list = nlohmann::json::array();
+                                   for (const ConformRow& row : so_far) list.push_back(transfer::ToJson(row));
+                                   send({{"step", step}, {"rows", list}});
+                               });
     nlohmann::json list = nlohmann::json::array();
     if (rows)
         for (const ConformRow& row : *rows) list.push_back(transfer::ToJson(row));
@@ -90,13 +97,22 @@ int Conform(const CommonOptions& options) {
     }
     for (const std::string& name : names) {
         IsolatedOutcome outcome = RunIsolated("backend " + name, IsolationFrom(options),
-                                              [&](const SendMessage&) { return IsolatedConformance(**session, name); });
+                                              [&](const SendMessage& send) {
+                                                  return IsolatedConformance(**session, name, send);
+                                              });
         if (!outcome.result) {
             const ChildFailure& failure = *outcome.failure;
             std::fprintf(stderr, "backend %s %s\n", name.c_str(), failure.Describe().c_str());
             (*session)->AddBackendRecord(
                 {name, failure.stage == "opening backend" ? "unavailable" : "available", "", failure.Describe()});
-            rows.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe()});
+            // The comparisons of the steps it finished are kept, each row's worst over those steps.
+            std::string kept;
+            if (!outcome.messages.empty()) {
+                const nlohmann::json& last = outcome.messages.back();
+                for (const nlohmann::json& row : last["rows"]) rows.push_back(transfer::ConformRowFromJson(row));
+                kept = "; rows above cover steps 0-" + std::to_string(last["step"].get<uint32_t>());
+            }
+            rows.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe() + kept});
             anyCrashed = true;
             continue;
         }
