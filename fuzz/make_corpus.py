@@ -5,6 +5,7 @@
 - every JSON object written as a raw string literal R"(...)" in tests/*.cpp (the parser and validator cases);
 - every `--set` override the tests use ({"path", "value"} pairs in tests/*.cpp, --set PATH=VALUE in tests/*.cmake
   and tests/CMakeLists.txt), applied to the first shipped scene;
+- every input that once broke the fuzzer, kept in fuzz/regressions/ (small text files, one per bug);
 - every file under tests/bad_inputs/ (the bad-input set), when that folder exists.
 
 An input is the scene text, then, when there are overrides, one NUL byte and PATH=VALUE lines (fuzz/SceneFuzzer.cpp).
@@ -61,9 +62,10 @@ def main() -> int:
     for item in sorted(overrides):
         seeds.add(with_overrides(small, [item]))
 
-    bad = root / "tests" / "bad_inputs"
-    if bad.is_dir():
-        for path in sorted(bad.rglob("*")):
+    for folder in [root / "fuzz" / "regressions", root / "tests" / "bad_inputs"]:
+        if not folder.is_dir():
+            continue
+        for path in sorted(folder.rglob("*")):
             if path.is_file() and path.stat().st_size <= (1 << 20):
                 seeds.add(path.read_bytes())
 

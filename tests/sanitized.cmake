@@ -9,8 +9,9 @@ if(NOT CLOUDBENCH_SANITIZED)
   return()
 endif()
 
+# Leaks are checked too: the CPU-only sanitized CLI frees everything (unlike lavapipe, see the debug preset).
 set(sanitized_env "UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1"
-                  "ASAN_OPTIONS=detect_leaks=0:abort_on_error=1")
+                  "ASAN_OPTIONS=detect_leaks=1:abort_on_error=1")
 
 # ---- Fuzz.* ------------------------------------------------------------------------------------------------------
 set(fuzz_dir ${CMAKE_CURRENT_BINARY_DIR}/fuzz)
