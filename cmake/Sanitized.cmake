@@ -18,15 +18,14 @@ cmake_host_system_information(RESULT cloudbench_cores QUERY NUMBER_OF_LOGICAL_CO
 set(CLOUDBENCH_SANITIZED_JOBS ${cloudbench_cores} CACHE STRING "Parallel jobs of the sanitized sub-build")
 
 set(cloudbench_sanitized_dir ${CMAKE_BINARY_DIR}/sanitized)
-set(CLOUDBENCH_SANITIZED_FLAGS
-    "-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer -fsanitize=fuzzer-no-link -Wno-unknown-warning-option -U__cpp_concepts -D__cpp_concepts=202002L"
-    CACHE STRING "Compiler flags of the sanitized sub-build")
+set(cloudbench_sanitized_flags
+    "-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer -fsanitize=fuzzer-no-link -Wno-unknown-warning-option -U__cpp_concepts -D__cpp_concepts=202002L")
 set(cloudbench_sanitized_cache
     -DCMAKE_CXX_COMPILER:FILEPATH=${CLOUDBENCH_CLANGXX}
     -DCMAKE_BUILD_TYPE:STRING=Debug
     # -O1: optimised enough that `run ci-small` takes seconds, and asserts stay on.
     "-DCMAKE_CXX_FLAGS_DEBUG:STRING=-O1 -g"
-    "-DCMAKE_CXX_FLAGS:STRING=${CLOUDBENCH_SANITIZED_FLAGS}"
+    "-DCMAKE_CXX_FLAGS:STRING=${cloudbench_sanitized_flags}"
     -DCLOUDBENCH_SANITIZED:BOOL=OFF
     -DCLOUDBENCH_BUILD_FUZZER:BOOL=ON
     -DCLOUDBENCH_WITH_GL:BOOL=OFF
