@@ -7,7 +7,8 @@
 namespace cb {
 
 double Ellipsoid::ShrinkFactor(uint32_t shrinkSteps) const {
-    if (shrinkSteps == 0 || age + shrinkSteps <= lifetime) return 1.0;
+    // In 64 bits: shrink_steps may be up to 2^32 - 1, and age + shrinkSteps must not wrap.
+    if (shrinkSteps == 0 || uint64_t(age) + shrinkSteps <= lifetime) return 1.0;
     uint32_t left = lifetime > age ? lifetime - age : 0;
     return double(left) / double(shrinkSteps);
 }
@@ -31,7 +32,8 @@ Ellipsoid EllipsoidList::Spawn(bool randomAge) {
     }
     e.yaw = mRng.Uniform(0.0, 2.0 * std::numbers::pi);
     double life = mRng.Uniform(s.lifetimeMean - s.lifetimeVariance, s.lifetimeMean + s.lifetimeVariance);
-    e.lifetime = static_cast<uint32_t>(std::max(1.0, std::round(life)));
+    // Clamped before the cast: lifetime_mean has no upper bound, and a double beyond uint32 is undefined to convert.
+    e.lifetime = static_cast<uint32_t>(std::clamp(std::round(life), 1.0, double(UINT32_MAX)));
     e.age = randomAge ? mRng.Below(e.lifetime) : 0;
     return e;
 }

@@ -69,6 +69,29 @@ TEST(Ellipsoids, ShrinkFactor) {
     EXPECT_EQ(e.ShrinkFactor(0), 1.0);
 }
 
+// Test that a shrink longer than 2^32 - 1 - age still shrinks: age + shrink_steps must not wrap (fuzzing, issue 11).
+TEST(Ellipsoids, ShrinkFactorWithLongestShrink) {
+    Ellipsoid e{};
+    e.lifetime = 10;
+    e.age = 5;
+    EXPECT_DOUBLE_EQ(e.ShrinkFactor(UINT32_MAX), 5.0 / double(UINT32_MAX));
+}
+
+// Test that a lifetime beyond uint32 saturates at 2^32 - 1 steps instead of converting out of range (undefined
+// behaviour: SSE code wraps 1e10 to 1410065408, while AVX-512's unsigned conversion happens to saturate, so this
+// test can pass on such a machine without the fix; Sanitized.RunHugeLifetime's UBSan catches it on every machine).
+TEST(Ellipsoids, HugeLifetimeSaturates) {
+    for (double mean : {1e10, 1e20, 1e300}) {
+        EllipsoidSettings s = Settings();
+        s.lifetimeMean = mean;
+        s.lifetimeVariance = 0;
+        EllipsoidList list(s, {64, 32, 16});
+        list.Update();
+        ASSERT_FALSE(list.Items().empty());
+        for (const Ellipsoid& e : list.Items()) EXPECT_EQ(e.lifetime, UINT32_MAX) << "lifetime_mean " << mean;
+    }
+}
+
 // Test that the wind moves the centres: with no jitter, every survivor moves
 // by exactly the wind vector.
 TEST(Ellipsoids, WindMovesCentres) {
