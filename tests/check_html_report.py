@@ -220,7 +220,7 @@ def main():
     if counts.change_points != 1:
         fail(f"{counts.change_points} change points marked, expected the 1 planted")
     if len(sys.argv) == 5:
-        subprocess.run([chromium, *CHROMIUM_FLAGS, "--hide-scrollbars", "--window-size=1100,2600",
+        subprocess.run([chromium, *CHROMIUM_FLAGS, "--hide-scrollbars", "--window-size=1100,4300",
                         f"--screenshot={os.path.abspath(sys.argv[4])}", "file://" + os.path.abspath(page)],
                        capture_output=True, timeout=120, check=True)
     print(f"html report: ok ({sum(plots.values())} plots {plots}, {tables} tables, {images} images, "

@@ -31,7 +31,8 @@ dl.kv dt { font-weight: 600; } dl.kv dd { margin: 0; word-break: break-word; }
 .st-pass, .st-ok { background: #dff3df; } .st-fail, .st-failed, .st-crashed, .st-timed-out,
 .st-out-of-memory { background: #f9d6d5; } .st-skipped, .st-unavailable, .st-unsupported { background: #eee; color: #666; }
 figure { margin: 10px 0 18px; } figcaption { font-size: 12px; color: #555; }
-figure img { image-rendering: pixelated; border: 1px solid #ccc; max-width: 100%; }
+figure.frame { display: inline-block; vertical-align: top; max-width: 360px; margin: 6px 14px 12px 0; }
+figure.frame img { image-rendering: pixelated; border: 1px solid #ccc; width: 100%; min-width: 240px; }
 svg.plot { font: 11px sans-serif; max-width: 100%; height: auto; }
 svg.plot .grid { stroke: #e4e4e4; } svg.plot .frame { stroke: #555; } svg.plot .plot-title { font-size: 13px; }
 p.verdict-0 { background: #dff3df; padding: 6px 10px; } p.verdict-bad { background: #f9d6d5; padding: 6px 10px; }

@@ -535,14 +535,15 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
     verdict.blocks.emplace_back(report::Paragraph{
         combined == 0 ? "Verdict: pass (exit code 0)." : "Verdict: fail (exit code " + std::to_string(combined) + ")."});
     verdict.blocks.emplace_back(std::move(verdictTable));
-    out.sections.push_back(std::move(verdict));
-
-    Section provenance{"Provenance", {}};
-    for (const ReportInput& input : inputs) {
-        provenance.blocks.emplace_back(report::Paragraph{input.path + " (" + std::string(InputKindName(input.kind)) + ")"});
-        provenance.blocks.emplace_back(ProvenanceItems(Obj(input.doc, "provenance")));
+    if (!inputs.empty()) {
+        // The first input's provenance in short; every input's in full under "Provenance".
+        report::KeyValues summary = ProvenanceItems(Obj(inputs.front().doc, "provenance"));
+        std::erase_if(summary.items, [](const auto& item) {
+            return item.first != "commit" && item.first != "build" && item.first != "machine" && item.first != "date";
+        });
+        verdict.blocks.emplace_back(std::move(summary));
     }
-    out.sections.push_back(std::move(provenance));
+    out.sections.push_back(std::move(verdict));
 
     // Conformance: stage x backend.
     for (const ReportInput& input : inputs) {
@@ -594,10 +595,6 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
         timing.blocks.emplace_back(TimingBoxes(input));
         out.sections.push_back(std::move(timing));
     }
-    out.sections.push_back({"The seeds' figures",
-                            {report::Paragraph{"From docs/seed-timings.json (the seeds' TABLES.md), with the hardware "
-                                               "each was measured on."},
-                             SeedSources(), SeedTable()}});
 
     if (!historyPath.empty()) out.sections.push_back({"History", HistoryBlocks(history, historyPath)});
 
@@ -610,6 +607,18 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
         if (input.kind == InputKind::Results)
             out.sections.push_back(
                 {"Frames: " + Str(Obj(input.doc, "scene"), "name") + " (" + input.path + ")", FrameBlocks(input)});
+
+    out.sections.push_back({"The seeds' figures",
+                            {report::Paragraph{"From docs/seed-timings.json (the seeds' TABLES.md), with the hardware "
+                                               "each was measured on."},
+                             SeedSources(), SeedTable()}});
+
+    Section provenance{"Provenance", {}};
+    for (const ReportInput& input : inputs) {
+        provenance.blocks.emplace_back(report::Paragraph{input.path + " (" + std::string(InputKindName(input.kind)) + ")"});
+        provenance.blocks.emplace_back(ProvenanceItems(Obj(input.doc, "provenance")));
+    }
+    out.sections.push_back(std::move(provenance));
 
     // Each input's own tables, as its command printed them.
     for (const ReportInput& input : inputs) {
