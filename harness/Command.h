@@ -48,6 +48,11 @@ struct CommonOptions {
     int repeats = 5;
     bool switches = false;
     std::string metric = "max";
+    // A command that takes arguments rather than a scene (Command::takesArguments): them, in order.
+    std::vector<std::string> arguments;
+    // report: --history FILE and -o FILE (docs/cli.md).
+    std::string history;
+    std::string outFile;
     // argv as given, for the provenance of the outputs.
     std::vector<std::string> commandLine;
 
@@ -96,6 +101,8 @@ struct Command {
     bool takesScene = true;
     // Whether the scene's warm-up steps are kept (run times them; the others set them to 0).
     bool keepsWarmup = false;
+    // Whether it takes any number of arguments (files) into CommonOptions::arguments; only without a scene.
+    bool takesArguments = false;
     std::vector<OptionSpec> extraOptions = {};  // besides SceneCommandOptions()
     std::function<int(const CommonOptions&)> run;
 };

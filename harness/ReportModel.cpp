@@ -114,6 +114,9 @@ json BlockJson(const Block& block) {
                                  },
                                  [](const Link& l) {
                                      return json{{"link", {{"target", l.target}, {"text", l.text}}}};
+                                 },
+                                 [](const Figure& f) {
+                                     return json{{"figure", {{"kind", f.kind}, {"caption", f.caption}}}};
                                  }},
                       block);
 }
@@ -128,7 +131,8 @@ std::string BlockMarkdown(const Block& block) {
                                  },
                                  [](const Paragraph& p) { return p.text + "\n"; },
                                  [](const Image& i) { return "![" + i.caption + "](" + i.path + ")\n"; },
-                                 [](const Link& l) { return "[" + l.text + "](" + l.target + ")\n"; }},
+                                 [](const Link& l) { return "[" + l.text + "](" + l.target + ")\n"; },
+                                 [](const Figure& f) { return "*" + f.caption + "* (" + f.kind + " plot)\n"; }},
                       block);
 }
 
@@ -161,7 +165,8 @@ std::string RenderText(const Block& block) {
                    },
                    [](const Paragraph& p) { return p.text + "\n"; },
                    [](const Image& i) { return i.caption + ": " + i.path + "\n"; },
-                   [](const Link& l) { return l.text + ": " + l.target + "\n"; }},
+                   [](const Link& l) { return l.text + ": " + l.target + "\n"; },
+                   [](const Figure& f) { return f.caption + " (" + f.kind + " plot)\n"; }},
         block);
 }
 
@@ -188,6 +193,60 @@ json RenderJson(const Report& report) {
         sections.push_back({{"title", section.title}, {"blocks", blocks}});
     }
     return {{"title", report.title}, {"sections", sections}};
+}
+
+Report ReportFromJson(const json& doc) {
+    Report report(doc.at("title").get<std::string>());
+    for (const json& s : doc.at("sections")) {
+        Section section{s.at("title").get<std::string>(), {}};
+        for (const json& b : s.at("blocks")) {
+            if (b.contains("table")) {
+                Table table;
+                for (const json& c : b["table"].at("columns")) {
+                    Column column(c.at("title").get<std::string>());
+                    const std::string type = c.value("type", "text");
+                    if (type == "real") column.Real("%g");
+                    if (type == "integer") column.Integer();
+                    column.Unit(c.value("unit", ""));
+                    table.columns.push_back(column);
+                }
+                for (const json& r : b["table"].at("rows")) {
+                    std::vector<Cell> row;
+                    for (const json& cell : r) {
+                        if (cell.is_string())
+                            row.emplace_back(cell.get<std::string>());
+                        else if (cell.is_number_integer())
+                            row.emplace_back(cell.get<int64_t>());
+                        else if (cell.is_number())
+                            row.emplace_back(cell.get<double>());
+                        else if (cell.is_null())
+                            row.emplace_back();
+                        else
+                            throw json::type_error::create(302, "a table cell is not a string, number or null",
+                                                           &cell);
+                    }
+                    table.rows.push_back(std::move(row));
+                }
+                section.blocks.emplace_back(std::move(table));
+            } else if (b.contains("key_values")) {
+                KeyValues kv;
+                for (const json& item : b["key_values"])
+                    kv.items.emplace_back(item.at("key").get<std::string>(), item.at("value").get<std::string>());
+                section.blocks.emplace_back(std::move(kv));
+            } else if (b.contains("paragraph")) {
+                section.blocks.emplace_back(Paragraph{b["paragraph"].get<std::string>()});
+            } else if (b.contains("image")) {
+                section.blocks.emplace_back(
+                    Image{b["image"].at("path").get<std::string>(), b["image"].value("caption", ""), ""});
+            } else if (b.contains("link")) {
+                section.blocks.emplace_back(
+                    Link{b["link"].at("target").get<std::string>(), b["link"].value("text", "")});
+            }
+            // Figures are not read back: their markup is not in the JSON.
+        }
+        report.sections.push_back(std::move(section));
+    }
+    return report;
 }
 
 }  // namespace cb::report

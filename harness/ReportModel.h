@@ -1,8 +1,8 @@
 // What a command reports, apart from how it is shown: a report of titled
 // sections holding typed tables, key-value lists, paragraphs, images and
-// links, with three renderers: plain text (the terminal), Markdown and JSON.
-// run, conform, accuracy and sweep build their tables here; an HTML renderer
-// can be added beside these without touching the commands.
+// links, with three renderers: plain text (the terminal), Markdown and JSON;
+// harness/html/HtmlRender.h renders it as one self-contained HTML page.
+// run, conform, accuracy and sweep build their tables here.
 #pragma once
 
 #include <cstdint>
@@ -111,6 +111,17 @@ struct Paragraph {
 struct Image {
     std::string path;  // relative to the report's folder
     std::string caption;
+    // The encoded file (PNG) when the image is held in memory: the HTML
+    // renderer embeds it as a data: URI. The other renderers show `path`.
+    std::string data = {};
+};
+
+// A plot drawn by the project (harness/html/SvgPlot.h), as SVG markup that the
+// HTML renderer inlines; text and Markdown show its caption, JSON its kind and caption.
+struct Figure {
+    std::string kind;  // "box", "history", "pareto"
+    std::string svg;
+    std::string caption;
 };
 
 struct Link {
@@ -118,7 +129,7 @@ struct Link {
     std::string text;
 };
 
-using Block = std::variant<Table, KeyValues, Paragraph, Image, Link>;
+using Block = std::variant<Table, KeyValues, Paragraph, Image, Link, Figure>;
 
 struct Section {
     std::string title;
@@ -141,5 +152,9 @@ std::string RenderText(const Block& block);
 // Markdown: "# title", then "## section" per section with its blocks.
 std::string RenderMarkdown(const Report& report);
 nlohmann::json RenderJson(const Report& report);
+// The inverse of RenderJson for its tables, key-value lists, paragraphs,
+// images and links (a Real column's format becomes "%g"): the report block of
+// a JSON output read back. Throws nlohmann::json::exception on a wrong shape.
+Report ReportFromJson(const nlohmann::json& doc);
 
 }  // namespace cb::report

@@ -79,6 +79,8 @@ int main(int argc, char** argv) {
             if (auto message = option->apply(options, value)) return Usage(*message, command->help);
         } else if (arg.starts_with("-")) {
             return Usage("unknown option '" + std::string(arg) + "'", command->help);
+        } else if (command->takesArguments) {
+            options.arguments.emplace_back(arg);
         } else if (!command->takesScene) {
             return Usage("unexpected argument '" + std::string(arg) + "'", command->help);
         } else if (!sceneGiven) {

@@ -1,0 +1,95 @@
+// `cloudbench report`: one self-contained HTML page from the JSON outputs of
+// run, conform, accuracy and sweep and a perf history (harness/html/).
+#include <cstdio>
+
+#include "harness/Command.h"
+#include "harness/Session.h"
+#include "harness/html/HtmlRender.h"
+#include "harness/html/HtmlReport.h"
+
+namespace cb {
+namespace {
+
+constexpr const char* kHelp = R"(usage: cloudbench report [RESULTS...] [--history FILE] [-o FILE]
+
+Writes one self-contained HTML page (no script, no network; plots as inline
+SVG, images embedded) from any of results.json, conform.json, accuracy.json
+and sweep.json (recognised by their "format"; a folder stands for those of
+them it holds) and a perf history (JSON Lines of cloudbench-perf/1 records):
+the provenance and the verdict with its exit code, the stage x backend
+conformance matrix, per-stage timing tables beside the seeds' figures, box
+plots of the per-step times, history plots, the accuracy Pareto plots, the
+rendered frames with their difference images, and each input's own tables.
+
+  -o, --output FILE   the page to write (default report.html)
+  --history FILE      a perf history; lines that are not records are skipped
+                      with a warning
+
+Exits 0 when the page is written (whatever the verdict it shows), 1 when it
+cannot be written, 2 for a bad command line (no input), 3 for an input that
+cannot be read or is not a cloudbench output (the message names the file).
+)";
+
+int Report(const CommonOptions& options) {
+    if (options.arguments.empty() && options.history.empty()) {
+        std::fprintf(stderr, "cloudbench: report needs a results, conform, accuracy or sweep file, or --history\n\n%s",
+                     kHelp);
+        return kExitUsage;
+    }
+    std::vector<html::ReportInput> inputs;
+    for (const std::string& path : options.arguments) {
+        auto read = html::ReadReportInput(path);
+        if (!read) {
+            std::fprintf(stderr, "%s\n", read.error().message.c_str());
+            return kExitBadScene;
+        }
+        for (html::ReportInput& input : *read) inputs.push_back(std::move(input));
+    }
+    std::vector<nlohmann::json> history;
+    if (!options.history.empty()) {
+        std::vector<std::string> warnings;
+        auto read = html::ReadHistory(options.history, warnings);
+        for (const std::string& warning : warnings) std::fprintf(stderr, "warning: %s\n", warning.c_str());
+        if (!read) {
+            std::fprintf(stderr, "%s\n", read.error().message.c_str());
+            return kExitBadScene;
+        }
+        history = std::move(*read);
+    }
+    std::string page;
+    try {
+        page = html::RenderHtml(html::BuildReport(inputs, history, options.history));
+    } catch (const nlohmann::json::exception& e) {
+        // A field of the right name and the wrong type in one of the inputs.
+        std::fprintf(stderr, "cloudbench: report: an input has an unexpected shape: %s\n", e.what());
+        return kExitBadScene;
+    }
+    const std::string out = options.outFile.empty() ? "report.html" : options.outFile;
+    if (Status s = Session::WriteText(out, page); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    std::printf("report: %s\n", out.c_str());
+    return kExitOk;
+}
+
+const CommandRegistration kRegistration({
+    .name = "report",
+    .summary = "Write one self-contained HTML page from results, conform, accuracy, sweep and history files",
+    .help = kHelp,
+    .helpOrder = 6,
+    .takesScene = false,
+    .takesArguments = true,
+    .extraOptions = {{"-o", "--output", true,
+                      [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                          if (!v) return "-o needs a file, e.g. -o report.html";
+                          if (!*v) return "-o: must not be empty";
+                          o.outFile = v;
+                          return std::nullopt;
+                      }},
+                     TextOption("--history", &CommonOptions::history, "--history needs a file")},
+    .run = Report,
+});
+
+}  // namespace
+}  // namespace cb

@@ -1,0 +1,23 @@
+# `cloudbench report` (issue 12, item 5): a page from a real small run, conformance check and sweep of ci-small
+# and a synthetic history, loaded in headless chromium (skipped, 77, without it; CI installs it through
+# tools/debian-packages.txt). Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
+add_test(NAME Cli.HtmlReport
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_html_report.py ${cli} ${cli_out}/html ci-small)
+set_tests_properties(Cli.HtmlReport PROPERTIES TIMEOUT 300 SKIP_RETURN_CODE 77 PASS_REGULAR_EXPRESSION "html report: ok")
+# Bad inputs exit 3 with the file named; no input at all is a usage error (2).
+add_test(NAME Cli.ReportMissingFileExits3 COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
+         "-DARGS=report;${cli_out}/html-bad/missing.json;-o;${cli_out}/html-bad/r.html" -DEXPECT=3 ${expect_exit})
+set_tests_properties(Cli.ReportMissingFileExits3 PROPERTIES PASS_REGULAR_EXPRESSION
+                     "missing.json: cannot read: No such file or directory")
+add_test(NAME Cli.ReportNotJsonExits3 COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
+         "-DARGS=report;${CMAKE_CURRENT_SOURCE_DIR}/check_html_report.py;-o;${cli_out}/html-bad/r.html" -DEXPECT=3
+         ${expect_exit})
+set_tests_properties(Cli.ReportNotJsonExits3 PROPERTIES PASS_REGULAR_EXPRESSION "check_html_report.py: not JSON")
+add_test(NAME Cli.ReportUnknownFormatExits3 COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
+         "-DARGS=report;${CLOUDBENCH_ROOT}/docs/seed-timings.json;-o;${cli_out}/html-bad/r.html" -DEXPECT=3 ${expect_exit})
+set_tests_properties(Cli.ReportUnknownFormatExits3 PROPERTIES PASS_REGULAR_EXPRESSION
+                     "seed-timings.json: not a cloudbench results, conform, accuracy or sweep file")
+add_test(NAME Cli.ReportNoInputExits2 COMMAND ${CMAKE_COMMAND} -DCMD=${cli} "-DARGS=report" -DEXPECT=2 ${expect_exit})
+add_test(NAME Cli.ReportWritesNothingOnBadInput COMMAND /bin/sh -c "! test -e \"$0\"" ${cli_out}/html-bad/r.html)
+set_tests_properties(Cli.ReportWritesNothingOnBadInput PROPERTIES DEPENDS
+                     "Cli.ReportMissingFileExits3;Cli.ReportNotJsonExits3;Cli.ReportUnknownFormatExits3")
