@@ -3,18 +3,12 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "harness/Overloaded.h"
+
 namespace cb::report {
 namespace {
 
 using nlohmann::json;
-
-template <class... Fs>
-struct Overloaded : Fs... {
-    using Fs::operator()...;
-};
-// Spelled out for clang 16 (the sanitized build), which lacks aggregate deduction (P1816).
-template <typename... Fs>
-Overloaded(Fs...) -> Overloaded<Fs...>;
 
 bool IsEmpty(const Cell& cell) { return cell.kind == Cell::Kind::Empty; }
 

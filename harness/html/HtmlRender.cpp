@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "harness/html/SvgPlot.h"
+#include "harness/Overloaded.h"
 
 namespace cb::html {
 namespace {
@@ -12,10 +13,6 @@ namespace {
 using report::Block;
 using report::CellType;
 
-template <class... Fs>
-struct Overloaded : Fs... {
-    using Fs::operator()...;
-};
 
 constexpr std::string_view kStyle = R"(
 body { font: 14px/1.45 system-ui, sans-serif; margin: 0 auto; max-width: 1100px; padding: 0 16px 48px; color: #222; }
