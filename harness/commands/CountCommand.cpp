@@ -24,8 +24,8 @@ thesis-medium) under valgrind's callgrind, on the CPU backend at one thread,
 and writes FILE (default: out/<scene name>/count.json, format cloudbench-count/1):
 each stage's count summed over the steps after warm-up, and each step's count.
 The same binary and scene give the same counts on every run, so a change of
-2 % is a change of the code, not noise. The run costs about 35 times a plain
-run's time. Needs valgrind and a build without -march=native:
+2 % is a change of the code, not noise. The run costs about 15 to 20 times a
+plain run's CPU time. Needs valgrind and a build without -march=native:
   cmake --preset exact && cmake --build --preset exact
   build/exact/cloudbench count ci-small
 

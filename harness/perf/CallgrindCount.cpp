@@ -84,6 +84,9 @@ std::optional<std::string> WhyCannotCount(const std::string& buildFlags) {
     if (buildFlags.find("-march=native") != std::string::npos)
         return "this binary was built with -march=native, which valgrind cannot run (no AVX-512): build with the "
                "exact preset (cmake --preset exact && cmake --build --preset exact) and run build/exact/cloudbench";
+    if (buildFlags.find("-fsanitize=address") != std::string::npos)
+        return "this binary was built with AddressSanitizer, which cannot run under valgrind: build with the exact "
+               "preset";
     if (FindOnPath("valgrind").empty())
         return "valgrind is not on PATH: install the valgrind package (tools/debian-packages.txt)";
     return std::nullopt;
