@@ -4,21 +4,28 @@
 
 #include "harness/Isolation.h"
 #include "harness/StageParams.h"
+#include "harness/perf/CallgrindRequests.h"
 
 namespace cb {
 namespace {
 
 // Runs one backend call, adding its wall and device time to the record.
+// Under callgrind the call alone (not the clock reads) is counted as one dump
+// named by `label` (harness/perf/CallgrindRequests.h).
 template <typename Fn>
-Status Timed(Backend& backend, StageCallRecord& record, Fn&& call) {
+Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& label, Fn&& call) {
+    const CallgrindStageBracket counted(label);
     const auto start = std::chrono::steady_clock::now();
+    counted.Begin();
     Status status = call();
+    counted.End();
     record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (auto device = backend.LastDeviceMs()) record.deviceMs = record.deviceMs.value_or(0) + *device;
     return status;
 }
 
-Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageBuffers& io, StageCallRecord& record) {
+Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
+                         StageCallRecord& record) {
     for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
         SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
         // The order is host work shared by all backends, outside the stage time.
@@ -33,7 +40,9 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageBuffers& 
         frame.renderer = Stage::RenderSplat;
         frame.camera = sc.render.cameras[n].name;
         const double before = record.ms;
-        Status status = Timed(backend, record, [&] {
+        const std::string backendName = backend.Name();
+        const StageCountLabel label{StageName(Stage::RenderSplat), backendName, step, frame.camera};
+        Status status = Timed(backend, record, label, [&] {
             return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats);
         });
         frame.ms = record.ms - before;
@@ -45,7 +54,9 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageBuffers& 
 
 Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
             StageCallRecord& record) {
-    auto timed = [&](auto&& call) { return Timed(backend, record, call); };
+    const std::string backendName = backend.Name();
+    const StageCountLabel label{StageName(stage), backendName, host.step, ""};
+    auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
     switch (stage) {
         case Stage::Region:
             return timed([&] { return backend.Region(host.raster, *io.Current(Resource::Region)); });
@@ -82,7 +93,7 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
                 [&] { return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow)); });
         }
         case Stage::RenderSplat:
-            return RenderSplatFrames(backend, sc, io, record);
+            return RenderSplatFrames(backend, sc, host.step, io, record);
         case Stage::Noise: {
             const NoiseParams p{host.step};
             return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });

@@ -1,0 +1,69 @@
+# Exact mode (docs/performance.md): instruction counts per stage under
+# callgrind. Included from tests/CMakeLists.txt where `cli` and `cli_out` are set.
+#
+# Valgrind cannot run the native build (AVX-512: SIGILL), so unless this build
+# is already without -march=native, Exact.Build configures and builds the
+# cloudbench target in ${CMAKE_BINARY_DIR}/exact-tests with the exact preset's
+# settings, CPU backend only (the counts are the CPU's), and the count tests run
+# that binary. Without valgrind the counting tests are not registered; the
+# refusals below still are.
+
+# A native binary refuses to count, naming the exact preset (exit 4).
+if(CLOUDBENCH_NATIVE)
+  add_test(NAME Exact.NativeBuildRefusesToCount COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
+           "-DARGS=count;ci-small;--steps;11;--out;${cli_out}/count-native.json" -DEXPECT=4
+           -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+  set_tests_properties(Exact.NativeBuildRefusesToCount PROPERTIES PASS_REGULAR_EXPRESSION "exact preset")
+endif()
+# Counts at 2 threads vary, and only the CPU's are counted: usage errors (exit 2).
+add_test(NAME Exact.CountRefusesTwoThreads COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
+         "-DARGS=count;ci-small;--threads;2;--out;${cli_out}/count-threads.json" -DEXPECT=2
+         -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+set_tests_properties(Exact.CountRefusesTwoThreads PROPERTIES PASS_REGULAR_EXPRESSION "--threads must be 1")
+add_test(NAME Exact.CountRefusesGpuBackends COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
+         "-DARGS=count;ci-small;--backend;vk;--out;${cli_out}/count-vk.json" -DEXPECT=2
+         -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+set_tests_properties(Exact.CountRefusesGpuBackends PROPERTIES PASS_REGULAR_EXPRESSION "backend vk is not counted")
+
+find_program(VALGRIND_EXECUTABLE valgrind)
+find_path(CALLGRIND_INCLUDE_DIR valgrind/callgrind.h)
+if(NOT VALGRIND_EXECUTABLE OR NOT CALLGRIND_INCLUDE_DIR)
+  message(STATUS "exact mode tests: valgrind or valgrind/callgrind.h not found; counting tests not registered")
+  return()
+endif()
+
+if(CLOUDBENCH_NATIVE)
+  set(exact_dir ${CMAKE_BINARY_DIR}/exact-tests)
+  set(exact_cli ${exact_dir}/cloudbench)
+  set(exact_launcher "")
+  if(CMAKE_CXX_COMPILER_LAUNCHER)
+    set(exact_launcher "-DCMAKE_CXX_COMPILER_LAUNCHER=${CMAKE_CXX_COMPILER_LAUNCHER}")
+  endif()
+  add_test(NAME Exact.Build COMMAND /bin/sh -c [=[
+"$0" -S "$1" -B "$2" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOUDBENCH_NATIVE=OFF -DCLOUDBENCH_WITH_GL=OFF \
+  -DCLOUDBENCH_WITH_VK=OFF -DCLOUDBENCH_BUILD_TESTS=OFF -DCLOUDBENCH_BUILD_BENCHMARKS=OFF $3 >/dev/null &&
+"$0" --build "$2" --target cloudbench -j 2]=]
+           ${CMAKE_COMMAND} ${CLOUDBENCH_ROOT} ${exact_dir} "${exact_launcher}")
+  set_tests_properties(Exact.Build PROPERTIES FIXTURES_SETUP exact_build TIMEOUT 900)
+else()
+  set(exact_cli ${cli})
+endif()
+
+# ci-small for 14 steps (4 after the warm-up), counted twice: the same counts,
+# stage by stage and step by step. Then twice the voxels (128 x 64 x 16): the
+# per-voxel passes count more than the exact gate's 2 % more.
+set(exact_count_args count ci-small --steps 14 --quiet)
+add_test(NAME Exact.CountCiSmallA COMMAND ${exact_cli} ${exact_count_args} --out ${cli_out}/count-a.json)
+add_test(NAME Exact.CountCiSmallB COMMAND ${exact_cli} ${exact_count_args} --out ${cli_out}/count-b.json)
+add_test(NAME Exact.CountCiSmallWide COMMAND ${exact_cli} ${exact_count_args} --set grid.size=[128,64,16]
+         --out ${cli_out}/count-wide.json)
+foreach(name CountCiSmallA CountCiSmallB CountCiSmallWide)
+  set_tests_properties(Exact.${name} PROPERTIES FIXTURES_REQUIRED exact_build FIXTURES_SETUP exact_counts
+                       TIMEOUT 300 PASS_REGULAR_EXPRESSION "counts: .*count-")
+endforeach()
+add_test(NAME Exact.CountsIdenticalAcrossRuns COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_counts.py
+         same ${cli_out}/count-a.json ${cli_out}/count-b.json)
+add_test(NAME Exact.TwiceTheVoxelsCountsMore COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_counts.py
+         more ${cli_out}/count-a.json ${cli_out}/count-wide.json smooth,density)
+set_tests_properties(Exact.CountsIdenticalAcrossRuns Exact.TwiceTheVoxelsCountsMore PROPERTIES
+                     FIXTURES_REQUIRED exact_counts DEPENDS "Exact.CountCiSmallA;Exact.CountCiSmallB;Exact.CountCiSmallWide")
