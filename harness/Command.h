@@ -25,6 +25,7 @@ enum ExitCode : int {
     kExitBadScene = 3,
     kExitNoBackend = 4,  // none of the requested backends is available
     kExitNonConformant = 5,
+    kExitRegression = 6,  // perf compare: a confirmed performance regression
 };
 
 // What the command line sets; every command reads the fields its options fill.
@@ -50,6 +51,8 @@ struct CommonOptions {
     std::string metric = "max";
     // argv as given, for the provenance of the outputs.
     std::vector<std::string> commandLine;
+    // For a command with rawArguments: every argument after the command's name, unparsed.
+    std::vector<std::string> arguments;
 
     BackendOptions Backend() const;
 };
@@ -96,6 +99,9 @@ struct Command {
     bool takesScene = true;
     // Whether the scene's warm-up steps are kept (run times them; the others set them to 0).
     bool keepsWarmup = false;
+    // Whether the command parses its own arguments (perf's subcommands): main
+    // passes them in CommonOptions::arguments and handles only --help.
+    bool rawArguments = false;
     std::vector<OptionSpec> extraOptions = {};  // besides SceneCommandOptions()
     std::function<int(const CommonOptions&)> run;
 };
