@@ -225,7 +225,12 @@ CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings
             c.note = "not significant";
         }
     }
-    // Instruction counts are exact: a change beyond the threshold is a change, no test needed.
+    // Instruction counts are exact: a change beyond the threshold is a change, no test needed. A side
+    // without any counts (no `count` run) is not compared.
+    if (base.instructions.empty() || head.instructions.empty()) {
+        out.headFailed = std::any_of(out.rows.begin(), out.rows.end(), [](const Comparison& c) { return c.mark == 'x'; });
+        return out;
+    }
     for (const auto& [scene, backend, stage] : Keys(base.instructions, head.instructions)) {
         Comparison c;
         c.scene = scene, c.backend = backend, c.stage = stage, c.metric = "instructions";
