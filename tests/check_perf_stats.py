@@ -122,6 +122,16 @@ def case_compare():
     check(rows["slower3x"]["regression"] and rows["faster3x"]["mark"] == "-", "the planted changes must be found")
     check(not rows["tiny3x"]["regression"] and not rows["slower1_3"]["regression"], "floor and threshold must hold")
     check("s/cpu/slower3x" in p.stdout, "the regression line must name the stage")
+    # gl and vk have their own default threshold, 3x (software drivers); --threshold gl=R sets gl's.
+    gl_base, gl_head = lognormal(40, 1.0, 0.05), lognormal(40, 2.5, 0.05)
+    results_json(f"{WORK}/gl-base.json", "s", {"x": gl_base}, backend="gl")
+    results_json(f"{WORK}/gl-head.json", "s", {"x": gl_head}, backend="gl")
+    run("perf", "compare", f"{WORK}/gl-base.json", f"{WORK}/gl-head.json", "--json", f"{WORK}/gl.json", expect=0)
+    check(json.load(open(f"{WORK}/gl.json"))["comparisons"][0]["threshold"] == 3.0, "gl's default threshold is 3")
+    run("perf", "compare", f"{WORK}/gl-base.json", f"{WORK}/gl-head.json", "--threshold", "gl=2", "--json",
+        f"{WORK}/gl.json", expect=6)
+    check(json.load(open(f"{WORK}/gl.json"))["comparisons"][0]["threshold"] == 2.0, "--threshold gl=2")
+    run("perf", "compare", f"{WORK}/gl-base.json", f"{WORK}/gl-head.json", "--threshold", "=2", expect=2)
     # A file compared with itself: no regression.
     run("perf", "compare", f"{WORK}/base.json", f"{WORK}/base.json", expect=0)
     # HEAD failed: marked x, exit 1 (no regression to report).

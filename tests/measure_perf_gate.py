@@ -5,6 +5,8 @@ often a slowdown planted with CLOUDBENCH_TEST_SLOWDOWN=<stage>:<factor> is
 caught. Not a CTest test (minutes); its numbers go to reports/perf/walltime.md.
 
 usage: measure_perf_gate.py CLOUDBENCH WORKDIR identical N BACKENDS ROUNDS
+       measure_perf_gate.py CLOUDBENCH WORKDIR separate N BACKENDS ROUNDS
+         (N + 1 back-to-back runs, each pair of neighbours compared as two files: not interleaved)
        measure_perf_gate.py CLOUDBENCH WORKDIR slowdown N BACKENDS ROUNDS STAGE FACTOR...
 Prints one line per comparison and a summary; every comparison's JSON is kept in WORKDIR.
 """
@@ -56,6 +58,25 @@ if CASE == "identical":
     print(f"SUMMARY identical: {alarms} of {N} comparisons exit 6; {significant} of {tested} stage comparisons "
           f"significant (Holm, alpha 0.01); ratios {min(ratios):.3f}..{max(ratios):.3f}; "
           f"median {sorted(seconds)[len(seconds) // 2]:.1f} s a comparison")
+elif CASE == "separate":
+    for n in range(N + 1):
+        subprocess.run([CLI, "run", "ci-small", "--backend", BACKENDS, "--quiet", "--out", os.path.join(WORK, f"run{n}")],
+                       capture_output=True, check=True)
+    alarms, ratios, named = 0, [], []
+    for n in range(N):
+        out = os.path.join(WORK, f"separate-{n}.json")
+        p = subprocess.run([CLI, "perf", "compare", os.path.join(WORK, f"run{n}", "results.json"),
+                            os.path.join(WORK, f"run{n + 1}", "results.json"), "--json", out], capture_output=True,
+                           text=True)
+        doc = json.load(open(out))
+        rows = [c for c in doc["comparisons"] if c["p_slower_holm"] is not None]
+        ratios += [r["ratio"] for r in rows]
+        flagged = ["%s/%s x%.2f" % (c["backend"], c["stage"], c["ratio"]) for c in doc["comparisons"] if c["regression"]]
+        alarms += p.returncode == 6
+        named += flagged
+        print(f"{n}: exit {p.returncode}, regressions {flagged}", flush=True)
+    print(f"SUMMARY separate: {alarms} of {N} comparisons exit 6 (threshold {doc['threshold']}); "
+          f"tested ratios {min(ratios):.3f}..{max(ratios):.3f}; flagged {named}")
 else:
     stage, factors = sys.argv[7], sys.argv[8:]
     for factor in factors:

@@ -58,7 +58,8 @@ compare  compares per-step stage times (median ratio with a 95 % bootstrap
          (A B A B ..., K rounds, default 5) and pools each side's samples.
          Marks: + slower, - faster, ~ not significant or within the threshold,
          x failed or missing in HEAD, ! new.
-  --threshold R   a time regression needs a median ratio above R (default 1.5)
+  --threshold [BACKEND=]R  a time regression needs a median ratio above R
+                  (default 1.5; gl and vk 3, software drivers here)
   --separate-threshold R  used instead when BASE and HEAD were not run
                   interleaved (default 2.0)
   --floor MS      and the medians to differ by more than MS (default 0.05)
@@ -345,6 +346,7 @@ json ComparisonJson(const perf::Comparison& c) {
             {"base_median", number(c.baseMedian)},
             {"head_median", number(c.headMedian)},
             {"ratio", number(c.ratio)},
+            {"threshold", number(c.threshold)},
             {"ratio_ci", {number(c.interval.low), number(c.interval.high)}},
             {"p_slower", number(c.pSlower)},
             {"p_faster", number(c.pFaster)},
@@ -368,7 +370,10 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
         header.items.push_back(
             {"note", "BASE and HEAD were measured at different times, not interleaved: the wider threshold " +
                          Num("%gx", outcome.threshold) + " applies"});
-    header.items.push_back({"gate", "+ when slower by more than " + Num("%gx", outcome.threshold) + " and " +
+    std::string own;
+    for (const auto& [backend, unused] : settings.backendThreshold)
+        own += ", " + backend + " " + Num("%gx", perf::ThresholdOf(settings, backend));
+    header.items.push_back({"gate", "+ when slower by more than " + Num("%gx", outcome.threshold) + own + " and " +
                                         Num("%g ms", settings.floorMs) + ", Holm-adjusted p < " +
                                         Num("%g", settings.alpha) + "; instructions: more than " +
                                         Num("%g %%", settings.instructionThreshold * 100)});
@@ -410,6 +415,7 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
                     {"mode", mode},
                     {"separate", outcome.separate},
                     {"threshold", outcome.threshold},
+                    {"backend_thresholds", json::object()},
                     {"floor_ms", settings.floorMs},
                     {"alpha", settings.alpha},
                     {"instruction_threshold", settings.instructionThreshold},
@@ -418,6 +424,8 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
                     {"exit_code", code},
                     {"report", report::RenderJson(rep)}};
         for (const perf::Comparison& c : outcome.rows) doc["comparisons"].push_back(ComparisonJson(c));
+        for (const auto& [backend, unused] : settings.backendThreshold)
+            doc["backend_thresholds"][backend] = perf::ThresholdOf(settings, backend);
         if (!WriteJsonFile(jsonPath, doc) && code == kExitOk) code = kExitFailed;
     }
     return code;
@@ -431,9 +439,25 @@ int ComparePerf(const std::vector<std::string>& args) {
                        {"--interleave", "--quiet"}, a))
         return Usage(*m);
     perf::CompareSettings settings;
+    // --threshold R sets the default; --threshold BACKEND=R that backend's own.
+    if (a.values.count("--threshold")) {
+        std::vector<std::string> defaults;
+        for (const std::string& value : a.values.at("--threshold")) {
+            const size_t equals = value.find('=');
+            ParsedArgs one;
+            one.values["--threshold"] = {equals == std::string::npos ? value : value.substr(equals + 1)};
+            double threshold = 0;
+            if (auto m = NumberOption(one, "--threshold", 1.0, 1e6, threshold)) return Usage(*m);
+            if (equals == std::string::npos)
+                settings.threshold = threshold;
+            else if (equals == 0)
+                return Usage("--threshold: empty backend name in '" + value + "'");
+            else
+                settings.backendThreshold[value.substr(0, equals)] = threshold;
+        }
+    }
     for (auto [name, low, high, field] :
-         {std::tuple{"--threshold", 1.0, 1e6, &settings.threshold},
-          std::tuple{"--separate-threshold", 1.0, 1e6, &settings.separateThreshold},
+         {std::tuple{"--separate-threshold", 1.0, 1e6, &settings.separateThreshold},
           std::tuple{"--floor", 0.0, 1e9, &settings.floorMs}, std::tuple{"--alpha", 1e-12, 1.0, &settings.alpha},
           std::tuple{"--instruction-threshold", 0.0, 1e6, &settings.instructionThreshold}})
         if (auto m = NumberOption(a, name, low, high, *field)) return Usage(*m);

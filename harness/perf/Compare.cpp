@@ -173,10 +173,16 @@ std::vector<std::array<std::string, 3>> Keys(const ByStage<T>& a, const ByStage<
 
 }  // namespace
 
+double ThresholdOf(const CompareSettings& s, const std::string& backend) {
+    auto own = s.backendThreshold.find(backend);
+    const double threshold = own == s.backendThreshold.end() ? s.threshold : own->second;
+    return s.interleaved ? threshold : std::max(threshold, s.separateThreshold);
+}
+
 CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings& s) {
     CompareOutcome out;
     out.separate = !s.interleaved;
-    out.threshold = s.interleaved ? s.threshold : std::max(s.threshold, s.separateThreshold);
+    out.threshold = ThresholdOf(s, "");
     std::vector<size_t> tested;  // rows with a test, for Holm's correction
     for (const auto& [scene, backend, stage] : Keys(base.samplesMs, head.samplesMs)) {
         Comparison c;
@@ -212,11 +218,12 @@ CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings
         c.pFasterHolm = fasterHolm[n];
         const bool slowerSignificant = c.pSlowerHolm < s.alpha, fasterSignificant = c.pFasterHolm < s.alpha;
         const double difference = c.headMedian - c.baseMedian;
-        if (slowerSignificant && c.ratio > out.threshold && difference > s.floorMs) {
+        c.threshold = ThresholdOf(s, c.backend);
+        if (slowerSignificant && c.ratio > c.threshold && difference > s.floorMs) {
             c.mark = '+';
             c.regression = true;
             c.note = "regression";
-        } else if (fasterSignificant && c.ratio < 1 / out.threshold && -difference > s.floorMs) {
+        } else if (fasterSignificant && c.ratio < 1 / c.threshold && -difference > s.floorMs) {
             c.mark = '-';
             c.note = "improvement";
         } else if (slowerSignificant || fasterSignificant) {
@@ -246,6 +253,7 @@ CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings
             c.note = "new: no count in BASE";
         } else {
             c.ratio = *b > 0 ? *h / *b : (*h > 0 ? INFINITY : 1.0);
+            c.threshold = 1 + s.instructionThreshold;
             if (c.ratio > 1 + s.instructionThreshold) {
                 c.mark = '+';
                 c.regression = true;

@@ -44,6 +44,9 @@ nlohmann::json RecordSections(const Side& side);
 
 struct CompareSettings {
     double threshold = 1.5;          // a slowdown ratio of medians above this (and the rest) is a regression
+    // Per backend, instead of `threshold`: OpenGL and Vulkan run on software drivers (llvmpipe, lavapipe)
+    // that share the CPU, and moved up to 2.28x between identical builds (reports/perf/walltime.md).
+    std::map<std::string, double> backendThreshold = {{"gl", 3.0}, {"vk", 3.0}};
     double separateThreshold = 2.0;  // used instead when the sides were not measured interleaved
     bool interleaved = false;
     double floorMs = 0.05;           // and the medians differ by more than this
@@ -60,6 +63,7 @@ struct Comparison {
     std::string metric;  // "time" (ms) or "instructions"
     size_t baseCount = 0, headCount = 0;
     double baseMedian = NAN, headMedian = NAN, ratio = NAN;  // ratio = head / base
+    double threshold = NAN;  // the ratio a regression must exceed
     Interval interval{NAN, NAN};
     double pSlower = NAN, pFaster = NAN;          // one-sided Mann-Whitney
     double pSlowerHolm = NAN, pFasterHolm = NAN;  // Holm-adjusted over every time comparison
@@ -70,11 +74,15 @@ struct Comparison {
 
 struct CompareOutcome {
     std::vector<Comparison> rows;
-    double threshold = 0;  // the wall-time threshold applied
+    double threshold = 0;  // the wall-time threshold applied to backends without their own
     bool separate = false;
     bool headFailed = false;  // some row is 'x'
     size_t Regressions() const;
 };
+
+// The wall-time threshold of `backend`: its own or the default, at least
+// separateThreshold when the sides were not interleaved.
+double ThresholdOf(const CompareSettings& settings, const std::string& backend);
 
 CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings& settings);
 
