@@ -8,6 +8,7 @@ usage: measure_perf_gate.py CLOUDBENCH WORKDIR identical N BACKENDS ROUNDS
        measure_perf_gate.py CLOUDBENCH WORKDIR separate N BACKENDS ROUNDS
          (N + 1 back-to-back runs, each pair of neighbours compared as two files: not interleaved)
        measure_perf_gate.py CLOUDBENCH WORKDIR slowdown N BACKENDS ROUNDS STAGE FACTOR...
+The scene is ci-small, or $PERF_SCENE with the extra run options in $PERF_EXTRA (e.g. "--steps 120").
 Prints one line per comparison and a summary; every comparison's JSON is kept in WORKDIR.
 """
 import json
@@ -20,13 +21,15 @@ import time
 CLI, WORK, CASE, N, BACKENDS, ROUNDS = os.path.abspath(sys.argv[1]), sys.argv[2], sys.argv[3], int(sys.argv[4]), \
     sys.argv[5], sys.argv[6]
 os.makedirs(WORK, exist_ok=True)
+SCENE = os.environ.get("PERF_SCENE", "ci-small")
+EXTRA = os.environ.get("PERF_EXTRA", "").split()
 
 
 def compare(head, tag):
     out = os.path.join(WORK, f"{tag}.json")
     start = time.time()
-    p = subprocess.run([CLI, "perf", "compare", "--interleave", CLI, head, "ci-small", "--backend", BACKENDS,
-                        "--rounds", ROUNDS, "--quiet", "--json", out], capture_output=True, text=True)
+    p = subprocess.run([CLI, "perf", "compare", "--interleave", CLI, head, SCENE, "--backend", BACKENDS,
+                        "--rounds", ROUNDS, "--quiet", "--json", out, *EXTRA], capture_output=True, text=True)
     doc = json.load(open(out))
     rows = [c for c in doc["comparisons"] if c["p_slower_holm"] is not None]
     return p.returncode, doc, rows, time.time() - start
@@ -60,7 +63,7 @@ if CASE == "identical":
           f"median {sorted(seconds)[len(seconds) // 2]:.1f} s a comparison")
 elif CASE == "separate":
     for n in range(N + 1):
-        subprocess.run([CLI, "run", "ci-small", "--backend", BACKENDS, "--quiet", "--out", os.path.join(WORK, f"run{n}")],
+        subprocess.run([CLI, "run", SCENE, *EXTRA, "--backend", BACKENDS, "--quiet", "--out", os.path.join(WORK, f"run{n}")],
                        capture_output=True, check=True)
     alarms, ratios, named = 0, [], []
     for n in range(N):
