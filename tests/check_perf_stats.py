@@ -88,7 +88,7 @@ def case_compare():
     check(doc["threshold"] == SEPARATE_THRESHOLD, "separate files must use the wider threshold")
     rows = {c["stage"]: c for c in doc["comparisons"]}
     check(set(rows) == set(stages), f"stages compared: {sorted(rows)}")
-    tested = [k for k in sorted(stages) if len(stages[k][0]) >= 10 and len(stages[k][1]) >= 10]
+    tested = [k for k in sorted(stages) if len(stages[k][0]) >= 20 and len(stages[k][1]) >= 20]
     slower = {k: stats.mannwhitneyu(stages[k][1], stages[k][0], alternative="greater", method="asymptotic").pvalue
               for k in tested}
     faster = {k: stats.mannwhitneyu(stages[k][1], stages[k][0], alternative="less", method="asymptotic").pvalue

@@ -55,7 +55,7 @@ struct CompareSettings {
     double confidence = 0.95;
     int resamples = 2000;
     uint64_t seed = 20260101;
-    size_t minSamples = 10;  // fewer on a side: reported, never significant
+    size_t minSamples = 20;  // fewer on a side: reported, never tested (the normal approximation needs about 20)
 };
 
 struct Comparison {
