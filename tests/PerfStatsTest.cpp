@@ -50,8 +50,8 @@ TEST(PerfStats, BootstrapIsDeterministic) {
     EXPECT_EQ(a.high, b.high);
     EXPECT_LT(a.low, 2.0);
     EXPECT_GT(a.high, 2.0);
-    const Interval constant = BootstrapRatioOfMedians(std::vector<double>(9, 2.0), std::vector<double>(9, 3.0), 0.9,
-                                                      100, 1);
+    const Interval constant =
+        BootstrapRatioOfMedians(std::vector<double>(9, 2.0), std::vector<double>(9, 3.0), 0.9, 100, 1);
     EXPECT_DOUBLE_EQ(constant.low, 1.5);
     EXPECT_DOUBLE_EQ(constant.high, 1.5);
 }

@@ -15,8 +15,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <set>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <tuple>
 
@@ -128,8 +128,7 @@ std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& 
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     if (end == text.c_str() || *end != '\0' || !(v >= low && v <= high))
-        return name + ": needs a number in [" + Num("%g", low) + ", " + Num("%g", high) +
-               "], got '" + text + "'";
+        return name + ": needs a number in [" + Num("%g", low) + ", " + Num("%g", high) + "], got '" + text + "'";
     value = v;
     return std::nullopt;
 }
@@ -290,7 +289,8 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
         for (int r = 0; r < int(repeat); ++r) {
             const std::string out = temporary.path + "/" + std::to_string(suiteJson.size()) + "-" + std::to_string(r);
             const auto runStart = std::chrono::steady_clock::now();
-            if (!a.Has("--quiet")) std::fprintf(stderr, "perf record: %s (%d of %d)\n", entry.scene.c_str(), r + 1, int(repeat));
+            if (!a.Has("--quiet"))
+                std::fprintf(stderr, "perf record: %s (%d of %d)\n", entry.scene.c_str(), r + 1, int(repeat));
             if (auto code = RunInto(self, entry.scene, runArgs, out, temporary.path + "/runs.log", side, failed))
                 return *code;
             if (!a.Has("--quiet"))
@@ -359,7 +359,7 @@ json ComparisonJson(const perf::Comparison& c) {
 
 // Prints the comparison, writes --json, returns the exit code.
 int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::CompareSettings& settings,
-           const std::string& mode, const std::string& jsonPath) {
+                    const std::string& mode, const std::string& jsonPath) {
     const perf::CompareOutcome outcome = perf::Compare(base, head, settings);
     report::Report rep("perf compare");
     report::Section section;
@@ -385,10 +385,11 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
     for (const perf::Comparison& c : outcome.rows) {
         const bool time = c.metric == "time";
         const char* f = time ? "%.3f ms" : "%.0f";
-        table.rows.push_back({std::string(1, c.mark), c.scene, c.backend, c.stage + (time ? "" : " (instructions)"),
-                              Num(f, c.baseMedian), Num(f, c.headMedian), Num("%.3f", c.ratio),
-                              std::isnan(c.interval.low) ? "" : Num("%.3f", c.interval.low) + "-" + Num("%.3f", c.interval.high),
-                              Num("%.2g", c.pSlowerHolm), c.note});
+        table.rows.push_back(
+            {std::string(1, c.mark), c.scene, c.backend, c.stage + (time ? "" : " (instructions)"),
+             Num(f, c.baseMedian), Num(f, c.headMedian), Num("%.3f", c.ratio),
+             std::isnan(c.interval.low) ? "" : Num("%.3f", c.interval.low) + "-" + Num("%.3f", c.interval.high),
+             Num("%.2g", c.pSlowerHolm), c.note});
     }
     section.blocks.push_back(table);
     rep.sections.push_back(section);
@@ -506,14 +507,15 @@ int ComparePerf(const std::vector<std::string>& args) {
                 if (!a.Has("--quiet"))
                     std::fprintf(stderr, "perf compare: round %d of %d, %s, %s\n", round + 1, int(rounds),
                                  scenes[s].c_str(), n ? "HEAD" : "BASE");
-                const std::string out = temporary.path + "/" + std::to_string(round) + "-" + std::to_string(s) +
-                                        (n ? "-head" : "-base");
-                if (auto code = RunInto(binaries[n], scenes[s], extra, out, temporary.path + "/runs.log", sides[n], failed))
+                const std::string out =
+                    temporary.path + "/" + std::to_string(round) + "-" + std::to_string(s) + (n ? "-head" : "-base");
+                if (auto code =
+                        RunInto(binaries[n], scenes[s], extra, out, temporary.path + "/runs.log", sides[n], failed))
                     return *code;
             }
     settings.interleaved = true;
-    const int code = PrintComparison(sides[0], sides[1], settings, "interleaved, " + std::to_string(int(rounds)) + " rounds",
-                            jsonPath);
+    const int code = PrintComparison(sides[0], sides[1], settings,
+                                     "interleaved, " + std::to_string(int(rounds)) + " rounds", jsonPath);
     return code == kExitOk && failed ? kExitFailed : code;
 }
 
@@ -530,7 +532,8 @@ std::map<std::string, std::string> FlatProvenance(const json& p) {
                 for (const auto& [field, v] : b.items())
                     if (field != "name") flat["backends." + b.value("name", "?") + "." + field] = v.dump();
         } else if (value.is_object()) {
-            for (const auto& [field, v] : value.items()) flat[key + "." + field] = v.is_string() ? v.get<std::string>() : v.dump();
+            for (const auto& [field, v] : value.items())
+                flat[key + "." + field] = v.is_string() ? v.get<std::string>() : v.dump();
         } else {
             flat[key] = value.dump();
         }
@@ -597,8 +600,8 @@ int History(const std::vector<std::string>& args) {
             const json& first = (*records)[points[at].first].record;
             const json& last = (*records)[points[at - 1].first].record;
             const double b = perf::Median(before), h = perf::Median(after);
-            const std::vector<std::string> what = ProvenanceChanges(last.value("provenance", json::object()),
-                                                                    first.value("provenance", json::object()));
+            const std::vector<std::string> what =
+                ProvenanceChanges(last.value("provenance", json::object()), first.value("provenance", json::object()));
             std::printf("%s/%s/%s: step at record %s (line %zu): %s -> %s (x%.2f)\n", key[0].c_str(), key[1].c_str(),
                         key[2].c_str(), first.value("id", "?").c_str(), (*records)[points[at].first].line,
                         Num(metric == "time" ? "%.3f ms" : "%.0f", b).c_str(),
@@ -620,12 +623,11 @@ int History(const std::vector<std::string>& args) {
     }
     std::printf("%zu change point%s in %zu series over %zu records\n", changes.size(), changes.size() == 1 ? "" : "s",
                 series.size(), records->size());
-    if (a.Has("--json") &&
-        !WriteJsonFile(a.Value("--json"), {{"format", "cloudbench-perf-history/1"},
-                                           {"history", a.positional[0]},
-                                           {"records", records->size()},
-                                           {"metric", metric},
-                                           {"change_points", changes}}))
+    if (a.Has("--json") && !WriteJsonFile(a.Value("--json"), {{"format", "cloudbench-perf-history/1"},
+                                                              {"history", a.positional[0]},
+                                                              {"records", records->size()},
+                                                              {"metric", metric},
+                                                              {"change_points", changes}}))
         return kExitFailed;
     return kExitOk;
 }

@@ -17,7 +17,7 @@ namespace {
 using nlohmann::json;
 
 bool IsFile(const std::string& path) {
-    struct stat st{};
+    struct stat st {};
     return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
@@ -31,7 +31,8 @@ Status AddRecord(Side& side, const json& record) {
                 }
         if (record.contains("failures"))
             for (const auto& [scene, backends] : record["failures"].items())
-                for (const auto& [backend, why] : backends.items()) side.failures[scene][backend] = why.get<std::string>();
+                for (const auto& [backend, why] : backends.items())
+                    side.failures[scene][backend] = why.get<std::string>();
         if (record.contains("instructions")) CB_TRY(AddInstructions(side, record));
         side.provenance = record.value("provenance", json::object());
         side.date = record.value("time", "");
@@ -52,7 +53,8 @@ Status AddResults(Side& side, const json& results) {
             const std::string status = entry.value("status", "");
             if (status == "unavailable" || status == "unsupported") continue;  // not measured here: absent
             if (status != "ok") {
-                side.failures[scene][backend] = status + (entry.contains("error") ? ": " + entry.value("error", "") : "");
+                side.failures[scene][backend] =
+                    status + (entry.contains("error") ? ": " + entry.value("error", "") : "");
             }
             if (!entry.contains("stages")) continue;
             for (const auto& [stage, stats] : entry["stages"].items()) {
@@ -91,7 +93,8 @@ Result<Side> LoadSide(const std::string& spec) {
     Side side;
     side.label = spec;
     std::ifstream file(path, std::ios::binary);
-    if (!file || !IsFile(path)) return MakeError(path + ": cannot read: " + (errno ? std::strerror(errno) : "not a file"));
+    if (!file || !IsFile(path))
+        return MakeError(path + ": cannot read: " + (errno ? std::strerror(errno) : "not a file"));
     std::stringstream text;
     text << file.rdbuf();
     const json doc = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
@@ -227,7 +230,8 @@ CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings
             c.mark = '-';
             c.note = "improvement";
         } else if (slowerSignificant || fasterSignificant) {
-            c.note = std::abs(difference) <= s.floorMs ? "significant, under the floor" : "significant, within the threshold";
+            c.note = std::abs(difference) <= s.floorMs ? "significant, under the floor"
+                                                       : "significant, within the threshold";
         } else {
             c.note = "not significant";
         }
@@ -235,7 +239,8 @@ CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings
     // Instruction counts are exact: a change beyond the threshold is a change, no test needed. A side
     // without any counts (no `count` run) is not compared.
     if (base.instructions.empty() || head.instructions.empty()) {
-        out.headFailed = std::any_of(out.rows.begin(), out.rows.end(), [](const Comparison& c) { return c.mark == 'x'; });
+        out.headFailed =
+            std::any_of(out.rows.begin(), out.rows.end(), [](const Comparison& c) { return c.mark == 'x'; });
         return out;
     }
     for (const auto& [scene, backend, stage] : Keys(base.instructions, head.instructions)) {

@@ -22,9 +22,9 @@ struct Side {
     std::string label;  // what it was loaded from: "FILE", "FILE@ID"
     std::string date;   // when it was measured (ISO 8601); "" when unknown
     nlohmann::json provenance = nlohmann::json::object();
-    ByStage<std::vector<double>> samplesMs;                  // per-step wall times, pooled over runs
+    ByStage<std::vector<double>> samplesMs;                              // per-step wall times, pooled over runs
     std::map<std::string, std::map<std::string, std::string>> failures;  // scene, backend: why it gave no result
-    ByStage<double> instructions;                            // `cloudbench count`: exact per-stage counts
+    ByStage<double> instructions;                                        // `cloudbench count`: exact per-stage counts
 };
 
 // Adds a results.json document's samples (pooled with any already there),
@@ -43,14 +43,14 @@ Result<Side> LoadSide(const std::string& spec);
 nlohmann::json RecordSections(const Side& side);
 
 struct CompareSettings {
-    double threshold = 1.5;          // a slowdown ratio of medians above this (and the rest) is a regression
+    double threshold = 1.5;  // a slowdown ratio of medians above this (and the rest) is a regression
     // Per backend, instead of `threshold`: OpenGL and Vulkan run on software drivers (llvmpipe, lavapipe)
     // that share the CPU, and moved up to 2.28x between identical builds (reports/perf/walltime.md).
     std::map<std::string, double> backendThreshold = {{"gl", 3.0}, {"vk", 3.0}};
     double separateThreshold = 2.0;  // used instead when the sides were not measured interleaved
     bool interleaved = false;
-    double floorMs = 0.05;           // and the medians differ by more than this
-    double alpha = 0.01;             // family-wise, after Holm's correction
+    double floorMs = 0.05;               // and the medians differ by more than this
+    double alpha = 0.01;                 // family-wise, after Holm's correction
     double instructionThreshold = 0.02;  // relative change of an exact count
     double confidence = 0.95;
     int resamples = 2000;
@@ -63,7 +63,7 @@ struct Comparison {
     std::string metric;  // "time" (ms) or "instructions"
     size_t baseCount = 0, headCount = 0;
     double baseMedian = NAN, headMedian = NAN, ratio = NAN;  // ratio = head / base
-    double threshold = NAN;  // the ratio a regression must exceed
+    double threshold = NAN;                                  // the ratio a regression must exceed
     Interval interval{NAN, NAN};
     double pSlower = NAN, pFaster = NAN;          // one-sided Mann-Whitney
     double pSlowerHolm = NAN, pFasterHolm = NAN;  // Holm-adjusted over every time comparison

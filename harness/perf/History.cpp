@@ -60,7 +60,7 @@ Status AppendRecord(const std::string& path, const nlohmann::json& record) {
     if (fd < 0) return fail();
     std::string line = record.dump() + "\n";
     // A previous line cut short has no newline: end it, so this record stays readable.
-    struct stat st{};
+    struct stat st {};
     if (::fstat(fd, &st) == 0 && st.st_size > 0) {
         char last = '\n';
         const int reader = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -84,8 +84,7 @@ Result<const HistoryRecord*> SelectRecord(const std::vector<HistoryRecord>& reco
                                           const std::string& selector) {
     const std::string name = path + "@" + selector;
     if (records.empty()) return MakeError(name + ": the history holds no record");
-    if (selector.size() > 1 && selector[0] == '-' &&
-        selector.find_first_not_of("0123456789", 1) == std::string::npos) {
+    if (selector.size() > 1 && selector[0] == '-' && selector.find_first_not_of("0123456789", 1) == std::string::npos) {
         const size_t back = std::strtoul(selector.c_str() + 1, nullptr, 10);
         if (back == 0 || back > records.size())
             return MakeError(name + ": the history holds " + std::to_string(records.size()) + " records");
