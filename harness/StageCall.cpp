@@ -117,7 +117,8 @@ const std::optional<Slowdown>& TestSlowdown() {
         const double factor = colon == std::string::npos ? 0 : std::strtod(text.c_str() + colon + 1, &end);
         if (colon == std::string::npos || colon == 0 || end == text.c_str() + colon + 1 || *end != '\0' ||
             !(factor >= 1 && factor <= 1000)) {
-            std::fprintf(stderr, "CLOUDBENCH_TEST_SLOWDOWN: ignored, expected <stage>:<factor> with factor in [1, 1000]\n");
+            std::fprintf(stderr,
+                         "CLOUDBENCH_TEST_SLOWDOWN: ignored, expected <stage>:<factor> with factor in [1, 1000]\n");
             return std::nullopt;
         }
         return Slowdown{text.substr(0, colon), factor};
