@@ -25,6 +25,7 @@ enum ExitCode : int {
     kExitBadScene = 3,
     kExitNoBackend = 4,  // none of the requested backends is available
     kExitNonConformant = 5,
+    kExitRegression = 6,  // perf compare: a confirmed performance regression
 };
 
 // What the command line sets; every command reads the fields its options fill.
@@ -48,7 +49,9 @@ struct CommonOptions {
     int repeats = 5;
     bool switches = false;
     std::string metric = "max";
-    // A command that takes arguments rather than a scene (Command::takesArguments): them, in order.
+    // The positional arguments of a command that takes them rather than a scene
+    // (Command::takesArguments: report's files), or, for a command with
+    // Command::rawArguments (perf), every argument after its name, unparsed.
     std::vector<std::string> arguments;
     // report: --history FILE and -o FILE (docs/cli.md).
     std::string history;
@@ -103,6 +106,9 @@ struct Command {
     bool keepsWarmup = false;
     // Whether it takes any number of arguments (files) into CommonOptions::arguments; only without a scene.
     bool takesArguments = false;
+    // Whether the command parses its own arguments (perf's subcommands): main
+    // passes them in CommonOptions::arguments and handles only --help.
+    bool rawArguments = false;
     std::vector<OptionSpec> extraOptions = {};  // besides SceneCommandOptions()
     std::function<int(const CommonOptions&)> run;
 };

@@ -1,6 +1,10 @@
 #include "harness/StageCall.h"
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <string>
 
 #include "harness/Isolation.h"
 #include "harness/StageParams.h"
@@ -104,6 +108,41 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
     return MakeError("the harness cannot call stage '" + std::string(StageName(stage)) + "' yet");
 }
 
+// The test-only slowdown switch, CLOUDBENCH_TEST_SLOWDOWN=<stage>:<factor>
+// (docs/cli.md): the named stage's time becomes `factor` times its own, by
+// spinning for (factor - 1) times the call's time after it, inside the timed
+// record. It exists so that the performance gate's tests can plant a known
+// regression; nothing else reads it.
+struct Slowdown {
+    std::string stage;
+    double factor = 1;
+};
+
+const std::optional<Slowdown>& TestSlowdown() {
+    static const std::optional<Slowdown> slowdown = []() -> std::optional<Slowdown> {
+        const char* value = std::getenv("CLOUDBENCH_TEST_SLOWDOWN");
+        if (!value || !*value) return std::nullopt;
+        const std::string text = value;
+        const size_t colon = text.find(':');
+        char* end = nullptr;
+        const double factor = colon == std::string::npos ? 0 : std::strtod(text.c_str() + colon + 1, &end);
+        if (colon == std::string::npos || colon == 0 || end == text.c_str() + colon + 1 || *end != '\0' ||
+            !(factor >= 1 && factor <= 1000)) {
+            std::fprintf(stderr,
+                         "CLOUDBENCH_TEST_SLOWDOWN: ignored, expected <stage>:<factor> with factor in [1, 1000]\n");
+            return std::nullopt;
+        }
+        return Slowdown{text.substr(0, colon), factor};
+    }();
+    return slowdown;
+}
+
+void SpinFor(double ms) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
+    while (std::chrono::steady_clock::now() < until) {
+    }
+}
+
 }  // namespace
 
 Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
@@ -111,7 +150,13 @@ Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageH
     // Where a crash happens, for the parent of an isolated backend (harness/Isolation.h).
     MarkPhase(StageName(stage), host.step);
     InjectTestFault(backend.Name(), StageName(stage));
+    const double before = record.ms;
     Status status = Call(stage, backend, scene, host, buffers, record);
+    if (const auto& slowdown = TestSlowdown(); slowdown && slowdown->stage == StageName(stage)) {
+        const auto start = std::chrono::steady_clock::now();
+        SpinFor((slowdown->factor - 1) * (record.ms - before));
+        record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    }
     if (!status && stage != Stage::RenderSplat)
         return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
     return status;

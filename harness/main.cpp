@@ -15,7 +15,7 @@ namespace {
 constexpr const char* kExitCodesHelp = R"(
 Exit codes: 0 success, 1 a stage failed or an output could not be written,
 2 bad command line, 3 bad scene file or --set value, 4 no requested backend
-available, 5 a conformance check failed.
+available, 5 a conformance check failed, 6 perf compare found a regression.
 )";
 
 std::string MainHelp() {
@@ -74,7 +74,9 @@ int main(int argc, char** argv) {
             std::fputs(std::string(command->help).c_str(), stdout);
             return cb::kExitOk;
         }
-        if (const cb::OptionSpec* option = FindOption(*command, arg)) {
+        if (command->rawArguments) {
+            options.arguments.emplace_back(arg);
+        } else if (const cb::OptionSpec* option = FindOption(*command, arg)) {
             const char* value = option->takesValue ? (n + 1 < argc ? argv[++n] : nullptr) : nullptr;
             if (auto message = option->apply(options, value)) return Usage(*message, command->help);
         } else if (arg.starts_with("-")) {

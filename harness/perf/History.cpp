@@ -1,0 +1,118 @@
+#include "harness/perf/History.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "harness/PosixIo.h"
+
+namespace cb::perf {
+
+std::string DefaultHistoryPath() {
+    if (const char* path = std::getenv("CLOUDBENCH_HISTORY"); path && *path) return path;
+    if (const char* data = std::getenv("XDG_DATA_HOME"); data && *data)
+        return std::string(data) + "/cloudbench/history.jsonl";
+    const char* home = std::getenv("HOME");
+    return std::string(home && *home ? home : ".") + "/.local/share/cloudbench/history.jsonl";
+}
+
+Result<std::vector<HistoryRecord>> ReadHistory(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) return MakeError(path + ": cannot read: " + std::strerror(errno));
+    std::vector<HistoryRecord> records;
+    size_t lineNumber = 0;
+    for (std::string line; std::getline(file, line);) {
+        ++lineNumber;
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        nlohmann::json record = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
+        std::string why;
+        if (record.is_discarded())
+            why = "not JSON (a write cut short?)";
+        else if (!record.is_object() || record.value("format", nlohmann::json()) != kRecordFormat)
+            why = std::string("not a ") + kRecordFormat + " record";
+        else if (!record.contains("results") || !record["results"].is_object())
+            why = "no \"results\" object";
+        if (!why.empty()) {
+            std::fprintf(stderr, "%s:%zu: skipped: %s\n", path.c_str(), lineNumber, why.c_str());
+            continue;
+        }
+        records.push_back({lineNumber, std::move(record)});
+    }
+    if (file.bad()) return MakeError(path + ": cannot read: " + std::strerror(errno));
+    return records;
+}
+
+Status AppendRecord(const std::string& path, const nlohmann::json& record) {
+    auto fail = [&] { return MakeError(path + ": cannot write: " + std::strerror(errno)); };
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) return fail();
+    std::string line = record.dump() + "\n";
+    // A previous line cut short has no newline: end it, so this record stays readable.
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && st.st_size > 0) {
+        char last = '\n';
+        const int reader = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (reader >= 0) {
+            if (::pread(reader, &last, 1, st.st_size - 1) != 1) last = '\n';
+            ::close(reader);
+        }
+        if (last != '\n') line.insert(line.begin(), '\n');
+    }
+    if (!WriteAll(fd, line) || ::fsync(fd) != 0) {
+        const int error = errno;
+        ::close(fd);
+        errno = error;
+        return fail();
+    }
+    if (::close(fd) != 0) return fail();
+    return {};
+}
+
+Result<const HistoryRecord*> SelectRecord(const std::vector<HistoryRecord>& records, const std::string& path,
+                                          const std::string& selector) {
+    const std::string name = path + "@" + selector;
+    if (records.empty()) return MakeError(name + ": the history holds no record");
+    if (selector.size() > 1 && selector[0] == '-' && selector.find_first_not_of("0123456789", 1) == std::string::npos) {
+        const size_t back = std::strtoul(selector.c_str() + 1, nullptr, 10);
+        if (back == 0 || back > records.size())
+            return MakeError(name + ": the history holds " + std::to_string(records.size()) + " records");
+        return &records[records.size() - back];
+    }
+    const HistoryRecord* match = nullptr;
+    for (const HistoryRecord& r : records) {
+        const std::string id = r.record.value("id", "");
+        if (id == selector) return &r;
+        if (!selector.empty() && id.starts_with(selector)) {
+            if (match) return MakeError(name + ": more than one record id starts with '" + selector + "'");
+            match = &r;
+        }
+    }
+    if (!match) return MakeError(name + ": no record with this id");
+    return match;
+}
+
+std::string NewRecordId() {
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    gmtime_r(&now, &utc);
+    char text[40];
+    std::strftime(text, sizeof text, "%Y%m%dT%H%M%SZ", &utc);
+    std::random_device random;
+    char suffix[16];
+    std::snprintf(suffix, sizeof suffix, "-%06x", unsigned(random() & 0xffffffu));
+    return text + std::string(suffix);
+}
+
+}  // namespace cb::perf

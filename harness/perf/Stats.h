@@ -1,0 +1,60 @@
+// The statistics of `perf compare` and `perf history` (docs/cli.md, "perf"):
+// medians, a one-sided Mann-Whitney U test, Holm's correction, a bootstrap
+// interval for a ratio of medians, and change points in a series. Each
+// formula is checked against SciPy in tests/check_perf_stats.py.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace cb::perf {
+
+// The median, averaging the two middle values of an even count (NumPy's);
+// NaN for no values.
+double Median(std::span<const double> values);
+
+struct UTestResult {
+    double u = 0;  // U of `x`: the number of pairs (x_i, y_j) with x_i > y_j, ties counting 1/2
+    double z = 0;
+    double p = 1;  // one-sided: the probability of a U this large if x and y had one distribution
+};
+
+// The one-sided Mann-Whitney U test that `x` is stochastically greater than
+// `y`, by the normal approximation with the tie correction and a continuity
+// correction of 1/2: scipy.stats.mannwhitneyu(x, y, alternative="greater",
+// method="asymptotic"). p = 1 when either side is empty or every value ties.
+UTestResult MannWhitneyGreater(std::span<const double> x, std::span<const double> y);
+
+// Holm's step-down adjusted p-values (Holm-Bonferroni), in the input order:
+// the family-wise error rate is at most alpha when the hypotheses with an
+// adjusted p below alpha are rejected.
+std::vector<double> HolmAdjusted(std::span<const double> p);
+
+struct Interval {
+    double low = 0, high = 0;
+};
+
+// The percentile bootstrap interval of median(head) / median(base): `resamples`
+// times, each side is resampled with replacement on its own; the interval is
+// the (1 - confidence) / 2 and (1 + confidence) / 2 quantiles of the ratios
+// (linear interpolation, NumPy's default). Deterministic for a given seed.
+Interval BootstrapRatioOfMedians(std::span<const double> base, std::span<const double> head, double confidence,
+                                 int resamples, uint64_t seed);
+
+// Change points in `series` by binary segmentation: the split that maximises
+// sqrt(nL nR / n) |mean(left) - mean(right)| (both sides at least minSegment
+// long) is kept when the medians of its sides differ by at least minChange and
+// a permutation test (`permutations` shuffles, fixed seed) gives p <= alpha;
+// each side is then searched again. Returns the index of the first value after
+// each change, ascending. For relative changes pass logs and log(1 + change).
+struct ChangePointSettings {
+    int minSegment = 4;
+    double minChange = 0.1;  // |median(right) - median(left)|, in the series' units
+    double alpha = 0.01;
+    int permutations = 999;
+    uint64_t seed = 12345;
+};
+std::vector<size_t> ChangePoints(std::span<const double> series, const ChangePointSettings& settings);
+
+}  // namespace cb::perf

@@ -1,0 +1,88 @@
+#!/usr/bin/python3
+"""`cloudbench perf record` (issue 12, item 1): each record is one JSON line
+appended to the history with the documented shape (docs/results.md); earlier
+lines are never rewritten; a line cut short is skipped with a warning naming
+the file and line, and the next record still starts a line of its own; a
+`count` output's "instructions" are merged in.
+
+usage: check_perf_record.py CLOUDBENCH WORKDIR
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+CLI, WORK = sys.argv[1], sys.argv[2]
+shutil.rmtree(WORK, ignore_errors=True)
+os.makedirs(WORK)
+history = os.path.join(WORK, "sub", "history.jsonl")  # the folder is created by the first record
+suite = os.path.join(WORK, "suite.json")
+json.dump({"scenes": [{"scene": "ci-small", "set": ["steps=16", "warmup_steps=4"]}]}, open(suite, "w"))
+counts = os.path.join(WORK, "counts.json")
+json.dump({"instructions": {"ci-small": {"cpu": {"region": 123456, "ca": 654321}}}}, open(counts, "w"))
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def record(*extra, expect=0):
+    p = subprocess.run([CLI, "perf", "record", "--suite", suite, "--history", history, "--backend", "cpu", "--quiet",
+                        *extra], capture_output=True, text=True, timeout=300)
+    if p.returncode != expect:
+        fail(f"perf record exited {p.returncode}, expected {expect}\n{p.stdout}\n{p.stderr}")
+    return p
+
+
+record("--instructions", counts, "--repeat", "2")
+first = open(history, "rb").read()
+lines = first.decode().splitlines()
+if len(lines) != 1:
+    fail(f"one record must be one line, got {len(lines)}")
+r = json.loads(lines[0])
+for key in ("format", "id", "time", "provenance", "suite", "results", "failures", "instructions", "seconds"):
+    if key not in r:
+        fail(f"record lacks '{key}'")
+if r["format"] != "cloudbench-perf/1":
+    fail(f"format {r['format']}")
+for key in ("git", "build", "machine"):
+    if key not in r["provenance"]:
+        fail(f"provenance lacks '{key}'")
+stages = r["results"]["ci-small"]["cpu"]
+# 16 steps, 4 of warm-up: 12 samples a run, two runs pooled (--repeat 2).
+for name in ("region", "ca", "smooth", "density"):
+    samples = stages[name]["samples_ms"]
+    if len(samples) != 24:
+        fail(f"{name}: {len(samples)} samples, expected 2 x 12")
+    if abs(stages[name]["median_ms"] - float(np.median(samples))) > 1e-12:
+        fail(f"{name}: median_ms is not the median of samples_ms")
+if r["instructions"] != {"ci-small": {"cpu": {"region": 123456, "ca": 654321}}}:
+    fail(f"instructions not merged: {r['instructions']}")
+
+# A write cut short (no newline), then another record.
+with open(history, "ab") as f:
+    f.write(b'{"format": "cloudbench-perf/1", "id": "cut')
+record()
+data = open(history, "rb").read()
+if not data.startswith(first):
+    fail("an earlier record was rewritten")
+lines = data.decode().splitlines()
+if len(lines) != 3 or json.loads(lines[2])["format"] != "cloudbench-perf/1":
+    fail(f"the new record must start a line of its own after the cut line: {len(lines)} lines")
+p = subprocess.run([CLI, "perf", "compare", f"{history}@-2", f"{history}@-1"], capture_output=True, text=True,
+                   timeout=120)
+if p.returncode not in (0, 6) or f"{history}:2: skipped" not in p.stderr:
+    fail(f"compare of the two records: exit {p.returncode}, stderr {p.stderr!r}")
+if "different times" not in p.stdout:
+    fail("two records are measured at different times: the output must say so")
+
+# A bad suite file is a bad input (exit 3) and appends nothing.
+json.dump({"scenes": []}, open(suite, "w"))
+p = record(expect=3)
+if "scenes" not in p.stderr or open(history, "rb").read() != data:
+    fail(f"bad suite: {p.stderr}")
+print("perf record: ok")

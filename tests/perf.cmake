@@ -1,0 +1,19 @@
+# Performance tracking (issue 12; `cloudbench perf`, docs/cli.md): the
+# statistics against SciPy, the history's records, and the CI gate on this
+# machine (an identical build passes, a planted slowdown fails with exit 6).
+# Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
+foreach(case compare instructions inputs history changepoints gbench)
+  add_test(NAME Perf.Stats.${case}
+           COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_stats.py ${cli} ${cli_out}/perf-${case} ${case})
+  set_tests_properties(Perf.Stats.${case} PROPERTIES PASS_REGULAR_EXPRESSION ": ok" SKIP_RETURN_CODE 77 TIMEOUT 300)
+endforeach()
+add_test(NAME Perf.Record
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_record.py ${cli} ${cli_out}/perf-record)
+set_tests_properties(Perf.Record PROPERTIES PASS_REGULAR_EXPRESSION "perf record: ok" TIMEOUT 600)
+foreach(case identical slowdown)
+  add_test(NAME Perf.Gate.${case}
+           COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_gate.py ${cli} ${cli_out}/perf-gate-${case} ${case})
+  # Two gate runs side by side would each see the other's load, so they run one at a time.
+  set_tests_properties(Perf.Gate.${case} PROPERTIES PASS_REGULAR_EXPRESSION "perf gate ${case}: ok" TIMEOUT 600
+                       RESOURCE_LOCK perf_gate)
+endforeach()
