@@ -254,9 +254,10 @@ std::string RenderHistoryPlot(const LinePlot& plot) {
         out += "<g class=\"series\"" + Attr("data-series", s.name) + Attr("data-points", std::to_string(s.y.size())) +
                ">\n";
         std::string points;
-        for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k)
-            points += (points.empty() ? "" : " ") + Px(x.ToPixel(s.x[k], kPlotLeft, kPlotRight)) + "," +
-                      Px(y.ToPixel(s.y[k], kPlotBottom, kPlotTop));
+        for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+            if (!points.empty()) points += ' ';
+            points += Px(x.ToPixel(s.x[k], kPlotLeft, kPlotRight)) + "," + Px(y.ToPixel(s.y[k], kPlotBottom, kPlotTop));
+        }
         out += "<polyline points=\"" + points + "\" fill=\"none\" stroke=\"" + colour + "\"/>\n";
         for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
             const double px = x.ToPixel(s.x[k], kPlotLeft, kPlotRight), py = y.ToPixel(s.y[k], kPlotBottom, kPlotTop);
