@@ -22,6 +22,7 @@
 
 #include "harness/Command.h"
 #include "harness/ReportModel.h"
+#include "harness/perf/CallgrindCount.h"
 #include "harness/perf/Compare.h"
 #include "harness/perf/History.h"
 #include "harness/perf/Spawn.h"
@@ -48,8 +49,11 @@ record   runs the suite (default: thesis-low, thesis-medium, thesis-high, each a
          FILE: docs/cli.md) and appends one record to the history (default:
          $CLOUDBENCH_HISTORY, else $XDG_DATA_HOME/cloudbench/history.jsonl, else
          ~/.local/share/cloudbench/history.jsonl). --repeat N runs each scene N
-         times and pools the samples; --instructions FILE merges the
-         "instructions" of a `cloudbench count` output.
+         times and pools the samples. It also counts each scene's CPU
+         instructions (`cloudbench count`) when this build can (no
+         -march=native: the exact preset; valgrind installed), else the
+         record's "instructions_not_counted" says why; --instructions FILE
+         merges a `cloudbench count` output instead.
 compare  compares per-step stage times (median ratio with a 95 % bootstrap
          interval, one-sided Mann-Whitney U tests with Holm's correction) and
          instruction counts. BASE and HEAD: a results.json, a count output, a
@@ -298,6 +302,30 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
                              std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count());
         }
     }
+    // Exact mode: each suite scene's CPU instruction counts, when this build can count them
+    // (no -march=native, valgrind present); otherwise the record says why not.
+    std::string notCounted;
+    if (a.Has("--instructions")) {
+        notCounted = "";  // given by the caller
+    } else if (auto why = WhyCannotCount(side.provenance.value("build", json::object()).value("flags", ""))) {
+        notCounted = *why;
+    } else {
+        for (size_t i = 0; i < suite.size(); ++i) {
+            const std::string out = temporary.path + "/count-" + std::to_string(i) + ".json";
+            std::vector<std::string> argv = {self, "count", suite[i].scene, "--out", out, "--quiet"};
+            for (const std::string& set : suite[i].set) argv.insert(argv.end(), {"--set", set});
+            if (!a.Has("--quiet")) std::fprintf(stderr, "perf record: counting %s\n", suite[i].scene.c_str());
+            auto rc = perf::RunChild(argv, temporary.path + "/runs.log");
+            std::ifstream file(out);
+            const json counts = json::parse(file, nullptr, /*allow_exceptions=*/false);
+            if (!rc || *rc != kExitOk || !counts.is_object() || !perf::AddInstructions(side, counts)) {
+                std::fprintf(stderr, "perf record: counting %s failed (exit %d)\n", suite[i].scene.c_str(),
+                             rc ? *rc : -1);
+                notCounted += (notCounted.empty() ? "" : "; ") + suite[i].scene + ": count failed";
+                failed = true;
+            }
+        }
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     json provenance = side.provenance;
     if (provenance.is_object()) {
@@ -315,6 +343,7 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
                    {"results", sections["results"]},
                    {"failures", sections["failures"]},
                    {"instructions", sections["instructions"]}};
+    if (!notCounted.empty()) record["instructions_not_counted"] = notCounted;
     if (Status s = perf::AppendRecord(historyPath, record); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
