@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks `cloudbench report` end to end (issue 12, item 5): makes a small run, a
-conformance check and a sweep of SCENE, and a synthetic perf history with a planted
-change point and a half-written last line; writes the report; then loads the page
+conformance check and a sweep of SCENE, and a synthetic perf history with two planted
+steps (one listed by its record, one in the instruction counts left to the detector)
+and a half-written last line; writes the report; then loads the page
 in Debian's headless chromium from file:// and checks that
 
 - no console message appears (the page has no script, so any message is an error),
@@ -12,7 +13,7 @@ in Debian's headless chromium from file:// and checks that
   the history plus one for instruction counts, one Pareto plot per swept stage; the
   verdict, conformance matrix, timing and seeds' tables plus each input's own
   tables; the frames, their differences and top views as data: images; exactly the
-  planted change point.
+  two planted change points.
 
 The checker is first run on a page with a script error and an external image, and
 must reject it (so that a broken check cannot pass). Exits 77 (skipped) without
@@ -217,8 +218,10 @@ def main():
         fail(f"{counts.tables} tables, expected {tables}")
     if counts.data_images != images or counts.other_images:
         fail(f"{counts.data_images} embedded images and {counts.other_images} others, expected {images} embedded")
-    if counts.change_points != 1:
-        fail(f"{counts.change_points} change points marked, expected the 1 planted")
+    # Two planted steps, both at record 7: cpu smooth 1.5x slower (also listed by the record, marked once) and
+    # smooth's instruction count 1.3x; the other series move by under 5 %, below the detector's 10 %.
+    if counts.change_points != 2:
+        fail(f"{counts.change_points} change points marked, expected the 2 planted")
     if len(sys.argv) == 5:
         subprocess.run([chromium, *CHROMIUM_FLAGS, "--hide-scrollbars", "--window-size=1100,4300",
                         f"--screenshot={os.path.abspath(sys.argv[4])}", "file://" + os.path.abspath(page)],

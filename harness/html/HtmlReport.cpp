@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,7 @@
 
 #include "cloudbench_seed_timings.h"
 #include "harness/html/SvgPlot.h"
+#include "harness/perf/Stats.h"
 
 namespace cb::html {
 namespace {
@@ -317,10 +319,30 @@ std::vector<report::Block> HistoryBlocks(const std::vector<json>& history, const
                 line.pointLabels.push_back(RecordLabel(record, r) + ": " + count.dump() + " instructions");
             }
     }
+    // Step changes found in each series by `perf history`'s detector, with its defaults (a change of
+    // 10 % or more in the median, segments of 4 records or more), added to those the records list.
+    perf::ChangePointSettings settings;
+    settings.minChange = std::log1p(0.1);
+    auto detect = [&](Series& line) {
+        std::vector<double> logs;
+        for (double v : line.y) logs.push_back(v > 0 ? std::log(v) : 0.0);
+        for (size_t at : perf::ChangePoints(logs, settings))
+            if (std::ranges::find(line.marks, at) == line.marks.end()) {
+                line.marks.push_back(at);
+                ++marked;
+            }
+    };
+    for (auto& [scene, stages] : series)
+        for (auto& [stage, backends] : stages)
+            for (auto& [backend, line] : backends) detect(line);
+    for (auto& [scene, stages] : instructions)
+        for (auto& [stage, line] : stages) detect(line);
     blocks.emplace_back(report::Paragraph{
         std::to_string(history.size()) + " records from " + path + ", oldest first. " +
-        (marked ? std::to_string(marked) + " change point(s) marked (dashed lines), as the records list them."
-                : "No record lists change points, so none are marked.")});
+        (marked ? std::to_string(marked) +
+                      " change point(s) marked (dashed lines): listed by the records or found by perf history's "
+                      "detector (a step of 10 % or more in the median, segments of 4 records or more)."
+                : "No change point listed or found.")});
     for (auto& [scene, stages] : series)
         for (auto& [stage, backends] : stages) {
             LinePlot plot{scene + ": " + stage + ", median per record", "record (oldest first)", "median ms", {}};
