@@ -59,9 +59,9 @@ nlohmann::json IsolatedConformance(Session& session, const std::string& name, co
     for (const BackendProvenance& record : session.BackendRecords()) backends.push_back(transfer::ToJson(record));
     if (!cpu[0].backend) return {{"error", cpu[0].reason}, {"backends", backends}};
     auto rows = RunConformance(session.GetScene(), *cpu[0].backend, other,
-                               [&](uint32_t step, const std::vector<ConformRow>& so_far) {
+                               [&](uint32_t step, const std::vector<ConformRow>& soFar) {
                                    nlohmann::json list = nlohmann::json::array();
-                                   for (const ConformRow& row : so_far) list.push_back(transfer::ToJson(row));
+                                   for (const ConformRow& row : soFar) list.push_back(transfer::ToJson(row));
                                    send({{"step", step}, {"rows", list}});
                                });
     nlohmann::json list = nlohmann::json::array();
