@@ -49,6 +49,9 @@ struct CommonOptions {
     int repeats = 5;
     bool switches = false;
     std::string metric = "max";
+    // sweep --shard I/N: share I (1-based) of N; shardCount 0 = not sharded.
+    int shardIndex = 0;
+    int shardCount = 0;
     // The positional arguments of a command that takes them rather than a scene
     // (Command::takesArguments: report's files), or, for a command with
     // Command::rawArguments (perf), every argument after its name, unparsed.

@@ -2,12 +2,15 @@
 // shade and shadow stages timed and compared with the exact reference on
 // every backend, the Pareto front marked; writes sweep.json, sweep.md and the
 // plot sweep.png (tools/plot_sweep.py).
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <expected>
 
 #include "harness/IsolatedMeasurement.h"
 #include "harness/Measurement.h"
+#include "harness/Transfer.h"
+#include "harness/commands/SweepOutput.h"
 
 namespace cb {
 namespace {
@@ -37,6 +40,11 @@ Options:
   --threads N        CPU backend and reference threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name
   --gl-context CTX   OpenGL context: osmesa (default) or egl
+  --shard I/N        measure only share I of N (1 <= I <= N): the points whose
+                     index k (0-based, in the order above) has k % N == I-1;
+                     every point is still validated. sweep.json gains a
+                     "shard" block for `cloudbench merge`; the Pareto marks
+                     of a shard are within the shard only
   --quiet            no progress lines
 )";
 const std::string kHelp = kHelpText + IsolationOptionsHelp();
@@ -64,31 +72,7 @@ std::vector<std::string> SplitValues(const std::string& text) {
     return out;
 }
 
-struct Axis {
-    std::string path;
-    std::vector<std::string> values;
-};
-
-// Pareto front per stage: no other ok row is at least as fast and as accurate
-// and strictly better in one.
-void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
-    auto error = [&](const Row& r) {
-        return metric == "mean" ? r.result.all.mean : metric == "p99" ? r.result.all.p99 : r.result.all.max;
-    };
-    for (Row& r : rows) {
-        if (r.result.status != "ok") continue;
-        r.pareto = true;
-        for (const Row& o : rows) {
-            if (&o == &r || o.stage != r.stage || o.result.status != "ok") continue;
-            const double t = o.result.timeMs.median, e = error(o);
-            const double tr = r.result.timeMs.median, er = error(r);
-            if (t <= tr && e <= er && (t < tr || e < er)) {
-                r.pareto = false;
-                break;
-            }
-        }
-    }
-}
+using Axis = SweepAxis;
 
 // The --vary arguments as axes; a usage message when one is malformed.
 std::expected<std::vector<Axis>, std::string> ParseAxes(const std::vector<std::string>& vary) {
@@ -133,40 +117,6 @@ std::expected<std::vector<std::vector<SceneOverride>>, int> Points(const Session
     return points;
 }
 
-// Plots sweep.json into `pngPath` with tools/plot_sweep.py (matplotlib); says
-// why on stderr and returns false when it cannot. The JSON and the table stand without it.
-bool Plot(const std::string& jsonPath, const std::string& mdPath, const std::string& pngPath) {
-    auto quote = [](const std::string& s) {
-        std::string out = "'";
-        for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-        return out + "'";
-    };
-    // Debian's python3-matplotlib is for /usr/bin/python3, which another python3
-    // on the PATH (a virtual environment, pyenv) may hide: the first that has it.
-    std::string python;
-    for (const char* candidate : {"/usr/bin/python3", "python3"})
-        if (std::system((std::string(candidate) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) == 0) {
-            python = candidate;
-            break;
-        }
-    const std::string script = std::string(CLOUDBENCH_TOOLS_DIR) + "/plot_sweep.py";
-    std::string command;
-    const bool plotted = !python.empty() && Session::WriteAtomically(pngPath, [&](const std::string& temp) -> Status {
-        command = python + " " + quote(script) + " " + quote(jsonPath) + " " + quote(temp);
-        if (std::system(command.c_str()) != 0) return MakeError(pngPath + ": plot_sweep.py failed");
-        return {};
-    });
-    if (python.empty())
-        std::fprintf(stderr,
-                     "sweep: no plot: python3 with matplotlib was not found (apt-get install "
-                     "python3-matplotlib); %s and %s are written\n",
-                     jsonPath.c_str(), mdPath.c_str());
-    else if (!plotted)
-        std::fprintf(stderr, "sweep: no plot: '%s' failed; %s and %s are written\n", command.c_str(), jsonPath.c_str(),
-                     mdPath.c_str());
-    return plotted;
-}
-
 int Sweep(const CommonOptions& options) {
     if (options.vary.empty()) {
         std::fprintf(stderr, "sweep: needs at least one --vary PATH=V1,V2,...\n");
@@ -181,6 +131,16 @@ int Sweep(const CommonOptions& options) {
         std::fprintf(stderr, "sweep: %s\n", axes.error().c_str());
         return kExitUsage;
     }
+    const bool sharded = options.shardCount > 0;
+    if (sharded)
+        for (const Axis& a : *axes)
+            for (size_t i = 0; i < a.values.size(); ++i)
+                if (std::find(a.values.begin(), a.values.begin() + ptrdiff_t(i), a.values[i]) !=
+                    a.values.begin() + ptrdiff_t(i)) {
+                    std::fprintf(stderr, "sweep: --vary %s: value %s given twice (not allowed with --shard)\n",
+                                 a.path.c_str(), a.values[i].c_str());
+                    return kExitUsage;
+                }
     auto session = Session::Open(options, "sweep");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
@@ -193,21 +153,19 @@ int Sweep(const CommonOptions& options) {
         "sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "
         "%s error\n",
         scene.name.c_str(), points->size(), names.size(), options.repeats, options.metric.c_str());
-    // A stage is left out when every varied field belongs to the other one
-    // (shadow's beer form reads shade.sigma, so that one counts for both).
-    bool onlyShade = true, onlyShadow = true;
-    for (const Axis& a : *axes) {
-        onlyShade &= a.path.starts_with("shade.") && a.path != "shade.sigma";
-        onlyShadow &= a.path.starts_with("shadow.");
-    }
-    std::vector<Stage> stages;
-    if (!onlyShadow) stages.push_back(Stage::Shade);
-    if (!onlyShade) stages.push_back(Stage::Shadow);
+    if (sharded)
+        std::printf("shard %d/%d: points k with k %% %d == %d (the Pareto marks are within the shard)\n",
+                    options.shardIndex, options.shardCount, options.shardCount, options.shardIndex - 1);
+    const std::vector<Stage> stages = SweepStages(*axes);
+    // With --shard I/N, the points whose global index k has k % N == I-1.
+    std::vector<size_t> planPoint;
+    for (size_t k = 0; k < points->size(); ++k)
+        if (!sharded || int(k % size_t(options.shardCount)) == options.shardIndex - 1) planPoint.push_back(k);
     // Each backend measures every point in a process of its own (harness/IsolatedMeasurement.h).
     std::vector<PlannedSetting> plan;
-    for (const auto& point : *points) plan.push_back({point, stages});
+    for (size_t k : planPoint) plan.push_back({(*points)[k], stages});
     auto parts = MeasureEachBackend(**session, names, plan, {}, [&](size_t n) {
-        if (!options.quiet) std::fprintf(stderr, "sweep: point %zu/%zu done\n", n + 1, points->size());
+        if (!options.quiet) std::fprintf(stderr, "sweep: point %zu/%zu done\n", n + 1, plan.size());
     });
     if (!parts) {
         std::fprintf(stderr, "sweep: %s\n", parts.error().message.c_str());
@@ -217,6 +175,14 @@ int Sweep(const CommonOptions& options) {
     const bool anyCrashed =
         std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
     std::vector<Row> rows = MergeRows(scene, plan, *parts);
+    // MergeRows keeps the plan's order and every row carries its item's
+    // settings, so a walk over the plan gives each row its point (the values
+    // of an axis are distinct when sharded, so no two points share settings).
+    std::vector<size_t> rowPoint;
+    for (size_t i = 0, item = 0; i < rows.size(); ++i) {
+        while (item + 1 < plan.size() && SettingsLabel(rows[i].settings) != SettingsLabel(plan[item].setting)) ++item;
+        rowPoint.push_back(planPoint[item]);
+    }
     MarkPareto(rows, options.metric);
 
     json doc = {{"format", "cloudbench-sweep/1"},
@@ -226,49 +192,23 @@ int Sweep(const CommonOptions& options) {
                 {"metric", options.metric},
                 {"repeats", options.repeats},
                 {"reference_start", "voxel-exit"},
-                {"vary", json::array()},
-                {"rows", json::array()}};
-    for (const Axis& a : *axes) doc["vary"].push_back({{"path", a.path}, {"values", a.values}});
-    report::Report report("Sweep of " + scene.name);
-    report.sections.push_back({"",
-                               {report::Paragraph{"Pareto front (*) on median time and " + options.metric +
-                                                  " |error| over all elements, per stage."}}});
-    for (Stage stage : stages) {
-        report::Table table;
-        for (const Axis& a : *axes) table.columns.emplace_back(a.path);
-        for (report::Column& c : ErrorColumns({}, stage)) table.columns.push_back(std::move(c));
-        table.columns.insert(table.columns.begin() + ptrdiff_t(axes->size()) + 1, report::Column("pareto"));
-        for (const Row& r : rows) {
-            if (r.stage != stage) continue;
-            doc["rows"].push_back(RowJson(r));
-            doc["rows"].back()["pareto"] = r.pareto;
-            std::vector<report::Cell> cells;
-            for (const SceneOverride& o : r.settings) cells.push_back(o.value);
-            for (report::Cell& cell : RowCells(r)) cells.push_back(std::move(cell));
-            cells.insert(cells.begin() + ptrdiff_t(axes->size()) + 1, r.pareto ? "*" : "");
-            table.rows.push_back(std::move(cells));
+                {"references", ReferencesJson(FirstRecords(*parts), options.cpuThreads)}};
+    if (sharded) {
+        // Every measured row with its point's global index, for `cloudbench merge`.
+        json shardRows = json::array();
+        for (size_t i = 0; i < rows.size(); ++i) {
+            shardRows.push_back(transfer::ToJson(rows[i]));
+            shardRows.back()["point"] = rowPoint[i];
         }
-        if (table.rows.empty()) continue;
-        report::Section section{std::string(StageName(stage)), {std::move(table)}};
-        std::printf("\n%s", report::RenderText(section).c_str());
-        report.sections.push_back(std::move(section));
+        doc["shard"] = {{"index", options.shardIndex},
+                        {"count", options.shardCount},
+                        {"points", points->size()},
+                        {"rows", std::move(shardRows)}};
     }
-    doc["references"] = ReferencesJson(FirstRecords(*parts), options.cpuThreads);
-    doc["report"] = report::RenderJson(report);
-
-    const std::string& outDir = (*session)->OutDir();
-    const std::string jsonPath = outDir + "/sweep.json", mdPath = outDir + "/sweep.md", pngPath = outDir + "/sweep.png";
-    if (Status s = (*session)->WriteJson(jsonPath, doc); !s) {
-        std::fprintf(stderr, "%s\n", s.error().message.c_str());
-        return kExitFailed;
-    }
-    const bool plotted = Plot(jsonPath, mdPath, pngPath);
-    if (plotted) report.sections.push_back({"Plot", {report::Image{"sweep.png", "error against time"}}});
-    if (Status s = Session::WriteText(mdPath, report::RenderMarkdown(report)); !s) {
-        std::fprintf(stderr, "%s\n", s.error().message.c_str());
-        return kExitFailed;
-    }
-    std::printf("results: %s %s%s\n", jsonPath.c_str(), mdPath.c_str(), plotted ? (" " + pngPath).c_str() : "");
+    const int written =
+        WriteSweepOutputs(std::move(doc), scene.name, options.metric, *axes, stages, rows, (*session)->OutDir(),
+                          [&](const std::string& path, json d) { return (*session)->WriteJson(path, std::move(d)); });
+    if (written != kExitOk) return written;
     return anyCrashed ? kExitFailed : kExitOk;
 }
 
@@ -279,7 +219,20 @@ const CommandRegistration kRegistration({
     .helpOrder = 5,
     .extraOptions = WithIsolationOptions(
         {ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
-         TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"), RepeatOption()}),
+         TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"),
+         RepeatOption(),
+         {"--shard", "", true,
+          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+              const std::string bad = "--shard needs I/N with 1 <= I <= N, e.g. --shard 2/8";
+              if (!v) return bad;
+              int index = 0, count = 0, used = 0;
+              if (std::sscanf(v, "%d/%d%n", &index, &count, &used) != 2 || v[used] != '\0' || index < 1 ||
+                  count < index || count > 1000000)
+                  return bad + ", got '" + v + "'";
+              o.shardIndex = index;
+              o.shardCount = count;
+              return std::nullopt;
+          }}}),
     .run = Sweep,
 });
 

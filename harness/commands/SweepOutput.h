@@ -1,0 +1,44 @@
+// The output half of `cloudbench sweep`, shared with `cloudbench merge` (which
+// combines the files of `sweep --shard I/N`): the Pareto front and the
+// sweep.json, sweep.md and sweep.png writer.
+#pragma once
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/Error.h"
+#include "harness/Measurement.h"
+
+namespace cb {
+
+// One --vary field and its values, in the order given.
+struct SweepAxis {
+    std::string path;
+    std::vector<std::string> values;
+};
+
+// Pareto front per stage: no other ok row is at least as fast and as accurate
+// (on `metric`: max, mean or p99) and strictly better in one.
+void MarkPareto(std::vector<Row>& rows, const std::string& metric);
+
+// The stages a sweep over `axes` measures: a stage is left out when every
+// varied field belongs to the other one (shadow's beer form reads
+// shade.sigma, so that one counts for both).
+std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes);
+
+// Writes `path` with `doc` (and whatever provenance the writer adds).
+using SweepJsonWriter = std::function<Status(const std::string& path, nlohmann::json doc)>;
+
+// Writes OUTDIR/sweep.json (through `writeJson`), sweep.md and sweep.png, and
+// prints the tables. `doc` holds the header fields (format, scene, grid,
+// step, metric, repeats, reference_start, references, and shard when there
+// is one); "vary", "rows" and "report" are added here. `rows` (their Pareto
+// marks already set) go out stage by stage, in their order within a stage.
+// Returns kExitOk, or kExitFailed after the message when a file cannot be written.
+int WriteSweepOutputs(nlohmann::json doc, const std::string& sceneName, const std::string& metric,
+                      const std::vector<SweepAxis>& axes, const std::vector<Stage>& stages,
+                      const std::vector<Row>& rows, const std::string& outDir, const SweepJsonWriter& writeJson);
+
+}  // namespace cb
