@@ -13,7 +13,7 @@ cli, out = sys.argv[1], sys.argv[2]
 shutil.rmtree(out, ignore_errors=True)
 os.makedirs(out)
 SWEEP = ["sweep", "ci-small", "--backend", "cpu", "--steps", "12", "--repeat", "1",
-         "--vary", "shade.resolution=1,2,4", "--quiet"]
+         "--vary", "shade.sigma=0.5,1,2", "--quiet"]  # sigma: both shade and shadow are measured
 SHARDS = 2
 
 
@@ -41,12 +41,12 @@ shard_files = []
 for i in range(1, SHARDS + 1):
     run(SWEEP + ["--shard", f"{i}/{SHARDS}", "--out", f"{out}/shard{i}"])
     shard_files.append(f"{out}/shard{i}/sweep.json")
-# Shard 1 of 2 holds points 0 and 2 (k % 2 == 0): resolution 1 and 4.
+# Shard 1 of 2 holds points 0 and 2 (k % 2 == 0): sigma 0.5 and 2.
 with open(shard_files[0]) as f:
     shard1 = json.load(f)["shard"]
 assert (shard1["index"], shard1["count"], shard1["points"]) == (1, 2, 3), shard1
 assert sorted({r["point"] for r in shard1["rows"]}) == [0, 2], shard1["rows"]
-assert {r["settings"][0][1] for r in shard1["rows"]} == {"1", "4"}, shard1["rows"]
+assert {r["settings"][0][1] for r in shard1["rows"]} == {"0.5", "2"}, shard1["rows"]
 
 # Given in reverse order: merge orders by shard index and point, not by argument.
 run(["merge"] + shard_files[::-1] + ["--out", f"{out}/merged"])
@@ -55,7 +55,8 @@ if [deterministic(r) for r in whole] != [deterministic(r) for r in merged]:
     sys.exit("FAIL: merged rows differ from the unsharded sweep:\n" +
              json.dumps([deterministic(r) for r in whole], indent=1) + "\n" +
              json.dumps([deterministic(r) for r in merged], indent=1))
-assert len(whole) == 3, whole  # 3 points x cpu; shade.resolution leaves the shadow stage out
+assert len(whole) == 6, whole  # 3 points x 2 stages (shade, shadow) x cpu
+assert [r["stage"] for r in whole] == ["shade"] * 3 + ["shadow"] * 3, whole  # by stage, then point
 # The merged Pareto front is recomputed over all rows: per stage, a marked row
 # is never dominated by another ok row (on median time and max error).
 for r in merged:
