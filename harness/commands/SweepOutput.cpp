@@ -118,7 +118,9 @@ int WriteSweepOutputs(json doc, const std::string& sceneName, const std::string&
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
     }
-    const bool plotted = Plot(jsonPath, mdPath, pngPath);
+    // Nothing to plot without a measured row (an empty shard, or every backend unavailable).
+    const bool measured = std::ranges::any_of(rows, [](const Row& r) { return r.result.status == "ok"; });
+    const bool plotted = measured && Plot(jsonPath, mdPath, pngPath);
     if (plotted) report.sections.push_back({"Plot", {report::Image{"sweep.png", "error against time"}}});
     if (Status s = Session::WriteText(mdPath, report::RenderMarkdown(report)); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
