@@ -114,6 +114,21 @@ double Quantile(const std::vector<double>& sorted, double p) {
     return sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - double(lo));
 }
 
+// Every series' x and y values pooled (for the axes' ranges), and the series' names (for the legend).
+struct PooledSeries {
+    std::vector<double> xs, ys;
+    std::vector<std::string> names;
+};
+PooledSeries Pooled(const std::vector<Series>& series) {
+    PooledSeries out;
+    for (const Series& s : series) {
+        out.xs.insert(out.xs.end(), s.x.begin(), s.x.end());
+        out.ys.insert(out.ys.end(), s.y.begin(), s.y.end());
+        out.names.push_back(s.name);
+    }
+    return out;
+}
+
 }  // namespace
 
 double Axis::ToPixel(double value, double pixelLo, double pixelHi) const {
@@ -236,13 +251,7 @@ std::string RenderBoxPlot(const BoxPlot& plot) {
 }
 
 std::string RenderHistoryPlot(const LinePlot& plot) {
-    std::vector<double> xs, ys;
-    std::vector<std::string> names;
-    for (const Series& s : plot.series) {
-        xs.insert(xs.end(), s.x.begin(), s.x.end());
-        ys.insert(ys.end(), s.y.begin(), s.y.end());
-        names.push_back(s.name);
-    }
+    const auto [xs, ys, names] = Pooled(plot.series);
     auto [xlo, xhi] = RangeOf(xs, false);
     auto [ylo, yhi] = RangeOf(ys, false);
     const Axis x = MakeAxis(xlo, xhi, false, 8);
@@ -293,13 +302,7 @@ std::vector<std::pair<double, double>> ParetoFront(std::vector<std::pair<double,
 }
 
 std::string RenderParetoPlot(const ScatterPlot& plot) {
-    std::vector<double> xs, ys;
-    std::vector<std::string> names;
-    for (const Series& s : plot.series) {
-        xs.insert(xs.end(), s.x.begin(), s.x.end());
-        ys.insert(ys.end(), s.y.begin(), s.y.end());
-        names.push_back(s.name);
-    }
+    const auto [xs, ys, names] = Pooled(plot.series);
     auto [xlo, xhi] = RangeOf(xs, plot.logX);
     const bool logX = plot.logX && xlo <= xhi && RangeOf(xs, false).first > 0;
     if (!logX) std::tie(xlo, xhi) = RangeOf(xs, false);
