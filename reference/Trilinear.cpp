@@ -15,8 +15,8 @@
 //   margin far above that copy's rounding and the scene is
 //   RTC_SCENE_FLAG_ROBUST, so every box the exact ray crosses is visited. The
 //   callback works on the exact double ray kept in the ray's context.
-// - All clipping is in double; every plane p of an axis gives t = (p - o)/d
-//   by one expression wherever it appears, so neighbouring pieces meet at the
+// - All clipping is in double; every plane p of an axis gives t = (p - o)/d,
+//   computed as (p - o) * (1/d), by one expression wherever it appears, so neighbouring pieces meet at the
 //   same t. An axis with d = 0 uses half-open intervals [lo, hi), closed at the
 //   box's upper face, so a ray in a shared face counts once and a ray in the
 //   box's face counts (the box is closed).
@@ -56,15 +56,16 @@ struct TriGeometry {
 struct TriRayContext {
     RTCIntersectContext base;
     double o[3], d[3];  // the exact ray
+    double inv[3];      // 1 / d (unused where d = 0)
     double t0 = 0, t1 = 0;  // integrate over [t0, t1], already inside the box
     double sum = 0;
 };
 
-// Clips [t0, t1] to lo <= o + t d <= hi along one axis. With d = 0 the slab is
-// [lo, hi), or [lo, hi] when closedHi. False if empty.
-inline bool TriClip(double o, double d, double lo, double hi, bool closedHi, double& t0, double& t1) {
+// Clips [t0, t1] to lo <= o + t d <= hi along one axis (inv = 1 / d). With
+// d = 0 the slab is [lo, hi), or [lo, hi] when closedHi. False if empty.
+inline bool TriClip(double o, double d, double inv, double lo, double hi, bool closedHi, double& t0, double& t1) {
     if (d == 0.0) return lo <= o && (o < hi || (closedHi && o == hi));
-    double ta = (lo - o) / d, tb = (hi - o) / d;
+    double ta = (lo - o) * inv, tb = (hi - o) * inv;
     if (ta > tb) std::swap(ta, tb);
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
@@ -114,11 +115,12 @@ void TriIntersect(const RTCIntersectFunctionNArguments* args) {
     const TriRun& r = g.runs[args->primID];
     const double* o = ctx.o;
     const double* d = ctx.d;
+    const double* inv = ctx.inv;
     const Extent3& e = g.extent;
     double t0 = ctx.t0, t1 = ctx.t1;
-    if (!TriClip(o[1], d[1], TriLo(r.b), TriHi(r.b + 1, e.ny), r.b + 1 == int32_t(e.ny), t0, t1) ||
-        !TriClip(o[2], d[2], TriLo(r.c), TriHi(r.c + 1, e.nz), r.c + 1 == int32_t(e.nz), t0, t1) ||
-        !TriClip(o[0], d[0], TriLo(r.a0), TriHi(r.a1, e.nx), r.a1 == int32_t(e.nx), t0, t1))
+    if (!TriClip(o[1], d[1], inv[1], TriLo(r.b), TriHi(r.b + 1, e.ny), r.b + 1 == int32_t(e.ny), t0, t1) ||
+        !TriClip(o[2], d[2], inv[2], TriLo(r.c), TriHi(r.c + 1, e.nz), r.c + 1 == int32_t(e.nz), t0, t1) ||
+        !TriClip(o[0], d[0], inv[0], TriLo(r.a0), TriHi(r.a1, e.nx), r.a1 == int32_t(e.nx), t0, t1))
         return;
     // The dual cells of the run between x(t0) and x(t1); cells at the ends that
     // rounding put in the range get an empty piece.
@@ -137,8 +139,8 @@ void TriIntersect(const RTCIntersectFunctionNArguments* args) {
     for (int32_t a = first; a <= last; ++a) {
         double ta = t0, tb = t1;
         if (d[0] != 0.0) {
-            double pa = (std::max(0.0, a + 0.5) - o[0]) / d[0];
-            double pb = (std::min(double(e.nx), a + 1.5) - o[0]) / d[0];
+            double pa = (std::max(0.0, a + 0.5) - o[0]) * inv[0];
+            double pb = (std::min(double(e.nx), a + 1.5) - o[0]) * inv[0];
             if (pa > pb) std::swap(pa, pb);
             ta = std::max(ta, pa);
             tb = std::min(tb, pb);
@@ -290,7 +292,8 @@ double TrilinearDepthTracer::Integrate(const Point3d& origin, const Point3d& dir
     for (int a = 0; a < 3; ++a) {
         ctx.o[a] = origin[a];
         ctx.d[a] = dir[a];
-        if (!TriClip(origin[a], dir[a], 0.0, double(n[a]), true, t0, t1)) return 0.0;
+        ctx.inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
+        if (!TriClip(origin[a], dir[a], ctx.inv[a], 0.0, double(n[a]), true, t0, t1)) return 0.0;
     }
     ctx.t0 = t0;
     ctx.t1 = t1;
