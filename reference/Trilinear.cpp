@@ -52,13 +52,20 @@ struct TriGeometry {
     float margin = 0;  // box padding for the float ray Embree traces
 };
 
-// Per-ray state. `base` must come first: Embree hands the callback &base.
+// One ray's state: the exact ray, its range and its accumulator.
+struct TriLane {
+    double o[3], d[3];
+    double inv[3];  // 1 / d (unused where d = 0)
+    double t0, t1;  // integrate over [t0, t1], already inside the box
+    double sum;
+};
+
+// Up to 16 rays (a packet); a ray's `id` is its lane. `base` must come first:
+// Embree hands the callback &base.
+constexpr int kTriPacket = 16;
 struct TriRayContext {
     RTCIntersectContext base;
-    double o[3], d[3];  // the exact ray
-    double inv[3];      // 1 / d (unused where d = 0)
-    double t0 = 0, t1 = 0;  // integrate over [t0, t1], already inside the box
-    double sum = 0;
+    TriLane lane[kTriPacket];
 };
 
 // Clips [t0, t1] to lo <= o + t d <= hi along one axis (inv = 1 / d). With
@@ -108,16 +115,13 @@ inline double TriCellIntegral(const double c[8], double ox, double oy, double oz
     return half * sum;
 }
 
-void TriIntersect(const RTCIntersectFunctionNArguments* args) {
-    if (args->N != 1 || !args->valid[0]) return;  // rtcIntersect1 only
-    const TriGeometry& g = *static_cast<const TriGeometry*>(args->geometryUserPtr);
-    TriRayContext& ctx = *reinterpret_cast<TriRayContext*>(args->context);
-    const TriRun& r = g.runs[args->primID];
-    const double* o = ctx.o;
-    const double* d = ctx.d;
-    const double* inv = ctx.inv;
+// Adds run r's part of one ray to the ray's accumulator.
+void TriAccumulate(const TriGeometry& g, const TriRun& r, TriLane& lane) {
+    const double* o = lane.o;
+    const double* d = lane.d;
+    const double* inv = lane.inv;
     const Extent3& e = g.extent;
-    double t0 = ctx.t0, t1 = ctx.t1;
+    double t0 = lane.t0, t1 = lane.t1;
     if (!TriClip(o[1], d[1], inv[1], TriLo(r.b), TriHi(r.b + 1, e.ny), r.b + 1 == int32_t(e.ny), t0, t1) ||
         !TriClip(o[2], d[2], inv[2], TriLo(r.c), TriHi(r.c + 1, e.nz), r.c + 1 == int32_t(e.nz), t0, t1) ||
         !TriClip(o[0], d[0], inv[0], TriLo(r.a0), TriHi(r.a1, e.nx), r.a1 == int32_t(e.nx), t0, t1))
@@ -150,7 +154,42 @@ void TriIntersect(const RTCIntersectFunctionNArguments* args) {
         const double c[8] = {p[0], p[1], p[px], p[px + 1], p[pxy], p[pxy + 1], p[pxy + px], p[pxy + px + 1]};
         sum += TriCellIntegral(c, o[0] - (a + 0.5), oy, oz, d, ta, tb);
     }
-    ctx.sum += sum;
+    lane.sum += sum;
+}
+
+// Single rays and packets alike: each valid ray's id names its lane.
+void TriIntersect(const RTCIntersectFunctionNArguments* args) {
+    const TriGeometry& g = *static_cast<const TriGeometry*>(args->geometryUserPtr);
+    TriRayContext& ctx = *reinterpret_cast<TriRayContext*>(args->context);
+    const TriRun& r = g.runs[args->primID];
+    RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i]) TriAccumulate(g, r, ctx.lane[RTCRayN_id(rays, args->N, i)]);
+}
+
+// Sets up one ray: the exact ray clipped to the box in `lane`, and the float
+// copy Embree traces from the box entry over the clipped length plus the
+// margin. False if the ray misses the box.
+bool TriSetup(const TriGeometry& g, const Point3d& origin, const Point3d& dir, double tMin, double tMax,
+              TriLane& lane, float org[3], float dirF[3], float& tfar) {
+    if (!(tMin < tMax)) return false;
+    double t0 = tMin, t1 = tMax;
+    const uint32_t n[3] = {g.extent.nx, g.extent.ny, g.extent.nz};
+    for (int a = 0; a < 3; ++a) {
+        lane.o[a] = origin[a];
+        lane.d[a] = dir[a];
+        lane.inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
+        if (!TriClip(origin[a], dir[a], lane.inv[a], 0.0, double(n[a]), true, t0, t1)) return false;
+    }
+    lane.t0 = t0;
+    lane.t1 = t1;
+    lane.sum = 0;
+    for (int a = 0; a < 3; ++a) {
+        org[a] = float(origin[a] + t0 * dir[a]);
+        dirF[a] = float(dir[a]);
+    }
+    tfar = float((t1 - t0) * (1.0 + 1e-6) + 4.0 * g.margin);
+    return true;
 }
 
 void TriOccluded(const RTCOccludedFunctionNArguments*) {}
@@ -179,6 +218,7 @@ struct TrilinearDepthTracer::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     tbb::task_arena arena;
+    bool packets = true;
 
     explicit Impl(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
     ~Impl() {
@@ -186,15 +226,56 @@ struct TrilinearDepthTracer::Impl {
         if (device) rtcReleaseDevice(device);
     }
 
-    // A batch: depth(i) for every point, in parallel.
-    template <class Depth>
-    std::vector<double> Batch(size_t n, Depth depth, TraceStats* stats) {
+    // Rays [begin, end) (at most 16) as one packet; ray(i, lane, org, dir,
+    // tfar) sets ray i up (TriSetup). Writes each ray's depth to out[i].
+    template <class Ray>
+    void Packet(size_t begin, size_t end, Ray ray, double* out) const {
+        TriRayContext ctx;
+        rtcInitIntersectContext(&ctx.base);
+        alignas(64) RTCRayHit16 rh;
+        alignas(64) int valid[kTriPacket];
+        bool any = false;
+        for (int l = 0; l < kTriPacket; ++l) {
+            const size_t i = begin + size_t(l);
+            float org[3] = {0, 0, 0}, dir[3] = {0, 0, 1}, tfar = 0;
+            const bool live = i < end && ray(i, ctx.lane[l], org, dir, tfar);
+            valid[l] = live ? -1 : 0;
+            if (!live) ctx.lane[l].sum = 0;
+            any = any || live;
+            rh.ray.org_x[l] = org[0];
+            rh.ray.org_y[l] = org[1];
+            rh.ray.org_z[l] = org[2];
+            rh.ray.dir_x[l] = dir[0];
+            rh.ray.dir_y[l] = dir[1];
+            rh.ray.dir_z[l] = dir[2];
+            rh.ray.tnear[l] = 0.0f;
+            rh.ray.tfar[l] = tfar;
+            rh.ray.time[l] = 0.0f;
+            rh.ray.mask[l] = ~0u;
+            rh.ray.id[l] = unsigned(l);
+            rh.ray.flags[l] = 0;
+            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+        }
+        if (any) rtcIntersect16(valid, scene, &ctx.base, &rh);
+        for (size_t i = begin; i < end; ++i) out[i] = ctx.lane[i - begin].sum;
+    }
+
+    // A batch: depth(i) for every point, in parallel; with packets on,
+    // packet(begin, end, out) does 16 at a time.
+    template <class Depth, class PacketFn>
+    std::vector<double> Batch(size_t n, Depth depth, PacketFn packet, TraceStats* stats) {
         std::vector<double> out(n, 0.0);
         const auto start = std::chrono::steady_clock::now();
         if (!geometry.runs.empty())
             arena.execute([&] {
                 tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
-                    for (size_t i = r.begin(); i != r.end(); ++i) out[i] = depth(i);
+                    if (packets) {
+                        for (size_t i = r.begin(); i < r.end(); i += kTriPacket)
+                            packet(i, std::min(r.end(), i + kTriPacket), out.data());
+                    } else {
+                        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = depth(i);
+                    }
                 });
             });
         if (stats) {
@@ -209,6 +290,8 @@ TrilinearDepthTracer::TrilinearDepthTracer(const Extent3& extent) : mExtent(exte
 TrilinearDepthTracer::~TrilinearDepthTracer() = default;
 
 size_t TrilinearDepthTracer::Primitives() const { return mImpl->geometry.runs.size(); }
+
+void TrilinearDepthTracer::UsePackets(bool on) { mImpl->packets = on; }
 
 Result<std::unique_ptr<TrilinearDepthTracer>> TrilinearDepthTracer::Create(const Extent3& extent,
                                                                            std::span<const float> q, int threads) {
@@ -284,35 +367,26 @@ Result<std::unique_ptr<TrilinearDepthTracer>> TrilinearDepthTracer::Create(const
 
 double TrilinearDepthTracer::Integrate(const Point3d& origin, const Point3d& dir, double tMin, double tMax) const {
     const TriGeometry& g = mImpl->geometry;
-    if (g.runs.empty() || !(tMin < tMax)) return 0.0;
+    if (g.runs.empty()) return 0.0;
     TriRayContext ctx;
     rtcInitIntersectContext(&ctx.base);
-    double t0 = tMin, t1 = tMax;
-    const uint32_t n[3] = {g.extent.nx, g.extent.ny, g.extent.nz};
-    for (int a = 0; a < 3; ++a) {
-        ctx.o[a] = origin[a];
-        ctx.d[a] = dir[a];
-        ctx.inv[a] = dir[a] != 0.0 ? 1.0 / dir[a] : 0.0;
-        if (!TriClip(origin[a], dir[a], ctx.inv[a], 0.0, double(n[a]), true, t0, t1)) return 0.0;
-    }
-    ctx.t0 = t0;
-    ctx.t1 = t1;
-    // Embree traces a float copy from the box entry over the clipped length
-    // (plus the margin); the callback integrates the exact double ray.
     alignas(16) RTCRayHit rh{};
-    rh.ray.org_x = float(origin[0] + t0 * dir[0]);
-    rh.ray.org_y = float(origin[1] + t0 * dir[1]);
-    rh.ray.org_z = float(origin[2] + t0 * dir[2]);
-    rh.ray.dir_x = float(dir[0]);
-    rh.ray.dir_y = float(dir[1]);
-    rh.ray.dir_z = float(dir[2]);
+    float org[3], dirF[3], tfar;
+    if (!TriSetup(g, origin, dir, tMin, tMax, ctx.lane[0], org, dirF, tfar)) return 0.0;
+    rh.ray.org_x = org[0];
+    rh.ray.org_y = org[1];
+    rh.ray.org_z = org[2];
+    rh.ray.dir_x = dirF[0];
+    rh.ray.dir_y = dirF[1];
+    rh.ray.dir_z = dirF[2];
     rh.ray.tnear = 0.0f;
-    rh.ray.tfar = float((t1 - t0) * (1.0 + 1e-6) + 4.0 * g.margin);
+    rh.ray.tfar = tfar;
     rh.ray.mask = ~0u;
+    rh.ray.id = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(mImpl->scene, &ctx.base, &rh);
-    return ctx.sum;
+    return ctx.lane[0].sum;
 }
 
 double TrilinearDepthTracer::IntegrateSegment(const Point3d& a, const Point3d& b) const {
@@ -327,12 +401,39 @@ std::vector<double> TrilinearDepthTracer::DepthsToward(std::span<const Point3d> 
     const double length = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
     if (!(length > 0)) return std::vector<double>(points.size(), 0.0);
     const Point3d u = {dir[0] / length, dir[1] / length, dir[2] / length};
-    return mImpl->Batch(points.size(), [&](size_t i) { return Integrate(points[i], u, 0.0, kTriInf); }, stats);
+    const TriGeometry& g = mImpl->geometry;
+    return mImpl->Batch(
+        points.size(), [&](size_t i) { return Integrate(points[i], u, 0.0, kTriInf); },
+        [&](size_t begin, size_t end, double* out) {
+            mImpl->Packet(
+                begin, end,
+                [&](size_t i, TriLane& lane, float* org, float* dirF, float& tfar) {
+                    return TriSetup(g, points[i], u, 0.0, kTriInf, lane, org, dirF, tfar);
+                },
+                out);
+        },
+        stats);
 }
 
 std::vector<double> TrilinearDepthTracer::DepthsToPoint(std::span<const Point3d> points, const Point3d& target,
                                                         TraceStats* stats) const {
-    return mImpl->Batch(points.size(), [&](size_t i) { return IntegrateSegment(points[i], target); }, stats);
+    const TriGeometry& g = mImpl->geometry;
+    return mImpl->Batch(
+        points.size(), [&](size_t i) { return IntegrateSegment(points[i], target); },
+        [&](size_t begin, size_t end, double* out) {
+            mImpl->Packet(
+                begin, end,
+                [&](size_t i, TriLane& lane, float* org, float* dirF, float& tfar) {
+                    const Point3d& a = points[i];
+                    const Point3d v = {target[0] - a[0], target[1] - a[1], target[2] - a[2]};
+                    const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                    if (!(length > 0)) return false;
+                    const Point3d u = {v[0] / length, v[1] / length, v[2] / length};
+                    return TriSetup(g, a, u, 0.0, length, lane, org, dirF, tfar);
+                },
+                out);
+        },
+        stats);
 }
 
 namespace {

@@ -69,6 +69,12 @@ class TrilinearDepthTracer {
     std::vector<float> TransmittanceToPoint(std::span<const Point3d> points, const Point3d& target, double sigmaH,
                                             TraceStats* stats = nullptr) const;
 
+    // Batches trace packets of 16 rays (rtcIntersect16, the default) or
+    // single rays (rtcIntersect1); the depths agree to rounding (the order in
+    // which a ray's runs are summed may differ). Not to be called while a
+    // batch runs.
+    void UsePackets(bool on);
+
     const Extent3& Extent() const { return mExtent; }
     // Boxes in the Embree scene (runs of dual cells along x).
     size_t Primitives() const;

@@ -366,9 +366,10 @@ TEST(ReferenceTrilinear, SegmentsStopAtTheEndAndAreSymmetric) {
     }
 }
 
-// Test the sun batch: it equals single rays to the box edge, is the same with
-// 1 and 2 threads, normalises its direction, and stays finite in [0, 1] for
-// sigma h = 0 and 1e6.
+// Test the sun batch: it equals single rays to the box edge (to rounding: a
+// packet may visit a ray's runs in another order), with 16-ray packets and
+// with single rays, 1 and 2 threads; it normalises its direction, and stays
+// finite in [0, 1] for sigma h = 0 and 1e6.
 TEST(ReferenceTrilinear, SunBatchMatchesSingleRays) {
     const Extent3 e{12, 9, 7};
     Pcg32 rng(31);
@@ -380,19 +381,25 @@ TEST(ReferenceTrilinear, SunBatchMatchesSingleRays) {
     for (uint32_t k = 0; k < e.nz; ++k)
         for (uint32_t j = 0; j < e.ny; ++j)
             for (uint32_t i = 0; i < e.nx; ++i) points.push_back({i + 0.5, j + 0.5, k + 0.5});
+    points.push_back({-5, 4, 3});  // outside, aimed away from the box: 0
     const Point3d sun = {0.4, -0.3, 0.6};  // not unit: the batch normalises it
     const double norm = std::sqrt(0.16 + 0.09 + 0.36);
     const Point3d unit = {0.4 / norm, -0.3 / norm, 0.6 / norm};
     ref::TraceStats stats;
     const std::vector<double> a = one->DepthsToward(points, sun, &stats);
     const std::vector<double> b = two->DepthsToward(points, sun);
+    two->UsePackets(false);
+    const std::vector<double> c = two->DepthsToward(points, sun);
     EXPECT_EQ(stats.rays, points.size());
+    EXPECT_EQ(a.back(), 0.0);
     for (size_t i = 0; i < points.size(); ++i) {
-        ASSERT_EQ(a[i], b[i]) << i;
-        ASSERT_EQ(a[i], one->Integrate(points[i], unit, 0, kTriTestInf)) << i;
+        const double single = one->Integrate(points[i], unit, 0, kTriTestInf);
+        ASSERT_NEAR(a[i], single, 1e-13 * (1 + single)) << i;
+        ASSERT_NEAR(b[i], single, 1e-13 * (1 + single)) << i;
+        ASSERT_EQ(c[i], single) << i;  // single rays: the same code, the same order
     }
     for (double sigmaH : {0.0, 1e6}) {
-        const std::vector<float> T = two->TransmittanceToward(points, sun, sigmaH);
+        const std::vector<float> T = one->TransmittanceToward(points, sun, sigmaH);
         for (size_t i = 0; i < points.size(); ++i) {
             ASSERT_TRUE(T[i] >= 0.0f && T[i] <= 1.0f) << i;
             if (sigmaH == 0.0) {
@@ -402,6 +409,26 @@ TEST(ReferenceTrilinear, SunBatchMatchesSingleRays) {
                 ASSERT_EQ(T[i], 0.0f);
             }
         }
+    }
+}
+
+// Test point-light packets against single rays, with points on the light,
+// beside it and outside the box.
+TEST(ReferenceTrilinear, PointPacketsMatchSingleRays) {
+    const Extent3 e{11, 10, 6};
+    Pcg32 rng(8);
+    const std::vector<float> q = TriRandomGrid(rng, e, 0.5);
+    auto tracer = TriTrace(e, q, 2);
+    const Point3d light = {4.2, 5.5, 2.9};
+    std::vector<Point3d> points = {light, {4.2, 5.5, 3.0}, {-3, -3, -3}, {20, 5, 3}};
+    for (int r = 0; r < 500; ++r) points.push_back({rng.Uniform(-1, 12), rng.Uniform(-1, 11), rng.Uniform(-1, 7)});
+    const std::vector<double> packets = tracer->DepthsToPoint(points, light);
+    tracer->UsePackets(false);
+    const std::vector<double> single = tracer->DepthsToPoint(points, light);
+    EXPECT_EQ(packets[0], 0.0);
+    for (size_t i = 0; i < points.size(); ++i) {
+        ASSERT_EQ(single[i], tracer->IntegrateSegment(points[i], light)) << i;
+        ASSERT_NEAR(packets[i], single[i], 1e-13 * (1 + single[i])) << i;
     }
 }
 

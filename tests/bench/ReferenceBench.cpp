@@ -155,6 +155,7 @@ void TriBuild(benchmark::State& state) {
 void TriSun(benchmark::State& state) {
     const BlobField& f = Blob128();
     auto tracer = TriTracer(f, int(state.range(0)));
+    tracer->UsePackets(state.range(1) != 0);
     const std::vector<ref::Point3d> points = VoxelCentres(f.grid);
     for (auto _ : state) benchmark::DoNotOptimize(tracer->TransmittanceToward(points, BlobSun(), 1.0));
     state.counters["rays/s"] = benchmark::Counter(double(points.size()), benchmark::Counter::kIsIterationInvariantRate);
@@ -163,6 +164,7 @@ void TriSun(benchmark::State& state) {
 void TriPointLight(benchmark::State& state) {
     const BlobField& f = Blob128();
     auto tracer = TriTracer(f, int(state.range(0)));
+    tracer->UsePackets(state.range(1) != 0);
     const std::vector<ref::Point3d> points = VoxelCentres(f.grid);
     for (auto _ : state) benchmark::DoNotOptimize(tracer->TransmittanceToPoint(points, {64.0, 64.0, 40.0}, 1.0));
     state.counters["rays/s"] = benchmark::Counter(double(points.size()), benchmark::Counter::kIsIterationInvariantRate);
@@ -187,11 +189,12 @@ BENCHMARK(TriBuild)->Name("Trilinear/build/blob128")->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
-BENCHMARK(TriSun)->Name("Trilinear/sun/blob128")->Arg(1)->Arg(2)
+// Arguments: threads, packets (1: 16-ray packets, 0: single rays).
+BENCHMARK(TriSun)->Name("Trilinear/sun/blob128")->Args({1, 0})->Args({1, 1})->Args({2, 0})->Args({2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
-BENCHMARK(TriPointLight)->Name("Trilinear/point/blob128")->Arg(2)
+BENCHMARK(TriPointLight)->Name("Trilinear/point/blob128")->Args({2, 0})->Args({2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
