@@ -46,7 +46,7 @@ struct TriRun {
 
 struct TriGeometry {
     Extent3 extent;
-    uint32_t px = 0, py = 0;   // padded sizes nx + 2, ny + 2
+    uint32_t px = 0, py = 0;    // padded sizes nx + 2, ny + 2
     std::vector<float> padded;  // q(i,j,k) at (i+1) + px ((j+1) + py (k+1)); zero border
     std::vector<TriRun> runs;
     float margin = 0;  // box padding for the float ray Embree traces
@@ -170,8 +170,8 @@ void TriIntersect(const RTCIntersectFunctionNArguments* args) {
 // Sets up one ray: the exact ray clipped to the box in `lane`, and the float
 // copy Embree traces from the box entry over the clipped length plus the
 // margin. False if the ray misses the box.
-bool TriSetup(const TriGeometry& g, const Point3d& origin, const Point3d& dir, double tMin, double tMax,
-              TriLane& lane, float org[3], float dirF[3], float& tfar) {
+bool TriSetup(const TriGeometry& g, const Point3d& origin, const Point3d& dir, double tMin, double tMax, TriLane& lane,
+              float org[3], float dirF[3], float& tfar) {
     if (!(tMin < tMax)) return false;
     double t0 = tMin, t1 = tMax;
     const uint32_t n[3] = {g.extent.nx, g.extent.ny, g.extent.nz};

@@ -50,14 +50,16 @@ double TriField(const Extent3& e, const std::vector<float>& q, const Point3d& x)
     return sum;
 }
 
-Point3d TriAt(const Point3d& o, const Point3d& d, double t) { return {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]}; }
+Point3d TriAt(const Point3d& o, const Point3d& d, double t) {
+    return {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+}
 
 // A finite end for a ray to infinity: past the box from anywhere we test.
 double TriFiniteEnd(const Extent3& e, double t) { return std::min(t, 4.0 * (e.nx + e.ny + e.nz + 10)); }
 
 // Composite midpoint rule with `steps` equal steps over [t0, t1]: the brute force.
 double TriMidpoint(const Extent3& e, const std::vector<float>& q, const Point3d& o, const Point3d& d, double t0,
-                double t1, size_t steps) {
+                   double t1, size_t steps) {
     const double h = (t1 - t0) / double(steps);
     double sum = 0;
     for (size_t s = 0; s < steps; ++s) sum += TriField(e, q, TriAt(o, d, t0 + (s + 0.5) * h));
@@ -68,7 +70,7 @@ double TriMidpoint(const Extent3& e, const std::vector<float>& q, const Point3d&
 // faces splits the ray; on each piece the field is one cubic, integrated by
 // 2-point Gauss-Legendre at TriField above.
 double TriDualWalk(const Extent3& e, const std::vector<float>& q, const Point3d& o, const Point3d& d, double t0,
-                double t1) {
+                   double t1) {
     const uint32_t n[3] = {e.nx, e.ny, e.nz};
     std::vector<double> cuts = {t0, t1};
     for (int a = 0; a < 3; ++a) {
@@ -122,10 +124,14 @@ std::vector<TriTestRay> TriRandomRays(Pcg32& rng, const Extent3& e, int perKind)
     auto special = [&](int a) {
         const uint32_t m = uint32_t(n[a]);
         switch (rng.NextU32() % 4) {
-            case 0: return 0.0;
-            case 1: return n[a];
-            case 2: return double(rng.NextU32() % (m + 1));
-            default: return (rng.NextU32() % m) + 0.5;
+            case 0:
+                return 0.0;
+            case 1:
+                return n[a];
+            case 2:
+                return double(rng.NextU32() % (m + 1));
+            default:
+                return (rng.NextU32() % m) + 0.5;
         }
     };
     std::vector<TriTestRay> rays;
@@ -183,6 +189,7 @@ bool TriClipToBox(const Extent3& e, const TriTestRay& r, double& t0, double& t1)
     return t0 < t1;
 }
 
+// Test that a q whose size is not the grid's is refused.
 TEST(ReferenceTrilinear, RefusesAWrongSize) {
     const std::vector<float> q(5, 1.0f);
     EXPECT_FALSE(TrilinearDepthTracer::Create(Extent3{2, 2, 2}, q).has_value());
@@ -299,8 +306,8 @@ TEST(ReferenceTrilinear, MatchesMidpointBruteForce) {
             const double bound = h * h * qMax * (length / 4 + kinks / 4);
             worst = std::max(worst, std::fabs(got - brute));
             ASSERT_NEAR(got, brute, bound + 1e-12 * (1 + brute))
-                << r.kind << " grid " << e.nx << "x" << e.ny << "x" << e.nz << " o " << r.o[0] << "," << r.o[1]
-                << "," << r.o[2] << " d " << r.d[0] << "," << r.d[1] << "," << r.d[2];
+                << r.kind << " grid " << e.nx << "x" << e.ny << "x" << e.nz << " o " << r.o[0] << "," << r.o[1] << ","
+                << r.o[2] << " d " << r.d[0] << "," << r.d[1] << "," << r.d[2];
             ++checked;
         }
     }
@@ -321,8 +328,8 @@ TEST(ReferenceTrilinear, MatchesDualCellWalk) {
             const double got = tracer->Integrate(r.o, r.d, r.t0, r.t1);
             const double walk = TriClipToBox(e, r, t0, t1) ? TriDualWalk(e, q, r.o, r.d, t0, t1) : 0.0;
             ASSERT_NEAR(got, walk, 1e-12 * (1 + walk))
-                << r.kind << " grid " << grid << " o " << r.o[0] << "," << r.o[1] << "," << r.o[2] << " d "
-                << r.d[0] << "," << r.d[1] << "," << r.d[2] << " t " << r.t0 << ".." << r.t1;
+                << r.kind << " grid " << grid << " o " << r.o[0] << "," << r.o[1] << "," << r.o[2] << " d " << r.d[0]
+                << "," << r.d[1] << "," << r.d[2] << " t " << r.t0 << ".." << r.t1;
         }
     }
 }
@@ -345,8 +352,7 @@ TEST(ReferenceTrilinear, SegmentsStopAtTheEndAndAreSymmetric) {
     const std::vector<float> q = TriRandomGrid(rng, e, 0.5);
     auto tracer = TriTrace(e, q, 2);
     std::vector<Point3d> points;
-    for (int r = 0; r < 300; ++r)
-        points.push_back({rng.Uniform(-2, 12), rng.Uniform(-2, 10), rng.Uniform(-1, 7)});
+    for (int r = 0; r < 300; ++r) points.push_back({rng.Uniform(-2, 12), rng.Uniform(-2, 10), rng.Uniform(-1, 7)});
     const Point3d target = {3.3, 4.1, 2.7};
     ref::TraceStats stats;
     const std::vector<double> toTarget = tracer->DepthsToPoint(points, target, &stats);
@@ -381,7 +387,7 @@ TEST(ReferenceTrilinear, SunBatchMatchesSingleRays) {
     for (uint32_t k = 0; k < e.nz; ++k)
         for (uint32_t j = 0; j < e.ny; ++j)
             for (uint32_t i = 0; i < e.nx; ++i) points.push_back({i + 0.5, j + 0.5, k + 0.5});
-    points.push_back({-5, 4, 3});  // outside, aimed away from the box: 0
+    points.push_back({-5, 4, 3});          // outside, aimed away from the box: 0
     const Point3d sun = {0.4, -0.3, 0.6};  // not unit: the batch normalises it
     const double norm = std::sqrt(0.16 + 0.09 + 0.36);
     const Point3d unit = {0.4 / norm, -0.3 / norm, 0.6 / norm};

@@ -185,20 +185,33 @@ void ConstantSun(benchmark::State& state) {
 }
 
 // Wall time, and the CPU time of the whole process (every thread).
-BENCHMARK(TriBuild)->Name("Trilinear/build/blob128")->Arg(2)
+BENCHMARK(TriBuild)
+    ->Name("Trilinear/build/blob128")
+    ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
 // Arguments: threads, packets (1: 16-ray packets, 0: single rays).
-BENCHMARK(TriSun)->Name("Trilinear/sun/blob128")->Args({1, 0})->Args({1, 1})->Args({2, 0})->Args({2, 1})
+BENCHMARK(TriSun)
+    ->Name("Trilinear/sun/blob128")
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({2, 0})
+    ->Args({2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
-BENCHMARK(TriPointLight)->Name("Trilinear/point/blob128")->Args({2, 0})->Args({2, 1})
+BENCHMARK(TriPointLight)
+    ->Name("Trilinear/point/blob128")
+    ->Args({2, 0})
+    ->Args({2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
-BENCHMARK(ConstantSun)->Name("Constant/sun/blob128")->Arg(1)->Arg(2)
+BENCHMARK(ConstantSun)
+    ->Name("Constant/sun/blob128")
+    ->Arg(1)
+    ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
