@@ -117,45 +117,56 @@ double SizeDensity(const Distribution& d, double r) {
     return std::exp(p * std::log(u) - (u - 1.0) / d.vEff);
 }
 
+// Per-thread work arrays of AccumulateIntensity, one entry per angle.
+struct IntensityScratch {
+    std::vector<double> piPrev, piCur, plusRe, plusIm, minusRe, minusIm;
+};
+
+// One Legendre order n at every angle: advances pi_n to pi_(n+1) (pCur, pPrev)
+// and adds c (pi_n + tau_n) to plus and d (pi_n - tau_n) to minus. Free of
+// the containers so that GCC vectorises it.
+static void AddOrder(size_t J, double n, double cr, double ci, double dr, double di, const double* __restrict mu,
+                     double* __restrict pPrev, double* __restrict pCur, double* __restrict plusRe,
+                     double* __restrict plusIm, double* __restrict minusRe, double* __restrict minusIm) {
+    const double np1 = n + 1, tnp1 = 2 * n + 1, invN = 1.0 / n;
+    for (size_t j = 0; j < J; ++j) {
+        const double p = pCur[j], q = pPrev[j], mp = mu[j] * p, nq = np1 * q;
+        const double tau = n * mp - nq;
+        const double u = p + tau, v = p - tau;
+        plusRe[j] += cr * u;
+        plusIm[j] += ci * u;
+        minusRe[j] += dr * v;
+        minusIm[j] += di * v;
+        pPrev[j] = p;
+        pCur[j] = (tnp1 * mp - nq) * invN;
+    }
+}
+
 // |S1|^2 + |S2|^2 at the cosines, times w, added to `sum`. The same sums as
 // ComputeAmplitudes, arranged for speed: |S1|^2 + |S2|^2 = (|S+|^2 + |S-|^2)/2
 // with S+- = S1 +- S2 = sum f_n (a_n +- b_n)(pi_n +- tau_n), and the angles as
-// the inner loop (vectorised). `scratch` holds 6 arrays of cosTheta.size().
+// the inner loop (vectorised).
 static void AccumulateIntensity(const Coefficients& c, std::span<const double> cosTheta, double w,
-                                std::vector<double>& sum, std::vector<double>& scratch) {
+                                std::vector<double>& sum, IntensityScratch& s) {
     const size_t J = cosTheta.size();
-    scratch.assign(6 * J, 0.0);
-    double* const pPrev = scratch.data();
-    double* const pCur = pPrev + J;
-    double* const plusRe = pCur + J;
-    double* const plusIm = plusRe + J;
-    double* const minusRe = plusIm + J;
-    double* const minusIm = minusRe + J;
-    const double* const mu = cosTheta.data();
-    for (size_t j = 0; j < J; ++j) pCur[j] = 1.0;  // pi_1 = 1, pi_0 = 0
+    s.piPrev.assign(J, 0.0);  // pi_0
+    s.piCur.assign(J, 1.0);   // pi_1
+    s.plusRe.assign(J, 0.0);
+    s.plusIm.assign(J, 0.0);
+    s.minusRe.assign(J, 0.0);
+    s.minusIm.assign(J, 0.0);
     const size_t N = c.a.size();
     for (size_t i = 0; i < N; ++i) {
         const double n = double(i + 1);
         const double f = (2 * n + 1) / (n * (n + 1));
         const std::complex<double> plus = f * (c.a[i] + c.b[i]), minus = f * (c.a[i] - c.b[i]);
-        const double cr = plus.real(), ci = plus.imag(), dr = minus.real(), di = minus.imag();
-        const double np1 = n + 1, tnp1 = 2 * n + 1, invN = 1.0 / n;
-        for (size_t j = 0; j < J; ++j) {
-            const double p = pCur[j], q = pPrev[j];
-            const double tau = n * mu[j] * p - np1 * q;
-            const double u = p + tau, v = p - tau;
-            plusRe[j] += cr * u;
-            plusIm[j] += ci * u;
-            minusRe[j] += dr * v;
-            minusIm[j] += di * v;
-            pPrev[j] = p;
-            pCur[j] = (tnp1 * mu[j] * p - np1 * q) * invN;
-        }
+        AddOrder(J, n, plus.real(), plus.imag(), minus.real(), minus.imag(), cosTheta.data(), s.piPrev.data(),
+                 s.piCur.data(), s.plusRe.data(), s.plusIm.data(), s.minusRe.data(), s.minusIm.data());
     }
     const double half = 0.5 * w;
     for (size_t j = 0; j < J; ++j)
-        sum[j] += half * (plusRe[j] * plusRe[j] + plusIm[j] * plusIm[j] + minusRe[j] * minusRe[j] +
-                          minusIm[j] * minusIm[j]);
+        sum[j] += half * (s.plusRe[j] * s.plusRe[j] + s.plusIm[j] * s.plusIm[j] + s.minusRe[j] * s.minusRe[j] +
+                          s.minusIm[j] * s.minusIm[j]);
 }
 
 Averaged AverageOverDistribution(const Distribution& d, std::span<const double> cosTheta, unsigned threads) {
@@ -172,7 +183,7 @@ Averaged AverageOverDistribution(const Distribution& d, std::span<const double> 
     std::vector<Partial> partial(threads);
     auto work = [&](unsigned t) {
         Partial& p = partial[t];
-        std::vector<double> scratch;
+        IntensityScratch scratch;
         p.intensity.assign(cosTheta.size(), 0.0);
         for (uint32_t i = t; i < nodes; i += threads) {
             const double r = d.rMin + h * double(i);
