@@ -62,8 +62,7 @@ Efficiencies ComputeEfficiencies(const Coefficients& c) {
         back += (2 * n + 1) * ((i % 2 == 0) ? -1.0 : 1.0) * (an - bn);  // (-1)^n
         // g Q_sca x^2 / 4 = sum n(n+2)/(n+1) Re(a_n a*_{n+1} + b_n b*_{n+1}) + (2n+1)/(n(n+1)) Re(a_n b*_n)
         asy += (2 * n + 1) / (n * (n + 1)) * (an * std::conj(bn)).real();
-        if (i + 1 < N)
-            asy += n * (n + 2) / (n + 1) * (an * std::conj(c.a[i + 1]) + bn * std::conj(c.b[i + 1])).real();
+        if (i + 1 < N) asy += n * (n + 2) / (n + 1) * (an * std::conj(c.a[i + 1]) + bn * std::conj(c.b[i + 1])).real();
     }
     const double x2 = c.x * c.x;
     e.qExt = 2.0 / x2 * ext;

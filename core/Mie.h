@@ -50,12 +50,12 @@ std::vector<double> SpherePhase(const Coefficients& c, std::span<const double> c
 // radius <r^3>/<r^2> is r_eff and effective variance v_eff (0 < v_eff < 1/3).
 // Water at one wavelength. Lengths in micrometres.
 struct Distribution {
-    double rEff = 10.0;          // cumulus (Hansen & Travis 1974; Olajos's table is for cumulus too)
+    double rEff = 10.0;  // cumulus (Hansen & Travis 1974; Olajos's table is for cumulus too)
     double vEff = 0.1;
-    double wavelength = 0.55;    // green, the middle of the visible
+    double wavelength = 0.55;            // green, the middle of the visible
     std::complex<double> m{1.333, 0.0};  // water at 0.55 um (Hale & Querry 1973: k ~ 2e-9, neglected)
-    double rMin = 2.0, rMax = 30.0;  // quadrature range (see CloudDistribution)
-    uint32_t radii = 2048;           // quadrature nodes over [rMin, rMax] (composite Simpson, odd count used)
+    double rMin = 2.0, rMax = 30.0;      // quadrature range (see CloudDistribution)
+    uint32_t radii = 2048;               // quadrature nodes over [rMin, rMax] (composite Simpson, odd count used)
 };
 
 // n(r) up to a constant, for r > 0.
@@ -86,12 +86,12 @@ double LinearTableNorm(std::span<const double> values);
 // came to: written by tools/MieTableGen.cpp beside the table.
 struct TableInfo {
     Distribution distribution;
-    uint32_t count = 0;          // table entries over [0, pi]
-    double g = 0;                // the distribution's asymmetry parameter (exact, not from the table)
-    double qSca = 0;             // scattering-weighted <Q_sca>
-    double normBefore = 0;       // LinearTableNorm of the float table before renormalisation
-    double normAfter = 0;        // and after (1 within float rounding)
-    double seconds = 0;          // generation wall time
+    uint32_t count = 0;     // table entries over [0, pi]
+    double g = 0;           // the distribution's asymmetry parameter (exact, not from the table)
+    double qSca = 0;        // scattering-weighted <Q_sca>
+    double normBefore = 0;  // LinearTableNorm of the float table before renormalisation
+    double normAfter = 0;   // and after (1 within float rounding)
+    double seconds = 0;     // generation wall time
     unsigned threads = 0;
 };
 extern const TableInfo kCloudTableInfo;

@@ -43,7 +43,8 @@ double MieDeg(double degrees) { return degrees * kMiePi / 180.0; }
 // Test that the published values of Bohren-Huffman and Wiscombe are reproduced.
 TEST(Mie, PublishedSingleSphereValues) {
     {
-        const mie::Efficiencies e = mie::ComputeEfficiencies(mie::ComputeCoefficients(2 * kMiePi * 0.525 / 0.6328, {1.55, 0}));
+        const mie::Efficiencies e =
+            mie::ComputeEfficiencies(mie::ComputeCoefficients(2 * kMiePi * 0.525 / 0.6328, {1.55, 0}));
         EXPECT_NEAR(e.qExt, 3.10543, 1e-5);
         EXPECT_NEAR(e.qSca, 3.10543, 1e-5);
         EXPECT_NEAR(e.qBack, 2.92534, 1e-5);
@@ -70,13 +71,55 @@ struct MieReferenceCase {
 };
 constexpr double kMieReferenceAngles[5] = {0, 30, 90, 140, 180};
 const MieReferenceCase kMieReference[] = {
-    {0.5, {1.33, 0}, 0.00677313988, 0.00677313988, 0.00907253577, 0.0454647818, {1.66918881, 1.4421655, 0.748417524, 1.08753624, 1.33948743}},
-    {1, {1.33, 0}, 0.0939240012, 0.0939240012, 0.0846252648, 0.184516674, {2.24069599, 1.86711555, 0.724012061, 0.788623744, 0.900997228}},
-    {10, {1.33, 0}, 2.20654871, 2.20654871, 0.56117943, 0.71245927, {64.7883138, 4.0137651, 0.151952817, 0.347325866, 0.254324515}},
-    {30, {1.33, 0}, 1.99840984, 1.99840984, 0.395958002, 0.826938666, {461.624686, 2.31615813, 0.0626219413, 0.0901373593, 0.198136535}},
-    {3, {1.55, 0}, 3.70220135, 3.70220135, 0.802728345, 0.707863653, {9.96730834, 4.87207615, 0.15505634, 0.137575973, 0.216824605}},
-    {5, {1.5, 0.1}, 3.15369353, 1.96346816, 0.139849045, 0.836154345, {31.7658774, 1.86325322, 0.134728534, 0.072158033, 0.0712255223}},
-    {10, {1.33, 0.05}, 2.36406361, 1.33084807, 0.0634489535, 0.865184611, {108.179951, 2.84445511, 0.0675213375, 0.0736127621, 0.0476755798}},
+    {0.5,
+     {1.33, 0},
+     0.00677313988,
+     0.00677313988,
+     0.00907253577,
+     0.0454647818,
+     {1.66918881, 1.4421655, 0.748417524, 1.08753624, 1.33948743}},
+    {1,
+     {1.33, 0},
+     0.0939240012,
+     0.0939240012,
+     0.0846252648,
+     0.184516674,
+     {2.24069599, 1.86711555, 0.724012061, 0.788623744, 0.900997228}},
+    {10,
+     {1.33, 0},
+     2.20654871,
+     2.20654871,
+     0.56117943,
+     0.71245927,
+     {64.7883138, 4.0137651, 0.151952817, 0.347325866, 0.254324515}},
+    {30,
+     {1.33, 0},
+     1.99840984,
+     1.99840984,
+     0.395958002,
+     0.826938666,
+     {461.624686, 2.31615813, 0.0626219413, 0.0901373593, 0.198136535}},
+    {3,
+     {1.55, 0},
+     3.70220135,
+     3.70220135,
+     0.802728345,
+     0.707863653,
+     {9.96730834, 4.87207615, 0.15505634, 0.137575973, 0.216824605}},
+    {5,
+     {1.5, 0.1},
+     3.15369353,
+     1.96346816,
+     0.139849045,
+     0.836154345,
+     {31.7658774, 1.86325322, 0.134728534, 0.072158033, 0.0712255223}},
+    {10,
+     {1.33, 0.05},
+     2.36406361,
+     1.33084807,
+     0.0634489535,
+     0.865184611,
+     {108.179951, 2.84445511, 0.0675213375, 0.0736127621, 0.0476755798}},
 };
 
 // Test water-like, glass-like and absorbing spheres against the independent implementation.
@@ -94,7 +137,8 @@ TEST(Mie, MatchesIndependentImplementation) {
         std::vector<double> mu;
         for (double a : kMieReferenceAngles) mu.push_back(std::cos(MieDeg(a)));
         const std::vector<double> p = mie::SpherePhase(c, mu);
-        for (size_t k = 0; k < mu.size(); ++k) EXPECT_NEAR(p[k], r.phase[k], 1e-8 * r.phase[k]) << kMieReferenceAngles[k];
+        for (size_t k = 0; k < mu.size(); ++k)
+            EXPECT_NEAR(p[k], r.phase[k], 1e-8 * r.phase[k]) << kMieReferenceAngles[k];
     }
 }
 
@@ -168,7 +212,8 @@ TEST(Mie, SpherePhaseIsNormalised) {
     const std::vector<double> p = mie::SpherePhase(c, mu);
     auto at = [&](double t) { return p[size_t(std::lround(t / (kMiePi / n)))]; };
     EXPECT_NEAR(MieSphereAverage(at, n), 1.0, 1e-6);
-    EXPECT_NEAR(MieSphereAverage([&](double t) { return at(t) * std::cos(t); }, n), mie::ComputeEfficiencies(c).g, 1e-6);
+    EXPECT_NEAR(MieSphereAverage([&](double t) { return at(t) * std::cos(t); }, n), mie::ComputeEfficiencies(c).g,
+                1e-6);
 }
 
 // Test that Henyey-Greenstein and Cornette-Shanks average to 1 over the sphere
@@ -176,8 +221,11 @@ TEST(Mie, SpherePhaseIsNormalised) {
 TEST(Mie, AnalyticPhaseFunctionsAreNormalised) {
     for (PhaseKind kind : {PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks})
         for (float g : {-0.5f, 0.0f, 0.6f, 0.9f}) {
-            const double avg = MieSphereAverage([&](double t) { return double(PhaseValue({kind, g}, float(std::cos(t)))); },
-                                             200000);
+            const double avg = MieSphereAverage(
+                [&](double t) {
+                    return double(PhaseValue({kind, g}, float(std::cos(t))));
+                },
+                200000);
             EXPECT_NEAR(avg, 1.0, 1e-4) << int(kind) << " g " << g;
         }
 }
@@ -189,7 +237,7 @@ TEST(Mie, SamplePhaseTableIsLinearInTheta) {
     const PhaseTable table{values.data(), uint32_t(values.size()), float(180.0 / kMiePi)};
     EXPECT_EQ(SamplePhaseTable(table, 1.0f), 0.0f);
     EXPECT_NEAR(SamplePhaseTable(table, -1.0f), 180.0f, 1e-4f);
-    EXPECT_NEAR(SamplePhaseTable(table, 2.0f), 0.0f, 1e-6f);    // clamped
+    EXPECT_NEAR(SamplePhaseTable(table, 2.0f), 0.0f, 1e-6f);     // clamped
     EXPECT_NEAR(SamplePhaseTable(table, -2.0f), 180.0f, 1e-4f);  // clamped
     for (double deg : {0.25, 12.5, 89.9, 90.0, 137.3, 179.75})
         EXPECT_NEAR(SamplePhaseTable(table, float(std::cos(MieDeg(deg)))), deg, 2e-3) << deg;
@@ -207,8 +255,11 @@ TEST(MieTable, IsNormalised) {
     EXPECT_FLOAT_EQ(kMieCloudTable.indexPerRadian, float((mie::kCloudTableCount - 1) / kMiePi));
     EXPECT_NEAR(mie::LinearTableNorm(MieCloudValues()), 1.0, 1e-6);
     // PhaseValue samples through float acos, so the quadrature sees the table to ~1e-4.
-    EXPECT_NEAR(MieSphereAverage([](double t) { return double(PhaseValue({PhaseKind::Mie, 0.0f}, float(std::cos(t)))); },
-                              400000),
+    EXPECT_NEAR(MieSphereAverage(
+                    [](double t) {
+                        return double(PhaseValue({PhaseKind::Mie, 0.0f}, float(std::cos(t))));
+                    },
+                    400000),
                 1.0, 2e-4);
     // The renormalisation was small: the Mie average is normalised by construction.
     EXPECT_NEAR(mie::kCloudTableInfo.normBefore, 1.0, 0.005);
@@ -241,7 +292,8 @@ TEST(MieTable, CloudFeatures) {
     // Asymmetry parameter: the generator's (exact) and the table's own mean cosine.
     EXPECT_GT(mie::kCloudTableInfo.g, 0.85);
     EXPECT_LT(mie::kCloudTableInfo.g, 0.87);
-    const double tableG = MieSphereAverage([](double th) { return MieTableAt(th * 180 / kMiePi) * std::cos(th); }, 400000);
+    const double tableG =
+        MieSphereAverage([](double th) { return MieTableAt(th * 180 / kMiePi) * std::cos(th); }, 400000);
     EXPECT_NEAR(tableG, mie::kCloudTableInfo.g, 2e-3);
 }
 

@@ -50,13 +50,14 @@ int main(int argc, char** argv) {
                  "namespace mie {\nconst TableInfo kCloudTableInfo{\n"
                  "    Distribution{%.17g, %.17g, %.17g, {%.17g, %.17g}, %.17g, %.17g, %u},\n"
                  "    %u, %.17g, %.17g, %.17g, %.17g, %.6g, %u};\n}  // namespace mie\n}  // namespace cb\n",
-                 d.rEff, d.vEff, d.wavelength, d.m.real(), d.m.imag(), d.rMin, d.rMax, d.radii, kCloudTableCount,
-                 avg.g, avg.qSca, before, after, seconds, threads);
+                 d.rEff, d.vEff, d.wavelength, d.m.real(), d.m.imag(), d.rMin, d.rMax, d.radii, kCloudTableCount, avg.g,
+                 avg.qSca, before, after, seconds, threads);
     if (std::fclose(f) != 0) {
         std::perror(argv[1]);
         return 1;
     }
-    std::printf("Mie table: %u values, P^(0) = %.6g, P^(180) = %.6g, g = %.5f, norm %.6f -> %.9f, %.2f s on %u threads\n",
-                kCloudTableCount, double(table.front()), double(table.back()), avg.g, before, after, seconds, threads);
+    std::printf(
+        "Mie table: %u values, P^(0) = %.6g, P^(180) = %.6g, g = %.5f, norm %.6f -> %.9f, %.2f s on %u threads\n",
+        kCloudTableCount, double(table.front()), double(table.back()), avg.g, before, after, seconds, threads);
     return 0;
 }
