@@ -107,14 +107,40 @@ inline float StorageQuantum(StorageFormat format) {
     return 0.0f;
 }
 
+// a (1 - t) + b t (the build never fuses it into an FMA). GLSL twin: shading.glsl Lerp.
+inline float Lerp(float a, float b, float t) { return a * (1.0f - t) + b * t; }
+
 // ---- Phase functions (SPEC 9), normalised so that isotropic gives 1 ----------
 
-enum class PhaseKind : uint8_t { None, HenyeyGreenstein, CornetteShanks };
+enum class PhaseKind : uint8_t { None, HenyeyGreenstein, CornetteShanks, Mie };
 
 struct PhaseParams {
     PhaseKind kind = PhaseKind::HenyeyGreenstein;
-    float g = 0.6f;
+    float g = 0.6f;  // Henyey-Greenstein and Cornette-Shanks; Mie ignores it (its g is the table's)
 };
+
+// P^ tabulated at `count` uniform angles theta_i = i pi / (count - 1), values[0]
+// at theta = 0 and values[count - 1] at pi; count >= 2. Not owning.
+struct PhaseTable {
+    const float* values = nullptr;
+    uint32_t count = 0;
+    float indexPerRadian = 0;  // (count - 1) / pi
+};
+
+// The table linearly interpolated in theta = acos(cosTheta), cosTheta clamped
+// to [-1, 1]. The result lies between the two nearest values.
+inline float SamplePhaseTable(const PhaseTable& table, float cosTheta) {
+    const float theta = std::acos(std::clamp(cosTheta, -1.0f, 1.0f));
+    const float x = std::clamp(theta * table.indexPerRadian, 0.0f, float(table.count - 1));
+    const uint32_t i = std::min(uint32_t(x), table.count - 2);
+    return Lerp(table.values[i], table.values[i + 1], x - float(i));
+}
+
+// The project's Lorenz-Mie table for cumulus droplets (r_eff 10 um, v_eff 0.1,
+// 0.55 um, water): generated at build time by tools/MieTableGen.cpp
+// (docs/pipeline.md, "Mie phase table"); defined in the generated MieTable.cpp
+// of cloudbench_core.
+extern const PhaseTable kMieCloudTable;
 
 // P^(cos theta) = 4 pi p(theta).
 inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
@@ -129,6 +155,7 @@ inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
             const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
             return 1.5f * (1.0f - g * g) / (2.0f + g * g) * (1.0f + cosTheta * cosTheta) / (denom * std::sqrt(denom));
         }
+        case PhaseKind::Mie: return SamplePhaseTable(kMieCloudTable, cosTheta);
     }
     return 1.0f;
 }
@@ -186,9 +213,6 @@ inline UpsampleTaps UpsampleTap(uint32_t i, int f, uint32_t cells) {
     const uint32_t i0 = uint32_t(x);
     return {i0, std::min(i0 + 1, cells - 1), x - float(i0)};
 }
-
-// a (1 - t) + b t (the build never fuses it into an FMA). GLSL twin: shading.glsl Lerp.
-inline float Lerp(float a, float b, float t) { return a * (1.0f - t) + b * t; }
 
 // Bilinear blend of four taps: t00 at (0,0), t10 at (1,0), t01 at (0,1), t11 at (1,1).
 // GLSL twin: shading.glsl Bilinear.

@@ -10,6 +10,9 @@ namespace cb::gl {
 // box is visible. The RGBA32F target is drawn with row 0 at the top, so one
 // read into a pixel buffer and one upload from it give the canonical (3, W, H) image.
 Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
+    // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
+    if (p.phase.kind == PhaseKind::Mie)
+        return MakeError("gl does not implement phase 'mie' in render_splat yet (issue 14)");
     if (!p.order || !in.qPrev || !in.qCur || !in.T)
         return MakeError("gl: render_splat needs q (both steps), T and an order");
     if (image.Extent().nx != 3) return MakeError("gl: render_splat image must have extent (3, width, height)");

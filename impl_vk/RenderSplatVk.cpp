@@ -9,6 +9,9 @@
 namespace cb::vk {
 
 Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
+    // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
+    if (p.phase.kind == PhaseKind::Mie)
+        return MakeError("vk does not implement phase 'mie' in render_splat yet (issue 14)");
     if (!p.order || !in.qPrev || !in.qCur || !in.T)
         return MakeError("vk: render_splat needs q (both steps), T and an order");
     const Extent3 e = in.qCur->Extent();

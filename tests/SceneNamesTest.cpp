@@ -18,7 +18,7 @@
 namespace cb {
 namespace {
 
-static_assert(kPhaseKindNames.size() == size_t(PhaseKind::CornetteShanks) + 1);
+static_assert(kPhaseKindNames.size() == size_t(PhaseKind::Mie) + 1);
 static_assert(kAttenuationKindNames.size() == size_t(AttenuationKind::Thesis) + 1);
 static_assert(kSampleFilterNames.size() == size_t(SampleFilter::Nearest) + 1);
 static_assert(kStorageFormatNames.size() == size_t(StorageFormat::Unorm8) + 1);

@@ -69,6 +69,9 @@ double PhaseMax(const PhaseParams& phase) {
         case PhaseKind::None: return 1;
         case PhaseKind::HenyeyGreenstein: return (1 + g) / ((1 - g) * (1 - g));
         case PhaseKind::CornetteShanks: return 3 * (1 - g * g) / ((2 + g * g) * std::pow(1 - g, 3));
+        // Linear interpolation never exceeds the largest tabulated value.
+        case PhaseKind::Mie:
+            return *std::max_element(kMieCloudTable.values, kMieCloudTable.values + kMieCloudTable.count);
     }
     return std::numeric_limits<double>::infinity();
 }

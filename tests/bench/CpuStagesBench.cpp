@@ -12,6 +12,8 @@
 #include "core/Ellipsoids.h"
 #include "core/Random.h"
 #include "core/Scene.h"
+#include "core/SceneNames.h"
+#include "core/Shading.h"
 #include "harness/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 
@@ -220,6 +222,19 @@ void BM_MachineEllipsoidRate(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(e.Count()));
 }
 
+// PhaseValue calls per second on one core (SPEC 9): 4096 cosines spread over
+// [-1, 1] per iteration, so the Mie table is read across its whole range.
+void BM_PhaseValue(benchmark::State& state, PhaseKind kind) {
+    std::vector<float> cosines(4096), out(cosines.size());
+    for (size_t i = 0; i < cosines.size(); ++i) cosines[i] = std::cos(float(i) * 0.7853f);
+    const PhaseParams phase{kind, 0.6f};
+    for (auto _ : state) {
+        for (size_t i = 0; i < cosines.size(); ++i) out[i] = PhaseValue(phase, cosines[i]);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(cosines.size()));
+}
+
 void Register() {
     const char* scenes[] = {"thesis-low", "thesis-medium", "thesis-high"};
     for (const char* scene : scenes) {
@@ -234,6 +249,8 @@ void Register() {
         benchmark::RegisterBenchmark(("RenderSplat/" + s).c_str(), BM_RenderSplat, s)
             ->ArgsProduct({{2}, {0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
     }
+    for (PhaseKind kind : {PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie})
+        benchmark::RegisterBenchmark(("PhaseValue/" + std::string(PhaseKindName(kind))).c_str(), BM_PhaseValue, kind);
     // Small variants for the CTest smoke run.
     std::string small = "ci-small";
     benchmark::RegisterBenchmark("Small/Region", BM_Region, small)->Arg(2);
