@@ -186,14 +186,19 @@ struct MarchBricks {
     uint32_t count[3] = {0, 0, 0};
 };
 
-// Distance along o + t d at which the ray leaves the box [lo, hi] (at least t).
-inline float RayExitFromBox(const Vec3& o, const Vec3& d, const Vec3& lo, const Vec3& hi, float t) {
+// 1/d per component for RayExitFromBox: FLT_MAX where d is (nearly) zero, so
+// that axis never bounds the exit (o lies inside that slab of the brick).
+inline Vec3 InverseDirection(const Vec3& d) {
+    Vec3 inv;
+    for (int a = 0; a < 3; ++a) inv[a] = std::fabs(d[a]) < 1e-20f ? std::numeric_limits<float>::max() : 1.0f / d[a];
+    return inv;
+}
+
+// Distance along o + t d at which the ray leaves the box [lo, hi] (at least t);
+// invD = InverseDirection(d).
+inline float RayExitFromBox(const Vec3& o, const Vec3& invD, const Vec3& lo, const Vec3& hi, float t) {
     float exit = std::numeric_limits<float>::max();
-    for (int a = 0; a < 3; ++a) {
-        if (std::fabs(d[a]) < 1e-20f) continue;
-        const float bound = d[a] > 0 ? hi[a] : lo[a];
-        exit = std::min(exit, (bound - o[a]) / d[a]);
-    }
+    for (int a = 0; a < 3; ++a) exit = std::min(exit, ((invD[a] >= 0.0f ? hi[a] : lo[a]) - o[a]) * invD[a]);
     return std::max(exit, t);
 }
 
@@ -260,33 +265,36 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
     if (!ray.Empty()) {
         // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
         const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
-        const float B = bricks ? float(bricks->brick) : 1.0f;
+        const float B = bricks ? float(bricks->brick) : 1.0f, invB = 1.0f / B;
+        const Vec3 invDir = InverseDirection(ray.dir);
         float tn = ray.tMin;
         uint32_t n = 0;
         while (tn < ray.tMax) {
             const float delta = MarchStepAt(s, tn);
+            float tNext = s.adaptive ? tn + delta : ray.tMin + float(n + 1) * delta;
             // Never stalls: a step below the float spacing at tn still moves on.
-            const float tNext = std::max(s.adaptive ? tn + delta : ray.tMin + float(n + 1) * delta,
-                                         std::nextafter(tn, std::numeric_limits<float>::max()));
+            if (!(tNext > tn)) tNext = std::nextafter(tn, std::numeric_limits<float>::max());
             const float len = std::min(tNext, ray.tMax) - tn;
             const float ts = tn + xi * len;
             const Vec3 p = MarchAlong(ray.origin, ray.dir, ts);
             if (bricks) {
-                const int bx = int(std::floor(p[0] / B)), by = int(std::floor(p[1] / B)), bz = int(std::floor(p[2] / B));
+                // p * (1/B) may round across a brick face; the bricks' one-voxel margin covers that.
+                const int bx = int(std::floor(p[0] * invB)), by = int(std::floor(p[1] * invB)),
+                          bz = int(std::floor(p[2] * invB));
                 const bool inside = bx >= 0 && by >= 0 && bz >= 0 && uint32_t(bx) < bricks->count[0] &&
                                     uint32_t(by) < bricks->count[1] && uint32_t(bz) < bricks->count[2];
                 if (inside && bricks->empty[uint32_t(bx) + bricks->count[0] * (uint32_t(by) + bricks->count[1] * uint32_t(bz))]) {
                     // Jump to the first sample at or past the brick's exit; the samples in between read q = 0.
                     const Vec3 lo{float(bx) * B, float(by) * B, float(bz) * B};
                     const Vec3 hi{lo[0] + B, lo[1] + B, lo[2] + B};
-                    const float tExit = RayExitFromBox(ray.origin, ray.dir, lo, hi, ts);
+                    const float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
                     ++r.bricksSkipped;
                     if (s.adaptive) {
                         // Iterate the cheap recurrence; the positions are those of the unskipped march.
                         float t = tNext;
                         while (t < ray.tMax) {
-                            const float tAfter = std::max(t + MarchStepAt(s, t),
-                                                          std::nextafter(t, std::numeric_limits<float>::max()));
+                            float tAfter = t + MarchStepAt(s, t);
+                            if (!(tAfter > t)) tAfter = std::nextafter(t, std::numeric_limits<float>::max());
                             const float sample = t + xi * (std::min(tAfter, ray.tMax) - t);
                             if (sample >= tExit) break;
                             t = tAfter;

@@ -5,11 +5,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <functional>
 #include <limits>
 #include <vector>
 
 #include "core/March.h"
+#include "core/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 
@@ -500,6 +506,115 @@ TEST(MarchCpu, NoNanOrInfAtTheExtremes) {
                         for (size_t i = 0; i < im.rgb.size(); ++i)
                             ASSERT_EQ(im.rgb[i], c.params.setup.background[i % 3]);
                 }
+}
+
+// ---- Benchmark (run by hand: --gtest_also_run_disabled_tests --gtest_filter='*MarchBench*') ----
+// reports/march/march.md: a 128^3 cumulus-like field of Gaussian puffs (flat
+// bottoms), T from the CPU shade stage, 1280x720, 7 frames per setting; prints
+// wall and process CPU ms per frame (median, min, max) and samples per second.
+namespace bench {
+
+double CpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+std::vector<float> CumulusField(const Extent3& e) {
+    std::vector<float> q(e.Count(), 0.0f);
+    Pcg32 rng(11);
+    for (int b = 0; b < 60; ++b) {
+        const double cx = rng.NextDouble() * e.nx, cy = rng.NextDouble() * e.ny;
+        const double cz = (0.3 + 0.25 * rng.NextDouble()) * e.nz, r = 5 + 9 * rng.NextDouble();
+        const double base = 0.28 * e.nz;
+        for (uint32_t k = uint32_t(std::max(base, cz - 3 * r)); k < std::min<double>(e.nz, cz + 3 * r); ++k)
+            for (uint32_t j = uint32_t(std::max(0.0, cy - 3 * r)); j < std::min<double>(e.ny, cy + 3 * r); ++j)
+                for (uint32_t i = uint32_t(std::max(0.0, cx - 3 * r)); i < std::min<double>(e.nx, cx + 3 * r); ++i) {
+                    const double dx = i + 0.5 - cx, dy = j + 0.5 - cy, dz = (k + 0.5 - cz) * 1.3;
+                    const double v = 1.6 * std::exp(-(dx * dx + dy * dy + dz * dz) / (2 * r * r)) - 0.35;
+                    float& out = q[VoxelIndex(e, i, j, k)];
+                    out = std::max(out, float(std::clamp(v, 0.0, 1.0)));
+                }
+    }
+    return q;
+}
+
+}  // namespace bench
+
+TEST(MarchBench, DISABLED_Cumulus128At720p) {
+    const Extent3 e{128, 128, 128};
+    const std::vector<float> field = bench::CumulusField(e);
+    cpu::BackendCpu backend(2);
+    auto q = test::MakeFilled(backend, BufferFormat::F32, e, field);
+    auto T = test::MakeBuffer(backend, BufferFormat::F32, e);
+    ShadeParams sp;
+    sp.sun = SunDirection(0.7, 0.5);
+    sp.sigma = 0.02f;
+    sp.voxelSize = 50;
+    ASSERT_TRUE(backend.Shade(sp, *q, *T).has_value());
+    auto image = test::MakeBuffer(backend, BufferFormat::F32, {3, 1280, 720});
+    CameraSettings cam;
+    cam.eye = {-1500, -1500, 2500};
+    cam.target = {3200, 3200, 2800};
+    cam.fovDeg = 60;
+    cam.nearPlane = 1;
+    cam.farPlane = 50000;
+    auto base = [&] {
+        MarchParams p;
+        p.camera = MakeCameraFrame(cam, 1280, 720);
+        p.setup.size = {128, 128, 128};
+        p.setup.voxelSize = 50;
+        p.setup.step = 0.5f;
+        p.setup.sigmaH = MarchOpticalDepthPerVoxel(0.02f, 50);
+        p.setup.epsilon = 0.01f;
+        p.setup.sun = sp.sun;
+        p.setup.sunRadiance = {1.6f, 1.44f, 1.2f};
+        p.setup.ambient = {0.22f, 0.26f, 0.34f};
+        p.setup.background = {0.42f, 0.58f, 0.85f};
+        p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+        p.alpha = 0.5f;
+        return p;
+    };
+    struct Row {
+        const char* name;
+        std::function<void(MarchParams&)> edit;
+    };
+    const std::vector<Row> rows = {
+        {"shade, skip, HG (baseline)", [](MarchParams&) {}},
+        {"skipping off", [](MarchParams& p) { p.skipping = false; }},
+        {"adaptive (kappa 0.02, t_a 64)",
+         [](MarchParams& p) { p.setup.adaptive = true, p.setup.kappa = 0.02f, p.setup.adaptiveStart = 64; }},
+        {"light march n_l 6", [](MarchParams& p) { p.light = MarchLightSource::March, p.lightSteps = 6; }},
+        {"phase none", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::None; }},
+        {"jitter", [](MarchParams& p) { p.jitter = true; }},
+        {"step 1.0", [](MarchParams& p) { p.setup.step = 1.0f; }},
+    };
+    const char* only = std::getenv("MARCH_BENCH_ROWS");  // e.g. "1": the first row only
+    const size_t count = only ? std::min(rows.size(), size_t(std::atoi(only))) : rows.size();
+    for (size_t r = 0; r < count; ++r) {
+        const Row& row = rows[r];
+        MarchParams p = base();
+        row.edit(p);
+        std::vector<double> wall, cpu;
+        MarchStats stats;
+        for (int f = 0; f < 7; ++f) {
+            p.frame = uint32_t(f);
+            const double c0 = bench::CpuMs();
+            const auto t0 = std::chrono::steady_clock::now();
+            const MarchInputs in{q.get(), q.get(), T.get()};
+            ASSERT_TRUE(backend.RenderMarch(p, in, *image, &stats).has_value());
+            wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            cpu.push_back(bench::CpuMs() - c0);
+        }
+        std::sort(wall.begin(), wall.end());
+        std::sort(cpu.begin(), cpu.end());
+        std::printf("%-32s wall %8.1f [%7.1f %7.1f] ms  cpu %8.1f [%7.1f %7.1f] ms  rays %8llu  samples %10llu  light %9llu  "
+                    "skipped %9llu  empty bricks %llu/%llu  Msamples/cpu-s %.1f\n",
+                    row.name, wall[3], wall[0], wall[6], cpu[3], cpu[0], cpu[6], (unsigned long long)stats.rays,
+                    (unsigned long long)stats.samples, (unsigned long long)stats.lightSamples,
+                    (unsigned long long)stats.bricksSkipped, (unsigned long long)stats.emptyBricks,
+                    (unsigned long long)stats.bricks, stats.samples / (cpu[3] * 1e3));
+    }
 }
 
 }  // namespace
