@@ -502,9 +502,10 @@ TEST(MarchCpu, NoNanOrInfAtTheExtremes) {
                     const MarchImage im = RenderCpu(c, 1);
                     ASSERT_TRUE(AllFinite(im.rgb)) << "sigma " << sigma;
                     for (float v : im.rgb) ASSERT_GE(v, 0.0f);
-                    if (sigma == 0.0f)
+                    if (sigma == 0.0f) {
                         for (size_t i = 0; i < im.rgb.size(); ++i)
                             ASSERT_EQ(im.rgb[i], c.params.setup.background[i % 3]);
+                    }
                 }
 }
 
