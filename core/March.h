@@ -287,8 +287,24 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                     // Jump to the first sample at or past the brick's exit; the samples in between read q = 0.
                     const Vec3 lo{float(bx) * B, float(by) * B, float(bz) * B};
                     const Vec3 hi{lo[0] + B, lo[1] + B, lo[2] + B};
-                    const float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
+                    float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
                     ++r.bricksSkipped;
+                    // Walk on through the empty bricks that follow (probing a hundredth of a voxel past each
+                    // exit face: the points in between lie within the next brick's one-voxel margin).
+                    while (tExit < ray.tMax) {
+                        const float tProbe = tExit + 0.01f;
+                        const Vec3 pe = MarchAlong(ray.origin, ray.dir, tProbe);
+                        const int ex = int(std::floor(pe[0] * invB)), ey = int(std::floor(pe[1] * invB)),
+                                  ez = int(std::floor(pe[2] * invB));
+                        if (!(ex >= 0 && ey >= 0 && ez >= 0 && uint32_t(ex) < bricks->count[0] &&
+                              uint32_t(ey) < bricks->count[1] && uint32_t(ez) < bricks->count[2]) ||
+                            !bricks->empty[uint32_t(ex) + bricks->count[0] * (uint32_t(ey) + bricks->count[1] * uint32_t(ez))])
+                            break;
+                        const Vec3 elo{float(ex) * B, float(ey) * B, float(ez) * B};
+                        const Vec3 ehi{elo[0] + B, elo[1] + B, elo[2] + B};
+                        tExit = RayExitFromBox(ray.origin, invDir, elo, ehi, tProbe);
+                        ++r.bricksSkipped;
+                    }
                     if (s.adaptive) {
                         // Iterate the cheap recurrence; the positions are those of the unskipped march.
                         float t = tNext;

@@ -589,6 +589,9 @@ TEST(MarchBench, DISABLED_Cumulus128At720p) {
         {"phase none", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::None; }},
         {"jitter", [](MarchParams& p) { p.jitter = true; }},
         {"step 1.0", [](MarchParams& p) { p.setup.step = 1.0f; }},
+        {"brick 4", [](MarchParams& p) { p.brick = 4; }},
+        {"brick 16", [](MarchParams& p) { p.brick = 16; }},
+        {"epsilon 0 (no early stop)", [](MarchParams& p) { p.setup.epsilon = 0; }},
     };
     const char* only = std::getenv("MARCH_BENCH_ROWS");  // e.g. "1": the first row only
     const size_t count = only ? std::min(rows.size(), size_t(std::atoi(only))) : rows.size();
