@@ -19,6 +19,8 @@
 #include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
+#include "core/March.h"
+#include "core/MarchSettings.h"
 #include "core/Rules.h"
 #include "core/Shading.h"
 #include "core/Stage.h"
@@ -169,6 +171,35 @@ struct SplatStats {
     uint64_t fragments = 0;      // pixel blends: covered pixels summed over splats, clipped to the image
 };
 
+// Inputs of the ray marcher (SPEC 10) besides its buffers: the kernel's
+// constants (core/March.h, voxel units) and how the backend feeds it.
+struct MarchParams {
+    CameraFrame camera;
+    MarchSetup setup;
+    std::array<float, 3> origin{0, 0, 0};  // world position of voxel corner (0, 0, 0)
+    float alpha = 0.5f;                    // q_alpha = (1 - alpha) q_prev + alpha q_cur
+    MarchLightSource light = MarchLightSource::Shade;
+    uint32_t lightSteps = 8;  // n_l of the light march (sun with `march`, and the point light)
+    bool jitter = false;
+    uint32_t seed = 1, frame = 0;  // xi = rand24(seed, frame, 3, x + W y) / 2^24 with jitter
+    bool skipping = true;
+    uint32_t brick = 8;
+};
+
+struct MarchInputs {
+    const Buffer* qPrev = nullptr;  // F32 volume
+    const Buffer* qCur = nullptr;   // F32 volume
+    const Buffer* T = nullptr;      // F32 volume; required with MarchLightSource::Shade, else unread
+};
+
+struct MarchStats {
+    uint64_t rays = 0;           // rays that met the box between the near and far planes
+    uint64_t samples = 0;        // density samples
+    uint64_t lightSamples = 0;   // light functor calls (samples with q_alpha > 0)
+    uint64_t bricksSkipped = 0;  // empty bricks jumped over, summed over rays
+    uint64_t emptyBricks = 0, bricks = 0;  // of the skip structure (0 without skipping)
+};
+
 // The backends' entry points, X(stage, Method, (parameters)): one or more per
 // stage (the automaton has two). Contracts:
 //   Region        R = max-blend of the ellipsoids; region is U8 of the grid size.
@@ -182,6 +213,8 @@ struct SplatStats {
 //   Shadow        G (F32, (nx, ny, 1)) from D.
 //   RenderSplat   a linear RGB image, F32 with extent (3, width, height):
 //                 channel fastest, then x, then y, row 0 at the top.
+//   RenderMarch   the same image layout, linear HDR, one MarchRay per pixel
+//                 (core/March.h); the brick structure is built inside the call.
 #define CB_SPLAT_PIPELINE_ENTRIES(X)                                                                            \
     X(Region, Region, (std::span<const RasterEllipsoid> ellipsoids, Buffer & region))                           \
     X(Ca, CaInitialize, (const CaInitParams& params, CaFields out))                                             \
@@ -196,8 +229,12 @@ struct SplatStats {
 // grid size) formed from noise (SPEC 10a); no backend implements it yet.
 #define CB_NOISE_ENTRIES(X) X(Noise, Noise, (const NoiseParams& params, Buffer& q))
 
-// Every entry point; the ray marcher joins here (issue 13).
-#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X) CB_NOISE_ENTRIES(X)
+// The ray marcher (SPEC 10); only the CPU implements it so far (issue 14 ports it).
+#define CB_MARCH_ENTRIES(X) \
+    X(RenderMarch, RenderMarch, (const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats))
+
+// Every entry point.
+#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X) CB_NOISE_ENTRIES(X) CB_MARCH_ENTRIES(X)
 
 // In a backend's class: declares the override of one entry.
 #define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;

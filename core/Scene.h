@@ -11,6 +11,7 @@
 #include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
+#include "core/MarchSettings.h"
 #include "core/Shading.h"
 #include "core/Stage.h"
 
@@ -156,6 +157,8 @@ struct Scene {
     ShadowSettings shadow;
     RenderSettings render;
     SplatSettings splat;
+    MarchSettings march;          // stage render_march (section `march`)
+    LightningSettings lightning;  // the point light of render_march (section `lightning`)
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

@@ -42,4 +42,9 @@ void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow);
 bool ReadRender(const Json& root, Validator& check, RenderSettings& render);
 void ReadSplat(const Json& root, Validator& check, SplatSettings& splat);
 
+// The ray marcher's sections (core/SceneMarchReader.cpp). `stages` is the scene's list: the
+// default light source "shade" needs the shade stage when render_march runs.
+void ReadMarch(const Json& root, Validator& check, const StageSet& stages, MarchSettings& march);
+void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning);
+
 }  // namespace cb::scene_io

@@ -144,6 +144,9 @@ std::vector<Resource> SplatPrevious(const Scene& scene) {
     return {Resource::Q};
 }
 
+// The ray marcher interpolates q between the last two steps, like the splat renderer.
+std::vector<Resource> MarchPrevious(const Scene&) { return {Resource::Q}; }
+
 // The table, made on first use: commands describe stages in their help text
 // during static initialisation, before a namespace-scope table would exist.
 // Fields left out take their defaults (GCC warns about designated initialisers that omit fields).
@@ -204,6 +207,8 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
         {.stage = Stage::RenderMarch,
          .section = "render",
          .reads = {Resource::Q},
+         .optionalReads = {Resource::T},  // march.light "shade" (the default) needs it: checked by the scene reader
+         .readsPrevious = MarchPrevious,
          .writes = {Resource::MarchImage},
          .outputStepsOnly = true,
          .renderer = true,

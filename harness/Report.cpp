@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "core/March.h"
 #include "harness/Session.h"
 
 namespace cb {
@@ -99,7 +100,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                 nlohmann::json steps = nlohmann::json::array(), splats = nlohmann::json::array();
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
-                        if (f.camera == camera.name) {
+                        if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
                             ms.push_back(f.ms);
                             steps.push_back(r.step);
                             splats.push_back(f.stats.splats);
@@ -111,6 +112,32 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                 cameras[camera.name] = c;
             }
             b["frames"] = cameras;
+        }
+        if (scene.stages.Has(Stage::RenderMarch)) {
+            // Per camera: every march frame's time and counters (MarchStats), and their summary.
+            nlohmann::json cameras = nlohmann::json::object();
+            for (const CameraSettings& camera : scene.render.cameras) {
+                std::vector<double> ms;
+                nlohmann::json steps = nlohmann::json::array(), samples = nlohmann::json::array(),
+                               lightSamples = nlohmann::json::array(), skipped = nlohmann::json::array();
+                for (const StepRecord& r : run.steps)
+                    for (const FrameRecord& f : r.frames)
+                        if (f.renderer == Stage::RenderMarch && f.camera == camera.name) {
+                            ms.push_back(f.ms);
+                            steps.push_back(r.step);
+                            samples.push_back(f.march.samples);
+                            lightSamples.push_back(f.march.lightSamples);
+                            skipped.push_back(f.march.bricksSkipped);
+                        }
+                nlohmann::json c = SummaryJson(ms);
+                c["steps"] = steps;
+                c["samples"] = samples;
+                c["light_samples"] = lightSamples;
+                c["bricks_skipped"] = skipped;
+                c["fps_median"] = ms.empty() ? 0.0 : 1000.0 / Summarize(ms).median;
+                cameras[camera.name] = c;
+            }
+            b["march_frames"] = cameras;
         }
         if (scene.stages.Has(Stage::Density)) {
             nlohmann::json cover = nlohmann::json::array();
@@ -182,7 +209,7 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
             uint64_t lastSplats = 0;
             for (const StepRecord& r : run.steps)
                 for (const FrameRecord& f : r.frames)
-                    if (f.camera == camera.name) {
+                    if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
                         ms.push_back(f.ms);
                         lastSplats = f.stats.splats;
                     }
@@ -190,6 +217,22 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
             std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu splats", s.count,
                           s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(lastSplats));
             table.rows.push_back(TimingRow(("  frame " + camera.name).substr(0, 18), ms, {}, line));
+        }
+    }
+    if (scene.stages.Has(Stage::RenderMarch)) {
+        for (const CameraSettings& camera : scene.render.cameras) {
+            std::vector<double> ms;
+            uint64_t lastSamples = 0;
+            for (const StepRecord& r : run.steps)
+                for (const FrameRecord& f : r.frames)
+                    if (f.renderer == Stage::RenderMarch && f.camera == camera.name) {
+                        ms.push_back(f.ms);
+                        lastSamples = f.march.samples;
+                    }
+            const Summary s = Summarize(ms);
+            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu samples", s.count,
+                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(lastSamples));
+            table.rows.push_back(TimingRow(("  march " + camera.name).substr(0, 18), ms, {}, line));
         }
     }
     if (scene.stages.Has(Stage::Region)) {
@@ -300,7 +343,7 @@ Status WriteDifferenceImage(const std::string& path, const std::vector<float>& r
 }
 
 Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
-                                            uint32_t height, bool png) {
+                                            uint32_t height, bool png, const std::optional<FrameToneMap>& toneMap) {
     OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::FLOAT);
     OIIO::ImageBuf linear(spec, const_cast<float*>(rgb.data()));  // wraps, does not copy
     std::vector<std::string> written;
@@ -308,8 +351,17 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
     CB_TRY(WriteImage(exr, linear));
     written.push_back(exr);
     if (png) {
+        std::vector<float> mapped;
+        OIIO::ImageBuf display;
+        if (toneMap) {
+            mapped.resize(rgb.size());
+            for (size_t i = 0; i < rgb.size(); ++i)
+                mapped[i] = toneMap->reinhard ? ReinhardToneMap(rgb[i], toneMap->exposure)
+                                              : std::clamp(rgb[i] * toneMap->exposure, 0.0f, 1.0f);
+            display = OIIO::ImageBuf(spec, mapped.data());
+        }
         OIIO::ImageBuf srgb;
-        if (!OIIO::ImageBufAlgo::colorconvert(srgb, linear, "linear", "sRGB"))
+        if (!OIIO::ImageBufAlgo::colorconvert(srgb, toneMap ? display : linear, "linear", "sRGB"))
             return MakeError(stem + ".png: colour conversion failed: " + srgb.geterror());
         const std::string path = stem + ".png";
         srgb.set_write_format(OIIO::TypeDesc::UINT8);

@@ -56,6 +56,29 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, const
     return {};
 }
 
+Status RenderMarchFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
+                         StageCallRecord& record) {
+    for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
+        const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step);
+        // Without a previous step the renderer interpolates a step with itself; T only where shade runs.
+        const MarchInputs in{io.Previous(Resource::Q) ? io.Previous(Resource::Q) : io.Current(Resource::Q),
+                             io.Current(Resource::Q), io.Current(Resource::T)};
+        FrameRecord frame;
+        frame.renderer = Stage::RenderMarch;
+        frame.camera = sc.render.cameras[n].name;
+        const double before = record.ms;
+        const std::string backendName = backend.Name();
+        const StageCountLabel label{StageName(Stage::RenderMarch), backendName, step, frame.camera};
+        Status status = Timed(backend, record, label, [&] {
+            return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march);
+        });
+        frame.ms = record.ms - before;
+        if (!status) return MakeError("render_march (" + frame.camera + "): " + status.error().message);
+        record.frames.push_back(frame);
+    }
+    return {};
+}
+
 Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
             StageCallRecord& record) {
     const std::string backendName = backend.Name();
@@ -103,7 +126,7 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
             return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });
         }
         case Stage::RenderMarch:
-            break;
+            return RenderMarchFrames(backend, sc, host.step, io, record);
     }
     return MakeError("the harness cannot call stage '" + std::string(StageName(stage)) + "' yet");
 }
@@ -157,7 +180,7 @@ Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageH
         SpinFor((slowdown->factor - 1) * (record.ms - before));
         record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
-    if (!status && stage != Stage::RenderSplat)
+    if (!status && stage != Stage::RenderSplat && stage != Stage::RenderMarch)
         return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
     return status;
 }

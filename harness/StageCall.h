@@ -46,6 +46,7 @@ struct FrameRecord {
     std::string camera;
     double ms = 0;
     SplatStats stats;
+    MarchStats march;  // render_march's counters
 };
 
 // What one call measured and returned besides its buffers.

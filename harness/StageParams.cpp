@@ -71,4 +71,45 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
     return p;
 }
 
+MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint32_t step) {
+    MarchParams p;
+    p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
+    const float h = float(sc.grid.voxelSize);
+    p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
+    MarchSetup& s = p.setup;
+    s.size = {float(sc.grid.size.nx), float(sc.grid.size.ny), float(sc.grid.size.nz)};
+    s.voxelSize = h;
+    s.step = float(sc.march.step);
+    s.adaptive = sc.march.adaptive;
+    s.kappa = float(sc.march.kappa);
+    s.adaptiveStart = float(sc.march.adaptiveStart);
+    s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
+    s.epsilon = float(sc.march.epsilon);
+    s.sun = sc.sun.Direction();
+    s.sunRadiance = sc.sun.Radiance();
+    for (int c = 0; c < 3; ++c) {
+        s.ambient[c] = float(sc.lighting.ambient[c]);
+        s.background[c] = float(sc.lighting.background[c]);
+    }
+    s.phase = sc.phase;
+    s.powder = sc.march.powder;
+    s.powderC = float(sc.march.powderC);
+    const LightningSettings& l = sc.lightning;
+    s.point.on = l.OnAt(step);
+    for (int c = 0; c < 3; ++c) {
+        s.point.position[c] = float((l.position[c] - sc.grid.origin[c]) / sc.grid.voxelSize);
+        s.point.radiance[c] = float(l.color[c] * l.intensity);
+    }
+    s.point.minDistance2 = float(l.radius * l.radius);
+    p.alpha = float(sc.render.alpha);
+    p.light = sc.march.light;
+    p.lightSteps = sc.march.lightSteps;
+    p.jitter = sc.march.jitter;
+    p.seed = sc.ca.seed;
+    p.frame = step;
+    p.skipping = sc.march.skipping;
+    p.brick = sc.march.brick;
+    return p;
+}
+
 }  // namespace cb

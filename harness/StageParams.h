@@ -15,5 +15,7 @@ ShadeParams MakeShadeParams(const Scene& scene);
 ShadowParams MakeShadowParams(const Scene& scene);
 // Everything but the order, which the caller makes (MakeSplatOrder) and keeps alive.
 SplatParams MakeSplatParams(const Scene& scene, const CameraSettings& camera);
+// The ray marcher's parameters for one camera at `step` (the jitter's frame and the lightning's flash window).
+MarchParams MakeMarchParams(const Scene& scene, const CameraSettings& camera, uint32_t step);
 
 }  // namespace cb

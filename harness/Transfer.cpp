@@ -62,7 +62,13 @@ json ToJson(const StepRecord& r) {
                           {"ms", D(f.ms)},
                           {"splats", f.stats.splats},
                           {"voxels_visited", f.stats.voxelsVisited},
-                          {"fragments", f.stats.fragments}});
+                          {"fragments", f.stats.fragments},
+                          {"march", {{"rays", f.march.rays},
+                                     {"samples", f.march.samples},
+                                     {"light_samples", f.march.lightSamples},
+                                     {"bricks_skipped", f.march.bricksSkipped},
+                                     {"empty_bricks", f.march.emptyBricks},
+                                     {"bricks", f.march.bricks}}}});
     return {{"step", r.step},
             {"stage_ms", stageMs},
             {"device_ms", deviceMs},
@@ -87,6 +93,10 @@ StepRecord StepFromJson(const json& j) {
         frame.ms = FromD(f.at("ms"));
         frame.stats = {f.at("splats").get<uint64_t>(), f.at("voxels_visited").get<uint64_t>(),
                        f.at("fragments").get<uint64_t>()};
+        if (const auto m = f.find("march"); m != f.end())
+            frame.march = {m->at("rays").get<uint64_t>(),          m->at("samples").get<uint64_t>(),
+                           m->at("light_samples").get<uint64_t>(), m->at("bricks_skipped").get<uint64_t>(),
+                           m->at("empty_bricks").get<uint64_t>(),  m->at("bricks").get<uint64_t>()};
         r.frames.push_back(std::move(frame));
     }
     return r;

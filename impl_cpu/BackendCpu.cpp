@@ -25,7 +25,7 @@ std::string BackendCpu::Device() const {
     return std::to_string(mArena.max_concurrency()) + " threads (TBB), " + CaKernelName();
 }
 
-bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
+bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::RenderMarch; }
 
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("cpu: cannot create an empty buffer");
@@ -66,6 +66,13 @@ uint64_t BackendCpu::ScratchBytes(const Scene& scene) const {
         if (f > 1) bytes = SaturatingAdd(bytes, SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4));
         std::sort(cells, cells + 3);
         bytes = SaturatingAdd(bytes, 2 * 4 * (cells[1] + 3) * (cells[2] + 3));
+    }
+    if (scene.stages.Has(Stage::RenderMarch)) {
+        // The padded (q_alpha, T) volume and one byte per brick (RenderMarchCpu.cpp).
+        const uint64_t padded = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
+        const uint32_t b = std::max(scene.march.brick, 1u);
+        const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
+        bytes = SaturatingAdd(bytes, SaturatingAdd(SaturatingMul(padded, sizeof(MarchQT)), bricks));
     }
     return bytes;
 }

@@ -35,6 +35,12 @@ class BufferCpu final : public Buffer {
     std::vector<float> mF32;
 };
 
+// One voxel of the ray marcher's formed volume: q_alpha and T side by side,
+// so a trilinear sample of both touches one set of cache lines.
+struct MarchQT {
+    float q, t;
+};
+
 // Not final: tests derive test-only stages from it (a producer of q other than smooth).
 class BackendCpu : public Backend {
   public:
@@ -59,6 +65,7 @@ class BackendCpu : public Backend {
     std::optional<uint64_t> AvailableBytes() const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     int Threads() const { return mArena.max_concurrency(); }
 
@@ -67,6 +74,8 @@ class BackendCpu : public Backend {
     // Scratch kept between calls so that steady-state steps do not allocate.
     std::vector<BitField> mAdvectScratch;
     std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
+    std::vector<MarchQT> mMarchVolume;                // render_march: padded (q_alpha, T)
+    std::vector<uint8_t> mMarchBricks;                // render_march: empty bricks
 };
 
 }  // namespace cb::cpu

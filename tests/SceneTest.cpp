@@ -153,8 +153,14 @@ TEST(SceneTest, IntegralFloatIsAnInteger) {
 TEST(SceneTest, OtherKnownStagesNeedTheirInputs) {
     EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, "stages": ["noise"]})").stages, Stages({Stage::Noise}));
     const std::string camera = R"("render": {"cameras": [{"eye": [0, 0, 0], "target": [1, 0, 0]}]})";
-    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, )" + camera + R"(, "stages": ["render_march", "noise"]})").stages,
+    const std::string lightMarch = R"("march": {"light": "march"})";
+    EXPECT_EQ(Parsed(R"({"grid": {"size": [8, 4, 6]}, )" + camera + ", " + lightMarch +
+                     R"(, "stages": ["render_march", "noise"]})")
+                  .stages,
               Stages({Stage::RenderMarch, Stage::Noise}));
+    // The default light source reads T from the shade stage.
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + camera + R"(, "stages": ["render_march", "noise"]})"),
+                        R"(test.json: march.light: "shade" needs stage "shade" (add it to stages, or set march.light to "march"))"));
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "stages": ["render_march", "noise"]})"),
                         R"(test.json: render.cameras: "render_march" needs at least one camera)"));
 }

@@ -80,7 +80,10 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
                 continue;
             }
             const std::string stem = outDir + "/" + FrameFileStem(renderer, scene.render.cameras[n].name, run.name);
-            auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height);
+            // The ray marcher's frames are HDR: its PNG is tone-mapped with the scene's exposure.
+            std::optional<FrameToneMap> toneMap;
+            if (renderer == Stage::RenderMarch) toneMap = FrameToneMap{scene.march.toneMap, float(scene.march.exposure)};
+            auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, true, toneMap);
             if (paths)
                 written.insert(written.end(), paths->begin(), paths->end());
             else

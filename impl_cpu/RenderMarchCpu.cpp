@@ -1,0 +1,196 @@
+// The ray marcher on the CPU (SPEC 10): per call, q_alpha and T are formed
+// once into one padded volume of (q, T) pairs (a border voxel of q = 0, T = 1
+// stands for "outside the grid", so the trilinear taps need no bounds checks),
+// the brick skip structure is built from it, and then every pixel runs the
+// shared kernel MarchRay (core/March.h), TBB over 8 x 8 pixel tiles.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/blocked_range3d.h>
+#include <tbb/parallel_for.h>
+
+#include "core/March.h"
+#include "impl_cpu/BackendCpu.h"
+
+namespace cb::cpu {
+namespace {
+
+// Trilinear reads of the padded (q, T) volume; p in voxel units is clamped to
+// the box [0, n], where the padded taps (p + 0.5 floored, and +1) stay inside.
+struct MarchPaddedVolume {
+    const MarchQT* v = nullptr;
+    size_t px = 0, pxy = 0;  // padded row and slice strides
+    Vec3 size{};
+
+    struct Taps {
+        size_t base;
+        float wx, wy, wz;
+    };
+    Taps TapsAt(const Vec3& p) const {
+        const float cx = std::clamp(p[0], 0.0f, size[0]) + 0.5f;
+        const float cy = std::clamp(p[1], 0.0f, size[1]) + 0.5f;
+        const float cz = std::clamp(p[2], 0.0f, size[2]) + 0.5f;
+        const size_t i = size_t(cx), j = size_t(cy), k = size_t(cz);
+        return {i + px * j + pxy * k, cx - float(i), cy - float(j), cz - float(k)};
+    }
+    template <float MarchQT::*Field>
+    float Blend(const Taps& t) const {
+        const MarchQT* a = v + t.base;
+        const MarchQT* b = a + pxy;
+        const float c00 = Lerp(a[0].*Field, a[1].*Field, t.wx);
+        const float c10 = Lerp(a[px].*Field, a[px + 1].*Field, t.wx);
+        const float c01 = Lerp(b[0].*Field, b[1].*Field, t.wx);
+        const float c11 = Lerp(b[px].*Field, b[px + 1].*Field, t.wx);
+        return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
+    }
+    float Q(const Vec3& p) const { return Blend<&MarchQT::q>(TapsAt(p)); }
+};
+
+// The main march's density functor: keeps the taps of its last sample so that
+// the shade light source reads T there without recomputing them.
+struct MarchCachedDensity {
+    const MarchPaddedVolume* volume;
+    MarchPaddedVolume::Taps last{};
+    float operator()(const Vec3& p) {
+        last = volume->TapsAt(p);
+        return volume->Blend<&MarchQT::q>(last);
+    }
+    float LastT() const { return volume->Blend<&MarchQT::t>(last); }
+};
+
+template <class Light>
+void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks, float* image,
+                 MarchStats& stats, Light&& makeLight) {
+    const CameraFrame& cam = params.camera;
+    const uint32_t W = cam.width, H = cam.height;
+    std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0};
+    tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) {
+        uint64_t nRays = 0, nSamples = 0, nLight = 0, nSkipped = 0;
+        MarchCachedDensity density{&volume};
+        auto light = makeLight(density);
+        for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
+            for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
+                const MarchRayGeometry ray =
+                    MakePixelRay(cam, params.origin, params.setup.voxelSize, params.setup.size, x, y);
+                const uint32_t pixel = x + W * y;
+                const float xi = params.jitter ? MarchJitter(params.seed, params.frame, pixel) : 0.5f;
+                const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
+                float* out = image + 3 * size_t(pixel);
+                out[0] = m.color[0];
+                out[1] = m.color[1];
+                out[2] = m.color[2];
+                nRays += ray.Empty() ? 0 : 1;
+                nSamples += m.samples;
+                nLight += m.lightCalls;
+                nSkipped += m.bricksSkipped;
+            }
+        rays += nRays;
+        samples += nSamples;
+        lightSamples += nLight;
+        skipped += nSkipped;
+    });
+    stats.rays = rays;
+    stats.samples = samples;
+    stats.lightSamples = lightSamples;
+    stats.bricksSkipped = skipped;
+    (void)H;
+}
+
+}  // namespace
+
+Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
+    if (!in.qPrev || !in.qCur) return MakeError("cpu: render_march needs q");
+    const Extent3 e = in.qCur->Extent();
+    if (in.qPrev->Extent() != e) return MakeError("cpu: render_march: q_prev and q_cur differ in size");
+    const bool shadeLight = params.light == MarchLightSource::Shade;
+    if (shadeLight && !in.T) return MakeError("cpu: render_march: light source \"shade\" needs T");
+    if (shadeLight && in.T->Extent() != e) return MakeError("cpu: render_march: T and q differ in size");
+    if (image.Extent() != Extent3{3, params.camera.width, params.camera.height})
+        return MakeError("cpu: render_march: the image is not (3, width, height)");
+
+    const float* qPrev = static_cast<const BufferCpu*>(in.qPrev)->F32();
+    const float* qCur = static_cast<const BufferCpu*>(in.qCur)->F32();
+    const float* T = shadeLight ? static_cast<const BufferCpu*>(in.T)->F32() : nullptr;
+    float* out = static_cast<BufferCpu&>(image).F32();
+    const float alpha = params.alpha;
+    const size_t px = size_t(e.nx) + 2, py = size_t(e.ny) + 2, pz = size_t(e.nz) + 2;
+    const uint32_t B = std::max(params.brick, 1u);
+    const uint32_t bx = CeilDiv(e.nx, B), by = CeilDiv(e.ny, B), bz = CeilDiv(e.nz, B);
+    MarchStats local;
+
+    mArena.execute([&] {
+        // 1. q_alpha and T into the padded volume; the border reads q = 0, T = 1.
+        mMarchVolume.assign(px * py * pz, MarchQT{0.0f, 1.0f});
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.nz), [&](const tbb::blocked_range<uint32_t>& r) {
+            for (uint32_t k = r.begin(); k < r.end(); ++k)
+                for (uint32_t j = 0; j < e.ny; ++j) {
+                    const size_t src = size_t(e.nx) * (j + size_t(e.ny) * k);
+                    MarchQT* dst = mMarchVolume.data() + 1 + px * (j + 1) + px * py * (k + 1);
+                    for (uint32_t i = 0; i < e.nx; ++i)
+                        dst[i] = {Lerp(qPrev[src + i], qCur[src + i], alpha), T ? T[src + i] : 1.0f};
+                }
+        });
+        // 2. Bricks: empty iff q_alpha = 0 over the brick grown by one voxel (padded indices b B .. (b+1) B + 1).
+        MarchBricks bricks;
+        if (params.skipping) {
+            mMarchBricks.assign(size_t(bx) * by * bz, 0);
+            tbb::parallel_for(tbb::blocked_range<uint32_t>(0, bz), [&](const tbb::blocked_range<uint32_t>& r) {
+                for (uint32_t c = r.begin(); c < r.end(); ++c)
+                    for (uint32_t b = 0; b < by; ++b)
+                        for (uint32_t a = 0; a < bx; ++a) {
+                            bool empty = true;
+                            const size_t k1 = std::min<size_t>(size_t(c + 1) * B + 1, pz - 1);
+                            const size_t j1 = std::min<size_t>(size_t(b + 1) * B + 1, py - 1);
+                            const size_t i1 = std::min<size_t>(size_t(a + 1) * B + 1, px - 1);
+                            for (size_t k = size_t(c) * B; k <= k1 && empty; ++k)
+                                for (size_t j = size_t(b) * B; j <= j1 && empty; ++j)
+                                    for (size_t i = size_t(a) * B; i <= i1; ++i)
+                                        if (mMarchVolume[i + px * (j + py * k)].q != 0.0f) {
+                                            empty = false;
+                                            break;
+                                        }
+                            mMarchBricks[a + size_t(bx) * (b + size_t(by) * c)] = empty ? 1 : 0;
+                        }
+            });
+            bricks.empty = mMarchBricks.data();
+            bricks.brick = B;
+            bricks.count[0] = bx;
+            bricks.count[1] = by;
+            bricks.count[2] = bz;
+            local.bricks = mMarchBricks.size();
+            local.emptyBricks = uint64_t(std::count(mMarchBricks.begin(), mMarchBricks.end(), uint8_t(1)));
+        }
+        // 3. The rays.
+        const MarchPaddedVolume volume{mMarchVolume.data(), px, px * py, params.setup.size};
+        const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
+        const MarchSetup& s = params.setup;
+        const uint32_t nl = params.lightSteps;
+        auto plainQ = [&volume](const Vec3& p) { return volume.Q(p); };
+        if (shadeLight) {
+            MarchPixels(params, volume, brickPtr, out, local, [&](MarchCachedDensity& density) {
+                return [&density, &s, nl, plainQ](const Vec3& p) {
+                    MarchLightSample l;
+                    l.sun = density.LastT();
+                    if (s.point.on) l.point = PointLightMarch(s, p, nl, plainQ);
+                    return l;
+                };
+            });
+        } else {
+            MarchPixels(params, volume, brickPtr, out, local, [&](MarchCachedDensity&) {
+                return [&s, nl, plainQ](const Vec3& p) {
+                    MarchLightSample l;
+                    l.sun = SunLightMarch(s, p, nl, plainQ);
+                    if (s.point.on) l.point = PointLightMarch(s, p, nl, plainQ);
+                    return l;
+                };
+            });
+        }
+    });
+    if (stats) *stats = local;
+    return {};
+}
+
+}  // namespace cb::cpu
