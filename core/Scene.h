@@ -11,6 +11,7 @@
 #include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
+#include "core/NoiseSettings.h"
 #include "core/Shading.h"
 #include "core/Stage.h"
 
@@ -156,6 +157,7 @@ struct Scene {
     ShadowSettings shadow;
     RenderSettings render;
     SplatSettings splat;
+    NoiseSettings noise;  // stage `noise` (SPEC 10a)
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

@@ -42,4 +42,7 @@ void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow);
 bool ReadRender(const Json& root, Validator& check, RenderSettings& render);
 void ReadSplat(const Json& root, Validator& check, SplatSettings& splat);
 
+// The noise section (core/SceneNoiseReader.cpp).
+void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise);
+
 }  // namespace cb::scene_io

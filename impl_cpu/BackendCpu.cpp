@@ -25,7 +25,7 @@ std::string BackendCpu::Device() const {
     return std::to_string(mArena.max_concurrency()) + " threads (TBB), " + CaKernelName();
 }
 
-bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
+bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise; }
 
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("cpu: cannot create an empty buffer");
@@ -66,6 +66,12 @@ uint64_t BackendCpu::ScratchBytes(const Scene& scene) const {
         if (f > 1) bytes = SaturatingAdd(bytes, SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4));
         std::sort(cells, cells + 3);
         bytes = SaturatingAdd(bytes, 2 * 4 * (cells[1] + 3) * (cells[2] + 3));
+    }
+    // noise: the detail volume (size^3 floats) and the weather map (nx * ny floats) (NoiseCpu.cpp).
+    if (scene.stages.Has(Stage::Noise)) {
+        if (scene.noise.detail.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(scene.noise.detail.size) *
+                                                                         scene.noise.detail.size * scene.noise.detail.size);
+        if (scene.noise.coverage.enabled) bytes = SaturatingAdd(bytes, 4 * slice);
     }
     return bytes;
 }

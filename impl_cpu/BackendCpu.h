@@ -9,6 +9,7 @@
 
 #include "core/Backend.h"
 #include "core/MemoryPlan.h"
+#include "core/Noise.h"
 #include "impl_cpu/BitField.h"
 
 namespace cb::cpu {
@@ -59,6 +60,7 @@ class BackendCpu : public Backend {
     std::optional<uint64_t> AvailableBytes() const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     int Threads() const { return mArena.max_concurrency(); }
 
@@ -67,6 +69,11 @@ class BackendCpu : public Backend {
     // Scratch kept between calls so that steady-state steps do not allocate.
     std::vector<BitField> mAdvectScratch;
     std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
+    // Noise: what does not change per step (permutations, the detail volume),
+    // made on the first call and again only when the settings or grid change;
+    // and the weather map of one call (coverage only).
+    std::unique_ptr<noise::NoiseForm> mNoiseForm;
+    std::vector<float> mNoiseMap;
 };
 
 }  // namespace cb::cpu
