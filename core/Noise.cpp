@@ -127,9 +127,10 @@ void NoiseForm::BaseCoordinates(const StepOffsets& o, uint32_t i, uint32_t j, ui
 float NoiseForm::Map(const StepOffsets& o, uint32_t i, uint32_t j) const {
     const NoiseCoverage& c = mSettings.coverage;
     const Lattice lattice{NoiseBasis::Perlin, mMapPerm.data(), 0};
-    return Fbm01(lattice, MapFbm(c), (float(i) + 0.5f) * mMapScale[0] + o.map[0],
-                 (float(j) + 0.5f) * mMapScale[1] + o.map[1], 0.5f,
-                 Period{int32_t(c.frequency[0]), int32_t(c.frequency[1]), 1});
+    const float f = Fbm01(lattice, MapFbm(c), (float(i) + 0.5f) * mMapScale[0] + o.map[0],
+                          (float(j) + 0.5f) * mMapScale[1] + o.map[1], 0.5f,
+                          Period{int32_t(c.frequency[0]), int32_t(c.frequency[1]), 1});
+    return std::fmax(2.0f * f - 1.0f, 0.0f);
 }
 
 float NoiseForm::Detail(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k) const {

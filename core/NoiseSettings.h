@@ -54,11 +54,13 @@ struct NoiseDetail {
     bool operator==(const NoiseDetail&) const = default;
 };
 
-// Wang's coverage and density modulation (seed 002 eq. 15-16) with a 2-D
-// weather map m(x, y) in [0, 1] (Perlin fBm over x and y, tiled).
+// Wang's coverage and density modulation (seed 002 eq. 15-16), in place of the
+// threshold: q = D max(v - (m + 1 - C), 0), with a 2-D weather map
+// m(x, y) = max(0, 2 f - 1), f a Perlin fBm over x and y in [0, 1], tiled: half
+// the sky has m = 0 (only the coverage thins it), the rest is thinned up to m = 1.
 struct NoiseCoverage {
     bool enabled = false;
-    double coverage = 1.0;  // C in [0, 1]
+    double coverage = 0.65;  // C in [0, 1]; 1 - C acts as the threshold where m = 0
     double density = 1.0;   // D >= 0
     std::array<uint32_t, 2> frequency{2, 2};  // lattice cells of the map across the grid in x and y
     uint32_t octaves = 3;
