@@ -38,7 +38,7 @@ struct FbmSettings {
 // A Gaussian tower (Olajos 2.3.2): amplitude * exp(-1/2 sum_a ((p_a - centre_a) / sigma_a)^2), in voxels.
 struct NoiseTower {
     std::array<double, 3> center{0, 0, 0};  // voxel coordinates (voxel (i,j,k) has its centre at i+0.5, ...)
-    std::array<double, 3> sigma{4, 4, 4};   // voxels, > 0
+    std::array<double, 3> sigma{4, 4, 4};   // voxels, >= 0.001
     double amplitude = 0.5;
     bool operator==(const NoiseTower&) const = default;
 };
@@ -50,7 +50,7 @@ struct NoiseDetail {
     uint32_t size = 32;       // edge of the cubic detail volume, voxels
     uint32_t frequency = 4;   // lattice cells across the detail volume per axis
     FbmSettings fbm{NoiseBasis::Worley, 3, 0.5, 2, false};
-    double strength = 0.3;    // in [0, 1): v <- (v - s d) / (1 - s d)
+    double strength = 0.3;    // in [0, 0.99]: v <- (v - s d) / (1 - s d)
     bool operator==(const NoiseDetail&) const = default;
 };
 
@@ -74,7 +74,7 @@ struct NoiseSettings {
     FbmSettings fbm;
     double heightA = 50, heightB = 4;  // HD(h) = (1 - e^{-a h}) e^{-b h}
     std::vector<NoiseTower> towers;
-    double threshold = 0.35;  // c in [0, 1): q = clamp((v - c) / (1 - c), 0, 1) (without coverage)
+    double threshold = 0.35;  // c in [0, 0.99]: q = clamp((v - c) / (1 - c), 0, 1) (without coverage)
     NoiseDetail detail;
     NoiseCoverage coverage;
     // Time: the noise moves by this many voxels per step. Zero: the noise is

@@ -21,6 +21,11 @@ constexpr std::string_view kCoverageKeys[] = {"coverage", "density", "frequency"
 constexpr int64_t kMaxLatticeFrequency = 4096;
 constexpr size_t kMaxTowers = 1024;
 constexpr double kMaxVoxels = 1e6;  // tower centres, sizes and drift, in voxels
+// The threshold c and the erosion strength s divide by 1 - c and 1 - s d in
+// float: at most 0.99, so the divisor never rounds to 0.
+constexpr double kMaxFraction = 0.99;
+// A tower's sigma, so 1 / sigma^2 stays a modest float.
+constexpr double kMinSigma = 1e-3;
 
 // fBm fields (basis, octaves, gain, lacunarity, turbulence) of `section` into `fbm`.
 void ReadFbm(const Json& section, std::string_view parent, Validator& check, FbmSettings& fbm) {
@@ -76,7 +81,7 @@ void ReadTowers(const Json& list, Validator& check, std::vector<NoiseTower>& tow
     }
     towers.clear();
     const Range position{.lo = -kMaxVoxels, .hi = kMaxVoxels};
-    const Range size{.lo = 0, .loOpen = true, .hi = kMaxVoxels};
+    const Range size{.lo = kMinSigma, .hi = kMaxVoxels};
     for (size_t n = 0; n < list.size(); ++n) {
         const std::string tf = IndexField(field, n);
         const Json& item = list[n];
@@ -114,7 +119,7 @@ void ReadDetail(const Json& root, Validator& check, NoiseDetail& detail) {
     if (!section) return;
     detail.enabled = true;
     if (const Json* v = Validator::Find(*section, "size")) {
-        if (auto n = check.Integer(*v, "noise.detail.size", 1, 256)) detail.size = uint32_t(*n);
+        if (auto n = check.Integer(*v, "noise.detail.size", 1, 128)) detail.size = uint32_t(*n);
     }
     bool frequencyOk = true;
     if (const Json* v = Validator::Find(*section, "frequency")) {
@@ -125,7 +130,7 @@ void ReadDetail(const Json& root, Validator& check, NoiseDetail& detail) {
     const size_t before = check.ErrorCount();
     ReadFbm(*section, "noise.detail", check, detail.fbm);
     if (const Json* v = Validator::Find(*section, "strength")) {
-        if (auto d = check.Number(*v, "noise.detail.strength", Range{.lo = 0, .hi = 1, .hiOpen = true}))
+        if (auto d = check.Number(*v, "noise.detail.strength", Range{.lo = 0, .hi = kMaxFraction}))
             detail.strength = *d;
     }
     if (frequencyOk && check.ErrorCount() == before)
@@ -184,7 +189,7 @@ void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise) {
     }
     if (const Json* v = find("towers")) ReadTowers(*v, check, noise.towers);
     if (const Json* v = find("threshold")) {
-        if (auto d = check.Number(*v, "noise.threshold", Range{.lo = 0, .hi = 1, .hiOpen = true}))
+        if (auto d = check.Number(*v, "noise.threshold", Range{.lo = 0, .hi = kMaxFraction}))
             noise.threshold = *d;
     }
     ReadDetail(*section, check, noise.detail);

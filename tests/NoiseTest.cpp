@@ -454,7 +454,7 @@ TEST(Noise, SceneSection) {
     EXPECT_EQ(error(R"({"basis": "simplex"})"),
               "test.json: noise.frequency[0]: must be a multiple of 3 with the simplex basis (its lattice tiles only "
               "on such periods), got 4");
-    EXPECT_EQ(error(R"({"threshold": 1})"), "test.json: noise.threshold: must be in [0, 1), got 1");
+    EXPECT_EQ(error(R"({"threshold": 1})"), "test.json: noise.threshold: must be in [0, 0.99], got 1");
     EXPECT_EQ(error(R"({"frequency": [512, 4, 4], "octaves": 5})"),
               "test.json: noise.frequency[0]: times lacunarity^(octaves - 1) must be at most 4096 lattice cells, got "
               "512 x 16");
