@@ -34,8 +34,11 @@ using Permutation = std::array<uint8_t, 256>;
 // 0..255 shuffled by Fisher-Yates, drawing from Pcg32(seed) (core/Random.h).
 Permutation MakePermutation(uint32_t seed);
 
-// i mod n in [0, n) for any sign of i (n > 0).
+// i mod n in [0, n) for any sign of i (n > 0). The stage's coordinates lie in
+// [0, 2n), so the common cases skip the division.
 inline int32_t WrapIndex(int32_t i, int32_t n) {
+    if (uint32_t(i) < uint32_t(n)) return i;
+    if (i >= n && i - n < n) return i - n;
     const int32_t r = i % n;
     return r < 0 ? r + n : r;
 }
