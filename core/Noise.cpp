@@ -24,9 +24,9 @@ float Worley(uint32_t seed, float x, float y, float z, Period period) {
                 const std::array<float, 3> f = WorleyFeature(seed, WrapIndex(X + dx, period.x),
                                                              WrapIndex(Y + dy, period.y), WrapIndex(Z + dz, period.z));
                 const float ex = float(dx) + f[0] - x, ey = float(dy) + f[1] - y, ez = float(dz) + f[2] - z;
-                best = std::fmin(best, ex * ex + ey * ey + ez * ez);
+                best = std::min(best, ex * ex + ey * ey + ez * ez);
             }
-    return std::fmin(std::fmax(1.0f - std::sqrt(best) * 0.57735026918962576f, 0.0f), 1.0f);
+    return Clamp01(1.0f - std::sqrt(best) * 0.57735026918962576f);
 }
 
 float Fbm(const Lattice& lattice, const FbmSettings& fbm, float x, float y, float z, Period period) {
@@ -52,7 +52,7 @@ float FbmNorm(const FbmSettings& fbm) {
 float Fbm01(const Lattice& lattice, const FbmSettings& fbm, float x, float y, float z, Period period) {
     const float f = Fbm(lattice, fbm, x, y, z, period) / FbmNorm(fbm);
     const bool unsignedBasis = fbm.turbulence || lattice.basis == NoiseBasis::Worley;
-    return std::fmin(std::fmax(unsignedBasis ? f : 0.5f + 0.5f * f, 0.0f), 1.0f);
+    return Clamp01(unsignedBasis ? f : 0.5f + 0.5f * f);
 }
 
 namespace {
@@ -130,7 +130,7 @@ float NoiseForm::Map(const StepOffsets& o, uint32_t i, uint32_t j) const {
     const float f = Fbm01(lattice, MapFbm(c), (float(i) + 0.5f) * mMapScale[0] + o.map[0],
                           (float(j) + 0.5f) * mMapScale[1] + o.map[1], 0.5f,
                           Period{int32_t(c.frequency[0]), int32_t(c.frequency[1]), 1});
-    return std::fmax(2.0f * f - 1.0f, 0.0f);
+    return std::max(2.0f * f - 1.0f, 0.0f);
 }
 
 float NoiseForm::Detail(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k) const {

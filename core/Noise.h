@@ -11,6 +11,7 @@
 // docs/pipeline.md, section "Noise".
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -62,12 +63,15 @@ constexpr Real Lerp(Real t, Real a, Real b) {
 // Improved Perlin's gradient dot product: the 12 cube-edge midpoints (+-1, +-1, 0)
 // and permutations, padded to 16 by repeating (1,1,0), (-1,1,0), (0,-1,1),
 // (0,-1,-1) as in Perlin's 2002 reference code.
+// Written as a table (branch-free); entry h is the gradient of Perlin's
+// `h < 8 ? x : y` / `h < 4 ? y : h == 12 || h == 14 ? x : z` selection.
 template <typename Real>
-Real PerlinGradient(uint32_t hash, Real x, Real y, Real z) {
-    const uint32_t h = hash & 15u;
-    const Real u = h < 8u ? x : y;
-    const Real v = h < 4u ? y : (h == 12u || h == 14u ? x : z);
-    return ((h & 1u) == 0 ? u : -u) + ((h & 2u) == 0 ? v : -v);
+[[gnu::always_inline]] inline Real PerlinGradient(uint32_t hash, Real x, Real y, Real z) {
+    static constexpr int8_t kGrad[16][3] = {{1, 1, 0},  {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+                                            {1, 0, -1}, {-1, 0, -1}, {0, 1, 1},  {0, -1, 1},  {0, 1, -1}, {0, -1, -1},
+                                            {1, 1, 0},  {0, -1, 1}, {-1, 1, 0}, {0, -1, -1}};
+    const int8_t* g = kGrad[hash & 15u];
+    return Real(g[0]) * x + Real(g[1]) * y + Real(g[2]) * z;
 }
 
 // Improved Perlin noise (Perlin 2002), periodic with `period`. Zero at every
@@ -212,15 +216,19 @@ float FbmNorm(const FbmSettings& fbm);
 // 0.5 + 0.5 f / norm for the signed bases; clamped.
 float Fbm01(const Lattice& lattice, const FbmSettings& fbm, float x, float y, float z, Period period);
 
+// x clamped to [0, 1] (inline compares; the inputs are finite).
+inline float Clamp01(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
+
 // Olajos's height distribution HD(h) = (1 - e^{-a h}) e^{-b h}, h in [0, 1].
 inline float HeightDistribution(float h, float a, float b) { return (1.0f - std::exp(-a * h)) * std::exp(-b * h); }
 
 // Threshold q = clamp((v - c) / (1 - c), 0, 1), c in [0, 1): c -> 0, 1 -> 1.
-inline float Threshold(float v, float c) { return std::fmin(std::fmax((v - c) / (1.0f - c), 0.0f), 1.0f); }
+inline float Threshold(float v, float c) { return Clamp01((v - c) / (1.0f - c)); }
 
 // Wang eq. 16: q = D max(v - (m + 1 - C), 0), clamped to 1.
 inline float CoverageModulate(float v, float m, float coverage, float density) {
-    return std::fmin(density * std::fmax(v - (m + 1.0f - coverage), 0.0f), 1.0f);
+    const float excess = v - (m + 1.0f - coverage);
+    return std::min(density * (excess > 0.0f ? excess : 0.0f), 1.0f);
 }
 
 // Schneider's erosion by detail noise d in [0, 1] with strength s in [0, 1):
