@@ -50,7 +50,7 @@ struct NoiseDetail {
     uint32_t size = 32;       // edge of the cubic detail volume, voxels
     uint32_t frequency = 4;   // lattice cells across the detail volume per axis
     FbmSettings fbm{NoiseBasis::Worley, 3, 0.5, 2, false};
-    double strength = 0.3;    // in [0, 0.99]: v <- (v - s d) / (1 - s d)
+    double strength = 0.2;    // in [0, 0.99]: v <- (v - s d) / (1 - s d)
     bool operator==(const NoiseDetail&) const = default;
 };
 
