@@ -49,10 +49,14 @@ float FbmNorm(const FbmSettings& fbm) {
     return norm;
 }
 
-float Fbm01(const Lattice& lattice, const FbmSettings& fbm, float x, float y, float z, Period period) {
-    const float f = Fbm(lattice, fbm, x, y, z, period) / FbmNorm(fbm);
-    const bool unsignedBasis = fbm.turbulence || lattice.basis == NoiseBasis::Worley;
+float Fbm01FromSum(NoiseBasis basis, const FbmSettings& fbm, float sum) {
+    const float f = sum / FbmNorm(fbm);
+    const bool unsignedBasis = fbm.turbulence || basis == NoiseBasis::Worley;
     return Clamp01(unsignedBasis ? f : 0.5f + 0.5f * f);
+}
+
+float Fbm01(const Lattice& lattice, const FbmSettings& fbm, float x, float y, float z, Period period) {
+    return Fbm01FromSum(lattice.basis, fbm, Fbm(lattice, fbm, x, y, z, period));
 }
 
 namespace {

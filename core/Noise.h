@@ -78,25 +78,49 @@ template <typename Real>
 // lattice point; C2 (the quintic fade); |n| <= 2 provably (a convex blend of
 // g.d with |g.d| <= 2), within [-0.997, 0.997] measured over 5e6 points.
 template <typename Real>
-Real Perlin(const uint8_t* perm, Real x, Real y, Real z, Period period) {
-    const Real fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
-    const int32_t X0 = WrapIndex(int32_t(fx), period.x), Y0 = WrapIndex(int32_t(fy), period.y),
-                  Z0 = WrapIndex(int32_t(fz), period.z);
-    const int32_t X1 = X0 + 1 == period.x ? 0 : X0 + 1, Y1 = Y0 + 1 == period.y ? 0 : Y0 + 1,
-                  Z1 = Z0 + 1 == period.z ? 0 : Z0 + 1;
-    x -= fx, y -= fy, z -= fz;
+Real Perlin(const uint8_t* perm, Real x, Real y, Real z, Period period);
+
+// The lattice index `floor` of a coordinate wrapped to the period, and the next one, wrapped.
+struct WrappedCell {
+    int32_t lo, hi;
+};
+inline WrappedCell WrapCell(int32_t floor, int32_t period) {
+    const int32_t lo = WrapIndex(floor, period);
+    return {lo, lo + 1 == period ? 0 : lo + 1};
+}
+
+// The hashes of a Perlin cell's eight corners, in the order 000, 100, 010, 110, 001, 101, 011, 111 (x fastest).
+inline void PerlinCornerHashes(const uint8_t* perm, WrappedCell X, WrappedCell Y, WrappedCell Z, uint32_t h[8]) {
+    h[0] = LatticeHash(perm, X.lo, Y.lo, Z.lo), h[1] = LatticeHash(perm, X.hi, Y.lo, Z.lo);
+    h[2] = LatticeHash(perm, X.lo, Y.hi, Z.lo), h[3] = LatticeHash(perm, X.hi, Y.hi, Z.lo);
+    h[4] = LatticeHash(perm, X.lo, Y.lo, Z.hi), h[5] = LatticeHash(perm, X.hi, Y.lo, Z.hi);
+    h[6] = LatticeHash(perm, X.lo, Y.hi, Z.hi), h[7] = LatticeHash(perm, X.hi, Y.hi, Z.hi);
+}
+
+// Perlin's blend of the corner gradients at the offset (x, y, z) in [0, 1)^3 inside the cell.
+template <typename Real>
+[[gnu::always_inline]] inline Real PerlinBlend(const uint32_t h[8], Real x, Real y, Real z) {
     const Real u = Fade(x), v = Fade(y), w = Fade(z);
     const Real one = Real(1);
-    const Real n000 = PerlinGradient(LatticeHash(perm, X0, Y0, Z0), x, y, z);
-    const Real n100 = PerlinGradient(LatticeHash(perm, X1, Y0, Z0), x - one, y, z);
-    const Real n010 = PerlinGradient(LatticeHash(perm, X0, Y1, Z0), x, y - one, z);
-    const Real n110 = PerlinGradient(LatticeHash(perm, X1, Y1, Z0), x - one, y - one, z);
-    const Real n001 = PerlinGradient(LatticeHash(perm, X0, Y0, Z1), x, y, z - one);
-    const Real n101 = PerlinGradient(LatticeHash(perm, X1, Y0, Z1), x - one, y, z - one);
-    const Real n011 = PerlinGradient(LatticeHash(perm, X0, Y1, Z1), x, y - one, z - one);
-    const Real n111 = PerlinGradient(LatticeHash(perm, X1, Y1, Z1), x - one, y - one, z - one);
+    const Real n000 = PerlinGradient(h[0], x, y, z);
+    const Real n100 = PerlinGradient(h[1], x - one, y, z);
+    const Real n010 = PerlinGradient(h[2], x, y - one, z);
+    const Real n110 = PerlinGradient(h[3], x - one, y - one, z);
+    const Real n001 = PerlinGradient(h[4], x, y, z - one);
+    const Real n101 = PerlinGradient(h[5], x - one, y, z - one);
+    const Real n011 = PerlinGradient(h[6], x, y - one, z - one);
+    const Real n111 = PerlinGradient(h[7], x - one, y - one, z - one);
     return Lerp(w, Lerp(v, Lerp(u, n000, n100), Lerp(u, n010, n110)),
                 Lerp(v, Lerp(u, n001, n101), Lerp(u, n011, n111)));
+}
+
+template <typename Real>
+Real Perlin(const uint8_t* perm, Real x, Real y, Real z, Period period) {
+    const Real fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
+    uint32_t h[8];
+    PerlinCornerHashes(perm, WrapCell(int32_t(fx), period.x), WrapCell(int32_t(fy), period.y),
+                       WrapCell(int32_t(fz), period.z), h);
+    return PerlinBlend(h, x - fx, y - fy, z - fz);
 }
 
 // Gustavson's 12 gradients of "Simplex noise demystified" (2005), indexed by hash mod 12.
@@ -213,7 +237,9 @@ float Fbm(const Lattice& lattice, const FbmSettings& fbm, float x, float y, floa
 float FbmNorm(const FbmSettings& fbm);
 
 // fBm mapped to [0, 1]: f / norm for Worley and turbulence (non-negative),
-// 0.5 + 0.5 f / norm for the signed bases; clamped.
+// 0.5 + 0.5 f / norm for the signed bases; clamped. Fbm01FromSum maps an fBm
+// sum already formed (the CPU stage forms Perlin's row by row).
+float Fbm01FromSum(NoiseBasis basis, const FbmSettings& fbm, float sum);
 float Fbm01(const Lattice& lattice, const FbmSettings& fbm, float x, float y, float z, Period period);
 
 // x clamped to [0, 1] (inline compares; the inputs are finite).

@@ -347,8 +347,10 @@ TEST(Noise, DriftMovesTheClouds) {
 TEST(Noise, CpuStageEqualsTheFormula) {
     cpu::BackendCpu backend(2);
     const Extent3 grid{16, 8, 8};
-    for (NoiseBasis basis : {NoiseBasis::Perlin, NoiseBasis::Simplex, NoiseBasis::Worley}) {
-        const NoiseSettings s = Busy(basis);
+    NoiseSettings turbulent = Busy();  // the stage forms Perlin fBm row by row: turbulence and lacunarity 3 too
+    turbulent.fbm.turbulence = true;
+    turbulent.fbm.lacunarity = 3;
+    for (const NoiseSettings& s : {Busy(NoiseBasis::Perlin), Busy(NoiseBasis::Simplex), Busy(NoiseBasis::Worley), turbulent}) {
         const noise::NoiseForm form(s, grid);
         auto q = test::MakeBuffer(backend, BufferFormat::F32, grid);
         for (uint32_t step : {0u, 1u, 5u}) {
@@ -358,7 +360,8 @@ TEST(Noise, CpuStageEqualsTheFormula) {
             for (uint32_t k = 0; k < grid.nz; ++k)
                 for (uint32_t j = 0; j < grid.ny; ++j)
                     for (uint32_t i = 0; i < grid.nx; ++i)
-                        ASSERT_EQ(values[VoxelIndex(grid, i, j, k)], form.Q(o, i, j, k)) << i << "," << j << "," << k;
+                        ASSERT_EQ(values[VoxelIndex(grid, i, j, k)], form.Q(o, i, j, k))
+                            << i << "," << j << "," << k << " basis " << int(s.fbm.basis);
         }
     }
     NoiseSettings a = Busy(), b = Busy();
