@@ -148,7 +148,9 @@ float NoiseForm::Detail(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k
         i0[a] = WrapIndex(int32_t(f), s);
         i1[a] = i0[a] + 1 == s ? 0 : i0[a] + 1;
     }
-    auto at = [&](int32_t a, int32_t b, int32_t c) { return mDetail[size_t(a) + size_t(s) * (size_t(b) + size_t(s) * c)]; };
+    auto at = [&](int32_t a, int32_t b, int32_t c) {
+        return mDetail[size_t(a) + size_t(s) * (size_t(b) + size_t(s) * c)];
+    };
     const float c00 = Lerp(t[0], at(i0[0], i0[1], i0[2]), at(i1[0], i0[1], i0[2]));
     const float c10 = Lerp(t[0], at(i0[0], i1[1], i0[2]), at(i1[0], i1[1], i0[2]));
     const float c01 = Lerp(t[0], at(i0[0], i0[1], i1[2]), at(i1[0], i0[1], i1[2]));
@@ -157,13 +159,12 @@ float NoiseForm::Detail(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k
 }
 
 float NoiseForm::Towers(uint32_t i, uint32_t j, uint32_t k) const {
-    return TowerSum(mTowers.data(), mTowers.size(), float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f,
-                    float(mGrid.nx), float(mGrid.ny));
+    return TowerSum(mTowers.data(), mTowers.size(), float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f, float(mGrid.nx),
+                    float(mGrid.ny));
 }
 
 float NoiseForm::Height(uint32_t k) const {
-    return HeightDistribution((float(k) + 0.5f) / float(mGrid.nz), float(mSettings.heightA),
-                              float(mSettings.heightB));
+    return HeightDistribution((float(k) + 0.5f) / float(mGrid.nz), float(mSettings.heightA), float(mSettings.heightB));
 }
 
 float NoiseForm::Form(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k, float base01, float map) const {

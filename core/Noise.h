@@ -67,9 +67,9 @@ constexpr Real Lerp(Real t, Real a, Real b) {
 // `h < 8 ? x : y` / `h < 4 ? y : h == 12 || h == 14 ? x : z` selection.
 template <typename Real>
 [[gnu::always_inline]] inline Real PerlinGradient(uint32_t hash, Real x, Real y, Real z) {
-    static constexpr int8_t kGrad[16][3] = {{1, 1, 0},  {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+    static constexpr int8_t kGrad[16][3] = {{1, 1, 0},  {-1, 1, 0},  {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
                                             {1, 0, -1}, {-1, 0, -1}, {0, 1, 1},  {0, -1, 1},  {0, 1, -1}, {0, -1, -1},
-                                            {1, 1, 0},  {0, -1, 1}, {-1, 1, 0}, {0, -1, -1}};
+                                            {1, 1, 0},  {0, -1, 1},  {-1, 1, 0}, {0, -1, -1}};
     const int8_t* g = kGrad[hash & 15u];
     return Real(g[0]) * x + Real(g[1]) * y + Real(g[2]) * z;
 }
@@ -126,9 +126,8 @@ Real Perlin(const uint8_t* perm, Real x, Real y, Real z, Period period) {
 // Gustavson's 12 gradients of "Simplex noise demystified" (2005), indexed by hash mod 12.
 template <typename Real>
 Real SimplexGradient(uint32_t hash, Real x, Real y, Real z) {
-    static constexpr int8_t kGrad[12][3] = {{1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0},
-                                            {1, 0, 1}, {-1, 0, 1}, {1, 0, -1}, {-1, 0, -1},
-                                            {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1}};
+    static constexpr int8_t kGrad[12][3] = {{1, 1, 0},  {-1, 1, 0},  {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+                                            {1, 0, -1}, {-1, 0, -1}, {0, 1, 1},  {0, -1, 1},  {0, 1, -1}, {0, -1, -1}};
     const int8_t* g = kGrad[hash % 12u];
     return Real(g[0]) * x + Real(g[1]) * y + Real(g[2]) * z;
 }
@@ -198,8 +197,7 @@ Real Simplex(const uint8_t* perm, Real x, Real y, Real z, Period period) {
 // period) as an offset in [0, 1)^3 from the cell's corner: three lowbias32
 // draws from key = lowbias32(cx + lowbias32(cy + lowbias32(cz + lowbias32(seed)))).
 inline std::array<float, 3> WorleyFeature(uint32_t seed, int32_t cx, int32_t cy, int32_t cz) {
-    const uint32_t key =
-        LowBias32(uint32_t(cx) + LowBias32(uint32_t(cy) + LowBias32(uint32_t(cz) + LowBias32(seed))));
+    const uint32_t key = LowBias32(uint32_t(cx) + LowBias32(uint32_t(cy) + LowBias32(uint32_t(cz) + LowBias32(seed))));
     constexpr float kScale = 1.0f / 16777216.0f;
     return {float(LowBias32(key) >> 8) * kScale, float(LowBias32(key + 1u) >> 8) * kScale,
             float(LowBias32(key + 2u) >> 8) * kScale};

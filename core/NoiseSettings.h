@@ -47,10 +47,10 @@ struct NoiseTower {
 // voxel per grid voxel), that erodes the base shape (Schneider's remap).
 struct NoiseDetail {
     bool enabled = false;
-    uint32_t size = 32;       // edge of the cubic detail volume, voxels
-    uint32_t frequency = 4;   // lattice cells across the detail volume per axis
+    uint32_t size = 32;      // edge of the cubic detail volume, voxels
+    uint32_t frequency = 4;  // lattice cells across the detail volume per axis
     FbmSettings fbm{NoiseBasis::Worley, 3, 0.5, 2, false};
-    double strength = 0.2;    // in [0, 0.99]: v <- (v - s d) / (1 - s d)
+    double strength = 0.2;  // in [0, 0.99]: v <- (v - s d) / (1 - s d)
     bool operator==(const NoiseDetail&) const = default;
 };
 
@@ -60,8 +60,8 @@ struct NoiseDetail {
 // the sky has m = 0 (only the coverage thins it), the rest is thinned up to m = 1.
 struct NoiseCoverage {
     bool enabled = false;
-    double coverage = 0.65;  // C in [0, 1]; 1 - C acts as the threshold where m = 0
-    double density = 1.0;   // D >= 0
+    double coverage = 0.65;                   // C in [0, 1]; 1 - C acts as the threshold where m = 0
+    double density = 1.0;                     // D >= 0
     std::array<uint32_t, 2> frequency{2, 2};  // lattice cells of the map across the grid in x and y
     uint32_t octaves = 3;
     double gain = 0.5;

@@ -7,12 +7,12 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kNoiseKeys[] = {"seed",     "basis",    "frequency", "octaves",  "gain",
-                                           "lacunarity", "turbulence", "height_a", "height_b", "towers",
-                                           "threshold", "detail",   "coverage",  "drift"};
+constexpr std::string_view kNoiseKeys[] = {"seed",       "basis",      "frequency", "octaves",  "gain",
+                                           "lacunarity", "turbulence", "height_a",  "height_b", "towers",
+                                           "threshold",  "detail",     "coverage",  "drift"};
 constexpr std::string_view kTowerKeys[] = {"center", "sigma", "amplitude"};
-constexpr std::string_view kDetailKeys[] = {"size",       "basis",      "frequency", "octaves",
-                                            "gain",       "lacunarity", "turbulence", "strength"};
+constexpr std::string_view kDetailKeys[] = {"size", "basis",      "frequency",  "octaves",
+                                            "gain", "lacunarity", "turbulence", "strength"};
 constexpr std::string_view kCoverageKeys[] = {"coverage", "density", "frequency", "octaves", "gain"};
 
 // Lattice frequencies (cells across the grid, or the detail volume) at the
@@ -62,8 +62,10 @@ void CheckFrequencies(const FbmSettings& fbm, const uint32_t* frequency, size_t 
             return;
         }
         if (fbm.basis == NoiseBasis::Simplex && frequency[a] % 3 != 0) {
-            check.Fail(name, "must be a multiple of 3 with the simplex basis (its lattice tiles only on such "
-                             "periods), got " + std::to_string(frequency[a]));
+            check.Fail(name,
+                       "must be a multiple of 3 with the simplex basis (its lattice tiles only on such "
+                       "periods), got " +
+                           std::to_string(frequency[a]));
             return;
         }
     }
@@ -189,8 +191,7 @@ void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise) {
     }
     if (const Json* v = find("towers")) ReadTowers(*v, check, noise.towers);
     if (const Json* v = find("threshold")) {
-        if (auto d = check.Number(*v, "noise.threshold", Range{.lo = 0, .hi = kMaxFraction}))
-            noise.threshold = *d;
+        if (auto d = check.Number(*v, "noise.threshold", Range{.lo = 0, .hi = kMaxFraction})) noise.threshold = *d;
     }
     ReadDetail(*section, check, noise.detail);
     ReadCoverage(*section, check, noise.coverage);

@@ -9,12 +9,12 @@
 // for voxel. Perlin fBm runs octave by octave along a row: y and z are the
 // same for the whole row, and a cell's eight corner hashes are reused until x
 // enters the next cell (at octave 0 of frequency 4 on 128 voxels, once per 32).
-#include <climits>
-#include <vector>
-
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+
+#include <climits>
+#include <vector>
 
 #include "impl_cpu/BackendCpu.h"
 

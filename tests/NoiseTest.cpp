@@ -183,8 +183,8 @@ TEST(Noise, WorleyEqualsBruteForce) {
     for (int cz = 0; cz < P[2]; ++cz)
         for (int cy = 0; cy < P[1]; ++cy)
             for (int cx = 0; cx < P[0]; ++cx) {
-                const uint32_t key = LowBias32(uint32_t(cx) + LowBias32(uint32_t(cy) +
-                                                                        LowBias32(uint32_t(cz) + LowBias32(seed))));
+                const uint32_t key =
+                    LowBias32(uint32_t(cx) + LowBias32(uint32_t(cy) + LowBias32(uint32_t(cz) + LowBias32(seed))));
                 points.push_back({cx + (LowBias32(key) >> 8) / 16777216.0, cy + (LowBias32(key + 1) >> 8) / 16777216.0,
                                   cz + (LowBias32(key + 2) >> 8) / 16777216.0});
             }
@@ -350,7 +350,8 @@ TEST(Noise, CpuStageEqualsTheFormula) {
     NoiseSettings turbulent = Busy();  // the stage forms Perlin fBm row by row: turbulence and lacunarity 3 too
     turbulent.fbm.turbulence = true;
     turbulent.fbm.lacunarity = 3;
-    for (const NoiseSettings& s : {Busy(NoiseBasis::Perlin), Busy(NoiseBasis::Simplex), Busy(NoiseBasis::Worley), turbulent}) {
+    for (const NoiseSettings& s :
+         {Busy(NoiseBasis::Perlin), Busy(NoiseBasis::Simplex), Busy(NoiseBasis::Worley), turbulent}) {
         const noise::NoiseForm form(s, grid);
         auto q = test::MakeBuffer(backend, BufferFormat::F32, grid);
         for (uint32_t step : {0u, 1u, 5u}) {
