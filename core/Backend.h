@@ -21,6 +21,7 @@
 #include "core/Grid.h"
 #include "core/March.h"
 #include "core/MarchSettings.h"
+#include "core/NoiseSettings.h"
 #include "core/Rules.h"
 #include "core/Shading.h"
 #include "core/Stage.h"
@@ -103,10 +104,13 @@ struct DensityParams {
     uint32_t band = 4;
 };
 
-// Inputs of the noise producer of q (SPEC 10a). The noise settings themselves
-// arrive with the stage (issue 13); a step index is its time coordinate.
+// Inputs of the noise producer of q (SPEC 10a): the scene's noise settings,
+// the grid q has, and the step, whose index is the time coordinate (the
+// noise drifts by settings->drift voxels per step).
 struct NoiseParams {
     uint32_t step = 0;
+    const NoiseSettings* settings = nullptr;  // not owned; must outlive the call
+    Extent3 grid;                             // must equal q's extent
 };
 
 // Inputs of the shade stage (SPEC 6) besides q.
@@ -226,7 +230,8 @@ struct MarchStats {
     X(RenderSplat, RenderSplat, (const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats))
 
 // The producers of q other than the automaton and smoothing. Noise  q (F32,
-// grid size) formed from noise (SPEC 10a); no backend implements it yet.
+// grid size) formed from noise (SPEC 10a); the CPU implements it (issue 13),
+// the GPU backends do not yet (issue 14).
 #define CB_NOISE_ENTRIES(X) X(Noise, Noise, (const NoiseParams& params, Buffer& q))
 
 // The ray marcher (SPEC 10); only the CPU implements it so far (issue 14 ports it).

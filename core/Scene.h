@@ -12,6 +12,7 @@
 #include "core/Error.h"
 #include "core/Grid.h"
 #include "core/MarchSettings.h"
+#include "core/NoiseSettings.h"
 #include "core/Shading.h"
 #include "core/Stage.h"
 
@@ -159,6 +160,7 @@ struct Scene {
     SplatSettings splat;
     MarchSettings march;          // stage render_march (section `march`)
     LightningSettings lightning;  // the point light of render_march (section `lightning`)
+    NoiseSettings noise;  // stage `noise` (SPEC 10a)
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

@@ -25,7 +25,7 @@ constexpr Stage kDefaultStages[] = {Stage::Region, Stage::Ca, Stage::Smooth, Sta
 constexpr std::string_view kTopKeys[] = {"name",  "description", "grid",   "steps",   "warmup_steps", "stages",
                                          "ca",    "ellipsoids",  "smooth", "density", "sun",          "lighting",
                                          "phase", "shade",       "shadow", "render",
-                                         "march", "lightning"};
+                                         "march", "lightning",   "noise"};
 constexpr std::string_view kGridKeys[] = {"size", "voxel_size", "origin"};
 constexpr std::string_view kCaKeys[] = {"seed", "hum0", "act0", "p_ext", "p_hum", "p_act", "wind_shift"};
 // clang-format off
@@ -379,6 +379,7 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
     ReadSplat(root, check, scene.splat);
     ReadMarch(root, check, scene.stages, scene.march);
     ReadLightning(root, check, scene.lightning);
+    ReadNoise(root, check, scene.noise);
     // Every renderer draws one image per camera.
     for (Stage stage : kAllStages)
         if (Describe(stage).renderer && scene.stages.Has(stage) && camerasOk && scene.render.cameras.empty())

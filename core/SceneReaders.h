@@ -46,5 +46,7 @@ void ReadSplat(const Json& root, Validator& check, SplatSettings& splat);
 // default light source "shade" needs the shade stage when render_march runs.
 void ReadMarch(const Json& root, Validator& check, const StageSet& stages, MarchSettings& march);
 void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning);
+// The noise section (core/SceneNoiseReader.cpp).
+void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise);
 
 }  // namespace cb::scene_io

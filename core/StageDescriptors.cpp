@@ -137,6 +137,9 @@ CompareRule MarchImageRule(const Scene&) {
 // SPEC 10a.
 CompareRule NoiseRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}; }
 
+// Noise reads nothing: static noise is made once, drifting noise every step (SPEC 14).
+bool NoiseAnimated(const Scene& scene) { return scene.noise.Animated(); }
+
 // The splat renderer interpolates q between the last two steps, and skips
 // boxes empty in both steps' occupancy.
 std::vector<Resource> SplatPrevious(const Scene& scene) {
@@ -214,7 +217,13 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
          .renderer = true,
          .symbol = "image",
          .rule = MarchImageRule},
-        {.stage = Stage::Noise, .section = "noise", .writes = {Resource::Q}, .symbol = "q", .rule = NoiseRule},
+        {.stage = Stage::Noise,
+         .section = "noise",
+         .writes = {Resource::Q},
+         .skipsUnchangedInputs = true,
+         .dependsOnStep = NoiseAnimated,
+         .symbol = "q",
+         .rule = NoiseRule},
     }};
     return table;
 }

@@ -96,6 +96,10 @@ struct StageDescriptor {
     bool outputStepsOnly = false;
     // Skipped when none of its inputs changed since it last ran.
     bool skipsUnchangedInputs = false;
+    // True when its outputs depend on the step itself in this scene (a time
+    // coordinate): it then runs every step despite skipsUnchangedInputs.
+    // nullptr: never (a stage with no inputs and no time runs once).
+    bool (*dependsOnStep)(const Scene& scene) = nullptr;
     // A renderer: writes one image per camera.
     bool renderer = false;
     std::string_view symbol;  // the compared quantity in rule texts ("R", "T", ...)

@@ -79,6 +79,7 @@ std::vector<uint64_t> Simulation::InputVersions(Stage stage) const {
 }
 
 bool Simulation::InputsChangedSinceLastRun(Stage stage) const {
+    if (const StageDescriptor& d = Describe(stage); d.dependsOnStep && d.dependsOnStep(mScene)) return true;
     const auto& last = mInputsAtLastRun[size_t(stage)];
     return !last || *last != InputVersions(stage);
 }

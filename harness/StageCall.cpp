@@ -122,7 +122,7 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
         case Stage::RenderSplat:
             return RenderSplatFrames(backend, sc, host.step, io, record);
         case Stage::Noise: {
-            const NoiseParams p{host.step};
+            const NoiseParams p = MakeNoiseParams(sc, host.step);
             return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });
         }
         case Stage::RenderMarch:

@@ -48,6 +48,8 @@ ShadowParams MakeShadowParams(const Scene& sc) {
     return p;
 }
 
+NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.noise, sc.grid.size}; }
+
 SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
     SplatParams p;
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);

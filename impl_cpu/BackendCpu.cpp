@@ -25,7 +25,9 @@ std::string BackendCpu::Device() const {
     return std::to_string(mArena.max_concurrency()) + " threads (TBB), " + CaKernelName();
 }
 
-bool BackendCpu::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::RenderMarch; }
+bool BackendCpu::Supports(Stage stage) const {
+    return IsSplatPipelineStage(stage) || stage == Stage::RenderMarch || stage == Stage::Noise;
+}
 
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("cpu: cannot create an empty buffer");
@@ -73,6 +75,12 @@ uint64_t BackendCpu::ScratchBytes(const Scene& scene) const {
         const uint32_t b = std::max(scene.march.brick, 1u);
         const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
         bytes = SaturatingAdd(bytes, SaturatingAdd(SaturatingMul(padded, sizeof(MarchQT)), bricks));
+    }
+    // noise: the detail volume (size^3 floats) and the weather map (nx * ny floats) (NoiseCpu.cpp).
+    if (scene.stages.Has(Stage::Noise)) {
+        if (scene.noise.detail.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(scene.noise.detail.size) *
+                                                                         scene.noise.detail.size * scene.noise.detail.size);
+        if (scene.noise.coverage.enabled) bytes = SaturatingAdd(bytes, 4 * slice);
     }
     return bytes;
 }

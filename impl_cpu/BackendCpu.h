@@ -9,6 +9,7 @@
 
 #include "core/Backend.h"
 #include "core/MemoryPlan.h"
+#include "core/Noise.h"
 #include "impl_cpu/BitField.h"
 
 namespace cb::cpu {
@@ -66,6 +67,7 @@ class BackendCpu : public Backend {
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     int Threads() const { return mArena.max_concurrency(); }
 
@@ -76,6 +78,11 @@ class BackendCpu : public Backend {
     std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
     std::vector<MarchQT> mMarchVolume;                // render_march: padded (q_alpha, T)
     std::vector<uint8_t> mMarchBricks;                // render_march: empty bricks
+    // Noise: what does not change per step (permutations, the detail volume),
+    // made on the first call and again only when the settings or grid change;
+    // and the weather map of one call (coverage only).
+    std::unique_ptr<noise::NoiseForm> mNoiseForm;
+    std::vector<float> mNoiseMap;
 };
 
 }  // namespace cb::cpu

@@ -92,7 +92,8 @@ TEST(Simulation, AnotherProducerOfQ) {
     auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json",
                            {{"steps", "3"},
                             {"warmup_steps", "0"},
-                            {"stages", R"(["noise", "density", "shade", "shadow", "render_splat"])"}});
+                            {"stages", R"(["noise", "density", "shade", "shadow", "render_splat"])"},
+                            {"noise.drift", "[1, 0, 0]"}});  // animated: the producer runs every step
     ASSERT_TRUE(scene.has_value()) << scene.error().message;
     BlobProducer backend;
     auto sim = Simulation::Create(*scene, backend, /*everyStepOutputs=*/true);

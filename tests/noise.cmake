@@ -1,0 +1,6 @@
+# Stage noise from the command line (issue 13): the test noise scene runs end to end on the CPU
+# (noise, density, shade, shadow, render_splat) and writes its results. Included from tests/CMakeLists.txt.
+add_test(NAME Cli.RunNoiseSmall
+         COMMAND ${cli} run ${CMAKE_CURRENT_SOURCE_DIR}/scenes/noise-small.json --backend cpu --quiet
+                 --out ${cli_out}/noise-small)
+set_tests_properties(Cli.RunNoiseSmall PROPERTIES PASS_REGULAR_EXPRESSION "results: .*results.json")
