@@ -29,7 +29,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 #include <thread>
 

@@ -33,7 +33,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 
 namespace cb::ref {
