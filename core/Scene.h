@@ -100,6 +100,10 @@ struct SunSettings {
 struct LightingSettings {
     std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
     std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
+
+    // In single precision, as the renderers use them.
+    Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }
+    Vec3 Background() const { return {float(background[0]), float(background[1]), float(background[2])}; }
 };
 
 // Stage `shade` (SPEC 6).

@@ -55,10 +55,8 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
     p.sun = sc.sun.Direction();
     p.sunRadiance = sc.sun.Radiance();
-    for (int c = 0; c < 3; ++c) {
-        p.ambient[c] = float(sc.lighting.ambient[c]);
-        p.background[c] = float(sc.lighting.background[c]);
-    }
+    p.ambient = sc.lighting.Ambient();
+    p.background = sc.lighting.Background();
     p.phase = sc.phase;
     p.qMin = float(sc.splat.qMin);
     p.splatDiameter = float(sc.splat.splatScale * sc.grid.voxelSize);
@@ -89,10 +87,8 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     s.epsilon = float(sc.march.epsilon);
     s.sun = sc.sun.Direction();
     s.sunRadiance = sc.sun.Radiance();
-    for (int c = 0; c < 3; ++c) {
-        s.ambient[c] = float(sc.lighting.ambient[c]);
-        s.background[c] = float(sc.lighting.background[c]);
-    }
+    s.ambient = sc.lighting.Ambient();
+    s.background = sc.lighting.Background();
     s.phase = sc.phase;
     s.powder = sc.march.powder;
     s.powderC = float(sc.march.powderC);
