@@ -62,3 +62,9 @@ PY]=])
 add_test(NAME Cli.SweepImages COMMAND /bin/sh -c "${cli_imgacc_sweep_script}" ${cli} ${cli_out}/imgacc-sweep
          ${CMAKE_CURRENT_SOURCE_DIR})
 set_tests_properties(Cli.SweepImages PROPERTIES TIMEOUT 120 PASS_REGULAR_EXPRESSION "sweep images ok")
+# --reference-step must be a number of voxel edges in [1/1024, 1].
+add_test(NAME Cli.AccuracyBadReferenceStepExits2
+         COMMAND ${CMAKE_COMMAND} -DCMD=${cli} "-DARGS=accuracy;ci-small;--reference-step;0" -DEXPECT=2
+                 ${expect_exit})
+set_tests_properties(Cli.AccuracyBadReferenceStepExits2 PROPERTIES PASS_REGULAR_EXPRESSION
+                     "--reference-step needs a number")
