@@ -67,7 +67,7 @@ constexpr std::string_view StageSpecSection(Stage stage) {
 }
 
 // The stages of the thesis's splat pipeline (SPEC 2-8), which every backend
-// implements; render_march (CPU only so far) and noise are not.
+// implements; render_march and noise are the CPU's alone until issue 14 ports them.
 constexpr bool IsSplatPipelineStage(Stage stage) {
     switch (stage) {
 #define CB_STAGE_SPLAT(name, text, spec, splat) \

@@ -28,55 +28,61 @@ Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& l
     return status;
 }
 
-Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
-                         StageCallRecord& record) {
+// One frame per camera: `renderOne(n, frame, timed)` makes camera n's frame,
+// running its backend call through `timed` (host work outside it is not
+// stage time); each frame's time is what `timed` measured.
+template <typename RenderOne>
+Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, uint32_t step, StageCallRecord& record,
+                        RenderOne&& renderOne) {
+    const std::string backendName = backend.Name();
     for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
-        SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
-        // The order is host work shared by all backends, outside the stage time.
-        const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
-        p.order = &order;
-        // Without a previous step (step 0, or no history kept) the renderer interpolates a step with itself.
-        auto previousOr = [&](Resource r) { return io.Previous(r) ? io.Previous(r) : io.Current(r); };
-        const SplatInputs in{previousOr(Resource::Q),      io.Current(Resource::Q),     io.Current(Resource::T),
-                             io.Previous(Resource::Tiles), io.Current(Resource::Tiles), io.Previous(Resource::Bands),
-                             io.Current(Resource::Bands)};
         FrameRecord frame;
-        frame.renderer = Stage::RenderSplat;
+        frame.renderer = renderer;
         frame.camera = sc.render.cameras[n].name;
         const double before = record.ms;
-        const std::string backendName = backend.Name();
-        const StageCountLabel label{StageName(Stage::RenderSplat), backendName, step, frame.camera};
-        Status status = Timed(backend, record, label, [&] {
-            return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats);
-        });
+        const StageCountLabel label{StageName(renderer), backendName, step, frame.camera};
+        auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
+        Status status = renderOne(n, frame, timed);
         frame.ms = record.ms - before;
-        if (!status) return MakeError("render_splat (" + frame.camera + "): " + status.error().message);
+        if (!status)
+            return MakeError(std::string(StageName(renderer)) + " (" + frame.camera + "): " + status.error().message);
         record.frames.push_back(frame);
     }
     return {};
 }
 
+// Without a previous step (step 0, or no history kept) a renderer interpolates a step with itself.
+Buffer* PreviousOrCurrent(const StageBuffers& io, Resource r) {
+    return io.Previous(r) ? io.Previous(r) : io.Current(r);
+}
+
+Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
+                         StageCallRecord& record) {
+    return RenderEachCamera(
+        Stage::RenderSplat, backend, sc, step, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
+            // The order is host work shared by all backends, outside the stage time.
+            const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
+            p.order = &order;
+            const SplatInputs in{
+                PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q),     io.Current(Resource::T),
+                io.Previous(Resource::Tiles),       io.Current(Resource::Tiles), io.Previous(Resource::Bands),
+                io.Current(Resource::Bands)};
+            return timed(
+                [&] { return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats); });
+        });
+}
+
 Status RenderMarchFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
                          StageCallRecord& record) {
-    for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
-        const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step);
-        // Without a previous step the renderer interpolates a step with itself; T only where shade runs.
-        const MarchInputs in{io.Previous(Resource::Q) ? io.Previous(Resource::Q) : io.Current(Resource::Q),
-                             io.Current(Resource::Q), io.Current(Resource::T)};
-        FrameRecord frame;
-        frame.renderer = Stage::RenderMarch;
-        frame.camera = sc.render.cameras[n].name;
-        const double before = record.ms;
-        const std::string backendName = backend.Name();
-        const StageCountLabel label{StageName(Stage::RenderMarch), backendName, step, frame.camera};
-        Status status = Timed(backend, record, label, [&] {
-            return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march);
+    return RenderEachCamera(
+        Stage::RenderMarch, backend, sc, step, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step);
+            // T only where shade runs (the light source "shade").
+            const MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            return timed(
+                [&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march); });
         });
-        frame.ms = record.ms - before;
-        if (!status) return MakeError("render_march (" + frame.camera + "): " + status.error().message);
-        record.frames.push_back(frame);
-    }
-    return {};
 }
 
 Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
@@ -180,7 +186,7 @@ Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageH
         SpinFor((slowdown->factor - 1) * (record.ms - before));
         record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
-    if (!status && stage != Stage::RenderSplat && stage != Stage::RenderMarch)
+    if (!status && !Describe(stage).renderer)
         return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
     return status;
 }

@@ -17,6 +17,8 @@
 //   voxel only.
 #include "reference/Reference.h"
 
+#include "reference/EmbreeRuns.h"
+
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -27,7 +29,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 #include <thread>
 
@@ -113,18 +114,6 @@ void RunIntersect(const RTCIntersectFunctionNArguments* args) {
 // Never called (the tracer only intersects), but user geometry needs one.
 void RunOccluded(const RTCOccludedFunctionNArguments*) {}
 
-struct DeviceErrors {
-    std::mutex mutex;
-    std::string message;
-};
-
-void OnDeviceError(void* user, RTCError code, const char* text) {
-    auto& errors = *static_cast<DeviceErrors*>(user);
-    std::lock_guard lock(errors.mutex);
-    if (errors.message.empty())
-        errors.message = "Embree error " + std::to_string(int(code)) + ": " + (text ? text : "");
-}
-
 }  // namespace
 
 const char* RayStartName(RayStart start) { return start == RayStart::VoxelExit ? "voxel-exit" : "voxel-centre"; }
@@ -136,16 +125,9 @@ double VoxelExitDistance(const Vec3& dir) {
 
 struct OpticalDepthTracer::Impl {
     Geometry geometry;
-    DeviceErrors errors;
-    RTCDevice device = nullptr;
-    RTCScene scene = nullptr;
-    tbb::task_arena arena;
+    EmbreeRunScene embree;
 
-    explicit Impl(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
-    ~Impl() {
-        if (scene) rtcReleaseScene(scene);
-        if (device) rtcReleaseDevice(device);
-    }
+    explicit Impl(int threads) : embree(threads) {}
 };
 
 OpticalDepthTracer::OpticalDepthTracer(const Extent3& extent) : mExtent(extent) {}
@@ -180,28 +162,7 @@ Result<std::unique_ptr<OpticalDepthTracer>> OpticalDepthTracer::Create(const Ext
             }
         }
 
-    impl.device = rtcNewDevice(threads > 0 ? ("threads=" + std::to_string(threads)).c_str() : nullptr);
-    if (!impl.device)
-        return MakeError("reference: cannot create the Embree device (error " +
-                         std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
-    rtcSetDeviceErrorFunction(impl.device, OnDeviceError, &impl.errors);
-    impl.scene = rtcNewScene(impl.device);
-    rtcSetSceneFlags(impl.scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(impl.scene, RTC_BUILD_QUALITY_MEDIUM);
-    if (!g.runs.empty()) {
-        RTCGeometry geometry = rtcNewGeometry(impl.device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(geometry, unsigned(g.runs.size()));
-        rtcSetGeometryUserData(geometry, &g);
-        rtcSetGeometryBoundsFunction(geometry, RunBounds, nullptr);
-        rtcSetGeometryIntersectFunction(geometry, RunIntersect);
-        rtcSetGeometryOccludedFunction(geometry, RunOccluded);
-        rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_MEDIUM);
-        rtcCommitGeometry(geometry);
-        rtcAttachGeometry(impl.scene, geometry);
-        rtcReleaseGeometry(geometry);
-    }
-    impl.arena.execute([&] { rtcCommitScene(impl.scene); });
-    if (!impl.errors.message.empty()) return MakeError("reference: " + impl.errors.message);
+    CB_TRY(impl.embree.Build(unsigned(g.runs.size()), &g, {RunBounds, RunIntersect, RunOccluded}));
     tracer->mBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return tracer;
 }
@@ -223,7 +184,7 @@ double OpticalDepthTracer::Integrate(const std::array<double, 3>& origin, const 
     rh.ray.mask = ~0u;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(mImpl->scene, &ctx.base, &rh);
+    rtcIntersect1(mImpl->embree.Scene(), &ctx.base, &rh);
     return ctx.sum;
 }
 
@@ -236,7 +197,7 @@ std::vector<float> OpticalDepthTracer::Transmittance(const ReferenceParams& p, T
     const auto start = std::chrono::steady_clock::now();
     {
         const uint32_t rows = e.ny * e.nz;
-        mImpl->arena.execute([&] {
+        mImpl->embree.Arena().execute([&] {
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, rows, 4), [&](const tbb::blocked_range<uint32_t>& r) {
                 for (uint32_t row = r.begin(); row != r.end(); ++row) {
                     const uint32_t j = row % e.ny, k = row / e.ny;
@@ -262,7 +223,7 @@ std::vector<float> OpticalDepthTracer::GroundShadow(const ReferenceParams& p, Tr
     if (p.sun[2] <= 0.0f || mImpl->geometry.runs.empty()) return G;
     const double depthPerSum = p.sigma * p.voxelSize;
     const auto start = std::chrono::steady_clock::now();
-    mImpl->arena.execute([&] {
+    mImpl->embree.Arena().execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny, 4), [&](const tbb::blocked_range<uint32_t>& r) {
             for (uint32_t j = r.begin(); j != r.end(); ++j)
                 for (uint32_t i = 0; i < e.nx; ++i) {

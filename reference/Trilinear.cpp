@@ -22,6 +22,8 @@
 //   box's face counts (the box is closed).
 #include "reference/Trilinear.h"
 
+#include "reference/EmbreeRuns.h"
+
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -31,7 +33,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 
 namespace cb::ref {
@@ -194,18 +195,6 @@ bool TriSetup(const TriGeometry& g, const Point3d& origin, const Point3d& dir, d
 
 void TriOccluded(const RTCOccludedFunctionNArguments*) {}
 
-struct TriDeviceErrors {
-    std::mutex mutex;
-    std::string message;
-};
-
-void TriOnDeviceError(void* user, RTCError code, const char* text) {
-    auto& errors = *static_cast<TriDeviceErrors*>(user);
-    std::lock_guard lock(errors.mutex);
-    if (errors.message.empty())
-        errors.message = "Embree error " + std::to_string(int(code)) + ": " + (text ? text : "");
-}
-
 double Seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
@@ -214,17 +203,10 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 struct TrilinearDepthTracer::Impl {
     TriGeometry geometry;
-    TriDeviceErrors errors;
-    RTCDevice device = nullptr;
-    RTCScene scene = nullptr;
-    tbb::task_arena arena;
+    EmbreeRunScene embree;
     bool packets = true;
 
-    explicit Impl(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
-    ~Impl() {
-        if (scene) rtcReleaseScene(scene);
-        if (device) rtcReleaseDevice(device);
-    }
+    explicit Impl(int threads) : embree(threads) {}
 
     // Rays [begin, end) (at most 16) as one packet; ray(i, lane, org, dir,
     // tfar) sets ray i up (TriSetup). Writes each ray's depth to out[i].
@@ -257,7 +239,7 @@ struct TrilinearDepthTracer::Impl {
             rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
-        if (any) rtcIntersect16(valid, scene, &ctx.base, &rh);
+        if (any) rtcIntersect16(valid, embree.Scene(), &ctx.base, &rh);
         for (size_t i = begin; i < end; ++i) out[i] = ctx.lane[i - begin].sum;
     }
 
@@ -268,7 +250,7 @@ struct TrilinearDepthTracer::Impl {
         std::vector<double> out(n, 0.0);
         const auto start = std::chrono::steady_clock::now();
         if (!geometry.runs.empty())
-            arena.execute([&] {
+            embree.Arena().execute([&] {
                 tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
                     if (packets) {
                         for (size_t i = r.begin(); i < r.end(); i += kTriPacket)
@@ -339,28 +321,7 @@ Result<std::unique_ptr<TrilinearDepthTracer>> TrilinearDepthTracer::Create(const
             }
         }
 
-    impl.device = rtcNewDevice(threads > 0 ? ("threads=" + std::to_string(threads)).c_str() : nullptr);
-    if (!impl.device)
-        return MakeError("reference: cannot create the Embree device (error " +
-                         std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
-    rtcSetDeviceErrorFunction(impl.device, TriOnDeviceError, &impl.errors);
-    impl.scene = rtcNewScene(impl.device);
-    rtcSetSceneFlags(impl.scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(impl.scene, RTC_BUILD_QUALITY_MEDIUM);
-    if (!g.runs.empty()) {
-        RTCGeometry geometry = rtcNewGeometry(impl.device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(geometry, unsigned(g.runs.size()));
-        rtcSetGeometryUserData(geometry, &g);
-        rtcSetGeometryBoundsFunction(geometry, TriBounds, nullptr);
-        rtcSetGeometryIntersectFunction(geometry, TriIntersect);
-        rtcSetGeometryOccludedFunction(geometry, TriOccluded);
-        rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_MEDIUM);
-        rtcCommitGeometry(geometry);
-        rtcAttachGeometry(impl.scene, geometry);
-        rtcReleaseGeometry(geometry);
-    }
-    impl.arena.execute([&] { rtcCommitScene(impl.scene); });
-    if (!impl.errors.message.empty()) return MakeError("reference: " + impl.errors.message);
+    CB_TRY(impl.embree.Build(unsigned(g.runs.size()), &g, {TriBounds, TriIntersect, TriOccluded}));
     tracer->mBuildSeconds = Seconds(start);
     return tracer;
 }
@@ -385,7 +346,7 @@ double TrilinearDepthTracer::Integrate(const Point3d& origin, const Point3d& dir
     rh.ray.id = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(mImpl->scene, &ctx.base, &rh);
+    rtcIntersect1(mImpl->embree.Scene(), &ctx.base, &rh);
     return ctx.lane[0].sum;
 }
 
