@@ -86,11 +86,11 @@ json ImageTimeJson(const Summary& s) {
 // model the reference renders (the reference fixes its own step, light,
 // epsilon, jitter and skipping, and reads no shade, shadow or density setting).
 bool MethodOnlyPath(const std::string& p) {
-    for (const char* exact : {"march.step", "march.adaptive.enabled", "march.adaptive.kappa", "march.adaptive.start",
-                              "march.jitter", "march.light", "march.light_steps", "march.epsilon",
-                              "march.skipping.enabled", "march.skipping.brick", "march.exposure", "march.tone_map",
-                              "render.q_min", "render.splat_scale", "render.opacity", "render.culling",
-                              "render.skipping", "repeats", "warmup_steps"})
+    for (const char* exact :
+         {"march.step", "march.adaptive.enabled", "march.adaptive.kappa", "march.adaptive.start", "march.jitter",
+          "march.light", "march.light_steps", "march.epsilon", "march.skipping.enabled", "march.skipping.brick",
+          "march.exposure", "march.tone_map", "render.q_min", "render.splat_scale", "render.opacity", "render.culling",
+          "render.skipping", "repeats", "warmup_steps"})
         if (p == exact) return true;
     if (p == "shade.sigma") return false;
     for (const char* prefix : {"shade.", "shadow.", "density."})
@@ -131,7 +131,8 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, const std
         // A setting the scene refuses (e.g. a light source that needs a stage the scene lacks).
         for (Stage r : renderers)
             for (const OpenedBackend& slot : backends)
-                rows.push_back(ImageRowJson(r, slot.name, setting, "", RenderNotMeasured("invalid", loaded.error().message)));
+                rows.push_back(
+                    ImageRowJson(r, slot.name, setting, "", RenderNotMeasured("invalid", loaded.error().message)));
         return {};
     }
     for (Stage r : renderers)
@@ -152,44 +153,44 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, const std
 ImageReferences::ImageReferences(Evaluator& eval, const Session& session) : mEval(eval), mSession(session) {}
 
 Result<ImageReferences::Loaded> ImageReferences::Load(const std::vector<SceneOverride>& setting) {
-        auto scene = mSession.LoadVariant(setting);
-        if (!scene) return std::unexpected(scene.error());
-        std::vector<SceneOverride> all = mSession.Options().overrides;
-        all.insert(all.end(), setting.begin(), setting.end());
-        auto in = mEval.Inputs(*scene, all);
-        if (!in) return std::unexpected(in.error());
-        std::vector<SceneOverride> physical;
-        for (const SceneOverride& o : setting)
-            if (!MethodOnlyPath(o.path) && o.path != "phase.function") physical.push_back(o);
-        if (VariesPhase(setting)) physical.push_back({"phase.function", "mie"});
-        std::string key;
-        for (const SceneOverride& o : physical) key += (key.empty() ? "" : " ") + o.path + "=" + o.value;
-        auto it = mCache.find(key);
-        if (it == mCache.end()) {
-            auto refScene = mSession.LoadVariant(physical);
-            if (!refScene) return std::unexpected(refScene.error());
-            const float step = float(mSession.Options().referenceStep);
-            if (!mSession.Options().quiet)
-                std::fprintf(stderr, "reference render of %s%s%s at step %g voxel\n", scene->name.c_str(),
-                             key.empty() ? "" : " with ", key.c_str(), double(step));
-            auto r = ComputeImageReference(*refScene, **in, step, mSession.Options().cpuThreads);
-            if (!r) return std::unexpected(r.error());
-            if (mCache.size() >= 4) mCache.clear();  // bounds memory; the caller holds no pointer across calls
-            it = mCache.emplace(key, std::move(*r)).first;
-            json rec = {{"inputs", key.empty() ? "(scene)" : key},
-                        {"phase", it->second.phase},
-                        {"step_voxels", it->second.stepVoxels},
-                        {"width", it->second.width},
-                        {"height", it->second.height},
-                        {"samples", it->second.result.samples},
-                        {"light_rays", it->second.result.light.rays},
-                        {"seconds", it->second.result.light.seconds},
-                        {"rays_per_s", it->second.result.light.RaysPerSecond()},
-                        {"build_s", it->second.result.buildSeconds},
-                        {"boxes", it->second.result.primitives}};
-            mRecords.push_back(rec);
-        }
-        return Loaded{std::move(*scene), *in, &it->second};
+    auto scene = mSession.LoadVariant(setting);
+    if (!scene) return std::unexpected(scene.error());
+    std::vector<SceneOverride> all = mSession.Options().overrides;
+    all.insert(all.end(), setting.begin(), setting.end());
+    auto in = mEval.Inputs(*scene, all);
+    if (!in) return std::unexpected(in.error());
+    std::vector<SceneOverride> physical;
+    for (const SceneOverride& o : setting)
+        if (!MethodOnlyPath(o.path) && o.path != "phase.function") physical.push_back(o);
+    if (VariesPhase(setting)) physical.push_back({"phase.function", "mie"});
+    std::string key;
+    for (const SceneOverride& o : physical) key += (key.empty() ? "" : " ") + o.path + "=" + o.value;
+    auto it = mCache.find(key);
+    if (it == mCache.end()) {
+        auto refScene = mSession.LoadVariant(physical);
+        if (!refScene) return std::unexpected(refScene.error());
+        const float step = float(mSession.Options().referenceStep);
+        if (!mSession.Options().quiet)
+            std::fprintf(stderr, "reference render of %s%s%s at step %g voxel\n", scene->name.c_str(),
+                         key.empty() ? "" : " with ", key.c_str(), double(step));
+        auto r = ComputeImageReference(*refScene, **in, step, mSession.Options().cpuThreads);
+        if (!r) return std::unexpected(r.error());
+        if (mCache.size() >= 4) mCache.clear();  // bounds memory; the caller holds no pointer across calls
+        it = mCache.emplace(key, std::move(*r)).first;
+        json rec = {{"inputs", key.empty() ? "(scene)" : key},
+                    {"phase", it->second.phase},
+                    {"step_voxels", it->second.stepVoxels},
+                    {"width", it->second.width},
+                    {"height", it->second.height},
+                    {"samples", it->second.result.samples},
+                    {"light_rays", it->second.result.light.rays},
+                    {"seconds", it->second.result.light.seconds},
+                    {"rays_per_s", it->second.result.light.RaysPerSecond()},
+                    {"build_s", it->second.result.buildSeconds},
+                    {"boxes", it->second.result.primitives}};
+        mRecords.push_back(rec);
+    }
+    return Loaded{std::move(*scene), *in, &it->second};
 }
 
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
@@ -305,7 +306,8 @@ Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<co
     if (scene.stages.Has(Stage::RenderMarch)) {
         const Stage march[] = {Stage::RenderMarch};
         CB_TRY(MeasureImageRows(refs, session, {}, backends, march, rows));
-        for (const auto& v : MarchImageVariants(scene)) CB_TRY(MeasureImageRows(refs, session, v, backends, march, rows));
+        for (const auto& v : MarchImageVariants(scene))
+            CB_TRY(MeasureImageRows(refs, session, v, backends, march, rows));
     }
     if (scene.stages.Has(Stage::RenderSplat)) {
         const Stage splat[] = {Stage::RenderSplat};
@@ -316,10 +318,10 @@ Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<co
 
 report::Table ImageRowsTable(const json& rows) {
     using report::Column;
-    report::Table table({Column("renderer"), Column("setting"), Column("backend"),
-                         Column("time ms (q1-q3)").Unit("ms"), Column("T etc. ms").Real("%.3f").Unit("ms"),
-                         Column("max").Real("%.3g"), Column("mean").Real("%.3g"), Column("p99").Real("%.3g"),
-                         Column("PSNR dB").Real("%.2f"), Column("reference phase")});
+    report::Table table({Column("renderer"), Column("setting"), Column("backend"), Column("time ms (q1-q3)").Unit("ms"),
+                         Column("T etc. ms").Real("%.3f").Unit("ms"), Column("max").Real("%.3g"),
+                         Column("mean").Real("%.3g"), Column("p99").Real("%.3g"), Column("PSNR dB").Real("%.2f"),
+                         Column("reference phase")});
     for (const json& r : rows) {
         std::vector<report::Cell> cells = {r["renderer"].get<std::string>(), r["label"].get<std::string>(),
                                            r["backend"].get<std::string>()};
@@ -329,8 +331,8 @@ report::Table ImageRowsTable(const json& rows) {
             continue;
         }
         const json& t = r["time"];
-        cells.push_back(Fmt("%.3f", t["median_ms"].get<double>()) + " (" + Fmt("%.3f", t["q1_ms"].get<double>()) +
-                        "-" + Fmt("%.3f", t["q3_ms"].get<double>()) + ")");
+        cells.push_back(Fmt("%.3f", t["median_ms"].get<double>()) + " (" + Fmt("%.3f", t["q1_ms"].get<double>()) + "-" +
+                        Fmt("%.3f", t["q3_ms"].get<double>()) + ")");
         cells.push_back(r["prep_ms"].get<double>());
         const json& e = r["error"];
         cells.push_back(e["max"].get<double>());
@@ -352,11 +354,11 @@ report::Table ImageReferenceTable(const json& references) {
                          Column("image"), Column("samples").Integer(), Column("light rays").Integer(),
                          Column("s").Real("%.3f").Unit("s"), Column("M light rays/s").Real("%.3f")});
     for (const json& r : references)
-        table.rows.push_back({r["inputs"].get<std::string>(), r["phase"].get<std::string>(),
-                              r["step_voxels"].get<double>(),
-                              std::to_string(r["width"].get<uint32_t>()) + "x" + std::to_string(r["height"].get<uint32_t>()),
-                              int64_t(r["samples"].get<uint64_t>()), int64_t(r["light_rays"].get<uint64_t>()),
-                              r["seconds"].get<double>(), r["rays_per_s"].get<double>() / 1e6});
+        table.rows.push_back(
+            {r["inputs"].get<std::string>(), r["phase"].get<std::string>(), r["step_voxels"].get<double>(),
+             std::to_string(r["width"].get<uint32_t>()) + "x" + std::to_string(r["height"].get<uint32_t>()),
+             int64_t(r["samples"].get<uint64_t>()), int64_t(r["light_rays"].get<uint64_t>()),
+             r["seconds"].get<double>(), r["rays_per_s"].get<double>() / 1e6});
     return table;
 }
 

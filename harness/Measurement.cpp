@@ -13,7 +13,8 @@ bool IsRenderer(Stage s) { return s == Stage::RenderMarch || s == Stage::RenderS
 
 // Paths whose value changes only the lighting stages, not q or D.
 bool LightingOnly(const std::string& path) {
-    for (const char* prefix : {"shade", "shadow", "sun", "phase", "render", "lighting", "description", "march", "lightning"})
+    for (const char* prefix :
+         {"shade", "shadow", "sun", "phase", "render", "lighting", "description", "march", "lightning"})
         if (path == prefix || path.starts_with(std::string(prefix) + ".")) return true;
     return false;
 }
@@ -171,9 +172,8 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
                     row.result = std::move(*a);
                 }
                 if (row.result.status != "ok" && !options.quiet)
-                    std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(),
-                                 std::string(StageName(stage)).c_str(), SettingsLabel(setting).c_str(),
-                                 row.result.status.c_str(), row.result.detail.c_str());
+                    std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(stage)).c_str(),
+                                 SettingsLabel(setting).c_str(), row.result.status.c_str(), row.result.detail.c_str());
                 rows.push_back(std::move(row));
             }
             continue;

@@ -45,33 +45,35 @@ Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, con
     std::atomic<uint64_t> lightRays{0}, samples{0};
     tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
     arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 4, 0, W, 4), [&](const tbb::blocked_range2d<uint32_t>& b) {
-            uint64_t nLight = 0, nSamples = 0;
-            auto density = [&](const Vec3& p) { return TrilinearSample(q.data(), grid, 0.0f, p); };
-            auto exactLight = [&](const Vec3& p) {
-                const Point3d at{p[0], p[1], p[2]};
-                MarchLightSample l;
-                l.sun = float(std::exp(-sigmaH * exact.Integrate(at, sun, 0.0, std::numeric_limits<double>::infinity())));
-                ++nLight;
-                if (s.point.on) {
-                    l.point = float(std::exp(-sigmaH * exact.IntegrateSegment(at, light)));
+        tbb::parallel_for(
+            tbb::blocked_range2d<uint32_t>(0, H, 4, 0, W, 4), [&](const tbb::blocked_range2d<uint32_t>& b) {
+                uint64_t nLight = 0, nSamples = 0;
+                auto density = [&](const Vec3& p) { return TrilinearSample(q.data(), grid, 0.0f, p); };
+                auto exactLight = [&](const Vec3& p) {
+                    const Point3d at{p[0], p[1], p[2]};
+                    MarchLightSample l;
+                    l.sun = float(
+                        std::exp(-sigmaH * exact.Integrate(at, sun, 0.0, std::numeric_limits<double>::infinity())));
                     ++nLight;
-                }
-                return l;
-            };
-            for (uint32_t y = b.rows().begin(); y < b.rows().end(); ++y)
-                for (uint32_t x = b.cols().begin(); x < b.cols().end(); ++x) {
-                    const MarchRayGeometry ray = MakePixelRay(cam, params.origin, s.voxelSize, s.size, x, y);
-                    const MarchRayResult m = MarchRay(s, ray, 0.5f, nullptr, density, exactLight);
-                    float* out = r.image.data() + 3 * (size_t(x) + size_t(W) * y);
-                    out[0] = m.color[0];
-                    out[1] = m.color[1];
-                    out[2] = m.color[2];
-                    nSamples += m.samples;
-                }
-            lightRays += nLight;
-            samples += nSamples;
-        });
+                    if (s.point.on) {
+                        l.point = float(std::exp(-sigmaH * exact.IntegrateSegment(at, light)));
+                        ++nLight;
+                    }
+                    return l;
+                };
+                for (uint32_t y = b.rows().begin(); y < b.rows().end(); ++y)
+                    for (uint32_t x = b.cols().begin(); x < b.cols().end(); ++x) {
+                        const MarchRayGeometry ray = MakePixelRay(cam, params.origin, s.voxelSize, s.size, x, y);
+                        const MarchRayResult m = MarchRay(s, ray, 0.5f, nullptr, density, exactLight);
+                        float* out = r.image.data() + 3 * (size_t(x) + size_t(W) * y);
+                        out[0] = m.color[0];
+                        out[1] = m.color[1];
+                        out[2] = m.color[2];
+                        nSamples += m.samples;
+                    }
+                lightRays += nLight;
+                samples += nSamples;
+            });
     });
     r.light.rays = lightRays;
     r.samples = samples;

@@ -44,8 +44,7 @@ MarchParams RefCamera(const Extent3& e, std::array<double, 3> eye, std::array<do
     return p;
 }
 
-std::vector<float> RenderRef(const MarchParams& p, const Extent3& e, const std::vector<float>& q,
-                             float step = 0.125f) {
+std::vector<float> RenderRef(const MarchParams& p, const Extent3& e, const std::vector<float>& q, float step = 0.125f) {
     ref::MarchReferenceOptions o;
     o.stepVoxels = step;
     o.threads = 2;

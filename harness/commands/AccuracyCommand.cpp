@@ -426,8 +426,8 @@ const CommandRegistration kRegistration({
     .summary = "Measure every shade and shadow option against the exact (Embree) reference",
     .help = kHelp,
     .helpOrder = 4,
-    .extraOptions = WithIsolationOptions(
-        {RepeatOption(), FlagOption("--switches", &CommonOptions::switches), ReferenceStepOption()}),
+    .extraOptions = WithIsolationOptions({RepeatOption(), FlagOption("--switches", &CommonOptions::switches),
+                                          ReferenceStepOption()}),
     .run = Accuracy,
 });
 
