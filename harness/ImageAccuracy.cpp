@@ -137,6 +137,8 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, const std
     }
     for (Stage r : renderers)
         for (const OpenedBackend& slot : backends) {
+            // A backend without the renderer has one "unsupported" row, at the scene's settings.
+            if (slot.backend && !slot.backend->Supports(r) && !setting.empty()) continue;
             RenderAccuracy a = slot.backend ? MeasureRender(*slot.backend, r, loaded->scene, *loaded->in,
                                                             loaded->reference->result.image, session.Options().repeats)
                                             : RenderNotMeasured("unavailable", slot.reason);
@@ -279,8 +281,11 @@ std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& sc) {
     out.push_back({{"march.jitter", sc.march.jitter ? "false" : "true"}});
     out.push_back({{"march.skipping.enabled", sc.march.skipping ? "false" : "true"}});
     if (sc.march.epsilon != 0) out.push_back({{"march.epsilon", "0"}});
+    // Every phase function against the Mie reference, the scene's own included
+    // (its row is the cost of approximating Mie); for a Mie scene that row is the scene's.
     for (const auto& [name, kind] : kPhaseKindNames)
-        if (kind != sc.phase.kind) out.push_back({{"phase.function", std::string(name)}});
+        if (kind != PhaseKind::Mie || sc.phase.kind != PhaseKind::Mie)
+            out.push_back({{"phase.function", std::string(name)}});
     return out;
 }
 

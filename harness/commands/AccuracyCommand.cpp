@@ -372,15 +372,22 @@ int Accuracy(const CommonOptions& options) {
         doc["switches"] = sw.doc;
     }
     if (images) {
-        // Row n of every backend's process is the same renderer and setting: merge them row by row.
+        // Rows by (renderer, setting) in the order they first appear, then by backend (the parts' order);
+        // a backend without a renderer has its one "unsupported" row only.
         json imageRows = json::array(), imageRefs = json::array();
-        size_t most = 0;
+        std::vector<std::string> keys;
+        auto keyOf = [](const json& r) {
+            return r["renderer"].get<std::string>() + "|" + r["label"].get<std::string>();
+        };
         for (const BackendMeasurement& part : *parts)
-            if (part.extra.contains("images")) most = std::max(most, part.extra["images"]["rows"].size());
-        for (size_t n = 0; n < most; ++n)
+            if (part.extra.contains("images"))
+                for (const json& r : part.extra["images"]["rows"])
+                    if (std::ranges::find(keys, keyOf(r)) == keys.end()) keys.push_back(keyOf(r));
+        for (const std::string& key : keys)
             for (const BackendMeasurement& part : *parts)
-                if (part.extra.contains("images") && n < part.extra["images"]["rows"].size())
-                    imageRows.push_back(part.extra["images"]["rows"][n]);
+                if (part.extra.contains("images"))
+                    for (const json& r : part.extra["images"]["rows"])
+                        if (keyOf(r) == key) imageRows.push_back(r);
         // A backend that did not open or whose process died: one row per renderer with why.
         for (const BackendMeasurement& part : *parts) {
             if (part.extra.contains("images")) {
