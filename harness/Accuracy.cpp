@@ -39,11 +39,12 @@ ErrorStats AbsoluteErrors(std::span<const float> approx, std::span<const float> 
 }
 
 Result<LightingInputs> SimulateLightingInputs(const Scene& scene, int threads) {
-    if (!scene.stages.Has(Stage::Smooth))
-        return MakeError(scene.path + ": stages: the reference needs q, so the scene must have \"smooth\"");
+    if (!scene.stages.Has(Stage::Smooth) && !scene.stages.Has(Stage::Noise))
+        return MakeError(scene.path +
+                         ": stages: the reference needs q, so the scene must have \"smooth\" or \"noise\"");
     Scene sim = scene;
     sim.stages = StageSet{};
-    for (Stage s : {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density})
+    for (Stage s : {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Noise, Stage::Density})
         if (scene.stages.Has(s)) sim.stages.Add(s);
     BackendOptions options;
     options.cpuThreads = threads;

@@ -5,6 +5,7 @@
 // are in AccuracyCommands.cpp; docs/accuracy.md describes the method.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -28,7 +29,7 @@ ErrorStats AbsoluteErrors(std::span<const float> approx, std::span<const float> 
                           std::span<const uint8_t> mask = {});
 
 // q and D at a scene's last step (steps - 1), computed by the CPU backend with
-// the scene's simulation stages only (region, ca, smooth, density).
+// the scene's simulation stages only (region, ca, smooth or noise, density).
 struct LightingInputs {
     Extent3 grid;
     uint32_t step = 0;
@@ -59,6 +60,7 @@ struct StageAccuracy {
     Summary timeMs;
     ErrorStats all, subset;     // subset: voxels in cloud (shade), cells under cloud (shadow)
     std::vector<float> output;  // the stage's output, kept when asked
+    std::optional<double> psnrDb;  // renderers only (harness/ImageAccuracy.h); none when infinite
 };
 StageAccuracy MeasureShade(Backend& backend, const Scene& scene, const LightingInputs& inputs,
                            const ReferenceResult& reference, int repeats, bool keepOutput = false);

@@ -186,6 +186,17 @@ OptionSpec RepeatOption() {
             }};
 }
 
+OptionSpec ReferenceStepOption() {
+    return {"--reference-step", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                char* end = nullptr;
+                const double step = std::strtod(v, &end);
+                if (end == v || *end != '\0' || !(step >= 1.0 / 1024 && step <= 1))
+                    return "--reference-step needs a number of voxel edges in [1/1024, 1]";
+                o.referenceStep = step;
+                return std::nullopt;
+            }};
+}
+
 CommandRegistration::CommandRegistration(Command command) {
     const std::string_view name = command.name;
     Registry().emplace(name, std::move(command));

@@ -48,6 +48,8 @@ struct CommonOptions {
     std::vector<std::string> vary;
     int repeats = 5;
     bool switches = false;
+    // accuracy and sweep: the step of the exact reference render, voxel edges (--reference-step).
+    double referenceStep = 0.125;
     std::string metric = "max";
     // sweep --shard I/N: share I (1-based) of N; shardCount 0 = not sharded.
     int shardIndex = 0;
@@ -97,6 +99,8 @@ std::span<const OptionSpec> SceneCommandOptions();
 std::string GlOptionsHelp();
 // --repeat N, shared by accuracy and sweep.
 OptionSpec RepeatOption();
+// --reference-step X: the exact reference render's step in voxel edges, (0, 1] (accuracy, sweep).
+OptionSpec ReferenceStepOption();
 
 struct Command {
     std::string_view name;

@@ -2,14 +2,19 @@
 
 #include <cstdio>
 
+#include "harness/ImageAccuracy.h"
+
 namespace cb {
 using nlohmann::json;
 
 namespace {
 
+bool IsRenderer(Stage s) { return s == Stage::RenderMarch || s == Stage::RenderSplat; }
+
 // Paths whose value changes only the lighting stages, not q or D.
 bool LightingOnly(const std::string& path) {
-    for (const char* prefix : {"shade", "shadow", "sun", "phase", "render", "lighting", "description"})
+    for (const char* prefix :
+         {"shade", "shadow", "sun", "phase", "render", "lighting", "description", "march", "lightning"})
         if (path == prefix || path.starts_with(std::string(prefix) + ".")) return true;
     return false;
 }
@@ -78,6 +83,11 @@ Result<const ReferenceResult*> Evaluator::Reference(const Scene& scene, const Li
     mLastReference = key;
     return &it->second;
 }
+ImageReferences& Evaluator::Images() {
+    if (!mImages) mImages = std::make_shared<ImageReferences>(*this, mSession);
+    return *mImages;
+}
+
 Result<Evaluator::Point> Evaluator::Load(std::span<const SceneOverride> extra) {
     auto scene = mSession.LoadVariant(extra);
     if (!scene) return std::unexpected(scene.error());
@@ -124,20 +134,50 @@ json RowJson(const Row& r) {
     if (!r.result.detail.empty()) j["detail"] = r.result.detail;
     if (r.result.status == "ok") {
         j["time"] = TimeJson(r.result.timeMs);
-        j["error"] = {{"all", StatsJson(r.result.all)},
-                      {r.stage == Stage::Shade ? "in_cloud" : "under_cloud", StatsJson(r.result.subset)}};
+        if (IsRenderer(r.stage))
+            j["error"] = {{"all", StatsJson(r.result.all)},
+                          {"psnr_db", r.result.psnrDb ? json(*r.result.psnrDb) : json(nullptr)}};
+        else
+            j["error"] = {{"all", StatsJson(r.result.all)},
+                          {r.stage == Stage::Shade ? "in_cloud" : "under_cloud", StatsJson(r.result.subset)}};
     }
     return j;
 }
 
 Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting, std::span<const Stage> stages,
                       std::span<const OpenedBackend> backends, std::vector<Row>& rows) {
-    auto point = eval.Load(setting);
-    if (!point) return std::unexpected(point.error());
+    const bool lighting = std::ranges::any_of(stages, [](Stage s) { return s == Stage::Shade || s == Stage::Shadow; });
+    std::optional<Evaluator::Point> point;
+    if (lighting) {
+        auto loaded = eval.Load(setting);
+        if (!loaded) return std::unexpected(loaded.error());
+        point = std::move(*loaded);
+    } else {
+        auto scene = eval.GetSession().LoadVariant(setting);
+        if (!scene) return std::unexpected(scene.error());
+        point = Evaluator::Point{std::move(*scene), nullptr, nullptr};
+    }
     const Scene& scene = point->scene;
     const CommonOptions& options = eval.Options();
     for (Stage stage : stages) {
         if (!scene.stages.Has(stage)) continue;
+        if (stage == Stage::RenderMarch || stage == Stage::RenderSplat) {
+            for (const OpenedBackend& slot : backends) {
+                Row row{setting, slot.name, stage, {}, false};
+                if (!slot.backend)
+                    row.result = {"unavailable", slot.reason, {}, {}, {}, {}};
+                else {
+                    auto a = MeasureImageStage(eval, setting, stage, *slot.backend);
+                    if (!a) return std::unexpected(a.error());
+                    row.result = std::move(*a);
+                }
+                if (row.result.status != "ok" && !options.quiet)
+                    std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(stage)).c_str(),
+                                 SettingsLabel(setting).c_str(), row.result.status.c_str(), row.result.detail.c_str());
+                rows.push_back(std::move(row));
+            }
+            continue;
+        }
         for (const OpenedBackend& slot : backends) {
             Row row{setting, slot.name, stage, {}, false};
             if (!slot.backend)
@@ -169,6 +209,10 @@ std::vector<report::Column> ErrorColumns(std::initializer_list<std::string> firs
     columns.emplace_back("backend");
     columns.push_back(report::Column("time ms (q1-q3)").Unit("ms"));
     for (auto& c : StatsColumns()) columns.push_back(c);
+    if (IsRenderer(stage)) {
+        columns.push_back(report::Column("PSNR dB").Real("%.2f"));
+        return columns;
+    }
     for (auto& c : StatsColumns(stage == Stage::Shade ? " (in cloud)" : " (under cloud)")) columns.push_back(c);
     return columns;
 }
@@ -182,6 +226,10 @@ std::vector<report::Cell> RowCells(const Row& r) {
     const Summary& t = r.result.timeMs;
     cells.push_back(Fmt("%.3f", t.median) + " (" + Fmt("%.3f", t.q1) + "-" + Fmt("%.3f", t.q3) + ")");
     for (auto& c : StatsCells(r.result.all)) cells.push_back(c);
+    if (IsRenderer(r.stage)) {
+        cells.push_back(r.result.psnrDb ? report::Cell(*r.result.psnrDb) : report::Cell("inf"));
+        return cells;
+    }
     for (auto& c : StatsCells(r.result.subset)) cells.push_back(c);
     return cells;
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -15,6 +16,8 @@
 #include "harness/Session.h"
 
 namespace cb {
+
+class ImageReferences;  // harness/ImageAccuracy.h
 
 // printf of one value, for labels and cache keys.
 std::string Fmt(const char* format, double value);
@@ -48,6 +51,9 @@ class Evaluator {
 
     const std::vector<ReferenceRecord>& Records() const { return mRecords; }
     const CommonOptions& Options() const { return mSession.Options(); }
+    const Session& GetSession() const { return mSession; }
+    // The reference renders of this process (harness/ImageAccuracy.h), made on first use.
+    ImageReferences& Images();
 
   private:
     // Bounds memory (a thesis-sized reference is about 11 MB): past kKept
@@ -67,6 +73,7 @@ class Evaluator {
     std::map<std::string, ReferenceResult> mReferences;
     std::vector<ReferenceRecord> mRecords;
     std::string mLastKey;
+    std::shared_ptr<ImageReferences> mImages;
 };
 
 // One measured row: a setting (list of overrides) x backend x stage.

@@ -133,7 +133,7 @@ json ToJson(const Row& r) {
             {"stage", StageName(r.stage)}, {"status", r.result.status},
             {"detail", r.result.detail},   {"time", ToJson(r.result.timeMs)},
             {"all", ToJson(r.result.all)}, {"subset", ToJson(r.result.subset)},
-            {"pareto", r.pareto}};
+            {"pareto", r.pareto},          {"psnr_db", r.result.psnrDb ? json(*r.result.psnrDb) : json(nullptr)}};
 }
 Row RowFromJson(const json& j) {
     Row r;
@@ -147,6 +147,7 @@ Row RowFromJson(const json& j) {
     r.result.all = ErrorStatsFromJson(j.at("all"));
     r.result.subset = ErrorStatsFromJson(j.at("subset"));
     r.pareto = j.at("pareto").get<bool>();
+    if (j.contains("psnr_db") && !j["psnr_db"].is_null()) r.result.psnrDb = j["psnr_db"].get<double>();
     return r;
 }
 

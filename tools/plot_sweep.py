@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Plots a `cloudbench sweep` result: error against time, one series per backend,
-one panel per stage, the Pareto front marked. Usage: plot_sweep.py sweep.json sweep.png"""
+one panel per stage (shade, shadow; the two renderers render_march and
+render_splat share one "images" panel, one series per renderer x backend), the
+Pareto front marked. Usage: plot_sweep.py sweep.json sweep.png"""
 import json
 import sys
 
@@ -17,18 +19,24 @@ def main():
         doc = json.load(f)
     metric = doc["metric"]
     rows = [r for r in doc["rows"] if r["status"] == "ok"]
-    stages = [s for s in ("shade", "shadow") if any(r["stage"] == s for r in rows)]
+    renderers = ("render_march", "render_splat")
+    for r in rows:
+        # The renderers' rows go in one panel, a series per renderer x backend.
+        r["panel"] = "images" if r["stage"] in renderers else r["stage"]
+        r["series"] = (r["stage"].replace("render_", "") + " " + r["backend"]) if r["stage"] in renderers \
+            else r["backend"]
+    stages = [s for s in ("shade", "shadow", "images") if any(r["panel"] == s for r in rows)]
     if not stages:
         sys.exit("plot_sweep.py: no measured rows in " + sys.argv[1])
     fig, axes = plt.subplots(1, len(stages), figsize=(6.5 * len(stages), 5), squeeze=False)
     varied = [v["path"] for v in doc["vary"]]
     # One colour per backend in every panel.
-    colours = {b: f"C{n}" for n, b in enumerate(sorted({r["backend"] for r in rows}))}
+    colours = {b: f"C{n}" for n, b in enumerate(sorted({r["series"] for r in rows}))}
     for ax, stage in zip(axes[0], stages):
-        stage_rows = [r for r in rows if r["stage"] == stage]
-        backends = sorted({r["backend"] for r in stage_rows})
+        stage_rows = [r for r in rows if r["panel"] == stage]
+        backends = sorted({r["series"] for r in stage_rows})
         for backend in backends:
-            mine = [r for r in stage_rows if r["backend"] == backend]
+            mine = [r for r in stage_rows if r["series"] == backend]
             t = [r["time"]["median_ms"] for r in mine]
             e = [r["error"]["all"][metric] for r in mine]
             lo = [r["time"]["median_ms"] - r["time"]["q1_ms"] for r in mine]
@@ -47,7 +55,8 @@ def main():
         if all(r["error"]["all"][metric] > 0 for r in stage_rows):
             ax.set_yscale("log")
         ax.set_xlabel("median time of the stage (ms)")
-        ax.set_ylabel(f"{metric} |error| against the Embree reference")
+        ax.set_ylabel(f"{metric} |error| against the exact reference render" if stage == "images"
+                      else f"{metric} |error| against the Embree reference")
         ax.set_title(f"{doc['scene']}: {stage}\nvarying {', '.join(varied)}", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)

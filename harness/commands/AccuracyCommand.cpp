@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/SceneNames.h"
+#include "harness/ImageAccuracy.h"
 #include "harness/IsolatedMeasurement.h"
 #include "harness/Measurement.h"
 #include "harness/StageParams.h"
@@ -29,12 +30,22 @@ over the voxels in cloud (q > 0) or ground cells under cloud (G_ref < 1), the
 reference's own speed in rays per second, and writes DIR/accuracy.json and
 DIR/accuracy.md.
 
+With render_march and/or render_splat in the scene it also renders the exact
+reference image (render_march's kernel with exact light toward the sun and the
+point light, a fine step, no early termination, no jitter) and measures each
+renderer on each backend against it: the scene's settings, then for
+render_march each of step (x0.5, x2, x4), adaptive step, light source and n_l,
+jitter, skipping, epsilon 0 and phase function changed one at a time; per-pixel
+error = max over channels of |C - C_ref|, with max, mean, p99 and PSNR.
+
 Options:
   --backend LIST     backends to measure (default: all built); unavailable ones
                      are reported, and a stage a backend lacks is listed as unsupported
   --repeat N         timed calls per measurement, after one warm-up (default 5)
   --switches         also cross the principal axis's 45-degree switches: error on
                      each side (1e-6 rad, 1e-3 rad, 1 degree) and the jump in T
+  --reference-step X the exact reference render's step in voxel edges (default
+                     0.125), for scenes with render_march or render_splat
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/accuracy)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
@@ -243,8 +254,10 @@ int Accuracy(const CommonOptions& options) {
     auto session = Session::Open(options, "accuracy");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
-    if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow)) {
-        std::fprintf(stderr, "%s: stages: accuracy needs \"shade\" or \"shadow\"\n", scene.path.c_str());
+    const bool images = scene.stages.Has(Stage::RenderMarch) || scene.stages.Has(Stage::RenderSplat);
+    if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow) && !images) {
+        std::fprintf(stderr, "%s: stages: accuracy needs \"shade\", \"shadow\", \"render_march\" or \"render_splat\"\n",
+                     scene.path.c_str());
         return kExitBadScene;
     }
     if (!(*session)->MakeOutDir()) return kExitFailed;
@@ -284,6 +297,11 @@ int Accuracy(const CommonOptions& options) {
                 jumps.push_back({sw->jumpKeys[n], transfer::ToJson(sw->jumps.rows[n])});
             for (size_t n = 0; n < sw->doc.size(); ++n) items.push_back({sw->docKeys[n], sw->doc[n]});
             extra["switches"] = {{"errors", errors}, {"jumps", jumps}, {"doc", items}};
+        }
+        if (images) {
+            auto rows = MeasureImages(eval, **session, backends);
+            if (!rows) return MakeError("images: " + rows.error().message);
+            extra["images"] = std::move(*rows);
         }
         return extra;
     };
@@ -353,6 +371,47 @@ int Accuracy(const CommonOptions& options) {
         Emit(report, {"Jump at the switch", {std::move(sw.jumps)}});
         doc["switches"] = sw.doc;
     }
+    if (images) {
+        // Rows by (renderer, setting) in the order they first appear, then by backend (the parts' order);
+        // a backend without a renderer has its one "unsupported" row only.
+        json imageRows = json::array(), imageRefs = json::array();
+        std::vector<std::string> keys;
+        auto keyOf = [](const json& r) {
+            return r["renderer"].get<std::string>() + "|" + r["label"].get<std::string>();
+        };
+        for (const BackendMeasurement& part : *parts)
+            if (part.extra.contains("images"))
+                for (const json& r : part.extra["images"]["rows"])
+                    if (std::ranges::find(keys, keyOf(r)) == keys.end()) keys.push_back(keyOf(r));
+        for (const std::string& key : keys)
+            for (const BackendMeasurement& part : *parts)
+                if (part.extra.contains("images"))
+                    for (const json& r : part.extra["images"]["rows"])
+                        if (keyOf(r) == key) imageRows.push_back(r);
+        // A backend that did not open or whose process died: one row per renderer with why.
+        for (const BackendMeasurement& part : *parts) {
+            if (part.extra.contains("images")) {
+                if (imageRefs.empty()) imageRefs = part.extra["images"]["references"];
+                continue;
+            }
+            for (Stage r : {Stage::RenderMarch, Stage::RenderSplat})
+                if (scene.stages.Has(r))
+                    imageRows.push_back({{"renderer", StageName(r)},
+                                         {"backend", part.name},
+                                         {"settings", json::object()},
+                                         {"label", "(scene)"},
+                                         {"reference_phase", ""},
+                                         {"status", part.failure ? part.failure->status : part.status},
+                                         {"detail", part.failure ? part.failure->message : part.reason}});
+        }
+        doc["image_rows"] = imageRows;
+        doc["image_references"] = imageRefs;
+        doc["reference_step_voxels"] = options.referenceStep;
+        Emit(report, {"images: per-pixel max over channels of |C - C_ref| (linear HDR) against the exact reference "
+                      "render, and PSNR (peak: the reference's largest value)",
+                      {ImageRowsTable(imageRows)}});
+        Emit(report, {"Reference render", {ImageReferenceTable(imageRefs)}});
+    }
     doc["references"] = ReferencesJson(FirstRecords(*parts), options.cpuThreads);
     Emit(report, {"Reference speed", {ReferenceSpeedTable(FirstRecords(*parts))}});
     doc["report"] = report::RenderJson(report);
@@ -374,7 +433,8 @@ const CommandRegistration kRegistration({
     .summary = "Measure every shade and shadow option against the exact (Embree) reference",
     .help = kHelp,
     .helpOrder = 4,
-    .extraOptions = WithIsolationOptions({RepeatOption(), FlagOption("--switches", &CommonOptions::switches)}),
+    .extraOptions = WithIsolationOptions({RepeatOption(), FlagOption("--switches", &CommonOptions::switches),
+                                          ReferenceStepOption()}),
     .run = Accuracy,
 });
 

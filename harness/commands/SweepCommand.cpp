@@ -29,11 +29,19 @@ accurate) per stage and writes DIR/sweep.json, DIR/sweep.md and DIR/sweep.png
 (error against time, one series per backend; needs python3 with matplotlib,
 otherwise the plot is skipped with a message).
 
+When a varied field belongs to the march, render, phase or lightning sections,
+the scene's renderers (render_march, render_splat) are measured too, against
+the exact reference render (see cloudbench help accuracy): per-pixel error =
+max over channels of |C - C_ref|, and PSNR; both renderers share one Pareto
+front and one panel of the plot.
+
 Options:
   --vary PATH=V1,... a field and its values; repeat for more fields
   --backend LIST     backends to measure (default: all built)
   --metric M         error for the Pareto front: max (default), mean or p99
   --repeat N         timed calls per point, after one warm-up (default 5)
+  --reference-step X the exact reference render's step in voxel edges
+                     (default 0.125), when images are measured
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/sweep)
   --set PATH=VALUE   override a scene field for every point
@@ -221,6 +229,7 @@ const CommandRegistration kRegistration({
         {ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
          TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"),
          RepeatOption(),
+         ReferenceStepOption(),
          {"--shard", "", true,
           [](CommonOptions& o, const char* v) -> std::optional<std::string> {
               const std::string bad = "--shard needs I/N with 1 <= I <= N, e.g. --shard 2/8";

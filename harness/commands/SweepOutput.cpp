@@ -16,11 +16,13 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
     auto error = [&](const Row& r) {
         return metric == "mean" ? r.result.all.mean : metric == "p99" ? r.result.all.p99 : r.result.all.max;
     };
+    // The two renderers share one front: they make the same image.
+    auto group = [](Stage s) { return s == Stage::RenderSplat ? Stage::RenderMarch : s; };
     for (Row& r : rows) {
         if (r.result.status != "ok") continue;
         r.pareto = true;
         for (const Row& o : rows) {
-            if (&o == &r || o.stage != r.stage || o.result.status != "ok") continue;
+            if (&o == &r || group(o.stage) != group(r.stage) || o.result.status != "ok") continue;
             const double t = o.result.timeMs.median, e = error(o);
             const double tr = r.result.timeMs.median, er = error(r);
             if (t <= tr && e <= er && (t < tr || e < er)) {
@@ -32,6 +34,18 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
 }
 
 std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
+    // Fields of the image sections: the renderers are measured (the scene's own,
+    // MeasureSetting skips the others); fields that only a renderer reads measure nothing else.
+    auto imagePath = [](const std::string& p, bool withPhase) {
+        for (const char* prefix : {"march.", "render.", "lightning.", "phase."})
+            if (p.starts_with(prefix) && (withPhase || std::string_view(prefix) != "phase.")) return true;
+        return false;
+    };
+    const bool images = std::ranges::any_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, true); });
+    const bool onlyImages = std::ranges::all_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, false); });
+    std::vector<Stage> renderers;
+    if (images) renderers = {Stage::RenderMarch, Stage::RenderSplat};
+    if (onlyImages) return renderers;
     bool onlyShade = true, onlyShadow = true;
     for (const SweepAxis& a : axes) {
         onlyShade &= a.path.starts_with("shade.") && a.path != "shade.sigma";
@@ -40,6 +54,7 @@ std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
     std::vector<Stage> stages;
     if (!onlyShadow) stages.push_back(Stage::Shade);
     if (!onlyShade) stages.push_back(Stage::Shadow);
+    stages.insert(stages.end(), renderers.begin(), renderers.end());
     return stages;
 }
 
