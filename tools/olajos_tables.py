@@ -46,6 +46,9 @@ SETTINGS = [
     ("light_march", "light march n_l = 8", ["march.light=march", "march.light_steps=8"]),
     ("mie", "phase Mie", ["phase.function=mie"]),
     ("none", "phase none", ["phase.function=none"]),
+    # Not a table row: the same process without render_march, so that the march's CPU time is
+    # process CPU time minus this one (noise, shade and start-up).
+    ("nomarch", "(noise + shade only)", ['stages=["noise","shade"]']),
 ]
 
 # Olajos's GTX 680 averages (seed 001 Tables 3.1-3.4, ms).
@@ -68,7 +71,7 @@ def run_once(cli, scene, out, overrides, quick):
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     r = json.loads((out / "results.json").read_text())
-    frames = r["backends"]["cpu"]["march_frames"]
+    frames = r["backends"]["cpu"].get("march_frames", {})
     ms = {cam: f["samples_ms"][-1] for cam, f in frames.items()}
     samples = {cam: f["samples"][-1] for cam, f in frames.items()}
     light = {cam: f["light_samples"][-1] for cam, f in frames.items()}
@@ -96,9 +99,14 @@ def main():
         for key, _, overrides in SETTINGS:  # interleaved: every setting once per round
             loads.append(os.getloadavg()[0])
             runs[key].append(run_once(a.cli, a.scene, Path(a.out) / key, overrides, a.quick))
-            print(f"round {rnd} {key}: {sum(runs[key][-1]['ms'].values()) / len(runs[key][-1]['ms']):.1f} ms/frame",
-                  file=sys.stderr)
+            ms = runs[key][-1]["ms"]
+            print(f"round {rnd} {key}: {sum(ms.values()) / max(len(ms), 1):.1f} ms/frame, "
+                  f"{runs[key][-1]['process_cpu_s']:.2f} CPU s", file=sys.stderr)
     cams = list(runs["base"][0]["ms"].keys())
+    nomarch_cpu = median(r["process_cpu_s"] for r in runs.pop("nomarch"))
+
+    def cpu_frame(run):  # the march's CPU ms per frame (both threads), over the track
+        return (run["process_cpu_s"] - nomarch_cpu) * 1e3 / len(cams)
 
     def avg_frame(run):  # Olajos's average frame time over the track
         return sum(run["ms"][c] for c in cams) / len(cams)
@@ -110,33 +118,42 @@ def main():
     med = {k: median(v) for k, v in avg.items()}
     print(f"\nScene {a.scene}, {len(cams)} cameras, {rounds} interleaved rounds; 1-minute load average "
           f"{min(loads):.1f}..{max(loads):.1f} during the runs.\n")
-    print("| setting | ms/frame, track average: median [min max] | M samples/frame | M light samples/frame "
-          "| M samples/s (wall) | process CPU s/run |")
-    print("|---|---|---|---|---|---|")
+    print("| setting | wall ms/frame, track average: median [min max] | march CPU ms/frame | M samples/frame "
+          "| M light samples/frame | M samples/s (wall) | M samples per CPU-s |")
+    print("|---|---|---|---|---|---|---|")
     for key, label, _ in SETTINGS:
+        if key == "nomarch":
+            continue
         rs = runs[key]
         spf = median(samples_per_frame(r) for r in rs)
         lpf = median(sum(r["light_samples"][c] for c in cams) / len(cams) for r in rs)
-        print(f"| {label} | {fmt(avg[key])} | {spf / 1e6:.2f} | {lpf / 1e6:.2f} | {spf / med[key] / 1e3:.1f} | "
-              f"{median(r['process_cpu_s'] for r in rs):.2f} |")
+        cpu = [cpu_frame(r) for r in rs]
+        print(f"| {label} | {fmt(avg[key])} | {fmt(cpu)} | {spf / 1e6:.2f} | {lpf / 1e6:.2f} | "
+              f"{spf / med[key] / 1e3:.1f} | {spf / median(cpu) / 1e3:.1f} |")
     print("\nPer camera, base row, median ms: " +
           ", ".join(f"{c} {median(r['ms'][c] for r in runs['base']):.0f}" for c in cams))
     o = OLAJOS
-    print("\n| table | ours (ms) | ratio | Olajos, GTX 680 (ms) | his ratio |")
-    print("|---|---|---|---|---|")
-    print(f"| 3.1 skip structure off / on | {med['skip_off']:.0f} / {med['base']:.0f} | "
-          f"{med['skip_off'] / med['base']:.2f} | {o['skip'][1]:.1f} / {o['skip'][0]:.1f} | {o['skip'][1] / o['skip'][0]:.2f} |")
-    for key in ("adaptive", "adaptive_gentle"):
-        print(f"| 3.2 adaptive on / off ({'kappa 1' if key == 'adaptive' else 'kappa 0.05'}) | {med[key]:.0f} / "
-              f"{med['base']:.0f} | {med[key] / med['base']:.2f} | {o['adaptive'][0]:.1f} / {o['adaptive'][1]:.1f} | "
-              f"{o['adaptive'][0] / o['adaptive'][1]:.2f} |")
-    print(f"| 3.3 light march on / off (ours: march / shade) | {med['light_march']:.0f} / {med['base']:.0f} | "
-          f"{med['light_march'] / med['base']:.2f} | {o['light'][0]:.1f} / {o['light'][1]:.1f} | "
-          f"{o['light'][0] / o['light'][1]:.2f} |")
-    print(f"| 3.4 phase Mie / HG / none | {med['mie']:.0f} / {med['base']:.0f} / {med['none']:.0f} | "
-          f"{med['mie'] / med['base']:.2f} / 1 / {med['none'] / med['base']:.2f} | {o['phase'][0]:.1f} / "
-          f"{o['phase'][1]:.1f} / {o['phase'][2]:.1f} | {o['phase'][0] / o['phase'][1]:.2f} / 1 / "
-          f"{o['phase'][2] / o['phase'][1]:.2f} |")
+    print(f"\n(noise + shade + start-up without the march: {nomarch_cpu:.2f} CPU s per run, subtracted.)")
+    medc = {k: median(cpu_frame(r) for r in v) for k, v in runs.items()}
+    print("\nRatios (wall: medians of the track-average frame time; CPU: of the march's CPU time per frame):")
+    print("\n| table | ours, wall ms | ratio (wall) | ours, CPU ms | ratio (CPU) | Olajos, GTX 680 ms | his ratio |")
+    print("|---|---|---|---|---|---|---|")
+    o = OLAJOS
+
+    def row(title, keys, his):
+        wall = " / ".join(f"{med[k]:.0f}" for k in keys)
+        cpu = " / ".join(f"{medc[k]:.0f}" for k in keys)
+        rw = " / ".join(f"{med[k] / med[keys[-1]]:.2f}" for k in keys[:-1])
+        rc = " / ".join(f"{medc[k] / medc[keys[-1]]:.2f}" for k in keys[:-1])
+        hs = " / ".join(f"{v:.1f}" for v in his)
+        hr = " / ".join(f"{v / his[-1]:.2f}" for v in his[:-1])
+        print(f"| {title} | {wall} | {rw} | {cpu} | {rc} | {hs} | {hr} |")
+
+    row("3.1 skip structure off / on", ["skip_off", "base"], [o["skip"][1], o["skip"][0]])
+    row("3.2 adaptive on (kappa 1) / off", ["adaptive", "base"], list(o["adaptive"]))
+    row("3.2 adaptive on (kappa 0.05) / off", ["adaptive_gentle", "base"], list(o["adaptive"]))
+    row("3.3 light march on / off (ours: march / shade)", ["light_march", "base"], list(o["light"]))
+    row("3.4 phase Mie / none / HG", ["mie", "none", "base"], [o["phase"][0], o["phase"][2], o["phase"][1]])
     if a.json:
         Path(a.json).write_text(json.dumps({"scene": a.scene, "rounds": rounds, "loads": loads, "base": BASE,
                                             "settings": {k: ov for k, _, ov in SETTINGS}, "runs": runs,
