@@ -20,7 +20,7 @@ had no light at all); phase Mie / HG / none is `phase.function`.
 
 Usage: tools/olajos_tables.py [--cli build/release/cloudbench] [--rounds 5]
        [--out /tmp/olajos] [--json reports/march/olajos-tables.json] [--quick]
---quick renders 320x180 and 1 round (a smoke test of the script, not a measurement).
+--quick renders 320x180 of a 32^3 grid, 1 round (a smoke test of the script, not a measurement).
 """
 import argparse
 import json
@@ -35,7 +35,8 @@ from statistics import median
 ROOT = Path(__file__).resolve().parent.parent
 
 # (key, label, overrides). The base row is key "base".
-BASE = ["march.step=1", "march.light=shade", "phase.function=henyey-greenstein", "march.skipping.enabled=true"]
+BASE = ["march.step=1", "march.light=shade", "phase.function=henyey-greenstein", "march.skipping.enabled=true",
+        "warmup_steps=0", "render.every_steps=1"]
 SETTINGS = [
     ("base", "skip on, fixed step 1, light shade, HG (base)", []),
     ("skip_off", "skip structure off", ["march.skipping.enabled=false"]),
@@ -46,10 +47,13 @@ SETTINGS = [
     ("light_march", "light march n_l = 8", ["march.light=march", "march.light_steps=8"]),
     ("mie", "phase Mie", ["phase.function=mie"]),
     ("none", "phase none", ["phase.function=none"]),
-    # Not a table row: the same process without render_march, so that the march's CPU time is
-    # process CPU time minus this one (noise, shade and start-up).
-    ("nomarch", "(noise + shade only)", ['stages=["noise","shade"]']),
+    # Not a table row: the base setting with one frame per camera instead of FRAMES. Every run
+    # writes each camera's last frame (EXR and PNG, zlib: about a fifth of a run's CPU time), starts
+    # up and forms the noise once; the difference to the base row is FRAMES - 1 frames of march
+    # alone, which prices that fixed part (see cpu_frame below).
+    ("once", "(base, one frame per camera)", ["steps=1"]),
 ]
+FRAMES = 2  # frames per camera per run: a static scene renders the same march every step
 
 # Olajos's GTX 680 averages (seed 001 Tables 3.1-3.4, ms).
 OLAJOS = {
@@ -62,17 +66,17 @@ OLAJOS = {
 
 def run_once(cli, scene, out, overrides, quick):
     args = [cli, "run", scene, "--backend", "cpu", "--quiet", "--out", str(out)]
-    for o in BASE + overrides:
+    for o in BASE + [f"steps={FRAMES}"] + overrides:
         args += ["--set", o]
     if quick:
-        args += ["--set", "render.width=320", "--set", "render.height=180"]
+        args += ["--set", "render.width=320", "--set", "render.height=180", "--set", "grid.size=[32,32,32]"]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     r = json.loads((out / "results.json").read_text())
     frames = r["backends"]["cpu"].get("march_frames", {})
-    ms = {cam: f["samples_ms"][-1] for cam, f in frames.items()}
+    ms = {cam: median(f["samples_ms"]) for cam, f in frames.items()}
     samples = {cam: f["samples"][-1] for cam, f in frames.items()}
     light = {cam: f["light_samples"][-1] for cam, f in frames.items()}
     return {"ms": ms, "samples": samples, "light_samples": light, "process_cpu_s": cpu_s,
@@ -103,10 +107,14 @@ def main():
             print(f"round {rnd} {key}: {sum(ms.values()) / max(len(ms), 1):.1f} ms/frame, "
                   f"{runs[key][-1]['process_cpu_s']:.2f} CPU s", file=sys.stderr)
     cams = list(runs["base"][0]["ms"].keys())
-    nomarch_cpu = median(r["process_cpu_s"] for r in runs.pop("nomarch"))
+    # Fixed CPU per run (start-up, noise, shade, writing the frames): once = fixed + 1 march of the track,
+    # base = fixed + FRAMES marches, so fixed = once - (base - once) / (FRAMES - 1).
+    once = median(r["process_cpu_s"] for r in runs.pop("once"))
+    base_cpu = median(r["process_cpu_s"] for r in runs["base"])
+    fixed_cpu = once - (base_cpu - once) / (FRAMES - 1)
 
-    def cpu_frame(run):  # the march's CPU ms per frame (both threads), over the track
-        return (run["process_cpu_s"] - nomarch_cpu) * 1e3 / len(cams)
+    def cpu_frame(run):  # the march's CPU ms per frame (both threads), averaged over the track's cameras
+        return (run["process_cpu_s"] - fixed_cpu) * 1e3 / (FRAMES * len(cams))
 
     def avg_frame(run):  # Olajos's average frame time over the track
         return sum(run["ms"][c] for c in cams) / len(cams)
@@ -122,7 +130,7 @@ def main():
           "| M light samples/frame | M samples/s (wall) | M samples per CPU-s |")
     print("|---|---|---|---|---|---|---|")
     for key, label, _ in SETTINGS:
-        if key == "nomarch":
+        if key == "once":
             continue
         rs = runs[key]
         spf = median(samples_per_frame(r) for r in rs)
@@ -133,7 +141,8 @@ def main():
     print("\nPer camera, base row, median ms: " +
           ", ".join(f"{c} {median(r['ms'][c] for r in runs['base']):.0f}" for c in cams))
     o = OLAJOS
-    print(f"\n(noise + shade + start-up without the march: {nomarch_cpu:.2f} CPU s per run, subtracted.)")
+    print(f"\n(Fixed CPU per run, start-up, noise, shade and writing {len(cams)} EXR + PNG frames: "
+          f"{fixed_cpu:.2f} s, subtracted; {FRAMES} frames per camera per run.)")
     medc = {k: median(cpu_frame(r) for r in v) for k, v in runs.items()}
     print("\nRatios (wall: medians of the track-average frame time; CPU: of the march's CPU time per frame):")
     print("\n| table | ours, wall ms | ratio (wall) | ours, CPU ms | ratio (CPU) | Olajos, GTX 680 ms | his ratio |")
