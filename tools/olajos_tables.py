@@ -6,7 +6,9 @@ backend once per setting, the settings interleaved (A B C ... A B C ...), ROUNDS
 rounds, and prints a Markdown table: the frame time averaged over the track's
 cameras (Olajos's "average frame time"), as median [min max] over the rounds,
 the samples per frame and per second, and the ratios Olajos reports beside his
-GTX 680 numbers.
+GTX 680 numbers. Wall times swing with the machine's load; the march's CPU time
+per frame (process CPU time less a fixed part priced by a 1-frame run, see
+cpu_frame) is the stable figure.
 
 Translation of his settings (docs/performance.md, "The ray-march path"): one of
 his texture units is one of our voxels (his texture is 128^3, so is our grid);
