@@ -48,7 +48,8 @@ TEST(ScenesShipped, ThesisCoverInBands) {
         const char* name;
         double lo, hi;
     };
-    for (Band band : {Band{"thesis-low", 0.15, 0.20}, Band{"thesis-medium", 0.35, 0.45}, Band{"thesis-high", 0.70, 1.0}}) {
+    for (Band band :
+         {Band{"thesis-low", 0.15, 0.20}, Band{"thesis-medium", 0.35, 0.45}, Band{"thesis-high", 0.70, 1.0}}) {
         // Cover needs only the simulation stages; lighting and rendering are left out.
         auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/" + band.name + ".json",
                                {{"stages", R"(["region", "ca", "smooth", "density"])"}});
