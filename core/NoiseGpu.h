@@ -14,11 +14,35 @@ namespace cb::noise {
 
 // The header's word indices; noise.glsl's kNoise* constants must match.
 enum GpuWord : uint32_t {
-    kGpuNx = 0, kGpuNy = 1, kGpuNz = 2, kGpuBasis = 3, kGpuOctaves = 4, kGpuGain = 5, kGpuLacunarity = 6,
-    kGpuTurbulence = 7, kGpuScale = 8, kGpuPeriod = 11, kGpuDetailOn = 14, kGpuDetailSize = 15, kGpuStrength = 16,
-    kGpuCoverageOn = 17, kGpuCoverage = 18, kGpuDensity = 19, kGpuThreshold = 20, kGpuMapOctaves = 21,
-    kGpuMapGain = 22, kGpuMapPeriod = 23, kGpuMapScale = 25, kGpuTowerCount = 27, kGpuSeed = 28, kGpuBasePerm = 29,
-    kGpuMapPerm = 30, kGpuHeights = 31, kGpuTowers = 32, kGpuDetail = 33, kGpuHeaderWords = 64
+    kGpuNx = 0,
+    kGpuNy = 1,
+    kGpuNz = 2,
+    kGpuBasis = 3,
+    kGpuOctaves = 4,
+    kGpuGain = 5,
+    kGpuLacunarity = 6,
+    kGpuTurbulence = 7,
+    kGpuScale = 8,
+    kGpuPeriod = 11,
+    kGpuDetailOn = 14,
+    kGpuDetailSize = 15,
+    kGpuStrength = 16,
+    kGpuCoverageOn = 17,
+    kGpuCoverage = 18,
+    kGpuDensity = 19,
+    kGpuThreshold = 20,
+    kGpuMapOctaves = 21,
+    kGpuMapGain = 22,
+    kGpuMapPeriod = 23,
+    kGpuMapScale = 25,
+    kGpuTowerCount = 27,
+    kGpuSeed = 28,
+    kGpuBasePerm = 29,
+    kGpuMapPerm = 30,
+    kGpuHeights = 31,
+    kGpuTowers = 32,
+    kGpuDetail = 33,
+    kGpuHeaderWords = 64
 };
 
 // Header (64 words), then: the base permutation (256 words, one entry each),
