@@ -262,8 +262,8 @@ TEST_P(Conformance, Noise) {
                 const float d = std::fabs(a[n] - b[n]);
                 if (!(d <= worstError)) worstError = d, worst = n;
             }
-            EXPECT_LE(worstError, 1e-5f) << "at " << Where(e, worst) << ": cpu " << a[worst] << ", "
-                                         << mBackend->Name() << " " << b[worst];
+            EXPECT_LE(worstError, 1e-5f) << "at " << Where(e, worst) << ": cpu " << a[worst] << ", " << mBackend->Name()
+                                         << " " << b[worst];
             if (e.nx > 1) EXPECT_GT(sum, 0.0f) << "the variant forms no cloud: a weak test";
         }
     }

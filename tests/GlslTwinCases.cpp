@@ -387,10 +387,18 @@ std::vector<TwinCase> Cases() {
             for (int a = 0; a < 3; ++a) {
                 float v;
                 switch (r.Below(5)) {
-                    case 0: v = float(int(r.Below(2 * periods[a] + 1)) - 1); break;           // a lattice point
-                    case 1: v = std::nextafter(float(periods[a]), r.Below(2) ? -INFINITY : INFINITY); break;  // period edge
-                    case 2: v = float(2 * periods[a]) * float(r.Below(1024)) / 1024.0f; break;  // the stage's grid
-                    default: v = Uniform(r, -3, 2 * periods[a] + 3); break;
+                    case 0:  // a lattice point
+                        v = float(int(r.Below(2 * periods[a] + 1)) - 1);
+                        break;
+                    case 1:  // a period's edge
+                        v = std::nextafter(float(periods[a]), r.Below(2) ? -INFINITY : INFINITY);
+                        break;
+                    case 2:  // a voxel of the stage's grid
+                        v = float(2 * periods[a]) * float(r.Below(1024)) / 1024.0f;
+                        break;
+                    default:
+                        v = Uniform(r, -3, 2 * periods[a] + 3);
+                        break;
                 }
                 in[a] = Bits(v);
             }
@@ -410,16 +418,24 @@ std::vector<TwinCase> Cases() {
                 }
             return e;
         };
-        auto period = [](const Words& in) {
-            return noise::Period{Int(in[3]), Int(in[4]), Int(in[5])};
-        };
-        c.push_back({"NoisePerlin", 28, {Kind::F}, [point](Pcg32& r, Words& in) { point(r, in, 1); }, edgesFor(1),
+        auto period = [](const Words& in) { return noise::Period{Int(in[3]), Int(in[4]), Int(in[5])}; };
+        c.push_back({"NoisePerlin",
+                     28,
+                     {Kind::F},
+                     [point](Pcg32& r, Words& in) { point(r, in, 1); },
+                     edgesFor(1),
                      [period](const Words& in, Words& out) {
-                         out[0] = Bits(noise::Perlin(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
+                         out[0] = Bits(
+                             noise::Perlin(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
                      }});
-        c.push_back({"NoiseSimplex", 29, {Kind::F}, [point](Pcg32& r, Words& in) { point(r, in, 3); }, edgesFor(3),
+        c.push_back({"NoiseSimplex",
+                     29,
+                     {Kind::F},
+                     [point](Pcg32& r, Words& in) { point(r, in, 3); },
+                     edgesFor(3),
                      [period](const Words& in, Words& out) {
-                         out[0] = Bits(noise::Simplex(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
+                         out[0] = Bits(
+                             noise::Simplex(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
                      }});
         c.push_back({"NoiseWorley",
                      30,
@@ -447,7 +463,8 @@ std::vector<TwinCase> Cases() {
                          const NoiseBasis basis = NoiseBasis(in[6]);
                          const FbmSettings fbm{basis, in[8], double(Float(in[9])), in[10], in[11] != 0};
                          const noise::Lattice lattice{basis, kTwinPerm.data(), in[7]};
-                         const float sum = noise::Fbm(lattice, fbm, Float(in[0]), Float(in[1]), Float(in[2]), period(in));
+                         const float sum =
+                             noise::Fbm(lattice, fbm, Float(in[0]), Float(in[1]), Float(in[2]), period(in));
                          out[0] = Bits(sum);
                          out[1] = Bits(noise::Fbm01FromSum(basis, fbm, sum));
                      },
@@ -480,37 +497,37 @@ std::vector<TwinCase> Cases() {
                          out[4] = Bits(std::round(Float(in[9])));
                      },
                      /*otherDeviceUlps=*/3});
-        TwinCase exps{"NoiseHeightAndTower",
-                      33,
-                      {Kind::F, Kind::F},
-                      [](Pcg32& r, Words& in) {
-                          // A voxel centre within 4 sigma of the tower per axis (the result stays a normal
-                          // float), x and y wrapped onto the grid, so half the towers straddle an edge. HD's
-                          // a h >= 1: below, 1 - e^{-a h} cancels and multiplies exp's relative error by 1 / (a h)
-                          // (the stage reads HD from the host, so only the formula is checked here).
-                          const float n[3] = {float(1 + r.Below(128)), float(1 + r.Below(128)), 32};
-                          float centre[3], inv[3], at[3];
-                          for (int a = 0; a < 3; ++a) {
-                              const float sigma = Uniform(r, 0.5, 12);
-                              centre[a] = Uniform(r, 0, n[a]);
-                              inv[a] = float(1.0 / (double(sigma) * sigma));
-                              float p = centre[a] + Uniform(r, -4 * sigma, 4 * sigma);
-                              if (a < 2) p = p < 0 ? p + n[a] : (p >= n[a] ? p - n[a] : p);
-                              at[a] = std::floor(std::clamp(p, 0.0f, n[a] - 0.5f)) + 0.5f;
-                          }
-                          in = WF({Uniform(r, 0.05, 1), Uniform(r, 20, 60), Uniform(r, 0, 10), centre[0], centre[1],
-                                   centre[2], inv[0], inv[1], inv[2], Uniform(r, 0.05, 1), at[0], at[1], at[2], n[0],
-                                   n[1]});
-                      },
-                      {},
-                      [](const Words& in, Words& out) {
-                          out[0] = Bits(noise::HeightDistribution(Float(in[0]), Float(in[1]), Float(in[2])));
-                          const noise::TowerF t{Float(in[3]), Float(in[4]), Float(in[5]), Float(in[6]),
-                                                Float(in[7]),  Float(in[8]), Float(in[9])};
-                          out[1] = Bits(noise::TowerSum(&t, 1, Float(in[10]), Float(in[11]), Float(in[12]), Float(in[13]),
-                                                        Float(in[14])));
-                      },
-                      /*otherDeviceUlps=*/0};
+        TwinCase exps{
+            "NoiseHeightAndTower",
+            33,
+            {Kind::F, Kind::F},
+            [](Pcg32& r, Words& in) {
+                // A voxel centre within 4 sigma of the tower per axis (the result stays a normal
+                // float), x and y wrapped onto the grid, so half the towers straddle an edge. HD's
+                // a h >= 1: below, 1 - e^{-a h} cancels and multiplies exp's relative error by 1 / (a h)
+                // (the stage reads HD from the host, so only the formula is checked here).
+                const float n[3] = {float(1 + r.Below(128)), float(1 + r.Below(128)), 32};
+                float centre[3], inv[3], at[3];
+                for (int a = 0; a < 3; ++a) {
+                    const float sigma = Uniform(r, 0.5, 12);
+                    centre[a] = Uniform(r, 0, n[a]);
+                    inv[a] = float(1.0 / (double(sigma) * sigma));
+                    float p = centre[a] + Uniform(r, -4 * sigma, 4 * sigma);
+                    if (a < 2) p = p < 0 ? p + n[a] : (p >= n[a] ? p - n[a] : p);
+                    at[a] = std::floor(std::clamp(p, 0.0f, n[a] - 0.5f)) + 0.5f;
+                }
+                in = WF({Uniform(r, 0.05, 1), Uniform(r, 20, 60), Uniform(r, 0, 10), centre[0], centre[1], centre[2],
+                         inv[0], inv[1], inv[2], Uniform(r, 0.05, 1), at[0], at[1], at[2], n[0], n[1]});
+            },
+            {},
+            [](const Words& in, Words& out) {
+                out[0] = Bits(noise::HeightDistribution(Float(in[0]), Float(in[1]), Float(in[2])));
+                const noise::TowerF t{Float(in[3]), Float(in[4]), Float(in[5]), Float(in[6]),
+                                      Float(in[7]), Float(in[8]), Float(in[9])};
+                out[1] = Bits(
+                    noise::TowerSum(&t, 1, Float(in[10]), Float(in[11]), Float(in[12]), Float(in[13]), Float(in[14])));
+            },
+            /*otherDeviceUlps=*/0};
         exps.expUlps = 160;  // |x| log2(e) + a few: exp2 of the rounded x log2(e), |x| < 88 before underflow
         c.push_back(exps);
     }

@@ -120,7 +120,8 @@ TEST_F(GlslTwin, EveryFunctionEqualsItsCppTwin) {
             c.random(rng, w);
             inputs.push_back(w);
         }
-        Compare(c.name, c.outputs, std::max(c.expUlps, sExact ? 0u : c.otherDeviceUlps), inputs, Run(c.fn, inputs, SplatFrame{}), c.cpp);
+        Compare(c.name, c.outputs, std::max(c.expUlps, sExact ? 0u : c.otherDeviceUlps), inputs,
+                Run(c.fn, inputs, SplatFrame{}), c.cpp);
     }
 }
 
