@@ -35,14 +35,18 @@ float NoiseLerp(float t, float a, float b) {
     return r;
 }
 
-const int kNoisePerlinGrad[48] = int[48](1, 1, 0, -1, 1, 0, 1, -1, 0, -1, -1, 0, 1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, -1,
-                                         0, 1, 1, 0, -1, 1, 0, 1, -1, 0, -1, -1, 1, 1, 0, 0, -1, 1, -1, 1, 0, 0, -1, -1);
+// Perlin's 16 gradients (core/Noise.h PerlinGradient's table; Gustavson's 12
+// are its first 12), each component c stored as c + 1 in two bits of a word
+// per axis: a constant array indexed per invocation costs lavapipe a copy.
+const uvec3 kNoiseGradBits = uvec3(0x46552222u, 0x2222550au, 0x190a0a55u);
 
-float NoisePerlinGradient(uint hash, float x, float y, float z) {
-    const int g = 3 * int(hash & 15u);
-    precise float r = float(kNoisePerlinGrad[g]) * x + float(kNoisePerlinGrad[g + 1]) * y + float(kNoisePerlinGrad[g + 2]) * z;
+float NoiseGradientDot(uint entry, float x, float y, float z) {
+    const uvec3 c = (kNoiseGradBits >> (2u * entry)) & 3u;
+    precise float r = float(int(c.x) - 1) * x + float(int(c.y) - 1) * y + float(int(c.z) - 1) * z;
     return r;
 }
+
+float NoisePerlinGradient(uint hash, float x, float y, float z) { return NoiseGradientDot(hash & 15u, x, y, z); }
 
 // The lattice index of a coordinate wrapped to the period (.x) and the next one, wrapped (.y).
 ivec2 NoiseWrapCell(int fl, int period) {
@@ -69,14 +73,7 @@ float NoisePerlin(uint table, float x, float y, float z, ivec3 period) {
                      NoiseLerp(v, NoiseLerp(u, n001, n101), NoiseLerp(u, n011, n111)));
 }
 
-const int kNoiseSimplexGrad[36] = int[36](1, 1, 0, -1, 1, 0, 1, -1, 0, -1, -1, 0, 1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, -1,
-                                          0, 1, 1, 0, -1, 1, 0, 1, -1, 0, -1, -1);
-
-float NoiseSimplexGradient(uint hash, float x, float y, float z) {
-    const int g = 3 * int(hash % 12u);
-    precise float r = float(kNoiseSimplexGrad[g]) * x + float(kNoiseSimplexGrad[g + 1]) * y + float(kNoiseSimplexGrad[g + 2]) * z;
-    return r;
-}
+float NoiseSimplexGradient(uint hash, float x, float y, float z) { return NoiseGradientDot(hash % 12u, x, y, z); }
 
 uint NoiseSimplexLatticeHash(uint table, int a, int b, int c, ivec3 period) {
     const int u = NoiseWrapIndex(5 * a - b - c, 6 * period.x);
