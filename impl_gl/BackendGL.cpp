@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/NoiseGpu.h"
 #include "core/Scene.h"
 #include "impl_gl/BackendGLInternal.h"
 
@@ -43,7 +44,7 @@ BackendGL::~BackendGL() {
 
 std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
 
-bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
+bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise; }
 
 GLuint BackendGL::Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
     const Functions& f = mContext->F();
@@ -153,6 +154,7 @@ uint64_t BackendGL::ScratchBytes(const Scene& scene) const {
     }
     if (scene.stages.Has(Stage::RenderSplat))
         bytes += uint64_t(scene.render.width) * scene.render.height * 16;  // SplatTarget: RGBA32F
+    if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);  // NoiseData
     return bytes;
 }
 

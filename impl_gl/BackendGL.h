@@ -21,6 +21,7 @@
 #include <utility>
 
 #include "core/Backend.h"
+#include "core/Noise.h"
 #include "impl_gl/GLContext.h"
 
 namespace cb::gl {
@@ -65,6 +66,7 @@ class BackendGL final : public Backend {
     uint64_t ScratchBytes(const Scene& scene) const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:
     // The scratch textures, each used by one stage only (named first), kept
@@ -94,6 +96,7 @@ class BackendGL final : public Backend {
         SplatFrame,     // RenderSplat: the shared frame block (core/Splat.h)
         SplatCounters,  // RenderSplat: the shader's counters (splats drawn)
         ImageCopy,      // RenderSplat: the pixel buffer the image passes through
+        NoiseData,      // Noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
         Count
     };
     // An array indexed by one slot enum and nothing else.
@@ -137,6 +140,8 @@ class BackendGL final : public Backend {
     std::optional<double> mLastDeviceMs;
     SlotArray<GlScratch, ScratchTexture> mScratch;
     SlotArray<GlScratchBuffer, std::pair<GLuint, size_t>> mBuffers;  // buffer, bytes
+    // Noise: the scene whose data block is in the NoiseData buffer (NoiseGL.cpp).
+    std::unique_ptr<noise::NoiseForm> mNoiseForm;
     // Which packed fields the thesis-layout state in Rgba8StateA holds: the last
     // step's outputs, valid until a bit field is written some other way.
     std::array<GLuint, 3> mStateOf{};

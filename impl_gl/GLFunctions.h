@@ -28,6 +28,7 @@
     X(PFNGLUNIFORM2IPROC, Uniform2i)                                           \
     X(PFNGLUNIFORM1UIPROC, Uniform1ui)                                         \
     X(PFNGLUNIFORM1FPROC, Uniform1f)                                           \
+    X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                         \
     X(PFNGLUNIFORM2FPROC, Uniform2f)                                           \
     X(PFNGLCREATETEXTURESPROC, CreateTextures)                                 \
     X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                 \

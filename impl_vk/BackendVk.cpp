@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/NoiseGpu.h"
 #include "core/Scene.h"
 #include "impl_vk/StageVk.h"
 
@@ -38,7 +39,7 @@ BackendVk::~BackendVk() {
     for (DeviceBuffer& b : mScratch) mContext->DestroyBuffer(b);
 }
 
-bool BackendVk::Supports(Stage stage) const { return IsSplatPipelineStage(stage); }
+bool BackendVk::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise; }
 
 Result<DeviceBuffer*> BackendVk::Scratch(VkScratch slot, VkDeviceSize size) {
     DeviceBuffer& b = mScratch.at(size_t(slot));
@@ -72,6 +73,8 @@ uint64_t BackendVk::ScratchBytes(const Scene& scene) const {
     // shade below full resolution: q and T on the coarse grid, ceil(n / f) cells per axis (ShadeVk.cpp).
     if (const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1)); scene.stages.Has(Stage::Shade) && f > 1)
         bytes += 2 * Extent3{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)}.Count() * 4;
+    // noise: the data block (core/NoiseGpu.h): header, two tables, HD per slice, towers, detail volume.
+    if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);
     return bytes;
 }
 

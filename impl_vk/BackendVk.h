@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/Backend.h"
+#include "core/Noise.h"
 #include "impl_vk/VulkanContext.h"
 
 namespace cb::vk {
@@ -53,6 +54,7 @@ enum class VkScratch {
     SplatTileTotals,    // render_splat: splats per screen tile
     SplatTileBases,     // render_splat: SplatTileTotals scanned, and the total
     SplatTileList,      // render_splat: splat indices, screen tile by screen tile
+    NoiseData,          // noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
     Count
 };
 
@@ -75,13 +77,14 @@ class BackendVk final : public Backend {
     // floats, each buffer padded to a multiple of 4 bytes.
     uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
     // The automaton's rule outputs with wind, smooth's two sum volumes, shade's
-    // coarse q and T below full resolution; the region's and the renderer's
+    // coarse q and T below full resolution, noise's data block; the region's and the renderer's
     // lists (which depend on the ellipsoids and the clouds) are not counted.
     uint64_t ScratchBytes(const Scene& scene) const override;
     // The largest device-local heap.
     std::optional<uint64_t> AvailableBytes() const override { return mContext->LargestDeviceLocalHeap(); }
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     // Device time of the last stage call (timestamp queries), in ms.
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
@@ -100,6 +103,8 @@ class BackendVk final : public Backend {
     // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
     // while others grow.
     std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};
+    // noise: the scene whose data block is in the NoiseData slot (NoiseVk.cpp).
+    std::unique_ptr<noise::NoiseForm> mNoiseForm;
 };
 
 }  // namespace cb::vk

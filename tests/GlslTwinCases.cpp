@@ -8,6 +8,7 @@
 
 #include "GlslTwinHarness.h"
 #include "core/Automaton.h"
+#include "core/Noise.h"
 #include "core/Random.h"
 #include "core/Rules.h"
 #include "core/Shading.h"
@@ -369,6 +370,167 @@ std::vector<TwinCase> Cases() {
          },
          {WF({0.6f, 0.5f, 0.5f}), WF({2, 0.5f, 0.5f}), WF({0.6f, 0, 0})},
          [](const Words& in, Words& out) { out[0] = Bits(SplatAlpha(Float(in[0]), Float(in[1]), Float(in[2]))); }});
+
+    // ---- noise.glsl ----
+    {
+        // twin.comp's NoiseWord: the permutation i -> (167 i + 13) mod 256.
+        static const noise::Permutation kTwinPerm = [] {
+            noise::Permutation p;
+            for (uint32_t i = 0; i < 256; ++i) p[i] = uint8_t((i * 167u + 13u) & 255u);
+            return p;
+        }();
+        // Words: x, y, z (floats), period x, y, z (ints); `multiple` makes the periods multiples of 3 (simplex).
+        auto point = [](Pcg32& r, Words& in, int multiple) {
+            const int px = multiple * int(1 + r.Below(8)), py = multiple * int(1 + r.Below(8)),
+                      pz = multiple * int(1 + r.Below(4));
+            const int periods[3] = {px, py, pz};
+            for (int a = 0; a < 3; ++a) {
+                float v;
+                switch (r.Below(5)) {
+                    case 0:  // a lattice point
+                        v = float(int(r.Below(2 * periods[a] + 1)) - 1);
+                        break;
+                    case 1:  // a period's edge
+                        v = std::nextafter(float(periods[a]), r.Below(2) ? -INFINITY : INFINITY);
+                        break;
+                    case 2:  // a voxel of the stage's grid
+                        v = float(2 * periods[a]) * float(r.Below(1024)) / 1024.0f;
+                        break;
+                    default:
+                        v = Uniform(r, -3, 2 * periods[a] + 3);
+                        break;
+                }
+                in[a] = Bits(v);
+            }
+            for (int a = 0; a < 3; ++a) in[3 + a] = uint32_t(periods[a]);
+        };
+        auto edgesFor = [](int multiple) {
+            std::vector<Words> e;
+            const uint32_t p = uint32_t(multiple * 4);
+            for (float v : {0.0f, 0.5f, 1.0f, float(p) - 0.5f, float(p), float(2 * p), -1.0f, -0.25f})
+                for (float u : AndNeighbours(v)) {
+                    Words w = WF({u, 0.5f, float(p) * 0.5f});
+                    w[3] = w[4] = w[5] = p;
+                    e.push_back(w);
+                    w = WF({u, u, u});
+                    w[3] = w[4] = w[5] = p;
+                    e.push_back(w);
+                }
+            return e;
+        };
+        auto period = [](const Words& in) { return noise::Period{Int(in[3]), Int(in[4]), Int(in[5])}; };
+        c.push_back({"NoisePerlin",
+                     28,
+                     {Kind::F},
+                     [point](Pcg32& r, Words& in) { point(r, in, 1); },
+                     edgesFor(1),
+                     [period](const Words& in, Words& out) {
+                         out[0] = Bits(
+                             noise::Perlin(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
+                     }});
+        c.push_back({"NoiseSimplex",
+                     29,
+                     {Kind::F},
+                     [point](Pcg32& r, Words& in) { point(r, in, 3); },
+                     edgesFor(3),
+                     [period](const Words& in, Words& out) {
+                         out[0] = Bits(
+                             noise::Simplex(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
+                     }});
+        c.push_back({"NoiseWorley",
+                     30,
+                     {Kind::F},
+                     [point](Pcg32& r, Words& in) {
+                         point(r, in, 1);
+                         in[6] = r.NextU32();
+                     },
+                     edgesFor(1),
+                     [period](const Words& in, Words& out) {
+                         out[0] = Bits(noise::Worley(in[6], Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
+                     },
+                     /*otherDeviceUlps=*/4});
+        c.push_back({"NoiseFbm",
+                     31,
+                     {Kind::F, Kind::F},
+                     [point](Pcg32& r, Words& in) {
+                         const uint32_t basis = r.Below(3);
+                         point(r, in, basis == 1 ? 3 : 1);
+                         in[6] = basis, in[7] = r.NextU32(), in[8] = 1 + r.Below(5);
+                         in[9] = Bits(Uniform(r, 0.2, 0.8)), in[10] = 2 + r.Below(2), in[11] = r.Below(2);
+                     },
+                     {},
+                     [period](const Words& in, Words& out) {
+                         const NoiseBasis basis = NoiseBasis(in[6]);
+                         const FbmSettings fbm{basis, in[8], double(Float(in[9])), in[10], in[11] != 0};
+                         const noise::Lattice lattice{basis, kTwinPerm.data(), in[7]};
+                         const float sum =
+                             noise::Fbm(lattice, fbm, Float(in[0]), Float(in[1]), Float(in[2]), period(in));
+                         out[0] = Bits(sum);
+                         out[1] = Bits(noise::Fbm01FromSum(basis, fbm, sum));
+                     },
+                     /*otherDeviceUlps=*/8});
+        c.push_back({"NoiseForming",
+                     32,
+                     {Kind::F, Kind::F, Kind::F, Kind::I, Kind::F},
+                     [](Pcg32& r, Words& in) {
+                         const float half = float(int(r.Below(41)) - 20) + 0.5f;  // round's ties half the time
+                         in = WF({Uniform(r, -0.2, 1.5), Uniform(r, 0, 0.99), Uniform(r, 0, 1), Uniform(r, 0, 1),
+                                  Uniform(r, 0, 3), Uniform(r, 0, 1), Uniform(r, 0, 0.99), 0, 0,
+                                  r.Below(2) ? half : Uniform(r, -20, 20)});
+                         in[7] = uint32_t(int(r.Below(401)) - 200), in[8] = 1 + r.Below(64);
+                     },
+                     {[] {
+                          Words w = WF({0.35f, 0.35f, 0, 0.65f, 1, 1, 0.99f, 0, 0, -0.5f});
+                          w[7] = uint32_t(-64), w[8] = 32;
+                          return w;
+                      }(),
+                      [] {
+                          Words w = WF({1, 0, 1, 0, 0, 0, 0, 0, 0, std::nextafter(0.5f, 0.0f)});
+                          w[7] = uint32_t(-1), w[8] = 7;
+                          return w;
+                      }()},
+                     [](const Words& in, Words& out) {
+                         out[0] = Bits(noise::Threshold(Float(in[0]), Float(in[1])));
+                         out[1] = Bits(noise::CoverageModulate(Float(in[0]), Float(in[2]), Float(in[3]), Float(in[4])));
+                         out[2] = Bits(noise::Erode(Float(in[0]), Float(in[5]), Float(in[6])));
+                         out[3] = uint32_t(noise::WrapIndex(Int(in[7]), Int(in[8])));
+                         out[4] = Bits(std::round(Float(in[9])));
+                     },
+                     /*otherDeviceUlps=*/3});
+        TwinCase exps{
+            "NoiseHeightAndTower",
+            33,
+            {Kind::F, Kind::F},
+            [](Pcg32& r, Words& in) {
+                // A voxel centre within 4 sigma of the tower per axis (the result stays a normal
+                // float), x and y wrapped onto the grid, so half the towers straddle an edge. HD's
+                // a h >= 1: below, 1 - e^{-a h} cancels and multiplies exp's relative error by 1 / (a h)
+                // (the stage reads HD from the host, so only the formula is checked here).
+                const float n[3] = {float(1 + r.Below(128)), float(1 + r.Below(128)), 32};
+                float centre[3], inv[3], at[3];
+                for (int a = 0; a < 3; ++a) {
+                    const float sigma = Uniform(r, 0.5, 12);
+                    centre[a] = Uniform(r, 0, n[a]);
+                    inv[a] = float(1.0 / (double(sigma) * sigma));
+                    float p = centre[a] + Uniform(r, -4 * sigma, 4 * sigma);
+                    if (a < 2) p = p < 0 ? p + n[a] : (p >= n[a] ? p - n[a] : p);
+                    at[a] = std::floor(std::clamp(p, 0.0f, n[a] - 0.5f)) + 0.5f;
+                }
+                in = WF({Uniform(r, 0.05, 1), Uniform(r, 20, 60), Uniform(r, 0, 10), centre[0], centre[1], centre[2],
+                         inv[0], inv[1], inv[2], Uniform(r, 0.05, 1), at[0], at[1], at[2], n[0], n[1]});
+            },
+            {},
+            [](const Words& in, Words& out) {
+                out[0] = Bits(noise::HeightDistribution(Float(in[0]), Float(in[1]), Float(in[2])));
+                const noise::TowerF t{Float(in[3]), Float(in[4]), Float(in[5]), Float(in[6]),
+                                      Float(in[7]), Float(in[8]), Float(in[9])};
+                out[1] = Bits(
+                    noise::TowerSum(&t, 1, Float(in[10]), Float(in[11]), Float(in[12]), Float(in[13]), Float(in[14])));
+            },
+            /*otherDeviceUlps=*/0};
+        exps.expUlps = 160;  // |x| log2(e) + a few: exp2 of the rounded x log2(e), |x| < 88 before underflow
+        c.push_back(exps);
+    }
     return c;
 }
 

@@ -43,6 +43,7 @@ struct TwinCase {
     std::vector<Words> edges;
     std::function<void(const Words&, Words&)> cpp;
     uint32_t otherDeviceUlps = 0;  // see the top of GlslTwinTest.cpp
+    uint32_t expUlps = 0;          // on every device, lavapipe too: the case calls exp (GlslTwinTest.cpp)
 };
 
 inline Words W(std::initializer_list<uint32_t> words) {

@@ -8,12 +8,16 @@
 #include "shading.glsl"
 #include "automaton.glsl"
 #include "splat.glsl"
+#include "noise.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In { uint inWords[]; };
 layout(std430, binding = 1) writeonly buffer Out { uint outWords[]; };
 layout(std430, binding = 2) readonly buffer Frame { SplatFrame frame; };
 layout(push_constant) uniform Params { uint fn, count; } pc;
+
+// noise.glsl's tables: one permutation, i -> (167 i + 13) mod 256 (tests/GlslTwinCases.cpp kTwinPerm).
+uint NoiseWord(uint index) { return ((index & 255u) * 167u + 13u) & 255u; }
 
 uint base;
 uint U(uint k) { return inWords[base + k]; }
@@ -92,6 +96,28 @@ void main() {
         case 24u: PutF(0u, SplatQ(F(0u), F(1u), F(2u))); break;
         case 25u: PutF(0u, SplatCoord(F(0u), F(1u), F(2u))); break;
         case 26u: PutF(0u, SplatAlpha(F(0u), F(1u), F(2u))); break;
+        case 28u: PutF(0u, NoisePerlin(0u, F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
+        case 29u: PutF(0u, NoiseSimplex(0u, F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
+        case 30u: PutF(0u, NoiseWorley(U(6u), F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
+        case 31u: {
+            const float sum = NoiseFbm(U(6u), 0u, U(7u), U(8u), F(9u), U(10u), U(11u) != 0u, F(0u), F(1u), F(2u),
+                                       ivec3(I(3u), I(4u), I(5u)));
+            PutF(0u, sum);
+            PutF(1u, NoiseFbm01FromSum(U(6u), U(8u), F(9u), U(11u) != 0u, sum));
+            break;
+        }
+        case 32u:
+            PutF(0u, NoiseThreshold(F(0u), F(1u)));
+            PutF(1u, NoiseCoverageModulate(F(0u), F(2u), F(3u), F(4u)));
+            PutF(2u, NoiseErode(F(0u), F(5u), F(6u)));
+            PutI(3u, NoiseWrapIndex(I(7u), I(8u)));
+            PutF(4u, NoiseRound(F(9u)));
+            break;
+        case 33u:
+            PutF(0u, NoiseHeightDistribution(F(0u), F(1u), F(2u)));
+            PutF(1u, NoiseTower(vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), F(9u), F(10u), F(11u), F(12u),
+                                F(13u), F(14u)));
+            break;
         case 27u: {
             Splat s;
             const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), s);

@@ -1,0 +1,33 @@
+// Stage `noise` (SPEC 10a) on Vulkan: noise.comp, one invocation per voxel.
+// The scene's data block (core/NoiseGpu.h: permutation tables, HD per slice,
+// towers, the detail volume) is made and uploaded once per scene and kept in
+// the NoiseData slot while the settings and the grid stay the same; each call
+// pushes only the step's offsets.
+#include "core/NoiseGpu.h"
+#include "impl_vk/StageVk.h"
+
+namespace cb::vk {
+
+Status BackendVk::Noise(const NoiseParams& params, Buffer& q) {
+    if (!params.settings) return MakeError("vk: noise without settings");
+    if (q.Format() != BufferFormat::F32 || !(q.Extent() == params.grid))
+        return MakeError("vk: noise: q must be an F32 volume of the grid's size");
+    auto pipeline = mContext->GetPipeline("noise", 2);
+    if (!pipeline) return std::unexpected(pipeline.error());
+    if (!mNoiseForm || !(mNoiseForm->Settings() == *params.settings) || !(mNoiseForm->Grid() == params.grid)) {
+        mNoiseForm.reset();
+        auto form = std::make_unique<noise::NoiseForm>(*params.settings, params.grid);
+        const std::vector<uint32_t> words = noise::GpuData(*form);
+        auto data = Scratch(VkScratch::NoiseData, words.size() * 4);
+        if (!data) return std::unexpected(data.error());
+        CB_TRY(mContext->Upload(**data, std::as_bytes(std::span(words))));
+        mNoiseForm = std::move(form);
+    }
+    const std::array<float, 8> push = noise::GpuOffsets(mNoiseForm->Offsets(params.step));
+    const DeviceBuffer* buffers[] = {&mScratch[size_t(VkScratch::NoiseData)], &Dev(q)};
+    return Record("noise", [&](VulkanContext::Recorder& r) {
+        r.Dispatch(**pipeline, buffers, push.data(), sizeof push, uint32_t(params.grid.Count()));
+    });
+}
+
+}  // namespace cb::vk
