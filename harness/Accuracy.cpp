@@ -99,47 +99,26 @@ Result<ReferenceResult> ComputeReference(const Scene& scene, const LightingInput
     return r;
 }
 
-namespace {
-
-// Runs `call` once to warm up and `repeats` more times, timed.
-template <typename Fn>
-Result<Summary> TimeRepeated(int repeats, Fn&& call) {
-    CB_TRY(call());
-    std::vector<double> ms;
-    for (int n = 0; n < repeats; ++n) {
-        const auto start = std::chrono::steady_clock::now();
-        CB_TRY(call());
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-    }
-    return Summarize(ms);
-}
-
-StageAccuracy Failed(std::string status, std::string detail) {
-    StageAccuracy a;
-    a.status = std::move(status);
-    a.detail = std::move(detail);
-    return a;
-}
-
-}  // namespace
 
 StageAccuracy MeasureShade(Backend& backend, const Scene& scene, const LightingInputs& in,
                            const ReferenceResult& reference, int repeats, bool keepOutput) {
-    if (!backend.Supports(Stage::Shade)) return Failed("unsupported", backend.Name() + " does not implement shade yet");
+    if (!backend.Supports(Stage::Shade))
+        return NotMeasured("unsupported", backend.Name() + " does not implement shade yet");
     auto q = backend.CreateBuffer(BufferFormat::F32, in.grid);
     auto T = backend.CreateBuffer(BufferFormat::F32, in.grid);
-    if (!q || !T) return Failed("failed", (!q ? q.error() : T.error()).message);
-    if (Status s = backend.Upload(**q, std::as_bytes(std::span(in.q))); !s) return Failed("failed", s.error().message);
+    if (!q || !T) return NotMeasured("failed", (!q ? q.error() : T.error()).message);
+    if (Status s = backend.Upload(**q, std::as_bytes(std::span(in.q))); !s)
+        return NotMeasured("failed", s.error().message);
     const ShadeParams params = MakeShadeParams(scene);
     MarkPhase("shade", in.step);  // for a crash report, as CallStage marks it
     InjectTestFault(backend.Name(), "shade");
     auto time = TimeRepeated(repeats, [&] { return backend.Shade(params, **q, **T); });
-    if (!time) return Failed("failed", "shade: " + time.error().message);
+    if (!time) return NotMeasured("failed", "shade: " + time.error().message);
     StageAccuracy a;
     a.timeMs = *time;
     std::vector<float> out(in.grid.Count());
     if (Status s = backend.Download(**T, std::as_writable_bytes(std::span(out))); !s)
-        return Failed("failed", s.error().message);
+        return NotMeasured("failed", s.error().message);
     a.all = AbsoluteErrors(out, reference.T);
     a.subset = AbsoluteErrors(out, reference.T, reference.cloud);
     if (keepOutput) a.output = std::move(out);
@@ -149,23 +128,24 @@ StageAccuracy MeasureShade(Backend& backend, const Scene& scene, const LightingI
 StageAccuracy MeasureShadow(Backend& backend, const Scene& scene, const LightingInputs& in,
                             const ReferenceResult& reference, int repeats) {
     if (!backend.Supports(Stage::Shadow))
-        return Failed("unsupported", backend.Name() + " does not implement shadow yet");
-    if (in.D.empty()) return Failed("unsupported", "the scene has no density stage, so no D to shadow from");
+        return NotMeasured("unsupported", backend.Name() + " does not implement shadow yet");
+    if (in.D.empty()) return NotMeasured("unsupported", "the scene has no density stage, so no D to shadow from");
     const Extent3 columns{in.grid.nx, in.grid.ny, 1};
     auto D = backend.CreateBuffer(BufferFormat::F32, columns);
     auto G = backend.CreateBuffer(BufferFormat::F32, columns);
-    if (!D || !G) return Failed("failed", (!D ? D.error() : G.error()).message);
-    if (Status s = backend.Upload(**D, std::as_bytes(std::span(in.D))); !s) return Failed("failed", s.error().message);
+    if (!D || !G) return NotMeasured("failed", (!D ? D.error() : G.error()).message);
+    if (Status s = backend.Upload(**D, std::as_bytes(std::span(in.D))); !s)
+        return NotMeasured("failed", s.error().message);
     const ShadowParams params = MakeShadowParams(scene);
     MarkPhase("shadow", in.step);
     InjectTestFault(backend.Name(), "shadow");
     auto time = TimeRepeated(repeats, [&] { return backend.Shadow(params, **D, **G); });
-    if (!time) return Failed("failed", "shadow: " + time.error().message);
+    if (!time) return NotMeasured("failed", "shadow: " + time.error().message);
     StageAccuracy a;
     a.timeMs = *time;
     std::vector<float> out(columns.Count());
     if (Status s = backend.Download(**G, std::as_writable_bytes(std::span(out))); !s)
-        return Failed("failed", s.error().message);
+        return NotMeasured("failed", s.error().message);
     a.all = AbsoluteErrors(out, reference.G);
     a.subset = AbsoluteErrors(out, reference.G, reference.shadowed);
     return a;

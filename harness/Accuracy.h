@@ -5,9 +5,11 @@
 // are in AccuracyCommands.cpp; docs/accuracy.md describes the method.
 #pragma once
 
+#include <chrono>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/Backend.h"
@@ -52,16 +54,36 @@ ref::ReferenceParams MakeReferenceParams(const Scene& scene, ref::RayStart start
 Result<ReferenceResult> ComputeReference(const Scene& scene, const LightingInputs& inputs, ref::RayStart start,
                                          int threads);
 
+// Runs `call` once to warm up and `repeats` more times, timed.
+template <typename Fn>
+Result<Summary> TimeRepeated(int repeats, Fn&& call) {
+    CB_TRY(call());
+    std::vector<double> ms;
+    for (int n = 0; n < repeats; ++n) {
+        const auto start = std::chrono::steady_clock::now();
+        CB_TRY(call());
+        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    }
+    return Summarize(ms);
+}
+
 // One lighting stage on one backend: time over `repeats` calls after one
 // warm-up call (transfers excluded) and the error of its output.
 struct StageAccuracy {
     std::string status = "ok";  // ok, unsupported, failed
     std::string detail;
     Summary timeMs;
-    ErrorStats all, subset;     // subset: voxels in cloud (shade), cells under cloud (shadow)
-    std::vector<float> output;  // the stage's output, kept when asked
+    ErrorStats all, subset;        // subset: voxels in cloud (shade), cells under cloud (shadow)
+    std::vector<float> output;     // the stage's output, kept when asked
     std::optional<double> psnrDb;  // renderers only (harness/ImageAccuracy.h); none when infinite
 };
+// A row that was not measured: its status (unsupported, unavailable, failed, crashed, ...) and why.
+inline StageAccuracy NotMeasured(std::string status, std::string detail) {
+    StageAccuracy a;
+    a.status = std::move(status);
+    a.detail = std::move(detail);
+    return a;
+}
 StageAccuracy MeasureShade(Backend& backend, const Scene& scene, const LightingInputs& inputs,
                            const ReferenceResult& reference, int repeats, bool keepOutput = false);
 StageAccuracy MeasureShadow(Backend& backend, const Scene& scene, const LightingInputs& inputs,

@@ -54,18 +54,6 @@ Result<ImageReference> ComputeImageReference(const Scene& scene, const LightingI
 
 namespace {
 
-template <typename Fn>
-Result<Summary> ImageTimeRepeated(int repeats, Fn&& call) {
-    CB_TRY(call());
-    std::vector<double> ms;
-    for (int n = 0; n < repeats; ++n) {
-        const auto start = std::chrono::steady_clock::now();
-        CB_TRY(call());
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-    }
-    return Summarize(ms);
-}
-
 RenderAccuracy RenderNotMeasured(std::string status, std::string detail) {
     RenderAccuracy a;
     a.status = std::move(status);
@@ -75,11 +63,6 @@ RenderAccuracy RenderNotMeasured(std::string status, std::string detail) {
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-json ImageTimeJson(const Summary& s) {
-    return {{"median_ms", s.median}, {"q1_ms", s.q1},   {"q3_ms", s.q3},
-            {"min_ms", s.min},       {"max_ms", s.max}, {"count", s.count}};
 }
 
 // Fields that change how a renderer computes the image but not the physical
@@ -110,7 +93,7 @@ json ImageRowJson(Stage renderer, const std::string& backend, const std::vector<
               {"status", a.status}};
     if (!a.detail.empty()) j["detail"] = a.detail;
     if (a.status == "ok") {
-        j["time"] = ImageTimeJson(a.timeMs);
+        j["time"] = TimeJson(a.timeMs);
         j["prep_ms"] = a.prepMs;
         j["error"] = {{"count", a.error.pixel.count},
                       {"max", a.error.pixel.max},
@@ -230,7 +213,7 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     if (renderer == Stage::RenderMarch) {
         const MarchParams p = MakeMarchParams(scene, camera, in.step);
         const MarchInputs inputs{q->get(), q->get(), T.get()};
-        time = ImageTimeRepeated(repeats, [&] { return backend.RenderMarch(p, inputs, **image, nullptr); });
+        time = TimeRepeated(repeats, [&] { return backend.RenderMarch(p, inputs, **image, nullptr); });
     } else {
         SplatParams p = MakeSplatParams(scene, camera);
         const SplatOrder order = MakeSplatOrder(p.camera, scene.grid.size, scene.grid.origin, scene.grid.voxelSize);
@@ -252,7 +235,7 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
             p.skipping = false;
         }
         const SplatInputs inputs{q->get(), q->get(), T.get(), tiles->get(), tiles->get(), bands->get(), bands->get()};
-        time = ImageTimeRepeated(repeats, [&] { return backend.RenderSplat(p, inputs, **image, nullptr); });
+        time = TimeRepeated(repeats, [&] { return backend.RenderSplat(p, inputs, **image, nullptr); });
     }
     if (!time) return fail(std::string(StageName(renderer)) + ": ", time.error());
     a.timeMs = *time;

@@ -99,9 +99,9 @@ std::vector<Row> MergeRows(const Scene& scene, const std::vector<PlannedSetting>
                 if (!scene.stages.Has(stage)) continue;
                 Row row{plan[k].setting, part.name, stage, {}, false};
                 if (part.failure)
-                    row.result = {part.failure->status, part.failure->Describe(), {}, {}, {}, {}};
+                    row.result = NotMeasured(part.failure->status, part.failure->Describe());
                 else
-                    row.result = {part.status, part.reason, {}, {}, {}, {}};
+                    row.result = NotMeasured(part.status, part.reason);
                 rows.push_back(std::move(row));
             }
         }

@@ -19,12 +19,12 @@ bool LightingOnly(const std::string& path) {
     return false;
 }
 
+}  // namespace
+
 json TimeJson(const Summary& s) {
     return {{"median_ms", s.median}, {"q1_ms", s.q1},   {"q3_ms", s.q3},
             {"min_ms", s.min},       {"max_ms", s.max}, {"count", s.count}};
 }
-
-}  // namespace
 
 std::string Fmt(const char* format, double value) {
     char buffer[64];
@@ -165,7 +165,7 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
             for (const OpenedBackend& slot : backends) {
                 Row row{setting, slot.name, stage, {}, false};
                 if (!slot.backend)
-                    row.result = {"unavailable", slot.reason, {}, {}, {}, {}};
+                    row.result = NotMeasured("unavailable", slot.reason);
                 else {
                     auto a = MeasureImageStage(eval, setting, stage, *slot.backend);
                     if (!a) return std::unexpected(a.error());
@@ -181,7 +181,7 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
         for (const OpenedBackend& slot : backends) {
             Row row{setting, slot.name, stage, {}, false};
             if (!slot.backend)
-                row.result = {"unavailable", slot.reason, {}, {}, {}, {}};
+                row.result = NotMeasured("unavailable", slot.reason);
             else if (stage == Stage::Shade)
                 row.result = MeasureShade(*slot.backend, scene, *point->in, *point->reference, options.repeats);
             else

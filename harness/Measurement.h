@@ -102,6 +102,8 @@ std::vector<report::Column> ErrorColumns(std::initializer_list<std::string> firs
 std::vector<report::Column> StatsColumns(const std::string& suffix = "");
 std::vector<report::Cell> StatsCells(const ErrorStats& e);
 
+// A time summary as the JSON rows give it: median_ms, q1_ms, q3_ms, min_ms, max_ms, count.
+nlohmann::json TimeJson(const Summary& s);
 nlohmann::json RowJson(const Row& row);
 nlohmann::json StatsJson(const ErrorStats& e);
 nlohmann::json ReferencesJson(const std::vector<ReferenceRecord>& records, int threads);
