@@ -6,18 +6,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <cstring>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
 #include "core/Ellipsoids.h"
+#include "core/Random.h"
 #include "core/Scene.h"
 #include "harness/Report.h"
 #include "harness/Simulation.h"
-#include "registry/Registry.h"
-#include "core/Random.h"
 #include "impl_cpu/BackendCpu.h"
+#include "registry/Registry.h"
 #include "tests/TestUtil.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/BackendVk.h"
@@ -68,8 +68,10 @@ class Conformance : public ::testing::TestWithParam<Param> {
     // Why the test of `stage` is skipped on this backend; nullopt when it runs.
     // A variant with another automaton layout differs from its backend in the ca stage only.
     std::optional<std::string> SkipReason(Stage stage) const {
-        if (!mBackend->Supports(stage)) return "not implemented yet: " + mBackend->Name() + " has no " + std::string(StageName(stage)) + " stage";
-        if (mAutomatonOnly && stage != Stage::Ca) return std::string("the RGBA8 automaton layout changes only the ca stage (tested as gl)");
+        if (!mBackend->Supports(stage))
+            return "not implemented yet: " + mBackend->Name() + " has no " + std::string(StageName(stage)) + " stage";
+        if (mAutomatonOnly && stage != Stage::Ca)
+            return std::string("the RGBA8 automaton layout changes only the ca stage (tested as gl)");
         return std::nullopt;
     }
 
@@ -104,9 +106,11 @@ std::vector<RasterEllipsoid> RandomEllipsoids(const Extent3& e, uint32_t seed) {
     std::vector<RasterEllipsoid> list;
     for (int n = 0; n < 25; ++n) {
         const double yaw = rng.Uniform(0, 6.283185307179586);
-        list.push_back({{float(rng.Uniform(-5, e.nx + 5)), float(rng.Uniform(-5, e.ny + 5)), float(rng.Uniform(0, e.nz))},
-                        {float(rng.Uniform(1, 14)), float(rng.Uniform(1, 10)), float(rng.Uniform(1, 5))},
-                        float(std::cos(yaw)), float(std::sin(yaw))});
+        list.push_back(
+            {{float(rng.Uniform(-5, e.nx + 5)), float(rng.Uniform(-5, e.ny + 5)), float(rng.Uniform(0, e.nz))},
+             {float(rng.Uniform(1, 14)), float(rng.Uniform(1, 10)), float(rng.Uniform(1, 5))},
+             float(std::cos(yaw)),
+             float(std::sin(yaw))});
     }
     return list;
 }
@@ -129,8 +133,8 @@ TEST_P(Conformance, Region) {
         differ += d != 0;
         if (d > worstDelta) worstDelta = d, worst = v;
     }
-    EXPECT_LE(worstDelta, 1) << "worst at " << Where(e, worst) << ": cpu " << +a[worst] << ", " << mBackend->Name() << " "
-                             << +b[worst];
+    EXPECT_LE(worstDelta, 1) << "worst at " << Where(e, worst) << ": cpu " << +a[worst] << ", " << mBackend->Name()
+                             << " " << +b[worst];
     EXPECT_LE(double(differ), 0.005 * double(a.size())) << differ << " voxels differ";
 }
 
@@ -264,7 +268,9 @@ TEST_P(Conformance, Noise) {
             }
             EXPECT_LE(worstError, 1e-5f) << "at " << Where(e, worst) << ": cpu " << a[worst] << ", " << mBackend->Name()
                                          << " " << b[worst];
-            if (e.nx > 1) EXPECT_GT(sum, 0.0f) << "the variant forms no cloud: a weak test";
+            if (e.nx > 1) {
+                EXPECT_GT(sum, 0.0f) << "the variant forms no cloud: a weak test";
+            }
         }
     }
 }
@@ -333,7 +339,8 @@ TEST_P(Conformance, Shade) {
     auto gotQ = test::MakeFilled(*mBackend, BufferFormat::F32, e, q);
     auto refT = test::MakeBuffer(mCpu, BufferFormat::F32, e);
     auto gotT = test::MakeBuffer(*mBackend, BufferFormat::F32, e);
-    const Vec3 suns[] = {{0, 0, 1}, SunDirection(0.44, 1.05), SunDirection(0.7853981633974483, 0.3), SunDirection(0.2, 3.5)};
+    const Vec3 suns[] = {
+        {0, 0, 1}, SunDirection(0.44, 1.05), SunDirection(0.7853981633974483, 0.3), SunDirection(0.2, 3.5)};
     for (const Vec3& sun : suns)
         for (AttenuationKind att : {AttenuationKind::Beer, AttenuationKind::Thesis})
             for (SampleFilter filter : {SampleFilter::Bilinear, SampleFilter::Nearest})
@@ -355,9 +362,10 @@ TEST_P(Conformance, Shade) {
                             const auto [worst, at] = WorstDifference(a, b);
                             const double tolerance = storage == StorageFormat::Fp32 ? 1e-5 : StorageQuantum(storage);
                             ASSERT_LE(worst, tolerance)
-                                << "sun (" << sun[0] << ", " << sun[1] << ", " << sun[2] << ") att " << int(att) << " filter "
-                                << int(filter) << " f " << f << " storage " << int(storage) << " scattering " << scattering
-                                << ": worst at " << Where(e, at) << ": cpu " << a[at] << ", " << mBackend->Name() << " " << b[at];
+                                << "sun (" << sun[0] << ", " << sun[1] << ", " << sun[2] << ") att " << int(att)
+                                << " filter " << int(filter) << " f " << f << " storage " << int(storage)
+                                << " scattering " << scattering << ": worst at " << Where(e, at) << ": cpu " << a[at]
+                                << ", " << mBackend->Name() << " " << b[at];
                         }
 }
 
@@ -384,8 +392,8 @@ TEST_P(Conformance, Shadow) {
             ASSERT_TRUE(s.has_value()) << s.error().message;
             const auto a = test::Read<float>(mCpu, *refG), b = test::Read<float>(*mBackend, *gotG);
             const auto [worst, at] = WorstDifference(a, b);
-            EXPECT_LE(worst, 1e-5) << "form " << int(form) << ": worst at " << Where(map, at) << ": cpu " << a[at] << ", "
-                                   << mBackend->Name() << " " << b[at];
+            EXPECT_LE(worst, 1e-5) << "form " << int(form) << ": worst at " << Where(map, at) << ": cpu " << a[at]
+                                   << ", " << mBackend->Name() << " " << b[at];
         }
 }
 
@@ -450,8 +458,13 @@ TEST_P(Conformance, RenderSplat) {
             p.band = 4;
             p.alpha = 0.4f;
             auto image = test::MakeBuffer(b, BufferFormat::F32, {3, W, H});
-            SplatInputs in{qp.get(), qc.get(), t.get(), occupancy[0][0].get(), occupancy[1][0].get(),
-                           occupancy[0][1].get(), occupancy[1][1].get()};
+            SplatInputs in{qp.get(),
+                           qc.get(),
+                           t.get(),
+                           occupancy[0][0].get(),
+                           occupancy[1][0].get(),
+                           occupancy[0][1].get(),
+                           occupancy[1][1].get()};
             Status s = b.RenderSplat(p, in, *image, &stats[n]);
             ASSERT_TRUE(s.has_value()) << s.error().message;
             images[n] = test::Read<float>(b, *image);
@@ -467,11 +480,12 @@ TEST_P(Conformance, RenderSplat) {
         }
         const ImageComparison cmp = CompareImages(images[0], images[1], W, H);
         if (!cmp.Passes()) {
-            const std::string path = ::testing::TempDir() + "/render_diff_" + mBackend->Name() + "_" + std::to_string(c) + ".exr";
+            const std::string path =
+                ::testing::TempDir() + "/render_diff_" + mBackend->Name() + "_" + std::to_string(c) + ".exr";
             (void)WriteDifferenceImage(path, images[0], images[1], W, H);
-            ADD_FAILURE() << "camera " << c << ": max error " << cmp.maxError << " at (" << cmp.worstX << ", " << cmp.worstY
-                          << "), " << cmp.pixelsOverTolerance << " of " << cmp.pixels << " pixels over 2/255, PSNR " << cmp.psnr
-                          << "; difference image: " << path;
+            ADD_FAILURE() << "camera " << c << ": max error " << cmp.maxError << " at (" << cmp.worstX << ", "
+                          << cmp.worstY << "), " << cmp.pixelsOverTolerance << " of " << cmp.pixels
+                          << " pixels over 2/255, PSNR " << cmp.psnr << "; difference image: " << path;
         }
     }
 }
@@ -480,8 +494,8 @@ TEST_P(Conformance, RenderSplat) {
 // otherwise only turn its conformance tests into skips.
 TEST_P(Conformance, ImplementsTheSplatPipeline) {
     if (std::get<1>(GetParam()).size.nx != 64) GTEST_SKIP() << "runs once per backend";
-    for (Stage stage : {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density, Stage::Shade, Stage::Shadow,
-                        Stage::RenderSplat})
+    for (Stage stage :
+         {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density, Stage::Shade, Stage::Shadow, Stage::RenderSplat})
         EXPECT_TRUE(mBackend->Supports(stage)) << mBackend->Name() << " lacks " << StageName(stage);
     // The noise producer is on every backend; the ray marcher is the CPU's alone until issue 14 ports it.
     EXPECT_TRUE(mBackend->Supports(Stage::Noise)) << mBackend->Name() << " lacks noise";
@@ -496,10 +510,13 @@ TEST_P(Conformance, ImplementsTheSplatPipeline) {
 // chained steps, where each step starts from the state the last one left.)
 TEST_P(Conformance, EndToEndSimulation) {
     for (Stage stage : {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density})
-        if (!mBackend->Supports(stage)) GTEST_SKIP() << "not implemented yet: " << mBackend->Name() << " has no " << StageName(stage) << " stage";
+        if (!mBackend->Supports(stage))
+            GTEST_SKIP() << "not implemented yet: " << mBackend->Name() << " has no " << StageName(stage) << " stage";
     if (std::get<1>(GetParam()).size.nx != 64) GTEST_SKIP() << "runs once per backend, on ci-small";
     auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json",
-                           {{"stages", R"(["region", "ca", "smooth", "density"])"}, {"steps", "15"}, {"warmup_steps", "0"},
+                           {{"stages", R"(["region", "ca", "smooth", "density"])"},
+                            {"steps", "15"},
+                            {"warmup_steps", "0"},
                             {"ca.wind_shift", "[[1, -1]]"}});
     ASSERT_TRUE(scene.has_value()) << scene.error().message;
     auto ref = Simulation::Create(*scene, mCpu);
@@ -517,12 +534,16 @@ TEST_P(Conformance, EndToEndSimulation) {
                                                    test::Read<uint8_t>(*mBackend, *(*got)->Region());
         if (regionsIdentical) {
             SCOPED_TRACE("step " + std::to_string(t));
-            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Cld()), test::Read<uint8_t>(*mBackend, *(*got)->Cld()), e, "cld");
-            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Hum()), test::Read<uint8_t>(*mBackend, *(*got)->Hum()), e, "hum");
-            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Act()), test::Read<uint8_t>(*mBackend, *(*got)->Act()), e, "act");
+            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Cld()), test::Read<uint8_t>(*mBackend, *(*got)->Cld()), e,
+                        "cld");
+            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Hum()), test::Read<uint8_t>(*mBackend, *(*got)->Hum()), e,
+                        "hum");
+            ExpectExact(test::Read<uint8_t>(mCpu, *(*ref)->Act()), test::Read<uint8_t>(*mBackend, *(*got)->Act()), e,
+                        "act");
         }
         const double columns = double(e.nx) * e.ny;
-        EXPECT_NEAR(*a.coveredColumns / columns, *b.coveredColumns / columns, regionsIdentical ? 0.0 : 0.02) << "step " << t;
+        EXPECT_NEAR(*a.coveredColumns / columns, *b.coveredColumns / columns, regionsIdentical ? 0.0 : 0.02)
+            << "step " << t;
     }
 }
 
@@ -532,14 +553,14 @@ std::vector<BackendVariant> AllBackends() {
     return {{"cpu", {}}, {"vk", {}}, {"gl", {}}, {"gl", rgba8}};
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Stages, Conformance,
-    ::testing::Combine(::testing::ValuesIn(AllBackends()),
-                       ::testing::Values(SizeCase{"Small64x64x16", {64, 64, 16}}, SizeCase{"Odd70x33x17", {70, 33, 17}},
-                                         SizeCase{"Thin1x1x9", {1, 1, 9}})),
-    [](const ::testing::TestParamInfo<Param>& info) {
-        return std::string(std::get<1>(info.param).name) + "_" + std::get<0>(info.param).Label();
-    });
+INSTANTIATE_TEST_SUITE_P(Stages, Conformance,
+                         ::testing::Combine(::testing::ValuesIn(AllBackends()),
+                                            ::testing::Values(SizeCase{"Small64x64x16", {64, 64, 16}},
+                                                              SizeCase{"Odd70x33x17", {70, 33, 17}},
+                                                              SizeCase{"Thin1x1x9", {1, 1, 9}})),
+                         [](const ::testing::TestParamInfo<Param>& info) {
+                             return std::string(std::get<1>(info.param).name) + "_" + std::get<0>(info.param).Label();
+                         });
 
 }  // namespace
 }  // namespace cb

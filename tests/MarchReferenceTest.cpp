@@ -120,22 +120,8 @@ TEST(MarchReference, HomogeneousSlabMatchesTheClosedForm) {
     }
 }
 
-// Gaussian blobs (as MarchTest's), zero below 1e-3.
-std::vector<float> RefBlobs(const Extent3& e) {
-    std::vector<float> q(e.Count());
-    const double centres[2][4] = {{8, 9, 7, 2.5}, {15, 14, 10, 2}};
-    for (uint32_t k = 0; k < e.nz; ++k)
-        for (uint32_t j = 0; j < e.ny; ++j)
-            for (uint32_t i = 0; i < e.nx; ++i) {
-                double v = 0;
-                for (const auto& c : centres) {
-                    const double dx = i + 0.5 - c[0], dy = j + 0.5 - c[1], dz = k + 0.5 - c[2];
-                    v += std::exp(-(dx * dx + dy * dy + dz * dz) / (2 * c[3] * c[3]));
-                }
-                q[VoxelIndex(e, i, j, k)] = v < 1e-3 ? 0.0f : float(std::min(v, 1.0));
-            }
-    return q;
-}
+// Two Gaussian blobs, zero below 1e-3.
+std::vector<float> RefBlobs(const Extent3& e) { return test::GaussianBlobField(e, {{8, 9, 7, 2.5}, {15, 14, 10, 2}}); }
 
 double MeanPixelError(const std::vector<float>& a, const std::vector<float>& b) {
     double sum = 0;

@@ -97,19 +97,7 @@ MarchParams CameraParams(const Extent3& e, std::array<double, 3> eye, std::array
 
 // A few Gaussian blobs, zero below 1e-3 so that whole bricks are empty.
 std::vector<float> BlobField(const Extent3& e) {
-    std::vector<float> q(e.Count());
-    const double centres[3][4] = {{10, 12, 8, 2}, {22, 20, 14, 2.5}, {14, 24, 18, 1.5}};
-    for (uint32_t k = 0; k < e.nz; ++k)
-        for (uint32_t j = 0; j < e.ny; ++j)
-            for (uint32_t i = 0; i < e.nx; ++i) {
-                double v = 0;
-                for (const auto& c : centres) {
-                    const double dx = i + 0.5 - c[0], dy = j + 0.5 - c[1], dz = k + 0.5 - c[2];
-                    v += std::exp(-(dx * dx + dy * dy + dz * dz) / (2 * c[3] * c[3]));
-                }
-                q[VoxelIndex(e, i, j, k)] = v < 1e-3 ? 0.0f : float(std::min(v, 1.0));
-            }
-    return q;
+    return test::GaussianBlobField(e, {{10, 12, 8, 2}, {22, 20, 14, 2.5}, {14, 24, 18, 1.5}});
 }
 
 bool AllFinite(const std::vector<float>& v) {
@@ -612,12 +600,13 @@ TEST(MarchBench, DISABLED_Cumulus128At720p) {
         }
         std::sort(wall.begin(), wall.end());
         std::sort(cpu.begin(), cpu.end());
-        std::printf("%-32s wall %8.1f [%7.1f %7.1f] ms  cpu %8.1f [%7.1f %7.1f] ms  rays %8llu  samples %10llu  light %9llu  "
-                    "skipped %9llu  empty bricks %llu/%llu  Msamples/cpu-s %.1f\n",
-                    row.name, wall[3], wall[0], wall[6], cpu[3], cpu[0], cpu[6], (unsigned long long)stats.rays,
-                    (unsigned long long)stats.samples, (unsigned long long)stats.lightSamples,
-                    (unsigned long long)stats.bricksSkipped, (unsigned long long)stats.emptyBricks,
-                    (unsigned long long)stats.bricks, stats.samples / (cpu[3] * 1e3));
+        std::printf(
+            "%-32s wall %8.1f [%7.1f %7.1f] ms  cpu %8.1f [%7.1f %7.1f] ms  rays %8llu  samples %10llu  light %9llu  "
+            "skipped %9llu  empty bricks %llu/%llu  Msamples/cpu-s %.1f\n",
+            row.name, wall[3], wall[0], wall[6], cpu[3], cpu[0], cpu[6], (unsigned long long)stats.rays,
+            (unsigned long long)stats.samples, (unsigned long long)stats.lightSamples,
+            (unsigned long long)stats.bricksSkipped, (unsigned long long)stats.emptyBricks,
+            (unsigned long long)stats.bricks, stats.samples / (cpu[3] * 1e3));
     }
 }
 

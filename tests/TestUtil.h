@@ -3,12 +3,37 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
 #include "core/Backend.h"
 
 namespace cb::test {
+
+// One Gaussian blob of a test field: centre (x, y, z) and sigma, in voxels.
+struct TestBlob {
+    double x, y, z, sigma;
+};
+
+// The sum of Gaussian blobs at voxel centres, clamped to 1, and 0 where it is
+// below 1e-3 (so that whole bricks of a ray-march test are empty).
+inline std::vector<float> GaussianBlobField(const Extent3& e, std::initializer_list<TestBlob> blobs) {
+    std::vector<float> q(e.Count());
+    for (uint32_t k = 0; k < e.nz; ++k)
+        for (uint32_t j = 0; j < e.ny; ++j)
+            for (uint32_t i = 0; i < e.nx; ++i) {
+                double v = 0;
+                for (const TestBlob& b : blobs) {
+                    const double dx = i + 0.5 - b.x, dy = j + 0.5 - b.y, dz = k + 0.5 - b.z;
+                    v += std::exp(-(dx * dx + dy * dy + dz * dz) / (2 * b.sigma * b.sigma));
+                }
+                q[VoxelIndex(e, i, j, k)] = v < 1e-3 ? 0.0f : float(std::min(v, 1.0));
+            }
+    return q;
+}
 
 inline std::unique_ptr<Buffer> MakeBuffer(Backend& backend, BufferFormat format, Extent3 extent) {
     auto buffer = backend.CreateBuffer(format, extent);
