@@ -127,10 +127,29 @@ struct PhaseTable {
     float indexPerRadian = 0;  // (count - 1) / pi
 };
 
-// The table linearly interpolated in theta = acos(cosTheta), cosTheta clamped
-// to [-1, 1]. The result lies between the two nearest values.
+// arccos(x) for x in [-1, 1], |error| < 1e-6 rad: Abramowitz & Stegun 4.4.46,
+// acos(x) = sqrt(1 - x) (a0 + a1 x + ... + a7 x^7) on [0, 1] (|error| <= 2e-8
+// in exact arithmetic), and pi - acos(-x) below 0. The project's own so that
+// every backend evaluates the same operations (GLSL's acos has no stated
+// precision); twin in core/glsl/shading.glsl.
+inline float ArcCos(float x) {
+    const float a = std::fabs(x);
+    float p = -0.0012624911f;
+    p = p * a + 0.0066700901f;
+    p = p * a - 0.0170881256f;
+    p = p * a + 0.0308918810f;
+    p = p * a - 0.0501743046f;
+    p = p * a + 0.0889789874f;
+    p = p * a - 0.2145988016f;
+    p = p * a + 1.5707963050f;
+    const float r = std::sqrt(1.0f - a) * p;
+    return x < 0.0f ? 3.14159265358979f - r : r;
+}
+
+// The table linearly interpolated in theta = ArcCos(cosTheta), cosTheta
+// clamped to [-1, 1]. The result lies between the two nearest values.
 inline float SamplePhaseTable(const PhaseTable& table, float cosTheta) {
-    const float theta = std::acos(std::clamp(cosTheta, -1.0f, 1.0f));
+    const float theta = ArcCos(std::clamp(cosTheta, -1.0f, 1.0f));
     const float x = std::clamp(theta * table.indexPerRadian, 0.0f, float(table.count - 1));
     const uint32_t i = std::min(uint32_t(x), table.count - 2);
     return Lerp(table.values[i], table.values[i + 1], x - float(i));

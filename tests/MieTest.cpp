@@ -243,6 +243,22 @@ TEST(Mie, SamplePhaseTableIsLinearInTheta) {
         EXPECT_NEAR(SamplePhaseTable(table, float(std::cos(MieDeg(deg)))), deg, 2e-3) << deg;
 }
 
+// ArcCos (Abramowitz & Stegun 4.4.46 in float) against the double-precision
+// library acos: within 1e-6 rad everywhere on [-1, 1], exact-ish at the ends.
+TEST(Mie, ArcCosMatchesTheLibraryWithinAMicroradian) {
+    double worst = 0;
+    for (int i = -100000; i <= 100000; ++i) {
+        const float x = float(i) / 100000.0f;
+        worst = std::max(worst, std::fabs(double(ArcCos(x)) - std::acos(double(x))));
+    }
+    EXPECT_LT(worst, 1e-6);
+    EXPECT_NEAR(ArcCos(1.0f), 0.0, 1e-7);
+    EXPECT_NEAR(ArcCos(0.0f), kMiePi / 2, 1e-7);
+    EXPECT_NEAR(ArcCos(-1.0f), kMiePi, 3e-7);
+    EXPECT_NEAR(ArcCos(0.5f), kMiePi / 3, 1e-6);
+    EXPECT_NEAR(ArcCos(-0.5f), 2 * kMiePi / 3, 1e-6);
+}
+
 std::span<const float> MieCloudValues() { return {kMieCloudTable.values, kMieCloudTable.count}; }
 
 // P^ of the table at theta (degrees), through PhaseValue as every stage calls it.

@@ -103,6 +103,22 @@ float PhaseValue(uint kind, float g, float cosTheta) {
     return cs;
 }
 
+// arccos(x), x in [-1, 1] (core/Shading.h ArcCos: Abramowitz & Stegun 4.4.46).
+float ArcCos(float x) {
+    const float a = abs(x);
+    precise float p = -0.0012624911;
+    p = p * a + 0.0066700901;
+    p = p * a - 0.0170881256;
+    p = p * a + 0.0308918810;
+    p = p * a - 0.0501743046;
+    p = p * a + 0.0889789874;
+    p = p * a - 0.2145988016;
+    p = p * a + 1.5707963050;
+    precise float r = sqrt(1.0 - a) * p;
+    precise float result = x < 0.0 ? 3.14159265358979 - r : r;
+    return result;
+}
+
 // kappa = max(0, 1 - rho^2)^2 at splat coordinate (a, b) (core/Shading.h SplatKernel).
 float SplatKernel(float a, float b) {
     precise float x = 2.0 * a - 1.0, y = 2.0 * b - 1.0;
