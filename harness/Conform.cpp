@@ -37,6 +37,7 @@ std::string Where(const Extent3& e, size_t v) {
 // Accumulates the worst result of one stage x backend over the steps.
 class Tally {
   public:
+    std::string differenceDir;  // where renderer rows write their worst frame's difference image; "" = nowhere
     ConformRow& Row(const std::string& stage, const std::string& backend, const std::string& rule, double tolerance) {
         auto key = stage + "/" + backend;
         auto [it, inserted] = mRows.try_emplace(key);
@@ -164,6 +165,13 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
                               camera.c_str(), cmp.worstX, cmp.worstY, cmp.pixelsOverTolerance,
                               rule.ToleranceText().c_str(), cmp.psnr);
                 row.detail = detail;
+                if (!tally.differenceDir.empty()) {
+                    const std::string file = "diff-" + stageName + "-" + name + ".exr";
+                    if (WriteDifferenceImage(tally.differenceDir + "/" + file, *r, *g, width, height))
+                        row.differenceImage = file, row.detail += "; difference image " + file;
+                    else
+                        row.detail += "; the difference image could not be written";
+                }
             }
             if (!cmp.Passes()) row.status = "fail";
             break;
@@ -185,8 +193,9 @@ Result<std::unique_ptr<Buffer>> CopyTo(Backend& cpu, const Buffer& from, Backend
 }  // namespace
 
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
-                                               const ConformProgress& afterStep) {
+                                               const ConformProgress& afterStep, const std::string& differenceDir) {
     Tally tally;
+    tally.differenceDir = differenceDir;
     auto sim = Simulation::Create(scene, cpu, /*everyStepOutputs=*/true);
     if (!sim) return std::unexpected(sim.error());
 
@@ -322,7 +331,8 @@ nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& ro
                         {"rule", r.rule},
                         {"worst", r.worst},
                         {"tolerance", r.tolerance},
-                        {"detail", r.detail}});
+                        {"detail", r.detail},
+                        {"difference_image", r.differenceImage}});
     return {{"format", "cloudbench-conform/1"}, {"scene", scene.name}, {"steps", scene.steps}, {"results", list}};
 }
 

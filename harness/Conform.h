@@ -23,6 +23,7 @@ struct ConformRow {
     double worst = 0;             // largest error seen (absolute; voxels differing for exact stages)
     double tolerance = 0;
     std::string detail;           // worst place and both values, or why it was skipped
+    std::string differenceImage;  // renderers: |cpu - backend| of the worst frame (EXR), when written
 };
 
 // Called after each step's comparisons with the rows so far (each row's worst over steps 0..step).
@@ -30,8 +31,11 @@ using ConformProgress = std::function<void(uint32_t step, const std::vector<Conf
 
 // Compares every available backend in `others` against `cpu` over the scene's
 // steps; one that did not open is a row "(all)" skipped with the reason.
+// With `differenceDir`, each renderer row's worst frame is written there as
+// diff-<stage>-<backend>.exr, |cpu - backend| per channel (linear float).
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
-                                               const ConformProgress& afterStep = {});
+                                               const ConformProgress& afterStep = {},
+                                               const std::string& differenceDir = "");
 
 // stage x backend: result, rule, worst error and where, as `conform` prints it.
 report::Table ConformTable(const std::vector<ConformRow>& rows);

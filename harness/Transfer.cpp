@@ -112,7 +112,8 @@ BackendProvenance ProvenanceFromJson(const json& j) {
 
 json ToJson(const ConformRow& r) {
     return {{"stage", r.stage},    {"backend", r.backend},        {"status", r.status}, {"rule", r.rule},
-            {"worst", D(r.worst)}, {"tolerance", D(r.tolerance)}, {"detail", r.detail}};
+            {"worst", D(r.worst)}, {"tolerance", D(r.tolerance)}, {"detail", r.detail},
+            {"difference_image", r.differenceImage}};
 }
 ConformRow ConformRowFromJson(const json& j) {
     ConformRow r;
@@ -123,6 +124,7 @@ ConformRow ConformRowFromJson(const json& j) {
     r.worst = FromD(j.at("worst"));
     r.tolerance = FromD(j.at("tolerance"));
     r.detail = j.at("detail").get<std::string>();
+    r.differenceImage = j.value("difference_image", "");
     return r;
 }
 

@@ -63,12 +63,13 @@ nlohmann::json IsolatedConformance(Session& session, const std::string& name, co
                                    nlohmann::json list = nlohmann::json::array();
                                    for (const ConformRow& row : soFar) list.push_back(transfer::ToJson(row));
                                    send({{"step", step}, {"rows", list}});
-                               });
+                               },
+                               session.OutDir());
     nlohmann::json list = nlohmann::json::array();
     if (rows)
         for (const ConformRow& row : *rows) list.push_back(transfer::ToJson(row));
     else
-        list.push_back(transfer::ToJson(ConformRow{"(all)", name, "failed", "", 0, 0, rows.error().message}));
+        list.push_back(transfer::ToJson(ConformRow{"(all)", name, "failed", "", 0, 0, rows.error().message, ""}));
     MarkPhase("closing backends");
     return {{"rows", list}, {"backends", backends}};
 }
@@ -112,7 +113,7 @@ int Conform(const CommonOptions& options) {
                 for (const nlohmann::json& row : last["rows"]) rows.push_back(transfer::ConformRowFromJson(row));
                 kept = "; rows above cover steps 0-" + std::to_string(last["step"].get<uint32_t>());
             }
-            rows.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe() + kept});
+            rows.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe() + kept, ""});
             anyCrashed = true;
             continue;
         }
