@@ -20,7 +20,14 @@ units" is `march.adaptive` with step 1, start 100, kappa 1 (a gentler kappa
 (n_l = 8) versus "shade" (the shade stage's T, the cheap source: his "off"
 had no light at all); phase Mie / HG / none is `phase.function`.
 
+With --backends cpu,vk,gl every setting runs on each backend, interleaved
+(round r: A on cpu, vk, gl, then B ...), and the tables come per backend; on
+lavapipe and llvmpipe the device is this machine's CPU, so the process CPU
+time prices their march the same way. --size WxH renders smaller frames (the
+ratios are what Olajos's tables compare).
+
 Usage: tools/olajos_tables.py [--cli build/release/cloudbench] [--rounds 5]
+       [--backends cpu] [--size 1280x720]
        [--out /tmp/olajos] [--json reports/march/olajos-tables.json] [--quick]
 --quick renders 320x180 of a 32^3 grid, 1 round (a smoke test of the script, not a measurement).
 """
@@ -66,10 +73,13 @@ OLAJOS = {
 }
 
 
-def run_once(cli, scene, out, overrides, quick):
-    args = [cli, "run", scene, "--backend", "cpu", "--quiet", "--out", str(out)]
+def run_once(cli, scene, out, overrides, quick, backend, size):
+    args = [cli, "run", scene, "--backend", backend, "--quiet", "--out", str(out)]
     for o in BASE + [f"steps={FRAMES}"] + overrides:
         args += ["--set", o]
+    if size:
+        w, h = size.split("x")
+        args += ["--set", f"render.width={w}", "--set", f"render.height={h}"]
     if quick:
         args += ["--set", "render.width=320", "--set", "render.height=180", "--set", "grid.size=[32,32,32]"]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -77,12 +87,12 @@ def run_once(cli, scene, out, overrides, quick):
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     r = json.loads((out / "results.json").read_text())
-    frames = r["backends"]["cpu"].get("march_frames", {})
+    frames = r["backends"][backend].get("march_frames", {})
     ms = {cam: median(f["samples_ms"]) for cam, f in frames.items()}
     samples = {cam: f["samples"][-1] for cam, f in frames.items()}
     light = {cam: f["light_samples"][-1] for cam, f in frames.items()}
     return {"ms": ms, "samples": samples, "light_samples": light, "process_cpu_s": cpu_s,
-            "stages_ms": {k: v["samples_ms"] for k, v in r["backends"]["cpu"]["stages"].items()}}
+            "stages_ms": {k: v["samples_ms"] for k, v in r["backends"][backend]["stages"].items()}}
 
 
 def fmt(values):
@@ -97,17 +107,34 @@ def main():
     ap.add_argument("--out", default="/tmp/olajos-tables")
     ap.add_argument("--json", default=None, help="write the raw runs here")
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--backends", default="cpu", help="comma-separated: cpu,vk,gl")
+    ap.add_argument("--size", default="", help="WxH instead of the scene's 1280x720")
     a = ap.parse_args()
     rounds = 1 if a.quick else a.rounds
-    runs = {k: [] for k, _, _ in SETTINGS}
+    backends = a.backends.split(",")
+    all_runs = {b: {k: [] for k, _, _ in SETTINGS} for b in backends}
     loads = []
     for rnd in range(rounds):
-        for key, _, overrides in SETTINGS:  # interleaved: every setting once per round
-            loads.append(os.getloadavg()[0])
-            runs[key].append(run_once(a.cli, a.scene, Path(a.out) / key, overrides, a.quick))
-            ms = runs[key][-1]["ms"]
-            print(f"round {rnd} {key}: {sum(ms.values()) / max(len(ms), 1):.1f} ms/frame, "
-                  f"{runs[key][-1]['process_cpu_s']:.2f} CPU s", file=sys.stderr)
+        for key, _, overrides in SETTINGS:  # interleaved: every setting once per round, on each backend
+            for b in backends:
+                loads.append(os.getloadavg()[0])
+                all_runs[b][key].append(
+                    run_once(a.cli, a.scene, Path(a.out) / b / key, overrides, a.quick, b, a.size))
+                ms = all_runs[b][key][-1]["ms"]
+                print(f"round {rnd} {b} {key}: {sum(ms.values()) / max(len(ms), 1):.1f} ms/frame, "
+                      f"{all_runs[b][key][-1]['process_cpu_s']:.2f} CPU s", file=sys.stderr)
+    for b in backends:
+        print(f"\n## Backend {b}" + (f", {a.size}" if a.size else ""))
+        report(a, b, all_runs[b], rounds, loads)
+    if a.json:
+        Path(a.json).write_text(json.dumps({"scene": a.scene, "rounds": rounds, "loads": loads, "base": BASE,
+                                            "size": a.size, "backends": backends,
+                                            "settings": {k: ov for k, _, ov in SETTINGS}, "runs": all_runs,
+                                            "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}, indent=1))
+
+
+def report(a, backend, runs, rounds, loads):
+    runs = dict(runs)
     cams = list(runs["base"][0]["ms"].keys())
     # Fixed CPU per run (start-up, noise, shade, writing the frames): once = fixed + 1 march of the track,
     # base = fixed + FRAMES marches, so fixed = once - (base - once) / (FRAMES - 1).
@@ -165,10 +192,6 @@ def main():
     row("3.2 adaptive on (kappa 0.05) / off", ["adaptive_gentle", "base"], list(o["adaptive"]))
     row("3.3 light march on / off (ours: march / shade)", ["light_march", "base"], list(o["light"]))
     row("3.4 phase Mie / none / HG", ["mie", "none", "base"], [o["phase"][0], o["phase"][2], o["phase"][1]])
-    if a.json:
-        Path(a.json).write_text(json.dumps({"scene": a.scene, "rounds": rounds, "loads": loads, "base": BASE,
-                                            "settings": {k: ov for k, _, ov in SETTINGS}, "runs": runs,
-                                            "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}, indent=1))
 
 
 if __name__ == "__main__":
