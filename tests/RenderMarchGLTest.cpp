@@ -1,0 +1,265 @@
+// Stage render_march on the OpenGL backend (impl_gl/RenderMarchGL.cpp): the
+// same image as the CPU backend (an independent implementation of SPEC 10 in
+// C++) to 1e-5 and the same MarchStats, option by option, on odd grids and odd
+// image sizes; and two closed forms on the GL backend alone. Skipped where no
+// OpenGL 4.5 context can be made.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/March.h"
+#include "impl_cpu/BackendCpu.h"
+#include "registry/Registry.h"
+#include "tests/TestUtil.h"
+
+namespace cb {
+namespace {
+
+struct GlMarchCase {
+    Extent3 grid{16, 16, 16};
+    std::vector<float> qPrev, qCur, T;  // T empty: no T buffer (light "march")
+    MarchParams params;
+};
+
+struct GlMarchImage {
+    std::vector<float> rgb;
+    MarchStats stats;
+    bool ok = false;
+};
+
+GlMarchImage RenderOn(Backend& backend, const GlMarchCase& c) {
+    const Extent3 e = c.grid;
+    auto qPrev = test::MakeFilled(backend, BufferFormat::F32, e, c.qPrev);
+    auto qCur = test::MakeFilled(backend, BufferFormat::F32, e, c.qCur);
+    std::unique_ptr<Buffer> t;
+    if (!c.T.empty()) t = test::MakeFilled(backend, BufferFormat::F32, e, c.T);
+    auto image = test::MakeBuffer(backend, BufferFormat::F32, {3, c.params.camera.width, c.params.camera.height});
+    GlMarchImage out;
+    // Garbage in the stats, so that a field the backend forgets to set fails.
+    out.stats = {777, 777, 777, 777, 777, 777};
+    const MarchInputs in{qPrev.get(), qCur.get(), t.get()};
+    Status status = backend.RenderMarch(c.params, in, *image, &out.stats);
+    EXPECT_TRUE(status.has_value()) << backend.Name() << ": " << status.error().message;
+    out.ok = status.has_value();
+    if (out.ok) out.rgb = test::Read<float>(backend, *image);
+    return out;
+}
+
+class RenderMarchGL : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        auto gl = CreateBackend("gl");
+        if (!gl) GTEST_SKIP() << "no OpenGL here: " << gl.error().message;
+        mGl = std::move(*gl);
+        ASSERT_TRUE(mGl->Supports(Stage::RenderMarch));
+    }
+    std::unique_ptr<Backend> mGl;
+};
+
+MarchParams GlCameraParams(const Extent3& e, std::array<double, 3> eye, std::array<double, 3> target, uint32_t w,
+                           uint32_t h, float sigmaH = 0.05f) {
+    CameraSettings cam;
+    cam.eye = eye;
+    cam.target = target;
+    cam.fovDeg = 50;
+    cam.nearPlane = 0.01;
+    cam.farPlane = 1e5;
+    MarchParams p;
+    p.camera = MakeCameraFrame(cam, w, h);
+    MarchSetup& s = p.setup;
+    s.size = {float(e.nx), float(e.ny), float(e.nz)};
+    s.voxelSize = 1;
+    s.step = 0.5f;
+    s.sigmaH = sigmaH;
+    s.epsilon = 0.01f;
+    s.sun = SunDirection(0.7, 0.4);
+    s.sunRadiance = {1.0f, 0.9f, 0.8f};
+    s.ambient = {0.2f, 0.25f, 0.3f};
+    s.background = {0.4f, 0.6f, 0.9f};
+    s.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+    p.alpha = 0.3f;
+    return p;
+}
+
+// Two different steps of blobs (so that q_alpha mixes them), zero below 1e-3
+// so that whole bricks are empty, and a T that varies from voxel to voxel.
+GlMarchCase BlobCase(const Extent3& e, uint32_t w, uint32_t h) {
+    GlMarchCase c;
+    c.grid = e;
+    const double x = e.nx, y = e.ny, z = e.nz;
+    c.qPrev = test::GaussianBlobField(e, {{0.3 * x, 0.4 * y, 0.35 * z, 2}, {0.7 * x, 0.6 * y, 0.6 * z, 2.5}});
+    c.qCur = test::GaussianBlobField(e, {{0.35 * x, 0.4 * y, 0.4 * z, 2.2}, {0.45 * x, 0.75 * y, 0.7 * z, 1.5}});
+    c.T.resize(e.Count());
+    for (size_t i = 0; i < c.T.size(); ++i) c.T[i] = 0.3f + 0.7f * float((i * 2654435761u) % 1000) / 1000.0f;
+    c.params = GlCameraParams(e, {-0.6 * x, -0.3 * y, 1.9 * z}, {0.5 * x, 0.5 * y, 0.4 * z}, w, h);
+    return c;
+}
+
+// Every option of SPEC 10 the GPU backends implement, alone and combined: the
+// GL image within 1e-5 of the CPU's (SPEC 10 allows 1e-4) and every counter equal.
+TEST_F(RenderMarchGL, MatchesTheCpuOnEveryOptionOnOddSizes) {
+    cpu::BackendCpu cpu(2);
+    struct Option {
+        std::string name;
+        std::function<void(GlMarchCase&)> edit;
+    };
+    const auto pointLight = [](GlMarchCase& c) {
+        MarchSetup& s = c.params.setup;
+        s.point.on = true;
+        s.point.position = {0.5f * s.size[0], 0.45f * s.size[1], 0.3f * s.size[2]};
+        s.point.radiance = {30, 28, 40};
+        s.point.minDistance2 = 1;
+    };
+    const std::vector<Option> options = {
+        {"shade, skipping, HG", [](GlMarchCase&) {}},
+        {"skipping off", [](GlMarchCase& c) { c.params.skipping = false; }},
+        {"brick 1", [](GlMarchCase& c) { c.params.brick = 1; }},
+        {"brick 5", [](GlMarchCase& c) { c.params.brick = 5; }},
+        {"jitter", [](GlMarchCase& c) { c.params.jitter = true, c.params.seed = 9, c.params.frame = 4; }},
+        {"adaptive", [](GlMarchCase& c) {
+             c.params.setup.adaptive = true, c.params.setup.kappa = 0.1f, c.params.setup.adaptiveStart = 8;
+         }},
+        {"adaptive, jitter, brick 3", [](GlMarchCase& c) {
+             c.params.setup.adaptive = true, c.params.setup.kappa = 0.1f, c.params.setup.adaptiveStart = 8;
+             c.params.jitter = true, c.params.frame = 2, c.params.brick = 3;
+         }},
+        {"light march", [](GlMarchCase& c) { c.params.light = MarchLightSource::March, c.T.clear(); }},
+        {"light march n_l 3, jitter", [](GlMarchCase& c) {
+             c.params.light = MarchLightSource::March, c.T.clear(), c.params.lightSteps = 3, c.params.jitter = true;
+         }},
+        {"powder", [](GlMarchCase& c) { c.params.setup.powder = true, c.params.setup.powderC = 2.5f; }},
+        {"phase none", [](GlMarchCase& c) { c.params.setup.phase.kind = PhaseKind::None; }},
+        {"phase cornette-shanks", [](GlMarchCase& c) { c.params.setup.phase = {PhaseKind::CornetteShanks, 0.7f}; }},
+        {"phase mie", [](GlMarchCase& c) { c.params.setup.phase.kind = PhaseKind::Mie; }},
+        {"point light", pointLight},
+        {"point light, mie, light march, powder", [&](GlMarchCase& c) {
+             pointLight(c);
+             c.params.setup.phase.kind = PhaseKind::Mie;
+             c.params.light = MarchLightSource::March, c.T.clear();
+             c.params.setup.powder = true;
+         }},
+        {"epsilon 0, step 0.37", [](GlMarchCase& c) { c.params.setup.epsilon = 0, c.params.setup.step = 0.37f; }},
+        {"dense (early stop)", [](GlMarchCase& c) { c.params.setup.sigmaH = 2.0f; }},
+    };
+    struct Size {
+        Extent3 grid;
+        uint32_t w, h;
+    };
+    for (const Size& size : {Size{{31, 29, 13}, 37, 23}, Size{{24, 20, 18}, 32, 24}})
+        for (const Option& option : options) {
+            GlMarchCase c = BlobCase(size.grid, size.w, size.h);
+            option.edit(c);
+            const GlMarchImage want = RenderOn(cpu, c);
+            const GlMarchImage got = RenderOn(*mGl, c);
+            if (!want.ok || !got.ok) continue;
+            const std::string where = option.name + " on " + std::to_string(size.grid.nx) + "x" +
+                                      std::to_string(size.grid.ny) + "x" + std::to_string(size.grid.nz);
+            ASSERT_EQ(got.rgb.size(), want.rgb.size()) << where;
+            double worst = 0;
+            size_t worstAt = 0;
+            for (size_t i = 0; i < want.rgb.size(); ++i) {
+                ASSERT_TRUE(std::isfinite(got.rgb[i])) << where << " at " << i;
+                const double d = std::fabs(double(got.rgb[i]) - want.rgb[i]);
+                if (d > worst) worst = d, worstAt = i;
+            }
+            EXPECT_LE(worst, 1e-5) << where << ": channel " << worstAt % 3 << " of pixel " << worstAt / 3;
+            EXPECT_EQ(got.stats.rays, want.stats.rays) << where;
+            EXPECT_EQ(got.stats.samples, want.stats.samples) << where;
+            EXPECT_EQ(got.stats.lightSamples, want.stats.lightSamples) << where;
+            EXPECT_EQ(got.stats.bricksSkipped, want.stats.bricksSkipped) << where;
+            EXPECT_EQ(got.stats.bricks, want.stats.bricks) << where;
+            EXPECT_EQ(got.stats.emptyBricks, want.stats.emptyBricks) << where;
+            // The case must exercise the marcher: clouds in view, and skipping where it is on.
+            EXPECT_GT(want.stats.lightSamples, 0u) << where;
+            if (c.params.skipping) EXPECT_GT(want.stats.bricksSkipped, 0u) << where;
+        }
+}
+
+// Looking straight down through the centre of a full volume of q = 1 with T = 1
+// (phase none): the trilinear optical depth is sigma h (nz - 1/4) (q ramps from
+// 1/2 to 1 in the half voxel at each face), and at step 1/2 the midpoint rule is
+// exact, so C = (sun + ambient)(1 - T) + T background; 2 nz samples on 1 ray.
+TEST_F(RenderMarchGL, FullVolumeSeenHeadOnMatchesTheTrilinearOpticalDepth) {
+    GlMarchCase c;
+    c.grid = {8, 8, 12};
+    c.qPrev.assign(c.grid.Count(), 1.0f);
+    c.qCur = c.qPrev;
+    c.T.assign(c.grid.Count(), 1.0f);
+    c.params = GlCameraParams(c.grid, {4, 4, 40}, {4, 4, 0}, 1, 1, 0.07f);
+    c.params.setup.phase.kind = PhaseKind::None;
+    c.params.setup.epsilon = 0;
+    const GlMarchImage im = RenderOn(*mGl, c);
+    ASSERT_TRUE(im.ok);
+    const double T = std::exp(-0.07 * (12 - 0.25));
+    const MarchSetup& s = c.params.setup;
+    for (int ch = 0; ch < 3; ++ch) {
+        const double expected = (double(s.sunRadiance[ch]) + s.ambient[ch]) * (1 - T) + T * s.background[ch];
+        EXPECT_NEAR(im.rgb[ch], expected, 1e-5 * expected) << ch;
+    }
+    EXPECT_EQ(im.stats.rays, 1u);
+    EXPECT_EQ(im.stats.samples, 24u);
+    EXPECT_EQ(im.stats.lightSamples, 24u);
+    EXPECT_EQ(im.stats.bricksSkipped, 0u);  // no brick is empty
+    EXPECT_EQ(im.stats.bricks, 2u);         // ceil(8/8) ceil(8/8) ceil(12/8)
+    EXPECT_EQ(im.stats.emptyBricks, 0u);
+}
+
+// An empty volume: every pixel is the background exactly, every brick is empty,
+// nothing is lit; the rays that miss the box (the image's corners, above the
+// volume's top face seen from below its edge) are not counted.
+TEST_F(RenderMarchGL, EmptyVolumeGivesTheBackgroundAndOnlyEmptyBricks) {
+    GlMarchCase c;
+    c.grid = {20, 12, 9};
+    c.qPrev.assign(c.grid.Count(), 0.0f);
+    c.qCur = c.qPrev;
+    c.T.assign(c.grid.Count(), 1.0f);
+    c.params = GlCameraParams(c.grid, {-10, 4, 12}, {8, 8, 8}, 24, 18);
+    c.params.brick = 4;
+    const GlMarchImage im = RenderOn(*mGl, c);
+    ASSERT_TRUE(im.ok);
+    for (size_t i = 0; i < im.rgb.size(); ++i) ASSERT_EQ(im.rgb[i], c.params.setup.background[i % 3]) << i;
+    EXPECT_EQ(im.stats.bricks, 5u * 3u * 3u);
+    EXPECT_EQ(im.stats.emptyBricks, im.stats.bricks);
+    EXPECT_EQ(im.stats.lightSamples, 0u);
+    EXPECT_GT(im.stats.rays, 0u);
+    EXPECT_LE(im.stats.rays, 24u * 18u);
+    EXPECT_GE(im.stats.bricksSkipped, im.stats.rays);  // each ray that meets the box skips at least one
+}
+
+// The image's row 0 is the top: looking down -z with up +y at a dense slab
+// that fills only the volume's +y half, the top rows see the slab, lit by
+// sun + ambient (blue 0.8 + 0.3, phase none, T = 1) over the background's blue
+// 0.9, and the bottom rows the background exactly.
+TEST_F(RenderMarchGL, RowZeroIsTheTopOfTheImage) {
+    GlMarchCase c;
+    c.grid = {16, 16, 4};
+    c.qPrev.assign(c.grid.Count(), 0.0f);
+    for (uint32_t k = 0; k < c.grid.nz; ++k)
+        for (uint32_t j = c.grid.ny / 2; j < c.grid.ny; ++j)
+            for (uint32_t i = 0; i < c.grid.nx; ++i) c.qPrev[VoxelIndex(c.grid, i, j, k)] = 1.0f;
+    c.qCur = c.qPrev;
+    c.T.assign(c.grid.Count(), 1.0f);
+    CameraSettings cam;
+    cam.eye = {8, 8, 30};
+    cam.target = {8, 8, 0};
+    cam.up = {0, 1, 0};
+    cam.fovDeg = 40;
+    cam.nearPlane = 0.01;
+    cam.farPlane = 1e5;
+    c.params = GlCameraParams(c.grid, cam.eye, cam.target, 16, 12, 1.0f);
+    c.params.camera = MakeCameraFrame(cam, 16, 12);
+    c.params.setup.phase.kind = PhaseKind::None;
+    const GlMarchImage im = RenderOn(*mGl, c);
+    ASSERT_TRUE(im.ok);
+    const float bg = c.params.setup.background[2];
+    const float top = im.rgb[3 * (8 + 16 * 1) + 2], bottom = im.rgb[3 * (8 + 16 * 10) + 2];
+    EXPECT_EQ(bottom, bg);      // row 10 of 12 looks at the empty -y half
+    EXPECT_GT(top, bg + 0.1f);  // row 1 looks into the slab: about 1.1
+}
+
+}  // namespace
+}  // namespace cb
