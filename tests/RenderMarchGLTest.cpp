@@ -267,6 +267,28 @@ TEST_F(RenderMarchGL, RowZeroIsTheTopOfTheImage) {
     EXPECT_GT(top, bg + 0.1f);  // row 1 looks into the slab: about 1.1
 }
 
+// The memory plan's scratch for render_march alone, by hand: the padded
+// volume (12 x 8 x 6 pairs of floats) and its storage-buffer copy; with
+// skipping at brick 4, 3 x 2 x 1 R32UI flags and their copy; the RGBA32F
+// target and the RGB32F image copy; with phase mie the 1801-float table.
+TEST_F(RenderMarchGL, ScratchBytesByHand) {
+    Scene scene;
+    scene.grid.size = {10, 6, 4};
+    scene.stages = StageSet{Stage::RenderMarch};
+    scene.render.width = 16, scene.render.height = 12;
+    scene.march.skipping = false;
+    scene.phase.kind = PhaseKind::HenyeyGreenstein;
+    const uint64_t volume = 2 * (12 * 8 * 6) * 8, image = 16 * 12 * (16 + 12);
+    EXPECT_EQ(mGl->ScratchBytes(scene), volume + image);
+    scene.march.skipping = true;
+    scene.march.brick = 4;
+    EXPECT_EQ(mGl->ScratchBytes(scene), volume + 2 * (3 * 2 * 1) * 4 + image);
+    scene.phase.kind = PhaseKind::Mie;
+    EXPECT_EQ(mGl->ScratchBytes(scene), volume + 2 * (3 * 2 * 1) * 4 + image + 1801 * 4);
+    scene.stages = StageSet{};
+    EXPECT_EQ(mGl->ScratchBytes(scene), 0u);
+}
+
 // ---- Benchmark (run by hand: --gtest_also_run_disabled_tests --gtest_filter='*RenderMarchGLBench*') ----
 // reports/march/gpu-march-gl.md: scenes/noise-layer.json's q and T made once
 // by the CPU backend and uploaded to both, then render_march on the CPU and on
