@@ -17,6 +17,7 @@
 
 #include "core/March.h"
 #include "core/Scene.h"
+#include "core/Shading.h"
 #include "harness/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
@@ -265,6 +266,60 @@ TEST_F(RenderMarchGL, RowZeroIsTheTopOfTheImage) {
     const float top = im.rgb[3 * (8 + 16 * 1) + 2], bottom = im.rgb[3 * (8 + 16 * 10) + 2];
     EXPECT_EQ(bottom, bg);      // row 10 of 12 looks at the empty -y half
     EXPECT_GT(top, bg + 0.1f);  // row 1 looks into the slab: about 1.1
+}
+
+// Issue 14 item 3: the Mie table read by hand in the shader gives the CPU's
+// lookup. The eye inside a full, very dense volume (sigma h 1000: the first
+// segment's transmittance underflows to 0), light T = 1, no ambient or
+// background, sun radiance 1: each pixel is exactly the phase at cos theta =
+// sun . dir, looking toward the sun (the forward peak), across and away from
+// it, so that the lookups span the table. Each value must also lie between
+// the two table entries around its angle.
+TEST_F(RenderMarchGL, MieLookupsEqualTheCpus) {
+    GlMarchCase c;
+    c.grid = {16, 16, 16};
+    c.qPrev.assign(c.grid.Count(), 1.0f);
+    c.qCur = c.qPrev;
+    c.T.assign(c.grid.Count(), 1.0f);
+    const Vec3 sun = SunDirection(0.5, 1.0);
+    const std::array<double, 3> eye{8, 8, 8};
+    uint64_t checked = 0;
+    for (double sign : {1.0, -1.0, 0.0}) {
+        std::array<double, 3> target{eye[0] + sign * sun[0], eye[1] + sign * sun[1], eye[2] + sign * sun[2]};
+        if (sign == 0.0) target = {eye[0] - sun[1], eye[1] + sun[0], eye[2]};  // across: perpendicular in xy
+        c.params = GlCameraParams(c.grid, eye, target, 48, 36, 1000.0f);
+        CameraSettings cam;
+        cam.eye = eye;
+        cam.target = target;
+        cam.fovDeg = 100;
+        cam.nearPlane = 0.01;
+        cam.farPlane = 1e5;
+        c.params.camera = MakeCameraFrame(cam, 48, 36);
+        MarchSetup& s = c.params.setup;
+        s.sun = sun;
+        s.sunRadiance = {1, 1, 1};
+        s.ambient = {0, 0, 0};
+        s.background = {0, 0, 0};
+        s.phase.kind = PhaseKind::Mie;
+        const GlMarchImage im = RenderOn(*mGl, c);
+        ASSERT_TRUE(im.ok);
+        const PhaseTable& table = kMieCloudTable;
+        for (uint32_t y = 0; y < 36; ++y)
+            for (uint32_t x = 0; x < 48; ++x) {
+                const MarchRayGeometry ray = MakePixelRay(c.params.camera, c.params.origin, 1.0f, s.size, x, y);
+                const float cosTheta = MarchDot(sun, ray.dir);
+                const float want = SamplePhaseTable(table, cosTheta);
+                const float got = im.rgb[3 * (x + 48 * y)];
+                ASSERT_NEAR(got, want, 1e-6 * want) << "pixel " << x << ", " << y << ", cos " << cosTheta;
+                const double theta = std::acos(std::clamp(double(cosTheta), -1.0, 1.0)) * table.indexPerRadian;
+                const uint32_t i = std::min(uint32_t(theta), table.count - 2);
+                ASSERT_GE(got, std::min(table.values[i], table.values[i + 1]) * (1 - 1e-6f));
+                ASSERT_LE(got, std::max(table.values[i], table.values[i + 1]) * (1 + 1e-6f));
+                EXPECT_EQ(im.rgb[3 * (x + 48 * y) + 1], got);
+                ++checked;
+            }
+    }
+    EXPECT_EQ(checked, 3u * 48u * 36u);
 }
 
 // The memory plan's scratch for render_march alone, by hand: the padded
