@@ -6,12 +6,15 @@
 //      brick layer into R32UI layers, copied likewise; counts the empty ones.
 //   3. render_march: the full-screen triangle over the image, one fragment per
 //      pixel, MarchPixel of core/glsl/march.glsl with the MarchGpu block
-//      (core/MarchGpu.h) as a std140 uniform block and the Mie table (uploaded
+//      (core/MarchGpu.h) as a std140 uniform block, in a program specialised
+//      for the call's option bits and phase kind (linked on first use of each
+//      combination, then cached), and the Mie table (uploaded
 //      once, only for phase mie) as a storage buffer; the counters of
 //      MarchStats by storage-buffer atomics.
 // The RGBA32F target's rows come back top row first (see render_march.frag)
 // and pass through a pixel buffer into the (3, width, height) image.
 #include <algorithm>
+#include <string>
 
 #include "core/MarchGpu.h"
 #include "core/Shading.h"
@@ -31,7 +34,11 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const Functions& f = mContext->F();
     auto volumeProgram = mContext->Program("march_volume");
     if (!volumeProgram) return std::unexpected(volumeProgram.error());
-    auto marchProgram = mContext->Program("render_march");
+    const MarchGpu block = MakeMarchGpu(params, e);
+    // The program specialised for this call's option bits and phase kind (render_march.frag).
+    auto marchProgram = mContext->Program("render_march", "#define MARCH_FLAGS " + std::to_string(block.flags[0]) +
+                                                              "u\n#define MARCH_PHASE " +
+                                                              std::to_string(block.flags[1]) + "u\n");
     if (!marchProgram) return std::unexpected(marchProgram.error());
     Result<GLuint> bricksProgram = GLuint(0);
     if (params.skipping) {
@@ -46,7 +53,6 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     if (volumeBytes > size_t(uint32_t(maxStorage)))
         return MakeError("gl: render_march: the padded volume takes " + std::to_string(volumeBytes) +
                          " bytes; this driver's storage blocks hold " + std::to_string(maxStorage));
-    const MarchGpu block = MakeMarchGpu(params, e);
     const uint32_t B = block.flags[3];
     const auto brickCounts = MarchBrickCounts(e, B);
 
