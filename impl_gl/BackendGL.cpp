@@ -5,6 +5,7 @@
 
 #include "core/NoiseGpu.h"
 #include "core/Scene.h"
+#include "core/Shading.h"
 #include "impl_gl/BackendGLInternal.h"
 
 namespace cb::gl {
@@ -44,7 +45,8 @@ BackendGL::~BackendGL() {
 
 std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
 
-bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise; }
+bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise || stage == Stage::RenderMarch;
+}
 
 GLuint BackendGL::Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
     const Functions& f = mContext->F();
@@ -155,6 +157,18 @@ uint64_t BackendGL::ScratchBytes(const Scene& scene) const {
     if (scene.stages.Has(Stage::RenderSplat))
         bytes += uint64_t(scene.render.width) * scene.render.height * 16;  // SplatTarget: RGBA32F
     if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);  // NoiseData
+    if (scene.stages.Has(Stage::RenderMarch)) {
+        // MarchVolume (RG32F) and its storage-buffer copy; with skipping MarchBricks (R32UI) and its copy;
+        // MarchTarget (RGBA32F) and the RGB32F image copy; with phase mie the table.
+        const uint64_t padded = uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2);
+        bytes += 2 * padded * 8;
+        if (scene.march.skipping) {
+            const uint32_t b = std::max(scene.march.brick, 1u);
+            bytes += 2 * uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b) * 4;
+        }
+        bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
+        if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    }
     return bytes;
 }
 

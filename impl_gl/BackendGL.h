@@ -61,12 +61,15 @@ class BackendGL final : public Backend {
     // The scratch textures whose size the scene fixes (GlScratch): region's R8
     // layers, the automaton's rule outputs with wind (and its RGBA8 state),
     // smooth's R16UI sums, density's cover flags, shade's volumes and slices
-    // (counted for the two longest axes), the splat target. Buffer objects
-    // (lists, counters) are not counted. GL does not report available memory.
+    // (counted for the two longest axes), the splat target; the ray marcher's
+    // padded volume, bricks and image, each with the storage or pixel buffer it
+    // is copied into, and the Mie table. Other buffer objects (lists, counters,
+    // blocks) are not counted. GL does not report available memory.
     uint64_t ScratchBytes(const Scene& scene) const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:
     // The scratch textures, each used by one stage only (named first), kept
@@ -86,6 +89,9 @@ class BackendGL final : public Backend {
         ShadePing,     // Shade: the slice loop's previous slice
         ShadePong,     // Shade: the slice loop's current slice
         SplatTarget,   // RenderSplat: the RGBA32F image
+        MarchVolume,   // RenderMarch: the padded (q_alpha, T) volume, RG32F layers
+        MarchBricks,   // RenderMarch, skipping: the R32UI empty flags of the bricks
+        MarchTarget,   // RenderMarch: the RGBA32F image
         Count
     };
     // The scratch buffer objects, each used by one stage only, grown as needed.
@@ -97,6 +103,12 @@ class BackendGL final : public Backend {
         SplatCounters,  // RenderSplat: the shader's counters (splats drawn)
         ImageCopy,      // RenderSplat: the pixel buffer the image passes through
         NoiseData,      // Noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
+        MarchBlock,     // RenderMarch: the MarchGpu uniform block (core/MarchGpu.h)
+        MarchVolumeCopy,  // RenderMarch: the padded volume as a storage buffer of (q_alpha, T) pairs
+        MarchBricksCopy,  // RenderMarch, skipping: the brick flags as a storage buffer
+        MarchPhaseTable,  // RenderMarch, phase mie: kMieCloudTable's values, uploaded once (mMieUploaded)
+        MarchCounters,    // RenderMarch: the shader's MarchStats counters
+        MarchImageCopy,   // RenderMarch: the pixel buffer the image passes through
         Count
     };
     // An array indexed by one slot enum and nothing else.
@@ -142,6 +154,8 @@ class BackendGL final : public Backend {
     SlotArray<GlScratchBuffer, std::pair<GLuint, size_t>> mBuffers;  // buffer, bytes
     // Noise: the scene whose data block is in the NoiseData buffer (NoiseGL.cpp).
     std::unique_ptr<noise::NoiseForm> mNoiseForm;
+    // RenderMarch: whether the MarchPhaseTable buffer holds kMieCloudTable (RenderMarchGL.cpp).
+    bool mMieUploaded = false;
     // Which packed fields the thesis-layout state in Rgba8StateA holds: the last
     // step's outputs, valid until a bit field is written some other way.
     std::array<GLuint, 3> mStateOf{};

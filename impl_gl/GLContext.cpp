@@ -151,12 +151,15 @@ Status GLContext::Check(const char* what) const {
     return MakeError(std::string("gl: ") + what + ": " + ErrorName(e));
 }
 
-Result<GLuint> GLContext::Program(const std::string& name) {
-    if (auto it = mPrograms.find(name); it != mPrograms.end()) return it->second;
+Result<GLuint> GLContext::Program(const std::string& name, const std::string& defines) {
+    const std::string key = defines.empty() ? name : name + "\n" + defines;
+    if (auto it = mPrograms.find(key); it != mPrograms.end()) return it->second;
     const std::string* fragment = FindShader(name + ".frag");
     if (!fragment) return MakeError("gl: no shader named '" + name + "'");
-    auto program = LinkProgram(name, FindShader(name + ".vert"), *fragment);
-    if (program) mPrograms[name] = *program;
+    std::string source = *fragment;
+    if (!defines.empty()) source.insert(source.find('\n') + 1, defines);
+    auto program = LinkProgram(name, FindShader(name + ".vert"), source);
+    if (program) mPrograms[key] = *program;
     return program;
 }
 

@@ -30,8 +30,10 @@ class GLContext {
     Status Check(const char* what) const;
     // The linked program of pass `name`: shaders/<name>.frag with
     // shaders/<name>.vert, or the full-screen triangle where there is none; a
-    // compile or link failure carries its log and the pass's name.
-    Result<GLuint> Program(const std::string& name);
+    // compile or link failure carries its log and the pass's name. `defines`
+    // (whole "#define ..." lines) go after the fragment shader's #version line:
+    // a specialised variant, linked on first use and cached apart.
+    Result<GLuint> Program(const std::string& name, const std::string& defines = "");
     // Compiles and links a program from full sources (vertex: nullptr for the
     // full-screen triangle); errors name `name` and carry the GL log.
     Result<GLuint> LinkProgram(const std::string& name, const std::string* vertex, const std::string& fragment);

@@ -1,0 +1,154 @@
+// Stage `render_march` (SPEC 10) on OpenGL, the thesis's way: fragment passes.
+//   1. march_volume: the padded (q_alpha, T) volume, one pass per padded layer
+//      into the RG32F layers of MarchVolume (border (0, 1); T only with light
+//      "shade", else 1), copied on the device into a storage buffer.
+//   2. march_bricks (skipping only): the bricks' empty flags, one pass per
+//      brick layer into R32UI layers, copied likewise; counts the empty ones.
+//   3. render_march: the full-screen triangle over the image, one fragment per
+//      pixel, MarchPixel of core/glsl/march.glsl with the MarchGpu block
+//      (core/MarchGpu.h) as a std140 uniform block, in a program specialised
+//      for the call's option bits and phase kind (linked on first use of each
+//      combination, then cached), and the Mie table (uploaded
+//      once, only for phase mie) as a storage buffer; the counters of
+//      MarchStats by storage-buffer atomics.
+// The RGBA32F target's rows come back top row first (see render_march.frag)
+// and pass through a pixel buffer into the (3, width, height) image.
+#include <algorithm>
+#include <string>
+
+#include "core/MarchGpu.h"
+#include "core/Shading.h"
+#include "impl_gl/BackendGLInternal.h"
+
+namespace cb::gl {
+
+Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
+    if (!in.qPrev || !in.qCur) return MakeError("gl: render_march needs q");
+    const Extent3 e = in.qCur->Extent();
+    if (in.qPrev->Extent() != e) return MakeError("gl: render_march: q_prev and q_cur differ in size");
+    const bool shadeLight = params.light == MarchLightSource::Shade;
+    if (shadeLight && !in.T) return MakeError("gl: render_march: light source \"shade\" needs T");
+    if (shadeLight && in.T->Extent() != e) return MakeError("gl: render_march: T and q differ in size");
+    const uint32_t W = params.camera.width, H = params.camera.height;
+    if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_march: the image is not (3, width, height)");
+    const Functions& f = mContext->F();
+    auto volumeProgram = mContext->Program("march_volume");
+    if (!volumeProgram) return std::unexpected(volumeProgram.error());
+    const MarchGpu block = MakeMarchGpu(params, e);
+    // The program specialised for this call's option bits and phase kind (render_march.frag).
+    auto marchProgram = mContext->Program("render_march", "#define MARCH_FLAGS " + std::to_string(block.flags[0]) +
+                                                              "u\n#define MARCH_PHASE " +
+                                                              std::to_string(block.flags[1]) + "u\n");
+    if (!marchProgram) return std::unexpected(marchProgram.error());
+    Result<GLuint> bricksProgram = GLuint(0);
+    if (params.skipping) {
+        bricksProgram = mContext->Program("march_bricks");
+        if (!bricksProgram) return std::unexpected(bricksProgram.error());
+    }
+
+    const GLsizei px = GLsizei(e.nx + 2), py = GLsizei(e.ny + 2), pz = GLsizei(e.nz + 2);
+    const size_t volumeBytes = size_t(px) * size_t(py) * size_t(pz) * 8;
+    GLint maxStorage = 0;
+    f.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxStorage);
+    if (volumeBytes > size_t(uint32_t(maxStorage)))
+        return MakeError("gl: render_march: the padded volume takes " + std::to_string(volumeBytes) +
+                         " bytes; this driver's storage blocks hold " + std::to_string(maxStorage));
+    const uint32_t B = block.flags[3];
+    const auto brickCounts = MarchBrickCounts(e, B);
+
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    const GLuint counters = ScratchBuffer(GlScratchBuffer::MarchCounters, 9 * 4);
+    const uint32_t zero[9] = {};
+    f.NamedBufferSubData(counters, 0, sizeof zero, zero);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, counters);
+
+    // 1. The padded (q_alpha, T) volume.
+    const GLuint volume = Scratch(GlScratch::MarchVolume, GL_TEXTURE_2D_ARRAY, GL_RG32F, px, py, pz);
+    f.UseProgram(*volumeProgram);
+    f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
+    f.BindTextureUnit(1, Tex(*in.qCur).Texture());
+    f.BindTextureUnit(2, Tex(shadeLight ? *in.T : *in.qCur).Texture());
+    f.Uniform3i(f.GetUniformLocation(*volumeProgram, "grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1f(f.GetUniformLocation(*volumeProgram, "alpha"), params.alpha);
+    f.Uniform1i(f.GetUniformLocation(*volumeProgram, "hasT"), shadeLight ? 1 : 0);
+    f.Viewport(0, 0, px, py);
+    CB_TRY(DrawLayers(*volumeProgram, uint32_t(pz), {volume}));
+    const GLuint volumeCopy = ScratchBuffer(GlScratchBuffer::MarchVolumeCopy, volumeBytes);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, volumeCopy);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(volume, 0, GL_RG, GL_FLOAT, GLsizei(volumeBytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+
+    // 2. The bricks: empty iff q_alpha = 0 over the brick grown by one voxel.
+    GLuint bricksCopy = volumeCopy;  // bound to the unused binding without skipping
+    if (params.skipping) {
+        const GLsizei bx = GLsizei(brickCounts[0]), by = GLsizei(brickCounts[1]), bz = GLsizei(brickCounts[2]);
+        const size_t brickBytes = size_t(bx) * size_t(by) * size_t(bz) * 4;
+        const GLuint bricks = Scratch(GlScratch::MarchBricks, GL_TEXTURE_2D_ARRAY, GL_R32UI, bx, by, bz);
+        f.UseProgram(*bricksProgram);
+        f.BindTextureUnit(0, volume);
+        f.Uniform1i(f.GetUniformLocation(*bricksProgram, "brick"), GLint(B));
+        f.Uniform3i(f.GetUniformLocation(*bricksProgram, "padded"), px, py, pz);
+        f.Viewport(0, 0, bx, by);
+        CB_TRY(DrawLayers(*bricksProgram, uint32_t(bz), {bricks}));
+        bricksCopy = ScratchBuffer(GlScratchBuffer::MarchBricksCopy, brickBytes);
+        f.BindBuffer(GL_PIXEL_PACK_BUFFER, bricksCopy);
+        f.GetTextureImage(bricks, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(brickBytes), nullptr);
+        f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        f.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+
+    // 3. The rays.
+    GLuint phaseTable = volumeCopy;  // bound to the unused binding unless the phase is Mie
+    if (params.setup.phase.kind == PhaseKind::Mie) {
+        const size_t tableBytes = size_t(kMieCloudTable.count) * 4;
+        phaseTable = ScratchBuffer(GlScratchBuffer::MarchPhaseTable, tableBytes);
+        if (!mMieUploaded) {
+            f.NamedBufferSubData(phaseTable, 0, GLsizeiptr(tableBytes), kMieCloudTable.values);
+            mMieUploaded = true;
+        }
+    }
+    const GLuint blockBuffer = ScratchBuffer(GlScratchBuffer::MarchBlock, sizeof block);
+    f.NamedBufferSubData(blockBuffer, 0, sizeof block, &block);
+    const GLuint target = Scratch(GlScratch::MarchTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    CB_TRY(BindTargets({{target, -1}}));
+    f.UseProgram(*marchProgram);
+    f.BindBufferBase(GL_UNIFORM_BUFFER, 0, blockBuffer);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, volumeCopy);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bricksCopy);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, phaseTable);
+    f.Viewport(0, 0, GLsizei(W), GLsizei(H));
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+
+    // The image: RGB floats of rows top first are exactly the canonical layout.
+    const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
+    const GLuint copy = ScratchBuffer(GlScratchBuffer::MarchImageCopy, imageBytes);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(target, 0, GL_RGB, GL_FLOAT, GLsizei(imageBytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, copy);
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    mLastDeviceMs = timer.StopMs();
+    if (stats) {
+        f.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        uint32_t words[9] = {};
+        f.GetNamedBufferSubData(counters, 0, sizeof words, words);
+        const auto wide = [&words](int n) { return uint64_t(words[2 * n]) | uint64_t(words[2 * n + 1]) << 32; };
+        *stats = {};
+        stats->rays = wide(0);
+        stats->samples = wide(1);
+        stats->lightSamples = wide(2);
+        stats->bricksSkipped = wide(3);
+        if (params.skipping) {
+            stats->bricks = uint64_t(brickCounts[0]) * brickCounts[1] * brickCounts[2];
+            stats->emptyBricks = words[8];
+        }
+    }
+    return mContext->Check("render_march");
+}
+
+}  // namespace cb::gl
