@@ -182,7 +182,9 @@ TEST_F(RenderMarchGL, MatchesTheCpuOnEveryOptionOnOddSizes) {
             EXPECT_EQ(got.stats.emptyBricks, want.stats.emptyBricks) << where;
             // The case must exercise the marcher: clouds in view, and skipping where it is on.
             EXPECT_GT(want.stats.lightSamples, 0u) << where;
-            if (c.params.skipping) EXPECT_GT(want.stats.bricksSkipped, 0u) << where;
+            if (c.params.skipping) {
+                EXPECT_GT(want.stats.bricksSkipped, 0u) << where;
+            }
         }
 }
 
