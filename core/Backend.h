@@ -234,7 +234,7 @@ struct MarchStats {
 // the GPU backends do not yet (issue 14).
 #define CB_NOISE_ENTRIES(X) X(Noise, Noise, (const NoiseParams& params, Buffer& q))
 
-// The ray marcher (SPEC 10); only the CPU implements it so far (issue 14 ports it).
+// The ray marcher (SPEC 10); the CPU and Vulkan implement it (issue 14 ports it to GL).
 #define CB_MARCH_ENTRIES(X) \
     X(RenderMarch, RenderMarch, (const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats))
 
