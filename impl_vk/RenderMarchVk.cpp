@@ -4,7 +4,8 @@
 //      the border reads (0, 1);
 //   2. march_bricks.comp (skipping only): one word per brick, 1 iff q_alpha = 0
 //      over the brick grown by one voxel (step 2), and the count of empty ones;
-//   3. render_march.comp: one invocation per pixel in 8 x 8 workgroups,
+//   3. render_march.comp (light "shade") or render_march_q.comp ("march"), both
+//      shaders/render_march.glsl: one invocation per pixel in 8 x 8 workgroups,
 //      MarchPixel of core/glsl/march.glsl, and the MarchStats counters.
 // The constants are core/MarchGpu.h's block in a storage buffer (256 bytes: more
 // than the 128 bytes of push constants every device guarantees). The Mie table
@@ -45,7 +46,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const bool mie = params.setup.phase.kind == PhaseKind::Mie;
 
     Pipeline* pipes[3] = {};
-    const char* names[3] = {"march_volume", "march_bricks", "render_march"};
+    const char* names[3] = {"march_volume", "march_bricks", shadeLight ? "render_march" : "render_march_q"};
     const uint32_t bindings[3] = {4, 3, 6};
     for (int n = 0; n < 3; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);

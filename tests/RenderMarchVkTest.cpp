@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/March.h"
+#include "core/Scene.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/TestUtil.h"
@@ -220,6 +221,30 @@ TEST_F(RenderMarchVk, MatchesTheCpuOverEveryOption) {
             EXPECT_LT(got.stats.emptyBricks, got.stats.bricks);
         }
     }
+}
+
+// Test the memory plan's render_march scratch by hand, on a 10 x 12 x 14 grid
+// (12 x 14 x 16 = 2688 padded voxels, 3 x 3 x 4 = 36 bricks of 4): the 256-byte
+// constants and 40 bytes of counters; (q, T) pairs with light "shade", q alone
+// with "march"; a word per brick only with skipping; the table only with Mie.
+TEST_F(RenderMarchVk, ScratchBytesByHand) {
+    Scene scene;
+    scene.stages = StageSet{Stage::RenderMarch};
+    scene.grid.size = {10, 12, 14};
+    scene.march.brick = 4;
+    scene.march.skipping = true;
+    scene.march.light = MarchLightSource::Shade;
+    scene.phase.kind = PhaseKind::HenyeyGreenstein;
+    EXPECT_EQ(mBackend->ScratchBytes(scene), 256u + 40u + 2688u * 8 + 36u * 4);
+    scene.march.light = MarchLightSource::March;
+    EXPECT_EQ(mBackend->ScratchBytes(scene), 256u + 40u + 2688u * 4 + 36u * 4);
+    scene.march.skipping = false;
+    EXPECT_EQ(mBackend->ScratchBytes(scene), 256u + 40u + 2688u * 4);
+    scene.phase.kind = PhaseKind::Mie;
+    EXPECT_EQ(mBackend->ScratchBytes(scene), 256u + 40u + 2688u * 4 + 1801u * 4);
+    scene.stages = StageSet{Stage::Shade};
+    scene.shade.resolution = 1;
+    EXPECT_EQ(mBackend->ScratchBytes(scene), 0u);  // no march, no march scratch
 }
 
 #endif  // CLOUDBENCH_HAVE_VK
