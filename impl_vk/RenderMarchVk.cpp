@@ -94,7 +94,8 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         r.DispatchGroups(*pipes[0], volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);
         r.Barrier();
         if (params.skipping) {
-            r.Dispatch(*pipes[1], brickBuffers, &brickPush, sizeof brickPush, brickCount);
+            r.DispatchGroups(*pipes[1], brickBuffers, &brickPush, sizeof brickPush, CeilDiv(frame.bricks[0], 64),
+                             frame.bricks[1], frame.bricks[2]);
             r.Barrier();
         }
         r.DispatchGroups(*pipes[2], marchBuffers, nullptr, 0, CeilDiv(W, 8), CeilDiv(H, 8), 1);

@@ -9,7 +9,8 @@ set(march_vk_cases
     "LightMarchMieJitterAdaptivePowderPoint|${march_vk_scene}|--set|${march_vk_stages}|--set|march.light=\"march\"|--set|phase.function=\"mie\"|--set|march.jitter=true|--set|march.adaptive.enabled=true|--set|march.adaptive.start=4|--set|march.powder.enabled=true|--set|lightning.position=[20,20,10]|--set|lightning.intensity=5000"
     "OddSizesNoSkipping|${march_vk_scene}|--set|${march_vk_stages}|--set|grid.size=[31,29,13]|--set|render.width=67|--set|render.height=45|--set|march.skipping.enabled=false|--set|phase.function=\"cornette-shanks\""
     "OddSizesBrick3|${march_vk_scene}|--set|${march_vk_stages}|--set|grid.size=[31,29,13]|--set|march.skipping.brick=3|--set|march.light=\"march\"|--set|phase.function=\"none\""
-    "NoiseLayer|${CMAKE_CURRENT_SOURCE_DIR}/../scenes/noise-layer.json|--set|render.width=160|--set|render.height=90")
+    "NoiseLayer|${CMAKE_CURRENT_SOURCE_DIR}/../scenes/noise-layer.json|--set|render.width=160|--set|render.height=90"
+    "NoiseLayerBrick1LightMarch|${CMAKE_CURRENT_SOURCE_DIR}/../scenes/noise-layer.json|--set|render.width=97|--set|render.height=61|--set|march.skipping.brick=1|--set|march.light=\"march\"")
 foreach(entry ${march_vk_cases})
   string(REPLACE "|" ";" fields "${entry}")
   list(POP_FRONT fields name scene)
