@@ -230,11 +230,10 @@ struct MarchStats {
     X(RenderSplat, RenderSplat, (const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats))
 
 // The producers of q other than the automaton and smoothing. Noise  q (F32,
-// grid size) formed from noise (SPEC 10a); the CPU implements it (issue 13),
-// the GPU backends do not yet (issue 14).
+// grid size) formed from noise (SPEC 10a); every backend implements it.
 #define CB_NOISE_ENTRIES(X) X(Noise, Noise, (const NoiseParams& params, Buffer& q))
 
-// The ray marcher (SPEC 10); only the CPU implements it so far (issue 14 ports it).
+// The ray marcher (SPEC 10); every backend implements it (GPU: core/glsl/march.glsl).
 #define CB_MARCH_ENTRIES(X) \
     X(RenderMarch, RenderMarch, (const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats))
 

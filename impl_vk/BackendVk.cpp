@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/MarchGpu.h"
 #include "core/NoiseGpu.h"
 #include "core/Scene.h"
 #include "impl_vk/StageVk.h"
@@ -39,7 +40,9 @@ BackendVk::~BackendVk() {
     for (DeviceBuffer& b : mScratch) mContext->DestroyBuffer(b);
 }
 
-bool BackendVk::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise; }
+bool BackendVk::Supports(Stage stage) const {
+    return IsSplatPipelineStage(stage) || stage == Stage::Noise || stage == Stage::RenderMarch;
+}
 
 Result<DeviceBuffer*> BackendVk::Scratch(VkScratch slot, VkDeviceSize size) {
     DeviceBuffer& b = mScratch.at(size_t(slot));
@@ -75,6 +78,16 @@ uint64_t BackendVk::ScratchBytes(const Scene& scene) const {
         bytes += 2 * Extent3{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)}.Count() * 4;
     // noise: the data block (core/NoiseGpu.h): header, two tables, HD per slice, towers, detail volume.
     if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);
+    // render_march: the constants, the padded volume (T only with light "shade"), a word per brick with
+    // skipping, the Mie table with phase Mie, the counters (RenderMarchVk.cpp).
+    if (scene.stages.Has(Stage::RenderMarch)) {
+        bytes += sizeof(MarchGpu) + MarchVolumeBytes(e, scene.march.light == MarchLightSource::Shade) + 10 * 4;
+        if (scene.march.skipping) {
+            const auto b = MarchBrickCounts(e, scene.march.brick);
+            bytes += uint64_t(b[0]) * b[1] * b[2] * 4;
+        }
+        if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    }
     return bytes;
 }
 

@@ -55,8 +55,16 @@ enum class VkScratch {
     SplatTileBases,     // render_splat: SplatTileTotals scanned, and the total
     SplatTileList,      // render_splat: splat indices, screen tile by screen tile
     NoiseData,          // noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
+    MarchFrame,         // render_march: the constants (core/MarchGpu.h), 256 bytes
+    MarchVolume,        // render_march: the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha
+    MarchBricks,        // render_march: one word per brick, 1 iff empty (only with skipping)
+    MarchMieTable,      // render_march: kMieCloudTable's values, uploaded once (only with phase Mie)
+    MarchStats,         // render_march: the MarchStats counters, 64-bit as two words each
     Count
 };
+
+// Bytes of render_march's padded volume on a grid of extent e: (q, T) pairs, or q alone.
+uint64_t MarchVolumeBytes(const Extent3& e, bool withT);
 
 class BackendVk final : public Backend {
   public:
@@ -85,6 +93,7 @@ class BackendVk final : public Backend {
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     // Device time of the last stage call (timestamp queries), in ms.
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
@@ -105,6 +114,8 @@ class BackendVk final : public Backend {
     std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};
     // noise: the scene whose data block is in the NoiseData slot (NoiseVk.cpp).
     std::unique_ptr<noise::NoiseForm> mNoiseForm;
+    // render_march: kMieCloudTable is in the MarchMieTable slot (RenderMarchVk.cpp).
+    bool mMieUploaded = false;
 };
 
 }  // namespace cb::vk

@@ -409,6 +409,12 @@ Result<double> VulkanContext::Submit(const char* what, Recorder& recorder) {
 
 void VulkanContext::Recorder::Dispatch(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
                                        const void* push, uint32_t pushBytes, uint32_t invocations) {
+    DispatchGroups(pipeline, buffers, push, pushBytes, (invocations + 63) / 64, 1, 1);
+}
+
+void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
+                                             const void* push, uint32_t pushBytes, uint32_t groupsX,
+                                             uint32_t groupsY, uint32_t groupsZ) {
     VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     alloc.descriptorPool = mContext.mDescriptors;
     alloc.descriptorSetCount = 1;
@@ -431,7 +437,7 @@ void VulkanContext::Recorder::Dispatch(Pipeline& pipeline, std::span<const Devic
     vkCmdBindPipeline(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
     vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout, 0, 1, &set, 0, nullptr);
     if (pushBytes) vkCmdPushConstants(mCmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes, push);
-    vkCmdDispatch(mCmd, (invocations + 63) / 64, 1, 1);
+    vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
 }
 
 void VulkanContext::Recorder::Barrier() {

@@ -82,6 +82,9 @@ class VulkanContext {
         // Binds `buffers` to a fresh descriptor set and dispatches ceil(invocations/64) groups.
         void Dispatch(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                       uint32_t pushBytes, uint32_t invocations);
+        // The same with an explicit grid of workgroups (shaders with 2-D workgroups).
+        void DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+                            uint32_t pushBytes, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ);
         // Makes every earlier shader write visible to later shader reads and writes.
         void Barrier();
         void Fill(const DeviceBuffer& buffer, uint32_t value);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/MarchGpu.h"
 #include "core/Random.h"
 #include "core/Splat.h"
 #if CLOUDBENCH_HAVE_VK
@@ -63,7 +64,8 @@ inline std::vector<float> AndNeighbours(float x) {
     return {std::nextafter(x, -INFINITY), x, std::nextafter(x, INFINITY)};
 }
 
-// Every function of core/glsl but MakeSplat, with its random inputs, edges and C++ twin.
+// Every function of core/glsl but MakeSplat, PowderTerm and those that read a MarchGpu block
+// (GlslTwinTest.cpp has them), with its random inputs, edges and C++ twin.
 std::vector<TwinCase> Cases();
 
 // Compares the GLSL's outputs with the C++ twin's, element by element; the
@@ -93,8 +95,9 @@ class GlslTwin : public ::testing::Test {
         if (!sContext) GTEST_SKIP() << sSkipReason;
     }
 
-    // Runs twin.comp's function `fn` on `inputs` with `frame` bound.
-    static std::vector<Words> Run(uint32_t fn, const std::vector<Words>& inputs, const SplatFrame& frame);
+    // Runs twin.comp's function `fn` on `inputs` with `frame`, `march` and kMieCloudTable bound.
+    static std::vector<Words> Run(uint32_t fn, const std::vector<Words>& inputs, const SplatFrame& frame,
+                                  const MarchGpu& march = MarchGpu{});
 
     static inline std::unique_ptr<vk::VulkanContext> sContext;
     static inline std::string sSkipReason;

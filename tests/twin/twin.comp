@@ -9,12 +9,29 @@
 #include "automaton.glsl"
 #include "splat.glsl"
 #include "noise.glsl"
+#include "march.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In { uint inWords[]; };
 layout(std430, binding = 1) writeonly buffer Out { uint outWords[]; };
 layout(std430, binding = 2) readonly buffer Frame { SplatFrame frame; };
+layout(std430, binding = 3) readonly buffer March { MarchGpu march; };
+layout(std430, binding = 4) readonly buffer MieTable { float mieTable[]; };  // kMieCloudTable
 layout(push_constant) uniform Params { uint fn, count; } pc;
+
+// march.glsl's volume: a hash of the padded index (tests/GlslTwinTest.cpp TwinPaddedQT);
+// bricks: every third empty; the phase table: kMieCloudTable.
+vec2 MarchFetchQT(uint i) {
+    return vec2(float(LowBias32(i) >> 8u) * (1.0 / 16777216.0),
+                float(LowBias32(i ^ 0x9E3779B9u) >> 8u) * (1.0 / 16777216.0));
+}
+bool MarchBrickEmpty(uint brick) { return brick % 3u == 0u; }
+float MarchPhaseTableValue(uint i) { return mieTable[i]; }
+
+MarchGpu ZeroMarch() {
+    return MarchGpu(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0),
+                    vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), uvec4(0u), uvec4(0u), uvec4(0u), uvec4(0u));
+}
 
 // noise.glsl's tables: one permutation, i -> (167 i + 13) mod 256 (tests/GlslTwinCases.cpp kTwinPerm).
 uint NoiseWord(uint index) { return ((index & 255u) * 167u + 13u) & 255u; }
@@ -118,6 +135,76 @@ void main() {
             PutF(1u, NoiseTower(vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), F(9u), F(10u), F(11u), F(12u),
                                 F(13u), F(14u)));
             break;
+        // ---- march.glsl ----
+        case 34u: PutF(0u, ArcCos(F(0u))); break;
+        case 35u: PutF(0u, SampleMiePhase(F(0u), U(1u), F(2u))); break;
+        case 36u: {
+            MarchGpu m = ZeroMarch();
+            m.flags.y = U(0u);
+            m.sun.w = F(1u);
+            m.ambient.w = F(3u);
+            m.strides.z = U(4u);
+            PutF(0u, MarchPhase(m, F(2u)));
+            break;
+        }
+        case 37u: {
+            float tMin = F(9u), tMax = F(10u);
+            ClipRayToBox(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), tMin, tMax);
+            PutF(0u, tMin);
+            PutF(1u, tMax);
+            break;
+        }
+        case 38u: {
+            MarchGpu m = ZeroMarch();
+            m.stepping = vec4(F(0u), F(1u), F(2u), 0.0);
+            m.flags.x = U(3u) != 0u ? kMarchAdaptive : 0u;
+            PutF(0u, MarchStepAt(m, F(4u)));
+            break;
+        }
+        case 39u: PutF(0u, MarchJitter(U(0u), U(1u), U(2u))); break;
+        case 40u: {
+            const vec3 inv = InverseDirection(vec3(F(3u), F(4u), F(5u)));
+            PutF(0u, RayExitFromBox(vec3(F(0u), F(1u), F(2u)), inv, vec3(F(6u), F(7u), F(8u)),
+                                    vec3(F(9u), F(10u), F(11u)), F(12u)));
+            PutF(1u, inv.x);
+            PutF(2u, inv.y);
+            PutF(3u, inv.z);
+            break;
+        }
+        case 41u: PutF(0u, PowderTerm(F(0u), F(1u))); break;
+        case 42u:
+            PutF(0u, SegmentTransmittance(F(0u), F(1u), F(2u)));
+            PutF(1u, PointLightFalloff(F(3u), F(4u)));
+            PutF(2u, MarchNextUp(F(5u)));
+            break;
+        // With the bound MarchGpu (tests/GlslTwinTest.cpp MarchFrameTwin).
+        case 43u: {
+            const MarchRayGeometry r = MakePixelRay(march, U(0u), U(1u));
+            PutF(0u, r.origin.x);
+            PutF(1u, r.origin.y);
+            PutF(2u, r.origin.z);
+            PutF(3u, r.dir.x);
+            PutF(4u, r.dir.y);
+            PutF(5u, r.dir.z);
+            PutF(6u, r.tMin);
+            PutF(7u, r.tMax);
+            break;
+        }
+        case 44u: {
+            const vec3 p = vec3(F(0u), F(1u), F(2u));
+            const MarchTaps t = MarchTapsAt(march, p);
+            const vec2 qt = MarchBlend(march, t);
+            PutU(0u, t.base);
+            PutF(1u, t.w.x);
+            PutF(2u, t.w.y);
+            PutF(3u, t.w.z);
+            PutF(4u, qt.x);
+            PutF(5u, qt.y);
+            PutF(6u, MarchSampleQ(march, p));
+            PutF(7u, SunLightMarch(march, p));
+            PutF(8u, PointLightMarch(march, p));
+            break;
+        }
         case 27u: {
             Splat s;
             const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), s);

@@ -1,0 +1,58 @@
+// The body of render_march.comp (light "shade": the volume holds (q_alpha, T) pairs) and
+// render_march_q.comp (light "march": q_alpha alone), which define MARCH_WITH_T 1 or 0 and include it:
+// two pipelines, so that no tap branches on the light source.
+#include "random.glsl"
+#include "shading.glsl"
+#include "march.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std430, binding = 0) readonly buffer Frame { MarchGpu frame; };
+#if MARCH_WITH_T
+layout(std430, binding = 1) readonly buffer Volume { vec2 volume[]; };  // (q_alpha, T)
+#else
+layout(std430, binding = 1) readonly buffer Volume { float volume[]; };  // q_alpha
+#endif
+layout(std430, binding = 2) readonly buffer Bricks { uint brickEmpty[]; };  // read only when skipping
+layout(std430, binding = 3) readonly buffer Mie { float mieTable[]; };     // read only with phase Mie
+layout(std430, binding = 4) writeonly buffer Image { float image[]; };
+// Words 2 n, 2 n + 1: counter n (low, high) of rays, samples, light samples, bricks skipped.
+layout(std430, binding = 5) buffer Stats { uint stats[]; };
+
+#if MARCH_WITH_T
+vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
+#else
+vec2 MarchFetchQT(uint paddedIndex) { return vec2(volume[paddedIndex], 1.0); }
+#endif
+bool MarchBrickEmpty(uint brick) { return brickEmpty[brick] != 0u; }
+float MarchPhaseTableValue(uint i) { return mieTable[i]; }
+
+shared uint gCounts[4];
+
+// Adds v to the 64-bit counter at words (2 n, 2 n + 1).
+void AddCounter(uint n, uint v) {
+    if (v == 0u) return;
+    const uint before = atomicAdd(stats[2u * n], v);
+    if (before + v < before) atomicAdd(stats[2u * n + 1u], 1u);
+}
+
+void main() {
+    const uint local = gl_LocalInvocationIndex;
+    if (local < 4u) gCounts[local] = 0u;
+    barrier();
+    const MarchGpu m = frame;
+    const uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
+    if (x < m.image.x && y < m.image.y) {
+        const MarchRayResult r = MarchPixel(m, x, y);
+        const uint pixel = x + m.image.x * y;
+        image[3u * pixel] = r.color.x;
+        image[3u * pixel + 1u] = r.color.y;
+        image[3u * pixel + 2u] = r.color.z;
+        const MarchRayGeometry ray = MakePixelRay(m, x, y);
+        if (ray.tMin < ray.tMax) atomicAdd(gCounts[0], 1u);
+        atomicAdd(gCounts[1], r.samples);
+        atomicAdd(gCounts[2], r.lightCalls);
+        atomicAdd(gCounts[3], r.bricksSkipped);
+    }
+    barrier();
+    if (local < 4u) AddCounter(local, gCounts[local]);
+}

@@ -1,0 +1,38 @@
+# render_march conforms on every built backend through `cloudbench conform` (issue 14 items 2 and 4): each
+# backend renders from the CPU's inputs and is compared by SPEC 10's rule (max |d| <= 1e-4 per linear channel
+# on 99.9 % of pixels; conform exits 5 on a failure). The Khronos validation layer is on
+# (CLOUDBENCH_VK_VALIDATION=1) and any message fails the test, as does a backend that skips the stage.
+# Each case runs every built GPU backend in one command (each in its own process, with its own CPU reference).
+# Included from tests/CMakeLists.txt where `cli` and `cli_out` are set.
+set(march_backends cpu)
+if(CLOUDBENCH_HAVE_GL)
+  string(APPEND march_backends ",gl")
+endif()
+if(CLOUDBENCH_HAVE_VK)
+  string(APPEND march_backends ",vk")
+endif()
+set(march_small ${CMAKE_CURRENT_SOURCE_DIR}/scenes/imgacc-small.json)
+set(march_layer ${CMAKE_CURRENT_SOURCE_DIR}/../scenes/noise-layer.json)
+set(march_stages "stages=[\"noise\",\"density\",\"shade\",\"render_march\"]")
+set(march_cases
+    # The noise test scene (32x32x16, 64x48) as it is.
+    "Small|${march_small}|--set|${march_stages}"
+    # ci-small: the automaton's clouds over three steps (q moves between them; alpha interpolates).
+    "CiSmall|ci-small|--steps|3|--set|stages=[\"region\",\"ca\",\"smooth\",\"density\",\"shade\",\"render_march\"]"
+    # An odd grid and image with every non-default option at once: jitter, no skipping, the adaptive step,
+    # the light march, powder, the Mie phase and the lightning (flashing at step 0).
+    "OddEveryOption|${march_small}|--set|stages=[\"noise\",\"density\",\"render_march\"]|--set|grid.size=[31,29,13]|--set|render.width=37|--set|render.height=23|--set|march.jitter=true|--set|march.skipping.enabled=false|--set|march.adaptive.enabled=true|--set|march.adaptive.start=8|--set|march.light=\"march\"|--set|march.light_steps=4|--set|march.powder.enabled=true|--set|phase.function=\"mie\"|--set|lightning.position=[800,700,300]|--set|lightning.intensity=200000"
+    "OddNoSkippingCornetteShanks|${march_small}|--set|${march_stages}|--set|grid.size=[31,29,13]|--set|render.width=67|--set|render.height=45|--set|march.skipping.enabled=false|--set|phase.function=\"cornette-shanks\""
+    "OddBrick3LightMarchNoPhase|${march_small}|--set|${march_stages}|--set|grid.size=[31,29,13]|--set|march.skipping.brick=3|--set|march.light=\"march\"|--set|phase.function=\"none\""
+    # The shipped noise scene (128^3) at small images.
+    "NoiseLayer|${march_layer}|--steps|1|--set|render.width=160|--set|render.height=90"
+    "NoiseLayerBrick1LightMarch|${march_layer}|--steps|1|--set|render.width=97|--set|render.height=61|--set|march.skipping.brick=1|--set|march.light=\"march\"")
+foreach(entry ${march_cases})
+  string(REPLACE "|" ";" fields "${entry}")
+  list(POP_FRONT fields name scene)
+  add_test(NAME Cli.ConformMarch${name}
+           COMMAND ${CMAKE_COMMAND} -E env CLOUDBENCH_VK_VALIDATION=1
+                   ${cli} conform ${scene} --backend ${march_backends} --out ${cli_out}/conform-march-${name} ${fields})
+  set_tests_properties(Cli.ConformMarch${name} PROPERTIES
+                       FAIL_REGULAR_EXPRESSION "vk validation|render_march +(vk|gl) +(fail|skipped)")
+endforeach()
