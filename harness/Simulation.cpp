@@ -186,7 +186,7 @@ Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame) {
     add(record.stageMs[size_t(stage)], call.ms);
     add(record.deviceMs[size_t(stage)], call.deviceMs);
     if (call.coveredColumns) record.coveredColumns = mLastCoveredColumns = call.coveredColumns;
-    for (FrameRecord& frame : call.frames) record.frames.push_back(std::move(frame));
+    for (FrameRecord& drawn : call.frames) record.frames.push_back(std::move(drawn));
     if (Describe(stage).renderer) mLastRendered = mStep;
     return {};
 }

@@ -188,6 +188,27 @@ TEST(Loop, MovingSunReshadesExactlyWhereItMoved) {
     EXPECT_EQ(RunAndCollect(scene, Stage::Density).ran, (std::set<uint32_t>{0}));
 }
 
+// Test that a sun that moved on a step that was not an output step still
+// re-shades on the next output step: renders on steps 0, 4 and 8 only, the sun
+// moves from (30, 40) to (50, 80) on step 2 and holds, so shade runs on 0 and
+// 4 (its direction differs from step 0's run) and skips 8.
+TEST(Loop, SunMovedBetweenOutputStepsReshadesOnTheNext) {
+    const Scene scene = LoopScene({{"steps", "9"},
+                                   {"warmup_steps", "0"},
+                                   {"stages", R"(["noise", "density", "shade", "shadow", "render_splat"])"},
+                                   {"render.every_steps", "4"},
+                                   {"sun.elevation_deg", "null"},
+                                   {"sun.azimuth_deg", "null"},
+                                   {"sun.path", R"([{"step": 1, "elevation_deg": 30, "azimuth_deg": 40},
+                                                    {"step": 2, "elevation_deg": 50, "azimuth_deg": 80}])"}});
+    for (Stage stage : {Stage::Shade, Stage::Shadow}) {
+        const StageSteps s = RunAndCollect(scene, stage);
+        EXPECT_EQ(s.ran, (std::set<uint32_t>{0, 4})) << StageName(stage);
+        EXPECT_EQ(s.skipped, (std::set<uint32_t>{8})) << StageName(stage);
+    }
+    EXPECT_EQ(RunAndCollect(scene, Stage::RenderSplat).ran, (std::set<uint32_t>{0, 4, 8}));
+}
+
 // Test that a constant angular speed re-shades on every step.
 TEST(Loop, SunSpeedReshadesEveryStep) {
     const Scene scene = LoopScene(StaticDensity(5, {{"sun.speed", R"({"azimuth_deg": 3})"}}));
