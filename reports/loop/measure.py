@@ -34,7 +34,7 @@ def main():
     figures = {c: [] for c in configs}
     if a.from_json:
         for key, v in json.load(open(a.from_json)).items():
-            s, b, fr = key.split("/")
+            s, b, fr = key.rsplit("/", 2)
             figures[(s, b, int(fr))] = v
         table(configs, figures)
         return
