@@ -57,6 +57,28 @@ Result<Scene> ParseSceneChecked(const std::string& text, const std::string& labe
 
 }  // namespace
 
+double SunSettings::ElevationAt(uint32_t step) const {
+    if (path.empty()) return elevationDeg + elevationSpeedDeg * double(step);
+    if (step <= path.front().step) return path.front().elevationDeg;
+    if (step >= path.back().step) return path.back().elevationDeg;
+    size_t b = 1;
+    while (path[b].step < step) ++b;
+    const SunKeyframe &lo = path[b - 1], &hi = path[b];
+    const double w = double(step - lo.step) / double(hi.step - lo.step);
+    return lo.elevationDeg + (hi.elevationDeg - lo.elevationDeg) * w;
+}
+
+double SunSettings::AzimuthAt(uint32_t step) const {
+    if (path.empty()) return azimuthDeg + azimuthSpeedDeg * double(step);
+    if (step <= path.front().step) return path.front().azimuthDeg;
+    if (step >= path.back().step) return path.back().azimuthDeg;
+    size_t b = 1;
+    while (path[b].step < step) ++b;
+    const SunKeyframe &lo = path[b - 1], &hi = path[b];
+    const double w = double(step - lo.step) / double(hi.step - lo.step);
+    return lo.azimuthDeg + (hi.azimuthDeg - lo.azimuthDeg) * w;
+}
+
 Result<Scene> ParseScene(const std::string& text, const std::string& label,
                          const std::vector<SceneOverride>& overrides) {
     try {

@@ -79,18 +79,42 @@ struct DensitySettings {
     uint32_t band = 4;   // slices per height band
 };
 
+// One keyframe of a sun path: the sun's angles at a step.
+struct SunKeyframe {
+    uint32_t step = 0;
+    double elevationDeg = 0, azimuthDeg = 0;
+    bool operator==(const SunKeyframe&) const = default;
+};
+
 // The sun (SPEC 0): direction from elevation and azimuth, and its radiance.
+// It may move (seed 000 section 1.3.2): along keyframes, or at a constant
+// angular speed. Either way it is evaluated once per step (ElevationAt,
+// AzimuthAt); the frames between two steps see step t's sun (docs/pipeline.md,
+// "The real-time loop").
 struct SunSettings {
-    double elevationDeg = 40;                     // above the horizon, degrees
-    double azimuthDeg = 30;                       // from +x toward +y, degrees
+    double elevationDeg = 40;                     // above the horizon, degrees (step 0's, with a path)
+    double azimuthDeg = 30;                       // from +x toward +y, degrees (step 0's, with a path)
     std::array<double, 3> color{1.0, 0.96, 0.9};  // linear RGB
     double intensity = 1.0;                       // multiplies color
+    // Keyframes in increasing step order; empty: no path. Between two
+    // keyframes both angles are interpolated linearly in the step; before the
+    // first and after the last the sun holds that keyframe's angles.
+    std::vector<SunKeyframe> path;
+    // Degrees per step added to elevationDeg and azimuthDeg (no path).
+    double elevationSpeedDeg = 0, azimuthSpeedDeg = 0;
 
-    // Unit vector toward the sun.
-    Vec3 Direction() const {
+    double ElevationAt(uint32_t step) const;
+    double AzimuthAt(uint32_t step) const;
+    // Unit vector toward the sun at `step`.
+    Vec3 DirectionAt(uint32_t step) const {
         constexpr double kDeg = 3.14159265358979323846 / 180.0;
-        return SunDirection(elevationDeg * kDeg, azimuthDeg * kDeg);
+        return SunDirection(ElevationAt(step) * kDeg, AzimuthAt(step) * kDeg);
     }
+    // Unit vector toward the sun at step 0 (the fixed sun's direction).
+    Vec3 Direction() const { return DirectionAt(0); }
+    // True when the direction may differ between steps (a path of two or more
+    // keyframes, or a non-zero speed).
+    bool Moves() const { return path.size() > 1 || elevationSpeedDeg != 0 || azimuthSpeedDeg != 0; }
     // color * intensity.
     Vec3 Radiance() const {
         return {float(color[0] * intensity), float(color[1] * intensity), float(color[2] * intensity)};
@@ -130,8 +154,17 @@ struct ShadowSettings {
 struct RenderSettings {
     uint32_t width = 320, height = 240;
     double alpha = 0.5;                   // interpolation between the previous and the current step
+    // Frames rendered per render step (seed 000 section 6.3). 1: one frame
+    // at `alpha`; F > 1: frames f = 0..F-1 at alpha = (f + 1) / F.
+    uint32_t framesPerStep = 1;
     uint32_t everySteps = 0;              // render every N steps after warm-up (and the last); 0 = last step only
     std::vector<CameraSettings> cameras;  // at least one when a renderer runs
+
+    // The interpolation weight of frame `frame` (0-based) of a render step.
+    float FrameAlpha(uint32_t frame) const {
+        if (framesPerStep <= 1) return float(alpha);
+        return float(double(frame + 1) / double(framesPerStep));
+    }
 };
 
 // Stage `render_splat` (SPEC 8): the splat renderer's own settings. In scene

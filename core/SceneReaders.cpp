@@ -319,12 +319,29 @@ void CheckOpticalDepths(const Scene& scene, Validator& check) {
                                   "at most 1e+30, got " + FormatNumber(perCell));
         return;
     }
-    const float sz = scene.sun.Direction()[2];
+    // The lowest sun above the horizon over the run (a moving sun is evaluated at every step).
+    float sz = scene.sun.Direction()[2];
+    if (scene.sun.Moves()) {
+        sz = 0;
+        for (uint32_t t = 0; t < scene.steps; ++t)
+            if (const float z = scene.sun.DirectionAt(t)[2]; z > 0 && (sz <= 0 || z < sz)) sz = z;
+    }
     if (sz <= 0.0f) return;  // no sun, no shadow factor
     const double perD = scene.shade.sigma * scene.grid.voxelSize / double(sz);
     if (perD > kMaxSingle)
         check.Fail("shade.sigma", "sigma * grid.voxel_size / sin(sun.elevation_deg) (the ground shadow's optical "
                                   "depth per unit of D) must be at most 1e+30, got " + FormatNumber(perD));
+}
+
+// A sun moving at a constant speed must stay within [-90, 90] degrees of elevation over the run's steps.
+void CheckSunSpeed(const Scene& scene, Validator& check) {
+    const SunSettings& sun = scene.sun;
+    if (!sun.path.empty() || sun.elevationSpeedDeg == 0) return;
+    const uint32_t last = scene.steps - 1;
+    const double el = sun.ElevationAt(last);
+    if (el < -90 || el > 90)
+        check.Fail("sun.speed.elevation_deg", "the elevation reaches " + FormatNumber(el) + " degrees at the last step (" +
+                                                  std::to_string(last) + "), outside [-90, 90]");
 }
 
 }  // namespace
@@ -385,6 +402,7 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
         if (Describe(stage).renderer && scene.stages.Has(stage) && camerasOk && scene.render.cameras.empty())
             check.Fail("render.cameras", Quote(StageName(stage)) + " needs at least one camera");
 
+    if (stepsOk) CheckSunSpeed(scene, check);
     CheckOpticalDepths(scene, check);
 
     // Size checks, before anything grid-sized exists.

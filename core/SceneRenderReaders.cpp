@@ -12,19 +12,23 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kSunKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity"};
+constexpr std::string_view kSunKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity", "path", "speed"};
+constexpr std::string_view kSunKeyframeKeys[] = {"step", "elevation_deg", "azimuth_deg"};
+constexpr std::string_view kSunSpeedKeys[] = {"elevation_deg", "azimuth_deg"};
 constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
 constexpr std::string_view kPhaseKeys[] = {"function", "g"};
 constexpr std::string_view kShadeKeys[] = {"attenuation", "sigma",   "thesis_ar", "filter",
                                            "resolution",  "storage", "scattering"};
 constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angle"};
 constexpr std::string_view kShadowKeys[] = {"form", "kappa"};
-constexpr std::string_view kRenderKeys[] = {"width", "height",  "q_min",    "splat_scale", "opacity",
-                                            "alpha", "culling", "skipping", "every_steps", "cameras"};
+constexpr std::string_view kRenderKeys[] = {"width",    "height",      "q_min",   "splat_scale",
+                                            "opacity",  "alpha",       "culling", "skipping",
+                                            "every_steps", "frames_per_step", "cameras"};
 constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
 
 constexpr int64_t kShadeResolutions[] = {1, 2, 4};
 constexpr int64_t kMaxImageEdge = 16384;
+constexpr int64_t kMaxFramesPerStep = 1024;
 
 // One entry of render.cameras; nullopt when anything in it is wrong (all of it reported).
 std::optional<CameraSettings> ReadCamera(const Json& value, const std::string& field, size_t index, Validator& check) {
@@ -110,6 +114,77 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
     }
     if (const Json* v = Validator::Find(*section, "intensity")) {
         if (auto d = check.Number(*v, "sun.intensity", kSingleNonNegative)) sun.intensity = *d;
+    }
+    // A path: keyframes {step, elevation_deg, azimuth_deg} in increasing step order; it replaces the fixed angles.
+    const Json* path = Validator::Find(*section, "path");
+    const Json* speed = Validator::Find(*section, "speed");
+    if (path) {
+        for (std::string_view key : {"elevation_deg", "azimuth_deg", "speed"})
+            if (Validator::Find(*section, key))
+                check.Fail(JoinField("sun", key), "cannot be combined with sun.path (the keyframes give the sun's angles)");
+        if (!path->is_array() || path->empty()) {
+            check.Fail("sun.path", "expected a non-empty array of keyframes {\"step\", \"elevation_deg\", "
+                                   "\"azimuth_deg\"}, got " + Describe(*path));
+        } else {
+            std::vector<SunKeyframe> keyframes;
+            bool pathOk = true;
+            for (size_t i = 0; i < path->size(); ++i) {
+                const Json& k = (*path)[i];
+                const std::string field = IndexField("sun.path", i);
+                if (!k.is_object()) {
+                    check.Fail(field, "expected a keyframe object {\"step\", \"elevation_deg\", \"azimuth_deg\"}, got " +
+                                          Describe(k));
+                    pathOk = false;
+                    continue;
+                }
+                check.CheckKeys(k, field, kSunKeyframeKeys);
+                SunKeyframe frame;
+                std::optional<int64_t> step;
+                std::optional<double> el, az;
+                if (const Json* v = Validator::Find(k, "step"))
+                    step = check.Integer(*v, JoinField(field, "step"), 0, kU32Max);
+                else
+                    check.Fail(JoinField(field, "step"), "required field is missing");
+                if (const Json* v = Validator::Find(k, "elevation_deg"))
+                    el = check.Number(*v, JoinField(field, "elevation_deg"), Range{.lo = -90, .hi = 90});
+                else
+                    check.Fail(JoinField(field, "elevation_deg"), "required field is missing");
+                if (const Json* v = Validator::Find(k, "azimuth_deg"))
+                    az = check.Number(*v, JoinField(field, "azimuth_deg"), kFinite);
+                else
+                    check.Fail(JoinField(field, "azimuth_deg"), "required field is missing");
+                if (!step || !el || !az) {
+                    pathOk = false;
+                    continue;
+                }
+                frame = {uint32_t(*step), *el, *az};
+                if (!keyframes.empty() && frame.step <= keyframes.back().step) {
+                    check.Fail(JoinField(field, "step"), "must be greater than the previous keyframe's step (" +
+                                                             std::to_string(keyframes.back().step) + "), got " +
+                                                             std::to_string(frame.step));
+                    pathOk = false;
+                    continue;
+                }
+                keyframes.push_back(frame);
+            }
+            if (pathOk) {
+                sun.path = std::move(keyframes);
+                sun.elevationDeg = sun.ElevationAt(0);
+                sun.azimuthDeg = sun.AzimuthAt(0);
+            }
+        }
+    } else if (speed) {
+        // Degrees per step; the elevation's range over the run is checked with the step count (CheckSunPath).
+        if (const Json* s = check.Section(*section, "sun", "speed", kSunSpeedKeys)) {
+            if (const Json* v = Validator::Find(*s, "elevation_deg")) {
+                if (auto d = check.Number(*v, "sun.speed.elevation_deg", Range{.lo = -180, .hi = 180}))
+                    sun.elevationSpeedDeg = *d;
+            }
+            if (const Json* v = Validator::Find(*s, "azimuth_deg")) {
+                if (auto d = check.Number(*v, "sun.speed.azimuth_deg", Range{.lo = -360, .hi = 360}))
+                    sun.azimuthSpeedDeg = *d;
+            }
+        }
     }
     // The radiance color * intensity is what the renderers use, in single precision.
     const double brightest = std::max({sun.color[0], sun.color[1], sun.color[2]}) * sun.intensity;
@@ -234,6 +309,15 @@ bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
     }
     if (const Json* v = find("every_steps")) {
         if (auto n = check.Integer(*v, field("every_steps"), 0, kU32Max)) render.everySteps = uint32_t(*n);
+    }
+    if (const Json* v = find("frames_per_step")) {
+        if (auto n = check.Integer(*v, field("frames_per_step"), 1, kMaxFramesPerStep)) {
+            render.framesPerStep = uint32_t(*n);
+            // F > 1 frames run alpha from 1/F to 1 themselves: a fixed alpha beside them would be ignored.
+            if (render.framesPerStep > 1 && find("alpha"))
+                check.Fail(field("alpha"), "cannot be combined with render.frames_per_step > 1 (the frames run alpha "
+                                           "from 1/F to 1); remove one");
+        }
     }
 
     const Json* cameras = find("cameras");

@@ -96,6 +96,9 @@ struct StageDescriptor {
     bool outputStepsOnly = false;
     // Skipped when none of its inputs changed since it last ran.
     bool skipsUnchangedInputs = false;
+    // Reads the sun's direction at the step (a host input): with
+    // skipsUnchangedInputs, a change of direction counts as a changed input.
+    bool readsSun = false;
     // True when its outputs depend on the step itself in this scene (a time
     // coordinate): it then runs every step despite skipsUnchangedInputs.
     // nullptr: never (a stage with no inputs and no time runs once).

@@ -1,5 +1,6 @@
 #include "harness/Conform.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -190,6 +191,57 @@ Result<std::unique_ptr<Buffer>> CopyTo(Backend& cpu, const Buffer& from, Backend
     return std::move(*to);
 }
 
+
+// Runs `stage` on backend `b` from copies of the CPU simulation's buffers of this step (and of the previous step
+// where the stage reads them), into fresh output buffers held in `owned` and named by `io`. A stage that advances
+// the state writes into `io.next`; its outputs are moved into a PendingState appended to `pending`.
+Status RunOnCopies(Stage stage, const Scene& scene, Backend& b, const Simulation& s, const StageHostInputs& host,
+                   std::vector<std::unique_ptr<Buffer>>& owned, StageBuffers& io, Backend* cpuFrom = nullptr,
+                   std::vector<PendingState>* pending = nullptr, const std::string& name = "") {
+    Backend& cpu = cpuFrom ? *cpuFrom : b;
+    const StageDescriptor& d = Describe(stage);
+    auto hold = [&](Result<std::unique_ptr<Buffer>> made) -> Result<Buffer*> {
+        if (!made) return std::unexpected(made.error());
+        owned.push_back(std::move(*made));
+        return owned.back().get();
+    };
+    // Inputs: the CPU's buffers of this step (and the previous one where kept).
+    std::vector<Resource> inputs = d.reads;
+    inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
+    for (Resource r : inputs) {
+        if (!s.Get(r) || !io.current[size_t(r)].empty()) continue;
+        auto copy = hold(CopyTo(cpu, *s.Get(r), b));
+        if (!copy) return std::unexpected(copy.error());
+        io.current[size_t(r)].push_back(*copy);
+    }
+    if (d.readsPrevious)
+        for (Resource r : d.readsPrevious(scene)) {
+            if (!s.Previous(r)) continue;
+            auto copy = hold(CopyTo(cpu, *s.Previous(r), b));
+            if (!copy) return std::unexpected(copy.error());
+            io.previous[size_t(r)] = *copy;
+        }
+    // Outputs: fresh buffers of the resource's shape.
+    PendingState state{stage, name, &b, {}};
+    for (Resource r : d.writes) {
+        const size_t count = IsPerCamera(r) ? scene.render.cameras.size() : 1;
+        if (!d.advancesState) io.current[size_t(r)].clear();
+        for (size_t n = 0; n < count; ++n) {
+            auto made = b.CreateBuffer(ResourceFormat(r), ResourceExtent(r, scene));
+            if (!made) return std::unexpected(made.error());
+            if (d.advancesState) {
+                io.next[size_t(r)] = made->get();
+                state.outputs.emplace_back(r, std::move(*made));
+            } else {
+                io.current[size_t(r)].push_back(*hold(std::move(*made)));
+            }
+        }
+    }
+    StageCallRecord record;
+    CB_TRY(CallStage(stage, b, scene, host, io, record));
+    if (d.advancesState && pending) pending->push_back(std::move(state));
+    return {};
+}
 }  // namespace
 
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
@@ -238,56 +290,31 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
                         }
                         continue;
                     }
-                    std::vector<std::unique_ptr<Buffer>> owned;
-                    StageBuffers io;
-                    auto hold = [&](Result<std::unique_ptr<Buffer>> made) -> Result<Buffer*> {
-                        if (!made) return std::unexpected(made.error());
-                        owned.push_back(std::move(*made));
-                        return owned.back().get();
-                    };
-                    // Inputs: the CPU's buffers of this step (and the previous one where kept).
-                    std::vector<Resource> inputs = d.reads;
-                    inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
-                    for (Resource r : inputs) {
-                        if (!s.Get(r) || !io.current[size_t(r)].empty()) continue;
-                        auto copy = hold(CopyTo(cpu, *s.Get(r), b));
-                        if (!copy) return std::unexpected(copy.error());
-                        io.current[size_t(r)].push_back(*copy);
-                    }
-                    if (d.readsPrevious)
-                        for (Resource r : d.readsPrevious(scene)) {
-                            if (!s.Previous(r)) continue;
-                            auto copy = hold(CopyTo(cpu, *s.Previous(r), b));
-                            if (!copy) return std::unexpected(copy.error());
-                            io.previous[size_t(r)] = *copy;
-                        }
-                    // Outputs: fresh buffers of the resource's shape.
-                    PendingState state{stage, c.name, &b, {}};
-                    for (Resource r : d.writes) {
-                        const size_t count = IsPerCamera(r) ? scene.render.cameras.size() : 1;
-                        if (!d.advancesState) io.current[size_t(r)].clear();
-                        for (size_t n = 0; n < count; ++n) {
-                            auto made = b.CreateBuffer(ResourceFormat(r), ResourceExtent(r, scene));
-                            if (!made) return std::unexpected(made.error());
-                            if (d.advancesState) {
-                                io.next[size_t(r)] = made->get();
-                                state.outputs.emplace_back(r, std::move(*made));
-                            } else {
-                                io.current[size_t(r)].push_back(*hold(std::move(*made)));
+                    // A renderer draws render.frames_per_step frames a step; the CPU's own run kept the last,
+                    // and the earlier ones are drawn on the CPU here from the same inputs.
+                    const uint32_t frames = d.renderer ? std::max(scene.render.framesPerStep, 1u) : 1;
+                    for (uint32_t f = 0; f < frames; ++f) {
+                        const bool lastFrame = f + 1 == frames;
+                        std::vector<std::unique_ptr<Buffer>> cpuOwned;
+                        StageBuffers cpuIo;
+                        if (!lastFrame)
+                            CB_TRY(RunOnCopies(stage, scene, cpu, s, {t, s.RasterList(), f}, cpuOwned, cpuIo));
+                        std::vector<std::unique_ptr<Buffer>> owned;
+                        StageBuffers io;
+                        if (Status run = RunOnCopies(stage, scene, b, s, {t, s.RasterList(), f}, owned, io, &cpu,
+                                                     d.advancesState ? &pending : nullptr, c.name);
+                            !run)
+                            return run;
+                        if (d.advancesState) continue;
+                        for (Resource r : d.writes)
+                            for (size_t n = 0; n < io.current[size_t(r)].size(); ++n) {
+                                std::string camera = IsPerCamera(r) ? scene.render.cameras[n].name : "";
+                                if (frames > 1) camera += " frame " + std::to_string(f);
+                                const Buffer& ref = lastFrame ? *s.Get(r, n) : *cpuIo.current[size_t(r)][n];
+                                CB_TRY(CompareOutput(tally, scene, stage, c.name, t, cpu, ref, b,
+                                                     *io.current[size_t(r)][n], camera));
                             }
-                        }
                     }
-                    StageCallRecord record;
-                    CB_TRY(CallStage(stage, b, scene, {t, s.RasterList()}, io, record));
-                    if (d.advancesState) {
-                        pending.push_back(std::move(state));
-                        continue;
-                    }
-                    for (Resource r : d.writes)
-                        for (size_t n = 0; n < io.current[size_t(r)].size(); ++n)
-                            CB_TRY(CompareOutput(tally, scene, stage, c.name, t, cpu, *s.Get(r, n), b,
-                                                 *io.current[size_t(r)][n],
-                                                 IsPerCamera(r) ? scene.render.cameras[n].name : ""));
                 }
             }
             return {};

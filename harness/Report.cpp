@@ -58,6 +58,33 @@ Summary Summarize(std::vector<double> samples) {
     return s;
 }
 
+LoopFigures MeasureLoop(const Scene& scene, const BackendRun& run) {
+    LoopFigures loop;
+    for (const StepRecord& r : run.steps) {
+        if (r.step < scene.warmupSteps) continue;
+        ++loop.steps;
+        loop.frames += r.framesRendered;
+        loop.wallMs += r.stepMs;
+        loop.stepMs.push_back(r.stepMs);
+    }
+    return loop;
+}
+
+StageRunCount CountStageRuns(const BackendRun& run, Stage stage) {
+    StageRunCount count;
+    for (const StepRecord& r : run.steps) {
+        if (r.stageMs[size_t(stage)]) {
+            ++count.ran;
+            if (Describe(stage).renderer) count.frames += r.framesRendered;
+        } else if (r.skippedUnchanged[size_t(stage)]) {
+            ++count.skippedUnchanged;
+        } else {
+            ++count.notOutputStep;
+        }
+    }
+    return count;
+}
+
 nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs) {
     nlohmann::json stages = nlohmann::json::array();
     for (Stage stage : kAllStages)
@@ -70,6 +97,8 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
           {"grid", {scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz}},
           {"steps", scene.steps},
           {"warmup_steps", scene.warmupSteps},
+          {"frames_per_step", scene.render.framesPerStep},
+          {"sun_moves", scene.sun.Moves()},
           {"stages", stages}}},
         {"backends", nlohmann::json::object()},
     };
@@ -86,6 +115,26 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             timing[std::string(StageName(stage))] = entry;
         }
         b["stages"] = timing;
+        nlohmann::json runsJson = nlohmann::json::object();
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            const StageRunCount c = CountStageRuns(run, stage);
+            nlohmann::json entry = {
+                {"ran", c.ran}, {"skipped_unchanged", c.skippedUnchanged}, {"not_output_step", c.notOutputStep}};
+            if (Describe(stage).renderer) entry["frames"] = c.frames;
+            runsJson[std::string(StageName(stage))] = entry;
+        }
+        b["stage_runs"] = runsJson;
+        const LoopFigures loop = MeasureLoop(scene, run);
+        nlohmann::json loopJson = SummaryJson(loop.stepMs);
+        loopJson.erase("samples_ms");
+        b["loop"] = {{"steps", loop.steps},
+                     {"frames", loop.frames},
+                     {"wall_ms", loop.wallMs},
+                     {"fps", loop.Fps() ? nlohmann::json(*loop.Fps()) : nlohmann::json(nullptr)},
+                     {"steps_per_second", loop.wallMs > 0 ? nlohmann::json(loop.steps * 1000.0 / loop.wallMs)
+                                                          : nlohmann::json(nullptr)},
+                     {"step_ms", SummaryJson(loop.stepMs)}};
         std::vector<double> hostSamples;
         for (const StepRecord& r : run.steps)
             if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region))
@@ -97,16 +146,19 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             nlohmann::json cameras = nlohmann::json::object();
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> ms;
-                nlohmann::json steps = nlohmann::json::array(), splats = nlohmann::json::array();
+                nlohmann::json steps = nlohmann::json::array(), splats = nlohmann::json::array(),
+                               alphas = nlohmann::json::array();
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
                         if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
                             ms.push_back(f.ms);
                             steps.push_back(r.step);
                             splats.push_back(f.stats.splats);
+                            alphas.push_back(f.alpha);
                         }
                 nlohmann::json c = SummaryJson(ms);
                 c["steps"] = steps;
+                c["alphas"] = alphas;
                 c["splats"] = splats;
                 c["fps_median"] = ms.empty() ? 0.0 : 1000.0 / Summarize(ms).median;
                 cameras[camera.name] = c;
@@ -119,18 +171,21 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> ms;
                 nlohmann::json steps = nlohmann::json::array(), samples = nlohmann::json::array(),
-                               lightSamples = nlohmann::json::array(), skipped = nlohmann::json::array();
+                               lightSamples = nlohmann::json::array(), skipped = nlohmann::json::array(),
+                               alphas = nlohmann::json::array();
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
                         if (f.renderer == Stage::RenderMarch && f.camera == camera.name) {
                             ms.push_back(f.ms);
                             steps.push_back(r.step);
+                            alphas.push_back(f.alpha);
                             samples.push_back(f.march.samples);
                             lightSamples.push_back(f.march.lightSamples);
                             skipped.push_back(f.march.bricksSkipped);
                         }
                 nlohmann::json c = SummaryJson(ms);
                 c["steps"] = steps;
+                c["alphas"] = alphas;
                 c["samples"] = samples;
                 c["light_samples"] = lightSamples;
                 c["bricks_skipped"] = skipped;
@@ -243,6 +298,35 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
     }
     if (!run.downloadMs.empty()) table.rows.push_back(TimingRow("(transfer) download", run.downloadMs, {}));
     section.blocks.push_back(std::move(table));
+    // The whole loop (simulation + frames) and how often each stage ran.
+    const LoopFigures loop = MeasureLoop(scene, run);
+    if (loop.steps > 0) {
+        const Summary st = Summarize(loop.stepMs);
+        if (const auto fps = loop.Fps())
+            std::snprintf(line, sizeof line,
+                          "  loop: %llu frames (%u per render step) in %u steps, %.1f ms: %.1f fps; step median %.3f ms, "
+                          "max %.3f ms",
+                          static_cast<unsigned long long>(loop.frames), scene.render.framesPerStep, loop.steps,
+                          loop.wallMs, *fps, st.median, st.max);
+        else
+            std::snprintf(line, sizeof line, "  loop: no frames in %u steps, %.1f ms: %.1f steps/s; step median %.3f ms",
+                          loop.steps, loop.wallMs, loop.wallMs > 0 ? loop.steps * 1000.0 / loop.wallMs : 0.0,
+                          st.median);
+        section.blocks.push_back(report::Paragraph{line});
+    }
+    if (!run.steps.empty()) {
+        std::string runs = "  stage runs (" + std::to_string(run.steps.size()) + " steps):";
+        const char* sep = " ";
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            const StageRunCount c = CountStageRuns(run, stage);
+            runs += sep + std::string(StageName(stage)) + " " + std::to_string(c.ran);
+            if (c.skippedUnchanged) runs += " (" + std::to_string(c.skippedUnchanged) + " skipped, unchanged)";
+            if (Describe(stage).renderer) runs += " (" + std::to_string(c.frames) + " frames)";
+            sep = ", ";
+        }
+        section.blocks.push_back(report::Paragraph{runs});
+    }
     if (scene.stages.Has(Stage::Density) && !run.steps.empty()) {
         std::vector<double> after;
         for (const StepRecord& r : run.steps)

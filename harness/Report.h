@@ -37,6 +37,31 @@ struct BackendRun {
     std::vector<double> downloadMs;
 };
 
+// The whole loop over the steps after warm-up (simulation, shading and every
+// frame, wall time): frames drawn (each frame is one image per camera and
+// renderer), steps, their wall time, and the frame rate that gives.
+struct LoopFigures {
+    uint64_t frames = 0;
+    uint32_t steps = 0;
+    double wallMs = 0;
+    std::vector<double> stepMs;  // each step's wall time
+    std::optional<double> Fps() const {
+        if (frames == 0 || !(wallMs > 0)) return std::nullopt;
+        return double(frames) * 1000.0 / wallMs;
+    }
+};
+LoopFigures MeasureLoop(const Scene& scene, const BackendRun& run);
+
+// How often an enabled stage ran over all of a run's steps: `ran` steps, and
+// the steps it skipped because none of its inputs (the sun's direction
+// included) changed; the rest are steps that were not output steps.
+// Renderers also count their frames (ran x render.frames_per_step).
+struct StageRunCount {
+    uint32_t ran = 0, skippedUnchanged = 0, notOutputStep = 0;
+    uint64_t frames = 0;
+};
+StageRunCount CountStageRuns(const BackendRun& run, Stage stage);
+
 nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs);
 
 // One backend's section of `run`'s report: its device and steps, the

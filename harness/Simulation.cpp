@@ -1,5 +1,7 @@
 #include "harness/Simulation.h"
 
+#include <algorithm>
+#include <bit>
 #include <chrono>
 
 #include "core/MemoryPlan.h"
@@ -74,7 +76,15 @@ Status Simulation::InitializeState() {
 
 std::vector<uint64_t> Simulation::InputVersions(Stage stage) const {
     std::vector<uint64_t> versions;
-    for (Resource r : Describe(stage).reads) versions.push_back(mSlots[size_t(r)].version);
+    const StageDescriptor& d = Describe(stage);
+    for (Resource r : d.reads) versions.push_back(mSlots[size_t(r)].version);
+    for (Resource r : d.optionalReads) versions.push_back(mSlots[size_t(r)].version);  // 0 when never written
+    if (d.readsSun) {
+        // The sun's direction at this step as the stage receives it (single precision): a stage re-runs when it
+        // differs in any bit from the direction of its last run, and only then.
+        const Vec3 s = mScene.sun.DirectionAt(mStep);
+        for (float c : s) versions.push_back(std::bit_cast<uint32_t>(c));
+    }
     return versions;
 }
 
@@ -85,6 +95,8 @@ bool Simulation::InputsChangedSinceLastRun(Stage stage) const {
 }
 
 Status Simulation::Step(StepRecord& record, const Observer& observe) {
+    const auto stepStart = std::chrono::steady_clock::now();
+    double observerMs = 0;
     record = StepRecord{};
     record.step = mStep;
     const bool outputStep = IsOutputStep(mStep);
@@ -92,13 +104,23 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     for (Stage stage : mSchedule) {
         const StageDescriptor& d = Describe(stage);
         if (d.advancesState || (d.outputStepsOnly && !outputStep)) continue;
-        if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage)) continue;
+        if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage)) {
+            record.skippedUnchanged[size_t(stage)] = true;
+            continue;
+        }
         // Keep step t-1's values for the renderer before they are overwritten.
         for (Resource r : d.writes) {
             Slot& slot = mSlots[size_t(r)];
             if (slot.previous && mStep > 0) std::swap(slot.current[0], slot.previous);
         }
-        CB_TRY(RunStage(stage, record));
+        if (d.renderer) {
+            // The frames between steps t-1 and t (seed 000 section 6.3): one per alpha of render.frames_per_step.
+            const uint32_t frames = std::max(mScene.render.framesPerStep, 1u);
+            for (uint32_t f = 0; f < frames; ++f) CB_TRY(RunStage(stage, record, f));
+            record.framesRendered = frames;
+        } else {
+            CB_TRY(RunStage(stage, record));
+        }
         mInputsAtLastRun[size_t(stage)] = InputVersions(stage);
         for (Resource r : d.writes) {
             Slot& slot = mSlots[size_t(r)];
@@ -111,7 +133,13 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
             }
         }
     }
-    if (observe) CB_TRY(observe(*this));
+    // A density stage that skipped (q unchanged) left the cover as it was.
+    if (!record.coveredColumns) record.coveredColumns = mLastCoveredColumns;
+    if (observe) {
+        const auto start = std::chrono::steady_clock::now();
+        CB_TRY(observe(*this));
+        observerMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    }
 
     for (Stage stage : mSchedule) {
         const StageDescriptor& d = Describe(stage);
@@ -130,6 +158,8 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
     ++mStep;
+    record.stepMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - stepStart).count() - observerMs;
     return {};
 }
 
@@ -144,14 +174,19 @@ StageBuffers Simulation::Buffers() {
     return buffers;
 }
 
-Status Simulation::RunStage(Stage stage, StepRecord& record) {
+Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame) {
     if (stage == Stage::Region) mRaster = mEllipsoids.Raster();
     StageCallRecord call;
-    CB_TRY(CallStage(stage, mBackend, mScene, {mStep, mRaster}, Buffers(), call));
-    record.stageMs[size_t(stage)] = call.ms;
-    record.deviceMs[size_t(stage)] = call.deviceMs;
-    if (call.coveredColumns) record.coveredColumns = call.coveredColumns;
-    for (FrameRecord& frame : call.frames) record.frames.push_back(std::move(frame));
+    CB_TRY(CallStage(stage, mBackend, mScene, {mStep, mRaster, frame}, Buffers(), call));
+    // A renderer's time in a step is the sum over its frames.
+    auto add = [](std::optional<double>& total, const std::optional<double>& part) {
+        if (part) total = total.value_or(0) + *part;
+    };
+    if (frame == 0) record.stageMs[size_t(stage)].reset(), record.deviceMs[size_t(stage)].reset();
+    add(record.stageMs[size_t(stage)], call.ms);
+    add(record.deviceMs[size_t(stage)], call.deviceMs);
+    if (call.coveredColumns) record.coveredColumns = mLastCoveredColumns = call.coveredColumns;
+    for (FrameRecord& drawn : call.frames) record.frames.push_back(std::move(drawn));
     if (Describe(stage).renderer) mLastRendered = mStep;
     return {};
 }

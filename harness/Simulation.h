@@ -8,9 +8,10 @@
 //   region   R_t from the ellipsoid list L_t
 //   smooth   q_t from cld_t
 //   density  D_t, occupancy and cover from q_t (and cld_t)
-//   shade    T_t from q_t           } on output steps only, and shade only when
-//   shadow   G_t from D_t           } q changed since it last ran
-//   render   one image per camera from q_{t-1}, q_t (interpolated by alpha), T_t
+//   shade    T_t from q_t and s_t   } on output steps only, and only when q (D)
+//   shadow   G_t from D_t and s_t   } or the sun's direction s_t changed since it last ran
+//   render   render.frames_per_step frames, each one image per camera from
+//            q_{t-1}, q_t (interpolated by the frame's alpha), T_t
 //   (observer: everything above plus hum_t, act_t, cld_t is readable here)
 //   ca       state_t -> state_{t+1} using R_t
 //   host     L_{t+1} = update(L_t)
@@ -37,9 +38,15 @@ struct StepRecord {
     std::array<std::optional<double>, kStageCount> stageMs{};
     // Device time of each stage in ms, where the backend measures it.
     std::array<std::optional<double>, kStageCount> deviceMs{};
+    // Stages that skipped this step because none of their inputs (the sun's
+    // direction included) changed since they last ran (skipsUnchangedInputs).
+    std::array<bool, kStageCount> skippedUnchanged{};
     double ellipsoidUpdateMs = 0;            // host-side list update
     std::optional<uint32_t> coveredColumns;  // from the density stage
-    std::vector<FrameRecord> frames;         // render_splat, one per camera
+    std::vector<FrameRecord> frames;         // renderers: one per camera and frame of the step
+    uint32_t framesRendered = 0;             // frames of this step (render.frames_per_step on render steps, else 0)
+    // Wall time of the whole step (stages, frames and host work; not the observer), ms.
+    double stepMs = 0;
 };
 
 class Simulation {
@@ -105,7 +112,7 @@ class Simulation {
     Status Allocate();
     Status InitializeState();
     // Runs one stage on this step's buffers (its writes go to `next` when it advances the state).
-    Status RunStage(Stage stage, StepRecord& record);
+    Status RunStage(Stage stage, StepRecord& record, uint32_t frame = 0);
     StageBuffers Buffers();
     bool InputsChangedSinceLastRun(Stage stage) const;
     std::vector<uint64_t> InputVersions(Stage stage) const;
@@ -122,6 +129,7 @@ class Simulation {
     std::array<std::optional<std::vector<uint64_t>>, kStageCount> mInputsAtLastRun;
     const bool mEveryStepOutputs;
     std::optional<uint32_t> mLastRendered;
+    std::optional<uint32_t> mLastCoveredColumns;  // the density stage's last cover
 };
 
 }  // namespace cb

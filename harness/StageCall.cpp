@@ -32,13 +32,15 @@ Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& l
 // running its backend call through `timed` (host work outside it is not
 // stage time); each frame's time is what `timed` measured.
 template <typename RenderOne>
-Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, uint32_t step, StageCallRecord& record,
-                        RenderOne&& renderOne) {
+Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, uint32_t step, uint32_t frameOfStep,
+                        StageCallRecord& record, RenderOne&& renderOne) {
     const std::string backendName = backend.Name();
     for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
         FrameRecord frame;
         frame.renderer = renderer;
         frame.camera = sc.render.cameras[n].name;
+        frame.frame = frameOfStep;
+        frame.alpha = sc.render.FrameAlpha(frameOfStep);
         const double before = record.ms;
         const StageCountLabel label{StageName(renderer), backendName, step, frame.camera};
         auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
@@ -56,11 +58,11 @@ Buffer* PreviousOrCurrent(const StageBuffers& io, Resource r) {
     return io.Previous(r) ? io.Previous(r) : io.Current(r);
 }
 
-Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
-                         StageCallRecord& record) {
+Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, uint32_t frameOfStep,
+                         const StageBuffers& io, StageCallRecord& record) {
     return RenderEachCamera(
-        Stage::RenderSplat, backend, sc, step, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n]);
+        Stage::RenderSplat, backend, sc, step, frameOfStep, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n], step, frameOfStep);
             // The order is host work shared by all backends, outside the stage time.
             const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
             p.order = &order;
@@ -73,11 +75,11 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, const
         });
 }
 
-Status RenderMarchFrames(Backend& backend, const Scene& sc, uint32_t step, const StageBuffers& io,
-                         StageCallRecord& record) {
+Status RenderMarchFrames(Backend& backend, const Scene& sc, uint32_t step, uint32_t frameOfStep,
+                         const StageBuffers& io, StageCallRecord& record) {
     return RenderEachCamera(
-        Stage::RenderMarch, backend, sc, step, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step);
+        Stage::RenderMarch, backend, sc, step, frameOfStep, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step, frameOfStep);
             // T only where shade runs (the light source "shade").
             const MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
             return timed(
@@ -117,22 +119,22 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
             return {};
         }
         case Stage::Shade: {
-            const ShadeParams p = MakeShadeParams(sc);
+            const ShadeParams p = MakeShadeParams(sc, host.step);
             return timed([&] { return backend.Shade(p, *io.Current(Resource::Q), *io.Current(Resource::T)); });
         }
         case Stage::Shadow: {
-            const ShadowParams p = MakeShadowParams(sc);
+            const ShadowParams p = MakeShadowParams(sc, host.step);
             return timed(
                 [&] { return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow)); });
         }
         case Stage::RenderSplat:
-            return RenderSplatFrames(backend, sc, host.step, io, record);
+            return RenderSplatFrames(backend, sc, host.step, host.frame, io, record);
         case Stage::Noise: {
             const NoiseParams p = MakeNoiseParams(sc, host.step);
             return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });
         }
         case Stage::RenderMarch:
-            return RenderMarchFrames(backend, sc, host.step, io, record);
+            return RenderMarchFrames(backend, sc, host.step, host.frame, io, record);
     }
     return MakeError("the harness cannot call stage '" + std::string(StageName(stage)) + "' yet");
 }

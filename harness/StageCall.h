@@ -38,12 +38,16 @@ struct StageBuffers {
 struct StageHostInputs {
     uint32_t step = 0;
     std::span<const RasterEllipsoid> raster;  // region: step t's ellipsoids
+    // Renderers: the frame of the step (0 .. render.frames_per_step - 1), which sets alpha (RenderSettings::FrameAlpha).
+    uint32_t frame = 0;
 };
 
 // One rendered image.
 struct FrameRecord {
     Stage renderer = Stage::RenderSplat;
     std::string camera;
+    uint32_t frame = 0;  // the frame of its step (render.frames_per_step)
+    float alpha = 0;     // the interpolation weight it was drawn with
     double ms = 0;
     SplatStats stats;
     MarchStats march;  // render_march's counters

@@ -20,9 +20,9 @@ CaStepParams MakeCaStepParams(const Scene& sc, uint32_t step) {
 
 DensityParams MakeDensityParams(const Scene& sc) { return {sc.density.tile, sc.density.band}; }
 
-ShadeParams MakeShadeParams(const Scene& sc) {
+ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
     ShadeParams p;
-    p.sun = sc.sun.Direction();
+    p.sun = sc.sun.DirectionAt(step);
     p.attenuation = sc.shade.attenuation;
     p.sigma = float(sc.shade.sigma);
     p.voxelSize = float(sc.grid.voxelSize);
@@ -37,9 +37,9 @@ ShadeParams MakeShadeParams(const Scene& sc) {
     return p;
 }
 
-ShadowParams MakeShadowParams(const Scene& sc) {
+ShadowParams MakeShadowParams(const Scene& sc, uint32_t step) {
     ShadowParams p;
-    p.sun = sc.sun.Direction();
+    p.sun = sc.sun.DirectionAt(step);
     p.form = sc.shadow.form;
     p.sigma = float(sc.shade.sigma);
     p.voxelSize = float(sc.grid.voxelSize);
@@ -50,10 +50,10 @@ ShadowParams MakeShadowParams(const Scene& sc) {
 
 NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.noise, sc.grid.size}; }
 
-SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
+SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame) {
     SplatParams p;
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
-    p.sun = sc.sun.Direction();
+    p.sun = sc.sun.DirectionAt(step);
     p.sunRadiance = sc.sun.Radiance();
     p.ambient = sc.lighting.Ambient();
     p.background = sc.lighting.Background();
@@ -61,7 +61,7 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
     p.qMin = float(sc.splat.qMin);
     p.splatDiameter = float(sc.splat.splatScale * sc.grid.voxelSize);
     p.opacity = float(sc.splat.opacity);
-    p.alpha = float(sc.render.alpha);
+    p.alpha = sc.render.FrameAlpha(frame);
     p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
     p.voxelSize = float(sc.grid.voxelSize);
     p.culling = sc.splat.culling;
@@ -71,7 +71,7 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera) {
     return p;
 }
 
-MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint32_t step) {
+MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame) {
     MarchParams p;
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
     const float h = float(sc.grid.voxelSize);
@@ -85,7 +85,7 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     s.adaptiveStart = float(sc.march.adaptiveStart);
     s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
     s.epsilon = float(sc.march.epsilon);
-    s.sun = sc.sun.Direction();
+    s.sun = sc.sun.DirectionAt(step);
     s.sunRadiance = sc.sun.Radiance();
     s.ambient = sc.lighting.Ambient();
     s.background = sc.lighting.Background();
@@ -99,7 +99,7 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
         s.point.radiance[c] = float(l.color[c] * l.intensity);
     }
     s.point.minDistance2 = float(l.radius * l.radius);
-    p.alpha = float(sc.render.alpha);
+    p.alpha = sc.render.FrameAlpha(frame);
     p.light = sc.march.light;
     p.lightSteps = sc.march.lightSteps;
     p.jitter = sc.march.jitter;

@@ -11,13 +11,16 @@ CaInitParams MakeCaInitParams(const Scene& scene);
 // Without the wind shifts, which the caller keeps alive and sets.
 CaStepParams MakeCaStepParams(const Scene& scene, uint32_t step);
 DensityParams MakeDensityParams(const Scene& scene);
-ShadeParams MakeShadeParams(const Scene& scene);
-ShadowParams MakeShadowParams(const Scene& scene);
+// The sun is the scene's at `step` (SunSettings::DirectionAt; step 0 is the fixed sun's).
+ShadeParams MakeShadeParams(const Scene& scene, uint32_t step = 0);
+ShadowParams MakeShadowParams(const Scene& scene, uint32_t step = 0);
 // Points into scene.noise: the scene must outlive the parameters.
 NoiseParams MakeNoiseParams(const Scene& scene, uint32_t step);
-// Everything but the order, which the caller makes (MakeSplatOrder) and keeps alive.
-SplatParams MakeSplatParams(const Scene& scene, const CameraSettings& camera);
-// The ray marcher's parameters for one camera at `step` (the jitter's frame and the lightning's flash window).
-MarchParams MakeMarchParams(const Scene& scene, const CameraSettings& camera, uint32_t step);
+// Everything but the order, which the caller makes (MakeSplatOrder) and keeps alive; the sun at `step`, alpha of
+// frame `frame` of the step (RenderSettings::FrameAlpha).
+SplatParams MakeSplatParams(const Scene& scene, const CameraSettings& camera, uint32_t step = 0, uint32_t frame = 0);
+// The ray marcher's parameters for one camera at `step` (the jitter's frame, the lightning's flash window and the
+// sun), frame `frame` of the step (its alpha).
+MarchParams MakeMarchParams(const Scene& scene, const CameraSettings& camera, uint32_t step, uint32_t frame = 0);
 
 }  // namespace cb

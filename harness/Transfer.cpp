@@ -51,14 +51,17 @@ ErrorStats ErrorStatsFromJson(const json& j) {
 }  // namespace
 
 json ToJson(const StepRecord& r) {
-    json stageMs = json::array(), deviceMs = json::array(), frames = json::array();
+    json stageMs = json::array(), deviceMs = json::array(), frames = json::array(), skipped = json::array();
     for (size_t s = 0; s < kStageCount; ++s) {
         stageMs.push_back(Optional(r.stageMs[s]));
         deviceMs.push_back(Optional(r.deviceMs[s]));
+        skipped.push_back(r.skippedUnchanged[s]);
     }
     for (const FrameRecord& f : r.frames)
         frames.push_back({{"renderer", StageName(f.renderer)},
                           {"camera", f.camera},
+                          {"frame", f.frame},
+                          {"alpha", D(f.alpha)},
                           {"ms", D(f.ms)},
                           {"splats", f.stats.splats},
                           {"voxels_visited", f.stats.voxelsVisited},
@@ -74,6 +77,9 @@ json ToJson(const StepRecord& r) {
             {"device_ms", deviceMs},
             {"ellipsoid_update_ms", D(r.ellipsoidUpdateMs)},
             {"covered_columns", Optional(r.coveredColumns)},
+            {"skipped_unchanged", skipped},
+            {"frames_rendered", r.framesRendered},
+            {"step_ms", D(r.stepMs)},
             {"frames", frames}};
 }
 
@@ -86,10 +92,15 @@ StepRecord StepFromJson(const json& j) {
     }
     r.ellipsoidUpdateMs = FromD(j.at("ellipsoid_update_ms"));
     r.coveredColumns = OptionalFrom<uint32_t>(j.at("covered_columns"));
+    for (size_t s = 0; s < kStageCount; ++s) r.skippedUnchanged[s] = j.at("skipped_unchanged").at(s).get<bool>();
+    r.framesRendered = j.at("frames_rendered").get<uint32_t>();
+    r.stepMs = FromD(j.at("step_ms"));
     for (const json& f : j.at("frames")) {
         FrameRecord frame;
         frame.renderer = ParseStage(f.at("renderer").get<std::string>()).value_or(Stage::RenderSplat);
         frame.camera = f.at("camera").get<std::string>();
+        frame.frame = f.at("frame").get<uint32_t>();
+        frame.alpha = float(FromD(f.at("alpha")));
         frame.ms = FromD(f.at("ms"));
         frame.stats = {f.at("splats").get<uint64_t>(), f.at("voxels_visited").get<uint64_t>(),
                        f.at("fragments").get<uint64_t>()};

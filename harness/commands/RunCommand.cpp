@@ -17,7 +17,9 @@ constexpr const char* kHelpHead = R"(usage: cloudbench run [SCENE] [options]
 
 Runs SCENE (a name in scenes/ or a path to a .json file; default: thesis-medium)
 on each backend, prints a per-stage timing table (median and spread over the
-steps after warm-up), each camera's frame rate and the cloud cover, and writes
+steps after warm-up), each camera's frame rate, the whole loop's frame rate
+(simulation and frames, wall time), how often each stage ran and skipped, and
+the cloud cover, and writes
 DIR/results.json, the last frame of each camera (DIR/frame-splat-<camera>-<backend>
 .exr and .png) and a top view of the last density map, DIR/topview-<backend>.png.
 
