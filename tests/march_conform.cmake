@@ -36,3 +36,34 @@ foreach(entry ${march_cases})
   set_tests_properties(Cli.ConformMarch${name} PROPERTIES
                        FAIL_REGULAR_EXPRESSION "vk validation|render_march +(vk|gl) +(fail|skipped)")
 endforeach()
+# conform reports a renderer's worst pixel with a difference image (issue 14 item 2): with powder (GLSL's pow
+# against glibc's, ~1e-7 apart) the GPU backends' images differ slightly, and each render_march row that
+# differs names diff-render_march-<backend>.exr in the output folder, whose largest value is the row's worst.
+set(march_diff_script [=[d="$1"; rm -rf "$d"; set -e
+"$0" conform "$2/scenes/imgacc-small.json" --backend "$3" --out "$d" \
+  --set 'stages=["noise","density","shade","render_march"]' --set march.powder.enabled=true >/dev/null
+/usr/bin/python3 - "$d" "$2" <<'PY'
+import json, pathlib, sys
+sys.path.insert(0, sys.argv[2])
+from check_bad_inputs import exr_floats
+d = pathlib.Path(sys.argv[1])
+rows = [r for r in json.load(open(d / "conform.json"))["results"] if r["stage"] == "render_march"]
+differing = [r for r in rows if r["worst"] > 0]
+assert differing, "no backend differs from the CPU: the test would prove nothing here"
+for r in rows:
+    if r["worst"] == 0:
+        assert r["difference_image"] == "", r
+        continue
+    assert r["difference_image"] == "diff-render_march-%s.exr" % r["backend"], r
+    pixels = exr_floats(d / r["difference_image"])
+    assert pixels.size == 64 * 48 * 3, pixels.size
+    assert abs(float(pixels.max()) - r["worst"]) <= 1e-6 * max(1.0, r["worst"]), (pixels.max(), r["worst"])
+    print("difference image", r["backend"], r["worst"])
+PY]=])
+if(CLOUDBENCH_HAVE_GL OR CLOUDBENCH_HAVE_VK)
+  string(REPLACE "cpu," "" march_gpu_backends "${march_backends}")
+  add_test(NAME Cli.ConformMarchWritesDifferenceImages
+           COMMAND /bin/sh -c "${march_diff_script}" ${cli} ${cli_out}/conform-march-diff ${CMAKE_CURRENT_SOURCE_DIR}
+                   cpu,${march_gpu_backends})
+  set_tests_properties(Cli.ConformMarchWritesDifferenceImages PROPERTIES PASS_REGULAR_EXPRESSION "difference image (gl|vk) [0-9]")
+endif()
