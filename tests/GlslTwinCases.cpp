@@ -260,7 +260,8 @@ std::vector<TwinCase> Cases() {
                      in = W({Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)),
                              Bits(Uniform(r, 0, 100))});
                  },
-                 {W({Bits(0.5f), Bits(1.0f), Bits(1.0f), Bits(2.0f)}), W({Bits(0.5f), Bits(0.8f), Bits(0.5f), Bits(2.0f)}),
+                 {W({Bits(0.5f), Bits(1.0f), Bits(1.0f), Bits(2.0f)}),
+                  W({Bits(0.5f), Bits(0.8f), Bits(0.5f), Bits(2.0f)}),
                   W({Bits(0.5f), Bits(0.3f), Bits(1.0f), Bits(2.0f)}), W({Bits(10.0f), 0, Bits(1.0f), Bits(100.0f)}),
                   W({0, Bits(1.0f), Bits(1.0f), 0})},
                  [](const Words& in, Words& out) {
