@@ -131,8 +131,9 @@ struct ShadeParams {
 // Inputs of the shadow stage (SPEC 7) besides D.
 struct ShadowParams {
     Vec3 sun{0, 0, 1};
-    AttenuationKind form = AttenuationKind::Beer;
+    ShadowForm form = ShadowForm::Beer;
     float sigma = 0.02f, voxelSize = 50, kappa = 0.25f;
+    float coverage = 1, densityFactor = 1;  // wang form (seed 002 eq. 19)
     uint32_t nz = 1;  // grid height in voxels (the volume's mid-height is nz/2)
 };
 

@@ -145,8 +145,10 @@ struct ShadeSettings {
 
 // Stage `shadow` (SPEC 7).
 struct ShadowSettings {
-    AttenuationKind form = AttenuationKind::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D)
-    double kappa = 0.25;                           // thesis form: shadow per unit of D
+    ShadowForm form = ShadowForm::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D); wang: eq. 19
+    double kappa = 0.25;                 // thesis form: shadow per unit of D
+    double coverage = 1;                 // wang form: coverage C (seed 002 eq. 15, 19)
+    double densityFactor = 1;            // wang form: density factor D_w (seed 002 eq. 16, 19)
 };
 
 // What every renderer shares (section `render`): the image, the cameras,

@@ -22,6 +22,11 @@ inline constexpr std::array<NamedValue<AttenuationKind>, 2> kAttenuationKindName
     {"beer", AttenuationKind::Beer},
     {"thesis", AttenuationKind::Thesis},
 }};
+inline constexpr std::array<NamedValue<ShadowForm>, 3> kShadowFormNames{{
+    {"beer", ShadowForm::Beer},
+    {"thesis", ShadowForm::Thesis},
+    {"wang", ShadowForm::Wang},
+}};
 inline constexpr std::array<NamedValue<SampleFilter>, 2> kSampleFilterNames{{
     {"bilinear", SampleFilter::Bilinear},
     {"nearest", SampleFilter::Nearest},
@@ -34,6 +39,7 @@ inline constexpr std::array<NamedValue<StorageFormat>, 3> kStorageFormatNames{{
 
 constexpr std::string_view PhaseKindName(PhaseKind kind) { return NameOf(kPhaseKindNames, kind); }
 constexpr std::string_view AttenuationKindName(AttenuationKind kind) { return NameOf(kAttenuationKindNames, kind); }
+constexpr std::string_view ShadowFormName(ShadowForm form) { return NameOf(kShadowFormNames, form); }
 constexpr std::string_view SampleFilterName(SampleFilter filter) { return NameOf(kSampleFilterNames, filter); }
 constexpr std::string_view StorageFormatName(StorageFormat format) { return NameOf(kStorageFormatNames, format); }
 

@@ -20,7 +20,7 @@ constexpr std::string_view kPhaseKeys[] = {"function", "g"};
 constexpr std::string_view kShadeKeys[] = {"attenuation", "sigma",   "thesis_ar", "filter",
                                            "resolution",  "storage", "scattering"};
 constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angle"};
-constexpr std::string_view kShadowKeys[] = {"form", "kappa"};
+constexpr std::string_view kShadowKeys[] = {"form", "kappa", "coverage", "density_factor"};
 constexpr std::string_view kRenderKeys[] = {"width",    "height",      "q_min",   "splat_scale",
                                             "opacity",  "alpha",       "culling", "skipping",
                                             "every_steps", "frames_per_step", "cameras"};
@@ -262,10 +262,16 @@ void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
     const Json* section = check.Section(root, "", "shadow", kShadowKeys);
     if (!section) return;
     if (const Json* v = Validator::Find(*section, "form")) {
-        if (auto kind = check.Choice(*v, "shadow.form", kAttenuationKindNames)) shadow.form = *kind;
+        if (auto kind = check.Choice(*v, "shadow.form", kShadowFormNames)) shadow.form = *kind;
     }
     if (const Json* v = Validator::Find(*section, "kappa")) {
         if (auto d = check.Number(*v, "shadow.kappa", kSingleNonNegative)) shadow.kappa = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "coverage")) {
+        if (auto d = check.Number(*v, "shadow.coverage", kProbability)) shadow.coverage = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "density_factor")) {
+        if (auto d = check.Number(*v, "shadow.density_factor", kProbability)) shadow.densityFactor = *d;
     }
 }
 

@@ -182,6 +182,9 @@ inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
 // ---- Per-slice attenuation (SPEC 6) --------------------------------------------
 
 enum class AttenuationKind : uint8_t { Beer, Thesis };
+// Forms of the ground shadow (SPEC 7): beer, the thesis's inverted density map,
+// and Wang's coverage-modulated shadow factor (seed 002 eq. 19).
+enum class ShadowForm : uint8_t { Beer, Thesis, Wang };
 enum class SampleFilter : uint8_t { Bilinear, Nearest };
 
 struct SliceAttenuation {
@@ -218,6 +221,18 @@ inline float StoreTransmittance(StorageFormat storage, float previousT, float fa
 // the beer form, 1 - clamp(kappa d) for the thesis form. GLSL twin: shading.glsl GroundShadow.
 inline float GroundShadow(bool beer, float opticalDepthPerD, float kappa, float d) {
     return beer ? ExpNonPositive(-opticalDepthPerD * d) : 1.0f - std::clamp(kappa * d, 0.0f, 1.0f);
+}
+
+// Wang's ground shadow (seed 002 eq. 19), S = 1 - D_w max(T_S - (T_2D + 1 - C), 0),
+// on our data (docs/pipeline.md "Wang's shadow form"): the shadow texture T_S
+// is the opacity of the column along the sun, 1 - exp(-opticalDepthPerD d);
+// the modulation texture T_2D is 0 (the automaton already varies the cloud);
+// C = coverage and D_w = densityFactor are scene constants in [0, 1].
+// GLSL twin: shading.glsl WangShadow.
+inline float WangShadow(float opticalDepthPerD, float coverage, float densityFactor, float d) {
+    const float shadowTexture = 1.0f - ExpNonPositive(-opticalDepthPerD * d);
+    const float modulation = 0.0f;
+    return 1.0f - densityFactor * std::max(shadowTexture - (modulation + 1.0f - coverage), 0.0f);
 }
 
 // Trilinear read-back of a shade grid at resolution f (SPEC 6): fine voxel i

@@ -44,6 +44,8 @@ ShadowParams MakeShadowParams(const Scene& sc, uint32_t step) {
     p.sigma = float(sc.shade.sigma);
     p.voxelSize = float(sc.grid.voxelSize);
     p.kappa = float(sc.shadow.kappa);
+    p.coverage = float(sc.shadow.coverage);
+    p.densityFactor = float(sc.shadow.densityFactor);
     p.nz = sc.grid.size.nz;
     return p;
 }

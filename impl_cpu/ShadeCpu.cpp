@@ -258,7 +258,7 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
         std::fill(G, G + size_t(e.nx) * e.ny, 1.0f);
         return {};
     }
-    const bool beer = params.form == AttenuationKind::Beer;
+    const bool beer = params.form == ShadowForm::Beer, wang = params.form == ShadowForm::Wang;
     auto tap = [&](int64_t i, int64_t j) -> float {
         return (i < 0 || j < 0 || i >= e.nx || j >= e.ny) ? 0.0f : D[size_t(i) + size_t(e.nx) * size_t(j)];
     };
@@ -268,7 +268,9 @@ Status BackendCpu::Shadow(const ShadowParams& params, const Buffer& columnSumBuf
                 for (uint32_t i = 0; i < e.nx; ++i) {
                     const int64_t x = int64_t(i) + l.baseX, y = int64_t(j) + l.baseY;
                     const float d = Bilinear(tap(x, y), tap(x + 1, y), tap(x, y + 1), tap(x + 1, y + 1), l.fx, l.fy);
-                    G[i + size_t(e.nx) * j] = GroundShadow(beer, l.opticalDepthPerD, params.kappa, d);
+                    G[i + size_t(e.nx) * j] =
+                        wang ? WangShadow(l.opticalDepthPerD, params.coverage, params.densityFactor, d)
+                             : GroundShadow(beer, l.opticalDepthPerD, params.kappa, d);
                 }
         });
     });

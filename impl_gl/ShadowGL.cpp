@@ -14,9 +14,11 @@ Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     f.Uniform2i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny));
     f.Uniform2i(f.GetUniformLocation(*program, "base"), l.baseX, l.baseY);
     f.Uniform2f(f.GetUniformLocation(*program, "fraction"), l.fx, l.fy);
-    f.Uniform1i(f.GetUniformLocation(*program, "beer"), params.form == AttenuationKind::Beer ? 1 : 0);
+    f.Uniform1i(f.GetUniformLocation(*program, "form"), int(params.form));
     f.Uniform1f(f.GetUniformLocation(*program, "opticalDepthPerD"), l.opticalDepthPerD);
     f.Uniform1f(f.GetUniformLocation(*program, "kappa"), params.kappa);
+    f.Uniform1f(f.GetUniformLocation(*program, "coverage"), params.coverage);
+    f.Uniform1f(f.GetUniformLocation(*program, "densityFactor"), params.densityFactor);
     f.Uniform1i(f.GetUniformLocation(*program, "noSun"), l.noSun ? 1 : 0);
     CB_TRY(BindTargets({{Tex(G).Texture(), 0}}));
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));

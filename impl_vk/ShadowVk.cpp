@@ -12,19 +12,22 @@ Status BackendVk::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
         uint32_t nx, ny;
         int32_t bx, by;
         float fx, fy;
-        uint32_t beer;
+        uint32_t form;  // ShadowForm
         float opticalDepthPerD, kappa;
         uint32_t noSun;
+        float coverage, densityFactor;
     } push{e.nx,
            e.ny,
            l.baseX,
            l.baseY,
            l.fx,
            l.fy,
-           params.form == AttenuationKind::Beer ? 1u : 0u,
+           uint32_t(params.form),
            l.opticalDepthPerD,
            params.kappa,
-           l.noSun ? 1u : 0u};
+           l.noSun ? 1u : 0u,
+           params.coverage,
+           params.densityFactor};
     const DeviceBuffer* buffers[] = {&Dev(columnSum), &Dev(G)};
     return Record("shadow", [&](VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny);

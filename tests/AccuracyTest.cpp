@@ -122,6 +122,42 @@ TEST(Accuracy, OverheadShadowEqualsReference) {
     }
 }
 
+// Test Wang's form against the exact G_ref with the sun overhead, where its
+// T_S = 1 - exp(-tau) is the exact column opacity: with C = D_w = 1 it is
+// exp(-tau) = G_ref; with coverage C, S = 1 - max(C - G_ref, 0), so the error
+// S - G_ref is 1 - C wherever G_ref < C and 1 - G_ref elsewhere, that is
+// min(1 - C, 1 - G_ref) in every cell (docs/pipeline.md, reports/loop/shadow-wang.md).
+TEST(Accuracy, OverheadWangShadowErrorIsTheCoverageGap) {
+    const Extent3 e{20, 14, 10};
+    const std::vector<float> q = Clouds(e, 7);
+    std::vector<float> D(size_t(e.nx) * e.ny, 0.0f);
+    for (uint32_t k = 0; k < e.nz; ++k)
+        for (uint32_t j = 0; j < e.ny; ++j)
+            for (uint32_t i = 0; i < e.nx; ++i) D[i + e.nx * j] += q[VoxelIndex(e, i, j, k)];
+    auto tracer = ref::OpticalDepthTracer::Create(e, q);
+    ASSERT_TRUE(tracer.has_value());
+    ShadowParams p;
+    p.form = ShadowForm::Wang;
+    p.sun = {0, 0, 1};
+    p.nz = e.nz;
+    const std::vector<float> exact = (*tracer)->GroundShadow({p.sun, p.sigma, p.voxelSize});
+    cpu::BackendCpu backend(0);
+    auto Db = test::MakeFilled(backend, BufferFormat::F32, {e.nx, e.ny, 1}, D);
+    auto G = test::MakeBuffer(backend, BufferFormat::F32, {e.nx, e.ny, 1});
+    int belowCoverage = 0;
+    for (float coverage : {1.0f, 0.6f}) {
+        p.coverage = coverage;
+        ASSERT_TRUE(backend.Shadow(p, *Db, *G).has_value());
+        const std::vector<float> got = test::Read<float>(backend, *G);
+        for (size_t c = 0; c < got.size(); ++c) {
+            const float expected = std::min(1.0f - coverage, 1.0f - exact[c]);
+            EXPECT_NEAR(got[c] - exact[c], expected, 1e-6) << "C " << coverage << " cell " << c;
+            if (coverage < 1 && exact[c] < coverage) ++belowCoverage;
+        }
+    }
+    EXPECT_GT(belowCoverage, 10);  // the coverage gap is exercised, not only clear sky
+}
+
 // Test the jump of T across each kind of principal-axis switch, 1e-6 rad on
 // either side, against the a-priori bound of SwitchSideBound (derived in
 // docs/accuracy.md from the fact that on the switch both axes give the same

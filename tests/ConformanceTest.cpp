@@ -369,7 +369,7 @@ TEST_P(Conformance, Shade) {
                         }
 }
 
-// Test the ground shadow in both forms, several suns: max |dG| <= 1e-5 (SPEC 7).
+// Test the ground shadow in every form, several suns: max |dG| <= 1e-5 (SPEC 7).
 TEST_P(Conformance, Shadow) {
     if (auto why = SkipReason(Stage::Shadow)) GTEST_SKIP() << *why;
     const Extent3 e = Size();
@@ -382,10 +382,12 @@ TEST_P(Conformance, Shadow) {
     auto refG = test::MakeBuffer(mCpu, BufferFormat::F32, map);
     auto gotG = test::MakeBuffer(*mBackend, BufferFormat::F32, map);
     for (const Vec3& sun : {Vec3{0, 0, 1}, SunDirection(0.5, 0.7), SunDirection(0.05, 2.0), SunDirection(-0.1, 0.0)})
-        for (AttenuationKind form : {AttenuationKind::Beer, AttenuationKind::Thesis}) {
+        for (ShadowForm form : {ShadowForm::Beer, ShadowForm::Thesis, ShadowForm::Wang}) {
             ShadowParams p;
             p.sun = sun;
             p.form = form;
+            p.coverage = 0.7f;  // wang: both of its terms active (C = D_w = 1 would be beer)
+            p.densityFactor = 0.8f;
             p.nz = e.nz;
             ASSERT_TRUE(mCpu.Shadow(p, *refD, *refG));
             Status s = mBackend->Shadow(p, *gotD, *gotG);

@@ -253,6 +253,20 @@ std::vector<TwinCase> Cases() {
                  [](const Words& in, Words& out) {
                      out[0] = Bits(GroundShadow(in[0] != 0, Float(in[1]), Float(in[2]), Float(in[3])));
                  }});
+    c.push_back({"WangShadow",
+                 45,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     in = W({Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)),
+                             Bits(Uniform(r, 0, 100))});
+                 },
+                 {W({Bits(0.5f), Bits(1.0f), Bits(1.0f), Bits(2.0f)}),
+                  W({Bits(0.5f), Bits(0.8f), Bits(0.5f), Bits(2.0f)}),
+                  W({Bits(0.5f), Bits(0.3f), Bits(1.0f), Bits(2.0f)}), W({Bits(10.0f), 0, Bits(1.0f), Bits(100.0f)}),
+                  W({0, Bits(1.0f), Bits(1.0f), 0})},
+                 [](const Words& in, Words& out) {
+                     out[0] = Bits(WangShadow(Float(in[0]), Float(in[1]), Float(in[2]), Float(in[3])));
+                 }});
     {
         std::vector<Words> edges;
         for (uint32_t f : {1u, 2u, 4u})

@@ -117,7 +117,7 @@ TEST(SceneTest, BadChoiceString) {
     EXPECT_TRUE(HasLine(message,
                         R"(test.json: phase.function: must be one of "none", "henyey-greenstein", )"
                         R"("cornette-shanks", "mie", got "Henyey-Greenstein" (did you mean "henyey-greenstein"?))"));
-    EXPECT_TRUE(HasLine(message, R"(test.json: shadow.form: must be one of "beer", "thesis", got 1)"));
+    EXPECT_TRUE(HasLine(message, R"(test.json: shadow.form: must be one of "beer", "thesis", "wang", got 1)"));
     EXPECT_EQ(SplitLines(message).size(), 4u) << message;
 }
 
@@ -243,7 +243,8 @@ TEST(SceneTest, WrongBooleanType) {
 // Test that the other new fields refuse out-of-range values with their ranges (a sample of each kind of bound).
 TEST(SceneTest, LightingFieldRanges) {
     std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "sun": {"intensity": -1},
-        "shade": {"sigma": -0.1, "scattering": {"solid_angle": 13, "albedo": 1.5}}, "shadow": {"kappa": -1},
+        "shade": {"sigma": -0.1, "scattering": {"solid_angle": 13, "albedo": 1.5}},
+        "shadow": {"kappa": -1, "coverage": 1.5, "density_factor": -0.5},
         "render": {"width": 0, "height": 16385, "splat_scale": 0, "opacity": 2, "every_steps": -1,
                    "cameras": {"eye": [0, 0, 0]}}})");
     EXPECT_TRUE(HasLine(message, "test.json: sun.intensity: must be in [0, 1e+30], got -1"));
@@ -252,6 +253,8 @@ TEST(SceneTest, LightingFieldRanges) {
         HasLine(message, "test.json: shade.scattering.solid_angle: must be in (0, 12.566370614359172], got 13"));
     EXPECT_TRUE(HasLine(message, "test.json: shade.scattering.albedo: must be in [0, 1], got 1.5"));
     EXPECT_TRUE(HasLine(message, "test.json: shadow.kappa: must be in [0, 1e+30], got -1"));
+    EXPECT_TRUE(HasLine(message, "test.json: shadow.coverage: must be in [0, 1], got 1.5"));
+    EXPECT_TRUE(HasLine(message, "test.json: shadow.density_factor: must be in [0, 1], got -0.5"));
     EXPECT_TRUE(HasLine(message, "test.json: render.width: must be in [1, 16384], got 0"));
     EXPECT_TRUE(HasLine(message, "test.json: render.height: must be in [1, 16384], got 16385"));
     EXPECT_TRUE(HasLine(message, "test.json: render.splat_scale: must be > 0, got 0"));
@@ -259,7 +262,7 @@ TEST(SceneTest, LightingFieldRanges) {
     EXPECT_TRUE(HasLine(message, "test.json: render.every_steps: must be in [0, 4294967295], got -1"));
     EXPECT_TRUE(
         HasLine(message, R"(test.json: render.cameras: expected an array of camera objects, got {"eye":[0,0,0]})"));
-    EXPECT_EQ(SplitLines(message).size(), 11u) << message;
+    EXPECT_EQ(SplitLines(message).size(), 13u) << message;
 }
 
 // Test that unknown keys inside the new sections and a camera are refused, a shortened key suggesting the full one.

@@ -20,6 +20,7 @@ namespace {
 
 static_assert(kPhaseKindNames.size() == size_t(PhaseKind::Mie) + 1);
 static_assert(kAttenuationKindNames.size() == size_t(AttenuationKind::Thesis) + 1);
+static_assert(kShadowFormNames.size() == size_t(ShadowForm::Wang) + 1);
 static_assert(kSampleFilterNames.size() == size_t(SampleFilter::Nearest) + 1);
 static_assert(kStorageFormatNames.size() == size_t(StorageFormat::Unorm8) + 1);
 static_assert(ValueNamed(kStorageFormatNames, "fp16") == StorageFormat::Fp16);
@@ -63,10 +64,9 @@ Scene SceneWith(const std::string& section, const std::string& field, std::strin
 
 TEST(SceneNames, TheLoaderAcceptsEveryName) {
     for (const auto& [name, value] : kPhaseKindNames) EXPECT_EQ(SceneWith("phase", "function", name).phase.kind, value);
-    for (const auto& [name, value] : kAttenuationKindNames) {
+    for (const auto& [name, value] : kAttenuationKindNames)
         EXPECT_EQ(SceneWith("shade", "attenuation", name).shade.attenuation, value);
-        EXPECT_EQ(SceneWith("shadow", "form", name).shadow.form, value);
-    }
+    for (const auto& [name, value] : kShadowFormNames) EXPECT_EQ(SceneWith("shadow", "form", name).shadow.form, value);
     for (const auto& [name, value] : kSampleFilterNames)
         EXPECT_EQ(SceneWith("shade", "filter", name).shade.filter, value);
     for (const auto& [name, value] : kStorageFormatNames)
@@ -110,7 +110,7 @@ TEST(SceneNames, AreThoseTheDocsList) {
     EXPECT_EQ(DocumentedNames("shade", "attenuation"), TableNames(kAttenuationKindNames));
     EXPECT_EQ(DocumentedNames("shade", "filter"), TableNames(kSampleFilterNames));
     EXPECT_EQ(DocumentedNames("shade", "storage"), TableNames(kStorageFormatNames));
-    EXPECT_EQ(DocumentedNames("shadow", "form"), TableNames(kAttenuationKindNames));
+    EXPECT_EQ(DocumentedNames("shadow", "form"), TableNames(kShadowFormNames));
 }
 
 }  // namespace

@@ -185,7 +185,9 @@ TEST(SceneTest, LightingSectionsDefaults) {
     EXPECT_FALSE(scene.shade.scattering);
     EXPECT_EQ(scene.shade.albedo, 0.9);
     EXPECT_EQ(scene.shade.solidAngle, 0.05);
-    EXPECT_EQ(scene.shadow.form, AttenuationKind::Beer);
+    EXPECT_EQ(scene.shadow.form, ShadowForm::Beer);
+    EXPECT_EQ(scene.shadow.coverage, 1.0);
+    EXPECT_EQ(scene.shadow.densityFactor, 1.0);
     EXPECT_EQ(scene.shadow.kappa, 0.25);
     EXPECT_EQ(scene.render.width, 320u);
     EXPECT_EQ(scene.render.height, 240u);
@@ -254,7 +256,7 @@ TEST(SceneTest, FullSceneParsesEveryLightingField) {
     EXPECT_TRUE(scene.shade.scattering);
     EXPECT_EQ(scene.shade.albedo, 0.8);
     EXPECT_EQ(scene.shade.solidAngle, 12.5);
-    EXPECT_EQ(scene.shadow.form, AttenuationKind::Thesis);
+    EXPECT_EQ(scene.shadow.form, ShadowForm::Thesis);
     EXPECT_EQ(scene.shadow.kappa, 0.0);
     EXPECT_EQ(scene.render.width, 16384u);
     EXPECT_EQ(scene.render.height, 1u);

@@ -355,7 +355,7 @@ TEST(Shadow, HandWorked) {
     G = ShadowOnCpu(e, D, p);
     EXPECT_NEAR(G[1 + 10 * 2], std::exp(-0.01f * 50 * 2.0f / s), 1e-6);
     EXPECT_EQ(G[5 + 10 * 2], 1.0f);
-    p.form = AttenuationKind::Thesis;
+    p.form = ShadowForm::Thesis;
     p.kappa = 0.3f;
     G = ShadowOnCpu(e, D, p);
     EXPECT_NEAR(G[1 + 10 * 2], 1.0f - 0.6f, 1e-6);
@@ -367,6 +367,49 @@ TEST(Shadow, HandWorked) {
     for (float g : ShadowOnCpu(e, D, p)) EXPECT_EQ(g, 1.0f);
     p.sun = SunDirection(1e-4, 0.0);  // grazing: finite
     for (float g : ShadowOnCpu(e, D, p)) EXPECT_TRUE(std::isfinite(g));
+}
+
+// Test Wang's form (seed 002 eq. 19, S = 1 - D_w max(T_S - (T_2D + 1 - C), 0))
+// by hand, with T_S the column's opacity 1 - exp(-sigma h D / s_z) and T_2D = 0
+// (docs/pipeline.md). D = 2, sigma h = 0.5: overhead tau = 1, opacity
+// 1 - e^-1 = 0.632121; C = 0.8, D_w = 0.5: S = 1 - 0.5 (0.632121 - 0.2) = 0.783940.
+// At 45 degrees tau = sqrt 2: S = 1 - 0.5 (1 - e^-1.414214 - 0.2) = 0.721558.
+// Coverage 0.3: 1 - C = 0.7 is above the overhead opacity (no shadow) but below
+// the slant one (S = 1 - 0.5 (0.756883 - 0.7) = 0.971558); C = D_w = 1 is plain
+// exp(-tau) = 0.367879.
+TEST(Shadow, WangHandWorked) {
+    const Extent3 e{10, 4, 8};
+    std::vector<float> D(40, 0.0f);
+    D[5 + 10 * 2] = 2.0f;
+    ShadowParams p;
+    p.form = ShadowForm::Wang;
+    p.sigma = 0.01f;
+    p.voxelSize = 50;
+    p.nz = e.nz;
+    p.coverage = 0.8f;
+    p.densityFactor = 0.5f;
+    p.kappa = 5.0f;  // the thesis form's; Wang's ignores it
+    p.sun = {0, 0, 1};
+    std::vector<float> G = ShadowOnCpu(e, D, p);
+    EXPECT_NEAR(G[5 + 10 * 2], 0.7839397f, 1e-6);
+    EXPECT_EQ(G[4 + 10 * 2], 1.0f);  // no cloud: opacity 0, no shadow
+    const float s = std::sqrt(0.5f);
+    p.sun = {s, 0, s};  // offset nz/2 = 4 cells toward +x
+    G = ShadowOnCpu(e, D, p);
+    EXPECT_NEAR(G[1 + 10 * 2], 0.7215584f, 1e-6);
+    EXPECT_EQ(G[5 + 10 * 2], 1.0f);
+    p.coverage = 0.3f;  // slant opacity 0.756883 still exceeds 1 - C = 0.7
+    EXPECT_NEAR(ShadowOnCpu(e, D, p)[1 + 10 * 2], 0.9715584f, 1e-6);
+    p.sun = {0, 0, 1};  // overhead opacity 0.632121 does not
+    for (float g : ShadowOnCpu(e, D, p)) EXPECT_EQ(g, 1.0f);
+    p.coverage = 1.0f;
+    p.densityFactor = 1.0f;
+    EXPECT_NEAR(ShadowOnCpu(e, D, p)[5 + 10 * 2], 0.3678794f, 1e-6);
+    p.densityFactor = 0.0f;  // no density: no shadow
+    for (float g : ShadowOnCpu(e, D, p)) EXPECT_EQ(g, 1.0f);
+    p.sun = {0.6f, 0, -0.8f};  // no sun above the horizon
+    p.densityFactor = 1.0f;
+    for (float g : ShadowOnCpu(e, D, p)) EXPECT_EQ(g, 1.0f);
 }
 
 }  // namespace

@@ -83,6 +83,17 @@ float GroundShadow(uint beer, float opticalDepthPerD, float kappa, float d) {
     return beer != 0u ? ExpNonPositive(depth) : thesis;
 }
 
+// Wang's ground shadow, seed 002 eq. 19 (core/Shading.h WangShadow): T_S is the
+// column's opacity along the sun, T_2D = 0, C = coverage, D_w = densityFactor.
+float WangShadow(float opticalDepthPerD, float coverage, float densityFactor, float d) {
+    precise float depth = -opticalDepthPerD * d;
+    precise float shadowTexture = 1.0 - ExpNonPositive(depth);
+    const float modulation = 0.0;
+    precise float excess = max(shadowTexture - (modulation + 1.0 - coverage), 0.0);
+    precise float s = 1.0 - densityFactor * excess;
+    return s;
+}
+
 // Where fine voxel i reads a grid of `cells` coarse cells (f fine voxels each):
 // coordinate (i + 0.5)/f - 0.5 clamped to the centres, taps i0 and i1, weight w
 // (core/Shading.h UpsampleTap).

@@ -76,7 +76,7 @@ std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage
         addNames("shade.storage", kStorageFormatNames, s.storage);
         add("shade.scattering.enabled", {"false", "true"}, s.scattering ? "true" : "false");
     } else {
-        addNames("shadow.form", kAttenuationKindNames, scene.shadow.form);
+        addNames("shadow.form", kShadowFormNames, scene.shadow.form);
     }
     return out;
 }

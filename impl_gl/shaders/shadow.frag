@@ -4,9 +4,10 @@ layout(binding = 0) uniform sampler2DArray d;
 uniform ivec2 size;
 uniform ivec2 base;      // floor of the offset
 uniform vec2 fraction;   // its fraction
-uniform int beer;        // 1: exp(-k D), 0: 1 - clamp(kappa D)
+uniform int form;        // ShadowForm: 0 beer exp(-k D), 1 thesis 1 - clamp(kappa D), 2 wang (seed 002 eq. 19)
 uniform float opticalDepthPerD;
 uniform float kappa;
+uniform float coverage, densityFactor;  // wang
 uniform int noSun;       // 1: G = 1
 layout(location = 0) out float g;
 
@@ -23,5 +24,6 @@ void main() {
     const ivec2 p = ivec2(gl_FragCoord.xy) + base;
     const float dd = Bilinear(TapD(p.x, p.y), TapD(p.x + 1, p.y), TapD(p.x, p.y + 1), TapD(p.x + 1, p.y + 1), fraction.x,
                               fraction.y);
-    g = GroundShadow(uint(beer), opticalDepthPerD, kappa, dd);
+    g = form == 2 ? WangShadow(opticalDepthPerD, coverage, densityFactor, dd)
+                  : GroundShadow(form == 0 ? 1u : 0u, opticalDepthPerD, kappa, dd);
 }

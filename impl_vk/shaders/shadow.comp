@@ -11,9 +11,10 @@ layout(push_constant) uniform Params {
     uint nx, ny;
     int bx, by;        // floor of the offset
     float fx, fy;      // its fraction
-    uint beer;         // 1: exp(-k D), 0: 1 - clamp(kappa D)
+    uint form;         // ShadowForm: 0 beer exp(-k D), 1 thesis 1 - clamp(kappa D), 2 wang (seed 002 eq. 19)
     float opticalDepthPerD, kappa;
     uint noSun;        // 1: G = 1
+    float coverage, densityFactor;  // wang
 } pc;
 
 float TapD(int i, int j) {
@@ -30,5 +31,6 @@ void main() {
     }
     const int x = int(id % pc.nx) + pc.bx, y = int(id / pc.nx) + pc.by;
     const float dd = Bilinear(TapD(x, y), TapD(x + 1, y), TapD(x, y + 1), TapD(x + 1, y + 1), pc.fx, pc.fy);
-    g[id] = GroundShadow(pc.beer, pc.opticalDepthPerD, pc.kappa, dd);
+    g[id] = pc.form == 2u ? WangShadow(pc.opticalDepthPerD, pc.coverage, pc.densityFactor, dd)
+                          : GroundShadow(pc.form == 0u ? 1u : 0u, pc.opticalDepthPerD, pc.kappa, dd);
 }

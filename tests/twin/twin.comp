@@ -68,6 +68,7 @@ void main() {
         case 15u: PutF(0u, SliceFactor(U(0u), F(1u), F(2u), F(3u), F(4u))); break;
         case 16u: PutF(0u, StoreTransmittance(U(0u), F(1u), F(2u))); break;
         case 17u: PutF(0u, GroundShadow(U(0u), F(1u), F(2u), F(3u))); break;
+        case 45u: PutF(0u, WangShadow(F(0u), F(1u), F(2u), F(3u))); break;
         case 18u: {
             int i0, i1;
             float w;
