@@ -147,19 +147,21 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> ms;
                 nlohmann::json steps = nlohmann::json::array(), splats = nlohmann::json::array(),
-                               alphas = nlohmann::json::array();
+                               alphas = nlohmann::json::array(), visited = nlohmann::json::array();
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
                         if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
                             ms.push_back(f.ms);
                             steps.push_back(r.step);
                             splats.push_back(f.stats.splats);
+                            visited.push_back(f.stats.voxelsVisited);
                             alphas.push_back(f.alpha);
                         }
                 nlohmann::json c = SummaryJson(ms);
                 c["steps"] = steps;
                 c["alphas"] = alphas;
                 c["splats"] = splats;
+                c["voxels_visited"] = visited;
                 c["fps_median"] = ms.empty() ? 0.0 : 1000.0 / Summarize(ms).median;
                 cameras[camera.name] = c;
             }
