@@ -67,6 +67,8 @@ inline std::vector<float> AndNeighbours(float x) {
 // Every function of core/glsl but MakeSplat, PowderTerm and those that read a MarchGpu block
 // (GlslTwinTest.cpp has them), with its random inputs, edges and C++ twin.
 std::vector<TwinCase> Cases();
+// The march.glsl part of Cases() (GlslTwinMarchCases.cpp).
+void AddMarchCases(std::vector<TwinCase>& cases);
 
 // Compares the GLSL's outputs with the C++ twin's, element by element; the
 // failure message shows the first few mismatches with their inputs.

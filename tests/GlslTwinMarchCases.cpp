@@ -1,0 +1,164 @@
+// The twin cases of core/glsl/march.glsl that need no MarchGpu block (the rest
+// run in GlslTwinTest.cpp): ArcCos, the Mie lookup, the ray and step formulas.
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "GlslTwinHarness.h"
+#include "core/March.h"
+#include "core/Shading.h"
+
+namespace cb::test {
+
+void AddMarchCases(std::vector<TwinCase>& c) {
+    {
+        // Every x of a grid of step 1/4096 over [-1, 1] (2^13 + 1 points), the ends and their neighbours.
+        std::vector<Words> edges;
+        for (int n = -4096; n <= 4096; ++n) edges.push_back(WF({float(n) / 4096.0f}));
+        for (float x : {1.0f, -1.0f, 0.0f, 0.5f, -0.5f})
+            for (float y : AndNeighbours(x))
+                if (std::fabs(y) <= 1.0f) edges.push_back(WF({y}));
+        edges.push_back(WF({-0.0f}));
+        c.push_back({"ArcCos",
+                     34,
+                     {Kind::F},
+                     [](Pcg32& r, Words& in) { in = WF({Uniform(r, -1, 1)}); },
+                     edges,
+                     [](const Words& in, Words& out) { out[0] = Bits(ArcCos(Float(in[0]))); },
+                     /*otherDeviceUlps=*/8});
+    }
+    {
+        // The lookup with the real table (bound by GlslTwin::Run): cos at every node of the table and
+        // one float either side, and cos slightly outside [-1, 1] (clamped).
+        const float perRadian = kMieCloudTable.indexPerRadian;
+        const uint32_t count = kMieCloudTable.count;
+        std::vector<Words> edges;
+        for (uint32_t i = 0; i < count; ++i)
+            for (float x : AndNeighbours(float(std::cos(double(i) / perRadian))))
+                edges.push_back(W({Bits(perRadian), count, Bits(std::clamp(x, -1.0f, 1.0f))}));
+        for (float x : {1.5f, -1.5f, 1.0f, -1.0f}) edges.push_back(W({Bits(perRadian), count, Bits(x)}));
+        c.push_back({"SampleMiePhase",
+                     35,
+                     {Kind::F},
+                     [perRadian, count](Pcg32& r, Words& in) {
+                         in = W({Bits(perRadian), count, Bits(Uniform(r, -1, 1))});
+                     },
+                     edges,
+                     [](const Words& in, Words& out) { out[0] = Bits(SamplePhaseTable(kMieCloudTable, Float(in[2]))); },
+                     /*otherDeviceUlps=*/64});
+        // PhaseValue of every kind through march.glsl's MarchPhase (Mie: the table; the others: shading.glsl).
+        c.push_back({"MarchPhase",
+                     36,
+                     {Kind::F},
+                     [perRadian, count](Pcg32& r, Words& in) {
+                         in = W({r.Below(4), Bits(Uniform(r, -0.95, 0.95)), Bits(Uniform(r, -1, 1)), Bits(perRadian),
+                                 count});
+                     },
+                     {W({3, Bits(0.6f), Bits(1.0f), Bits(perRadian), count}),
+                      W({3, Bits(0.6f), Bits(-1.0f), Bits(perRadian), count}),
+                      W({3, Bits(0.0f), Bits(0.0f), Bits(perRadian), count}),
+                      W({1, Bits(0.6f), Bits(1.0f), Bits(perRadian), count})},
+                     [](const Words& in, Words& out) {
+                         out[0] = Bits(PhaseValue({PhaseKind(in[0]), Float(in[1])}, Float(in[2])));
+                     },
+                     /*otherDeviceUlps=*/64});
+    }
+    {
+        // Boxes up to 300 voxels, origins inside and outside, directions with zero components (and
+        // components below 1e-20, treated as zero), and near / far intervals.
+        auto component = [](Pcg32& r) {
+            const uint32_t k = r.Below(6);
+            return k == 0 ? 0.0f : k == 1 ? -0.0f : k == 2 ? Uniform(r, -1e-21, 1e-21) : Uniform(r, -1, 1);
+        };
+        std::vector<Words> edges = {
+            WF({5, 5, 5, 0, 0, 1, 10, 10, 10, 0, 1e30f}),  WF({5, 5, -1, 0, 0, 1, 10, 10, 10, 0, 1e30f}),
+            WF({-1, 5, 5, 0, 0, 1, 10, 10, 10, 0, 1e30f}), WF({11, 5, 5, 0, 1, 0, 10, 10, 10, 0, 1e30f}),
+            WF({0, 0, 0, 1, 1, 1, 10, 10, 10, 0, 1e30f}),  WF({10, 10, 10, -1, -1, -1, 10, 10, 10, 2, 5}),
+            WF({5, 5, 5, -0.0f, 0, 1, 10, 10, 10, 0, 1e30f}), WF({5, 5, 5, 1e-20f, 0, 1, 10, 10, 10, 0, 3}),
+            WF({5, 5, 5, 0, 0, 0, 10, 10, 10, 0, 1e30f})};
+        c.push_back({"ClipRayToBox",
+                     37,
+                     {Kind::F, Kind::F},
+                     [component](Pcg32& r, Words& in) {
+                         const float n[3] = {float(1 + r.Below(300)), float(1 + r.Below(300)), float(1 + r.Below(300))};
+                         in = WF({Uniform(r, -50, n[0] + 50), Uniform(r, -50, n[1] + 50), Uniform(r, -50, n[2] + 50),
+                                  component(r), component(r), component(r), n[0], n[1], n[2], Uniform(r, 0, 20),
+                                  r.Below(2) ? 1e30f : Uniform(r, 20, 500)});
+                     },
+                     edges,
+                     [](const Words& in, Words& out) {
+                         float tMin = Float(in[9]), tMax = Float(in[10]);
+                         ClipRayToBox({Float(in[0]), Float(in[1]), Float(in[2])}, {Float(in[3]), Float(in[4]), Float(in[5])},
+                                      {Float(in[6]), Float(in[7]), Float(in[8])}, tMin, tMax);
+                         out[0] = Bits(tMin);
+                         out[1] = Bits(tMax);
+                     },
+                     /*otherDeviceUlps=*/3});
+        c.push_back({"RayExitFromBox",
+                     40,
+                     {Kind::F, Kind::F, Kind::F, Kind::F},
+                     [component](Pcg32& r, Words& in) {
+                         const float B = float(1 + r.Below(16));
+                         const float lo[3] = {B * float(r.Below(20)), B * float(r.Below(20)), B * float(r.Below(20))};
+                         in = WF({Uniform(r, lo[0], lo[0] + B), Uniform(r, lo[1], lo[1] + B), Uniform(r, lo[2], lo[2] + B),
+                                  component(r), component(r), component(r), lo[0], lo[1], lo[2], lo[0] + B, lo[1] + B,
+                                  lo[2] + B, Uniform(r, 0, 300)});
+                     },
+                     {WF({1, 1, 1, 0, 0, 1, 0, 0, 0, 8, 8, 8, 0}), WF({1, 1, 1, 0, -0.0f, -1, 0, 0, 0, 8, 8, 8, 0}),
+                      WF({1, 1, 1, 1e-21f, 1, 0, 0, 0, 0, 8, 8, 8, 100}), WF({8, 8, 8, 1, 1, 1, 0, 0, 0, 8, 8, 8, 0})},
+                     [](const Words& in, Words& out) {
+                         const Vec3 inv = InverseDirection({Float(in[3]), Float(in[4]), Float(in[5])});
+                         out[0] = Bits(RayExitFromBox({Float(in[0]), Float(in[1]), Float(in[2])}, inv,
+                                                      {Float(in[6]), Float(in[7]), Float(in[8])},
+                                                      {Float(in[9]), Float(in[10]), Float(in[11])}, Float(in[12])));
+                         out[1] = Bits(inv[0]);
+                         out[2] = Bits(inv[1]);
+                         out[3] = Bits(inv[2]);
+                     },
+                     /*otherDeviceUlps=*/3});
+    }
+    c.push_back({"MarchStepAt",
+                 38,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     in = W({Bits(Uniform(r, 0.01, 4)), Bits(Uniform(r, 0, 0.5)), Bits(Uniform(r, 0, 200)), r.Below(2),
+                             Bits(Uniform(r, 0, 2000))});
+                 },
+                 {W({Bits(0.5f), Bits(0.05f), Bits(64.0f), 1, Bits(64.0f)}),
+                  W({Bits(0.5f), Bits(0.05f), Bits(64.0f), 1, Bits(10.0f)}),
+                  W({Bits(0.5f), Bits(0.05f), Bits(64.0f), 0, Bits(1000.0f)})},
+                 [](const Words& in, Words& out) {
+                     MarchSetup s;
+                     s.step = Float(in[0]), s.kappa = Float(in[1]), s.adaptiveStart = Float(in[2]);
+                     s.adaptive = in[3] != 0;
+                     out[0] = Bits(MarchStepAt(s, Float(in[4])));
+                 }});
+    c.push_back({"MarchJitter",
+                 39,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) { in = W({r.NextU32(), r.Below(1000), r.Below(1u << 22)}); },
+                 {W({0, 0, 0}), W({1, 0, 0}), W({0xffffffffu, 0xffffffffu, 0xffffffffu})},
+                 [](const Words& in, Words& out) { out[0] = Bits(MarchJitter(in[0], in[1], in[2])); }});
+    // PowderTerm (fn 41) calls pow: GlslTwinTest.cpp compares it with an absolute bound.
+    {
+        std::vector<Words> edges = {WF({1, 0.5f, 2, 4, 1, 0}), WF({0, 1, 1, 0, 1, -0.0f}),
+                                    WF({3.4e38f, 1, 1, 1e-30f, 1e-30f, -1}), WF({0.07f, 0, 1e6f, 2500, 2500, 1e30f}),
+                                    WF({1, 1, 0, 1, 2, Float(0x7f7ffffeu)})};
+        c.push_back({"MarchKernelFormulas",
+                     42,
+                     {Kind::F, Kind::F, Kind::F},
+                     [](Pcg32& r, Words& in) {
+                         in = WF({Uniform(r, 0, 5), Uniform(r, 0, 1), Uniform(r, 0, 4), Uniform(r, 0, 1e6),
+                                  Uniform(r, 1, 1e4), Uniform(r, -1e3, 1e3)});
+                     },
+                     edges,
+                     [](const Words& in, Words& out) {
+                         out[0] = Bits(SegmentTransmittance(Float(in[0]), Float(in[1]), Float(in[2])));
+                         out[1] = Bits(PointLightFalloff(Float(in[3]), Float(in[4])));
+                         out[2] = Bits(std::nextafter(Float(in[5]), std::numeric_limits<float>::max()));
+                     },
+                     /*otherDeviceUlps=*/3});
+    }
+}
+
+}  // namespace cb::test
