@@ -17,27 +17,17 @@
 #include "core/March.h"
 #include "core/Random.h"
 #include "impl_cpu/BackendCpu.h"
+#include "tests/MarchTestUtil.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
 namespace {
 
+using test::CameraParams;
+using test::PlainSetup;
+
 // ---- Helpers ---------------------------------------------------------------------
 
-MarchSetup PlainSetup(Vec3 size, float sigmaH) {
-    MarchSetup s;
-    s.size = size;
-    s.voxelSize = 1;
-    s.step = 0.5f;
-    s.sigmaH = sigmaH;
-    s.epsilon = 0;
-    s.sun = {0, 0, 1};
-    s.sunRadiance = {1.0f, 0.9f, 0.8f};
-    s.ambient = {0.2f, 0.25f, 0.3f};
-    s.background = {0.4f, 0.6f, 0.9f};
-    s.phase.kind = PhaseKind::None;
-    return s;
-}
 
 // A ray along +z through (x, y), clipped to [t0, t1].
 MarchRayGeometry RayAlongZ(float x, float y, float t0, float t1) {
@@ -77,23 +67,6 @@ MarchImage RenderCpu(const MarchCase& c, int threads = 2) {
     return out;
 }
 
-MarchParams CameraParams(const Extent3& e, std::array<double, 3> eye, std::array<double, 3> target, uint32_t w,
-                         uint32_t h, float sigma = 0.05f) {
-    CameraSettings cam;
-    cam.eye = eye;
-    cam.target = target;
-    cam.fovDeg = 50;
-    cam.nearPlane = 0.01;
-    cam.farPlane = 1e5;
-    MarchParams p;
-    p.camera = MakeCameraFrame(cam, w, h);
-    p.setup = PlainSetup({float(e.nx), float(e.ny), float(e.nz)}, sigma);
-    p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
-    p.setup.sun = SunDirection(0.7, 0.4);
-    p.origin = {0, 0, 0};
-    p.alpha = 0.5f;
-    return p;
-}
 
 // A few Gaussian blobs, zero below 1e-3 so that whole bricks are empty.
 std::vector<float> BlobField(const Extent3& e) {

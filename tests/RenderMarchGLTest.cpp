@@ -21,6 +21,7 @@
 #include "harness/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
+#include "tests/MarchTestUtil.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
@@ -67,27 +68,11 @@ class RenderMarchGL : public ::testing::Test {
     std::unique_ptr<Backend> mGl;
 };
 
+// The shared test camera, with early termination at epsilon 0.01 and alpha 0.3.
 MarchParams GlCameraParams(const Extent3& e, std::array<double, 3> eye, std::array<double, 3> target, uint32_t w,
                            uint32_t h, float sigmaH = 0.05f) {
-    CameraSettings cam;
-    cam.eye = eye;
-    cam.target = target;
-    cam.fovDeg = 50;
-    cam.nearPlane = 0.01;
-    cam.farPlane = 1e5;
-    MarchParams p;
-    p.camera = MakeCameraFrame(cam, w, h);
-    MarchSetup& s = p.setup;
-    s.size = {float(e.nx), float(e.ny), float(e.nz)};
-    s.voxelSize = 1;
-    s.step = 0.5f;
-    s.sigmaH = sigmaH;
-    s.epsilon = 0.01f;
-    s.sun = SunDirection(0.7, 0.4);
-    s.sunRadiance = {1.0f, 0.9f, 0.8f};
-    s.ambient = {0.2f, 0.25f, 0.3f};
-    s.background = {0.4f, 0.6f, 0.9f};
-    s.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+    MarchParams p = test::CameraParams(e, eye, target, w, h, sigmaH);
+    p.setup.epsilon = 0.01f;
     p.alpha = 0.3f;
     return p;
 }

@@ -18,6 +18,7 @@
 #include "core/Scene.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
+#include "tests/MarchTestUtil.h"
 #include "tests/TestUtil.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/BackendVk.h"
@@ -53,27 +54,11 @@ VkMarchImage RenderOn(Backend& backend, const VkMarchCase& c) {
     return out;
 }
 
+// The shared test camera, with early termination at epsilon 0.01.
 MarchParams VkCameraParams(const Extent3& e, std::array<double, 3> eye, std::array<double, 3> target, uint32_t w,
                            uint32_t h, float sigmaH) {
-    CameraSettings cam;
-    cam.eye = eye;
-    cam.target = target;
-    cam.fovDeg = 50;
-    cam.nearPlane = 0.01;
-    cam.farPlane = 1e5;
-    MarchParams p;
-    p.camera = MakeCameraFrame(cam, w, h);
-    p.setup.size = {float(e.nx), float(e.ny), float(e.nz)};
-    p.setup.voxelSize = 1;
-    p.setup.step = 0.5f;
-    p.setup.sigmaH = sigmaH;
+    MarchParams p = test::CameraParams(e, eye, target, w, h, sigmaH);
     p.setup.epsilon = 0.01f;
-    p.setup.sun = SunDirection(0.7, 0.4);
-    p.setup.sunRadiance = {1.0f, 0.9f, 0.8f};
-    p.setup.ambient = {0.2f, 0.25f, 0.3f};
-    p.setup.background = {0.4f, 0.6f, 0.9f};
-    p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
-    p.alpha = 0.5f;
     return p;
 }
 
