@@ -131,6 +131,10 @@ class BackendGL final : public Backend {
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8) : mContext(std::move(context)), mRgba8(rgba8) {}
     GLuint Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
     GLuint ScratchBuffer(GlScratchBuffer slot, size_t bytes);
+    // Copies a renderer's W x H RGB(A) float target into `image` ((3, W, H) F32)
+    // on the device, through the pixel buffer in `slot`: the target's rows, top
+    // first, in RGB floats are exactly the canonical layout.
+    void CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScratchBuffer slot, Buffer& image);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the
     // context's framebuffer as colour attachments 0, 1, ... and makes them the
     // draw buffers; the other attachments are detached.

@@ -121,17 +121,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.Viewport(0, 0, GLsizei(W), GLsizei(H));
     f.DrawArrays(GL_TRIANGLES, 0, 3);
 
-    // The image: RGB floats of rows top first are exactly the canonical layout.
-    const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
-    const GLuint copy = ScratchBuffer(GlScratchBuffer::MarchImageCopy, imageBytes);
-    f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
-    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    f.GetTextureImage(target, 0, GL_RGB, GL_FLOAT, GLsizei(imageBytes), nullptr);
-    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, copy);
-    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
-    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    CopyTargetToImage(target, W, H, GlScratchBuffer::MarchImageCopy, image);
     mLastDeviceMs = timer.StopMs();
     if (stats) {
         f.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);

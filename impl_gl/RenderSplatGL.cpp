@@ -105,18 +105,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (stats) f.EndQuery(GL_SAMPLES_PASSED);
     f.Disable(GL_BLEND);
     f.Disable(GL_PROGRAM_POINT_SIZE);
-    // The image: RGB floats of rows top first are exactly the canonical layout.
-    const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
-    const GLuint copy = ScratchBuffer(GlScratchBuffer::ImageCopy, imageBytes);
-    f.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
-    f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
-    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    f.GetTextureImage(target, 0, GL_RGB, GL_FLOAT, GLsizei(imageBytes), nullptr);
-    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, copy);
-    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
-    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    CopyTargetToImage(target, W, H, GlScratchBuffer::ImageCopy, image);
     mLastDeviceMs = timer.StopMs();
     if (stats) {
         GLuint64 passed = 0;
@@ -129,6 +118,21 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         stats->fragments = passed;
     }
     return mContext->Check("render_splat");
+}
+
+void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScratchBuffer slot, Buffer& image) {
+    const Functions& f = mContext->F();
+    const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
+    const GLuint copy = ScratchBuffer(slot, imageBytes);
+    f.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(target, 0, GL_RGB, GL_FLOAT, GLsizei(imageBytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, copy);
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
+    f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
 }
 
 }  // namespace cb::gl
