@@ -62,6 +62,31 @@ class Buffer {
     Extent3 mExtent;
 };
 
+// A share of one stage call's work, for time-slicing (SPEC 13): the call
+// computes only the slices [begin, end) of the stage's share axis, clamped to
+// its share count, and leaves the rest of its outputs as they were. Running
+// a step's shares in ascending order, each once, with nothing in between
+// that writes the stage's outputs, gives exactly the whole call's outputs.
+// The axis of each stage (docs/pipeline.md, "Time-slicing"):
+//   region, ca, smooth   slices k; share count nz
+//   density              rows of tiles; share count ceil(ny / tile). D, tiles
+//                        and bands of those rows; coveredColumns counts the
+//                        covered columns of those rows only (the shares' counts add up)
+//   shade                the sweep's slices m (ShadePlan::SliceW, nearest the sun
+//                        first); share count ShadePlan::nw. At resolution f > 1 the
+//                        share holding m = 0 also fills the coarse grid and the share
+//                        ending at nw writes T (until then T is left as it was)
+// The default is the whole call.
+struct SliceRange {
+    uint32_t begin = 0;
+    uint32_t end = UINT32_MAX;
+
+    uint32_t Begin(uint32_t count) const { return begin < count ? begin : count; }
+    uint32_t End(uint32_t count) const { return end < count ? end : count; }
+    bool IsWhole(uint32_t count) const { return begin == 0 && end >= count; }
+    bool operator==(const SliceRange&) const = default;
+};
+
 // The automaton's three bit fields at one step.
 struct CaFields {
     Buffer* hum = nullptr;
@@ -82,6 +107,7 @@ struct CaStepParams {
     uint32_t qExt = 0, qHum = 0, qAct = 0;
     // Empty, or one (sx, sy) per slice k.
     std::span<const int32_t> shiftX, shiftY;
+    SliceRange slices;  // the slices k of `out` to write
 };
 
 struct CaInitParams {
@@ -102,6 +128,7 @@ struct DensityOutputs {
 struct DensityParams {
     uint32_t tile = 32;
     uint32_t band = 4;
+    SliceRange slices;  // the rows of tiles to compute
 };
 
 // Inputs of the noise producer of q (SPEC 10a): the scene's noise settings,
@@ -126,6 +153,7 @@ struct ShadeParams {
     bool scattering = false;
     float albedo = 0.9f, solidAngle = 0.05f;
     PhaseParams phase;
+    SliceRange slices;  // the sweep's slices m to compute
 };
 
 // Inputs of the shadow stage (SPEC 7) besides D.
@@ -207,6 +235,7 @@ struct MarchStats {
 
 // The backends' entry points, X(stage, Method, (parameters)): one or more per
 // stage (the automaton has two). Contracts:
+// Region, CaStep, Smooth, Density and Shade compute the share `slices` (SliceRange).
 //   Region        R = max-blend of the ellipsoids; region is U8 of the grid size.
 //   CaInitialize  the automaton's state at t = 0.
 //   CaStep        one step t -> t+1; `in` and `out` must be distinct buffers.
@@ -221,10 +250,10 @@ struct MarchStats {
 //   RenderMarch   the same image layout, linear HDR, one MarchRay per pixel
 //                 (core/March.h); the brick structure is built inside the call.
 #define CB_SPLAT_PIPELINE_ENTRIES(X)                                                                            \
-    X(Region, Region, (std::span<const RasterEllipsoid> ellipsoids, Buffer & region))                           \
+    X(Region, Region, (std::span<const RasterEllipsoid> ellipsoids, Buffer & region, SliceRange slices = {}))   \
     X(Ca, CaInitialize, (const CaInitParams& params, CaFields out))                                             \
     X(Ca, CaStep, (const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out))           \
-    X(Smooth, Smooth, (int radius, const Buffer& cld, Buffer& q))                                               \
+    X(Smooth, Smooth, (int radius, const Buffer& cld, Buffer& q, SliceRange slices = {}))                       \
     X(Density, Density, (const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out)) \
     X(Shade, Shade, (const ShadeParams& params, const Buffer& q, Buffer& T))                                    \
     X(Shadow, Shadow, (const ShadowParams& params, const Buffer& columnSum, Buffer& G))                         \

@@ -72,6 +72,7 @@ Status BackendCpu::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& regionBuffer, CaFields out) {
+    if (params.slices != SliceRange{}) return MakeError("cpu: ca in shares (time-slicing) is not implemented yet");
     const BitField& hum = static_cast<const BufferCpu&>(*in.hum).Bits();
     const BitField& act = static_cast<const BufferCpu&>(*in.act).Bits();
     const BitField& cld = static_cast<const BufferCpu&>(*in.cld).Bits();

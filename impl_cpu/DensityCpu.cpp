@@ -59,6 +59,7 @@ uint32_t ColumnsAboveZero(const float* D, size_t columns) {
 
 Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer* cldBuffer,
                            DensityOutputs& out) {
+    if (params.slices != SliceRange{}) return MakeError("cpu: density in shares (time-slicing) is not implemented yet");
     if (params.tile == 0 || params.band == 0) return MakeError("cpu: density tile and band must be positive");
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* D = static_cast<BufferCpu&>(*out.columnSum).F32();

@@ -42,7 +42,8 @@ EllipsoidBounds ComputeBounds(const RasterEllipsoid& e) {
 
 }  // namespace
 
-Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& regionBuffer) {
+Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& regionBuffer, SliceRange slices) {
+    if (slices != SliceRange{}) return MakeError("cpu: region in shares (time-slicing) is not implemented yet");
     uint8_t* region = static_cast<BufferCpu&>(regionBuffer).U8();
     const Extent3 e = regionBuffer.Extent();
     std::vector<EllipsoidBounds> bounds(ellipsoids.size());

@@ -167,6 +167,7 @@ void AddRowBlocks(const float* row, uint32_t n, int f, float* cell) {
 }  // namespace
 
 Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
+    if (params.slices != SliceRange{}) return MakeError("cpu: shade in shares (time-slicing) is not implemented yet");
     const int f = params.resolution;
     if (f != 1 && f != 2 && f != 4) return MakeError("cpu: shade resolution must be 1, 2 or 4");
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();

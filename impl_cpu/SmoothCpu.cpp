@@ -113,7 +113,8 @@ void SmoothSlices(const BitField& cld, float* q, uint32_t k0, uint32_t k1) {
 
 }  // namespace
 
-Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer) {
+Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, SliceRange slices) {
+    if (slices != SliceRange{}) return MakeError("cpu: smooth in shares (time-slicing) is not implemented yet");
     if (radius < 0 || radius > 2) return MakeError("cpu: smooth radius must be 0, 1 or 2");
     const BitField& cld = static_cast<const BufferCpu&>(cldBuffer).Bits();
     float* q = static_cast<BufferCpu&>(qBuffer).F32();

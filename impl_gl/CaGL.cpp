@@ -25,6 +25,7 @@ Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    if (params.slices != SliceRange{}) return MakeError("gl: ca in shares (time-slicing) is not implemented yet");
     if (mRgba8) return CaStepRgba8(params, in, region, out);
     const Functions& f = mContext->F();
     auto rules = mContext->Program("ca");

@@ -3,6 +3,7 @@
 namespace cb::gl {
 
 Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
+    if (params.slices != SliceRange{}) return MakeError("gl: density in shares (time-slicing) is not implemented yet");
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
     const Functions& f = mContext->F();
     auto sum = mContext->Program("density_sum");

@@ -5,7 +5,8 @@ namespace cb::gl {
 // region: per slice, one instanced quad per ellipsoid into an R8 UNORM layer
 // with MAX blending (integer targets cannot blend), then one copy into the
 // R8UI volume (the same 8-bit texel class, so the bits carry over).
-Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) {
+Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region, SliceRange slices) {
+    if (slices != SliceRange{}) return MakeError("gl: region in shares (time-slicing) is not implemented yet");
     const Functions& f = mContext->F();
     auto program = mContext->Program("region");
     if (!program) return std::unexpected(program.error());

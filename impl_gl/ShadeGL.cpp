@@ -11,6 +11,7 @@ namespace cb::gl {
 // w-major volume), then one pass that writes the z-layered T, reading the
 // w-major volume trilinearly (exactly, at f = 1).
 Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    if (params.slices != SliceRange{}) return MakeError("gl: shade in shares (time-slicing) is not implemented yet");
     const int res = params.resolution;
     if (res != 1 && res != 2 && res != 4) return MakeError("gl: shade resolution must be 1, 2 or 4");
     const Functions& f = mContext->F();

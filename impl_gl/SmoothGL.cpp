@@ -3,7 +3,8 @@
 namespace cb::gl {
 
 // smooth: three separable passes, x then y then z, through R16UI sums.
-Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q) {
+Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange slices) {
+    if (slices != SliceRange{}) return MakeError("gl: smooth in shares (time-slicing) is not implemented yet");
     if (radius < 0 || radius > 2) return MakeError("gl: smooth radius must be 0, 1 or 2");
     const Functions& f = mContext->F();
     GLuint passes[3];

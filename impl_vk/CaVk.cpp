@@ -33,6 +33,7 @@ Status BackendVk::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    if (params.slices != SliceRange{}) return MakeError("vk: ca in shares (time-slicing) is not implemented yet");
     const Extent3 e = in.hum->Extent();
     const uint32_t words = (e.nx + 31) / 32;
     const uint32_t count = words * e.ny * e.nz;

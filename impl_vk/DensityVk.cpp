@@ -5,6 +5,7 @@
 namespace cb::vk {
 
 Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
+    if (params.slices != SliceRange{}) return MakeError("vk: density in shares (time-slicing) is not implemented yet");
     if (params.tile == 0 || params.band == 0) return MakeError("vk: density tile and band must be positive");
     const Extent3 e = q.Extent();
     auto columns = mContext->GetPipeline("density", 4);

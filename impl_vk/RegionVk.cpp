@@ -8,7 +8,8 @@
 
 namespace cb::vk {
 
-Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) {
+Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region, SliceRange slices) {
+    if (slices != SliceRange{}) return MakeError("vk: region in shares (time-slicing) is not implemented yet");
     const Extent3 e = region.Extent();
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
     auto list = Scratch(VkScratch::EllipsoidList, std::max<VkDeviceSize>(32, ellipsoids.size_bytes()));

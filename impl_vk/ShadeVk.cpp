@@ -7,6 +7,7 @@
 namespace cb::vk {
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    if (params.slices != SliceRange{}) return MakeError("vk: shade in shares (time-slicing) is not implemented yet");
     const int f = params.resolution;
     if (f != 1 && f != 2 && f != 4) return MakeError("vk: shade resolution must be 1, 2 or 4");
     const Extent3 e = q.Extent();

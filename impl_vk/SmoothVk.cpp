@@ -3,7 +3,8 @@
 
 namespace cb::vk {
 
-Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q) {
+Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange slices) {
+    if (slices != SliceRange{}) return MakeError("vk: smooth in shares (time-slicing) is not implemented yet");
     if (radius < 0 || radius > 2) return MakeError("vk: smooth radius must be 0, 1 or 2");
     const Extent3 e = cld.Extent();
     auto pipeline = mContext->GetPipeline("smooth", 4);

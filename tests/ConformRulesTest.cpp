@@ -16,16 +16,16 @@ class FaultyCpu : public cpu::BackendCpu {
   public:
     FaultyCpu(Stage stage, float amount) : mStage(stage), mAmount(amount) {}
 
-    Status Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region) override {
-        CB_TRY(cpu::BackendCpu::Region(ellipsoids, region));
+    Status Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region, SliceRange slices = {}) override {
+        CB_TRY(cpu::BackendCpu::Region(ellipsoids, region, slices));
         return mStage == Stage::Region ? Bump<uint8_t>(region) : Status{};
     }
     Status CaStep(const CaStepParams& p, ConstCaFields in, const Buffer& region, CaFields out) override {
         CB_TRY(cpu::BackendCpu::CaStep(p, in, region, out));
         return mStage == Stage::Ca ? Bump<uint8_t>(*out.cld) : Status{};
     }
-    Status Smooth(int radius, const Buffer& cld, Buffer& q) override {
-        CB_TRY(cpu::BackendCpu::Smooth(radius, cld, q));
+    Status Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange slices = {}) override {
+        CB_TRY(cpu::BackendCpu::Smooth(radius, cld, q, slices));
         return mStage == Stage::Smooth ? Bump<float>(q) : Status{};
     }
     Status Shade(const ShadeParams& p, const Buffer& q, Buffer& T) override {

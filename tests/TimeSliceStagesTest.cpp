@@ -1,0 +1,253 @@
+// Time-slicing at the stage level (SPEC 13, core/Backend.h SliceRange): a
+// stage run as a sequence of shares, ascending and each once, must leave
+// exactly the outputs of the whole call, byte for byte, on every backend.
+// Each output starts filled with a pattern no stage writes, so a share that
+// leaves part of its slices unwritten, or writes past them, fails. Odd grids,
+// and share sizes that do not divide the share count.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/Ellipsoids.h"
+#include "core/Random.h"
+#include "core/ShadePlan.h"
+#include "registry/Registry.h"
+#include "tests/TestUtil.h"
+#if CLOUDBENCH_HAVE_VK
+#include "impl_vk/BackendVk.h"
+#endif
+
+namespace cb {
+namespace {
+
+constexpr Extent3 kGrid{37, 29, 11};
+// Share sizes: one slice, sizes that leave a short last share, and more than the count.
+constexpr uint32_t kShareSizes[] = {1, 3, 4, 64};
+
+// The shares [0, s), [s, 2s), ... of `count` slices.
+std::vector<SliceRange> Shares(uint32_t count, uint32_t size) {
+    std::vector<SliceRange> shares;
+    for (uint32_t b = 0; b < count; b += size) shares.push_back({b, std::min(count, b + size)});
+    return shares;
+}
+
+class TimeSliceStages : public ::testing::TestWithParam<std::string> {
+  protected:
+    void SetUp() override {
+        BackendOptions options;
+        options.vkValidation = true;
+        auto backend = CreateBackend(GetParam(), options);
+        if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
+        mBackend = std::move(*backend);
+    }
+    void TearDown() override {
+#if CLOUDBENCH_HAVE_VK
+        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) EXPECT_EQ(vk->ValidationMessages(), 0u);
+#endif
+    }
+
+    // A buffer holding a pattern no stage writes: 0xA5 bytes for U8, 1 for bits
+    // (a full field), -1 for floats.
+    std::unique_ptr<Buffer> Patterned(BufferFormat format, Extent3 extent) {
+        auto buffer = test::MakeBuffer(*mBackend, format, extent);
+        Fill(*buffer);
+        return buffer;
+    }
+    void Fill(Buffer& buffer) {
+        std::vector<std::byte> bytes(buffer.CanonicalBytes());
+        if (buffer.Format() == BufferFormat::F32) {
+            const float minusOne = -1.0f;
+            for (size_t n = 0; n < bytes.size(); n += 4) std::memcpy(&bytes[n], &minusOne, 4);
+        } else {
+            std::fill(bytes.begin(), bytes.end(), std::byte(buffer.Format() == BufferFormat::Bits ? 1 : 0xA5));
+        }
+        ASSERT_TRUE(mBackend->Upload(buffer, bytes));
+    }
+    std::vector<std::byte> Bytes(const Buffer& buffer) { return test::Read<std::byte>(*mBackend, buffer); }
+
+    // Runs `call(whole)` into the outputs, then for each share size refills them
+    // and runs `call(share)` per share; the bytes must equal the whole call's.
+    void ExpectSharesEqualWhole(const std::string& what, uint32_t count, const std::vector<Buffer*>& outputs,
+                                const std::function<Status(SliceRange)>& call) {
+        for (Buffer* out : outputs) Fill(*out);
+        Status whole = call(SliceRange{});
+        ASSERT_TRUE(whole.has_value()) << what << ": " << whole.error().message;
+        std::vector<std::vector<std::byte>> expected;
+        for (Buffer* out : outputs) expected.push_back(Bytes(*out));
+        for (uint32_t size : kShareSizes) {
+            for (Buffer* out : outputs) Fill(*out);
+            for (SliceRange share : Shares(count, size)) {
+                Status s = call(share);
+                ASSERT_TRUE(s.has_value()) << what << " share [" << share.begin << ", " << share.end
+                                           << "): " << s.error().message;
+            }
+            for (size_t n = 0; n < outputs.size(); ++n) {
+                const auto got = Bytes(*outputs[n]);
+                size_t differ = 0, first = got.size();
+                for (size_t b = 0; b < got.size(); ++b)
+                    if (got[b] != expected[n][b] && differ++ == 0) first = b;
+                EXPECT_EQ(differ, 0u) << what << ", output " << n << ", shares of " << size << " of " << count
+                                      << ": " << differ << " bytes differ from the whole call, first at byte " << first;
+            }
+        }
+    }
+
+    std::unique_ptr<Backend> mBackend;
+};
+
+std::vector<RasterEllipsoid> SomeEllipsoids(const Extent3& e) {
+    Pcg32 rng(7);
+    std::vector<RasterEllipsoid> list;
+    for (int n = 0; n < 12; ++n) {
+        const double yaw = rng.Uniform(0, 6.283185307179586);
+        list.push_back(
+            {{float(rng.Uniform(-3, e.nx + 3)), float(rng.Uniform(-3, e.ny + 3)), float(rng.Uniform(0, e.nz))},
+             {float(rng.Uniform(2, 12)), float(rng.Uniform(2, 9)), float(rng.Uniform(1, 5))},
+             float(std::cos(yaw)),
+             float(std::sin(yaw))});
+    }
+    return list;
+}
+
+std::vector<uint8_t> RandomBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
+    Pcg32 rng(seed);
+    std::vector<uint8_t> bits(e.Count());
+    for (uint8_t& b : bits) b = rng.Below(oneIn) == 0 ? 1 : 0;
+    return bits;
+}
+
+// A sparse q with exact zeros, so occupancy has empty tiles and bands.
+std::vector<float> SparseQ(const Extent3& e, uint32_t seed) {
+    Pcg32 rng(seed);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = rng.Below(5) == 0 ? float(1 + rng.Below(64)) / 64.0f : 0.0f;
+    return q;
+}
+
+TEST_P(TimeSliceStages, RegionInSlicesOfK) {
+    const auto ellipsoids = SomeEllipsoids(kGrid);
+    auto region = Patterned(BufferFormat::U8, kGrid);
+    ExpectSharesEqualWhole("region", kGrid.nz, {region.get()},
+                           [&](SliceRange s) { return mBackend->Region(ellipsoids, *region, s); });
+}
+
+TEST_P(TimeSliceStages, CaStepInSlicesOfK) {
+    const auto ellipsoids = SomeEllipsoids(kGrid);
+    auto region = Patterned(BufferFormat::U8, kGrid);
+    ASSERT_TRUE(mBackend->Region(ellipsoids, *region));
+    auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 1, 2));
+    auto act = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 2, 3));
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 3, 4));
+    auto hum1 = Patterned(BufferFormat::Bits, kGrid), act1 = Patterned(BufferFormat::Bits, kGrid),
+         cld1 = Patterned(BufferFormat::Bits, kGrid);
+    // A distinct wind shift per slice, both signs.
+    std::vector<int32_t> shiftX(kGrid.nz), shiftY(kGrid.nz);
+    for (uint32_t k = 0; k < kGrid.nz; ++k) shiftX[k] = int32_t(k % 3) - 1, shiftY[k] = int32_t(k % 5) - 2;
+    for (bool wind : {false, true}) {
+        CaStepParams p;
+        p.seed = 11, p.step = 3;
+        p.qExt = 0x20000000u, p.qHum = 0x30000000u, p.qAct = 0x40000000u;
+        if (wind) p.shiftX = shiftX, p.shiftY = shiftY;
+        ExpectSharesEqualWhole(wind ? "ca with wind" : "ca", kGrid.nz, {hum1.get(), act1.get(), cld1.get()},
+                               [&](SliceRange s) {
+                                   CaStepParams share = p;
+                                   share.slices = s;
+                                   return mBackend->CaStep(share, {hum.get(), act.get(), cld.get()}, *region,
+                                                           {hum1.get(), act1.get(), cld1.get()});
+                               });
+    }
+}
+
+TEST_P(TimeSliceStages, SmoothInSlicesOfK) {
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 4, 3));
+    auto q = Patterned(BufferFormat::F32, kGrid);
+    for (int radius : {0, 1, 2})
+        ExpectSharesEqualWhole("smooth radius " + std::to_string(radius), kGrid.nz, {q.get()},
+                               [&](SliceRange s) { return mBackend->Smooth(radius, *cld, *q, s); });
+}
+
+TEST_P(TimeSliceStages, DensityInRowsOfTilesAndTheCoverCountsAddUp) {
+    auto q = test::MakeFilled(*mBackend, BufferFormat::F32, kGrid, SparseQ(kGrid, 5));
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 6, 40));
+    DensityParams p;
+    p.tile = 8, p.band = 4;  // 5 x 4 tiles, 3 bands: the last row and band are partial
+    const uint32_t tilesX = CeilDiv(kGrid.nx, p.tile), tilesY = CeilDiv(kGrid.ny, p.tile);
+    auto D = Patterned(BufferFormat::F32, {kGrid.nx, kGrid.ny, 1});
+    auto tiles = Patterned(BufferFormat::U8, {tilesX, tilesY, 1});
+    auto bands = Patterned(BufferFormat::U8, {tilesX, tilesY, CeilDiv(kGrid.nz, p.band)});
+    for (const Buffer* cover : {static_cast<const Buffer*>(cld.get()), static_cast<const Buffer*>(nullptr)}) {
+        const std::string what = cover ? "density, cover from cld" : "density, cover from D";
+        uint64_t coverSum = 0;
+        std::optional<uint32_t> wholeCover;
+        ExpectSharesEqualWhole(what, tilesY, {D.get(), tiles.get(), bands.get()}, [&](SliceRange s) -> Status {
+            DensityParams share = p;
+            share.slices = s;
+            DensityOutputs out{D.get(), tiles.get(), bands.get()};
+            CB_TRY(mBackend->Density(share, *q, cover, out));
+            if (s == SliceRange{}) {
+                wholeCover = out.coveredColumns;
+            } else {
+                coverSum += out.coveredColumns;
+                if (s.end >= tilesY) {  // the last share: the counts of one sequence must add up to the whole's
+                    EXPECT_EQ(coverSum, wholeCover.value_or(~0u)) << what;
+                    coverSum = 0;
+                }
+            }
+            return {};
+        });
+        EXPECT_GT(wholeCover.value_or(0), 0u) << what << ": the test field must cover some columns";
+    }
+}
+
+TEST_P(TimeSliceStages, ShadeInSlicesOfTheSweep) {
+    auto q = test::MakeFilled(*mBackend, BufferFormat::F32, kGrid, SparseQ(kGrid, 8));
+    auto T = Patterned(BufferFormat::F32, kGrid);
+    // z principal, x principal from below the diagonal, y principal with negative components.
+    const Vec3 suns[] = {SunDirection(1.2, 0.3), SunDirection(0.35, 0.2), SunDirection(0.5, 4.4)};
+    for (const Vec3& sun : suns)
+        for (int f : {1, 2, 4})
+            for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Fp16, StorageFormat::Unorm8})
+                for (bool scattering : {false, true}) {
+                    ShadeParams p;
+                    p.sun = sun, p.resolution = f, p.storage = storage, p.scattering = scattering;
+                    p.attenuation = scattering ? AttenuationKind::Thesis : AttenuationKind::Beer;
+                    p.sigma = 0.01f;
+                    const uint32_t count = MakeShadePlan(p, kGrid).nw;
+                    const std::string what = "shade sun (" + std::to_string(sun[0]) + ", " + std::to_string(sun[1]) +
+                                             ", " + std::to_string(sun[2]) + ") f " + std::to_string(f) +
+                                             " storage " + std::to_string(int(storage)) +
+                                             (scattering ? " scattering" : "");
+                    ExpectSharesEqualWhole(what, count, {T.get()}, [&](SliceRange s) {
+                        ShadeParams share = p;
+                        share.slices = s;
+                        return mBackend->Shade(share, *q, *T);
+                    });
+                    if (HasFailure()) return;
+                }
+}
+
+// A share writes its own slices and nothing else: region slices [3, 5) only.
+TEST_P(TimeSliceStages, OneShareLeavesTheOtherSlicesAsTheyWere) {
+    const auto ellipsoids = SomeEllipsoids(kGrid);
+    auto whole = Patterned(BufferFormat::U8, kGrid);
+    ASSERT_TRUE(mBackend->Region(ellipsoids, *whole));
+    auto part = Patterned(BufferFormat::U8, kGrid);
+    ASSERT_TRUE(mBackend->Region(ellipsoids, *part, SliceRange{3, 5}));
+    const auto a = test::Read<uint8_t>(*mBackend, *whole), b = test::Read<uint8_t>(*mBackend, *part);
+    const size_t slice = size_t(kGrid.nx) * kGrid.ny;
+    size_t wrong = 0;
+    for (size_t v = 0; v < a.size(); ++v) {
+        const size_t k = v / slice;
+        wrong += (k >= 3 && k < 5) ? a[v] != b[v] : b[v] != 0xA5;
+    }
+    EXPECT_EQ(wrong, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceStages, ::testing::ValuesIn(BuiltBackends()),
+                         [](const auto& info) { return info.param; });
+
+}  // namespace
+}  // namespace cb
