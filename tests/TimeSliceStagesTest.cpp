@@ -45,7 +45,9 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
     }
     void TearDown() override {
 #if CLOUDBENCH_HAVE_VK
-        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) EXPECT_EQ(vk->ValidationMessages(), 0u);
+        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) {
+            EXPECT_EQ(vk->ValidationMessages(), 0u);
+        }
 #endif
     }
 
