@@ -114,15 +114,18 @@ void SmoothSlices(const BitField& cld, float* q, uint32_t k0, uint32_t k1) {
 }  // namespace
 
 Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, SliceRange slices) {
-    if (slices != SliceRange{}) return MakeError("cpu: smooth in shares (time-slicing) is not implemented yet");
     if (radius < 0 || radius > 2) return MakeError("cpu: smooth radius must be 0, 1 or 2");
     const BitField& cld = static_cast<const BufferCpu&>(cldBuffer).Bits();
     float* q = static_cast<BufferCpu&>(qBuffer).F32();
     const Extent3 e = cld.Extent();
+    // The share: output slices k in [k0, k1). Each reads cld slices k - radius ..
+    // k + radius, so a share of s slices filters s + 2 radius slices in x and y.
+    const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
+    if (k0 >= k1) return {};
 
     if (radius == 0) {
         mArena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
+            tbb::parallel_for(tbb::blocked_range<uint32_t>(e.ny * k0, e.ny * k1, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
                 std::vector<uint8_t> bytes(e.nx + 8);
                 for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
                     ExpandRow(cld.Row(r % e.ny, r / e.ny), e.nx, bytes.data());
@@ -136,11 +139,11 @@ Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, 
 
     // One run of slices per thread: each run recomputes `radius` slices of
     // x/y filtering on either side, so fewer, longer runs waste less.
-    const uint32_t runs = std::min<uint32_t>(e.nz, uint32_t(mArena.max_concurrency()));
-    const uint32_t grain = CeilDiv(e.nz, runs);
+    const uint32_t runs = std::min<uint32_t>(k1 - k0, uint32_t(mArena.max_concurrency()));
+    const uint32_t grain = CeilDiv(k1 - k0, runs);
     mArena.execute([&] {
         tbb::parallel_for(
-            tbb::blocked_range<uint32_t>(0, e.nz, grain),
+            tbb::blocked_range<uint32_t>(k0, k1, grain),
             [&](const tbb::blocked_range<uint32_t>& slices) {
                 if (radius == 1) SmoothSlices<1>(cld, q, slices.begin(), slices.end());
                 else SmoothSlices<2>(cld, q, slices.begin(), slices.end());
