@@ -44,7 +44,8 @@ TEST(TimeSliceGL, Rgba8StepsInSharesAndWholeCarryTheState) {
         std::unique_ptr<Buffer> a[2][3], b[2][3];
         for (int s = 0; s < 2; ++s)
             for (int n = 0; n < 3; ++n)
-                a[s][n] = test::MakeBuffer(*A, BufferFormat::Bits, e), b[s][n] = test::MakeBuffer(*B, BufferFormat::Bits, e);
+                a[s][n] = test::MakeBuffer(*A, BufferFormat::Bits, e),
+                b[s][n] = test::MakeBuffer(*B, BufferFormat::Bits, e);
         CaInitParams ip{9, 0x60000000u, 0x10000000u};
         ASSERT_TRUE(A->CaInitialize(ip, {a[0][0].get(), a[0][1].get(), a[0][2].get()}));
         ASSERT_TRUE(B->CaInitialize(ip, {b[0][0].get(), b[0][1].get(), b[0][2].get()}));
