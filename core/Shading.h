@@ -97,6 +97,24 @@ inline float RoundToStorage(StorageFormat format, float value) {
     return value;
 }
 
+// The integer code of a stored value (RoundToStorage's output, in [0, 1]): k
+// for k/255 in unorm8, the half's bit pattern in fp16, the float's bits in
+// fp32. Codes grow with the value and neighbouring stored values differ by
+// one, so SPEC 6's "one storage quantum" is |code difference| <= 1, compared
+// as integers: a float difference can exceed 1/255 by an ulp (issue 16).
+inline uint32_t StorageCode(StorageFormat format, float stored) {
+    switch (format) {
+        case StorageFormat::Fp32: return std::bit_cast<uint32_t>(stored);
+        case StorageFormat::Unorm8: return uint32_t(std::lround(std::clamp(stored, 0.0f, 1.0f) * 255.0f));
+        case StorageFormat::Fp16: {
+            const uint32_t bits = std::bit_cast<uint32_t>(std::fabs(stored));
+            if (bits < 0x38800000u) return uint32_t(std::lround(std::fabs(stored) * 16777216.0f));  // subnormal half
+            return ((((bits >> 23) - 112u) << 10) | ((bits >> 13) & 0x3ffu));  // rebias 127 -> 15, top 10 bits
+        }
+    }
+    return 0;
+}
+
 // One storage quantum at value v: the comparison tolerance for fp16/unorm8 (SPEC 6).
 inline float StorageQuantum(StorageFormat format) {
     switch (format) {

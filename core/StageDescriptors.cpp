@@ -104,6 +104,10 @@ std::string CompareRule::Text(std::string_view symbol) const {
         case Kind::Quantised:
             std::snprintf(text, sizeof text, "%s <= %g, <= %g %% differ", d.c_str(), tolerance, share * 100);
             break;
+        case Kind::Codes:
+            std::snprintf(text, sizeof text, "|d%s| <= %g %s code%s", std::string(symbol).c_str(), tolerance,
+                          storage == StorageFormat::Fp16 ? "fp16" : "unorm8", tolerance == 1 ? "" : "s");
+            break;
         case Kind::Image:
             std::snprintf(text, sizeof text, "%s on %g %%%s", ToleranceText().c_str(), 100 - share * 100,
                           std::isinf(limit) ? "" : (", " + PixelValueText(limit) + " max").c_str());
@@ -119,10 +123,13 @@ CompareRule BitExact(const Scene&) { return {CompareRule::Kind::BitExact}; }
 // SPEC 2: the region weight may round either way at a quantisation boundary.
 CompareRule RegionRule(const Scene&) { return {CompareRule::Kind::Quantised, 1, 0.005}; }
 
-// SPEC 6: 1e-5 in fp32; one storage quantum in the narrower formats.
+// SPEC 6: 1e-5 in fp32; one storage quantum in the narrower formats, compared on the stored codes.
 CompareRule ShadeRule(const Scene& scene) {
     const StorageFormat storage = scene.shade.storage;
-    return {CompareRule::Kind::Absolute, storage == StorageFormat::Fp32 ? 1e-5 : double(StorageQuantum(storage))};
+    if (storage == StorageFormat::Fp32) return {CompareRule::Kind::Absolute, 1e-5};
+    CompareRule rule{CompareRule::Kind::Codes, 1};
+    rule.storage = storage;
+    return rule;
 }
 
 CompareRule ShadowRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}; }

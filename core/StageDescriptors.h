@@ -66,11 +66,13 @@ struct CompareRule {
         Absolute,   // |d| <= tolerance everywhere
         Quantised,  // |d| <= tolerance everywhere, and at most `share` of elements differ at all
         Image,      // per channel |d| <= tolerance on at least 1 - share of pixels, <= limit everywhere
+        Codes,      // |code difference| <= tolerance everywhere, on the stored codes of `storage` (StorageCode)
     };
     Kind kind = Kind::BitExact;
     double tolerance = 0;
     double share = 0;
     double limit = 0;
+    StorageFormat storage = StorageFormat::Fp32;  // Codes: the format whose codes are compared
 
     // As the tables print it, e.g. "bit-exact", "|dT| <= 1e-05"; `symbol` names the compared quantity.
     std::string Text(std::string_view symbol) const;

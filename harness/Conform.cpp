@@ -154,6 +154,25 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
         case CompareRule::Kind::Quantised:
             tally.Within(stageName, name, t, e, *r, *g, rule.tolerance, rule.Text(d.symbol));
             break;
+        case CompareRule::Kind::Codes: {
+            // Stored codes as integers, never a float difference against 1/255 (SPEC 6).
+            ConformRow& row = tally.Row(stageName, name, rule.Text(d.symbol), rule.tolerance);
+            int64_t worst = 0;
+            size_t at = 0;
+            for (size_t v = 0; v < r->size(); ++v) {
+                const int64_t diff = std::llabs(int64_t(StorageCode(rule.storage, (*r)[v])) -
+                                                int64_t(StorageCode(rule.storage, (*g)[v])));
+                if (diff > worst) worst = diff, at = v;
+            }
+            if (double(worst) > row.worst) {
+                row.worst = double(worst);
+                row.detail = "step " + std::to_string(t) + " at " + Where(e, at) + ": cpu code " +
+                             std::to_string(StorageCode(rule.storage, (*r)[at])) + ", " + name + " code " +
+                             std::to_string(StorageCode(rule.storage, (*g)[at]));
+            }
+            if (double(worst) > rule.tolerance) row.status = "fail";
+            break;
+        }
         case CompareRule::Kind::Image: {
             const uint32_t width = e.ny, height = e.nz;  // images are (3, width, height)
             const ImageComparison cmp = CompareImages(*r, *g, width, height, rule);

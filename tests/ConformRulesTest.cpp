@@ -71,8 +71,9 @@ Scene SmallScene() {
     return *scene;
 }
 
-std::vector<ConformRow> Conform(Stage faulty, float amount) {
-    const Scene scene = SmallScene();
+std::vector<ConformRow> Conform(Stage faulty, float amount, StorageFormat storage = StorageFormat::Fp32) {
+    Scene scene = SmallScene();
+    scene.shade.storage = storage;
     cpu::BackendCpu reference;
     std::vector<OpenedBackend> others(1);
     others[0].name = "faulty";
@@ -108,6 +109,15 @@ TEST(ConformRules, FaultsWithinTheRulePass) {
         const std::vector<ConformRow> rows = Conform(faulty, amount);
         EXPECT_EQ(StatusOf(rows, faulty), "pass") << "fault in " << StageName(faulty);
     }
+}
+
+// Test that unorm8 T is compared on its stored codes (SPEC 6, issue 16): one
+// code lower passes even where the float difference exceeds 1/255 by an ulp,
+// two codes lower fail. (Lower, since T = 1 is common and higher would clamp.)
+TEST(ConformRules, Unorm8ShadeIsComparedOnCodes) {
+    EXPECT_EQ(StatusOf(Conform(Stage::Shade, -1.0f / 255.0f, StorageFormat::Unorm8), Stage::Shade), "pass");
+    EXPECT_EQ(StatusOf(Conform(Stage::Shade, -1.00001f / 255.0f, StorageFormat::Unorm8), Stage::Shade), "pass");
+    EXPECT_EQ(StatusOf(Conform(Stage::Shade, -2.0f / 255.0f, StorageFormat::Unorm8), Stage::Shade), "fail");
 }
 
 }  // namespace

@@ -328,7 +328,8 @@ std::pair<double, size_t> WorstDifference(const std::vector<T>& a, const std::ve
 }
 
 // Test shading for every option and several suns: max |dT| <= 1e-5 for fp32,
-// one storage quantum for fp16 and unorm8 (SPEC 6).
+// one stored code for fp16 and unorm8 (SPEC 6; issue 16: a float difference can
+// exceed 1/255 by an ulp where the codes differ by one).
 TEST_P(Conformance, Shade) {
     if (auto why = SkipReason(Stage::Shade)) GTEST_SKIP() << *why;
     const Extent3 e = Size();
@@ -359,8 +360,16 @@ TEST_P(Conformance, Shade) {
                             Status s = mBackend->Shade(p, *gotQ, *gotT);
                             ASSERT_TRUE(s.has_value()) << s.error().message;
                             const auto a = test::Read<float>(mCpu, *refT), b = test::Read<float>(*mBackend, *gotT);
-                            const auto [worst, at] = WorstDifference(a, b);
-                            const double tolerance = storage == StorageFormat::Fp32 ? 1e-5 : StorageQuantum(storage);
+                            // fp32 within 1e-5; fp16 and unorm8 within one stored code, compared as integers.
+                            auto [worst, at] = WorstDifference(a, b);
+                            double tolerance = 1e-5;
+                            if (storage != StorageFormat::Fp32) {
+                                std::vector<double> ca(a.size()), cb(b.size());
+                                for (size_t v = 0; v < a.size(); ++v)
+                                    ca[v] = StorageCode(storage, a[v]), cb[v] = StorageCode(storage, b[v]);
+                                std::tie(worst, at) = WorstDifference(ca, cb);
+                                tolerance = 1;
+                            }
                             ASSERT_LE(worst, tolerance)
                                 << "sun (" << sun[0] << ", " << sun[1] << ", " << sun[2] << ") att " << int(att)
                                 << " filter " << int(filter) << " f " << f << " storage " << int(storage)

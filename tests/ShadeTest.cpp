@@ -65,6 +65,28 @@ TEST(ShadingMath, RoundToUnorm8) {
     EXPECT_EQ(RoundToUnorm8(0.1f), 26.0f / 255.0f);   // 25.5 -> 26 (25.5000004 in float)
 }
 
+// Test the stored codes against an independent decoding: every half code in
+// [0, 1] (0 .. 0x3C00), built with ldexp from its exponent and mantissa fields,
+// gives its own code back, and so does every k/255; hand values besides.
+TEST(ShadingMath, StorageCodesAreTheStoredIntegers) {
+    for (uint32_t code = 0; code <= 0x3C00u; ++code) {
+        const uint32_t exponent = code >> 10, mantissa = code & 0x3ffu;
+        const float value = exponent == 0 ? float(std::ldexp(double(mantissa), -24))
+                                          : float(std::ldexp(1.0 + mantissa / 1024.0, int(exponent) - 15));
+        ASSERT_EQ(StorageCode(StorageFormat::Fp16, value), code) << value;
+    }
+    EXPECT_EQ(StorageCode(StorageFormat::Fp16, 1.0f), 0x3C00u);
+    EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0.5f), 0x3800u);
+    EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-24f), 1u);    // the smallest subnormal half
+    EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-14f), 0x400u);  // the smallest normal half
+    for (uint32_t k = 0; k <= 255; ++k) ASSERT_EQ(StorageCode(StorageFormat::Unorm8, float(k) / 255.0f), k);
+    // Issue 16's case (on the H200 it was 214/255 against 215/255 as the GPU rounded them): neighbouring codes
+    // whose float difference exceeds 1/255 in single precision, here 127/255 and 128/255 (also 3, 7, 15, 31, 63).
+    const float a = 127.0f / 255.0f, b = 128.0f / 255.0f;
+    EXPECT_GT(b - a, 1.0f / 255.0f);
+    EXPECT_EQ(StorageCode(StorageFormat::Unorm8, b) - StorageCode(StorageFormat::Unorm8, a), 1u);
+}
+
 // Test the principal axis rule, including exact ties (z wins over y, y over x).
 TEST(ShadingMath, PrincipalAxisTies) {
     EXPECT_EQ(PrincipalAxis({0, 0, 1}), 2);

@@ -135,8 +135,14 @@ TEST(StageRules, SpecRulesAndTexts) {
     EXPECT_EQ(text(Stage::Shadow), "|dG| <= 1e-05");
     EXPECT_EQ(text(Stage::RenderSplat), "2/255 on 99.9 %, 8/255 max");
     EXPECT_EQ(text(Stage::RenderMarch), "0.0001 on 99.9 %");
-    scene.shade.storage = StorageFormat::Unorm8;  // one storage quantum: 1/255
-    EXPECT_DOUBLE_EQ(Describe(Stage::Shade).rule(scene).tolerance, double(1.0f / 255.0f));
+    scene.shade.storage = StorageFormat::Unorm8;  // one storage quantum, on the stored codes (SPEC 6)
+    const CompareRule codes = Describe(Stage::Shade).rule(scene);
+    EXPECT_EQ(codes.kind, CompareRule::Kind::Codes);
+    EXPECT_EQ(codes.tolerance, 1.0);
+    EXPECT_EQ(codes.storage, StorageFormat::Unorm8);
+    EXPECT_EQ(text(Stage::Shade), "|dT| <= 1 unorm8 code");
+    scene.shade.storage = StorageFormat::Fp16;
+    EXPECT_EQ(text(Stage::Shade), "|dT| <= 1 fp16 code");
     const CompareRule image = Describe(Stage::RenderSplat).rule(scene);
     EXPECT_EQ(image.kind, CompareRule::Kind::Image);
     EXPECT_DOUBLE_EQ(image.share, 0.001);
