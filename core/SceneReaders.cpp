@@ -402,6 +402,11 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
         if (Describe(stage).renderer && scene.stages.Has(stage) && camerasOk && scene.render.cameras.empty())
             check.Fail("render.cameras", Quote(StageName(stage)) + " needs at least one camera");
 
+    // The ground is lit through G: the stage that computes it must run.
+    if (scene.render.ground.on && !scene.stages.Has(Stage::Shadow))
+        check.Fail("render.ground", "needs the stage \"shadow\", which computes the ground shadow G it is lit "
+                                    "through; enable it or remove render.ground");
+
     if (stepsOk) CheckSunSpeed(scene, check);
     CheckOpticalDepths(scene, check);
 

@@ -66,10 +66,11 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, uint3
             // The order is host work shared by all backends, outside the stage time.
             const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
             p.order = &order;
-            const SplatInputs in{
+            SplatInputs in{
                 PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q),     io.Current(Resource::T),
                 io.Previous(Resource::Tiles),       io.Current(Resource::Tiles), io.Previous(Resource::Bands),
                 io.Current(Resource::Bands)};
+            in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
             return timed(
                 [&] { return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats); });
         });
@@ -81,7 +82,8 @@ Status RenderMarchFrames(Backend& backend, const Scene& sc, uint32_t step, uint3
         Stage::RenderMarch, backend, sc, step, frameOfStep, record, [&](size_t n, FrameRecord& frame, auto timed) {
             const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step, frameOfStep);
             // T only where shade runs (the light source "shade").
-            const MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
             return timed(
                 [&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march); });
         });

@@ -18,6 +18,8 @@ ShadowParams MakeShadowParams(const Scene& scene, uint32_t step = 0);
 NoiseParams MakeNoiseParams(const Scene& scene, uint32_t step);
 // Everything but the order, which the caller makes (MakeSplatOrder) and keeps alive; the sun at `step`, alpha of
 // frame `frame` of the step (RenderSettings::FrameAlpha).
+// The scene's ground (render.ground) as both renderers take it.
+GroundParams MakeGroundParams(const Scene& scene);
 SplatParams MakeSplatParams(const Scene& scene, const CameraSettings& camera, uint32_t step = 0, uint32_t frame = 0);
 // The ray marcher's parameters for one camera at `step` (the jitter's frame, the lightning's flash window and the
 // sun), frame `frame` of the step (its alpha).
