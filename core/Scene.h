@@ -159,6 +159,11 @@ struct RenderSettings {
     // Frames rendered per render step (seed 000 section 6.3). 1: one frame
     // at `alpha`; F > 1: frames f = 0..F-1 at alpha = (f + 1) / F.
     uint32_t framesPerStep = 1;
+    // Time-slicing (SPEC 13, seed 000 sections 7.1 and 8.1.2): 0 computes a
+    // step all at once; s > 0 spreads the next step's stages over this step's
+    // frames, s slices of one stage per frame (docs/pipeline.md). A step then
+    // draws max(framesPerStep, the frames its shares take) frames.
+    uint32_t slicesPerFrame = 0;
     uint32_t everySteps = 0;              // render every N steps after warm-up (and the last); 0 = last step only
     std::vector<CameraSettings> cameras;  // at least one when a renderer runs
     // The ground plane z = origin_z under the clouds, lit through G (render.ground;
@@ -168,10 +173,13 @@ struct RenderSettings {
         std::array<double, 3> albedo{0.3, 0.3, 0.3};  // linear RGB reflectance, each in [0, 1]
     } ground;
 
-    // The interpolation weight of frame `frame` (0-based) of a render step.
-    float FrameAlpha(uint32_t frame) const {
-        if (framesPerStep <= 1) return float(alpha);
-        return float(double(frame + 1) / double(framesPerStep));
+    // The interpolation weight of frame `frame` (0-based) of a render step of
+    // `frames` frames (0: framesPerStep). One frame without time-slicing draws
+    // at the fixed `alpha`; otherwise frames run alpha = (frame + 1) / frames.
+    float FrameAlpha(uint32_t frame, uint32_t frames = 0) const {
+        if (frames == 0) frames = framesPerStep;
+        if (frames <= 1 && slicesPerFrame == 0) return float(alpha);
+        return float(double(frame + 1) / double(frames > 0 ? frames : 1));
     }
 };
 

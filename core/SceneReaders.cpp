@@ -401,6 +401,12 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
     for (Stage stage : kAllStages)
         if (Describe(stage).renderer && scene.stages.Has(stage) && camerasOk && scene.render.cameras.empty())
             check.Fail("render.cameras", Quote(StageName(stage)) + " needs at least one camera");
+    // Time-slicing spreads a step over the frames drawn between steps: without a renderer there are none.
+    if (scene.render.slicesPerFrame > 0 &&
+        std::none_of(kAllStages.begin(), kAllStages.end(),
+                     [&](Stage s) { return Describe(s).renderer && scene.stages.Has(s); }))
+        check.Fail("render.slices_per_frame", "time-slicing spreads a step over the frames drawn between steps, and "
+                                              "no renderer is enabled; enable render_splat or render_march, or remove it");
 
     // The ground is lit through G: the stage that computes it must run.
     if (scene.render.ground.on && !scene.stages.Has(Stage::Shadow))

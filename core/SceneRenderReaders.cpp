@@ -23,7 +23,7 @@ constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angl
 constexpr std::string_view kShadowKeys[] = {"form", "kappa", "coverage", "density_factor"};
 constexpr std::string_view kRenderKeys[] = {"width",    "height",      "q_min",   "splat_scale",
                                             "opacity",  "alpha",       "culling", "skipping",
-                                            "every_steps", "frames_per_step", "cameras", "ground"};
+                                            "every_steps", "frames_per_step", "slices_per_frame", "cameras", "ground"};
 constexpr std::string_view kGroundKeys[] = {"albedo"};
 constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
 
@@ -324,6 +324,16 @@ bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
             if (render.framesPerStep > 1 && find("alpha"))
                 check.Fail(field("alpha"), "cannot be combined with render.frames_per_step > 1 (the frames run alpha "
                                            "from 1/F to 1); remove one");
+        }
+    }
+
+    if (const Json* v = find("slices_per_frame")) {
+        if (auto n = check.Integer(*v, field("slices_per_frame"), 0, kU32Max)) {
+            render.slicesPerFrame = uint32_t(*n);
+            // Time-sliced frames run alpha over the step's frames, however many the shares take.
+            if (render.slicesPerFrame > 0 && find("alpha"))
+                check.Fail(field("alpha"), "cannot be combined with render.slices_per_frame > 0 (the frames of a "
+                                           "time-sliced step run alpha from 1/F to 1); remove one");
         }
     }
 

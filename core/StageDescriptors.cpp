@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/ShadePlan.h"
 #include "core/Shading.h"
 
 namespace cb {
@@ -140,6 +141,17 @@ CompareRule NoiseRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}
 // Noise reads nothing: static noise is made once, drifting noise every step (SPEC 14).
 bool NoiseAnimated(const Scene& scene) { return scene.noise.Animated(); }
 
+// Shares of time-slicing (core/Backend.h SliceRange): slices k; rows of
+// tiles; the sweep's slices, whose axis follows the sun at the step.
+uint32_t SlicesOfK(const Scene& scene, uint32_t) { return scene.grid.size.nz; }
+uint32_t RowsOfTiles(const Scene& scene, uint32_t) { return CeilDiv(scene.grid.size.ny, scene.density.tile); }
+uint32_t SweepSlices(const Scene& scene, uint32_t step) {
+    ShadeParams p;  // the plan's slices depend on the sun and the resolution alone
+    p.sun = scene.sun.DirectionAt(step);
+    p.resolution = scene.shade.resolution;
+    return MakeShadePlan(p, scene.grid.size).nw;
+}
+
 // The splat renderer interpolates q between the last two steps, and skips
 // boxes empty in both steps' occupancy.
 std::vector<Resource> SplatPrevious(const Scene& scene) {
@@ -160,6 +172,7 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
         {.stage = Stage::Region,
          .section = "ellipsoids",
          .writes = {Resource::Region},
+         .shareCount = SlicesOfK,
          .symbol = "R",
          .rule = RegionRule},
         {.stage = Stage::Ca,
@@ -167,12 +180,14 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
          .reads = {Resource::Region, Resource::Hum, Resource::Act, Resource::Cld},
          .writes = {Resource::Hum, Resource::Act, Resource::Cld},
          .advancesState = true,
+         .shareCount = SlicesOfK,
          .symbol = "cld",
          .rule = BitExact},
         {.stage = Stage::Smooth,
          .section = "smooth",
          .reads = {Resource::Cld},
          .writes = {Resource::Q},
+         .shareCount = SlicesOfK,
          .symbol = "q",
          .rule = BitExact},
         {.stage = Stage::Density,
@@ -181,6 +196,7 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
          .optionalReads = {Resource::Cld},
          .writes = {Resource::ColumnSum, Resource::Tiles, Resource::Bands},
          .skipsUnchangedInputs = true,
+         .shareCount = RowsOfTiles,
          .symbol = "D",
          .rule = BitExact},
         {.stage = Stage::Shade,
@@ -190,6 +206,7 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
          .outputStepsOnly = true,
          .skipsUnchangedInputs = true,
          .readsSun = true,
+         .shareCount = SweepSlices,
          .symbol = "T",
          .rule = ShadeRule,
          .ruleNote = "one storage quantum with fp16 or unorm8 storage"},
@@ -324,6 +341,11 @@ ResourcePlan PlanResources(const Scene& scene) {
         for (Resource r : d.readsPrevious(scene))
             if (plan.used[size_t(r)]) plan.previous[size_t(r)] = true;
     }
+    // Time-slicing's third buffer set (seed 000 section 7.1): the next step's
+    // value of everything but the images and the double-buffered state.
+    if (scene.render.slicesPerFrame > 0)
+        for (Resource r : kAllResources)
+            plan.pending[size_t(r)] = plan.used[size_t(r)] && !plan.doubleBuffered[size_t(r)] && !IsPerCamera(r);
     return plan;
 }
 
@@ -335,6 +357,8 @@ std::string_view BufferRoleName(BufferRole role) {
             return "next";
         case BufferRole::Previous:
             return "previous";
+        case BufferRole::Pending:
+            return "pending";
     }
     return "?";
 }
@@ -351,6 +375,7 @@ std::vector<PlannedBuffer> PlanBuffers(const Scene& scene) {
         for (size_t n = 0; n < copies; ++n) buffers.push_back({r, BufferRole::Current, uint32_t(n), format, extent});
         if (plan.doubleBuffered[i]) buffers.push_back({r, BufferRole::Next, 0, format, extent});
         if (plan.previous[i]) buffers.push_back({r, BufferRole::Previous, 0, format, extent});
+        if (plan.pending[i]) buffers.push_back({r, BufferRole::Pending, 0, format, extent});
     }
     return buffers;
 }

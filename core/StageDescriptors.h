@@ -103,6 +103,9 @@ struct StageDescriptor {
     // coordinate): it then runs every step despite skipsUnchangedInputs.
     // nullptr: never (a stage with no inputs and no time runs once).
     bool (*dependsOnStep)(const Scene& scene) = nullptr;
+    // Time-slicing (SPEC 13): how many shares its work at `step` splits into
+    // (core/Backend.h SliceRange); nullptr: it runs whole, as one share.
+    uint32_t (*shareCount)(const Scene& scene, uint32_t step) = nullptr;
     // A renderer: writes one image per camera.
     bool renderer = false;
     std::string_view symbol;  // the compared quantity in rule texts ("R", "T", ...)
@@ -135,13 +138,16 @@ struct ResourcePlan {
     std::array<bool, kResourceCount> used{};
     std::array<bool, kResourceCount> previous{};
     std::array<bool, kResourceCount> doubleBuffered{};  // written by a stage that advances the state
+    std::array<bool, kResourceCount> pending{};  // time-slicing: the next step's value, computed over frames
 };
 ResourcePlan PlanResources(const Scene& scene);
 
 // Which copy of a resource a buffer holds: this step's, the next step's (a
-// state-advancing writer's output), or the previous step's (an interpolating renderer's input).
-enum class BufferRole : uint8_t { Current, Next, Previous };
-std::string_view BufferRoleName(BufferRole role);  // "current", "next", "previous"
+// state-advancing writer's output), the previous step's (an interpolating
+// renderer's input), or the next step's value being computed over the frames
+// of this one (time-slicing's third set, render.slices_per_frame > 0).
+enum class BufferRole : uint8_t { Current, Next, Previous, Pending };
+std::string_view BufferRoleName(BufferRole role);  // "current", "next", "previous", "pending"
 
 struct PlannedBuffer {
     Resource resource;
@@ -154,7 +160,7 @@ struct PlannedBuffer {
 
 // Every buffer a simulation of `scene` allocates, in allocation order: per
 // resource its current buffers (one per camera for images), then its next, then its
-// previous. Simulation::Allocate allocates exactly these; the memory plan prices them.
+// previous, then its pending. Simulation::Allocate allocates exactly these; the memory plan prices them.
 std::vector<PlannedBuffer> PlanBuffers(const Scene& scene);
 
 }  // namespace cb

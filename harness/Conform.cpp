@@ -244,8 +244,13 @@ Status RunOnCopies(Stage stage, const Scene& scene, Backend& b, const Simulation
 }
 }  // namespace
 
-Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
-                                               const ConformProgress& afterStep, const std::string& differenceDir) {
+Result<std::vector<ConformRow>> RunConformance(const Scene& requested, Backend& cpu,
+                                               std::span<const OpenedBackend> others, const ConformProgress& afterStep,
+                                               const std::string& differenceDir) {
+    // Stages are compared whole: time-slicing changes when a stage's work is done, not what it computes
+    // (tests/TimeSlice*Test.cpp check that), and unsliced every step draws render.frames_per_step frames.
+    Scene scene = requested;
+    scene.render.slicesPerFrame = 0;
     Tally tally;
     tally.differenceDir = differenceDir;
     auto sim = Simulation::Create(scene, cpu, /*everyStepOutputs=*/true);
@@ -298,10 +303,10 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu,
                         std::vector<std::unique_ptr<Buffer>> cpuOwned;
                         StageBuffers cpuIo;
                         if (!lastFrame)
-                            CB_TRY(RunOnCopies(stage, scene, cpu, s, {t, s.RasterList(), f}, cpuOwned, cpuIo));
+                            CB_TRY(RunOnCopies(stage, scene, cpu, s, {t, s.RasterList(), f, 0, {}}, cpuOwned, cpuIo));
                         std::vector<std::unique_ptr<Buffer>> owned;
                         StageBuffers io;
-                        if (Status run = RunOnCopies(stage, scene, b, s, {t, s.RasterList(), f}, owned, io, &cpu,
+                        if (Status run = RunOnCopies(stage, scene, b, s, {t, s.RasterList(), f, 0, {}}, owned, io, &cpu,
                                                      d.advancesState ? &pending : nullptr, c.name);
                             !run)
                             return run;

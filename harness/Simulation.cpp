@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstdio>
 
 #include "core/MemoryPlan.h"
 #include "harness/StageParams.h"
@@ -62,6 +63,9 @@ Status Simulation::Allocate() {
             case BufferRole::Previous:
                 slot.previous = std::move(*buffer);
                 break;
+            case BufferRole::Pending:
+                slot.pending = std::move(*buffer);
+                break;
         }
     }
     return {};
@@ -74,37 +78,47 @@ Status Simulation::InitializeState() {
     return {};
 }
 
-std::vector<uint64_t> Simulation::InputVersions(Stage stage) const {
+std::vector<uint64_t> Simulation::InputVersions(Stage stage, uint32_t step) const {
     std::vector<uint64_t> versions;
     const StageDescriptor& d = Describe(stage);
     for (Resource r : d.reads) versions.push_back(mSlots[size_t(r)].version);
     for (Resource r : d.optionalReads) versions.push_back(mSlots[size_t(r)].version);  // 0 when never written
     if (d.readsSun) {
-        // The sun's direction at this step as the stage receives it (single precision): a stage re-runs when it
+        // The sun's direction at the step as the stage receives it (single precision): a stage re-runs when it
         // differs in any bit from the direction of its last run, and only then.
-        const Vec3 s = mScene.sun.DirectionAt(mStep);
+        const Vec3 s = mScene.sun.DirectionAt(step);
         for (float c : s) versions.push_back(std::bit_cast<uint32_t>(c));
     }
     return versions;
 }
 
-bool Simulation::InputsChangedSinceLastRun(Stage stage) const {
+bool Simulation::InputsChangedSinceLastRun(Stage stage, uint32_t step) const {
     if (const StageDescriptor& d = Describe(stage); d.dependsOnStep && d.dependsOnStep(mScene)) return true;
     const auto& last = mInputsAtLastRun[size_t(stage)];
-    return !last || *last != InputVersions(stage);
+    return !last || *last != InputVersions(stage, step);
 }
 
-Status Simulation::Step(StepRecord& record, const Observer& observe) {
-    const auto stepStart = std::chrono::steady_clock::now();
-    double observerMs = 0;
-    record = StepRecord{};
-    record.step = mStep;
-    const bool outputStep = IsOutputStep(mStep);
+namespace {
 
+double MsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Charges the step's time outside its frames to frame 0 (StepRecord::frameMs).
+void ChargeRestToFirstFrame(StepRecord& record) {
+    if (record.frameMs.empty()) return;
+    double frames = 0;
+    for (double ms : record.frameMs) frames += ms;
+    record.frameMs[0] += std::max(0.0, record.stepMs - frames);
+}
+
+}  // namespace
+
+Status Simulation::RunStepStages(StepRecord& record, bool outputStep) {
     for (Stage stage : mSchedule) {
         const StageDescriptor& d = Describe(stage);
-        if (d.advancesState || (d.outputStepsOnly && !outputStep)) continue;
-        if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage)) {
+        if (d.advancesState || d.renderer || (d.outputStepsOnly && !outputStep)) continue;
+        if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage, mStep)) {
             record.skippedUnchanged[size_t(stage)] = true;
             continue;
         }
@@ -113,15 +127,8 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
             Slot& slot = mSlots[size_t(r)];
             if (slot.previous && mStep > 0) std::swap(slot.current[0], slot.previous);
         }
-        if (d.renderer) {
-            // The frames between steps t-1 and t (seed 000 section 6.3): one per alpha of render.frames_per_step.
-            const uint32_t frames = std::max(mScene.render.framesPerStep, 1u);
-            for (uint32_t f = 0; f < frames; ++f) CB_TRY(RunStage(stage, record, f));
-            record.framesRendered = frames;
-        } else {
-            CB_TRY(RunStage(stage, record));
-        }
-        mInputsAtLastRun[size_t(stage)] = InputVersions(stage);
+        CB_TRY(RunStage(stage, record));
+        mInputsAtLastRun[size_t(stage)] = InputVersions(stage, mStep);
         for (Resource r : d.writes) {
             Slot& slot = mSlots[size_t(r)];
             ++slot.version;
@@ -135,10 +142,38 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     }
     // A density stage that skipped (q unchanged) left the cover as it was.
     if (!record.coveredColumns) record.coveredColumns = mLastCoveredColumns;
+    return {};
+}
+
+Status Simulation::RenderFrames(StepRecord& record, uint32_t frames, std::span<const FrameTasks> work) {
+    for (uint32_t f = 0; f < frames; ++f) {
+        const auto start = std::chrono::steady_clock::now();
+        if (!work.empty()) record.frameWork.emplace_back();
+        if (f < work.size()) CB_TRY(RunShares(work[f], record, &record.frameWork.back()));
+        for (Stage stage : mSchedule)
+            if (Describe(stage).renderer) CB_TRY(RunStage(stage, record, f, frames));
+        record.frameMs.push_back(MsSince(start));
+    }
+    record.framesRendered = frames;
+    return {};
+}
+
+Status Simulation::Step(StepRecord& record, const Observer& observe) {
+    if (mScene.render.slicesPerFrame > 0) return SlicedStep(record, observe);
+    const auto stepStart = std::chrono::steady_clock::now();
+    double observerMs = 0;
+    record = StepRecord{};
+    record.step = mStep;
+    const bool outputStep = IsOutputStep(mStep);
+    CB_TRY(RunStepStages(record, outputStep));
+    bool renders = false;
+    for (Stage stage : mSchedule) renders |= Describe(stage).renderer;
+    // The frames between steps t-1 and t (seed 000 section 6.3): one per alpha of render.frames_per_step.
+    if (renders && outputStep) CB_TRY(RenderFrames(record, std::max(mScene.render.framesPerStep, 1u), {}));
     if (observe) {
         const auto start = std::chrono::steady_clock::now();
         CB_TRY(observe(*this));
-        observerMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        observerMs = MsSince(start);
     }
 
     for (Stage stage : mSchedule) {
@@ -154,13 +189,144 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     if (mScene.stages.Has(Stage::Region)) {
         auto start = std::chrono::steady_clock::now();
         mEllipsoids.Update();
-        record.ellipsoidUpdateMs =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        record.ellipsoidUpdateMs = MsSince(start);
     }
     ++mStep;
-    record.stepMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - stepStart).count() - observerMs;
+    record.stepMs = MsSince(stepStart) - observerMs;
+    ChargeRestToFirstFrame(record);
     return {};
+}
+
+Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
+    const auto stepStart = std::chrono::steady_clock::now();
+    double observerMs = 0;
+    record = StepRecord{};
+    record.step = mStep;
+    const bool outputStep = IsOutputStep(mStep);
+    if (mStep == 0) {
+        CB_TRY(RunStepStages(record, outputStep));  // nothing was computed ahead of the first step
+    } else {
+        CommitAhead(record);
+    }
+    bool renders = false;
+    for (Stage stage : mSchedule) renders |= Describe(stage).renderer && outputStep;
+    // A step without frames (warm-up, or not a render step) computes the next one whole.
+    std::vector<FrameTasks> work;
+    if (mStep + 1 < mScene.steps) work = PlanAhead(renders ? mScene.render.slicesPerFrame : UINT32_MAX);
+    if (renders) {
+        const uint32_t frames = std::max<uint32_t>(std::max(mScene.render.framesPerStep, 1u), uint32_t(work.size()));
+        CB_TRY(RenderFrames(record, frames, work));
+    } else {
+        for (const FrameTasks& tasks : work) CB_TRY(RunShares(tasks, record));
+    }
+    if (observe) {
+        const auto start = std::chrono::steady_clock::now();
+        CB_TRY(observe(*this));
+        observerMs = MsSince(start);
+    }
+    ++mStep;
+    record.stepMs = MsSince(stepStart) - observerMs;
+    ChargeRestToFirstFrame(record);
+    return {};
+}
+
+std::vector<Simulation::FrameTasks> Simulation::PlanAhead(uint32_t slicesPerFrame) {
+    const uint32_t next = mStep + 1;
+    std::vector<FrameTasks> frames;
+    // One frame per share of `slicesPerFrame` slices; `first` (the list update) joins the stage's first frame.
+    auto addShares = [&](Stage stage, uint32_t step, std::optional<ShareTask> first) {
+        const StageDescriptor& d = Describe(stage);
+        const uint32_t count = d.shareCount ? d.shareCount(mScene, step) : 1;
+        const uint32_t size = d.shareCount ? slicesPerFrame : 1;
+        for (uint32_t b = 0; b < count; b += std::min(size, count - b)) {
+            FrameTasks tasks;
+            if (b == 0 && first) tasks.push_back(*first);
+            tasks.push_back({stage, d.shareCount ? SliceRange{b, b + std::min(size, count - b)} : SliceRange{}});
+            frames.push_back(std::move(tasks));
+        }
+    };
+    auto markAhead = [&](const StageDescriptor& d) {
+        for (Resource r : d.writes) {
+            mSlots[size_t(r)].ahead = true;
+            ++mSlots[size_t(r)].version;
+        }
+    };
+    // The state advances first (state_t -> state_t+1 from R_t), as at the end of an unsliced step.
+    for (Stage stage : mSchedule)
+        if (Describe(stage).advancesState) {
+            addShares(stage, mStep, std::nullopt);
+            markAhead(Describe(stage));
+        }
+    // Then step t+1's stages, each decided as an unsliced step t+1 would: versions count the writes planned so far.
+    std::optional<ShareTask> listUpdate;
+    if (mScene.stages.Has(Stage::Region)) listUpdate = ShareTask{};
+    for (Stage stage : mSchedule) {
+        const StageDescriptor& d = Describe(stage);
+        if (d.advancesState || d.renderer || (d.outputStepsOnly && !IsOutputStep(next))) continue;
+        if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage, next)) {
+            mAhead.skippedUnchanged[size_t(stage)] = true;
+            continue;
+        }
+        mInputsAtLastRun[size_t(stage)] = InputVersions(stage, next);
+        markAhead(d);
+        addShares(stage, next, stage == Stage::Region ? listUpdate : std::nullopt);
+    }
+    return frames;
+}
+
+Status Simulation::RunShares(const FrameTasks& tasks, StepRecord& record, std::string* describe) {
+    for (const ShareTask& task : tasks) {
+        if (!task.stage) {
+            const auto start = std::chrono::steady_clock::now();
+            mEllipsoids.Update();
+            mRasterAhead = mEllipsoids.Raster();
+            record.ellipsoidUpdateMs += MsSince(start);
+            if (describe) *describe += (describe->empty() ? "" : ", ") + std::string("ellipsoid list");
+            continue;
+        }
+        const Stage stage = *task.stage;
+        const bool advances = Describe(stage).advancesState;
+        // The automaton's share of step t is step t's work; the rest computes step t+1.
+        const uint32_t step = advances ? mStep : mStep + 1;
+        StageHostInputs host{step, mRasterAhead, 0, 0, task.slices};
+        StageCallRecord call;
+        CB_TRY(CallStage(stage, mBackend, mScene, host, advances ? Buffers() : AheadBuffers(), call));
+        StepRecord& target = advances ? record : mAhead;
+        target.stageMs[size_t(stage)] = target.stageMs[size_t(stage)].value_or(0) + call.ms;
+        if (call.deviceMs)
+            target.deviceMs[size_t(stage)] = target.deviceMs[size_t(stage)].value_or(0) + *call.deviceMs;
+        // The shares of density count the covered columns of their rows of tiles.
+        if (call.coveredColumns) target.coveredColumns = target.coveredColumns.value_or(0) + *call.coveredColumns;
+        if (!describe) continue;
+        char range[40] = "";
+        const uint32_t count = Describe(stage).shareCount ? Describe(stage).shareCount(mScene, step) : 1;
+        if (!task.slices.IsWhole(count))
+            std::snprintf(range, sizeof range, " %u-%u", task.slices.begin, task.slices.End(count) - 1);
+        *describe += (describe->empty() ? "" : ", ") + std::string(StageName(stage)) + range;
+    }
+    return {};
+}
+
+void Simulation::CommitAhead(StepRecord& record) {
+    for (Slot& slot : mSlots) {
+        if (!slot.ahead) continue;
+        slot.ahead = false;
+        if (slot.next) {
+            std::swap(slot.current[0], slot.next);
+        } else if (slot.previous) {  // previous <- current <- pending
+            std::swap(slot.previous, slot.current[0]);
+            std::swap(slot.current[0], slot.pending);
+        } else {
+            std::swap(slot.current[0], slot.pending);
+        }
+    }
+    if (mScene.stages.Has(Stage::Region)) mRaster = mRasterAhead;
+    record.stageMs = mAhead.stageMs;
+    record.deviceMs = mAhead.deviceMs;
+    record.skippedUnchanged = mAhead.skippedUnchanged;
+    if (mAhead.coveredColumns) mLastCoveredColumns = mAhead.coveredColumns;
+    record.coveredColumns = mLastCoveredColumns;
+    mAhead = StepRecord{};
 }
 
 StageBuffers Simulation::Buffers() {
@@ -174,15 +340,25 @@ StageBuffers Simulation::Buffers() {
     return buffers;
 }
 
-Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame) {
+StageBuffers Simulation::AheadBuffers() {
+    StageBuffers buffers = Buffers();
+    for (Resource r : kAllResources) {
+        Slot& slot = mSlots[size_t(r)];
+        if (!slot.ahead || IsPerCamera(r)) continue;
+        buffers.current[size_t(r)] = {slot.next ? slot.next.get() : slot.pending.get()};
+    }
+    return buffers;
+}
+
+Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame, uint32_t frames) {
     if (stage == Stage::Region) mRaster = mEllipsoids.Raster();
     StageCallRecord call;
-    CB_TRY(CallStage(stage, mBackend, mScene, {mStep, mRaster, frame}, Buffers(), call));
+    StageHostInputs host{mStep, mRaster, frame, frames, {}};
+    CB_TRY(CallStage(stage, mBackend, mScene, host, Buffers(), call));
     // A renderer's time in a step is the sum over its frames.
     auto add = [](std::optional<double>& total, const std::optional<double>& part) {
         if (part) total = total.value_or(0) + *part;
     };
-    if (frame == 0) record.stageMs[size_t(stage)].reset(), record.deviceMs[size_t(stage)].reset();
     add(record.stageMs[size_t(stage)], call.ms);
     add(record.deviceMs[size_t(stage)], call.deviceMs);
     if (call.coveredColumns) record.coveredColumns = mLastCoveredColumns = call.coveredColumns;

@@ -17,12 +17,27 @@
 //   host     L_{t+1} = update(L_t)
 // Output steps: every step when dumping or when the scene does not render;
 // otherwise the render steps (render.every_steps).
+//
+// Time-slicing (render.slices_per_frame = s > 0; SPEC 13, seed 000 section
+// 7.1): step t computes its stages once (step 0 all at once, later steps
+// during the frames of the step before), then draws its frames, and while
+// they are drawn computes step t+1 into a third buffer set (BufferRole::
+// Pending; the automaton's `next`): ca, the list update, region, smooth,
+// density, shade and shadow, s slices of one stage per frame (one share a
+// frame; stages without shares take one frame). The step draws
+// max(render.frames_per_step, the frames its shares take) frames. Step t+1
+// starts by making the third set current. Every resource the observer sees,
+// and every image, is what the unsliced loop gives: only when the work is
+// done changes.
 #pragma once
 
 #include <array>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "core/Backend.h"
 #include "core/Ellipsoids.h"
@@ -45,6 +60,11 @@ struct StepRecord {
     std::optional<uint32_t> coveredColumns;  // from the density stage
     std::vector<FrameRecord> frames;         // renderers: one per camera and frame of the step
     uint32_t framesRendered = 0;             // frames of this step (render.frames_per_step on render steps, else 0)
+    // Wall time of each frame, ms: its renders and, time-sliced, its shares. The
+    // step's work outside its frames is charged to frame 0, so they add up to stepMs.
+    std::vector<double> frameMs;
+    // Time-sliced: what each frame computed, e.g. "ca 4-7" or "region 0-3, ellipsoids" ("" for none).
+    std::vector<std::string> frameWork;
     // Wall time of the whole step (stages, frames and host work; not the observer), ms.
     double stepMs = 0;
 };
@@ -103,19 +123,40 @@ class Simulation {
     // inputs did not change.
     struct Slot {
         std::vector<std::unique_ptr<Buffer>> current;
-        std::unique_ptr<Buffer> next, previous;
+        std::unique_ptr<Buffer> next, previous, pending;
         uint64_t version = 0;
+        // Time-sliced: the next step's value is being computed (in `next` or `pending`); committed when it starts.
+        bool ahead = false;
     };
+    // One share of the next step's work in a frame; no stage: the ellipsoid list update.
+    struct ShareTask {
+        std::optional<Stage> stage;
+        SliceRange slices;
+    };
+    using FrameTasks = std::vector<ShareTask>;
 
     Simulation(const Scene& scene, Backend& backend, bool everyStepOutputs);
     // Allocates exactly PlanBuffers(scene), so the memory plan prices what is allocated.
     Status Allocate();
     Status InitializeState();
     // Runs one stage on this step's buffers (its writes go to `next` when it advances the state).
-    Status RunStage(Stage stage, StepRecord& record, uint32_t frame = 0);
+    Status RunStage(Stage stage, StepRecord& record, uint32_t frame = 0, uint32_t frames = 0);
+    // This step's non-renderer stages that do not advance the state, in schedule order.
+    Status RunStepStages(StepRecord& record, bool outputStep);
+    // `frames` frames of every renderer; frame f first runs work[f] where there is one.
+    Status RenderFrames(StepRecord& record, uint32_t frames, std::span<const FrameTasks> work);
+    Status SlicedStep(StepRecord& record, const Observer& observe);
+    // The next step's work split into frames of `slicesPerFrame` slices; marks its outputs ahead.
+    std::vector<FrameTasks> PlanAhead(uint32_t slicesPerFrame);
+    // Runs one frame's shares; `describe`, if given, gets what they computed ("smooth 4-7").
+    Status RunShares(const FrameTasks& tasks, StepRecord& record, std::string* describe = nullptr);
+    // Makes the next step's values current (the start of a time-sliced step).
+    void CommitAhead(StepRecord& record);
     StageBuffers Buffers();
-    bool InputsChangedSinceLastRun(Stage stage) const;
-    std::vector<uint64_t> InputVersions(Stage stage) const;
+    // Buffers as the next step's stages see them: resources being computed ahead read and write their third set.
+    StageBuffers AheadBuffers();
+    bool InputsChangedSinceLastRun(Stage stage, uint32_t step) const;
+    std::vector<uint64_t> InputVersions(Stage stage, uint32_t step) const;
     Buffer& Out(Resource resource, size_t n = 0);
 
     const Scene mScene;
@@ -130,6 +171,9 @@ class Simulation {
     const bool mEveryStepOutputs;
     std::optional<uint32_t> mLastRendered;
     std::optional<uint32_t> mLastCoveredColumns;  // the density stage's last cover
+    // Time-sliced: the next step's ellipsoids, and what its stages recorded (merged into its record when it starts).
+    std::vector<RasterEllipsoid> mRasterAhead;
+    StepRecord mAhead;
 };
 
 }  // namespace cb

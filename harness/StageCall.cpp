@@ -32,15 +32,16 @@ Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& l
 // running its backend call through `timed` (host work outside it is not
 // stage time); each frame's time is what `timed` measured.
 template <typename RenderOne>
-Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, uint32_t step, uint32_t frameOfStep,
+Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, const StageHostInputs& host,
                         StageCallRecord& record, RenderOne&& renderOne) {
+    const uint32_t step = host.step;
     const std::string backendName = backend.Name();
     for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
         FrameRecord frame;
         frame.renderer = renderer;
         frame.camera = sc.render.cameras[n].name;
-        frame.frame = frameOfStep;
-        frame.alpha = sc.render.FrameAlpha(frameOfStep);
+        frame.frame = host.frame;
+        frame.alpha = sc.render.FrameAlpha(host.frame, host.frames);
         const double before = record.ms;
         const StageCountLabel label{StageName(renderer), backendName, step, frame.camera};
         auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
@@ -58,11 +59,11 @@ Buffer* PreviousOrCurrent(const StageBuffers& io, Resource r) {
     return io.Previous(r) ? io.Previous(r) : io.Current(r);
 }
 
-Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, uint32_t frameOfStep,
-                         const StageBuffers& io, StageCallRecord& record) {
+Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                         StageCallRecord& record) {
     return RenderEachCamera(
-        Stage::RenderSplat, backend, sc, step, frameOfStep, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n], step, frameOfStep);
+        Stage::RenderSplat, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
             // The order is host work shared by all backends, outside the stage time.
             const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
             p.order = &order;
@@ -76,11 +77,11 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, uint32_t step, uint3
         });
 }
 
-Status RenderMarchFrames(Backend& backend, const Scene& sc, uint32_t step, uint32_t frameOfStep,
-                         const StageBuffers& io, StageCallRecord& record) {
+Status RenderMarchFrames(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                         StageCallRecord& record) {
     return RenderEachCamera(
-        Stage::RenderMarch, backend, sc, step, frameOfStep, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], step, frameOfStep);
+        Stage::RenderMarch, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
             // T only where shade runs (the light source "shade").
             MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
             in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
@@ -96,7 +97,7 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
     auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
     switch (stage) {
         case Stage::Region:
-            return timed([&] { return backend.Region(host.raster, *io.Current(Resource::Region)); });
+            return timed([&] { return backend.Region(host.raster, *io.Current(Resource::Region), host.slices); });
         case Stage::Ca: {
             CaStepParams params = MakeCaStepParams(sc, host.step);
             std::vector<int32_t> shiftX, shiftY;
@@ -104,24 +105,29 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
                 for (const SliceShift& s : sc.ca.windShift) shiftX.push_back(s.sx), shiftY.push_back(s.sy);
             params.shiftX = shiftX;
             params.shiftY = shiftY;
+            params.slices = host.slices;
             const ConstCaFields in{io.Current(Resource::Hum), io.Current(Resource::Act), io.Current(Resource::Cld)};
             const CaFields out{io.Next(Resource::Hum), io.Next(Resource::Act), io.Next(Resource::Cld)};
             return timed([&] { return backend.CaStep(params, in, *io.Current(Resource::Region), out); });
         }
         case Stage::Smooth:
-            return timed(
-                [&] { return backend.Smooth(sc.smooth.radius, *io.Current(Resource::Cld), *io.Current(Resource::Q)); });
+            return timed([&] {
+                return backend.Smooth(sc.smooth.radius, *io.Current(Resource::Cld), *io.Current(Resource::Q),
+                                      host.slices);
+            });
         case Stage::Density: {
             DensityOutputs out{io.Current(Resource::ColumnSum), io.Current(Resource::Tiles),
                                io.Current(Resource::Bands), 0};
-            const DensityParams params = MakeDensityParams(sc);
+            DensityParams params = MakeDensityParams(sc);
+            params.slices = host.slices;
             CB_TRY(timed(
                 [&] { return backend.Density(params, *io.Current(Resource::Q), io.Current(Resource::Cld), out); }));
             record.coveredColumns = out.coveredColumns;
             return {};
         }
         case Stage::Shade: {
-            const ShadeParams p = MakeShadeParams(sc, host.step);
+            ShadeParams p = MakeShadeParams(sc, host.step);
+            p.slices = host.slices;
             return timed([&] { return backend.Shade(p, *io.Current(Resource::Q), *io.Current(Resource::T)); });
         }
         case Stage::Shadow: {
@@ -130,13 +136,13 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
                 [&] { return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow)); });
         }
         case Stage::RenderSplat:
-            return RenderSplatFrames(backend, sc, host.step, host.frame, io, record);
+            return RenderSplatFrames(backend, sc, host, io, record);
         case Stage::Noise: {
             const NoiseParams p = MakeNoiseParams(sc, host.step);
             return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });
         }
         case Stage::RenderMarch:
-            return RenderMarchFrames(backend, sc, host.step, host.frame, io, record);
+            return RenderMarchFrames(backend, sc, host, io, record);
     }
     return MakeError("the harness cannot call stage '" + std::string(StageName(stage)) + "' yet");
 }

@@ -38,8 +38,12 @@ struct StageBuffers {
 struct StageHostInputs {
     uint32_t step = 0;
     std::span<const RasterEllipsoid> raster;  // region: step t's ellipsoids
-    // Renderers: the frame of the step (0 .. render.frames_per_step - 1), which sets alpha (RenderSettings::FrameAlpha).
+    // Renderers: the frame of the step (0 .. frames - 1) and the step's frames (0: render.frames_per_step), which
+    // set alpha (RenderSettings::FrameAlpha).
     uint32_t frame = 0;
+    uint32_t frames = 0;
+    // Region, ca, smooth, density and shade: the share of the stage to compute (time-slicing; core/Backend.h).
+    SliceRange slices;
 };
 
 // One rendered image.

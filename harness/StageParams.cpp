@@ -18,7 +18,12 @@ CaStepParams MakeCaStepParams(const Scene& sc, uint32_t step) {
     return p;
 }
 
-DensityParams MakeDensityParams(const Scene& sc) { return {sc.density.tile, sc.density.band}; }
+DensityParams MakeDensityParams(const Scene& sc) {
+    DensityParams p;
+    p.tile = sc.density.tile;
+    p.band = sc.density.band;
+    return p;
+}
 
 ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
     ShadeParams p;
@@ -57,7 +62,8 @@ GroundParams MakeGroundParams(const Scene& sc) {
     return {sc.render.ground.on, {float(a[0]), float(a[1]), float(a[2])}};
 }
 
-SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame) {
+SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame,
+                            uint32_t frames) {
     SplatParams p;
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
     p.sun = sc.sun.DirectionAt(step);
@@ -68,7 +74,7 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     p.qMin = float(sc.splat.qMin);
     p.splatDiameter = float(sc.splat.splatScale * sc.grid.voxelSize);
     p.opacity = float(sc.splat.opacity);
-    p.alpha = sc.render.FrameAlpha(frame);
+    p.alpha = sc.render.FrameAlpha(frame, frames);
     p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
     p.voxelSize = float(sc.grid.voxelSize);
     p.culling = sc.splat.culling;
@@ -79,7 +85,8 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
-MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame) {
+MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame,
+                            uint32_t frames) {
     MarchParams p;
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
     const float h = float(sc.grid.voxelSize);
@@ -107,7 +114,7 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
         s.point.radiance[c] = float(l.color[c] * l.intensity);
     }
     s.point.minDistance2 = float(l.radius * l.radius);
-    p.alpha = sc.render.FrameAlpha(frame);
+    p.alpha = sc.render.FrameAlpha(frame, frames);
     p.light = sc.march.light;
     p.lightSteps = sc.march.lightSteps;
     p.jitter = sc.march.jitter;

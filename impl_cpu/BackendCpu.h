@@ -42,6 +42,19 @@ struct MarchQT {
     float q, t;
 };
 
+// What smooth keeps between the shares of one sweep (SmoothCpu.cpp): the ring
+// of slices filtered in x and y, valid for a share that starts at `next` on the
+// same cld field and radius.
+struct SmoothShareState {
+    const BitField* cld = nullptr;  // not owned; nullptr: nothing to resume
+    int radius = 0;
+    Extent3 extent;
+    uint32_t next = 0;      // the first output slice of the share that may resume
+    uint32_t filtered = 0;  // slices below this one have been filtered into the ring
+    std::vector<uint8_t> ring;  // 2 radius + 1 slices of numerators (1 or 2 bytes each)
+    std::vector<uint8_t> xs;    // one slice of x sums
+};
+
 // Not final: tests derive test-only stages from it (a producer of q other than smooth).
 class BackendCpu : public Backend {
   public:
@@ -75,6 +88,7 @@ class BackendCpu : public Backend {
     tbb::task_arena mArena;
     // Scratch kept between calls so that steady-state steps do not allocate.
     std::vector<BitField> mAdvectScratch;
+    SmoothShareState mSmoothShare;                    // smooth in shares (time-slicing)
     std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
     std::vector<MarchQT> mMarchVolume;                // render_march: padded (q_alpha, T)
     std::vector<uint8_t> mMarchBricks;                // render_march: empty bricks

@@ -20,12 +20,14 @@ inline uint64_t BitsAt(const uint64_t* row, int64_t words, int64_t start) {
 }
 
 // X'(i, j, k) = X(i - sx, j - sy, k), zero-filled (SPEC 3 step 4).
+// Rows of slices [k0, k1) only: the shift stays within a slice.
 void AdvectField(const BitField& src, BitField& dst, std::span<const int32_t> shiftX,
-                 std::span<const int32_t> shiftY) {
+                 std::span<const int32_t> shiftY, uint32_t k0, uint32_t k1) {
     const Extent3 e = src.Extent();
     const uint32_t words = src.WordsPerRow();
     const uint64_t lastMask = src.LastWordMask();
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
+    const tbb::blocked_range<uint32_t> all(e.ny * k0, e.ny * k1, 64);
+    tbb::parallel_for(all, [&](const tbb::blocked_range<uint32_t>& rows) {
         for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
             uint32_t j = r % e.ny, k = r / e.ny;
             uint64_t* out = dst.Row(j, k);
@@ -72,7 +74,6 @@ Status BackendCpu::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& regionBuffer, CaFields out) {
-    if (params.slices != SliceRange{}) return MakeError("cpu: ca in shares (time-slicing) is not implemented yet");
     const BitField& hum = static_cast<const BufferCpu&>(*in.hum).Bits();
     const BitField& act = static_cast<const BufferCpu&>(*in.act).Bits();
     const BitField& cld = static_cast<const BufferCpu&>(*in.cld).Bits();
@@ -80,6 +81,12 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
     const Extent3 e = hum.Extent();
     const uint32_t words = hum.WordsPerRow();
     const uint64_t lastMask = hum.LastWordMask();
+    // The share: slices k in [k0, k1) of `out`. A bit field packs x into words,
+    // so a slice is whole rows of words; the rules read `in` at k - 2 .. k + 1,
+    // and the advection stays within a slice, so the scratch of these slices
+    // is all a share writes or reads.
+    const uint32_t k0 = params.slices.Begin(e.nz), k1 = params.slices.End(e.nz);
+    if (k0 >= k1) return {};
 
     bool wind = false;
     for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
@@ -130,11 +137,11 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
     };
 
     mArena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 16), rows);
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(e.ny * k0, e.ny * k1, 16), rows);
         if (wind) {
             for (int f = 0; f < 3; ++f) {
                 BitField& target = static_cast<BufferCpu&>(f == 0 ? *out.hum : f == 1 ? *out.act : *out.cld).Bits();
-                AdvectField(*dst[f], target, params.shiftX, params.shiftY);
+                AdvectField(*dst[f], target, params.shiftX, params.shiftY, k0, k1);
             }
         }
     });

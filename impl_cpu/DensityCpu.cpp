@@ -31,10 +31,11 @@ void TileFlags(const float* values, uint32_t nx, uint32_t rows, uint32_t T, std:
     }
 }
 
-// Columns (i, j) with any cld = 1: the OR of a column's slices, counted a word at a time.
-uint32_t CoveredColumns(const BitField& cld, const Extent3& e) {
+// Columns (i, j), j in [j0, j1), with any cld = 1: the OR of a column's
+// slices, counted a word at a time.
+uint32_t CoveredColumns(const BitField& cld, const Extent3& e, uint32_t j0, uint32_t j1) {
     return tbb::parallel_reduce(
-        tbb::blocked_range<uint32_t>(0, e.ny, 8), 0u,
+        tbb::blocked_range<uint32_t>(j0, j1, 8), 0u,
         [&](const tbb::blocked_range<uint32_t>& rows, uint32_t count) {
             std::vector<uint64_t> columns(cld.WordsPerRow());
             for (uint32_t j = rows.begin(); j != rows.end(); ++j) {
@@ -59,7 +60,6 @@ uint32_t ColumnsAboveZero(const float* D, size_t columns) {
 
 Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer* cldBuffer,
                            DensityOutputs& out) {
-    if (params.slices != SliceRange{}) return MakeError("cpu: density in shares (time-slicing) is not implemented yet");
     if (params.tile == 0 || params.band == 0) return MakeError("cpu: density tile and band must be positive");
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* D = static_cast<BufferCpu&>(*out.columnSum).F32();
@@ -69,10 +69,15 @@ Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, c
     const uint32_t T = params.tile, B = params.band;
     const uint32_t tilesX = CeilDiv(e.nx, T), tilesY = CeilDiv(e.ny, T), bandCount = CeilDiv(e.nz, B);
     const size_t sliceSize = size_t(e.nx) * e.ny;
+    // The share: rows of tiles [ty0, ty1), i.e. the columns of rows j in [jBegin, jEnd).
+    const uint32_t ty0 = params.slices.Begin(tilesY), ty1 = params.slices.End(tilesY);
+    out.coveredColumns = 0;
+    if (ty0 >= ty1) return {};
+    const uint32_t jBegin = ty0 * T, jEnd = std::min(e.ny, ty1 * T);
 
     mArena.execute([&] {
         tbb::parallel_for(
-            tbb::blocked_range<uint32_t>(0, tilesY, 1), [&](const tbb::blocked_range<uint32_t>& tileRows) {
+            tbb::blocked_range<uint32_t>(ty0, ty1, 1), [&](const tbb::blocked_range<uint32_t>& tileRows) {
                 // The columns of one row of tiles are contiguous in D and in each
                 // slice of q, so every inner loop runs over T*nx consecutive floats.
                 std::vector<float> bandMax;  // per column: the largest q within the current band
@@ -113,8 +118,9 @@ Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, c
                 }
             });
 
-        out.coveredColumns = cldBuffer ? CoveredColumns(static_cast<const BufferCpu&>(*cldBuffer).Bits(), e)
-                                       : ColumnsAboveZero(D, size_t(e.nx) * e.ny);
+        out.coveredColumns = cldBuffer
+                                 ? CoveredColumns(static_cast<const BufferCpu&>(*cldBuffer).Bits(), e, jBegin, jEnd)
+                                 : ColumnsAboveZero(D + size_t(e.nx) * jBegin, size_t(e.nx) * (jEnd - jBegin));
     });
     return {};
 }

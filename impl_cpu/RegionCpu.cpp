@@ -43,7 +43,6 @@ EllipsoidBounds ComputeBounds(const RasterEllipsoid& e) {
 }  // namespace
 
 Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& regionBuffer, SliceRange slices) {
-    if (slices != SliceRange{}) return MakeError("cpu: region in shares (time-slicing) is not implemented yet");
     uint8_t* region = static_cast<BufferCpu&>(regionBuffer).U8();
     const Extent3 e = regionBuffer.Extent();
     std::vector<EllipsoidBounds> bounds(ellipsoids.size());
@@ -108,7 +107,11 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
             }
         }
     };
-    mArena.execute([&] { tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, e.nz, 1, 0, e.ny, 16), rows); });
+    // The share: slices k in [k0, k1); every voxel's value depends on its own
+    // position alone, so a share is the whole call's loop over fewer slices.
+    const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
+    if (k0 >= k1) return {};
+    mArena.execute([&] { tbb::parallel_for(tbb::blocked_range2d<uint32_t>(k0, k1, 1, 0, e.ny, 16), rows); });
     return {};
 }
 

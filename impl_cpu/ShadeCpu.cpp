@@ -5,6 +5,7 @@
 // each f^3 block and the result is read back trilinearly.
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -54,8 +55,12 @@ void ShadeRow(const ShadeKernel& k, const float* t0, const float* t1, const floa
     }
 }
 
-// Shades the plan's grid (full or coarse): Q in, T out, both of plan.cells.
-void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena) {
+// Shades the sweep's slices m in [m0, m1) of the plan's grid (full or coarse):
+// Q in, T out, both of plan.cells. With m0 > 0, slice m0 - 1 of T must hold
+// what this function wrote there (an earlier share): it is read back as the
+// previous slice, exactly the values the whole sweep would carry over.
+void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena,
+               uint32_t m0, uint32_t m1) {
     const ShearWarp& g = plan.geometry;
     const int w = g.w, u = g.u, v = g.v;
     const uint32_t nu = plan.nu, nv = plan.nv, nw = plan.nw;
@@ -70,7 +75,22 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     std::vector<float> prevT(size_t(pitch) * (nv + 3), 1.0f), prevQ(size_t(pitch) * (nv + 3), 0.0f);
     auto padded = [&](int64_t a, int64_t b) { return size_t(a + 1) + size_t(pitch) * size_t(b + 1); };
 
-    for (uint32_t m = 0; m < nw; ++m) {
+    // Slice wIndex of T and Q becomes the previous one.
+    auto keep = [&](uint32_t wIndex) {
+        const size_t sliceBase = stride[w] * wIndex;
+        for (uint32_t b = 0; b < nv; ++b) {
+            float* pt = prevT.data() + padded(0, b);
+            float* pq = prevQ.data() + padded(0, b);
+            const float* t = T + sliceBase + stride[v] * b;
+            const float* q = Q + sliceBase + stride[v] * b;
+            for (uint32_t a = 0; a < nu; ++a) {
+                pt[a] = t[stride[u] * a];
+                pq[a] = q[stride[u] * a];
+            }
+        }
+    };
+    if (m0 > 0) keep(plan.SliceW(m0 - 1));
+    for (uint32_t m = m0; m < std::min(m1, nw); ++m) {
         const uint32_t wIndex = plan.SliceW(m);
         const size_t sliceBase = stride[w] * wIndex;
         if (m == 0) {
@@ -98,17 +118,7 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
             if (nv > grain) arena.execute([&] { tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nv, grain), rows); });
             else rows(tbb::blocked_range<uint32_t>(0, nv));
         }
-        // This slice becomes the previous one.
-        for (uint32_t b = 0; b < nv; ++b) {
-            float* pt = prevT.data() + padded(0, b);
-            float* pq = prevQ.data() + padded(0, b);
-            const float* t = T + sliceBase + stride[v] * b;
-            const float* q = Q + sliceBase + stride[v] * b;
-            for (uint32_t a = 0; a < nu; ++a) {
-                pt[a] = t[stride[u] * a];
-                pq[a] = q[stride[u] * a];
-            }
-        }
+        if (m + 1 < m1) keep(wIndex);
     }
 }
 
@@ -164,29 +174,14 @@ void AddRowBlocks(const float* row, uint32_t n, int f, float* cell) {
     else AddRowBlocksT<4>(row, n, cell);
 }
 
-}  // namespace
-
-Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
-    if (params.slices != SliceRange{}) return MakeError("cpu: shade in shares (time-slicing) is not implemented yet");
-    const int f = params.resolution;
-    if (f != 1 && f != 2 && f != 4) return MakeError("cpu: shade resolution must be 1, 2 or 4");
-    const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
-    float* T = static_cast<BufferCpu&>(TBuffer).F32();
-    const Extent3 e = qBuffer.Extent();
-    const ShadePlan plan = MakeShadePlan(params, e);
-    if (f == 1) {
-        ShadeGrid(plan, params.storage, q, T, mArena);
-        return {};
-    }
-
-    // Coarse grid: the mean of each f^3 block (partial blocks: of the voxels present).
+// The coarse grid of q at resolution f: the mean of each f^3 block (partial
+// blocks: of the voxels present). `cq` (plan.cells) must hold zeros.
+void DownsampleShadeQ(const ShadePlan& plan, int f, const float* q, const Extent3& e, float* cq,
+                      tbb::task_arena& arena) {
     const uint32_t* c = plan.cells;
     const size_t coarseSlice = size_t(c[0]) * c[1];
-    mShadeCoarseQ.assign(coarseSlice * c[2], 0.0f);
-    mShadeCoarseT.assign(coarseSlice * c[2], 1.0f);
-    float* cq = mShadeCoarseQ.data();
     auto blockSize = [&](uint32_t cell, uint32_t n) { return std::min<uint32_t>(f, n - cell * f); };
-    mArena.execute([&] {
+    arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, c[2]), [&](const tbb::blocked_range<uint32_t>& slices) {
             for (uint32_t K = slices.begin(); K != slices.end(); ++K) {
                 float* out = cq + coarseSlice * K;
@@ -203,7 +198,40 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
             }
         });
     });
-    ShadeGrid(plan, params.storage, cq, mShadeCoarseT.data(), mArena);
+}
+
+}  // namespace
+
+Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
+    const int f = params.resolution;
+    if (f != 1 && f != 2 && f != 4) return MakeError("cpu: shade resolution must be 1, 2 or 4");
+    const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
+    float* T = static_cast<BufferCpu&>(TBuffer).F32();
+    const Extent3 e = qBuffer.Extent();
+    const ShadePlan plan = MakeShadePlan(params, e);
+    // The share: the sweep's slices m in [m0, m1), of the shaded (at f > 1 the
+    // coarse) grid. At f > 1 the share with m = 0 also forms the coarse q, the
+    // coarse grids stay in mShadeCoarseQ/T until the last share, and the share
+    // ending at nw writes all of T from them.
+    const uint32_t m0 = params.slices.Begin(plan.nw), m1 = params.slices.End(plan.nw);
+    if (m0 >= m1) return {};
+    if (f == 1) {
+        ShadeGrid(plan, params.storage, q, T, mArena, m0, m1);
+        return {};
+    }
+
+    const uint32_t* c = plan.cells;
+    const size_t coarseSlice = size_t(c[0]) * c[1];
+    if (m0 > 0 && (mShadeCoarseQ.size() != coarseSlice * c[2] || mShadeCoarseT.size() != coarseSlice * c[2]))
+        return MakeError("cpu: shade share [" + std::to_string(m0) + ", " + std::to_string(m1) +
+                         ") without the share that starts the sweep");
+    if (m0 == 0) {
+        mShadeCoarseQ.assign(coarseSlice * c[2], 0.0f);
+        mShadeCoarseT.assign(coarseSlice * c[2], 1.0f);
+        DownsampleShadeQ(plan, f, q, e, mShadeCoarseQ.data(), mArena);
+    }
+    ShadeGrid(plan, params.storage, mShadeCoarseQ.data(), mShadeCoarseT.data(), mArena, m0, m1);
+    if (m1 < plan.nw) return {};
 
     // Full resolution, trilinear from the coarse grid: full voxel i sits at coarse
     // coordinate (i + 0.5)/f - 0.5, clamped to the coarse grid's centres. Per fine

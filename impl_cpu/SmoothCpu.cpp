@@ -6,6 +6,7 @@
 // them in x and then y into a small ring of slices that stays in L2, and sums
 // that ring in z straight into the float output. Every inner loop runs over a
 // whole row of bytes or integers, which the compiler vectorises.
+#include <algorithm>
 #include <array>
 #include <cstring>
 
@@ -46,17 +47,17 @@ constexpr int W(int d) {
     return SmoothWeight(R, d);
 }
 
-// x then y pass of slice k into `out` (nx*ny numerators); `padded` is scratch of
-// (nx + 2R) bytes per row, zero in the R bytes at both ends.
+// x pass of rows [j0, j1) of slice k into xs (nx bytes per row, the slice's
+// layout); `padded` is scratch of (nx + 2R + 8) bytes, zero in the R bytes at
+// the start.
 template <int R>
-void FilterSliceXY(const BitField& cld, uint32_t k, std::vector<uint8_t>& xs, std::vector<uint8_t>& padded,
-                   Acc<R>* out) {
-    const Extent3 e = cld.Extent();
-    const uint32_t nx = e.nx;
-    for (uint32_t j = 0; j < e.ny; ++j) {
+void FilterRowsX(const BitField& cld, uint32_t k, uint32_t j0, uint32_t j1, uint8_t* xs,
+                 std::vector<uint8_t>& padded) {
+    const uint32_t nx = cld.Extent().nx;
+    for (uint32_t j = j0; j < j1; ++j) {
         ExpandRow(cld.Row(j, k), nx, padded.data() + R);
         std::fill(padded.begin() + R + nx, padded.end(), 0);  // the expansion writes up to 7 bytes past nx
-        uint8_t* x = xs.data() + size_t(nx) * j;
+        uint8_t* x = xs + size_t(nx) * j;
         const uint8_t* p = padded.data() + R;
         // Shifted row pointers: i - 1 on an unsigned index would wrap.
         const uint8_t *m2 = p - R, *m1 = p - 1, *p1 = p + 1, *p2 = p + R;
@@ -66,16 +67,51 @@ void FilterSliceXY(const BitField& cld, uint32_t k, std::vector<uint8_t>& xs, st
             for (uint32_t i = 0; i < nx; ++i) x[i] = uint8_t(m2[i] + 4 * m1[i] + 6 * p[i] + 4 * p1[i] + p2[i]);
         }
     }
-    for (uint32_t j = 0; j < e.ny; ++j) {
+}
+
+// y pass of rows [j0, j1) from the x sums of the whole slice into `out`.
+template <int R>
+void FilterRowsY(const Extent3 e, const uint8_t* xs, uint32_t j0, uint32_t j1, Acc<R>* out) {
+    const uint32_t nx = e.nx;
+    for (uint32_t j = j0; j < j1; ++j) {
         Acc<R>* o = out + size_t(nx) * j;
         std::fill(o, o + nx, Acc<R>(0));
         for (int d = -R; d <= R; ++d) {
             const int64_t jj = int64_t(j) + d;
             if (jj < 0 || jj >= e.ny) continue;
-            const uint8_t* x = xs.data() + size_t(nx) * jj;
+            const uint8_t* x = xs + size_t(nx) * jj;
             const Acc<R> w = Acc<R>(W<R>(d));
             for (uint32_t i = 0; i < nx; ++i) o[i] = Acc<R>(o[i] + w * x[i]);
         }
+    }
+}
+
+// x then y pass of slice k into `out` (nx*ny numerators); `xs` is scratch of a slice.
+template <int R>
+void FilterSliceXY(const BitField& cld, uint32_t k, std::vector<uint8_t>& xs, std::vector<uint8_t>& padded,
+                   Acc<R>* out) {
+    FilterRowsX<R>(cld, k, 0, cld.Extent().ny, xs.data(), padded);
+    FilterRowsY<R>(cld.Extent(), xs.data(), 0, cld.Extent().ny, out);
+}
+
+// z pass of rows [j0, j1) of output slice k; slot(kk) gives slice kk's numerators.
+template <int R, typename Slot>
+void SumRowsZ(const Extent3 e, uint32_t k, uint32_t j0, uint32_t j1, const Slot& slot, uint32_t* acc, float* q) {
+    // `e` by value: stores through acc must not be able to alias its fields,
+    // or the loops below would not vectorise.
+    const size_t sliceSize = size_t(e.nx) * e.ny;
+    const float invW = 1.0f / float(SmoothNormaliser(R));  // a power of two: exact
+    for (uint32_t j = j0; j < j1; ++j) {
+        float* out = q + sliceSize * k + size_t(e.nx) * j;
+        std::fill(acc, acc + e.nx, 0u);
+        for (int d = -R; d <= R; ++d) {
+            const int64_t kk = int64_t(k) + d;
+            if (kk < 0 || kk >= e.nz) continue;
+            const Acc<R>* in = slot(kk) + size_t(e.nx) * j;
+            const uint32_t w = uint32_t(W<R>(d));
+            for (uint32_t i = 0; i < e.nx; ++i) acc[i] += w * in[i];
+        }
+        for (uint32_t i = 0; i < e.nx; ++i) out[i] = float(acc[i]) * invW;
     }
 }
 
@@ -83,7 +119,6 @@ template <int R>
 void SmoothSlices(const BitField& cld, float* q, uint32_t k0, uint32_t k1) {
     const Extent3 e = cld.Extent();
     const size_t sliceSize = size_t(e.nx) * e.ny;
-    const float invW = 1.0f / float(SmoothNormaliser(R));  // a power of two: exact
     constexpr int kRing = 2 * R + 1;
     // ring[k mod kRing] holds the xy numerators of slice k.
     std::vector<Acc<R>> ring(sliceSize * kRing);
@@ -96,33 +131,71 @@ void SmoothSlices(const BitField& cld, float* q, uint32_t k0, uint32_t k1) {
     for (uint32_t k = k0; k < k1; ++k) {
         const int64_t need = std::min<int64_t>(int64_t(k) + R, int64_t(e.nz) - 1);
         for (; filtered <= need; ++filtered) FilterSliceXY<R>(cld, uint32_t(filtered), xs, padded, slot(filtered));
-        for (uint32_t j = 0; j < e.ny; ++j) {
-            float* out = q + sliceSize * k + size_t(e.nx) * j;
-            std::fill(acc.begin(), acc.end(), 0u);
-            for (int d = -R; d <= R; ++d) {
-                const int64_t kk = int64_t(k) + d;
-                if (kk < 0 || kk >= e.nz) continue;
-                const Acc<R>* in = slot(kk) + size_t(e.nx) * j;
-                const uint32_t w = uint32_t(W<R>(d));
-                for (uint32_t i = 0; i < e.nx; ++i) acc[i] += w * in[i];
-            }
-            for (uint32_t i = 0; i < e.nx; ++i) out[i] = float(acc[i]) * invW;
-        }
+        SumRowsZ<R>(e, k, 0, e.ny, slot, acc.data(), q);
     }
+}
+
+// A share [k0, k1) of a sweep of shares in ascending order: one ring, kept in
+// `state` between the calls, so that the slices a share has filtered in x and
+// y for its last outputs serve the next share's first ones, and each slice is
+// filtered once per sweep as in the whole call. Rows of each slice are spread
+// over the arena. The numerators are integers, so the result does not depend
+// on how the work is split.
+template <int R>
+void SmoothShare(const BitField& cld, float* q, uint32_t k0, uint32_t k1, SmoothShareState& state,
+                 tbb::task_arena& arena) {
+    const Extent3 e = cld.Extent();
+    const size_t sliceSize = size_t(e.nx) * e.ny;
+    constexpr int kRing = 2 * R + 1;
+    const bool resume = k0 > 0 && state.cld == &cld && state.radius == R && state.next == k0 &&
+                        state.extent == e;
+    if (!resume) {
+        state.ring.resize(sizeof(Acc<R>) * sliceSize * kRing);
+        state.xs.resize(sliceSize);
+        state.filtered = uint32_t(std::max<int64_t>(0, int64_t(k0) - R));
+    }
+    state.cld = nullptr;  // not resumable until this share has finished
+    Acc<R>* ring = reinterpret_cast<Acc<R>*>(state.ring.data());
+    auto slot = [&](int64_t k) { return ring + sliceSize * size_t(k % kRing); };
+    const uint32_t rowGrain = std::max<uint32_t>(1, 16384 / std::max<uint32_t>(e.nx, 1));
+    const tbb::blocked_range<uint32_t> rows(0, e.ny, rowGrain);
+    arena.execute([&] {
+        for (uint32_t k = k0; k < k1; ++k) {
+            const uint32_t need = std::min(k + R, e.nz - 1);
+            for (; state.filtered <= need; ++state.filtered) {
+                const uint32_t kk = state.filtered;
+                tbb::parallel_for(rows, [&](const tbb::blocked_range<uint32_t>& r) {
+                    std::vector<uint8_t> padded(e.nx + 2 * R + 8, 0);
+                    FilterRowsX<R>(cld, kk, r.begin(), r.end(), state.xs.data(), padded);
+                });
+                tbb::parallel_for(rows, [&](const tbb::blocked_range<uint32_t>& r) {
+                    FilterRowsY<R>(e, state.xs.data(), r.begin(), r.end(), slot(kk));
+                });
+            }
+            tbb::parallel_for(rows, [&](const tbb::blocked_range<uint32_t>& r) {
+                std::vector<uint32_t> acc(e.nx);
+                SumRowsZ<R>(e, k, r.begin(), r.end(), slot, acc.data(), q);
+            });
+        }
+    });
+    state.cld = &cld, state.radius = R, state.next = k1, state.extent = e;
 }
 
 }  // namespace
 
 Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, SliceRange slices) {
-    if (slices != SliceRange{}) return MakeError("cpu: smooth in shares (time-slicing) is not implemented yet");
     if (radius < 0 || radius > 2) return MakeError("cpu: smooth radius must be 0, 1 or 2");
     const BitField& cld = static_cast<const BufferCpu&>(cldBuffer).Bits();
     float* q = static_cast<BufferCpu&>(qBuffer).F32();
     const Extent3 e = cld.Extent();
+    // The share: output slices k in [k0, k1). Each reads cld slices k - radius ..
+    // k + radius, so a share of s slices filters s + 2 radius slices in x and y.
+    const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
+    if (k0 >= k1) return {};
 
     if (radius == 0) {
         mArena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
+            tbb::parallel_for(tbb::blocked_range<uint32_t>(e.ny * k0, e.ny * k1, 64), [&](const tbb::blocked_range<uint32_t>& rows) {
                 std::vector<uint8_t> bytes(e.nx + 8);
                 for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
                     ExpandRow(cld.Row(r % e.ny, r / e.ny), e.nx, bytes.data());
@@ -131,6 +204,12 @@ Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, 
                 }
             });
         });
+        return {};
+    }
+
+    if (!slices.IsWhole(e.nz)) {
+        if (radius == 1) SmoothShare<1>(cld, q, k0, k1, mSmoothShare, mArena);
+        else SmoothShare<2>(cld, q, k0, k1, mSmoothShare, mArena);
         return {};
     }
 

@@ -105,6 +105,10 @@ Status BackendGL::DrawLayers(GLuint program, uint32_t layers, std::initializer_l
     return DrawLayers(program, layers, textures, [](uint32_t) {});
 }
 
+Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures) {
+    return DrawLayerRange(program, begin, end, textures, [](uint32_t) {});
+}
+
 Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("gl: cannot create an empty buffer");
     const Functions& f = mContext->F();

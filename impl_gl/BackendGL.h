@@ -147,10 +147,18 @@ class BackendGL final : public Backend {
     // set) once per layer k < layers: uniform "layer" = k, the render targets
     // layer k of each of `textures`, and perLayer(k) for whatever else changes
     // with k. The template is defined in BackendGLInternal.h.
+    // DrawLayerRange: the same for the layers begin <= k < end only (a share, SliceRange).
     template <typename PerLayer>
-    Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer);
+    Status DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures,
+                          PerLayer&& perLayer);
+    template <typename PerLayer>
+    Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer) {
+        return DrawLayerRange(program, 0, layers, textures, std::forward<PerLayer>(perLayer));
+    }
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures);
+    Status DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures);
     Status CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
+    Status CaStepRgba8Share(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
 
     std::unique_ptr<GLContext> mContext;
     bool mRgba8 = false;
@@ -165,6 +173,27 @@ class BackendGL final : public Backend {
     // step's outputs, valid until a bit field is written some other way.
     std::array<GLuint, 3> mStateOf{};
     uint64_t mBitsWrites = 0, mStateWrites = ~uint64_t(0);
+    // Smooth: the slices [begin, end) whose xy sums SmoothXY holds, of which cld
+    // at which radius, valid while no bit field is written (mBitsWrites).
+    struct SmoothSums {
+        GLuint cld = 0;
+        int radius = -1;
+        Extent3 extent;
+        uint64_t bitsWrites = ~uint64_t(0);
+        uint32_t begin = 0, end = 0;
+    };
+    SmoothSums mSmoothSums;
+    // CaStep in shares, RGBA8 layout: Rgba8StateA holds `inputs` for slices
+    // [packedBegin, packedEnd) and Rgba8StateB this step's rule results for
+    // [0, rulesEnd), valid while no bit field is written but by the shares.
+    struct Rgba8ShareState {
+        std::array<GLuint, 3> inputs{}, outputs{};
+        Extent3 extent;
+        uint64_t bitsWrites = ~uint64_t(0);
+        bool wind = false;
+        uint32_t packedBegin = 0, packedEnd = 0, rulesEnd = 0;
+    };
+    Rgba8ShareState mShareState;
 };
 
 }  // namespace cb::gl

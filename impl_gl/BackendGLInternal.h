@@ -40,13 +40,13 @@ class GpuTimer {
 };
 
 template <typename PerLayer>
-Status BackendGL::DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures,
-                             PerLayer&& perLayer) {
+Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures,
+                                 PerLayer&& perLayer) {
     const Functions& f = mContext->F();
     const GLint layerUniform = f.GetUniformLocation(program, "layer");
     std::array<std::pair<GLuint, int>, 4> targets;
     if (textures.size() > targets.size()) return MakeError("gl: a pass has more than 4 render targets");
-    for (uint32_t k = 0; k < layers; ++k) {
+    for (uint32_t k = begin; k < end; ++k) {
         size_t n = 0;
         for (GLuint texture : textures) targets[n++] = {texture, int(k)};
         CB_TRY(BindTargets(std::span(targets.data(), n)));

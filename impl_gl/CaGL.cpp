@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <array>
 #include <utility>
 
@@ -25,14 +26,19 @@ Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
-    if (params.slices != SliceRange{}) return MakeError("gl: ca in shares (time-slicing) is not implemented yet");
-    if (mRgba8) return CaStepRgba8(params, in, region, out);
+    if (mRgba8) return params.slices.IsWhole(in.hum->Extent().nz) ? CaStepRgba8(params, in, region, out)
+                                                                  : CaStepRgba8Share(params, in, region, out);
     const Functions& f = mContext->F();
     auto rules = mContext->Program("ca");
     if (!rules) return std::unexpected(rules.error());
     auto advect = mContext->Program("advect");
     if (!advect) return std::unexpected(advect.error());
     const Extent3 e = in.hum->Extent();
+    const uint32_t k0 = params.slices.Begin(e.nz), k1 = params.slices.End(e.nz);
+    if (k0 >= k1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
     const GLsizei words = GLsizei(CeilDiv(e.nx, 32));
     const bool wind = !params.shiftX.empty();
     // With wind the rules write scratch fields that the advection pass shifts into `out`.
@@ -57,15 +63,16 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
     f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
     f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
-    CB_TRY(DrawLayers(*rules, e.nz, {next[0], next[1], next[2]}));
+    CB_TRY(DrawLayerRange(*rules, k0, k1, {next[0], next[1], next[2]}));
     if (wind) {
         f.UseProgram(*advect);
         for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), next[n]);
         f.Uniform3i(f.GetUniformLocation(*advect, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
         f.Uniform1i(f.GetUniformLocation(*advect, "words"), words);
         const GLint shift = f.GetUniformLocation(*advect, "shift");
-        CB_TRY(DrawLayers(*advect, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()},
-                          [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
+        CB_TRY(DrawLayerRange(*advect, k0, k1,
+                              {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()},
+                              [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
     }
     ++mBitsWrites;
     mLastDeviceMs = timer.StopMs();
@@ -93,6 +100,7 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
     const bool packed = mStateOf == inputs && mStateWrites == mBitsWrites;
     const bool wind = !params.shiftX.empty();
+    mShareState = {};  // this call rewrites Rgba8StateA
     GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
     f.Viewport(0, 0, nx, ny);
@@ -133,6 +141,94 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     mStateWrites = mBitsWrites;
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("ca (RGBA8 layout)");
+}
+
+// A share [k0, k1) of a step in the thesis's layout. The rules read act at
+// k - 2 .. k + 1, so the share needs `in` in Rgba8StateA for slices
+// [k0 - 2, k1 + 1); it packs only those a preceding share (mShareState) or the
+// previous step (mStateOf) did not leave there. Rgba8StateA is not written: the
+// rules go to Rgba8StateB and are unpacked from there, with wind through a
+// shifted unpacking that folds in the advection. Without wind, the share that
+// ends a complete ascending sequence leaves the step's state in Rgba8StateA as
+// the whole call does; with wind the next step packs its input again.
+Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    const Functions& f = mContext->F();
+    const bool wind = !params.shiftX.empty();
+    auto pack = mContext->Program("ca_pack_rgba8");
+    if (!pack) return std::unexpected(pack.error());
+    auto rules = mContext->Program("ca_rgba8");
+    if (!rules) return std::unexpected(rules.error());
+    auto unpack = wind ? mContext->Program("ca_unpack_rgba8", "#define SHIFTED 1\n") : mContext->Program("ca_unpack_rgba8");
+    if (!unpack) return std::unexpected(unpack.error());
+    const Extent3 e = in.hum->Extent();
+    const uint32_t k0 = params.slices.Begin(e.nz), k1 = params.slices.End(e.nz);
+    if (k0 >= k1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
+    const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
+    const GLuint stateA = Scratch(GlScratch::Rgba8StateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateB = Scratch(GlScratch::Rgba8StateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
+    const std::array<GLuint, 3> outputs = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
+    // What Rgba8StateA holds of `in`, and what Rgba8StateB holds of this step's rules.
+    Rgba8ShareState& held = mShareState;
+    const bool continues = held.inputs == inputs && held.outputs == outputs && held.extent == e &&
+                           held.bitsWrites == mBitsWrites && held.wind == wind;
+    if (!continues) {
+        // The previous step's whole state, or nothing.
+        const bool whole = mStateOf == inputs && mStateWrites == mBitsWrites;
+        held = {inputs, outputs, e, mBitsWrites, wind, 0, whole ? e.nz : 0, 0};
+    }
+    mStateOf = {};  // Rgba8StateB is about to change; Rgba8StateA's claim lives on in `held`
+    const uint32_t lo = k0 >= 2 ? k0 - 2 : 0, hi = std::min(e.nz, k1 + 1);
+    uint32_t pack0 = lo;
+    if (held.packedBegin <= lo && held.packedEnd >= lo) {
+        pack0 = std::min(held.packedEnd, hi);
+    } else {
+        held.packedBegin = lo, held.packedEnd = 0;
+    }
+    GpuTimer timer(f);
+    f.BindVertexArray(mContext->EmptyVao());
+    f.Viewport(0, 0, nx, ny);
+    if (pack0 < hi) {
+        f.UseProgram(*pack);
+        for (int n = 0; n < 3; ++n) f.BindTextureUnit(GLuint(n), inputs[n]);
+        f.Uniform3i(f.GetUniformLocation(*pack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+        CB_TRY(DrawLayerRange(*pack, pack0, hi, {stateA}));
+    }
+    held.packedEnd = std::max(held.packedEnd, hi);
+    f.BindTextureUnit(0, stateA);
+    f.BindTextureUnit(1, Tex(region).Texture());
+    f.UseProgram(*rules);
+    f.Uniform3i(f.GetUniformLocation(*rules, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1ui(f.GetUniformLocation(*rules, "seed"), params.seed);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "step"), params.step);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qExt"), params.qExt);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
+    f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
+    CB_TRY(DrawLayerRange(*rules, k0, k1, {stateB}));
+    // Rgba8StateB's rule results: a run from slice 0 grown by ascending shares.
+    held.rulesEnd = held.rulesEnd == k0 ? k1 : 0;
+    f.BindTextureUnit(0, stateB);
+    f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), ny);
+    f.UseProgram(*unpack);
+    f.Uniform3i(f.GetUniformLocation(*unpack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    const GLint shift = wind ? f.GetUniformLocation(*unpack, "shift") : -1;
+    CB_TRY(DrawLayerRange(*unpack, k0, k1, {outputs[0], outputs[1], outputs[2]}, [&](uint32_t k) {
+        if (wind) f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]);
+    }));
+    ++mBitsWrites;
+    held.bitsWrites = mBitsWrites;
+    if (!wind && held.rulesEnd == e.nz) {
+        // The step is complete in Rgba8StateB: it becomes the state the next step starts from.
+        std::swap(mScratch[GlScratch::Rgba8StateA], mScratch[GlScratch::Rgba8StateB]);
+        mStateOf = outputs;
+        mStateWrites = mBitsWrites;
+        held = {};
+    }
+    mLastDeviceMs = timer.StopMs();
+    return mContext->Check("ca (RGBA8 layout, a share)");
 }
 
 }  // namespace cb::gl

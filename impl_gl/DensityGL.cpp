@@ -1,9 +1,10 @@
+#include <algorithm>
+
 #include "impl_gl/BackendGLInternal.h"
 
 namespace cb::gl {
 
 Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
-    if (params.slices != SliceRange{}) return MakeError("gl: density in shares (time-slicing) is not implemented yet");
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
     const Functions& f = mContext->F();
     auto sum = mContext->Program("density_sum");
@@ -15,14 +16,24 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     const Extent3 e = q.Extent();
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
+    // A share: the rows of tiles [t0, t1), columns' rows [y0, y1); each pass's
+    // viewport covers those rows only (gl_FragCoord stays the texel's).
+    const uint32_t t0 = params.slices.Begin(tilesY), t1 = params.slices.End(tilesY);
+    if (t0 >= t1) {
+        out.coveredColumns = 0;
+        mLastDeviceMs = 0.0;
+        return {};
+    }
+    const GLint y0 = GLint(t0 * params.tile);
+    const GLsizei rows = GLsizei(std::min(e.ny, t1 * params.tile)) - y0;
     GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
 
     // D: additive blending of the slices, k ascending.
     const float zero = 0.0f;
-    f.ClearTexImage(Tex(*out.columnSum).Texture(), 0, GL_RED, GL_FLOAT, &zero);
+    f.ClearTexSubImage(Tex(*out.columnSum).Texture(), 0, 0, y0, 0, GLsizei(e.nx), rows, 1, GL_RED, GL_FLOAT, &zero);
     CB_TRY(BindTargets({{Tex(*out.columnSum).Texture(), 0}}));
-    f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
+    f.Viewport(0, y0, GLsizei(e.nx), rows);
     f.UseProgram(*sum);
     f.BindTextureUnit(0, Tex(q).Texture());
     f.Enable(GL_BLEND);
@@ -42,7 +53,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
     const GLuint flags = Scratch(GlScratch::CoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
     CB_TRY(BindTargets({{flags, 0}}));
-    f.UseProgram(*cover);
+    f.UseProgram(*cover);  // in the rows' viewport: only their columns count
     // Without cld the cover counts columns with D > 0 and leaves the cld unit unbound.
     f.BindTextureUnit(0, cld ? Tex(*cld).Texture() : 0);
     f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
@@ -57,7 +68,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Uniform3i(f.GetUniformLocation(*occupancy, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
     f.Uniform2i(f.GetUniformLocation(*occupancy, "tileBand"), GLint(params.tile), GLint(params.band));
     const GLint mode = f.GetUniformLocation(*occupancy, "mode");
-    f.Viewport(0, 0, GLsizei(tilesX), GLsizei(tilesY));
+    f.Viewport(0, GLint(t0), GLsizei(tilesX), GLsizei(t1 - t0));
     f.Uniform1i(mode, 0);
     CB_TRY(DrawLayers(*occupancy, bandCount, {Tex(*out.bands).Texture()}));
     f.Uniform1i(mode, 1);

@@ -52,6 +52,8 @@
     X(PFNGLBLENDFUNCPROC, BlendFunc)                                           \
     X(PFNGLBLENDEQUATIONPROC, BlendEquation)                                   \
     X(PFNGLCLEARTEXIMAGEPROC, ClearTexImage)                                   \
+    X(PFNGLCLEARTEXSUBIMAGEPROC, ClearTexSubImage)                             \
+    X(PFNGLSCISSORPROC, Scissor)                                               \
     X(PFNGLCREATEBUFFERSPROC, CreateBuffers)                                   \
     X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                                   \
     X(PFNGLNAMEDBUFFERDATAPROC, NamedBufferData)                               \

@@ -4,9 +4,9 @@ namespace cb::gl {
 
 // region: per slice, one instanced quad per ellipsoid into an R8 UNORM layer
 // with MAX blending (integer targets cannot blend), then one copy into the
-// R8UI volume (the same 8-bit texel class, so the bits carry over).
+// R8UI volume (the same 8-bit texel class, so the bits carry over). A share
+// clears, draws and copies its own slices only.
 Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region, SliceRange slices) {
-    if (slices != SliceRange{}) return MakeError("gl: region in shares (time-slicing) is not implemented yet");
     const Functions& f = mContext->F();
     auto program = mContext->Program("region");
     if (!program) return std::unexpected(program.error());
@@ -17,8 +17,14 @@ Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     if (!ellipsoids.empty()) f.NamedBufferSubData(list, 0, GLsizeiptr(ellipsoids.size_bytes()), ellipsoids.data());
     const GLuint unorm =
         Scratch(GlScratch::RegionUnorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
+    if (k0 >= k1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
     const float zero = 0.0f;
-    f.ClearTexImage(unorm, 0, GL_RED, GL_FLOAT, &zero);
+    f.ClearTexSubImage(unorm, 0, 0, 0, GLint(k0), GLsizei(e.nx), GLsizei(e.ny), GLsizei(k1 - k0), GL_RED, GL_FLOAT,
+                       &zero);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
@@ -27,15 +33,15 @@ Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_MAX);
-    for (uint32_t k = 0; k < e.nz && !ellipsoids.empty(); ++k) {
+    for (uint32_t k = k0; k < k1 && !ellipsoids.empty(); ++k) {
         CB_TRY(BindTargets({{unorm, int(k)}}));
         f.Uniform1i(layer, GLint(k));
         f.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(ellipsoids.size()));
     }
     f.Disable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
-    f.CopyImageSubData(unorm, GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, Tex(region).Texture(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
-                       GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    f.CopyImageSubData(unorm, GL_TEXTURE_2D_ARRAY, 0, 0, 0, GLint(k0), Tex(region).Texture(), GL_TEXTURE_2D_ARRAY, 0, 0,
+                       0, GLint(k0), GLsizei(e.nx), GLsizei(e.ny), GLsizei(k1 - k0));
     mLastDeviceMs = timer.StopMs();
     return mContext->Check("region");
 }

@@ -9,9 +9,11 @@ namespace cb::gl {
 // shade: optional down-sampling pass, then the slice loop from the sun's side
 // (ping-pong between two 2-D textures, each slice also written to layer w of a
 // w-major volume), then one pass that writes the z-layered T, reading the
-// w-major volume trilinearly (exactly, at f = 1).
+// w-major volume trilinearly (exactly, at f = 1). A share [m0, m1) of the
+// sweep: the share with m = 0 down-samples, the slices m0 <= m < m1 run (the
+// slice before m0 is in the ping-pong texture of m0's parity, left by the
+// preceding share), and the share ending at nw writes T.
 Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
-    if (params.slices != SliceRange{}) return MakeError("gl: shade in shares (time-slicing) is not implemented yet");
     const int res = params.resolution;
     if (res != 1 && res != 2 && res != 4) return MakeError("gl: shade resolution must be 1, 2 or 4");
     const Functions& f = mContext->F();
@@ -27,11 +29,16 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const ShearWarp& g = plan.geometry;
     const SliceAttenuation& a = plan.attenuation;
     const int nu = int(plan.nu), nv = int(plan.nv), nw = int(plan.nw);
+    const uint32_t m0 = params.slices.Begin(plan.nw), m1 = params.slices.End(plan.nw);
+    if (m0 >= m1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
     GpuTimer timer(f);
     f.BindVertexArray(mContext->EmptyVao());
     GLuint shadedQ = Tex(q).Texture();
-    if (res > 1) {
-        shadedQ = Scratch(GlScratch::ShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
+    if (res > 1) shadedQ = Scratch(GlScratch::ShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
+    if (res > 1 && m0 == 0) {
         f.UseProgram(*down);
         f.BindTextureUnit(0, Tex(q).Texture());
         f.Uniform3i(f.GetUniformLocation(*down, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
@@ -62,8 +69,9 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     f.Uniform1ui(f.GetUniformLocation(*slice, "storage"), uint32_t(params.storage));
     const GLint first = f.GetUniformLocation(*slice, "first"), previousW = f.GetUniformLocation(*slice, "previousW");
     f.Viewport(0, 0, nu, nv);
-    int previous = 0;
-    for (int m = 0; m < nw; ++m) {
+    if (m0 % 2 == 1) std::swap(ping, pong);
+    int previous = m0 > 0 ? int(plan.SliceW(m0 - 1)) : 0;
+    for (int m = int(m0); m < int(m1); ++m) {
         const int w = int(plan.SliceW(uint32_t(m)));
         CB_TRY(BindTargets({{pong, -1}, {volume, w}}));
         f.BindTextureUnit(0, ping);
@@ -72,6 +80,10 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         f.DrawArrays(GL_TRIANGLES, 0, 3);
         std::swap(ping, pong);
         previous = w;
+    }
+    if (m1 < plan.nw) {
+        mLastDeviceMs = timer.StopMs();
+        return mContext->Check("shade, a share");
     }
     f.UseProgram(*up);
     f.BindTextureUnit(0, volume);

@@ -28,8 +28,9 @@ class BufferVk final : public Buffer {
 };
 
 // The backend's reusable device buffers (BackendVk::Scratch). Each slot belongs
-// to one stage, keeps its contents only within a call and grows to the largest
-// size asked of it.
+// to one stage, keeps its contents only within a call (except ShadeCoarseQ/T,
+// which carry a shade sweep from one share to the next, SPEC 13) and grows to
+// the largest size asked of it.
 enum class VkScratch {
     EllipsoidList,      // region: the ellipsoids, 32 bytes each
     RegionTileStarts,   // region: first RegionTileEntries index per 16x16 tile of a slice, and one past the end
@@ -41,8 +42,8 @@ enum class VkScratch {
     SmoothSumX,         // smooth: the bit field summed along x
     SmoothSumXY,        // smooth: those sums summed along y
     CoverCounter,       // density: covered columns, one uint
-    ShadeCoarseQ,       // shade: q on the coarse grid (resolution 2 or 4)
-    ShadeCoarseT,       // shade: T on the coarse grid (resolution 2 or 4)
+    ShadeCoarseQ,       // shade: q on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
+    ShadeCoarseT,       // shade: T on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
     SplatFrame,         // render_splat: grid, camera and light (the shaders' Frame)
     SplatOrder,         // render_splat: the flattened shared order
     SplatBoxes,         // render_splat: visibility of each tile x band box, one byte each

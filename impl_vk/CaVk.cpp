@@ -33,25 +33,31 @@ Status BackendVk::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
-    if (params.slices != SliceRange{}) return MakeError("vk: ca in shares (time-slicing) is not implemented yet");
     const Extent3 e = in.hum->Extent();
     const uint32_t words = (e.nx + 31) / 32;
-    const uint32_t count = words * e.ny * e.nz;
+    // The share's slices [k0, k1): both dispatches cover those slices' words only.
+    const uint32_t k0 = params.slices.Begin(e.nz), k1 = params.slices.End(e.nz);
+    if (k0 >= k1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
+    const uint32_t count = words * e.ny * (k1 - k0);
     auto rules = mContext->GetPipeline("ca", 7);
     if (!rules) return std::unexpected(rules.error());
     bool wind = false;
     for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
 
     struct {
-        uint32_t nx, ny, nz, words, seed, step, qExt, qHum, qAct;
-    } push{e.nx, e.ny, e.nz, words, params.seed, params.step, params.qExt, params.qHum, params.qAct};
+        uint32_t nx, ny, nz, words, seed, step, qExt, qHum, qAct, k0, sliceCount;
+    } push{e.nx, e.ny, e.nz, words, params.seed, params.step, params.qExt, params.qHum, params.qAct, k0, k1 - k0};
     const DeviceBuffer* targets[3] = {&Dev(*out.hum), &Dev(*out.act), &Dev(*out.cld)};
     Pipeline* advect = nullptr;
     DeviceBuffer* shifts = nullptr;
     if (wind) {
         // The rules write into scratch; advection moves the result into `out`.
+        // Advection shifts within a slice, so a share needs only its own slices.
         for (size_t f = 0; f < 3; ++f) {
-            auto s = Scratch(CaRulesOutputSlot(f), VkDeviceSize(count) * 4);
+            auto s = Scratch(CaRulesOutputSlot(f), VkDeviceSize(words) * e.ny * e.nz * 4);
             if (!s) return std::unexpected(s.error());
             targets[f] = *s;
         }
@@ -75,8 +81,8 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         if (advect) {
             r.Barrier();
             struct {
-                uint32_t nx, ny, nz, words;
-            } advectPush{e.nx, e.ny, e.nz, words};
+                uint32_t nx, ny, words, k0, sliceCount;
+            } advectPush{e.nx, e.ny, words, k0, k1 - k0};
             const DeviceBuffer* advectBuffers[] = {targets[0],     targets[1],     targets[2], &Dev(*out.hum),
                                                    &Dev(*out.act), &Dev(*out.cld), shifts};
             r.Dispatch(*advect, advectBuffers, &advectPush, sizeof advectPush, count);

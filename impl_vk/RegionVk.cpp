@@ -9,18 +9,23 @@
 namespace cb::vk {
 
 Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& region, SliceRange slices) {
-    if (slices != SliceRange{}) return MakeError("vk: region in shares (time-slicing) is not implemented yet");
     const Extent3 e = region.Extent();
+    // The share's slices [k0, k1): lists for those slices only, one dispatch over them.
+    const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
+    if (k0 >= k1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
     auto list = Scratch(VkScratch::EllipsoidList, std::max<VkDeviceSize>(32, ellipsoids.size_bytes()));
     if (!list) return std::unexpected(list.error());
     CB_TRY(mContext->Upload(**list, std::as_bytes(ellipsoids)));
-    // Per 16x16 tile of each slice, the ellipsoids whose bounding box (the
+    // Per 16x16 tile of each slice of the share, the ellipsoids whose bounding box (the
     // shader's rejection test, widened by a voxel) reaches a voxel centre of it.
     constexpr uint32_t kTile = 16;
     const uint32_t tilesX = CeilDiv(e.nx, kTile), tilesY = CeilDiv(e.ny, kTile);
-    std::vector<uint32_t> tileStart(size_t(tilesX) * tilesY * e.nz + 1, 0), tileList;
-    for (uint32_t k = 0, tile = 0; k < e.nz; ++k)
+    std::vector<uint32_t> tileStart(size_t(tilesX) * tilesY * (k1 - k0) + 1, 0), tileList;
+    for (uint32_t k = k0, tile = 0; k < k1; ++k)
         for (uint32_t ty = 0; ty < tilesY; ++ty)
             for (uint32_t tx = 0; tx < tilesX; ++tx, ++tile) {
                 const float x0 = float(tx * kTile) + 0.5f, x1 = float(std::min(e.nx, (tx + 1) * kTile) - 1) + 0.5f;
@@ -45,11 +50,11 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     auto pipeline = mContext->GetPipeline("region", 4);
     if (!pipeline) return std::unexpected(pipeline.error());
     struct {
-        uint32_t nx, ny, nz, tilesX, tilesY;
-    } push{e.nx, e.ny, e.nz, tilesX, tilesY};
+        uint32_t nx, ny, k0, sliceCount, tilesX, tilesY;
+    } push{e.nx, e.ny, k0, k1 - k0, tilesX, tilesY};
     const DeviceBuffer* buffers[] = {*list, &Dev(region), *starts, *entries};
     return Record("region", [&](VulkanContext::Recorder& r) {
-        r.Dispatch(**pipeline, buffers, &push, sizeof push, uint32_t(e.Count()));
+        r.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny * (k1 - k0));
     });
 }
 

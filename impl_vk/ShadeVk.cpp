@@ -1,18 +1,26 @@
 // Stage `shade` (SPEC 6) on Vulkan: inverse shear-warp, one shade_slice.comp
 // dispatch per slice; at resolution 2 or 4 on a coarse grid (shade_down.comp,
-// shade_up.comp).
+// shade_up.comp). A share [m0, m1) of the sweep (SPEC 13) dispatches the slices
+// m0 .. m1 - 1 in visiting order; at f > 1 the share with m = 0 also down-samples
+// q and the share ending at nw up-samples into T. The coarse q and T
+// (VkScratch::ShadeCoarseQ/T) carry the sweep from one share to the next.
 #include "core/ShadePlan.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
-    if (params.slices != SliceRange{}) return MakeError("vk: shade in shares (time-slicing) is not implemented yet");
     const int f = params.resolution;
     if (f != 1 && f != 2 && f != 4) return MakeError("vk: shade resolution must be 1, 2 or 4");
     const Extent3 e = q.Extent();
     const ShadePlan plan = MakeShadePlan(params, e);
     const uint32_t* n = plan.cells;
+    const uint32_t nw = plan.nw;
+    const uint32_t m0 = params.slices.Begin(nw), m1 = params.slices.End(nw);
+    if (m0 >= m1) {
+        mLastDeviceMs = 0.0;
+        return {};
+    }
     const VkDeviceSize coarseBytes = VkDeviceSize(n[0]) * n[1] * n[2] * 4;
     const DeviceBuffer* shadeQ = &Dev(q);
     const DeviceBuffer* shadeT = &Dev(T);
@@ -28,12 +36,14 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     if (!slice) return std::unexpected(slice.error());
     Pipeline* down = nullptr;
     Pipeline* up = nullptr;
-    if (f > 1) {
+    if (f > 1 && m0 == 0) {
         auto d = mContext->GetPipeline("shade_down", 2);
         if (!d) return std::unexpected(d.error());
+        down = *d;
+    }
+    if (f > 1 && m1 == nw) {
         auto u = mContext->GetPipeline("shade_up", 2);
         if (!u) return std::unexpected(u.error());
-        down = *d;
         up = *u;
     }
     const ShearWarp& g = plan.geometry;
@@ -68,14 +78,13 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const DeviceBuffer* sliceBuffers[] = {shadeQ, shadeT};
     const DeviceBuffer* downBuffers[] = {&Dev(q), shadeQ};
     const DeviceBuffer* upBuffers[] = {shadeT, &Dev(T)};
-    const uint32_t nw = plan.nw;
     return Record("shade", [&](VulkanContext::Recorder& r) {
         if (down) {
             r.Dispatch(*down, downBuffers, &resample, sizeof resample, n[0] * n[1] * n[2]);
             r.Barrier();
         }
-        uint32_t previous = 0;
-        for (uint32_t m = 0; m < nw; ++m) {
+        uint32_t previous = m0 > 0 ? plan.SliceW(m0 - 1) : 0;
+        for (uint32_t m = m0; m < m1; ++m) {
             const uint32_t wIndex = plan.SliceW(m);
             push.first = m == 0 ? 1u : 0u;
             push.sliceBase = wIndex * stride[g.w];

@@ -87,7 +87,7 @@ TEST_P(CaBitfield, EqualsByteReferenceEveryStep) {
         std::vector<uint8_t> region = RandomRegion(e, rng);
         auto regionBuffer = test::MakeFilled(backend, BufferFormat::U8, e, region);
         p.step = uint32_t(t);
-        CaStepParams params{p.seed, p.step, p.qExt, p.qHum, p.qAct, p.shiftX, p.shiftY};
+        CaStepParams params{p.seed, p.step, p.qExt, p.qHum, p.qAct, p.shiftX, p.shiftY, {}};
         ASSERT_TRUE(backend.CaStep(params, {fields[cur][0].get(), fields[cur][1].get(), fields[cur][2].get()},
                                    *regionBuffer, {fields[1 - cur][0].get(), fields[1 - cur][1].get(), fields[1 - cur][2].get()}));
         cur = 1 - cur;
@@ -145,7 +145,7 @@ TEST(CaBitfield, SameResultForOneAndTwoThreads) {
         auto r = test::MakeFilled(backend, BufferFormat::U8, e, region);
         int cur = 0;
         for (uint32_t t = 0; t < 20; ++t) {
-            CaStepParams params{5, t, QuantizeProbability(0.1), QuantizeProbability(0.1), QuantizeProbability(0.01), {}, {}};
+            CaStepParams params{5, t, QuantizeProbability(0.1), QuantizeProbability(0.1), QuantizeProbability(0.01), {}, {}, {}};
             ASSERT_TRUE(backend.CaStep(params, {s[cur][0].get(), s[cur][1].get(), s[cur][2].get()}, *r,
                                        {s[1 - cur][0].get(), s[1 - cur][1].get(), s[1 - cur][2].get()}));
             cur = 1 - cur;

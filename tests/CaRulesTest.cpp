@@ -36,7 +36,7 @@ class CaRules : public ::testing::Test {
         auto hum2 = test::MakeBuffer(backend, BufferFormat::Bits, e);
         auto act2 = test::MakeBuffer(backend, BufferFormat::Bits, e);
         auto cld2 = test::MakeBuffer(backend, BufferFormat::Bits, e);
-        CaStepParams p{9, 0, QuantizeProbability(pExt), QuantizeProbability(pHum), QuantizeProbability(pAct), sx, sy};
+        CaStepParams p{9, 0, QuantizeProbability(pExt), QuantizeProbability(pHum), QuantizeProbability(pAct), sx, sy, {}};
         Status s = backend.CaStep(p, {hum.get(), act.get(), cld.get()}, *r, {hum2.get(), act2.get(), cld2.get()});
         EXPECT_TRUE(s.has_value());
         return {test::Read<uint8_t>(backend, *hum2), test::Read<uint8_t>(backend, *act2), test::Read<uint8_t>(backend, *cld2)};

@@ -173,7 +173,7 @@ TEST_P(Conformance, CaSteps) {
             const std::vector<uint8_t> state = test::Read<uint8_t>(mCpu, *ref[f]);
             ASSERT_TRUE(mBackend->Upload(*got[f], std::as_bytes(std::span(state))));
         }
-        CaStepParams p{seed, t, QuantizeProbability(0.2), QuantizeProbability(0.1), QuantizeProbability(0.05), {}, {}};
+        CaStepParams p{seed, t, QuantizeProbability(0.2), QuantizeProbability(0.1), QuantizeProbability(0.05), {}, {}, {}};
         if (wind) p.shiftX = sx, p.shiftY = sy;
         ASSERT_TRUE(mCpu.CaStep(p, {ref[0].get(), ref[1].get(), ref[2].get()}, *region,
                                 {refOut[0].get(), refOut[1].get(), refOut[2].get()}));
@@ -288,7 +288,7 @@ TEST_P(Conformance, Density) {
     const std::vector<float> qData = test::Read<float>(mCpu, *q);
     auto gotQ = test::MakeFilled(*mBackend, BufferFormat::F32, e, qData);
     auto gotBits = test::MakeFilled(*mBackend, BufferFormat::Bits, e, cld);
-    const DensityParams params{8, 4};
+    const DensityParams params{8, 4, {}};
     const Extent3 tiles{CeilDiv(e.nx, 8), CeilDiv(e.ny, 8), 1}, bands{tiles.nx, tiles.ny, CeilDiv(e.nz, 4)};
     std::unique_ptr<Buffer> out[2][3];
     Backend* backends[2] = {&mCpu, mBackend.get()};
@@ -430,7 +430,7 @@ TEST_P(Conformance, RenderSplat) {
     cameras[3].target = {cx * 4, cy * 3, cz};
     const uint32_t W = 96, H = 72;
     Backend* backends[2] = {&mCpu, mBackend.get()};
-    const DensityParams density{8, 4};
+    const DensityParams density{8, 4, {}};
     for (size_t c = 0; c < cameras.size(); ++c) {
         std::vector<float> images[2];
         SplatStats stats[2];

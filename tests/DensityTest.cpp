@@ -24,7 +24,7 @@ DensityResult RunDensity(const Extent3& e, const std::vector<float>& q, const st
     auto tiles = test::MakeBuffer(backend, BufferFormat::U8, {CeilDiv(e.nx, T), CeilDiv(e.ny, T), 1});
     auto bands = test::MakeBuffer(backend, BufferFormat::U8, {CeilDiv(e.nx, T), CeilDiv(e.ny, T), CeilDiv(e.nz, B)});
     DensityOutputs out{D.get(), tiles.get(), bands.get(), 0};
-    EXPECT_TRUE(backend.Density({T, B}, *qb, cb.get(), out).has_value());
+    EXPECT_TRUE(backend.Density({T, B, {}}, *qb, cb.get(), out).has_value());
     return {test::Read<float>(backend, *D), test::Read<uint8_t>(backend, *tiles), test::Read<uint8_t>(backend, *bands),
             out.coveredColumns};
 }

@@ -41,7 +41,7 @@ Rendered Render(RenderCase c, bool culling, bool skipping, int threads = 0) {
         occupancy[step][0] = test::MakeBuffer(backend, BufferFormat::U8, tiles);
         occupancy[step][1] = test::MakeBuffer(backend, BufferFormat::U8, bands);
         DensityOutputs out{D.get(), occupancy[step][0].get(), occupancy[step][1].get(), 0};
-        EXPECT_TRUE(backend.Density({tile, band}, step == 0 ? *qp : *qc, cld.get(), out).has_value());
+        EXPECT_TRUE(backend.Density({tile, band, {}}, step == 0 ? *qp : *qc, cld.get(), out).has_value());
     }
     auto image = test::MakeBuffer(backend, BufferFormat::F32, {3, c.width, c.height});
     SplatParams p = c.params;

@@ -39,13 +39,18 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
     void SetUp() override {
         BackendOptions options;
         options.vkValidation = true;
-        auto backend = CreateBackend(GetParam(), options);
+        // "gl_rgba8": the gl backend with the automaton in the thesis's RGBA8 layout.
+        const bool rgba8 = GetParam() == "gl_rgba8";
+        if (rgba8) options.glCaLayout = gl::CaLayout::Rgba8;
+        auto backend = CreateBackend(rgba8 ? "gl" : GetParam(), options);
         if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
         mBackend = std::move(*backend);
     }
     void TearDown() override {
 #if CLOUDBENCH_HAVE_VK
-        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) EXPECT_EQ(vk->ValidationMessages(), 0u);
+        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) {
+            EXPECT_EQ(vk->ValidationMessages(), 0u);
+        }
 #endif
     }
 
@@ -247,6 +252,8 @@ TEST_P(TimeSliceStages, OneShareLeavesTheOtherSlicesAsTheyWere) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceStages, ::testing::ValuesIn(BuiltBackends()),
+                         [](const auto& info) { return info.param; });
+INSTANTIATE_TEST_SUITE_P(GlRgba8, TimeSliceStages, ::testing::Values(std::string("gl_rgba8")),
                          [](const auto& info) { return info.param; });
 
 }  // namespace

@@ -1,20 +1,21 @@
 #version 450
 // Stage `density` (SPEC 5), occupancy: one invocation per tile x band (bands:
 // some q > 0 in the tile's columns within the band) and, for band == nb, per
-// tile (some D > 0 in the tile).
+// tile (some D > 0 in the tile). A dispatch covers the rows of tiles
+// [ty0, ty0 + tileRows) (a share, SPEC 13).
 #extension GL_EXT_shader_8bit_storage : require
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Q { float q[]; };
 layout(std430, binding = 1) readonly buffer D { float d[]; };
 layout(std430, binding = 2) writeonly buffer Tiles { uint8_t tiles[]; };
 layout(std430, binding = 3) writeonly buffer Bands { uint8_t bands[]; };
-layout(push_constant) uniform Params { uint nx, ny, nz, tile, band, tilesX, tilesY, bandCount; } pc;
+layout(push_constant) uniform Params { uint nx, ny, nz, tile, band, tilesX, tilesY, bandCount, ty0, tileRows; } pc;
 
 void main() {
-    const uint id = gl_GlobalInvocationID.x;
-    const uint perLayer = pc.tilesX * pc.tilesY;
-    if (id >= perLayer * (pc.bandCount + 1u)) return;
-    const uint tx = id % pc.tilesX, ty = (id / pc.tilesX) % pc.tilesY, b = id / perLayer;
+    const uint local = gl_GlobalInvocationID.x, shareLayer = pc.tilesX * pc.tileRows;
+    if (local >= shareLayer * (pc.bandCount + 1u)) return;
+    const uint tx = local % pc.tilesX, ty = pc.ty0 + (local / pc.tilesX) % pc.tileRows, b = local / shareLayer;
+    const uint id = tx + pc.tilesX * (ty + pc.tilesY * b);
     const uint i0 = tx * pc.tile, i1 = min(pc.nx, i0 + pc.tile);
     const uint j0 = ty * pc.tile, j1 = min(pc.ny, j0 + pc.tile);
     bool any = false;

@@ -1,0 +1,236 @@
+// Time-slicing in the loop (SPEC 13, issue 15 item 1): a run that spreads
+// each step over the frames of the step before must see, step by step, the
+// same state, q, D, occupancy, T, G and images as the unsliced run, bit for
+// bit, on every backend; only when the work is done may differ. Also the
+// frame plan (which shares each frame computes), the frames' alpha, the
+// third buffer set and the scene rules, worked out by hand.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <nlohmann/json.hpp>
+
+#include "core/Scene.h"
+#include "core/ShadePlan.h"
+#include "harness/Simulation.h"
+#include "harness/StageParams.h"
+#include "impl_cpu/BackendCpu.h"
+#include "registry/Registry.h"
+#include "tests/TestUtil.h"
+#if CLOUDBENCH_HAVE_VK
+#include "impl_vk/BackendVk.h"
+#endif
+
+namespace cb {
+namespace {
+
+// scenes/ci-small.json on an odd 23 x 19 x 7 grid (tile 8: 3 rows of tiles, the last partial), a small view of all
+// of it, clouds from step 1, a sun that turns from the x to the y principal axis and climbs to the z axis (so shade
+// re-runs every step and its slice count changes), with `more` applied as --set does.
+Scene SlicedLoopScene(std::vector<SceneOverride> more) {
+    std::ifstream file(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json");
+    const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    std::vector<SceneOverride> sets = {
+        {"grid.size", "[23, 19, 7]"},
+        {"steps", "6"},
+        {"warmup_steps", "1"},
+        {"ca.act0", "0.03"},
+        {"ca.p_act", "0.02"},
+        {"density.tile", "8"},
+        {"density.band", "3"},
+        {"render.width", "40"},
+        {"render.height", "30"},
+        {"render.every_steps", "1"},
+        {"render.cameras",
+         R"([{"name": "a", "eye": [575, -700, 1100], "target": [575, 475, 150], "up": [0, 0, 1], "fov_deg": 70,
+              "near": 1, "far": 20000}])"},
+        {"sun.path", R"([[0, 20, 10], [2, 30, 80], [5, 75, 100]])"},
+    };
+    sets.insert(sets.end(), more.begin(), more.end());
+    auto scene = ParseScene(text, "ci-small.json", sets);
+    EXPECT_TRUE(scene.has_value()) << scene.error().message;
+    return scene ? *scene : Scene{};
+}
+
+// Everything the observer sees at each step: each resource's bytes (images per camera) and the step's records.
+struct StepView {
+    std::map<std::string, std::vector<std::byte>> bytes;
+    StepRecord record;
+};
+
+std::vector<StepView> RunAndKeepEveryStep(const Scene& scene, Backend& backend) {
+    auto sim = Simulation::Create(scene, backend);
+    EXPECT_TRUE(sim.has_value()) << sim.error().message;
+    if (!sim) return {};
+    std::vector<StepView> views;
+    for (uint32_t t = 0; t < scene.steps; ++t) {
+        StepView view;
+        Status s = (*sim)->Step(view.record, [&](const Simulation& at) -> Status {
+            for (Resource r : kAllResources)
+                for (size_t n = 0; at.Get(r, n); ++n) {
+                    std::vector<std::byte> data(at.Get(r, n)->CanonicalBytes());
+                    CB_TRY(backend.Download(*at.Get(r, n), data));
+                    view.bytes[std::string(ResourceName(r)) + "#" + std::to_string(n)] = std::move(data);
+                }
+            return {};
+        });
+        EXPECT_TRUE(s.has_value()) << s.error().message;
+        views.push_back(std::move(view));
+    }
+    return views;
+}
+
+class TimeSliceLoop : public ::testing::TestWithParam<std::string> {
+  protected:
+    void SetUp() override {
+        BackendOptions options;
+        options.vkValidation = true;
+        auto backend = CreateBackend(GetParam(), options);
+        if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
+        mBackend = std::move(*backend);
+    }
+    void TearDown() override {
+#if CLOUDBENCH_HAVE_VK
+        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) {
+            EXPECT_EQ(vk->ValidationMessages(), 0u);
+        }
+#endif
+    }
+    std::unique_ptr<Backend> mBackend;
+};
+
+// Frames per step well above what the shares take, so the sliced steps draw as many frames, at the same alphas, as
+// the unsliced ones: then every resource and every image must be equal at every step.
+TEST_P(TimeSliceLoop, EveryStepEqualsTheUnslicedLoop) {
+    const Scene whole = SlicedLoopScene({{"render.frames_per_step", "56"}});
+    const std::vector<StepView> expected = RunAndKeepEveryStep(whole, *mBackend);
+    ASSERT_EQ(expected.size(), whole.steps);
+    EXPECT_GT(expected.back().record.coveredColumns.value_or(0), 0u) << "the test needs clouds";
+    for (const char* slices : {"1", "3"}) {
+        const Scene sliced = SlicedLoopScene({{"render.frames_per_step", "56"}, {"render.slices_per_frame", slices}});
+        const std::vector<StepView> got = RunAndKeepEveryStep(sliced, *mBackend);
+        ASSERT_EQ(got.size(), expected.size());
+        for (size_t t = 0; t < got.size(); ++t) {
+            SCOPED_TRACE(std::string("slices per frame ") + slices + ", step " + std::to_string(t));
+            ASSERT_EQ(got[t].bytes.size(), expected[t].bytes.size());
+            for (const auto& [name, data] : expected[t].bytes) {
+                ASSERT_TRUE(got[t].bytes.count(name)) << name;
+                EXPECT_TRUE(got[t].bytes.at(name) == data) << name << " differs from the unsliced loop";
+            }
+            const StepRecord &a = expected[t].record, &b = got[t].record;
+            EXPECT_EQ(b.framesRendered, a.framesRendered);
+            EXPECT_EQ(b.coveredColumns, a.coveredColumns);
+            for (Stage stage : kAllStages) {
+                EXPECT_EQ(b.skippedUnchanged[size_t(stage)], a.skippedUnchanged[size_t(stage)]) << StageName(stage);
+                // The sliced loop does not advance past its last step (nothing would show it).
+                if (stage == Stage::Ca && t + 1 == got.size()) continue;
+                EXPECT_EQ(b.stageMs[size_t(stage)].has_value(), a.stageMs[size_t(stage)].has_value())
+                    << StageName(stage) << " ran in one loop and not in the other";
+            }
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceLoop, ::testing::ValuesIn(BuiltBackends()),
+                         [](const auto& info) { return info.param; });
+
+// A CPU backend that keeps the alpha of every splat call.
+class AlphaKeepingCpu : public cpu::BackendCpu {
+  public:
+    Status RenderSplat(const SplatParams& params, const SplatInputs& in, Buffer& image, SplatStats* stats) override {
+        alphas.push_back(params.alpha);
+        return cpu::BackendCpu::RenderSplat(params, in, image, stats);
+    }
+    std::vector<float> alphas;
+};
+
+// The frame plan at 3 slices per frame, by hand. Step 1 (a render step; step 0 is warm-up and computes step 1
+// whole) computes step 2 over its frames: ca over nz = 7 slices (3 frames: 0-2, 3-5, 6), the ellipsoid list with
+// region's first share, region (3), smooth (3), density over 3 rows of tiles (1 frame: whole), shade over the
+// sweep at step 2's sun (el 30, az 80: y principal, 19 slices -> 7 frames), shadow (1 frame): 18 frames, each
+// drawn at alpha (f + 1) / 18. Their times add up to the step's.
+TEST(TimeSliceLoopPlan, FramesComputeTheNextStepsShares) {
+    const Scene scene = SlicedLoopScene({{"render.slices_per_frame", "3"}});
+    ShadeParams sun2 = MakeShadeParams(scene, 2);
+    ASSERT_EQ(MakeShadePlan(sun2, scene.grid.size).nw, 19u) << "the sun at step 2 is y-principal";
+    AlphaKeepingCpu backend;
+    auto sim = Simulation::Create(scene, backend);
+    ASSERT_TRUE(sim.has_value()) << sim.error().message;
+    StepRecord warmup, step1;
+    ASSERT_TRUE((*sim)->Step(warmup));
+    EXPECT_EQ(warmup.framesRendered, 0u);
+    EXPECT_TRUE(warmup.frameWork.empty());
+    ASSERT_TRUE((*sim)->Step(step1));
+    const std::vector<std::string> plan = {
+        "ca 0-2",      "ca 3-5",      "ca 6-6",      "ellipsoid list, region 0-2", "region 3-5",  "region 6-6",
+        "smooth 0-2",  "smooth 3-5",  "smooth 6-6",  "density",                    "shade 0-2",   "shade 3-5",
+        "shade 6-8",   "shade 9-11",  "shade 12-14", "shade 15-17",                "shade 18-18", "shadow"};
+    EXPECT_EQ(step1.frameWork, plan);
+    ASSERT_EQ(step1.framesRendered, plan.size());
+    ASSERT_EQ(backend.alphas.size(), plan.size());
+    for (size_t f = 0; f < plan.size(); ++f) EXPECT_EQ(backend.alphas[f], float(double(f + 1) / plan.size())) << f;
+    double sum = 0;
+    for (double ms : step1.frameMs) sum += ms;
+    EXPECT_NEAR(sum, step1.stepMs, 1e-9 * step1.stepMs + 1e-12);
+    // The last step computes nothing ahead: its frames are render.frames_per_step (1), alpha 1.
+    StepRecord r;
+    for (uint32_t t = 2; t < scene.steps; ++t) ASSERT_TRUE((*sim)->Step(r));
+    EXPECT_EQ(r.framesRendered, 1u);
+    EXPECT_TRUE(r.frameWork.empty());
+    EXPECT_EQ(backend.alphas.back(), 1.0f);
+}
+
+// Without time-slicing the whole step is charged to its first frame (the thesis's drop in frame rate).
+TEST(TimeSliceLoopPlan, UnslicedStepChargesItsWorkToTheFirstFrame) {
+    const Scene scene = SlicedLoopScene({{"render.frames_per_step", "4"}});
+    cpu::BackendCpu backend;
+    auto sim = Simulation::Create(scene, backend);
+    ASSERT_TRUE(sim.has_value()) << sim.error().message;
+    StepRecord r;
+    ASSERT_TRUE((*sim)->Step(r));
+    ASSERT_TRUE((*sim)->Step(r));
+    ASSERT_EQ(r.frameMs.size(), 4u);
+    double renders0 = 0, sum = 0;
+    for (const FrameRecord& f : r.frames)
+        if (f.frame == 0) renders0 += f.ms;
+    for (double ms : r.frameMs) sum += ms;
+    EXPECT_NEAR(sum, r.stepMs, 1e-9 * r.stepMs + 1e-12);
+    double simulation = 0;
+    for (Stage stage : kAllStages)
+        if (!Describe(stage).renderer && r.stageMs[size_t(stage)]) simulation += *r.stageMs[size_t(stage)];
+    EXPECT_GE(r.frameMs[0], renders0 + simulation);
+}
+
+// The third buffer set: one pending buffer per resource the stages write, but not for the automaton's state (its
+// `next` is the third set) or the images; none without time-slicing.
+TEST(TimeSliceLoopPlan, ThirdBufferSetOnlyWhenSliced) {
+    auto pendingOf = [](const Scene& scene) {
+        std::set<Resource> pending;
+        for (const PlannedBuffer& b : PlanBuffers(scene))
+            if (b.role == BufferRole::Pending) pending.insert(b.resource);
+        return pending;
+    };
+    EXPECT_TRUE(pendingOf(SlicedLoopScene({})).empty());
+    const std::set<Resource> expected = {Resource::Region, Resource::Q,  Resource::ColumnSum, Resource::Tiles,
+                                         Resource::Bands,  Resource::T,  Resource::Shadow};
+    EXPECT_EQ(pendingOf(SlicedLoopScene({{"render.slices_per_frame", "4"}})), expected);
+}
+
+TEST(TimeSliceLoopPlan, SceneRules) {
+    std::ifstream file(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json");
+    const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    auto noRenderer = ParseScene(text, "ci-small.json",
+                                 {{"render.slices_per_frame", "2"}, {"stages", R"(["region", "ca", "smooth"])"}});
+    ASSERT_FALSE(noRenderer.has_value());
+    EXPECT_NE(noRenderer.error().message.find("render.slices_per_frame"), std::string::npos)
+        << noRenderer.error().message;
+    auto withAlpha = ParseScene(text, "ci-small.json", {{"render.slices_per_frame", "2"}, {"render.alpha", "0.3"}});
+    ASSERT_FALSE(withAlpha.has_value());
+    EXPECT_NE(withAlpha.error().message.find("render.alpha"), std::string::npos) << withAlpha.error().message;
+    auto negative = ParseScene(text, "ci-small.json", {{"render.slices_per_frame", "-1"}});
+    ASSERT_FALSE(negative.has_value());
+}
+
+}  // namespace
+}  // namespace cb
