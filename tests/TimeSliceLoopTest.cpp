@@ -30,7 +30,10 @@ namespace {
 // re-runs every step and its slice count changes), with `more` applied as --set does.
 Scene SlicedLoopScene(std::vector<SceneOverride> more) {
     std::ifstream file(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json");
-    const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    nlohmann::json root = nlohmann::json::parse(file);
+    root["sun"].erase("elevation_deg");  // the path gives the angles
+    root["sun"].erase("azimuth_deg");
+    const std::string text = root.dump();
     std::vector<SceneOverride> sets = {
         {"grid.size", "[23, 19, 7]"},
         {"steps", "6"},
@@ -45,11 +48,12 @@ Scene SlicedLoopScene(std::vector<SceneOverride> more) {
         {"render.cameras",
          R"([{"name": "a", "eye": [575, -700, 1100], "target": [575, 475, 150], "up": [0, 0, 1], "fov_deg": 70,
               "near": 1, "far": 20000}])"},
-        {"sun.path", R"([[0, 20, 10], [2, 30, 80], [5, 75, 100]])"},
+        {"sun.path", R"([{"step": 0, "elevation_deg": 20, "azimuth_deg": 10}, {"step": 2, "elevation_deg": 30, "azimuth_deg": 80},
+                        {"step": 5, "elevation_deg": 75, "azimuth_deg": 100}])"},
     };
     sets.insert(sets.end(), more.begin(), more.end());
     auto scene = ParseScene(text, "ci-small.json", sets);
-    EXPECT_TRUE(scene.has_value()) << scene.error().message;
+    EXPECT_TRUE(scene.has_value()) << (scene ? "" : scene.error().message);
     return scene ? *scene : Scene{};
 }
 
@@ -116,6 +120,9 @@ TEST_P(TimeSliceLoop, EveryStepEqualsTheUnslicedLoop) {
             ASSERT_EQ(got[t].bytes.size(), expected[t].bytes.size());
             for (const auto& [name, data] : expected[t].bytes) {
                 ASSERT_TRUE(got[t].bytes.count(name)) << name;
+                // Warm-up steps draw nothing and shade nothing: T, G and the images are not written yet.
+                const bool output = name.starts_with("T#") || name.starts_with("G#") || name.starts_with("image");
+                if (output && t < whole.warmupSteps) continue;
                 EXPECT_TRUE(got[t].bytes.at(name) == data) << name << " differs from the unsliced loop";
             }
             const StepRecord &a = expected[t].record, &b = got[t].record;
