@@ -12,6 +12,6 @@ if(CLOUDBENCH_HAVE_VK)
 endif()
 add_test(NAME Cli.ConformGroundShadow
          COMMAND ${CMAKE_COMMAND} -E env CLOUDBENCH_VK_VALIDATION=1
-                 ${cli} conform ground-shadow --backend ${ground_backends} --out ${cli_out}/conform-ground --steps 3)
+                 ${cli} conform ${CMAKE_CURRENT_SOURCE_DIR}/../scenes/ground-shadow.json --backend ${ground_backends} --out ${cli_out}/conform-ground --steps 3)
 set_tests_properties(Cli.ConformGroundShadow PROPERTIES
                      FAIL_REGULAR_EXPRESSION "vk validation|render_(splat|march) +(vk|gl) +(fail|skipped)")
