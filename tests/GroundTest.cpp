@@ -5,6 +5,7 @@
 // the backends against the CPU by SPEC 8's and SPEC 10's image rules.
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -67,6 +68,7 @@ TEST(GroundFormula, Channel) {
 // ---- Both renderers on every backend ------------------------------------------
 
 enum class Renderer { Splat, March };
+void PrintTo(Renderer r, std::ostream* os) { *os << (r == Renderer::Splat ? "render_splat" : "render_march"); }
 using GroundParam = std::tuple<std::string, Renderer>;
 
 // The test grid: 16 x 12 x 4 voxels of 1 m at the origin; the ground is z = 0.
