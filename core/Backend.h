@@ -77,7 +77,9 @@ class Buffer {
 //   shade                the sweep's slices m (ShadePlan::SliceW, nearest the sun
 //                        first); share count ShadePlan::nw. At resolution f > 1 the
 //                        share holding m = 0 also fills the coarse grid and the share
-//                        ending at nw writes T (until then T is left as it was)
+//                        ending at nw writes T (until then T is left as it was). At
+//                        f = 1 a share's slices of T may also wait for that share (a
+//                        backend may carry the sweep in scratch); no other slice changes
 // The default is the whole call.
 struct SliceRange {
     uint32_t begin = 0;

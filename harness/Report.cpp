@@ -60,12 +60,23 @@ Summary Summarize(std::vector<double> samples) {
 
 LoopFigures MeasureLoop(const Scene& scene, const BackendRun& run) {
     LoopFigures loop;
+    double slowest = 0;
     for (const StepRecord& r : run.steps) {
         if (r.step < scene.warmupSteps) continue;
         ++loop.steps;
         loop.frames += r.framesRendered;
+        loop.renderSteps += r.framesRendered > 0 ? 1 : 0;
         loop.wallMs += r.stepMs;
         loop.stepMs.push_back(r.stepMs);
+        for (size_t f = 0; f < r.frameMs.size(); ++f) {
+            if (loop.frameMs.empty() || r.frameMs[f] > slowest) {
+                slowest = r.frameMs[f];
+                loop.slowestStep = r.step;
+                loop.slowestFrame = uint32_t(f);
+                loop.slowestWork = f < r.frameWork.size() ? r.frameWork[f] : (f == 0 ? "the step's work" : "");
+            }
+            loop.frameMs.push_back(r.frameMs[f]);
+        }
     }
     return loop;
 }
@@ -134,7 +145,14 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                      {"fps", loop.Fps() ? nlohmann::json(*loop.Fps()) : nlohmann::json(nullptr)},
                      {"steps_per_second", loop.wallMs > 0 ? nlohmann::json(loop.steps * 1000.0 / loop.wallMs)
                                                           : nlohmann::json(nullptr)},
-                     {"step_ms", SummaryJson(loop.stepMs)}};
+                     {"step_ms", SummaryJson(loop.stepMs)},
+                     {"slices_per_frame", scene.render.slicesPerFrame}};
+        if (!loop.frameMs.empty()) {
+            nlohmann::json frameJson = SummaryJson(loop.frameMs);
+            frameJson["slowest"] = {
+                {"step", loop.slowestStep}, {"frame", loop.slowestFrame}, {"work", loop.slowestWork}};
+            b["loop"]["frame_ms"] = frameJson;
+        }
         std::vector<double> hostSamples;
         for (const StepRecord& r : run.steps)
             if (r.step >= scene.warmupSteps && scene.stages.Has(Stage::Region))
@@ -306,15 +324,28 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         const Summary st = Summarize(loop.stepMs);
         if (const auto fps = loop.Fps())
             std::snprintf(line, sizeof line,
-                          "  loop: %llu frames (%u per render step) in %u steps, %.1f ms: %.1f fps; step median %.3f ms, "
+                          "  loop: %llu frames (%.4g per render step) in %u steps, %.1f ms: %.1f fps; step median %.3f ms, "
                           "max %.3f ms",
-                          static_cast<unsigned long long>(loop.frames), scene.render.framesPerStep, loop.steps,
+                          static_cast<unsigned long long>(loop.frames), double(loop.frames) / loop.renderSteps, loop.steps,
                           loop.wallMs, *fps, st.median, st.max);
         else
             std::snprintf(line, sizeof line, "  loop: no frames in %u steps, %.1f ms: %.1f steps/s; step median %.3f ms",
                           loop.steps, loop.wallMs, loop.wallMs > 0 ? loop.steps * 1000.0 / loop.wallMs : 0.0,
                           st.median);
         section.blocks.push_back(report::Paragraph{line});
+        if (!loop.frameMs.empty()) {
+            // The thesis's figure of a loop: the frame the viewer waits longest for, beside the typical one.
+            const Summary fr = Summarize(loop.frameMs);
+            std::snprintf(line, sizeof line,
+                          "  frames: median %.3f ms [q1 %.3f, q3 %.3f], slowest %.3f ms (step %u frame %u%s%s)%s",
+                          fr.median, fr.q1, fr.q3, fr.max, loop.slowestStep, loop.slowestFrame,
+                          loop.slowestWork.empty() ? "" : ": ", loop.slowestWork.c_str(),
+                          scene.render.slicesPerFrame > 0
+                              ? (", time-sliced at " + std::to_string(scene.render.slicesPerFrame) + " slices per frame")
+                                    .c_str()
+                              : "");
+            section.blocks.push_back(report::Paragraph{line});
+        }
     }
     if (!run.steps.empty()) {
         std::string runs = "  stage runs (" + std::to_string(run.steps.size()) + " steps):";

@@ -43,8 +43,13 @@ struct BackendRun {
 struct LoopFigures {
     uint64_t frames = 0;
     uint32_t steps = 0;
+    uint32_t renderSteps = 0;  // steps that drew frames
     double wallMs = 0;
-    std::vector<double> stepMs;  // each step's wall time
+    std::vector<double> stepMs;   // each step's wall time
+    std::vector<double> frameMs;  // each frame's wall time (StepRecord::frameMs): what the viewer waits per frame
+    // The slowest frame: its step, its index in the step and what it computed ("" for renders alone).
+    uint32_t slowestStep = 0, slowestFrame = 0;
+    std::string slowestWork;
     std::optional<double> Fps() const {
         if (frames == 0 || !(wallMs > 0)) return std::nullopt;
         return double(frames) * 1000.0 / wallMs;

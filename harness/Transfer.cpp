@@ -72,6 +72,8 @@ json ToJson(const StepRecord& r) {
                                      {"bricks_skipped", f.march.bricksSkipped},
                                      {"empty_bricks", f.march.emptyBricks},
                                      {"bricks", f.march.bricks}}}});
+    json frameMs = json::array();
+    for (double ms : r.frameMs) frameMs.push_back(D(ms));
     return {{"step", r.step},
             {"stage_ms", stageMs},
             {"device_ms", deviceMs},
@@ -80,6 +82,8 @@ json ToJson(const StepRecord& r) {
             {"skipped_unchanged", skipped},
             {"frames_rendered", r.framesRendered},
             {"step_ms", D(r.stepMs)},
+            {"frame_ms", frameMs},
+            {"frame_work", r.frameWork},
             {"frames", frames}};
 }
 
@@ -95,6 +99,8 @@ StepRecord StepFromJson(const json& j) {
     for (size_t s = 0; s < kStageCount; ++s) r.skippedUnchanged[s] = j.at("skipped_unchanged").at(s).get<bool>();
     r.framesRendered = j.at("frames_rendered").get<uint32_t>();
     r.stepMs = FromD(j.at("step_ms"));
+    for (const json& ms : j.at("frame_ms")) r.frameMs.push_back(FromD(ms));
+    r.frameWork = j.at("frame_work").get<std::vector<std::string>>();
     for (const json& f : j.at("frames")) {
         FrameRecord frame;
         frame.renderer = ParseStage(f.at("renderer").get<std::string>()).value_or(Stage::RenderSplat);

@@ -26,8 +26,9 @@ Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
-    if (mRgba8) return params.slices.IsWhole(in.hum->Extent().nz) ? CaStepRgba8(params, in, region, out)
-                                                                  : CaStepRgba8Share(params, in, region, out);
+    if (mRgba8)
+        return params.slices.IsWhole(in.hum->Extent().nz) ? CaStepRgba8(params, in, region, out)
+                                                          : CaStepRgba8Share(params, in, region, out);
     const Functions& f = mContext->F();
     auto rules = mContext->Program("ca");
     if (!rules) return std::unexpected(rules.error());
@@ -158,7 +159,8 @@ Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in,
     if (!pack) return std::unexpected(pack.error());
     auto rules = mContext->Program("ca_rgba8");
     if (!rules) return std::unexpected(rules.error());
-    auto unpack = wind ? mContext->Program("ca_unpack_rgba8", "#define SHIFTED 1\n") : mContext->Program("ca_unpack_rgba8");
+    auto unpack =
+        wind ? mContext->Program("ca_unpack_rgba8", "#define SHIFTED 1\n") : mContext->Program("ca_unpack_rgba8");
     if (!unpack) return std::unexpected(unpack.error());
     const Extent3 e = in.hum->Extent();
     const uint32_t k0 = params.slices.Begin(e.nz), k1 = params.slices.End(e.nz);

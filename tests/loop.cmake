@@ -56,3 +56,40 @@ print("sun counted")
 PY]=])
 add_test(NAME Cli.LoopMovingSunCounts COMMAND /bin/sh -c "${cli_loop_sun_script}" ${cli} ${cli_out}/loop-sun)
 set_tests_properties(Cli.LoopMovingSunCounts PROPERTIES TIMEOUT 120 PASS_REGULAR_EXPRESSION "sun counted")
+
+# Time-slicing (SPEC 13) on every built backend: thesis-sunset at 8 slices per frame. Each step computes the next one
+# over its frames, so a step draws at least its 4 frames and as many as its shares take, alpha runs (f + 1) / F over
+# them, the loop reports each frame's time and the slowest frame with what it computed, and the stages run as often
+# as unsliced (the automaton once less: the last step computes nothing ahead).
+set(cli_loop_sliced_script [=[d="$1"; rm -rf "$d"; set -e
+"$0" run thesis-sunset --quiet --out "$d" --set render.slices_per_frame=8 >/dev/null || test $? -eq 4
+/usr/bin/python3 - "$d/results.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+ok = [name for name, b in r["backends"].items() if b["status"] == "ok"]
+assert "cpu" in ok, r["backends"].keys()
+for name in ok:
+    b = r["backends"][name]
+    loop = b["loop"]
+    assert loop["slices_per_frame"] == 8 and loop["steps"] == 20, (name, loop)
+    frames = loop["frame_ms"]
+    assert frames["count"] == loop["frames"] and loop["frames"] > 80, (name, frames["count"], loop["frames"])
+    assert abs(sum(frames["samples_ms"]) - loop["wall_ms"]) < 1e-6 * loop["wall_ms"], (name, "frames add up to the loop")
+    assert frames["max_ms"] >= frames["median_ms"] and frames["slowest"]["step"] >= 4, (name, frames["slowest"])
+    runs = b["stage_runs"]
+    for stage in ("shade", "shadow"):
+        assert runs[stage] == {"ran": 20, "skipped_unchanged": 0, "not_output_step": 4}, (name, stage, runs[stage])
+    for stage in ("region", "smooth", "density"):
+        assert runs[stage]["ran"] == 24, (name, stage, runs[stage])
+    assert runs["ca"]["ran"] == 23, (name, runs["ca"])
+    for camera, f in b["frames"].items():
+        steps = f["steps"]
+        for t in range(4, 24):
+            alphas = [a for s, a in zip(steps, f["alphas"]) if s == t]
+            n = len(alphas)
+            assert n >= 4 and all(abs(a - (i + 1) / n) < 1e-7 for i, a in enumerate(alphas)), (name, camera, t, alphas)
+    print(name, "sliced loop", round(loop["fps"], 1), "fps, slowest frame", round(frames["max_ms"], 3), "ms")
+print("sliced loop checked")
+PY]=])
+add_test(NAME Cli.LoopTimeSlicedRun COMMAND /bin/sh -c "${cli_loop_sliced_script}" ${cli} ${cli_out}/loop-sliced)
+set_tests_properties(Cli.LoopTimeSlicedRun PROPERTIES TIMEOUT 300 PASS_REGULAR_EXPRESSION "sliced loop checked")
