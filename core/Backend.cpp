@@ -50,4 +50,20 @@ Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const 
     return SplatBoxVisibility(p, in.qCur->Extent(), bandsPrev, bandsCur);
 }
 
+GroundLight MakeGroundLight(const SplatParams& p) {
+    return {p.ground.albedo, p.sunRadiance, p.ambient, p.background, p.sun[2]};
+}
+
+GroundLight MakeGroundLight(const MarchParams& p) {
+    return {p.ground.albedo, p.setup.sunRadiance, p.setup.ambient, p.setup.background, p.setup.sun[2]};
+}
+
+Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Extent3& grid, std::string_view where) {
+    if (!ground.on) return {};
+    if (!G) return MakeError(std::string(where) + ": the ground needs G (enable the stage \"shadow\")");
+    if (G->Format() != BufferFormat::F32 || G->Extent() != Extent3{grid.nx, grid.ny, 1})
+        return MakeError(std::string(where) + ": G must be F32 of extent (nx, ny, 1) of the grid");
+    return {};
+}
+
 }  // namespace cb

@@ -14,11 +14,13 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/Camera.h"
 #include "core/Error.h"
 #include "core/Grid.h"
+#include "core/Ground.h"
 #include "core/March.h"
 #include "core/MarchSettings.h"
 #include "core/NoiseSettings.h"
@@ -181,6 +183,7 @@ struct SplatParams {
     float voxelSize = 50;
     bool culling = true, skipping = true;
     uint32_t tile = 32, band = 4;  // of the occupancy maps
+    GroundParams ground;           // the ground plane under the clouds (core/Ground.h); on: SplatInputs::G
 };
 
 // Which tile x band boxes may hold a visible splat (SPEC 8): every box, less
@@ -198,6 +201,7 @@ struct SplatInputs {
     const Buffer* tilesCur = nullptr;
     const Buffer* bandsPrev = nullptr;
     const Buffer* bandsCur = nullptr;
+    const Buffer* G = nullptr;  // F32 (nx, ny, 1): the ground shadow; read only with params.ground.on
 };
 
 struct SplatStats {
@@ -219,13 +223,23 @@ struct MarchParams {
     uint32_t seed = 1, frame = 0;  // xi = rand24(seed, frame, 3, x + W y) / 2^24 with jitter
     bool skipping = true;
     uint32_t brick = 8;
+    GroundParams ground;  // the ground plane under the clouds (core/Ground.h); on: MarchInputs::G
 };
 
 struct MarchInputs {
     const Buffer* qPrev = nullptr;  // F32 volume
     const Buffer* qCur = nullptr;   // F32 volume
     const Buffer* T = nullptr;      // F32 volume; required with MarchLightSource::Shade, else unread
+    const Buffer* G = nullptr;      // F32 (nx, ny, 1): the ground shadow; read only with params.ground.on
 };
+
+// The light on the ground of a renderer's call (core/Ground.h): the ground's
+// albedo, the call's sun, ambient and flat background.
+GroundLight MakeGroundLight(const SplatParams& params);
+GroundLight MakeGroundLight(const MarchParams& params);
+// With the ground on, G must be an F32 buffer of extent (nx, ny, 1) of `grid`;
+// an error naming the backend and stage otherwise. Ok with the ground off.
+Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Extent3& grid, std::string_view where);
 
 struct MarchStats {
     uint64_t rays = 0;           // rays that met the box between the near and far planes

@@ -246,6 +246,7 @@ float PointLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& 
 
 struct MarchRayResult {
     Vec3 color{};         // C = L + T_view background (linear HDR)
+    Vec3 light{};         // L alone (a per-pixel background, the ground, composites as L + T_view background)
     float transmittance = 1;  // T_view at the end
     uint32_t samples = 0;       // density samples taken
     uint32_t lightCalls = 0;    // light functor calls (samples with q > 0)
@@ -361,6 +362,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
         }
     }
     r.transmittance = T;
+    r.light = {L0, L1, L2};
     r.color = {L0 + T * s.background[0], L1 + T * s.background[1], L2 + T * s.background[2]};
     return r;
 }

@@ -35,6 +35,7 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     if (s.point.on) flags |= kMarchGpuPointLight;
     if (params.skipping) flags |= kMarchGpuSkipping;
     if (params.light == MarchLightSource::March) flags |= kMarchGpuLightMarch;
+    if (params.ground.on) flags |= kMarchGpuGround;
     const uint32_t brick = std::max(params.brick, 1u);
     g.flags = {flags, uint32_t(s.phase.kind), params.lightSteps, brick};
     g.strides = {e.nx + 2, (e.nx + 2) * (e.ny + 2), kMieCloudTable.count, 0};

@@ -23,6 +23,7 @@ enum MarchGpuFlag : uint32_t {
     kMarchGpuPointLight = 1u << 3,
     kMarchGpuSkipping = 1u << 4,
     kMarchGpuLightMarch = 1u << 5,  // the sun's light from a light march; else shade's T
+    kMarchGpuGround = 1u << 6,      // the ground plane (core/Ground.h) is the background, per pixel
 };
 
 struct MarchGpu {

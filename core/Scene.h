@@ -166,6 +166,12 @@ struct RenderSettings {
     uint32_t slicesPerFrame = 0;
     uint32_t everySteps = 0;              // render every N steps after warm-up (and the last); 0 = last step only
     std::vector<CameraSettings> cameras;  // at least one when a renderer runs
+    // The ground plane z = origin_z under the clouds, lit through G (render.ground;
+    // docs/pipeline.md, "The ground in the frame"). Needs the stage `shadow`.
+    struct Ground {
+        bool on = false;                          // absent from the scene: off
+        std::array<double, 3> albedo{0.3, 0.3, 0.3};  // linear RGB reflectance, each in [0, 1]
+    } ground;
 
     // The interpolation weight of frame `frame` (0-based) of a render step of
     // `frames` frames (0: framesPerStep). One frame without time-slicing draws

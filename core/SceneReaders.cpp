@@ -408,6 +408,11 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
         check.Fail("render.slices_per_frame", "time-slicing spreads a step over the frames drawn between steps, and "
                                               "no renderer is enabled; enable render_splat or render_march, or remove it");
 
+    // The ground is lit through G: the stage that computes it must run.
+    if (scene.render.ground.on && !scene.stages.Has(Stage::Shadow))
+        check.Fail("render.ground", "needs the stage \"shadow\", which computes the ground shadow G it is lit "
+                                    "through; enable it or remove render.ground");
+
     if (stepsOk) CheckSunSpeed(scene, check);
     CheckOpticalDepths(scene, check);
 

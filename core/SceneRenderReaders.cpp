@@ -23,7 +23,8 @@ constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angl
 constexpr std::string_view kShadowKeys[] = {"form", "kappa", "coverage", "density_factor"};
 constexpr std::string_view kRenderKeys[] = {"width",    "height",      "q_min",   "splat_scale",
                                             "opacity",  "alpha",       "culling", "skipping",
-                                            "every_steps", "frames_per_step", "slices_per_frame", "cameras"};
+                                            "every_steps", "frames_per_step", "slices_per_frame", "cameras", "ground"};
+constexpr std::string_view kGroundKeys[] = {"albedo"};
 constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
 
 constexpr int64_t kShadeResolutions[] = {1, 2, 4};
@@ -333,6 +334,13 @@ bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {
             if (render.slicesPerFrame > 0 && find("alpha"))
                 check.Fail(field("alpha"), "cannot be combined with render.slices_per_frame > 0 (the frames of a "
                                            "time-sliced step run alpha from 1/F to 1); remove one");
+        }
+    }
+
+    if (const Json* ground = check.Section(*section, "render", "ground", kGroundKeys)) {
+        render.ground.on = true;
+        if (const Json* v = Validator::Find(*ground, "albedo")) {
+            if (auto a = check.Numbers<3>(*v, "render.ground.albedo", kProbability)) render.ground.albedo = *a;
         }
     }
 

@@ -229,6 +229,7 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
         {.stage = Stage::RenderSplat,
          .section = "render",
          .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
+         .optionalReads = {Resource::Shadow},  // render.ground needs it: checked by the scene reader
          .readsPrevious = SplatPrevious,
          .writes = {Resource::SplatImage},
          .outputStepsOnly = true,
@@ -238,7 +239,8 @@ const std::array<StageDescriptor, kStageCount>& Descriptors() {
         {.stage = Stage::RenderMarch,
          .section = "render",
          .reads = {Resource::Q},
-         .optionalReads = {Resource::T},  // march.light "shade" (the default) needs it: checked by the scene reader
+         .optionalReads = {Resource::T, Resource::Shadow},  // march.light "shade" (the default) needs T,
+                                                            // render.ground G: checked by the scene reader
          .readsPrevious = MarchPrevious,
          .writes = {Resource::MarchImage},
          .outputStepsOnly = true,

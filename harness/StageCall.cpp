@@ -67,10 +67,11 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageHostInput
             // The order is host work shared by all backends, outside the stage time.
             const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
             p.order = &order;
-            const SplatInputs in{
+            SplatInputs in{
                 PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q),     io.Current(Resource::T),
                 io.Previous(Resource::Tiles),       io.Current(Resource::Tiles), io.Previous(Resource::Bands),
                 io.Current(Resource::Bands)};
+            in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
             return timed(
                 [&] { return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats); });
         });
@@ -82,7 +83,8 @@ Status RenderMarchFrames(Backend& backend, const Scene& sc, const StageHostInput
         Stage::RenderMarch, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
             const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
             // T only where shade runs (the light source "shade").
-            const MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
             return timed(
                 [&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march); });
         });

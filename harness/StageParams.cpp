@@ -57,6 +57,11 @@ ShadowParams MakeShadowParams(const Scene& sc, uint32_t step) {
 
 NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.noise, sc.grid.size}; }
 
+GroundParams MakeGroundParams(const Scene& sc) {
+    const auto& a = sc.render.ground.albedo;
+    return {sc.render.ground.on, {float(a[0]), float(a[1]), float(a[2])}};
+}
+
 SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame,
                             uint32_t frames) {
     SplatParams p;
@@ -76,6 +81,7 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     p.skipping = sc.splat.skipping;
     p.tile = sc.density.tile;
     p.band = sc.density.band;
+    p.ground = MakeGroundParams(sc);
     return p;
 }
 
@@ -116,6 +122,7 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     p.frame = step;
     p.skipping = sc.march.skipping;
     p.brick = sc.march.brick;
+    p.ground = MakeGroundParams(sc);
     return p;
 }
 

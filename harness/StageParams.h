@@ -20,6 +20,8 @@ NoiseParams MakeNoiseParams(const Scene& scene, uint32_t step);
 // frame `frame` of a step of `frames` frames (RenderSettings::FrameAlpha; 0: render.frames_per_step).
 SplatParams MakeSplatParams(const Scene& scene, const CameraSettings& camera, uint32_t step = 0, uint32_t frame = 0,
                             uint32_t frames = 0);
+// The scene's ground (render.ground) as both renderers take it.
+GroundParams MakeGroundParams(const Scene& scene);
 // The ray marcher's parameters for one camera at `step` (the jitter's frame, the lightning's flash window and the
 // sun), frame `frame` of a step of `frames` frames (its alpha).
 MarchParams MakeMarchParams(const Scene& scene, const CameraSettings& camera, uint32_t step, uint32_t frame = 0,

@@ -63,7 +63,10 @@ struct MarchCachedDensity {
 
 template <class Light>
 void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks, float* image,
-                 MarchStats& stats, Light&& makeLight) {
+                 MarchStats& stats, const float* G, const Extent3& grid, Light&& makeLight) {
+    // The ground (core/Ground.h): with G, each pixel's background where its ray meets the plane.
+    const GroundLight groundLight = MakeGroundLight(params);
+    const Vec3 eyeVoxel = GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize);
     const CameraFrame& cam = params.camera;
     const uint32_t W = cam.width, H = cam.height;
     std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0};
@@ -79,9 +82,15 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
                 const float xi = params.jitter ? MarchJitter(params.seed, params.frame, pixel) : 0.5f;
                 const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
                 float* out = image + 3 * size_t(pixel);
-                out[0] = m.color[0];
-                out[1] = m.color[1];
-                out[2] = m.color[2];
+                if (G) {
+                    const Vec3 bg = GroundBackground(cam, eyeVoxel, params.setup.voxelSize, groundLight, G, grid.nx,
+                                                     grid.ny, x, y);
+                    for (int c = 0; c < 3; ++c) out[c] = m.light[c] + m.transmittance * bg[c];
+                } else {
+                    out[0] = m.color[0];
+                    out[1] = m.color[1];
+                    out[2] = m.color[2];
+                }
                 nRays += ray.Empty() ? 0 : 1;
                 nSamples += m.samples;
                 nLight += m.lightCalls;
@@ -115,6 +124,8 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
     const float* qCur = static_cast<const BufferCpu*>(in.qCur)->F32();
     const float* T = shadeLight ? static_cast<const BufferCpu*>(in.T)->F32() : nullptr;
     float* out = static_cast<BufferCpu&>(image).F32();
+    CB_TRY(CheckGroundInput(params.ground, in.G, e, "cpu: render_march"));
+    const float* G = params.ground.on ? static_cast<const BufferCpu*>(in.G)->F32() : nullptr;
     const float alpha = params.alpha;
     const size_t px = size_t(e.nx) + 2, py = size_t(e.ny) + 2, pz = size_t(e.nz) + 2;
     const uint32_t B = std::max(params.brick, 1u);
@@ -170,7 +181,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
         const uint32_t nl = params.lightSteps;
         auto plainQ = [&volume](const Vec3& p) { return volume.Q(p); };
         if (shadeLight) {
-            MarchPixels(params, volume, brickPtr, out, local, [&](MarchCachedDensity& density) {
+            MarchPixels(params, volume, brickPtr, out, local, G, e, [&](MarchCachedDensity& density) {
                 return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = density.LastT();
@@ -179,7 +190,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
                 };
             });
         } else {
-            MarchPixels(params, volume, brickPtr, out, local, [&](MarchCachedDensity&) {
+            MarchPixels(params, volume, brickPtr, out, local, G, e, [&](MarchCachedDensity&) {
                 return [&s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = SunLightMarch(s, p, nl, plainQ);

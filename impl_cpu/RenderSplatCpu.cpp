@@ -36,6 +36,11 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const float* qCur = static_cast<const BufferCpu&>(*in.qCur).F32();
     const float* T = static_cast<const BufferCpu&>(*in.T).F32();
     float* image = static_cast<BufferCpu&>(imageBuffer).F32();
+    // The ground (core/Ground.h): each pixel's background where its ray meets the plane.
+    CB_TRY(CheckGroundInput(p.ground, in.G, e, "cpu: render_splat"));
+    const float* G = p.ground.on ? static_cast<const BufferCpu&>(*in.G).F32() : nullptr;
+    const GroundLight groundLight = MakeGroundLight(p);
+    const Vec3 eyeVoxel = GroundEyeVoxel(p.camera, p.origin, p.voxelSize);
 
     // 1. Which tile x band boxes can contribute.
     const uint32_t tilesX = CeilDiv(e.nx, p.tile), tilesY = CeilDiv(e.ny, p.tile), bandCount = CeilDiv(e.nz, p.band);
@@ -135,8 +140,12 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                 const uint32_t rowLo = b * kRowsPerBand, rowHi = std::min(H, rowLo + kRowsPerBand) - 1;
                 for (uint32_t y = rowLo; y <= rowHi; ++y) {
                     float* row = image + size_t(3) * W * y;
-                    for (uint32_t x = 0; x < W; ++x)
-                        for (int c = 0; c < 3; ++c) row[3 * x + c] = p.background[c];
+                    for (uint32_t x = 0; x < W; ++x) {
+                        const Vec3 background =
+                            G ? GroundBackground(p.camera, eyeVoxel, p.voxelSize, groundLight, G, e.nx, e.ny, x, y)
+                              : p.background;
+                        for (int c = 0; c < 3; ++c) row[3 * x + c] = background[c];
+                    }
                 }
                 float* alphas = alphaRun.data();
                 float* colours = colourRun.data();

@@ -109,6 +109,7 @@ class BackendGL final : public Backend {
         MarchPhaseTable,  // RenderMarch, phase mie: kMieCloudTable's values, uploaded once (mMieUploaded)
         MarchCounters,    // RenderMarch: the shader's MarchStats counters
         MarchImageCopy,   // RenderMarch: the pixel buffer the image passes through
+        GroundBlock,      // RenderSplat, RenderMarch with the ground: the GroundGpu uniform block (core/Ground.h)
         Count
     };
     // An array indexed by one slot enum and nothing else.

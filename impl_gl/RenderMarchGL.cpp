@@ -34,6 +34,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const Functions& f = mContext->F();
     auto volumeProgram = mContext->Program("march_volume");
     if (!volumeProgram) return std::unexpected(volumeProgram.error());
+    CB_TRY(CheckGroundInput(params.ground, in.G, e, "gl: render_march"));
     const MarchGpu block = MakeMarchGpu(params, e);
     // The program specialised for this call's option bits and phase kind (render_march.frag).
     auto marchProgram = mContext->Program("render_march", "#define MARCH_FLAGS " + std::to_string(block.flags[0]) +
@@ -118,6 +119,16 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, volumeCopy);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bricksCopy);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, phaseTable);
+    // The ground's block and G (flag kMarchGpuGround); without the ground, stand-ins the program never reads.
+    GLuint groundBuffer = blockBuffer;
+    if (params.ground.on) {
+        const GroundGpu ground = MakeGroundGpu(params.camera, params.origin, params.setup.voxelSize,
+                                               MakeGroundLight(params), e.nx, e.ny);
+        groundBuffer = ScratchBuffer(GlScratchBuffer::GroundBlock, sizeof ground);
+        f.NamedBufferSubData(groundBuffer, 0, sizeof ground, &ground);
+    }
+    f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
+    f.BindTextureUnit(3, Tex(params.ground.on ? *in.G : *in.qCur).Texture());
     f.Viewport(0, 0, GLsizei(W), GLsizei(H));
     f.DrawArrays(GL_TRIANGLES, 0, 3);
 

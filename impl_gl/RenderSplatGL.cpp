@@ -21,6 +21,12 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (!program) return std::unexpected(program.error());
     const Extent3 e = in.qCur->Extent();
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
+    CB_TRY(CheckGroundInput(p.ground, in.G, e, "gl: render_splat"));
+    Result<GLuint> groundProgram = GLuint(0);
+    if (p.ground.on) {
+        groundProgram = mContext->Program("ground");
+        if (!groundProgram) return std::unexpected(groundProgram.error());
+    }
 
     auto visibility = DownloadSplatBoxVisibility(*this, p, in);
     if (!visibility) return std::unexpected(visibility.error());
@@ -80,10 +86,22 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
     const GLuint target = Scratch(GlScratch::SplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
     CB_TRY(BindTargets({{target, -1}}));
-    const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
-    f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
-    f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
+    if (p.ground.on) {
+        // The ground pass (ground.frag): each pixel's background, which the splats then blend over.
+        const GroundGpu block = MakeGroundGpu(p.camera, p.origin, p.voxelSize, MakeGroundLight(p), e.nx, e.ny);
+        const GLuint groundBuffer = ScratchBuffer(GlScratchBuffer::GroundBlock, sizeof block);
+        f.NamedBufferSubData(groundBuffer, 0, sizeof block, &block);
+        f.UseProgram(*groundProgram);
+        f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
+        f.BindTextureUnit(3, Tex(*in.G).Texture());
+        f.Viewport(0, 0, GLsizei(W), GLsizei(H));
+        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    } else {
+        const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
+        f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
+    }
+    f.UseProgram(*program);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, orderBuffer);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counters);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, frameBuffer);

@@ -61,6 +61,7 @@ enum class VkScratch {
     MarchBricks,        // render_march: one word per brick, 1 iff empty (only with skipping)
     MarchMieTable,      // render_march: kMieCloudTable's values, uploaded once (only with phase Mie)
     MarchStats,         // render_march: the MarchStats counters, 64-bit as two words each
+    GroundFrame,        // render_splat, render_march with the ground: the GroundGpu block (core/Ground.h)
     Count
 };
 

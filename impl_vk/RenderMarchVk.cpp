@@ -39,6 +39,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("vk: render_march: the image is not (3, width, height)");
 
+    CB_TRY(CheckGroundInput(params.ground, in.G, e, "vk: render_march"));
     const MarchGpu frame = MakeMarchGpu(params, e);
     const uint32_t px = e.nx + 2, py = e.ny + 2, pz = e.nz + 2;
     const uint32_t B = frame.flags[3];
@@ -47,7 +48,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     Pipeline* pipes[3] = {};
     const char* names[3] = {"march_volume", "march_bricks", shadeLight ? "render_march" : "render_march_q"};
-    const uint32_t bindings[3] = {4, 3, 6};
+    const uint32_t bindings[3] = {4, 3, 8};
     for (int n = 0; n < 3; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -77,6 +78,18 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         table = &mScratch[size_t(VkScratch::MarchMieTable)];
     }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
+    // The ground's block and G (flag kMarchGpuGround); without the ground, the frame stands in, unread.
+    const DeviceBuffer* groundBlock = *frameBuffer;
+    const DeviceBuffer* groundG = *frameBuffer;
+    if (params.ground.on) {
+        const GroundGpu block = MakeGroundGpu(params.camera, params.origin, params.setup.voxelSize,
+                                              MakeGroundLight(params), e.nx, e.ny);
+        auto b = Scratch(VkScratch::GroundFrame, sizeof block);
+        if (!b) return std::unexpected(b.error());
+        CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(&block, 1))));
+        groundBlock = *b;
+        groundG = &Dev(*in.G);
+    }
 
     const struct {
         uint32_t nx, ny, nz, hasT;
@@ -88,7 +101,8 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),
                                            *volume};
     const DeviceBuffer* brickBuffers[] = {*volume, bricks, *statsBuffer};
-    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume, bricks, table, &Dev(image), *statsBuffer};
+    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,       bricks,     table,
+                                          &Dev(image),  *statsBuffer, groundBlock, groundG};
     CB_TRY(Record("render_march", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(*pipes[0], volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);

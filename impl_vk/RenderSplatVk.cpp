@@ -17,6 +17,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const Extent3 e = in.qCur->Extent();
     if (image.Extent().nx != 3) return MakeError("vk: render_splat image must have extent (3, width, height)");
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
+    CB_TRY(CheckGroundInput(p.ground, in.G, e, "vk: render_splat"));
 
     // Which tile x band boxes can hold a splat: the frustum (host geometry,
     // shared with the CPU) and, when skipping, the two steps' band occupancy.
@@ -58,7 +59,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
     Pipeline* pipes[5] = {};
     const char* names[5] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite"};
-    const uint32_t bindings[5] = {8, 2, 8, 5, 4};
+    const uint32_t bindings[5] = {8, 2, 8, 5, 6};
     for (int n = 0; n < 5; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -124,8 +125,21 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     struct {
         uint32_t width, height, tilesX, tileSize;
         float background[4];
-    } composite{W, H, tilesX, kTileSize, {p.background[0], p.background[1], p.background[2], 0}};
-    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.tileList, &Dev(image)};
+        uint32_t ground;
+    } composite{W, H, tilesX, kTileSize, {p.background[0], p.background[1], p.background[2], 0}, p.ground.on ? 1u : 0u};
+    // The ground's block and G; without the ground, a buffer that exists (a binding needs one), unread.
+    const DeviceBuffer* groundBlock = scratch.frame;
+    const DeviceBuffer* groundG = scratch.frame;
+    if (p.ground.on) {
+        const GroundGpu block = MakeGroundGpu(p.camera, p.origin, p.voxelSize, MakeGroundLight(p), e.nx, e.ny);
+        auto b = Scratch(VkScratch::GroundFrame, sizeof block);
+        if (!b) return std::unexpected(b.error());
+        CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(&block, 1))));
+        groundBlock = *b;
+        groundG = &Dev(*in.G);
+    }
+    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.tileList, &Dev(image),
+                                              groundBlock,    groundG};
     CB_TRY(run("render_splat: compositing", [&](VulkanContext::Recorder& r) {
         bin.mode = 2;
         r.Dispatch(*pipes[3], fillBuffers, &bin, sizeof bin, splatChunks);

@@ -409,7 +409,8 @@ TEST_P(Conformance, Shadow) {
 }
 
 // Test the splat renderer from four cameras (outside, inside, straight down,
-// partly out of view) with culling and skipping on: per channel |d| <= 2/255
+// partly out of view) with culling and skipping on, the last two cameras over
+// the ground lit through a G (core/Ground.h): per channel |d| <= 2/255
 // on 99.9 % of pixels and <= 8/255 everywhere (SPEC 8). A failure writes the
 // difference image and names the worst pixel.
 TEST_P(Conformance, RenderSplat) {
@@ -423,6 +424,8 @@ TEST_P(Conformance, RenderSplat) {
         qCur[v] = cloudy ? float(rng.Below(65)) / 64.0f : 0.0f;
         T[v] = float(rng.Below(256)) / 255.0f;
     }
+    std::vector<float> G(size_t(e.nx) * e.ny);
+    for (float& g : G) g = float(rng.Below(257)) / 256.0f;
     const float h = 50;
     const double cx = e.nx * h / 2, cy = e.ny * h / 2, cz = e.nz * h / 2;
     std::vector<CameraSettings> cameras(4);
@@ -445,6 +448,7 @@ TEST_P(Conformance, RenderSplat) {
             auto qp = test::MakeFilled(b, BufferFormat::F32, e, qPrev);
             auto qc = test::MakeFilled(b, BufferFormat::F32, e, qCur);
             auto t = test::MakeFilled(b, BufferFormat::F32, e, T);
+            auto g = test::MakeFilled(b, BufferFormat::F32, {e.nx, e.ny, 1}, G);
             auto cld = test::MakeBuffer(b, BufferFormat::Bits, e);
             const Extent3 tiles{CeilDiv(e.nx, 8), CeilDiv(e.ny, 8), 1}, bands{tiles.nx, tiles.ny, CeilDiv(e.nz, 4)};
             std::unique_ptr<Buffer> occupancy[2][2];
@@ -468,6 +472,7 @@ TEST_P(Conformance, RenderSplat) {
             p.tile = 8;
             p.band = 4;
             p.alpha = 0.4f;
+            if (c >= 2) p.ground = {true, {0.4f, 0.35f, 0.3f}};
             auto image = test::MakeBuffer(b, BufferFormat::F32, {3, W, H});
             SplatInputs in{qp.get(),
                            qc.get(),
@@ -476,6 +481,7 @@ TEST_P(Conformance, RenderSplat) {
                            occupancy[1][0].get(),
                            occupancy[0][1].get(),
                            occupancy[1][1].get()};
+            in.G = p.ground.on ? g.get() : nullptr;
             Status s = b.RenderSplat(p, in, *image, &stats[n]);
             ASSERT_TRUE(s.has_value()) << s.error().message;
             images[n] = test::Read<float>(b, *image);

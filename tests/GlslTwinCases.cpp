@@ -547,6 +547,7 @@ std::vector<TwinCase> Cases() {
         c.push_back(exps);
     }
     AddMarchCases(c);
+    AddGroundCases(c);
     return c;
 }
 

@@ -69,6 +69,8 @@ inline std::vector<float> AndNeighbours(float x) {
 std::vector<TwinCase> Cases();
 // The march.glsl part of Cases() (GlslTwinMarchCases.cpp).
 void AddMarchCases(std::vector<TwinCase>& cases);
+// The ground.glsl part of Cases() (GlslTwinMarchCases.cpp).
+void AddGroundCases(std::vector<TwinCase>& cases);
 
 // Compares the GLSL's outputs with the C++ twin's, element by element; the
 // failure message shows the first few mismatches with their inputs.

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "GlslTwinHarness.h"
+#include "core/Ground.h"
 #include "core/March.h"
 #include "core/Shading.h"
 
@@ -159,6 +160,60 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      },
                      /*otherDeviceUlps=*/3});
     }
+}
+
+// twin.comp's G of ground cell (i, j): a hash of the cell.
+float TwinGroundG(uint32_t i, uint32_t j) { return float(LowBias32(i + 4096u * j) >> 8) * (1.0f / 16777216.0f); }
+
+void AddGroundCases(std::vector<TwinCase>& c) {
+    // Eyes above and below the plane, directions down, level and up, near / far intervals that cut the hit.
+    c.push_back({"GroundHit",
+                 46,
+                 {Kind::U, Kind::F, Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     const float near = Uniform(r, 0, 5);
+                     in = WF({Uniform(r, -50, 50), Uniform(r, -50, 50), Uniform(r, -2, 60), Uniform(r, -1, 1),
+                              Uniform(r, -1, 1), Uniform(r, -1, 0.2), near, r.Below(2) ? 1e30f : Uniform(r, near, 200)});
+                 },
+                 {WF({5, 5, 10, 0, 0, -1, 0.1f, 100}), WF({5, 5, 10, 0, 0, -1, 10, 10}),
+                  WF({5, 5, 10, 0, 0, -1, 10.01f, 100}), WF({5, 5, 10, 0, 0, -1, 0.1f, 9.99f}),
+                  WF({5, 5, 10, 1, 0, 0, 0.1f, 100}), WF({5, 5, 10, 0, 0, -0.0f, 0.1f, 100}),
+                  WF({5, 5, -1, 0, 0, -1, 0.1f, 100}), WF({5, 5, 0, 0.6f, 0, -0.8f, 0, 100})},
+                 [](const Words& in, Words& out) {
+                     float x = 0, y = 0;
+                     const bool hit = GroundHit({Float(in[0]), Float(in[1]), Float(in[2])},
+                                                {Float(in[3]), Float(in[4]), Float(in[5])}, Float(in[6]), Float(in[7]), x, y);
+                     out[0] = hit ? 1 : 0;
+                     out[1] = Bits(hit ? x : 0.0f);
+                     out[2] = Bits(hit ? y : 0.0f);
+                 },
+                 /*otherDeviceUlps=*/3});
+    // Points inside, on the edges of and outside the footprint of grids from 1 x 1 up.
+    std::vector<Words> edges;
+    for (uint32_t n : {1u, 2u, 7u})
+        for (float x : {0.0f, 0.25f, 0.5f, 1.0f, float(n) - 0.5f, float(n), float(n) + 0.01f, -0.01f})
+            edges.push_back(W({Bits(x), Bits(0.75f), n, n + 1}));
+    c.push_back({"GroundShadowAt",
+                 47,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     const uint32_t nx = 1 + r.Below(40), ny = 1 + r.Below(40);
+                     in = W({Bits(Uniform(r, -2, nx + 2.0)), Bits(Uniform(r, -2, ny + 2.0)), nx, ny});
+                 },
+                 edges,
+                 [](const Words& in, Words& out) {
+                     out[0] = Bits(GroundShadowAt(Float(in[0]), Float(in[1]), in[2], in[3], TwinGroundG));
+                 }});
+    c.push_back({"GroundChannel",
+                 48,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     in = WF({Uniform(r, 0, 1), Uniform(r, 0, 20), Uniform(r, -1, 1), Uniform(r, 0, 2), Uniform(r, 0, 1)});
+                 },
+                 {WF({0.5f, 1.2f, 1, 0.2f, 1}), WF({0.3f, 2, -0.5f, 0.25f, 0.5f}), WF({1, 1, 0, 0, 1})},
+                 [](const Words& in, Words& out) {
+                     out[0] = Bits(GroundChannel(Float(in[0]), Float(in[1]), Float(in[2]), Float(in[3]), Float(in[4])));
+                 }});
 }
 
 }  // namespace cb::test

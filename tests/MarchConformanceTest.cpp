@@ -79,6 +79,13 @@ std::vector<MarchVariant> MarchVariants(const Extent3& e) {
              p.setup.adaptive = true, p.setup.kappa = 0.05f, p.setup.adaptiveStart = 6;
          }},
         {"epsilon 0, dense", [](MarchParams& p) { p.setup.epsilon = 0, p.setup.sigmaH = 0.6f; }},
+        // The ground plane lit through G (core/Ground.h) as the background, per pixel.
+        {"ground", [](MarchParams& p) { p.ground = {true, {0.35f, 0.3f, 0.25f}}; }},
+        {"ground, light march, jitter",
+         [](MarchParams& p) {
+             p.ground = {true, {0.6f, 0.5f, 0.4f}};
+             p.light = MarchLightSource::March, p.lightSteps = 4, p.jitter = true;
+         }},
     };
 }
 
@@ -127,9 +134,9 @@ std::vector<std::pair<const char*, CameraSettings>> MarchCameras(const Extent3& 
     };
 }
 
-// q of two steps (a cloud that moves and changes between them), and T.
+// q of two steps (a cloud that moves and changes between them), T, and a ground shadow G.
 struct MarchFields {
-    std::vector<float> qPrev, qCur, T;
+    std::vector<float> qPrev, qCur, T, G;
 };
 MarchFields MakeMarchFields(const Extent3& e) {
     MarchFields f;
@@ -141,6 +148,8 @@ MarchFields MakeMarchFields(const Extent3& e) {
     Pcg32 rng(41);
     f.T.resize(e.Count());
     for (float& t : f.T) t = float(rng.Below(4097)) / 4096.0f;
+    f.G.resize(size_t(e.nx) * e.ny);
+    for (float& g : f.G) g = float(rng.Below(4097)) / 4096.0f;
     return f;
 }
 
@@ -154,7 +163,9 @@ MarchRendering RenderMarchOn(Backend& b, const Extent3& e, const MarchFields& f,
     auto qc = test::MakeFilled(b, BufferFormat::F32, e, f.qCur);
     auto t = test::MakeFilled(b, BufferFormat::F32, e, f.T);
     auto image = test::MakeBuffer(b, BufferFormat::F32, {3, p.camera.width, p.camera.height});
-    const MarchInputs in{qp.get(), qc.get(), p.light == MarchLightSource::Shade ? t.get() : nullptr};
+    auto g = test::MakeFilled(b, BufferFormat::F32, {e.nx, e.ny, 1}, f.G);
+    MarchInputs in{qp.get(), qc.get(), p.light == MarchLightSource::Shade ? t.get() : nullptr};
+    in.G = p.ground.on ? g.get() : nullptr;
     MarchRendering r;
     Status s = b.RenderMarch(p, in, *image, &r.stats);
     EXPECT_TRUE(s.has_value()) << b.Name() << ": " << s.error().message;

@@ -232,6 +232,29 @@ TEST(SceneTest, LightingStageDependencies) {
     EXPECT_EQ(SplitLines(message).size(), 1u) << message;
 }
 
+// Test that the ground is refused without the shadow stage that computes its G, and its albedo out of [0, 1];
+// with the shadow stage, the same ground is accepted.
+TEST(SceneTest, GroundNeedsShadow) {
+    const std::string render =
+        R"("render": {"ground": {"albedo": [0.3, 0.3, 0.3]}, "cameras": [{"eye": [0, 0, 9], "target": [1, 0, 0]}]})";
+    const std::string stages = R"("stages": ["region", "ca", "smooth", "density", "shade", "render_march"])";
+    const std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, )" + render + ", " + stages + "}");
+    EXPECT_TRUE(HasLine(message, R"(test.json: render.ground: needs the stage "shadow", which computes the ground )"
+                                 R"(shadow G it is lit through; enable it or remove render.ground)"));
+    EXPECT_EQ(SplitLines(message).size(), 1u) << message;
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"ground": {"albedo": [0.3, 1.5, 0]}}})"),
+                        "test.json: render.ground.albedo[1]: must be in [0, 1], got 1.5"));
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"ground": {"albedos": [0.3, 0.3, 0.3]}}})"),
+                        R"(test.json: render.ground.albedos: unknown field (did you mean "albedo"?))"));
+    const std::string shadowed = R"("stages": ["region", "ca", "smooth", "density", "shade", "shadow", "render_march"])";
+    const Scene scene = test::Parsed(R"({"grid": {"size": [8, 4, 6]}, )" + render + ", " + shadowed + "}");
+    EXPECT_TRUE(scene.render.ground.on);
+    EXPECT_EQ(scene.render.ground.albedo, (std::array<double, 3>{0.3, 0.3, 0.3}));
+    EXPECT_FALSE(test::Parsed(R"({"grid": {"size": [8, 4, 6]}, )" + shadowed + R"(, "render": {"cameras": [)"
+                        R"({"eye": [0, 0, 9], "target": [1, 0, 0]}]}})")
+                     .render.ground.on);
+}
+
 // Test that a number or a string where a boolean belongs is refused.
 TEST(SceneTest, WrongBooleanType) {
     std::string message = ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "render": {"culling": 1},

@@ -40,6 +40,7 @@ const uint kMarchPowder = 4u;
 const uint kMarchPointLight = 8u;
 const uint kMarchSkipping = 16u;
 const uint kMarchLightMarch = 32u;
+const uint kMarchGround = 64u;  // the background is the ground (core/glsl/ground.glsl), per pixel
 const uint kMarchPhaseMie = 3u;  // PhaseKind::Mie
 const uint kMarchStreamOther = 3u;
 const float kMarchFloatMax = 3.402823466e+38;
@@ -245,6 +246,7 @@ ivec3 MarchBrickOf(vec3 p, float invB) {
 
 struct MarchRayResult {
     vec3 color;
+    vec3 light;  // L alone (core/March.h MarchRayResult::light)
     float transmittance;
     uint samples, lightCalls, bricksSkipped;
 };
@@ -346,6 +348,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
         }
     }
     r.transmittance = T;
+    r.light = vec3(L0, L1, L2);
     precise vec3 c = vec3(L0 + T * m.background.x, L1 + T * m.background.y, L2 + T * m.background.z);
     r.color = c;
     return r;

@@ -10,11 +10,15 @@ layout(std430, binding = 1) readonly buffer MarchBricks { uint marchBrickEmpty[]
 layout(std430, binding = 2) readonly buffer MarchPhaseTable { float marchPhaseTable[]; };
 // rays, samples, light samples, bricks skipped: 64-bit sums as (low, high) word pairs.
 layout(std430, binding = 3) buffer MarchCounters { uint marchCounters[]; };
+// The ground (flag kMarchGround): its block and G, (nx, ny, 1).
+layout(std140, binding = 1) uniform GroundBlock { GroundGpu ground; };
+layout(binding = 3) uniform sampler2DArray groundShadow;
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return marchQT[paddedIndex]; }
 bool MarchBrickEmpty(uint brick) { return marchBrickEmpty[brick] != 0u; }
 float MarchPhaseTableValue(uint i) { return marchPhaseTable[i]; }
+float GroundFetchG(uint i, uint j) { return texelFetch(groundShadow, ivec3(i, j, 0), 0).r; }
 
 // Adds v to the 64-bit counter n; a carry out of the low word goes to the high one.
 void MarchCount(uint n, uint v) {
@@ -35,7 +39,15 @@ void main() {
     m.flags.y = MARCH_PHASE;
 #endif
     const MarchRayResult r = MarchPixel(m, x, y);
-    colour = vec4(r.color, 1.0);
+    if ((m.flags.x & kMarchGround) != 0u) {
+        // C = L + T_view background with the pixel's own background (impl_cpu/RenderMarchCpu.cpp).
+        const vec3 bg = GroundBackground(ground, x, y);
+        precise vec3 c = vec3(r.light.x + r.transmittance * bg.x, r.light.y + r.transmittance * bg.y,
+                              r.light.z + r.transmittance * bg.z);
+        colour = vec4(c, 1.0);
+    } else {
+        colour = vec4(r.color, 1.0);
+    }
     const MarchRayGeometry ray = MakePixelRay(m, x, y);
     MarchCount(0u, ray.tMin < ray.tMax ? 1u : 0u);
     MarchCount(1u, r.samples);

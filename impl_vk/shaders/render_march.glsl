@@ -4,6 +4,7 @@
 #include "random.glsl"
 #include "shading.glsl"
 #include "march.glsl"
+#include "ground.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 0) readonly buffer Frame { MarchGpu frame; };
@@ -17,6 +18,9 @@ layout(std430, binding = 3) readonly buffer Mie { float mieTable[]; };     // re
 layout(std430, binding = 4) writeonly buffer Image { float image[]; };
 // Words 2 n, 2 n + 1: counter n (low, high) of rays, samples, light samples, bricks skipped.
 layout(std430, binding = 5) buffer Stats { uint stats[]; };
+// The ground (flag kMarchGround): its block and G, (nx, ny); read only with the flag.
+layout(std430, binding = 6) readonly buffer Ground { GroundGpu ground; };
+layout(std430, binding = 7) readonly buffer GroundG { float groundG[]; };
 
 #if MARCH_WITH_T
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
@@ -25,6 +29,7 @@ vec2 MarchFetchQT(uint paddedIndex) { return vec2(volume[paddedIndex], 1.0); }
 #endif
 bool MarchBrickEmpty(uint brick) { return brickEmpty[brick] != 0u; }
 float MarchPhaseTableValue(uint i) { return mieTable[i]; }
+float GroundFetchG(uint i, uint j) { return groundG[i + ground.grid.x * j]; }
 
 shared uint gCounts[4];
 
@@ -44,9 +49,17 @@ void main() {
     if (x < m.image.x && y < m.image.y) {
         const MarchRayResult r = MarchPixel(m, x, y);
         const uint pixel = x + m.image.x * y;
-        image[3u * pixel] = r.color.x;
-        image[3u * pixel + 1u] = r.color.y;
-        image[3u * pixel + 2u] = r.color.z;
+        vec3 c = r.color;
+        if ((m.flags.x & kMarchGround) != 0u) {
+            // C = L + T_view background with the pixel's own background (impl_cpu/RenderMarchCpu.cpp).
+            const vec3 bg = GroundBackground(ground, x, y);
+            precise vec3 lit = vec3(r.light.x + r.transmittance * bg.x, r.light.y + r.transmittance * bg.y,
+                                    r.light.z + r.transmittance * bg.z);
+            c = lit;
+        }
+        image[3u * pixel] = c.x;
+        image[3u * pixel + 1u] = c.y;
+        image[3u * pixel + 2u] = c.z;
         const MarchRayGeometry ray = MakePixelRay(m, x, y);
         if (ray.tMin < ray.tMax) atomicAdd(gCounts[0], 1u);
         atomicAdd(gCounts[1], r.samples);

@@ -1,22 +1,28 @@
 #version 450
 // Splat compositing: one invocation per pixel walks its screen tile's splats
-// in the shared back-to-front order: C <- alpha c + (1 - alpha) C.
+// in the shared back-to-front order: C <- alpha c + (1 - alpha) C, from the
+// flat background, or with `ground` from the pixel's ground (ground.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
 #include "splat.glsl"
+#include "ground.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 1) readonly buffer Bases { uint bases[]; };
 layout(std430, binding = 2) readonly buffer List { uint list[]; };
 layout(std430, binding = 3) writeonly buffer Image { float image[]; };
-layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec4 background; } pc;
+layout(std430, binding = 4) readonly buffer Ground { GroundGpu ground; };  // read only with pc.ground
+layout(std430, binding = 5) readonly buffer GroundG { float groundG[]; };  // G, (nx, ny); likewise
+layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec4 background; uint ground; } pc;
+
+float GroundFetchG(uint i, uint j) { return groundG[i + ground.grid.x * j]; }
 
 void main() {
     const uint id = gl_GlobalInvocationID.x;
     if (id >= pc.width * pc.height) return;
     const int x = int(id % pc.width), y = int(id / pc.width);
     const uint tile = uint(x) / pc.tileSize + pc.tilesX * (uint(y) / pc.tileSize);
-    vec3 c = pc.background.rgb;
+    vec3 c = pc.ground != 0u ? GroundBackground(ground, uint(x), uint(y)) : pc.background.rgb;
     for (uint n = bases[tile]; n < bases[tile + 1u]; ++n) {
         const Splat s = splats[list[n]];
         if (x < s.x0 || x > s.x1 || y < s.y0 || y > s.y1) continue;

@@ -10,6 +10,7 @@
 #include "splat.glsl"
 #include "noise.glsl"
 #include "march.glsl"
+#include "ground.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In { uint inWords[]; };
@@ -26,6 +27,8 @@ vec2 MarchFetchQT(uint i) {
                 float(LowBias32(i ^ 0x9E3779B9u) >> 8u) * (1.0 / 16777216.0));
 }
 bool MarchBrickEmpty(uint brick) { return brick % 3u == 0u; }
+// ground.glsl's G: a hash of the cell (tests/GlslTwinMarchCases.cpp TwinGroundG).
+float GroundFetchG(uint i, uint j) { return float(LowBias32(i + 4096u * j) >> 8u) * (1.0 / 16777216.0); }
 float MarchPhaseTableValue(uint i) { return mieTable[i]; }
 
 MarchGpu ZeroMarch() {
@@ -69,6 +72,16 @@ void main() {
         case 16u: PutF(0u, StoreTransmittance(U(0u), F(1u), F(2u))); break;
         case 17u: PutF(0u, GroundShadow(U(0u), F(1u), F(2u), F(3u))); break;
         case 45u: PutF(0u, WangShadow(F(0u), F(1u), F(2u), F(3u))); break;
+        case 46u: {
+            vec2 p;
+            const bool hit = GroundHit(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), F(6u), F(7u), p);
+            PutU(0u, hit ? 1u : 0u);
+            PutF(1u, hit ? p.x : 0.0);
+            PutF(2u, hit ? p.y : 0.0);
+            break;
+        }
+        case 47u: PutF(0u, GroundShadowAt(F(0u), F(1u), U(2u), U(3u))); break;
+        case 48u: PutF(0u, GroundChannel(F(0u), F(1u), F(2u), F(3u), F(4u))); break;
         case 18u: {
             int i0, i1;
             float w;
