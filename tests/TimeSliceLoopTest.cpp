@@ -107,12 +107,15 @@ class TimeSliceLoop : public ::testing::TestWithParam<std::string> {
 // Frames per step well above what the shares take, so the sliced steps draw as many frames, at the same alphas, as
 // the unsliced ones: then every resource and every image must be equal at every step.
 TEST_P(TimeSliceLoop, EveryStepEqualsTheUnslicedLoop) {
-    const Scene whole = SlicedLoopScene({{"render.frames_per_step", "56"}});
+    // The ground lit by G too: the frames read the current G while the shares compute the next one.
+    const SceneOverride ground{"render.ground", R"({"albedo": [0.3, 0.35, 0.3]})"};
+    const Scene whole = SlicedLoopScene({{"render.frames_per_step", "56"}, ground});
     const std::vector<StepView> expected = RunAndKeepEveryStep(whole, *mBackend);
     ASSERT_EQ(expected.size(), whole.steps);
     EXPECT_GT(expected.back().record.coveredColumns.value_or(0), 0u) << "the test needs clouds";
     for (const char* slices : {"1", "3"}) {
-        const Scene sliced = SlicedLoopScene({{"render.frames_per_step", "56"}, {"render.slices_per_frame", slices}});
+        const Scene sliced =
+            SlicedLoopScene({{"render.frames_per_step", "56"}, {"render.slices_per_frame", slices}, ground});
         const std::vector<StepView> got = RunAndKeepEveryStep(sliced, *mBackend);
         ASSERT_EQ(got.size(), expected.size());
         for (size_t t = 0; t < got.size(); ++t) {
