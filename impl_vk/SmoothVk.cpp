@@ -18,7 +18,7 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     }
     const uint32_t r = uint32_t(radius);
     const uint32_t halo0 = k0 > r ? k0 - r : 0, halo1 = std::min(e.nz, k1 + r);
-    auto pipeline = mContext->GetPipeline("smooth", 4);
+    auto pipeline = mContext->GetPipeline("smooth", 4, true);
     if (!pipeline) return std::unexpected(pipeline.error());
     auto sumX = Scratch(VkScratch::SmoothSumX, e.Count() * 4);
     if (!sumX) return std::unexpected(sumX.error());
@@ -28,15 +28,15 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
         uint32_t nx, ny, nz, words;
         int32_t radius;
         float invW;
-        uint32_t pass, k0, sliceCount;
+        uint32_t pass, first, end;  // voxels
     } push{e.nx, e.ny, e.nz, (e.nx + 31) / 32, radius, 1.0f / float(SmoothNormaliser(radius)), 0, 0, 0};
     const DeviceBuffer* buffers[] = {&Dev(cld), *sumX, *sumXY, &Dev(q)};
     return Record("smooth", [&](VulkanContext::Recorder& rec) {
         for (push.pass = 0; push.pass < 3; ++push.pass) {
             if (push.pass > 0) rec.Barrier();
-            push.k0 = push.pass < 2 ? halo0 : k0;
-            push.sliceCount = (push.pass < 2 ? halo1 : k1) - push.k0;
-            rec.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny * push.sliceCount);
+            push.first = e.nx * e.ny * (push.pass < 2 ? halo0 : k0);
+            push.end = e.nx * e.ny * (push.pass < 2 ? halo1 : k1);
+            rec.DispatchRange(**pipeline, buffers, &push, sizeof push, push.first, push.end);
         }
     });
 }

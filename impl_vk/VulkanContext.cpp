@@ -1,6 +1,7 @@
 #include "impl_vk/VulkanContext.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
 #include "impl_vk/Shaders.h"
@@ -329,18 +330,27 @@ Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> 
     return {};
 }
 
-Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings) {
-    if (auto it = mPipelines.find(name); it != mPipelines.end()) return &it->second;
+Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings, bool ranged) {
+    if (auto it = mPipelines.find(name); it != mPipelines.end()) {
+        assert(it->second.ranged == ranged);
+        return &it->second;
+    }
     std::span<const uint32_t> spirv = FindShader(name);
     if (spirv.empty()) return MakeError("no compiled shader named '" + name + "'");
-    return GetPipeline(name, bindings, spirv);
+    return CreatePipeline(name, bindings, spirv, ranged);
 }
 
 Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings,
                                              std::span<const uint32_t> spirv) {
     if (auto it = mPipelines.find(name); it != mPipelines.end()) return &it->second;
+    return CreatePipeline(name, bindings, spirv, false);
+}
+
+Result<Pipeline*> VulkanContext::CreatePipeline(const std::string& name, uint32_t bindings,
+                                                std::span<const uint32_t> spirv, bool ranged) {
     Pipeline p;
     p.bindings = bindings;
+    p.ranged = ranged;
     std::vector<VkDescriptorSetLayoutBinding> b(bindings);
     for (uint32_t n = 0; n < bindings; ++n)
         b[n] = {n, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
@@ -362,6 +372,7 @@ Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t b
     VkShaderModule shader = VK_NULL_HANDLE;
     CB_TRY(CheckVk(vkCreateShaderModule(mDevice, &module, nullptr, &shader), what.c_str()));
     VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    if (ranged) info.flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT;
     info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     info.stage.module = shader;
@@ -412,9 +423,24 @@ void VulkanContext::Recorder::Dispatch(Pipeline& pipeline, std::span<const Devic
     DispatchGroups(pipeline, buffers, push, pushBytes, (invocations + 63) / 64, 1, 1);
 }
 
+void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
+                                            const void* push, uint32_t pushBytes, uint32_t first, uint32_t end) {
+    assert(pipeline.ranged && first < end);
+    const uint32_t base = first / 64, groups = (end + 63) / 64 - base;
+    if (base == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groups, 1, 1);
+    Bind(pipeline, buffers, push, pushBytes);
+    vkCmdDispatchBase(mCmd, base, 0, 0, groups, 1, 1);
+}
+
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
                                              const void* push, uint32_t pushBytes, uint32_t groupsX,
                                              uint32_t groupsY, uint32_t groupsZ) {
+    Bind(pipeline, buffers, push, pushBytes);
+    vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
+}
+
+void VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
+                                   const void* push, uint32_t pushBytes) {
     VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     alloc.descriptorPool = mContext.mDescriptors;
     alloc.descriptorSetCount = 1;
@@ -437,7 +463,6 @@ void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const
     vkCmdBindPipeline(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
     vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout, 0, 1, &set, 0, nullptr);
     if (pushBytes) vkCmdPushConstants(mCmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes, push);
-    vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
 }
 
 void VulkanContext::Recorder::Barrier() {
