@@ -27,8 +27,8 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     if (!counter) return std::unexpected(counter.error());
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
     struct {
-        uint32_t nx, ny, nz, words, fromCld, first, end;
-    } columnPush{e.nx, e.ny, e.nz, (e.nx + 31) / 32, cld ? 1u : 0u, e.nx * j0, e.nx * j1};
+        uint32_t nx, ny, nz, words, fromCld;
+    } columnPush{e.nx, e.ny, e.nz, (e.nx + 31) / 32, cld ? 1u : 0u};
     struct {
         uint32_t nx, ny, nz, tile, band, tilesX, tilesY, bandCount, ty0, tileRows;
     } occupancyPush{e.nx, e.ny, e.nz, params.tile, params.band, tilesX, tilesY, bandCount, row0, row1 - row0};
@@ -38,7 +38,7 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     CB_TRY(Record("density", [&](VulkanContext::Recorder& r) {
         r.Fill(**counter, 0);
         r.Barrier();
-        r.DispatchRange(**columns, columnBuffers, &columnPush, sizeof columnPush, columnPush.first, columnPush.end);
+        r.DispatchRows(**columns, columnBuffers, &columnPush, sizeof columnPush, CeilDiv(e.nx, 64), j0, j1 - j0);
         r.Barrier();
         r.Dispatch(**occupancy, occupancyBuffers, &occupancyPush, sizeof occupancyPush,
                    tilesX * (row1 - row0) * (bandCount + 1));

@@ -432,6 +432,15 @@ void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const 
     vkCmdDispatchBase(mCmd, base, 0, 0, groups, 1, 1);
 }
 
+void VulkanContext::Recorder::DispatchRows(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
+                                           const void* push, uint32_t pushBytes, uint32_t groupsX, uint32_t baseY,
+                                           uint32_t groupsY) {
+    assert(pipeline.ranged && groupsY > 0);
+    if (baseY == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groupsX, groupsY, 1);
+    Bind(pipeline, buffers, push, pushBytes);
+    vkCmdDispatchBase(mCmd, 0, baseY, 0, groupsX, groupsY, 1);
+}
+
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
                                              const void* push, uint32_t pushBytes, uint32_t groupsX,
                                              uint32_t groupsY, uint32_t groupsZ) {

@@ -94,6 +94,10 @@ class VulkanContext {
         // The same with an explicit grid of workgroups (shaders with 2-D workgroups).
         void DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                             uint32_t pushBytes, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ);
+        // groupsY rows of groupsX groups from row baseY on (vkCmdDispatchBase; a plain
+        // dispatch when baseY = 0). The pipeline must be ranged.
+        void DispatchRows(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+                          uint32_t pushBytes, uint32_t groupsX, uint32_t baseY, uint32_t groupsY);
         // Makes every earlier shader write visible to later shader reads and writes.
         void Barrier();
         void Fill(const DeviceBuffer& buffer, uint32_t value);
