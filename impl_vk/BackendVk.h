@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/Backend.h"
 #include "core/Noise.h"
@@ -107,12 +108,19 @@ class BackendVk final : public Backend {
     Status Record(const char* what, Fn&& fn);
     // The slot's buffer, grown to at least `size` bytes; its contents are undefined.
     Result<DeviceBuffer*> Scratch(VkScratch slot, VkDeviceSize size);
+    // The slot's buffer (at least `minSize` bytes) holding `bytes` from offset 0,
+    // uploaded only when they differ from what this last uploaded there; for
+    // slots the host writes and no shader does (the shares of a stage upload
+    // the same list once).
+    Result<DeviceBuffer*> ScratchHolding(VkScratch slot, std::span<const std::byte> bytes, VkDeviceSize minSize);
 
     std::unique_ptr<VulkanContext> mContext;
     std::optional<double> mLastDeviceMs;
     // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
     // while others grow.
     std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};
+    // What ScratchHolding last uploaded into each slot; reset when the slot grows.
+    std::array<std::optional<std::vector<std::byte>>, size_t(VkScratch::Count)> mScratchHeld{};
     // noise: the scene whose data block is in the NoiseData slot (NoiseVk.cpp).
     std::unique_ptr<noise::NoiseForm> mNoiseForm;
     // render_march: kMieCloudTable is in the MarchMieTable slot (RenderMarchVk.cpp).

@@ -66,10 +66,9 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
             packed.push_back(params.shiftX[k]);
             packed.push_back(params.shiftY[k]);
         }
-        auto s = Scratch(VkScratch::CaWindShifts, packed.size() * 4);
+        auto s = ScratchHolding(VkScratch::CaWindShifts, std::as_bytes(std::span(packed)), 8);
         if (!s) return std::unexpected(s.error());
         shifts = *s;
-        CB_TRY(mContext->Upload(*shifts, std::as_bytes(std::span(packed))));
         auto p = mContext->GetPipeline("advect", 7, true);
         if (!p) return std::unexpected(p.error());
         advect = *p;

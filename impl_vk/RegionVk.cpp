@@ -17,9 +17,8 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
         return {};
     }
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
-    auto list = Scratch(VkScratch::EllipsoidList, std::max<VkDeviceSize>(32, ellipsoids.size_bytes()));
+    auto list = ScratchHolding(VkScratch::EllipsoidList, std::as_bytes(ellipsoids), 32);
     if (!list) return std::unexpected(list.error());
-    CB_TRY(mContext->Upload(**list, std::as_bytes(ellipsoids)));
     // Per 16x16 tile of each slice of the share, the ellipsoids whose bounding box (the
     // shader's rejection test, widened by a voxel) reaches a voxel centre of it.
     constexpr uint32_t kTile = 16;
