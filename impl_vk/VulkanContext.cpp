@@ -331,13 +331,11 @@ Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> 
 }
 
 Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings, bool ranged) {
-    if (auto it = mPipelines.find(name); it != mPipelines.end()) {
-        assert(it->second.ranged == ranged);
-        return &it->second;
-    }
+    const std::string key = ranged ? name + "/ranged" : name;
+    if (auto it = mPipelines.find(key); it != mPipelines.end()) return &it->second;
     std::span<const uint32_t> spirv = FindShader(name);
     if (spirv.empty()) return MakeError("no compiled shader named '" + name + "'");
-    return CreatePipeline(name, bindings, spirv, ranged);
+    return CreatePipeline(key, bindings, spirv, ranged);
 }
 
 Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings,
@@ -372,12 +370,18 @@ Result<Pipeline*> VulkanContext::CreatePipeline(const std::string& name, uint32_
     VkShaderModule shader = VK_NULL_HANDLE;
     CB_TRY(CheckVk(vkCreateShaderModule(mDevice, &module, nullptr, &shader), what.c_str()));
     VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    if (ranged) info.flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT;
     info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     info.stage.module = shader;
     info.stage.pName = "main";
     info.layout = p.layout;
+    const VkBool32 kRanged = VK_TRUE;
+    const VkSpecializationMapEntry rangedEntry{0, 0, sizeof kRanged};
+    const VkSpecializationInfo specialization{1, &rangedEntry, sizeof kRanged, &kRanged};
+    if (ranged) {
+        info.flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT;
+        info.stage.pSpecializationInfo = &specialization;
+    }
     VkResult r = vkCreateComputePipelines(mDevice, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
     vkDestroyShaderModule(mDevice, shader, nullptr);
     CB_TRY(CheckVk(r, what.c_str()));
@@ -425,20 +429,11 @@ void VulkanContext::Recorder::Dispatch(Pipeline& pipeline, std::span<const Devic
 
 void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
                                             const void* push, uint32_t pushBytes, uint32_t first, uint32_t end) {
-    assert(pipeline.ranged && first < end);
+    assert((pipeline.ranged || first < 64) && first < end);
     const uint32_t base = first / 64, groups = (end + 63) / 64 - base;
     if (base == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groups, 1, 1);
     Bind(pipeline, buffers, push, pushBytes);
     vkCmdDispatchBase(mCmd, base, 0, 0, groups, 1, 1);
-}
-
-void VulkanContext::Recorder::DispatchRows(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
-                                           const void* push, uint32_t pushBytes, uint32_t groupsX, uint32_t baseY,
-                                           uint32_t groupsY) {
-    assert(pipeline.ranged && groupsY > 0);
-    if (baseY == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groupsX, groupsY, 1);
-    Bind(pipeline, buffers, push, pushBytes);
-    vkCmdDispatchBase(mCmd, 0, baseY, 0, groupsX, groupsY, 1);
 }
 
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,

@@ -45,7 +45,7 @@ struct Pipeline {
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VkPipeline pipeline = VK_NULL_HANDLE;
     uint32_t bindings = 0;
-    bool ranged = false;  // made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT: Recorder::DispatchRange may use it
+    bool ranged = false;  // the share variant: DISPATCH_BASE_BIT and kRanged = true (GetPipeline)
 };
 
 class VulkanContext {
@@ -72,8 +72,10 @@ class VulkanContext {
     Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
-    // ranged: it may dispatch a range of its invocations (Recorder::DispatchRange);
-    // a name must always be asked for the same way.
+    // ranged: the variant for shares (SPEC 13): made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT
+    // and the shader's specialisation constant 0 (`kRanged`, a bool) true, so that it
+    // tests both ends of [first, end) and may start at a base workgroup
+    // (Recorder::DispatchRange); the plain variant is the whole call's.
     Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, bool ranged = false);
     // The pipeline of SPIR-V compiled elsewhere (tests), cached under `name`.
     Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv);
@@ -88,16 +90,12 @@ class VulkanContext {
         // The groups of 64 that hold invocations [first, end), from group first / 64 on
         // (vkCmdDispatchBase, so gl_GlobalInvocationID keeps its whole-dispatch value);
         // the shader returns for ids outside [first, end). With first = 0 a plain dispatch.
-        // The pipeline must be ranged (GetPipeline).
+        // The pipeline must be ranged (GetPipeline) unless first < 64.
         void DispatchRange(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                            uint32_t pushBytes, uint32_t first, uint32_t end);
         // The same with an explicit grid of workgroups (shaders with 2-D workgroups).
         void DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                             uint32_t pushBytes, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ);
-        // groupsY rows of groupsX groups from row baseY on (vkCmdDispatchBase; a plain
-        // dispatch when baseY = 0). The pipeline must be ranged.
-        void DispatchRows(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
-                          uint32_t pushBytes, uint32_t groupsX, uint32_t baseY, uint32_t groupsY);
         // Makes every earlier shader write visible to later shader reads and writes.
         void Barrier();
         void Fill(const DeviceBuffer& buffer, uint32_t value);

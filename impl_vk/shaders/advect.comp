@@ -9,6 +9,8 @@ layout(std430, binding = 3) writeonly buffer Out0 { uint out0[]; };
 layout(std430, binding = 4) writeonly buffer Out1 { uint out1[]; };
 layout(std430, binding = 5) writeonly buffer Out2 { uint out2[]; };
 layout(std430, binding = 6) readonly buffer Shifts { ivec2 shift[]; };  // (sx, sy) per slice
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
 layout(push_constant) uniform Params { uint nx, ny, words, first, end; } pc;
 
 uint WordAt(uint field, int row, int w) {
@@ -27,7 +29,7 @@ uint BitsAt(uint field, int row, int start) {
 
 void main() {
     const uint id = gl_GlobalInvocationID.x;
-    if (id < pc.first || id >= pc.end) return;
+    if (id >= pc.end || (kRanged && id < pc.first)) return;
     const uint w = id % pc.words, row = id / pc.words;
     const uint j = row % pc.ny, k = row / pc.ny;
     const ivec2 s = shift[k];

@@ -15,6 +15,8 @@ layout(std430, binding = 3) readonly buffer Region { uint8_t region[]; };
 layout(std430, binding = 4) writeonly buffer HumOut { uint humOut[]; };
 layout(std430, binding = 5) writeonly buffer ActOut { uint actOut[]; };
 layout(std430, binding = 6) writeonly buffer CldOut { uint cldOut[]; };
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
 layout(push_constant) uniform Params { uint nx, ny, nz, words, seed, step, qExt, qHum, qAct, first, end; } pc;
 
 uint ActRow(uint w, int j, int k) {
@@ -24,7 +26,7 @@ uint ActRow(uint w, int j, int k) {
 
 void main() {
     const uint id = gl_GlobalInvocationID.x;
-    if (id < pc.first || id >= pc.end) return;
+    if (id >= pc.end || (kRanged && id < pc.first)) return;
     const uint w = id % pc.words, row = id / pc.words;
     const int j = int(row % pc.ny), k = int(row / pc.ny);
 

@@ -2,19 +2,20 @@
 // Stage `density` (SPEC 5), columns: D = sum of q over k ascending (the order
 // every backend sums in), and the cover count: columns with any cld = 1, or
 // with D > 0 when the scene has no automaton (fromCld = 0; cld is then unused).
-// One invocation per column: x = i, y = j; a dispatch covers the rows j of a
-// share (SPEC 13) by its base workgroup.
+// A dispatch covers the columns [first, end) (whole rows j: a share, SPEC 13).
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Q { float q[]; };
 layout(std430, binding = 1) readonly buffer Cld { uint cld[]; };
 layout(std430, binding = 2) writeonly buffer D { float d[]; };
 layout(std430, binding = 3) buffer Cover { uint covered; };
-layout(push_constant) uniform Params { uint nx, ny, nz, words, fromCld; } pc;
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
+layout(push_constant) uniform Params { uint nx, ny, nz, words, fromCld, first, end; } pc;
 
 void main() {
-    const uint i = gl_GlobalInvocationID.x, j = gl_GlobalInvocationID.y;
-    if (i >= pc.nx) return;
-    const uint column = i + pc.nx * j;
+    const uint column = gl_GlobalInvocationID.x;
+    if (column >= pc.end || (kRanged && column < pc.first)) return;
+    const uint i = column % pc.nx, j = column / pc.nx;
     float sum = 0.0;
     uint any = 0u;
     for (uint k = 0u; k < pc.nz; ++k) {

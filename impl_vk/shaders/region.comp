@@ -13,11 +13,13 @@ layout(std430, binding = 0) readonly buffer Ellipsoids { float ellipsoid[]; };  
 layout(std430, binding = 1) writeonly buffer Region { uint8_t region[]; };
 layout(std430, binding = 2) readonly buffer TileStart { uint tileStart[]; };  // per tile, and one past the end
 layout(std430, binding = 3) readonly buffer TileList { uint tileList[]; };    // ellipsoid indices
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
 layout(push_constant) uniform Params { uint nx, ny, k0, first, end, tilesX, tilesY; } pc;
 
 void main() {
     const uint v = gl_GlobalInvocationID.x;
-    if (v < pc.first || v >= pc.end) return;
+    if (v >= pc.end || (kRanged && v < pc.first)) return;
     const uint i = v % pc.nx, j = (v / pc.nx) % pc.ny, k = v / (pc.nx * pc.ny);
     const vec3 p = vec3(float(i) + 0.5, float(j) + 0.5, float(k) + 0.5);
     const uint tile = i / 16u + pc.tilesX * (j / 16u + pc.tilesY * (k - pc.k0));

@@ -13,11 +13,13 @@ layout(std430, binding = 0) readonly buffer Cld { uint cld[]; };
 layout(std430, binding = 1) buffer SumX { uint sumX[]; };
 layout(std430, binding = 2) buffer SumXY { uint sumXY[]; };
 layout(std430, binding = 3) writeonly buffer Q { float q[]; };
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
 layout(push_constant) uniform Params { uint nx, ny, nz, words; int radius; float invW; uint pass, first, end; } pc;
 
 void main() {
     const uint v = gl_GlobalInvocationID.x;
-    if (v < pc.first || v >= pc.end) return;
+    if (v >= pc.end || (kRanged && v < pc.first)) return;
     const int i = int(v % pc.nx), j = int((v / pc.nx) % pc.ny), k = int(v / (pc.nx * pc.ny));
     const int r = pc.radius;
     uint sum = 0u;
