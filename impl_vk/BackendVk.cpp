@@ -47,12 +47,25 @@ bool BackendVk::Supports(Stage stage) const {
 Result<DeviceBuffer*> BackendVk::Scratch(VkScratch slot, VkDeviceSize size) {
     DeviceBuffer& b = mScratch.at(size_t(slot));
     if (b.size < size) {
+        mScratchHeld.at(size_t(slot)).reset();
         mContext->DestroyBuffer(b);
         auto created = mContext->CreateBuffer(size);
         if (!created) return std::unexpected(created.error());
         b = *created;
     }
     return &b;
+}
+
+Result<DeviceBuffer*> BackendVk::ScratchHolding(VkScratch slot, std::span<const std::byte> bytes,
+                                                VkDeviceSize minSize) {
+    auto b = Scratch(slot, std::max<VkDeviceSize>(minSize, bytes.size()));
+    if (!b) return b;
+    auto& held = mScratchHeld.at(size_t(slot));
+    if (held && std::equal(held->begin(), held->end(), bytes.begin(), bytes.end())) return b;
+    held.reset();
+    if (!bytes.empty()) CB_TRY(mContext->Upload(**b, bytes));
+    held.emplace(bytes.begin(), bytes.end());
+    return b;
 }
 
 Result<std::unique_ptr<Buffer>> BackendVk::CreateBuffer(BufferFormat format, Extent3 extent) {

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/Backend.h"
 #include "core/Noise.h"
@@ -28,9 +29,9 @@ class BufferVk final : public Buffer {
 };
 
 // The backend's reusable device buffers (BackendVk::Scratch). Each slot belongs
-// to one stage, keeps its contents only within a call (except ShadeCoarseQ/T,
-// which carry a shade sweep from one share to the next, SPEC 13) and grows to
-// the largest size asked of it.
+// to one stage, keeps its contents only within a call (except ShadeCoarseQ/T
+// and SmoothSumXY, which carry a sweep from one share to the next, SPEC 13) and
+// grows to the largest size asked of it.
 enum class VkScratch {
     EllipsoidList,      // region: the ellipsoids, 32 bytes each
     RegionTileStarts,   // region: first RegionTileEntries index per 16x16 tile of a slice, and one past the end
@@ -40,7 +41,7 @@ enum class VkScratch {
     CaRulesCld,         // ca: the rules' cld before advection (only with wind)
     CaWindShifts,       // ca: (shiftX, shiftY) per slice (only with wind)
     SmoothSumX,         // smooth: the bit field summed along x
-    SmoothSumXY,        // smooth: those sums summed along y
+    SmoothSumXY,        // smooth: those sums summed along y; kept between the shares of a sweep
     CoverCounter,       // density: covered columns, one uint
     ShadeCoarseQ,       // shade: q on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
     ShadeCoarseT,       // shade: T on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
@@ -108,16 +109,32 @@ class BackendVk final : public Backend {
     Status Record(const char* what, Fn&& fn);
     // The slot's buffer, grown to at least `size` bytes; its contents are undefined.
     Result<DeviceBuffer*> Scratch(VkScratch slot, VkDeviceSize size);
+    // The slot's buffer (at least `minSize` bytes) holding `bytes` from offset 0,
+    // uploaded only when they differ from what this last uploaded there; for
+    // slots the host writes and no shader does (the shares of a stage upload
+    // the same list once).
+    Result<DeviceBuffer*> ScratchHolding(VkScratch slot, std::span<const std::byte> bytes, VkDeviceSize minSize);
 
     std::unique_ptr<VulkanContext> mContext;
     std::optional<double> mLastDeviceMs;
     // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
     // while others grow.
     std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};
+    // What ScratchHolding last uploaded into each slot; reset when the slot grows.
+    std::array<std::optional<std::vector<std::byte>>, size_t(VkScratch::Count)> mScratchHeld{};
     // noise: the scene whose data block is in the NoiseData slot (NoiseVk.cpp).
     std::unique_ptr<noise::NoiseForm> mNoiseForm;
     // render_march: kMieCloudTable is in the MarchMieTable slot (RenderMarchVk.cpp).
     bool mMieUploaded = false;
+    // smooth: the share sequence whose x-y sums are in the SmoothSumXY slot: the
+    // slices [0, summedTo) of `cld` at `radius`, its next share starting at `next`
+    // (SmoothVk.cpp). Reset by every smooth call that does not continue it.
+    struct SmoothSweep {
+        const Buffer* cld = nullptr;
+        int radius = 0;
+        uint32_t next = 0, summedTo = 0;
+    };
+    std::optional<SmoothSweep> mSmoothSweep;
 };
 
 }  // namespace cb::vk

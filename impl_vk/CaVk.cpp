@@ -41,15 +41,15 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         mLastDeviceMs = 0.0;
         return {};
     }
-    const uint32_t count = words * e.ny * (k1 - k0);
-    auto rules = mContext->GetPipeline("ca", 7);
+    const uint32_t first = words * e.ny * k0, end = words * e.ny * k1;  // the share's words
+    auto rules = mContext->GetPipeline("ca", 7, !params.slices.IsWhole(e.nz));
     if (!rules) return std::unexpected(rules.error());
     bool wind = false;
     for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
 
     struct {
-        uint32_t nx, ny, nz, words, seed, step, qExt, qHum, qAct, k0, sliceCount;
-    } push{e.nx, e.ny, e.nz, words, params.seed, params.step, params.qExt, params.qHum, params.qAct, k0, k1 - k0};
+        uint32_t nx, ny, nz, words, seed, step, qExt, qHum, qAct, first, end;
+    } push{e.nx, e.ny, e.nz, words, params.seed, params.step, params.qExt, params.qHum, params.qAct, first, end};
     const DeviceBuffer* targets[3] = {&Dev(*out.hum), &Dev(*out.act), &Dev(*out.cld)};
     Pipeline* advect = nullptr;
     DeviceBuffer* shifts = nullptr;
@@ -66,26 +66,25 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
             packed.push_back(params.shiftX[k]);
             packed.push_back(params.shiftY[k]);
         }
-        auto s = Scratch(VkScratch::CaWindShifts, packed.size() * 4);
+        auto s = ScratchHolding(VkScratch::CaWindShifts, std::as_bytes(std::span(packed)), 8);
         if (!s) return std::unexpected(s.error());
         shifts = *s;
-        CB_TRY(mContext->Upload(*shifts, std::as_bytes(std::span(packed))));
-        auto p = mContext->GetPipeline("advect", 7);
+        auto p = mContext->GetPipeline("advect", 7, !params.slices.IsWhole(e.nz));
         if (!p) return std::unexpected(p.error());
         advect = *p;
     }
     const DeviceBuffer* buffers[] = {&Dev(*in.hum), &Dev(*in.act), &Dev(*in.cld), &Dev(region),
                                      targets[0],    targets[1],    targets[2]};
     return Record("ca step", [&](VulkanContext::Recorder& r) {
-        r.Dispatch(**rules, buffers, &push, sizeof push, count);
+        r.DispatchRange(**rules, buffers, &push, sizeof push, first, end);
         if (advect) {
             r.Barrier();
             struct {
-                uint32_t nx, ny, words, k0, sliceCount;
-            } advectPush{e.nx, e.ny, words, k0, k1 - k0};
+                uint32_t nx, ny, words, first, end;
+            } advectPush{e.nx, e.ny, words, first, end};
             const DeviceBuffer* advectBuffers[] = {targets[0],     targets[1],     targets[2], &Dev(*out.hum),
                                                    &Dev(*out.act), &Dev(*out.cld), shifts};
-            r.Dispatch(*advect, advectBuffers, &advectPush, sizeof advectPush, count);
+            r.DispatchRange(*advect, advectBuffers, &advectPush, sizeof advectPush, first, end);
         }
     });
 }

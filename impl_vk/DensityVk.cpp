@@ -19,16 +19,16 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
         return {};
     }
     const uint32_t j0 = row0 * params.tile, j1 = std::min(e.ny, row1 * params.tile);  // the rows' columns
-    auto columns = mContext->GetPipeline("density", 4);
+    auto columns = mContext->GetPipeline("density", 4, !params.slices.IsWhole(tilesY));
     if (!columns) return std::unexpected(columns.error());
-    auto occupancy = mContext->GetPipeline("occupancy", 4);
+    auto occupancy = mContext->GetPipeline("occupancy", 4, !params.slices.IsWhole(tilesY));
     if (!occupancy) return std::unexpected(occupancy.error());
     auto counter = Scratch(VkScratch::CoverCounter, 4);
     if (!counter) return std::unexpected(counter.error());
     const uint32_t bandCount = CeilDiv(e.nz, params.band);
     struct {
-        uint32_t nx, ny, nz, words, fromCld, j0, rowCount;
-    } columnPush{e.nx, e.ny, e.nz, (e.nx + 31) / 32, cld ? 1u : 0u, j0, j1 - j0};
+        uint32_t nx, ny, nz, words, fromCld, first, end;
+    } columnPush{e.nx, e.ny, e.nz, (e.nx + 31) / 32, cld ? 1u : 0u, e.nx * j0, e.nx * j1};
     struct {
         uint32_t nx, ny, nz, tile, band, tilesX, tilesY, bandCount, ty0, tileRows;
     } occupancyPush{e.nx, e.ny, e.nz, params.tile, params.band, tilesX, tilesY, bandCount, row0, row1 - row0};
@@ -38,7 +38,7 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     CB_TRY(Record("density", [&](VulkanContext::Recorder& r) {
         r.Fill(**counter, 0);
         r.Barrier();
-        r.Dispatch(**columns, columnBuffers, &columnPush, sizeof columnPush, e.nx * (j1 - j0));
+        r.DispatchRange(**columns, columnBuffers, &columnPush, sizeof columnPush, columnPush.first, columnPush.end);
         r.Barrier();
         r.Dispatch(**occupancy, occupancyBuffers, &occupancyPush, sizeof occupancyPush,
                    tilesX * (row1 - row0) * (bandCount + 1));

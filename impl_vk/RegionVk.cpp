@@ -17,9 +17,8 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
         return {};
     }
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
-    auto list = Scratch(VkScratch::EllipsoidList, std::max<VkDeviceSize>(32, ellipsoids.size_bytes()));
+    auto list = ScratchHolding(VkScratch::EllipsoidList, std::as_bytes(ellipsoids), 32);
     if (!list) return std::unexpected(list.error());
-    CB_TRY(mContext->Upload(**list, std::as_bytes(ellipsoids)));
     // Per 16x16 tile of each slice of the share, the ellipsoids whose bounding box (the
     // shader's rejection test, widened by a voxel) reaches a voxel centre of it.
     constexpr uint32_t kTile = 16;
@@ -47,14 +46,14 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     auto entries = Scratch(VkScratch::RegionTileEntries, std::max<size_t>(16, tileList.size() * 4));
     if (!entries) return std::unexpected(entries.error());
     if (!tileList.empty()) CB_TRY(mContext->Upload(**entries, std::as_bytes(std::span(tileList))));
-    auto pipeline = mContext->GetPipeline("region", 4);
+    auto pipeline = mContext->GetPipeline("region", 4, !slices.IsWhole(e.nz));
     if (!pipeline) return std::unexpected(pipeline.error());
     struct {
-        uint32_t nx, ny, k0, sliceCount, tilesX, tilesY;
-    } push{e.nx, e.ny, k0, k1 - k0, tilesX, tilesY};
+        uint32_t nx, ny, k0, first, end, tilesX, tilesY;
+    } push{e.nx, e.ny, k0, e.nx * e.ny * k0, e.nx * e.ny * k1, tilesX, tilesY};
     const DeviceBuffer* buffers[] = {*list, &Dev(region), *starts, *entries};
     return Record("region", [&](VulkanContext::Recorder& r) {
-        r.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny * (k1 - k0));
+        r.DispatchRange(**pipeline, buffers, &push, sizeof push, push.first, push.end);
     });
 }
 

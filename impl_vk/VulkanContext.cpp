@@ -1,6 +1,7 @@
 #include "impl_vk/VulkanContext.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
 #include "impl_vk/Shaders.h"
@@ -329,18 +330,25 @@ Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> 
     return {};
 }
 
-Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings) {
-    if (auto it = mPipelines.find(name); it != mPipelines.end()) return &it->second;
+Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings, bool ranged) {
+    const std::string key = ranged ? name + "/ranged" : name;
+    if (auto it = mPipelines.find(key); it != mPipelines.end()) return &it->second;
     std::span<const uint32_t> spirv = FindShader(name);
     if (spirv.empty()) return MakeError("no compiled shader named '" + name + "'");
-    return GetPipeline(name, bindings, spirv);
+    return CreatePipeline(key, bindings, spirv, ranged);
 }
 
 Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings,
                                              std::span<const uint32_t> spirv) {
     if (auto it = mPipelines.find(name); it != mPipelines.end()) return &it->second;
+    return CreatePipeline(name, bindings, spirv, false);
+}
+
+Result<Pipeline*> VulkanContext::CreatePipeline(const std::string& name, uint32_t bindings,
+                                                std::span<const uint32_t> spirv, bool ranged) {
     Pipeline p;
     p.bindings = bindings;
+    p.ranged = ranged;
     std::vector<VkDescriptorSetLayoutBinding> b(bindings);
     for (uint32_t n = 0; n < bindings; ++n)
         b[n] = {n, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
@@ -367,6 +375,13 @@ Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t b
     info.stage.module = shader;
     info.stage.pName = "main";
     info.layout = p.layout;
+    const VkBool32 kRanged = VK_TRUE;
+    const VkSpecializationMapEntry rangedEntry{0, 0, sizeof kRanged};
+    const VkSpecializationInfo specialization{1, &rangedEntry, sizeof kRanged, &kRanged};
+    if (ranged) {
+        info.flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT;
+        info.stage.pSpecializationInfo = &specialization;
+    }
     VkResult r = vkCreateComputePipelines(mDevice, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
     vkDestroyShaderModule(mDevice, shader, nullptr);
     CB_TRY(CheckVk(r, what.c_str()));
@@ -412,9 +427,24 @@ void VulkanContext::Recorder::Dispatch(Pipeline& pipeline, std::span<const Devic
     DispatchGroups(pipeline, buffers, push, pushBytes, (invocations + 63) / 64, 1, 1);
 }
 
+void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
+                                            const void* push, uint32_t pushBytes, uint32_t first, uint32_t end) {
+    assert((pipeline.ranged || first < 64) && first < end);
+    const uint32_t base = first / 64, groups = (end + 63) / 64 - base;
+    if (base == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groups, 1, 1);
+    Bind(pipeline, buffers, push, pushBytes);
+    vkCmdDispatchBase(mCmd, base, 0, 0, groups, 1, 1);
+}
+
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
                                              const void* push, uint32_t pushBytes, uint32_t groupsX,
                                              uint32_t groupsY, uint32_t groupsZ) {
+    Bind(pipeline, buffers, push, pushBytes);
+    vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
+}
+
+void VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
+                                   const void* push, uint32_t pushBytes) {
     VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     alloc.descriptorPool = mContext.mDescriptors;
     alloc.descriptorSetCount = 1;
@@ -437,7 +467,6 @@ void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const
     vkCmdBindPipeline(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
     vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout, 0, 1, &set, 0, nullptr);
     if (pushBytes) vkCmdPushConstants(mCmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes, push);
-    vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
 }
 
 void VulkanContext::Recorder::Barrier() {

@@ -45,6 +45,7 @@ struct Pipeline {
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VkPipeline pipeline = VK_NULL_HANDLE;
     uint32_t bindings = 0;
+    bool ranged = false;  // the share variant: DISPATCH_BASE_BIT and kRanged = true (GetPipeline)
 };
 
 class VulkanContext {
@@ -71,7 +72,11 @@ class VulkanContext {
     Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
-    Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings);
+    // ranged: the variant for shares (SPEC 13): made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT
+    // and the shader's specialisation constant 0 (`kRanged`, a bool) true, so that it
+    // tests both ends of [first, end) and may start at a base workgroup
+    // (Recorder::DispatchRange); the plain variant is the whole call's.
+    Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, bool ranged = false);
     // The pipeline of SPIR-V compiled elsewhere (tests), cached under `name`.
     Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv);
 
@@ -82,6 +87,12 @@ class VulkanContext {
         // Binds `buffers` to a fresh descriptor set and dispatches ceil(invocations/64) groups.
         void Dispatch(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                       uint32_t pushBytes, uint32_t invocations);
+        // The groups of 64 that hold invocations [first, end), from group first / 64 on
+        // (vkCmdDispatchBase, so gl_GlobalInvocationID keeps its whole-dispatch value);
+        // the shader returns for ids outside [first, end). With first = 0 a plain dispatch.
+        // The pipeline must be ranged (GetPipeline) unless first < 64.
+        void DispatchRange(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+                           uint32_t pushBytes, uint32_t first, uint32_t end);
         // The same with an explicit grid of workgroups (shaders with 2-D workgroups).
         void DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                             uint32_t pushBytes, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ);
@@ -92,6 +103,9 @@ class VulkanContext {
       private:
         friend class VulkanContext;
         explicit Recorder(VulkanContext& context, VkCommandBuffer cmd) : mContext(context), mCmd(cmd) {}
+        // Binds the pipeline, a fresh descriptor set of `buffers` and the push constants.
+        void Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+                  uint32_t pushBytes);
         VulkanContext& mContext;
         VkCommandBuffer mCmd;
         std::vector<VkDescriptorSet> mSets;
@@ -108,6 +122,8 @@ class VulkanContext {
     VulkanContext() = default;
     Status Begin();
     Result<double> Submit(const char* what, Recorder& recorder);
+    Result<Pipeline*> CreatePipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv,
+                                     bool ranged);
     Result<DeviceBuffer> CreateRawBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags properties);
     Status EnsureStaging(VkDeviceSize size);
     Status CopyBuffer(VkBuffer from, VkBuffer to, VkDeviceSize size, const char* what);

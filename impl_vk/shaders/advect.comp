@@ -1,6 +1,6 @@
 #version 450
 // Stage `ca`, advection (SPEC 3 step 4): X'(i, j, k) = X(i - sx[k], j - sy[k], k), zero fill.
-// A dispatch covers the slices [k0, k0 + sliceCount) (a share, SPEC 13).
+// A dispatch covers the words [first, end) (whole slices: a share, SPEC 13).
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In0 { uint in0[]; };
 layout(std430, binding = 1) readonly buffer In1 { uint in1[]; };
@@ -9,7 +9,9 @@ layout(std430, binding = 3) writeonly buffer Out0 { uint out0[]; };
 layout(std430, binding = 4) writeonly buffer Out1 { uint out1[]; };
 layout(std430, binding = 5) writeonly buffer Out2 { uint out2[]; };
 layout(std430, binding = 6) readonly buffer Shifts { ivec2 shift[]; };  // (sx, sy) per slice
-layout(push_constant) uniform Params { uint nx, ny, words, k0, sliceCount; } pc;
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
+layout(push_constant) uniform Params { uint nx, ny, words, first, end; } pc;
 
 uint WordAt(uint field, int row, int w) {
     if (w < 0 || w >= int(pc.words)) return 0u;
@@ -26,8 +28,8 @@ uint BitsAt(uint field, int row, int start) {
 }
 
 void main() {
-    if (gl_GlobalInvocationID.x >= pc.words * pc.ny * pc.sliceCount) return;
-    const uint id = gl_GlobalInvocationID.x + pc.words * pc.ny * pc.k0;
+    const uint id = gl_GlobalInvocationID.x;
+    if (id >= pc.end || (kRanged && id < pc.first)) return;
     const uint w = id % pc.words, row = id / pc.words;
     const uint j = row % pc.ny, k = row / pc.ny;
     const ivec2 s = shift[k];

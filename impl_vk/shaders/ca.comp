@@ -1,7 +1,7 @@
 #version 450
 // Stage `ca` (SPEC 3): one invocation per 32-voxel word, bitwise rules
 // (the thesis's section 9.2), random numbers only where an event can flip a bit.
-// A dispatch covers the slices [k0, k0 + sliceCount) (a share, SPEC 13).
+// A dispatch covers the words [first, end) (whole slices: a share, SPEC 13).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_8bit_storage : require
 #include "random.glsl"
@@ -15,7 +15,9 @@ layout(std430, binding = 3) readonly buffer Region { uint8_t region[]; };
 layout(std430, binding = 4) writeonly buffer HumOut { uint humOut[]; };
 layout(std430, binding = 5) writeonly buffer ActOut { uint actOut[]; };
 layout(std430, binding = 6) writeonly buffer CldOut { uint cldOut[]; };
-layout(push_constant) uniform Params { uint nx, ny, nz, words, seed, step, qExt, qHum, qAct, k0, sliceCount; } pc;
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
+layout(push_constant) uniform Params { uint nx, ny, nz, words, seed, step, qExt, qHum, qAct, first, end; } pc;
 
 uint ActRow(uint w, int j, int k) {
     if (j < 0 || k < 0 || j >= int(pc.ny) || k >= int(pc.nz)) return 0u;
@@ -23,8 +25,8 @@ uint ActRow(uint w, int j, int k) {
 }
 
 void main() {
-    if (gl_GlobalInvocationID.x >= pc.words * pc.ny * pc.sliceCount) return;
-    const uint id = gl_GlobalInvocationID.x + pc.words * pc.ny * pc.k0;
+    const uint id = gl_GlobalInvocationID.x;
+    if (id >= pc.end || (kRanged && id < pc.first)) return;
     const uint w = id % pc.words, row = id / pc.words;
     const int j = int(row % pc.ny), k = int(row / pc.ny);
 

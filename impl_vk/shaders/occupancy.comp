@@ -9,13 +9,18 @@ layout(std430, binding = 0) readonly buffer Q { float q[]; };
 layout(std430, binding = 1) readonly buffer D { float d[]; };
 layout(std430, binding = 2) writeonly buffer Tiles { uint8_t tiles[]; };
 layout(std430, binding = 3) writeonly buffer Bands { uint8_t bands[]; };
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
 layout(push_constant) uniform Params { uint nx, ny, nz, tile, band, tilesX, tilesY, bandCount, ty0, tileRows; } pc;
 
 void main() {
-    const uint local = gl_GlobalInvocationID.x, shareLayer = pc.tilesX * pc.tileRows;
+    // The whole call (kRanged false) indexes as tile x band directly; a share maps
+    // its rows' tiles onto them.
+    const uint local = gl_GlobalInvocationID.x;
+    const uint rows = kRanged ? pc.tileRows : pc.tilesY, shareLayer = pc.tilesX * rows;
     if (local >= shareLayer * (pc.bandCount + 1u)) return;
-    const uint tx = local % pc.tilesX, ty = pc.ty0 + (local / pc.tilesX) % pc.tileRows, b = local / shareLayer;
-    const uint id = tx + pc.tilesX * (ty + pc.tilesY * b);
+    const uint tx = local % pc.tilesX, ty = (kRanged ? pc.ty0 : 0u) + (local / pc.tilesX) % rows, b = local / shareLayer;
+    const uint id = kRanged ? tx + pc.tilesX * (ty + pc.tilesY * b) : local;
     const uint i0 = tx * pc.tile, i1 = min(pc.nx, i0 + pc.tile);
     const uint j0 = ty * pc.tile, j1 = min(pc.ny, j0 + pc.tile);
     bool any = false;

@@ -2,7 +2,8 @@
 // Stage `region` (SPEC 2): one invocation per voxel, max over the ellipsoids
 // that can reach its 16x16-voxel tile of its slice (the host's per-tile
 // lists), then quantised once (quantising is monotone). A dispatch covers the
-// slices [k0, k0 + sliceCount) (a share, SPEC 13); the host's lists start at k0.
+// voxels [first, end), the slices from k0 on (a share, SPEC 13); the host's
+// lists start at slice k0.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_8bit_storage : require
 #include "rules.glsl"
@@ -12,12 +13,13 @@ layout(std430, binding = 0) readonly buffer Ellipsoids { float ellipsoid[]; };  
 layout(std430, binding = 1) writeonly buffer Region { uint8_t region[]; };
 layout(std430, binding = 2) readonly buffer TileStart { uint tileStart[]; };  // per tile, and one past the end
 layout(std430, binding = 3) readonly buffer TileList { uint tileList[]; };    // ellipsoid indices
-layout(push_constant) uniform Params { uint nx, ny, k0, sliceCount, tilesX, tilesY; } pc;
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
+layout(push_constant) uniform Params { uint nx, ny, k0, first, end, tilesX, tilesY; } pc;
 
 void main() {
-    const uint local = gl_GlobalInvocationID.x;
-    if (local >= pc.nx * pc.ny * pc.sliceCount) return;
-    const uint v = local + pc.nx * pc.ny * pc.k0;
+    const uint v = gl_GlobalInvocationID.x;
+    if (v >= pc.end || (kRanged && v < pc.first)) return;
     const uint i = v % pc.nx, j = (v / pc.nx) % pc.ny, k = v / (pc.nx * pc.ny);
     const vec3 p = vec3(float(i) + 0.5, float(j) + 0.5, float(k) + 0.5);
     const uint tile = i / 16u + pc.tilesX * (j / 16u + pc.tilesY * (k - pc.k0));

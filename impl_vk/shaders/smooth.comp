@@ -4,7 +4,7 @@
 // along z and scales by 1/W (a power of two: exact). The binomial weights are
 // a product w(di) w(dj) w(dk) and the sums are integers, so this is the direct
 // 27-tap (125 at r = 2) sum bit for bit, with 3 (5) reads a pass. A dispatch
-// covers the slices [k0, k0 + sliceCount) (SPEC 13 shares; SmoothVk.cpp).
+// covers the voxels [first, end) (whole slices: a SPEC 13 share; SmoothVk.cpp).
 #extension GL_GOOGLE_include_directive : require
 #include "rules.glsl"
 
@@ -13,11 +13,13 @@ layout(std430, binding = 0) readonly buffer Cld { uint cld[]; };
 layout(std430, binding = 1) buffer SumX { uint sumX[]; };
 layout(std430, binding = 2) buffer SumXY { uint sumXY[]; };
 layout(std430, binding = 3) writeonly buffer Q { float q[]; };
-layout(push_constant) uniform Params { uint nx, ny, nz, words; int radius; float invW; uint pass, k0, sliceCount; } pc;
+// kRanged: the share variant (GetPipeline's ranged), which also tests the lower end.
+layout(constant_id = 0) const bool kRanged = false;
+layout(push_constant) uniform Params { uint nx, ny, nz, words; int radius; float invW; uint pass, first, end; } pc;
 
 void main() {
-    if (gl_GlobalInvocationID.x >= pc.nx * pc.ny * pc.sliceCount) return;
-    const uint v = gl_GlobalInvocationID.x + pc.nx * pc.ny * pc.k0;
+    const uint v = gl_GlobalInvocationID.x;
+    if (v >= pc.end || (kRanged && v < pc.first)) return;
     const int i = int(v % pc.nx), j = int((v / pc.nx) % pc.ny), k = int(v / (pc.nx * pc.ny));
     const int r = pc.radius;
     uint sum = 0u;
