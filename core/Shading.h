@@ -90,9 +90,12 @@ inline float RoundToUnorm8(float value) { return std::nearbyint(std::clamp(value
 
 inline float RoundToStorage(StorageFormat format, float value) {
     switch (format) {
-        case StorageFormat::Fp32: return value;
-        case StorageFormat::Fp16: return RoundToHalf(value);
-        case StorageFormat::Unorm8: return RoundToUnorm8(value);
+        case StorageFormat::Fp32:
+            return value;
+        case StorageFormat::Fp16:
+            return RoundToHalf(value);
+        case StorageFormat::Unorm8:
+            return RoundToUnorm8(value);
     }
     return value;
 }
@@ -104,8 +107,10 @@ inline float RoundToStorage(StorageFormat format, float value) {
 // as integers: a float difference can exceed 1/255 by an ulp (issue 16).
 inline uint32_t StorageCode(StorageFormat format, float stored) {
     switch (format) {
-        case StorageFormat::Fp32: return std::bit_cast<uint32_t>(stored);
-        case StorageFormat::Unorm8: return uint32_t(std::lround(std::clamp(stored, 0.0f, 1.0f) * 255.0f));
+        case StorageFormat::Fp32:
+            return std::bit_cast<uint32_t>(stored);
+        case StorageFormat::Unorm8:
+            return uint32_t(std::lround(std::clamp(stored, 0.0f, 1.0f) * 255.0f));
         case StorageFormat::Fp16: {
             const uint32_t bits = std::bit_cast<uint32_t>(std::fabs(stored));
             if (bits < 0x38800000u) return uint32_t(std::lround(std::fabs(stored) * 16777216.0f));  // subnormal half
@@ -118,9 +123,12 @@ inline uint32_t StorageCode(StorageFormat format, float stored) {
 // One storage quantum at value v: the comparison tolerance for fp16/unorm8 (SPEC 6).
 inline float StorageQuantum(StorageFormat format) {
     switch (format) {
-        case StorageFormat::Fp32: return 0.0f;
-        case StorageFormat::Fp16: return 1.0f / 2048.0f;  // half spacing just below 1
-        case StorageFormat::Unorm8: return 1.0f / 255.0f;
+        case StorageFormat::Fp32:
+            return 0.0f;
+        case StorageFormat::Fp16:
+            return 1.0f / 2048.0f;  // half spacing just below 1
+        case StorageFormat::Unorm8:
+            return 1.0f / 255.0f;
     }
     return 0.0f;
 }
@@ -183,7 +191,8 @@ extern const PhaseTable kMieCloudTable;
 inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
     const float g = phase.g;
     switch (phase.kind) {
-        case PhaseKind::None: return 1.0f;
+        case PhaseKind::None:
+            return 1.0f;
         case PhaseKind::HenyeyGreenstein: {
             const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
             return (1.0f - g * g) / (denom * std::sqrt(denom));
@@ -192,7 +201,8 @@ inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
             const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
             return 1.5f * (1.0f - g * g) / (2.0f + g * g) * (1.0f + cosTheta * cosTheta) / (denom * std::sqrt(denom));
         }
-        case PhaseKind::Mie: return SamplePhaseTable(kMieCloudTable, cosTheta);
+        case PhaseKind::Mie:
+            return SamplePhaseTable(kMieCloudTable, cosTheta);
     }
     return 1.0f;
 }
@@ -277,8 +287,8 @@ inline float Bilinear(float t00, float t10, float t01, float t11, float fu, floa
 // (u, v) reads the previous slice: taps at (u + u0, v + v0) and +1, weights fu, fv.
 struct ShearWarp {
     int w = 2, u = 0, v = 1;
-    float absSw = 1;      // |s_w|
-    bool sunAbove = true; // s_w > 0: slices are visited from the highest w index down
+    float absSw = 1;       // |s_w|
+    bool sunAbove = true;  // s_w > 0: slices are visited from the highest w index down
     int u0 = 0, v0 = 0;
     float fu = 0, fv = 0;
 };
@@ -330,7 +340,8 @@ struct ShadowLookup {
     float opticalDepthPerD = 0;  // sigma h / s_z, the beer form's factor
 };
 
-inline ShadowLookup MakeShadowLookup(const Vec3& s, uint32_t nx, uint32_t ny, uint32_t nz, float sigma, float voxelSize) {
+inline ShadowLookup MakeShadowLookup(const Vec3& s, uint32_t nx, uint32_t ny, uint32_t nz, float sigma,
+                                     float voxelSize) {
     ShadowLookup l;
     if (s[2] <= 0.0f) return l;
     l.noSun = false;

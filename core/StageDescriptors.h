@@ -140,7 +140,7 @@ struct ResourcePlan {
     std::array<bool, kResourceCount> used{};
     std::array<bool, kResourceCount> previous{};
     std::array<bool, kResourceCount> doubleBuffered{};  // written by a stage that advances the state
-    std::array<bool, kResourceCount> pending{};  // time-slicing: the next step's value, computed over frames
+    std::array<bool, kResourceCount> pending{};         // time-slicing: the next step's value, computed over frames
 };
 ResourcePlan PlanResources(const Scene& scene);
 

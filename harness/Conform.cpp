@@ -210,7 +210,6 @@ Result<std::unique_ptr<Buffer>> CopyTo(Backend& cpu, const Buffer& from, Backend
     return std::move(*to);
 }
 
-
 // Runs `stage` on backend `b` from copies of the CPU simulation's buffers of this step (and of the previous step
 // where the stage reads them), into fresh output buffers held in `owned` and named by `io`. A stage that advances
 // the state writes into `io.next`; its outputs are moved into a PendingState appended to `pending`.

@@ -143,8 +143,8 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                      {"frames", loop.frames},
                      {"wall_ms", loop.wallMs},
                      {"fps", loop.Fps() ? nlohmann::json(*loop.Fps()) : nlohmann::json(nullptr)},
-                     {"steps_per_second", loop.wallMs > 0 ? nlohmann::json(loop.steps * 1000.0 / loop.wallMs)
-                                                          : nlohmann::json(nullptr)},
+                     {"steps_per_second",
+                      loop.wallMs > 0 ? nlohmann::json(loop.steps * 1000.0 / loop.wallMs) : nlohmann::json(nullptr)},
                      {"step_ms", SummaryJson(loop.stepMs)},
                      {"slices_per_frame", scene.render.slicesPerFrame}};
         if (!loop.frameMs.empty()) {
@@ -323,27 +323,28 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
     if (loop.steps > 0) {
         const Summary st = Summarize(loop.stepMs);
         if (const auto fps = loop.Fps())
-            std::snprintf(line, sizeof line,
-                          "  loop: %llu frames (%.4g per render step) in %u steps, %.1f ms: %.1f fps; step median %.3f ms, "
-                          "max %.3f ms",
-                          static_cast<unsigned long long>(loop.frames), double(loop.frames) / loop.renderSteps, loop.steps,
-                          loop.wallMs, *fps, st.median, st.max);
+            std::snprintf(
+                line, sizeof line,
+                "  loop: %llu frames (%.4g per render step) in %u steps, %.1f ms: %.1f fps; step median %.3f ms, "
+                "max %.3f ms",
+                static_cast<unsigned long long>(loop.frames), double(loop.frames) / loop.renderSteps, loop.steps,
+                loop.wallMs, *fps, st.median, st.max);
         else
-            std::snprintf(line, sizeof line, "  loop: no frames in %u steps, %.1f ms: %.1f steps/s; step median %.3f ms",
-                          loop.steps, loop.wallMs, loop.wallMs > 0 ? loop.steps * 1000.0 / loop.wallMs : 0.0,
-                          st.median);
+            std::snprintf(line, sizeof line,
+                          "  loop: no frames in %u steps, %.1f ms: %.1f steps/s; step median %.3f ms", loop.steps,
+                          loop.wallMs, loop.wallMs > 0 ? loop.steps * 1000.0 / loop.wallMs : 0.0, st.median);
         section.blocks.push_back(report::Paragraph{line});
         if (!loop.frameMs.empty()) {
             // The thesis's figure of a loop: the frame the viewer waits longest for, beside the typical one.
             const Summary fr = Summarize(loop.frameMs);
-            std::snprintf(line, sizeof line,
-                          "  frames: median %.3f ms [q1 %.3f, q3 %.3f], slowest %.3f ms (step %u frame %u%s%s)%s",
-                          fr.median, fr.q1, fr.q3, fr.max, loop.slowestStep, loop.slowestFrame,
-                          loop.slowestWork.empty() ? "" : ": ", loop.slowestWork.c_str(),
-                          scene.render.slicesPerFrame > 0
-                              ? (", time-sliced at " + std::to_string(scene.render.slicesPerFrame) + " slices per frame")
-                                    .c_str()
-                              : "");
+            std::snprintf(
+                line, sizeof line,
+                "  frames: median %.3f ms [q1 %.3f, q3 %.3f], slowest %.3f ms (step %u frame %u%s%s)%s", fr.median,
+                fr.q1, fr.q3, fr.max, loop.slowestStep, loop.slowestFrame, loop.slowestWork.empty() ? "" : ": ",
+                loop.slowestWork.c_str(),
+                scene.render.slicesPerFrame > 0
+                    ? (", time-sliced at " + std::to_string(scene.render.slicesPerFrame) + " slices per frame").c_str()
+                    : "");
             section.blocks.push_back(report::Paragraph{line});
         }
     }

@@ -293,8 +293,7 @@ Status Simulation::RunShares(const FrameTasks& tasks, StepRecord& record, std::s
         CB_TRY(CallStage(stage, mBackend, mScene, host, advances ? Buffers() : AheadBuffers(), call));
         StepRecord& target = advances ? record : mAhead;
         target.stageMs[size_t(stage)] = target.stageMs[size_t(stage)].value_or(0) + call.ms;
-        if (call.deviceMs)
-            target.deviceMs[size_t(stage)] = target.deviceMs[size_t(stage)].value_or(0) + *call.deviceMs;
+        if (call.deviceMs) target.deviceMs[size_t(stage)] = target.deviceMs[size_t(stage)].value_or(0) + *call.deviceMs;
         // The shares of density count the covered columns of their rows of tiles.
         if (call.coveredColumns) target.coveredColumns = target.coveredColumns.value_or(0) + *call.coveredColumns;
         if (!describe) continue;

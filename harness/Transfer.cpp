@@ -66,12 +66,13 @@ json ToJson(const StepRecord& r) {
                           {"splats", f.stats.splats},
                           {"voxels_visited", f.stats.voxelsVisited},
                           {"fragments", f.stats.fragments},
-                          {"march", {{"rays", f.march.rays},
-                                     {"samples", f.march.samples},
-                                     {"light_samples", f.march.lightSamples},
-                                     {"bricks_skipped", f.march.bricksSkipped},
-                                     {"empty_bricks", f.march.emptyBricks},
-                                     {"bricks", f.march.bricks}}}});
+                          {"march",
+                           {{"rays", f.march.rays},
+                            {"samples", f.march.samples},
+                            {"light_samples", f.march.lightSamples},
+                            {"bricks_skipped", f.march.bricksSkipped},
+                            {"empty_bricks", f.march.emptyBricks},
+                            {"bricks", f.march.bricks}}}});
     json frameMs = json::array();
     for (double ms : r.frameMs) frameMs.push_back(D(ms));
     return {{"step", r.step},
@@ -128,9 +129,10 @@ BackendProvenance ProvenanceFromJson(const json& j) {
 }
 
 json ToJson(const ConformRow& r) {
-    return {{"stage", r.stage},    {"backend", r.backend},        {"status", r.status}, {"rule", r.rule},
-            {"worst", D(r.worst)}, {"tolerance", D(r.tolerance)}, {"detail", r.detail},
-            {"difference_image", r.differenceImage}};
+    return {{"stage", r.stage},    {"backend", r.backend},
+            {"status", r.status},  {"rule", r.rule},
+            {"worst", D(r.worst)}, {"tolerance", D(r.tolerance)},
+            {"detail", r.detail},  {"difference_image", r.differenceImage}};
 }
 ConformRow ConformRowFromJson(const json& j) {
     ConformRow r;

@@ -42,7 +42,8 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         return {};
     }
     const uint32_t first = words * e.ny * k0, end = words * e.ny * k1;  // the share's words
-    auto rules = mContext->GetPipeline("ca", 7, !params.slices.IsWhole(e.nz));
+    auto rules =
+        mContext->GetPipeline("ca", 7, params.slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
     if (!rules) return std::unexpected(rules.error());
     bool wind = false;
     for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
@@ -69,7 +70,8 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         auto s = ScratchHolding(VkScratch::CaWindShifts, std::as_bytes(std::span(packed)), 8);
         if (!s) return std::unexpected(s.error());
         shifts = *s;
-        auto p = mContext->GetPipeline("advect", 7, !params.slices.IsWhole(e.nz));
+        auto p = mContext->GetPipeline("advect", 7,
+                                       params.slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
         if (!p) return std::unexpected(p.error());
         advect = *p;
     }

@@ -19,9 +19,11 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
         return {};
     }
     const uint32_t j0 = row0 * params.tile, j1 = std::min(e.ny, row1 * params.tile);  // the rows' columns
-    auto columns = mContext->GetPipeline("density", 4, !params.slices.IsWhole(tilesY));
+    auto columns = mContext->GetPipeline("density", 4,
+                                         params.slices.IsWhole(tilesY) ? PipelineRange::Whole : PipelineRange::Share);
     if (!columns) return std::unexpected(columns.error());
-    auto occupancy = mContext->GetPipeline("occupancy", 4, !params.slices.IsWhole(tilesY));
+    auto occupancy = mContext->GetPipeline("occupancy", 4,
+                                           params.slices.IsWhole(tilesY) ? PipelineRange::Whole : PipelineRange::Share);
     if (!occupancy) return std::unexpected(occupancy.error());
     auto counter = Scratch(VkScratch::CoverCounter, 4);
     if (!counter) return std::unexpected(counter.error());

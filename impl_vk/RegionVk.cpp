@@ -46,7 +46,8 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     auto entries = Scratch(VkScratch::RegionTileEntries, std::max<size_t>(16, tileList.size() * 4));
     if (!entries) return std::unexpected(entries.error());
     if (!tileList.empty()) CB_TRY(mContext->Upload(**entries, std::as_bytes(std::span(tileList))));
-    auto pipeline = mContext->GetPipeline("region", 4, !slices.IsWhole(e.nz));
+    auto pipeline =
+        mContext->GetPipeline("region", 4, slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
     if (!pipeline) return std::unexpected(pipeline.error());
     struct {
         uint32_t nx, ny, k0, first, end, tilesX, tilesY;

@@ -24,7 +24,8 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     const bool continues = k0 > 0 && sweep && sweep->cld == &cld && sweep->radius == radius && sweep->next == k0;
     const uint32_t sum1 = std::min(e.nz, k1 + r);
     const uint32_t sum0 = std::min(sum1, continues ? sweep->summedTo : (k0 > r ? k0 - r : 0));
-    auto pipeline = mContext->GetPipeline("smooth", 4, !slices.IsWhole(e.nz));
+    auto pipeline =
+        mContext->GetPipeline("smooth", 4, slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
     if (!pipeline) return std::unexpected(pipeline.error());
     auto sumX = Scratch(VkScratch::SmoothSumX, e.Count() * 4);
     if (!sumX) return std::unexpected(sumX.error());

@@ -11,29 +11,47 @@ namespace {
 
 const char* ResultName(VkResult r) {
     switch (r) {
-        case VK_SUCCESS: return "VK_SUCCESS";
-        case VK_NOT_READY: return "VK_NOT_READY";
-        case VK_TIMEOUT: return "VK_TIMEOUT";
-        case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
-        case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
-        case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
-        case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
-        case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
-        case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
-        case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
-        case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
-        case VK_ERROR_OUT_OF_POOL_MEMORY: return "VK_ERROR_OUT_OF_POOL_MEMORY";
-        default: return "VkResult error";
+        case VK_SUCCESS:
+            return "VK_SUCCESS";
+        case VK_NOT_READY:
+            return "VK_NOT_READY";
+        case VK_TIMEOUT:
+            return "VK_TIMEOUT";
+        case VK_ERROR_OUT_OF_HOST_MEMORY:
+            return "VK_ERROR_OUT_OF_HOST_MEMORY";
+        case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+            return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+        case VK_ERROR_INITIALIZATION_FAILED:
+            return "VK_ERROR_INITIALIZATION_FAILED";
+        case VK_ERROR_DEVICE_LOST:
+            return "VK_ERROR_DEVICE_LOST";
+        case VK_ERROR_LAYER_NOT_PRESENT:
+            return "VK_ERROR_LAYER_NOT_PRESENT";
+        case VK_ERROR_EXTENSION_NOT_PRESENT:
+            return "VK_ERROR_EXTENSION_NOT_PRESENT";
+        case VK_ERROR_FEATURE_NOT_PRESENT:
+            return "VK_ERROR_FEATURE_NOT_PRESENT";
+        case VK_ERROR_INCOMPATIBLE_DRIVER:
+            return "VK_ERROR_INCOMPATIBLE_DRIVER";
+        case VK_ERROR_OUT_OF_POOL_MEMORY:
+            return "VK_ERROR_OUT_OF_POOL_MEMORY";
+        default:
+            return "VkResult error";
     }
 }
 
 const char* DeviceTypeName(VkPhysicalDeviceType type) {
     switch (type) {
-        case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
-        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
-        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-        default: return "other";
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return "cpu";
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return "integrated GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return "discrete GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return "virtual GPU";
+        default:
+            return "other";
     }
 }
 
@@ -49,7 +67,8 @@ Result<VkInstance> MakeInstance(bool validation, bool& debugUtils) {
         std::vector<VkLayerProperties> available(count);
         vkEnumerateInstanceLayerProperties(&count, available.data());
         bool found = false;
-        for (const VkLayerProperties& l : available) found |= std::strcmp(l.layerName, "VK_LAYER_KHRONOS_validation") == 0;
+        for (const VkLayerProperties& l : available)
+            found |= std::strcmp(l.layerName, "VK_LAYER_KHRONOS_validation") == 0;
         if (!found)
             return MakeError("the Khronos validation layer is not installed (Debian package vulkan-validationlayers)");
         layers.push_back("VK_LAYER_KHRONOS_validation");
@@ -125,14 +144,18 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
     ctx->mInstance = *instance;
     if (debugUtils) {
         VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-        info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-        info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+        info.messageSeverity =
+            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+        info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                            VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
         info.pfnUserCallback = &VulkanContext::OnValidationMessage;
         info.pUserData = ctx.get();
         auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
             vkGetInstanceProcAddr(ctx->mInstance, "vkCreateDebugUtilsMessengerEXT"));
-        if (create) CB_TRY(CheckVk(create(ctx->mInstance, &info, nullptr, &ctx->mMessenger), "creating the validation messenger"));
+        if (create)
+            CB_TRY(
+                CheckVk(create(ctx->mInstance, &info, nullptr, &ctx->mMessenger), "creating the validation messenger"));
     }
 
     uint32_t count = 0;
@@ -144,7 +167,8 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
     for (uint32_t n = 0; n < count && chosen < 0; ++n) {
         VkPhysicalDeviceProperties p;
         vkGetPhysicalDeviceProperties(devices[n], &p);
-        if (device.empty() || device == std::to_string(n) || std::string(p.deviceName).find(device) != std::string::npos)
+        if (device.empty() || device == std::to_string(n) ||
+            std::string(p.deviceName).find(device) != std::string::npos)
             chosen = int(n);
     }
     if (chosen < 0) return MakeError("no Vulkan device matches '" + device + "' (see cloudbench devices)");
@@ -215,7 +239,8 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
     dp.maxSets = 8192;
     dp.poolSizeCount = 1;
     dp.pPoolSizes = &size;
-    CB_TRY(CheckVk(vkCreateDescriptorPool(ctx->mDevice, &dp, nullptr, &ctx->mDescriptors), "creating the descriptor pool"));
+    CB_TRY(CheckVk(vkCreateDescriptorPool(ctx->mDevice, &dp, nullptr, &ctx->mDescriptors),
+                   "creating the descriptor pool"));
     return ctx;
 }
 
@@ -256,7 +281,8 @@ Result<DeviceBuffer> VulkanContext::CreateRawBuffer(VkDeviceSize size, VkBufferU
     vkGetBufferMemoryRequirements(mDevice, b.buffer, &req);
     uint32_t type = UINT32_MAX;
     for (uint32_t t = 0; t < mMemory.memoryTypeCount && type == UINT32_MAX; ++t)
-        if ((req.memoryTypeBits & (1u << t)) && (mMemory.memoryTypes[t].propertyFlags & properties) == properties) type = t;
+        if ((req.memoryTypeBits & (1u << t)) && (mMemory.memoryTypes[t].propertyFlags & properties) == properties)
+            type = t;
     if (type == UINT32_MAX) {
         vkDestroyBuffer(mDevice, b.buffer, nullptr);
         return MakeError("no suitable memory type for a buffer");
@@ -275,8 +301,9 @@ Result<DeviceBuffer> VulkanContext::CreateRawBuffer(VkDeviceSize size, VkBufferU
 
 Result<DeviceBuffer> VulkanContext::CreateBuffer(VkDeviceSize size) {
     size = StorageBufferBytes(size);
-    return CreateRawBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                           VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    return CreateRawBuffer(
+        size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
 }
 
 VkDeviceSize VulkanContext::LargestDeviceLocalHeap() const {
@@ -302,7 +329,8 @@ Status VulkanContext::EnsureStaging(VkDeviceSize size) {
                                    VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     if (!staging) return std::unexpected(staging.error());
     mStaging = *staging;
-    return CheckVk(vkMapMemory(mDevice, mStaging.memory, 0, VK_WHOLE_SIZE, 0, &mStagingMap), "mapping the staging buffer");
+    return CheckVk(vkMapMemory(mDevice, mStaging.memory, 0, VK_WHOLE_SIZE, 0, &mStagingMap),
+                   "mapping the staging buffer");
 }
 
 Status VulkanContext::CopyBuffer(VkBuffer from, VkBuffer to, VkDeviceSize size, const char* what) {
@@ -330,7 +358,8 @@ Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> 
     return {};
 }
 
-Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings, bool ranged) {
+Result<Pipeline*> VulkanContext::GetPipeline(const std::string& name, uint32_t bindings, PipelineRange range) {
+    const bool ranged = range == PipelineRange::Share;
     const std::string key = ranged ? name + "/ranged" : name;
     if (auto it = mPipelines.find(key); it != mPipelines.end()) return &it->second;
     std::span<const uint32_t> spirv = FindShader(name);
@@ -437,14 +466,14 @@ void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const 
 }
 
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
-                                             const void* push, uint32_t pushBytes, uint32_t groupsX,
-                                             uint32_t groupsY, uint32_t groupsZ) {
+                                             const void* push, uint32_t pushBytes, uint32_t groupsX, uint32_t groupsY,
+                                             uint32_t groupsZ) {
     Bind(pipeline, buffers, push, pushBytes);
     vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
 }
 
-void VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
-                                   const void* push, uint32_t pushBytes) {
+void VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+                                   uint32_t pushBytes) {
     VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     alloc.descriptorPool = mContext.mDescriptors;
     alloc.descriptorSetCount = 1;

@@ -38,6 +38,11 @@ struct DeviceBuffer {
     VkDeviceSize size = 0;
 };
 
+// Which variant of a pipeline a call dispatches: the whole grid, or a share of
+// it (time-slicing). An enum, not a bool, so that a SPIR-V array never
+// converts to it in GetPipeline's overloads.
+enum class PipelineRange : uint8_t { Whole, Share };
+
 // One compute pipeline: N storage buffers at bindings 0..N-1 and up to 128
 // bytes of push constants.
 struct Pipeline {
@@ -72,11 +77,12 @@ class VulkanContext {
     Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
-    // ranged: the variant for shares (SPEC 13): made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT
+    // PipelineRange::Share: the variant for shares (SPEC 13): made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT
     // and the shader's specialisation constant 0 (`kRanged`, a bool) true, so that it
     // tests both ends of [first, end) and may start at a base workgroup
     // (Recorder::DispatchRange); the plain variant is the whole call's.
-    Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, bool ranged = false);
+    Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings,
+                                  PipelineRange range = PipelineRange::Whole);
     // The pipeline of SPIR-V compiled elsewhere (tests), cached under `name`.
     Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv);
 
@@ -129,9 +135,9 @@ class VulkanContext {
     Status CopyBuffer(VkBuffer from, VkBuffer to, VkDeviceSize size, const char* what);
 
     static VKAPI_ATTR VkBool32 VKAPI_CALL OnValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                                             VkDebugUtilsMessageTypeFlagsEXT type,
-                                                             const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                                             void* user);
+                                                              VkDebugUtilsMessageTypeFlagsEXT type,
+                                                              const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                              void* user);
 
     VkInstance mInstance = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT mMessenger = VK_NULL_HANDLE;

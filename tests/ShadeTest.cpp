@@ -1,8 +1,8 @@
 // Light attenuation (SPEC 6), the ground shadow (SPEC 7) and their shared math.
 #include <gtest/gtest.h>
+#include <immintrin.h>
 
 #include <cmath>
-#include <immintrin.h>
 
 #include "core/Random.h"
 #include "core/Shading.h"
@@ -77,7 +77,7 @@ TEST(ShadingMath, StorageCodesAreTheStoredIntegers) {
     }
     EXPECT_EQ(StorageCode(StorageFormat::Fp16, 1.0f), 0x3C00u);
     EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0.5f), 0x3800u);
-    EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-24f), 1u);    // the smallest subnormal half
+    EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-24f), 1u);      // the smallest subnormal half
     EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-14f), 0x400u);  // the smallest normal half
     for (uint32_t k = 0; k <= 255; ++k) ASSERT_EQ(StorageCode(StorageFormat::Unorm8, float(k) / 255.0f), k);
     // Issue 16's case (on the H200 it was 214/255 against 215/255 as the GPU rounded them): neighbouring codes
@@ -90,7 +90,7 @@ TEST(ShadingMath, StorageCodesAreTheStoredIntegers) {
 // Test the principal axis rule, including exact ties (z wins over y, y over x).
 TEST(ShadingMath, PrincipalAxisTies) {
     EXPECT_EQ(PrincipalAxis({0, 0, 1}), 2);
-    EXPECT_EQ(PrincipalAxis({1, 0, 1}), 2);   // |s_z| = |s_x|: z
+    EXPECT_EQ(PrincipalAxis({1, 0, 1}), 2);     // |s_z| = |s_x|: z
     EXPECT_EQ(PrincipalAxis({1, 1, 0.5f}), 1);  // |s_y| = |s_x|: y
     EXPECT_EQ(PrincipalAxis({-1, 0.5f, 0.5f}), 0);
     EXPECT_EQ(PrincipalAxis({0.3f, -0.9f, 0.2f}), 1);
@@ -193,8 +193,10 @@ TEST(Shade, HomogeneousSlabMatchesClosedForm) {
             for (uint32_t j = 16; j < 32; ++j)
                 for (uint32_t i = 16; i < 32; ++i) {
                     double depthVoxels = 0;  // cloud between the voxel centre and the top, in voxels along z
-                    if (k < k0) depthVoxels = k1 - k0;
-                    else if (k < k1) depthVoxels = k1 - (k + 0.5);
+                    if (k < k0)
+                        depthVoxels = k1 - k0;
+                    else if (k < k1)
+                        depthVoxels = k1 - (k + 0.5);
                     const double exact = std::exp(-tau * depthVoxels);
                     const double bound = (k >= k0 && k < k1) ? exact * (std::exp(tau / 2) - 1) : 0.0;
                     ASSERT_NEAR(T[VoxelIndex(e, i, j, k)], exact, bound + 2e-6) << "el " << elevationDeg << " k " << k;
@@ -244,7 +246,8 @@ TEST(Shade, ResolutionEqualsCoarseShadeReadTrilinearly) {
         std::vector<float> q(e.Count());
         for (uint32_t k = 0; k < e.nz; ++k)
             for (uint32_t j = 0; j < e.ny; ++j)
-                for (uint32_t i = 0; i < e.nx; ++i) q[VoxelIndex(e, i, j, k)] = coarseQ[VoxelIndex(c, i / f, j / f, k / f)];
+                for (uint32_t i = 0; i < e.nx; ++i)
+                    q[VoxelIndex(e, i, j, k)] = coarseQ[VoxelIndex(c, i / f, j / f, k / f)];
         ShadeParams p;
         p.sun = Normalized(0.3f, 0.6f, 0.7f);
         p.resolution = f;
@@ -271,7 +274,8 @@ TEST(Shade, ResolutionEqualsCoarseShadeReadTrilinearly) {
                     const float b0 = Bilinear(at(x0, y0, z0), at(x0, y1, z0), at(x0, y0, z1), at(x0, y1, z1), ty, tz);
                     const float b1 = Bilinear(at(x1, y0, z0), at(x1, y1, z0), at(x1, y0, z1), at(x1, y1, z1), ty, tz);
                     const float expected = b0 * (1.0f - tx) + b1 * tx;
-                    ASSERT_EQ(got[VoxelIndex(e, i, j, k)], expected) << "f " << f << " at " << i << "," << j << "," << k;
+                    ASSERT_EQ(got[VoxelIndex(e, i, j, k)], expected)
+                        << "f " << f << " at " << i << "," << j << "," << k;
                 }
     }
 }
@@ -285,11 +289,15 @@ TEST(Shade, EveryOptionFiniteAndBounded) {
     std::vector<float> q(e.Count());
     for (float& v : q) v = float(rng.Below(65)) / 64.0f;
     const float d45 = std::numbers::pi_v<float> / 4;
-    std::vector<Vec3> suns = {{0, 0, 1}, {0, 0, -1}, SunDirection(0.0, 0.3), SunDirection(1e-4, 0.2),
-                              SunDirection(-0.3, 1.0), SunDirection(0.5, 0.0)};
+    std::vector<Vec3> suns = {{0, 0, 1},
+                              {0, 0, -1},
+                              SunDirection(0.0, 0.3),
+                              SunDirection(1e-4, 0.2),
+                              SunDirection(-0.3, 1.0),
+                              SunDirection(0.5, 0.0)};
     for (double eps : {-1e-6, 0.0, 1e-6}) {
-        suns.push_back(SunDirection(d45 + eps, 0.0));          // z/x switch
-        suns.push_back(SunDirection(0.3, d45 + eps));           // y/x switch
+        suns.push_back(SunDirection(d45 + eps, 0.0));                            // z/x switch
+        suns.push_back(SunDirection(0.3, d45 + eps));                            // y/x switch
         suns.push_back(SunDirection(std::atan(1 / std::sqrt(2.0)) + eps, d45));  // all three equal
     }
     for (const Vec3& sun : suns)

@@ -8,8 +8,8 @@
 
 #include <fstream>
 #include <map>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "core/Scene.h"
 #include "core/ShadePlan.h"
@@ -48,7 +48,8 @@ Scene SlicedLoopScene(std::vector<SceneOverride> more) {
         {"render.cameras",
          R"([{"name": "a", "eye": [575, -700, 1100], "target": [575, 475, 150], "up": [0, 0, 1], "fov_deg": 70,
               "near": 1, "far": 20000}])"},
-        {"sun.path", R"([{"step": 0, "elevation_deg": 20, "azimuth_deg": 10}, {"step": 2, "elevation_deg": 30, "azimuth_deg": 80},
+        {"sun.path",
+         R"([{"step": 0, "elevation_deg": 20, "azimuth_deg": 10}, {"step": 2, "elevation_deg": 30, "azimuth_deg": 80},
                         {"step": 5, "elevation_deg": 75, "azimuth_deg": 100}])"},
     };
     sets.insert(sets.end(), more.begin(), more.end());
@@ -172,10 +173,11 @@ TEST(TimeSliceLoopPlan, FramesComputeTheNextStepsShares) {
     EXPECT_EQ(warmup.framesRendered, 0u);
     EXPECT_TRUE(warmup.frameWork.empty());
     ASSERT_TRUE((*sim)->Step(step1));
-    const std::vector<std::string> plan = {
-        "ca 0-2",      "ca 3-5",      "ca 6-6",      "ellipsoid list, region 0-2", "region 3-5",  "region 6-6",
-        "smooth 0-2",  "smooth 3-5",  "smooth 6-6",  "density",                    "shade 0-2",   "shade 3-5",
-        "shade 6-8",   "shade 9-11",  "shade 12-14", "shade 15-17",                "shade 18-18", "shadow"};
+    const std::vector<std::string> plan = {"ca 0-2",      "ca 3-5",     "ca 6-6",      "ellipsoid list, region 0-2",
+                                           "region 3-5",  "region 6-6", "smooth 0-2",  "smooth 3-5",
+                                           "smooth 6-6",  "density",    "shade 0-2",   "shade 3-5",
+                                           "shade 6-8",   "shade 9-11", "shade 12-14", "shade 15-17",
+                                           "shade 18-18", "shadow"};
     EXPECT_EQ(step1.frameWork, plan);
     ASSERT_EQ(step1.framesRendered, plan.size());
     ASSERT_EQ(backend.alphas.size(), plan.size());
@@ -222,8 +224,8 @@ TEST(TimeSliceLoopPlan, ThirdBufferSetOnlyWhenSliced) {
         return pending;
     };
     EXPECT_TRUE(pendingOf(SlicedLoopScene({})).empty());
-    const std::set<Resource> expected = {Resource::Region, Resource::Q,  Resource::ColumnSum, Resource::Tiles,
-                                         Resource::Bands,  Resource::T,  Resource::Shadow};
+    const std::set<Resource> expected = {Resource::Region, Resource::Q, Resource::ColumnSum, Resource::Tiles,
+                                         Resource::Bands,  Resource::T, Resource::Shadow};
     EXPECT_EQ(pendingOf(SlicedLoopScene({{"render.slices_per_frame", "4"}})), expected);
 }
 

@@ -75,8 +75,12 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
 
     // Runs `call(whole)` into the outputs, then for each share size refills them
     // and runs `call(share)` per share; the bytes must equal the whole call's.
+    // `decoy`, if given, runs the stage whole on other inputs before each sequence
+    // of shares, so scratch a backend keeps between calls holds another call's
+    // data: a share that relied on the whole call's scratch fails.
     void ExpectSharesEqualWhole(const std::string& what, uint32_t count, const std::vector<Buffer*>& outputs,
-                                const std::function<Status(SliceRange)>& call) {
+                                const std::function<Status(SliceRange)>& call,
+                                const std::function<Status()>& decoy = {}) {
         for (Buffer* out : outputs) Fill(*out);
         Status whole = call(SliceRange{});
         ASSERT_TRUE(whole.has_value()) << what << ": " << whole.error().message;
@@ -84,18 +88,21 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
         for (Buffer* out : outputs) expected.push_back(Bytes(*out));
         for (uint32_t size : kShareSizes) {
             for (Buffer* out : outputs) Fill(*out);
+            if (decoy) {
+                ASSERT_TRUE(decoy().has_value()) << what << ": the decoy call";
+            }
             for (SliceRange share : Shares(count, size)) {
                 Status s = call(share);
-                ASSERT_TRUE(s.has_value()) << what << " share [" << share.begin << ", " << share.end
-                                           << "): " << s.error().message;
+                ASSERT_TRUE(s.has_value())
+                    << what << " share [" << share.begin << ", " << share.end << "): " << s.error().message;
             }
             for (size_t n = 0; n < outputs.size(); ++n) {
                 const auto got = Bytes(*outputs[n]);
                 size_t differ = 0, first = got.size();
                 for (size_t b = 0; b < got.size(); ++b)
                     if (got[b] != expected[n][b] && differ++ == 0) first = b;
-                EXPECT_EQ(differ, 0u) << what << ", output " << n << ", shares of " << size << " of " << count
-                                      << ": " << differ << " bytes differ from the whole call, first at byte " << first;
+                EXPECT_EQ(differ, 0u) << what << ", output " << n << ", shares of " << size << " of " << count << ": "
+                                      << differ << " bytes differ from the whole call, first at byte " << first;
             }
         }
     }
@@ -130,7 +137,8 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
                     return std::equal(got.begin() + e * element, got.begin() + (e + 1) * element,
                                       expected.begin() + e * element);
                 };
-                const bool ok = inside ? equals(whole[n]) || (writtenMayWait && equals(pattern[n])) : equals(pattern[n]);
+                const bool ok =
+                    inside ? equals(whole[n]) || (writtenMayWait && equals(pattern[n])) : equals(pattern[n]);
                 if (!ok && wrong++ == 0) first = e;
             }
             EXPECT_EQ(wrong, 0u) << what << ", output " << n << ": " << wrong
@@ -208,9 +216,13 @@ TEST_P(TimeSliceStages, CaStepInSlicesOfK) {
 TEST_P(TimeSliceStages, SmoothInSlicesOfK) {
     auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 4, 3));
     auto q = Patterned(BufferFormat::F32, kGrid);
+    auto otherCld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 9, 2));
+    auto otherQ = Patterned(BufferFormat::F32, kGrid);
     for (int radius : {0, 1, 2})
-        ExpectSharesEqualWhole("smooth radius " + std::to_string(radius), kGrid.nz, {q.get()},
-                               [&](SliceRange s) { return mBackend->Smooth(radius, *cld, *q, s); });
+        ExpectSharesEqualWhole(
+            "smooth radius " + std::to_string(radius), kGrid.nz, {q.get()},
+            [&](SliceRange s) { return mBackend->Smooth(radius, *cld, *q, s); },
+            [&] { return mBackend->Smooth(radius, *otherCld, *otherQ); });
 }
 
 TEST_P(TimeSliceStages, DensityInRowsOfTilesAndTheCoverCountsAddUp) {
@@ -249,6 +261,8 @@ TEST_P(TimeSliceStages, DensityInRowsOfTilesAndTheCoverCountsAddUp) {
 TEST_P(TimeSliceStages, ShadeInSlicesOfTheSweep) {
     auto q = test::MakeFilled(*mBackend, BufferFormat::F32, kGrid, SparseQ(kGrid, 8));
     auto T = Patterned(BufferFormat::F32, kGrid);
+    auto otherQ = test::MakeFilled(*mBackend, BufferFormat::F32, kGrid, SparseQ(kGrid, 10));
+    auto otherT = Patterned(BufferFormat::F32, kGrid);
     // z principal, x principal from below the diagonal, y principal with negative components.
     const Vec3 suns[] = {SunDirection(1.2, 0.3), SunDirection(0.35, 0.2), SunDirection(0.5, 4.4)};
     for (const Vec3& sun : suns)
@@ -261,14 +275,16 @@ TEST_P(TimeSliceStages, ShadeInSlicesOfTheSweep) {
                     p.sigma = 0.01f;
                     const uint32_t count = MakeShadePlan(p, kGrid).nw;
                     const std::string what = "shade sun (" + std::to_string(sun[0]) + ", " + std::to_string(sun[1]) +
-                                             ", " + std::to_string(sun[2]) + ") f " + std::to_string(f) +
-                                             " storage " + std::to_string(int(storage)) +
-                                             (scattering ? " scattering" : "");
-                    ExpectSharesEqualWhole(what, count, {T.get()}, [&](SliceRange s) {
-                        ShadeParams share = p;
-                        share.slices = s;
-                        return mBackend->Shade(share, *q, *T);
-                    });
+                                             ", " + std::to_string(sun[2]) + ") f " + std::to_string(f) + " storage " +
+                                             std::to_string(int(storage)) + (scattering ? " scattering" : "");
+                    ExpectSharesEqualWhole(
+                        what, count, {T.get()},
+                        [&](SliceRange s) {
+                            ShadeParams share = p;
+                            share.slices = s;
+                            return mBackend->Shade(share, *q, *T);
+                        },
+                        [&] { return mBackend->Shade(p, *otherQ, *otherT); });
                     if (HasFailure()) return;
                 }
 }
@@ -283,8 +299,9 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
     // Bits and floats: one element per voxel; the pattern check reads canonical bytes per element.
     const auto ellipsoids = SomeEllipsoids(kGrid);
     auto region = Patterned(BufferFormat::U8, kGrid);
-    ExpectOnly("region", {region.get()}, [&](SliceRange s) { return mBackend->Region(ellipsoids, *region, s); },
-               {{3, 5}}, {3, 5}, sliceK);
+    ExpectOnly(
+        "region", {region.get()}, [&](SliceRange s) { return mBackend->Region(ellipsoids, *region, s); }, {{3, 5}},
+        {3, 5}, sliceK);
 
     auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 1, 2));
     auto act = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 2, 3));
@@ -293,19 +310,20 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
     auto hum1 = Patterned(BufferFormat::Bits, kGrid), act1 = Patterned(BufferFormat::Bits, kGrid),
          cld1 = Patterned(BufferFormat::Bits, kGrid);
     // The pattern of bits is 1: an empty state in the ca keeps most output bits 0, so untouched ones show.
-    ExpectOnly("ca", {hum1.get(), act1.get(), cld1.get()},
-               [&](SliceRange s) {
-                   CaStepParams p;
-                   p.seed = 11, p.step = 3, p.qExt = 0x20000000u, p.qHum = 0x30000000u, p.qAct = 0x40000000u;
-                   p.slices = s;
-                   return mBackend->CaStep(p, {hum.get(), act.get(), cld.get()}, *region,
-                                           {hum1.get(), act1.get(), cld1.get()});
-               },
-               {{3, 5}}, {3, 5}, sliceK);
+    ExpectOnly(
+        "ca", {hum1.get(), act1.get(), cld1.get()},
+        [&](SliceRange s) {
+            CaStepParams p;
+            p.seed = 11, p.step = 3, p.qExt = 0x20000000u, p.qHum = 0x30000000u, p.qAct = 0x40000000u;
+            p.slices = s;
+            return mBackend->CaStep(p, {hum.get(), act.get(), cld.get()}, *region,
+                                    {hum1.get(), act1.get(), cld1.get()});
+        },
+        {{3, 5}}, {3, 5}, sliceK);
 
     auto q = Patterned(BufferFormat::F32, kGrid);
-    ExpectOnly("smooth", {q.get()}, [&](SliceRange s) { return mBackend->Smooth(2, *cld, *q, s); }, {{3, 5}}, {3, 5},
-               sliceK);
+    ExpectOnly(
+        "smooth", {q.get()}, [&](SliceRange s) { return mBackend->Smooth(2, *cld, *q, s); }, {{3, 5}}, {3, 5}, sliceK);
 
     auto field = test::MakeFilled(*mBackend, BufferFormat::F32, kGrid, SparseQ(kGrid, 5));
     DensityParams dp;
@@ -314,17 +332,17 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
     auto D = Patterned(BufferFormat::F32, {kGrid.nx, kGrid.ny, 1});
     auto tiles = Patterned(BufferFormat::U8, {tilesX, tilesY, 1});
     auto bands = Patterned(BufferFormat::U8, {tilesX, tilesY, CeilDiv(kGrid.nz, dp.band)});
-    ExpectOnly("density", {D.get(), tiles.get(), bands.get()},
-               [&](SliceRange s) {
-                   DensityParams share = dp;
-                   share.slices = s;
-                   DensityOutputs out{D.get(), tiles.get(), bands.get()};
-                   return mBackend->Density(share, *field, cld.get(), out);
-               },
-               {{1, 2}}, {1, 2},
-               [&](size_t output, size_t e) {  // the row of tiles of a column of D, a tile, a tile x band
-                   return output == 0 ? uint32_t(e / kGrid.nx / dp.tile) : uint32_t((e / tilesX) % tilesY);
-               });
+    ExpectOnly(
+        "density", {D.get(), tiles.get(), bands.get()},
+        [&](SliceRange s) {
+            DensityParams share = dp;
+            share.slices = s;
+            DensityOutputs out{D.get(), tiles.get(), bands.get()};
+            return mBackend->Density(share, *field, cld.get(), out);
+        },
+        {{1, 2}}, {1, 2}, [&](size_t output, size_t e) {  // the row of tiles of a column of D, a tile, a tile x band
+            return output == 0 ? uint32_t(e / kGrid.nx / dp.tile) : uint32_t((e / tilesX) % tilesY);
+        });
 
     auto T = Patterned(BufferFormat::F32, kGrid);
     for (const Vec3& sun : {SunDirection(1.2, 0.3), SunDirection(0.35, 0.2), SunDirection(0.5, 4.4)}) {
