@@ -67,7 +67,7 @@ WarmState& Warm(const std::string& name, int threads) {
     const CaSettings& ca = w.scene.ca;
     (void)b.CaInitialize({ca.seed, QuantizeProbability(ca.hum0), QuantizeProbability(ca.act0)},
                          {w.hum[0].get(), w.act[0].get(), w.cld[0].get()});
-    w.params = {ca.seed, 0, QuantizeProbability(ca.pExt), QuantizeProbability(ca.pHum), QuantizeProbability(ca.pAct), {}, {}};
+    w.params = {ca.seed, 0, QuantizeProbability(ca.pExt), QuantizeProbability(ca.pHum), QuantizeProbability(ca.pAct), {}, {}, {}};
     EllipsoidList list(w.scene.ellipsoids, e);
     int cur = 0;
     for (uint32_t t = 0; t < w.scene.warmupSteps; ++t) {
@@ -88,7 +88,7 @@ WarmState& Warm(const std::string& name, int threads) {
     (void)b.Region(w.raster, *w.region);
     (void)b.Smooth(w.scene.smooth.radius, *w.cld[0], *w.q);
     DensityOutputs out{w.D.get(), w.tiles.get(), w.bands.get(), 0};
-    (void)b.Density({T, B}, *w.q, w.cld[0].get(), out);
+    (void)b.Density({T, B, {}}, *w.q, w.cld[0].get(), out);
     w.cover = double(out.coveredColumns) / (double(e.nx) * e.ny);
     w.T = Make(b, BufferFormat::F32, e);
     (void)b.Shade(MakeShadeParams(w.scene, w.scene.shade.resolution), *w.q, *w.T);
@@ -130,7 +130,7 @@ void BM_Smooth(benchmark::State& state, const std::string& scene) {
 void BM_Density(benchmark::State& state, const std::string& scene) {
     WarmState& w = Warm(scene, int(state.range(0)));
     DensityOutputs out{w.D.get(), w.tiles.get(), w.bands.get(), 0};
-    const DensityParams params{w.scene.density.tile, w.scene.density.band};
+    const DensityParams params{w.scene.density.tile, w.scene.density.band, {}};
     for (auto _ : state) (void)w.backend->Density(params, *w.q, w.cld[0].get(), out);
     Label(state, w);
     state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(w.scene.grid.size.Count()) * 4);
