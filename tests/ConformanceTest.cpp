@@ -101,25 +101,11 @@ class Conformance : public ::testing::TestWithParam<Param> {
     bool mAutomatonOnly = false;
 };
 
-std::vector<RasterEllipsoid> RandomEllipsoids(const Extent3& e, uint32_t seed) {
-    Pcg32 rng(seed);
-    std::vector<RasterEllipsoid> list;
-    for (int n = 0; n < 25; ++n) {
-        const double yaw = rng.Uniform(0, 6.283185307179586);
-        list.push_back(
-            {{float(rng.Uniform(-5, e.nx + 5)), float(rng.Uniform(-5, e.ny + 5)), float(rng.Uniform(0, e.nz))},
-             {float(rng.Uniform(1, 14)), float(rng.Uniform(1, 10)), float(rng.Uniform(1, 5))},
-             float(std::cos(yaw)),
-             float(std::sin(yaw))});
-    }
-    return list;
-}
-
 // Test region: |dR| <= 1 everywhere and at most 0.5 % of voxels differ (SPEC 2).
 TEST_P(Conformance, Region) {
     if (auto why = SkipReason(Stage::Region)) GTEST_SKIP() << *why;
     const Extent3 e = Size();
-    const std::vector<RasterEllipsoid> list = RandomEllipsoids(e, 3);
+    const std::vector<RasterEllipsoid> list = test::RandomEllipsoids(e, 3);
     auto ref = test::MakeBuffer(mCpu, BufferFormat::U8, e);
     auto got = test::MakeBuffer(*mBackend, BufferFormat::U8, e);
     ASSERT_TRUE(mCpu.Region(list, *ref));
@@ -159,7 +145,7 @@ TEST_P(Conformance, CaSteps) {
     for (int f = 0; f < 3; ++f)
         ExpectExact(test::Read<uint8_t>(mCpu, *ref[f]), test::Read<uint8_t>(*mBackend, *got[f]), e, names[f]);
 
-    std::vector<RasterEllipsoid> list = RandomEllipsoids(e, 5);
+    std::vector<RasterEllipsoid> list = test::RandomEllipsoids(e, 5);
     auto region = test::MakeBuffer(mCpu, BufferFormat::U8, e);
     std::vector<int32_t> sx(e.nz), sy(e.nz);
     for (uint32_t k = 0; k < e.nz; ++k) sx[k] = int32_t(k % 5) - 2, sy[k] = k % 3 == 0 ? 1 : -int32_t(k % 2);
@@ -173,7 +159,8 @@ TEST_P(Conformance, CaSteps) {
             const std::vector<uint8_t> state = test::Read<uint8_t>(mCpu, *ref[f]);
             ASSERT_TRUE(mBackend->Upload(*got[f], std::as_bytes(std::span(state))));
         }
-        CaStepParams p{seed, t, QuantizeProbability(0.2), QuantizeProbability(0.1), QuantizeProbability(0.05), {}, {}, {}};
+        CaStepParams p{seed, t, QuantizeProbability(0.2), QuantizeProbability(0.1), QuantizeProbability(0.05), {},
+                       {},   {}};
         if (wind) p.shiftX = sx, p.shiftY = sy;
         ASSERT_TRUE(mCpu.CaStep(p, {ref[0].get(), ref[1].get(), ref[2].get()}, *region,
                                 {refOut[0].get(), refOut[1].get(), refOut[2].get()}));

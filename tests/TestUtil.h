@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "core/Backend.h"
+#include "core/Ellipsoids.h"
+#include "core/Random.h"
 
 namespace cb::test {
 
@@ -33,6 +35,21 @@ inline std::vector<float> GaussianBlobField(const Extent3& e, std::initializer_l
                 q[VoxelIndex(e, i, j, k)] = v < 1e-3 ? 0.0f : float(std::min(v, 1.0));
             }
     return q;
+}
+
+// 25 ellipsoids of random centres (some past the grid's sides), radii and yaw.
+inline std::vector<RasterEllipsoid> RandomEllipsoids(const Extent3& e, uint32_t seed) {
+    Pcg32 rng(seed);
+    std::vector<RasterEllipsoid> list;
+    for (int n = 0; n < 25; ++n) {
+        const double yaw = rng.Uniform(0, 6.283185307179586);
+        list.push_back(
+            {{float(rng.Uniform(-5, e.nx + 5)), float(rng.Uniform(-5, e.ny + 5)), float(rng.Uniform(0, e.nz))},
+             {float(rng.Uniform(1, 14)), float(rng.Uniform(1, 10)), float(rng.Uniform(1, 5))},
+             float(std::cos(yaw)),
+             float(std::sin(yaw))});
+    }
+    return list;
 }
 
 inline std::unique_ptr<Buffer> MakeBuffer(Backend& backend, BufferFormat format, Extent3 extent) {

@@ -17,10 +17,8 @@
 #include "harness/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
-#if CLOUDBENCH_HAVE_VK
-#include "impl_vk/BackendVk.h"
-#endif
 
 namespace cb {
 namespace {
@@ -89,19 +87,11 @@ std::vector<StepView> RunAndKeepEveryStep(const Scene& scene, Backend& backend) 
 class TimeSliceLoop : public ::testing::TestWithParam<std::string> {
   protected:
     void SetUp() override {
-        BackendOptions options;
-        options.vkValidation = true;
-        auto backend = CreateBackend(GetParam(), options);
+        auto backend = test::MakeTestBackend(GetParam());
         if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
         mBackend = std::move(*backend);
     }
-    void TearDown() override {
-#if CLOUDBENCH_HAVE_VK
-        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) {
-            EXPECT_EQ(vk->ValidationMessages(), 0u);
-        }
-#endif
-    }
+    void TearDown() override { test::ExpectNoValidationMessages(mBackend.get()); }
     std::unique_ptr<Backend> mBackend;
 };
 

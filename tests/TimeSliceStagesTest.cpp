@@ -14,11 +14,8 @@
 #include "core/Ellipsoids.h"
 #include "core/Random.h"
 #include "core/ShadePlan.h"
-#include "registry/Registry.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
-#if CLOUDBENCH_HAVE_VK
-#include "impl_vk/BackendVk.h"
-#endif
 
 namespace cb {
 namespace {
@@ -37,22 +34,11 @@ std::vector<SliceRange> Shares(uint32_t count, uint32_t size) {
 class TimeSliceStages : public ::testing::TestWithParam<std::string> {
   protected:
     void SetUp() override {
-        BackendOptions options;
-        options.vkValidation = true;
-        // "gl_rgba8": the gl backend with the automaton in the thesis's RGBA8 layout.
-        const bool rgba8 = GetParam() == "gl_rgba8";
-        if (rgba8) options.glCaLayout = gl::CaLayout::Rgba8;
-        auto backend = CreateBackend(rgba8 ? "gl" : GetParam(), options);
+        auto backend = test::MakeTestBackend(GetParam());
         if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
         mBackend = std::move(*backend);
     }
-    void TearDown() override {
-#if CLOUDBENCH_HAVE_VK
-        if (auto* vk = dynamic_cast<vk::BackendVk*>(mBackend.get())) {
-            EXPECT_EQ(vk->ValidationMessages(), 0u);
-        }
-#endif
-    }
+    void TearDown() override { test::ExpectNoValidationMessages(mBackend.get()); }
 
     // A buffer holding a pattern no stage writes: 0xA5 bytes for U8, 1 for bits
     // (a full field), -1 for floats.
@@ -150,20 +136,6 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
     std::unique_ptr<Backend> mBackend;
 };
 
-std::vector<RasterEllipsoid> SomeEllipsoids(const Extent3& e) {
-    Pcg32 rng(7);
-    std::vector<RasterEllipsoid> list;
-    for (int n = 0; n < 12; ++n) {
-        const double yaw = rng.Uniform(0, 6.283185307179586);
-        list.push_back(
-            {{float(rng.Uniform(-3, e.nx + 3)), float(rng.Uniform(-3, e.ny + 3)), float(rng.Uniform(0, e.nz))},
-             {float(rng.Uniform(2, 12)), float(rng.Uniform(2, 9)), float(rng.Uniform(1, 5))},
-             float(std::cos(yaw)),
-             float(std::sin(yaw))});
-    }
-    return list;
-}
-
 std::vector<uint8_t> RandomBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
     Pcg32 rng(seed);
     std::vector<uint8_t> bits(e.Count());
@@ -180,14 +152,14 @@ std::vector<float> SparseQ(const Extent3& e, uint32_t seed) {
 }
 
 TEST_P(TimeSliceStages, RegionInSlicesOfK) {
-    const auto ellipsoids = SomeEllipsoids(kGrid);
+    const auto ellipsoids = test::RandomEllipsoids(kGrid, 7);
     auto region = Patterned(BufferFormat::U8, kGrid);
     ExpectSharesEqualWhole("region", kGrid.nz, {region.get()},
                            [&](SliceRange s) { return mBackend->Region(ellipsoids, *region, s); });
 }
 
 TEST_P(TimeSliceStages, CaStepInSlicesOfK) {
-    const auto ellipsoids = SomeEllipsoids(kGrid);
+    const auto ellipsoids = test::RandomEllipsoids(kGrid, 7);
     auto region = Patterned(BufferFormat::U8, kGrid);
     ASSERT_TRUE(mBackend->Region(ellipsoids, *region));
     auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 1, 2));
@@ -297,7 +269,7 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
     const size_t sliceSize = size_t(kGrid.nx) * kGrid.ny;
     auto sliceK = [&](size_t, size_t v) { return uint32_t(v / sliceSize); };
     // Bits and floats: one element per voxel; the pattern check reads canonical bytes per element.
-    const auto ellipsoids = SomeEllipsoids(kGrid);
+    const auto ellipsoids = test::RandomEllipsoids(kGrid, 7);
     auto region = Patterned(BufferFormat::U8, kGrid);
     ExpectOnly(
         "region", {region.get()}, [&](SliceRange s) { return mBackend->Region(ellipsoids, *region, s); }, {{3, 5}},
