@@ -33,4 +33,18 @@ inline void ExpectNoValidationMessages([[maybe_unused]] const Backend* backend) 
 #endif
 }
 
+// A test parametrised by a backend's name (MakeTestBackend): SetUp makes it,
+// or skips with the reason; TearDown expects no validation message.
+class BackendTest : public ::testing::TestWithParam<std::string> {
+  protected:
+    void SetUp() override {
+        auto backend = MakeTestBackend(GetParam());
+        if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
+        mBackend = std::move(*backend);
+    }
+    void TearDown() override { ExpectNoValidationMessages(mBackend.get()); }
+
+    std::unique_ptr<Backend> mBackend;
+};
+
 }  // namespace cb::test

@@ -84,16 +84,7 @@ std::vector<StepView> RunAndKeepEveryStep(const Scene& scene, Backend& backend) 
     return views;
 }
 
-class TimeSliceLoop : public ::testing::TestWithParam<std::string> {
-  protected:
-    void SetUp() override {
-        auto backend = test::MakeTestBackend(GetParam());
-        if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
-        mBackend = std::move(*backend);
-    }
-    void TearDown() override { test::ExpectNoValidationMessages(mBackend.get()); }
-    std::unique_ptr<Backend> mBackend;
-};
+using TimeSliceLoop = test::BackendTest;
 
 // Frames per step well above what the shares take, so the sliced steps draw as many frames, at the same alphas, as
 // the unsliced ones: then every resource and every image must be equal at every step.

@@ -31,15 +31,8 @@ std::vector<SliceRange> Shares(uint32_t count, uint32_t size) {
     return shares;
 }
 
-class TimeSliceStages : public ::testing::TestWithParam<std::string> {
+class TimeSliceStages : public test::BackendTest {
   protected:
-    void SetUp() override {
-        auto backend = test::MakeTestBackend(GetParam());
-        if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
-        mBackend = std::move(*backend);
-    }
-    void TearDown() override { test::ExpectNoValidationMessages(mBackend.get()); }
-
     // A buffer holding a pattern no stage writes: 0xA5 bytes for U8, 1 for bits
     // (a full field), -1 for floats.
     std::unique_ptr<Buffer> Patterned(BufferFormat format, Extent3 extent) {
@@ -133,7 +126,6 @@ class TimeSliceStages : public ::testing::TestWithParam<std::string> {
         }
     }
 
-    std::unique_ptr<Backend> mBackend;
 };
 
 std::vector<uint8_t> RandomBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
