@@ -6,6 +6,7 @@
 
 #include <cstring>
 #include <map>
+#include <numbers>
 #include <numeric>
 
 #include "core/Camera.h"
@@ -144,6 +145,18 @@ void BM_Shade(benchmark::State& state, const std::string& scene) {
     Label(state, w);
 }
 
+// Shading at f = 1 on range(0) threads with the sun at elevation range(1)
+// degrees, azimuth 60 (25: slices along y; 60 and 89: along z), or for 45 at
+// azimuth 0: the x/z tie, slices along z with whole-cell taps (u0 = 1, fu = 0).
+void BM_ShadeSun(benchmark::State& state, const std::string& scene) {
+    WarmState& w = Warm(scene, int(state.range(0)));
+    ShadeParams p = MakeShadeParams(w.scene, 1);
+    const double azimuth = state.range(1) == 45 ? 0.0 : 60.0;
+    p.sun = SunDirection(double(state.range(1)) * std::numbers::pi / 180.0, azimuth * std::numbers::pi / 180.0);
+    for (auto _ : state) (void)w.backend->Shade(p, *w.q, *w.T);
+    Label(state, w);
+}
+
 // Splat rendering of camera range(1) at the scene's 1024x768, with
 // range(2) = 0: no culling, 1: view-frustum culling, 2: culling and empty-space skipping
 // (the thesis's Tables 8.2, 8.3 and 8.4).
@@ -246,6 +259,8 @@ void Register() {
         benchmark::RegisterBenchmark(("Density/" + s).c_str(), BM_Density, s)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("Shade/" + s).c_str(), BM_Shade, s)
             ->Args({2, 1})->Args({2, 2})->Args({1, 1})->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("ShadeSun/" + s).c_str(), BM_ShadeSun, s)
+            ->ArgsProduct({{1, 2, 4, 8, 16}, {25, 45, 60, 89}})->Unit(benchmark::kMillisecond)->UseRealTime();
         benchmark::RegisterBenchmark(("RenderSplat/" + s).c_str(), BM_RenderSplat, s)
             ->ArgsProduct({{2}, {0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
     }
