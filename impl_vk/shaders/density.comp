@@ -10,6 +10,7 @@
 // global count once per workgroup. A dispatch covers the rows of tiles
 // [ty0, ty0 + gl_NumWorkGroups.y) (a share, SPEC 13).
 #extension GL_EXT_shader_8bit_storage : require
+#extension GL_EXT_control_flow_attributes : require
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Q { float q[]; };
 layout(std430, binding = 1) readonly buffer Cld { uint cld[]; };
@@ -22,6 +23,7 @@ layout(push_constant) uniform Params {
 } pc;
 
 const uint kGroup = 256u;
+const uint kBatch = 8u;
 const uint kBandWords = 64u;  // bands per tile: at most 32 * kBandWords (DensityVk checks)
 shared uint sBands[kBandWords];
 shared uint sCovered;
@@ -47,20 +49,27 @@ void main() {
         float sum = 0.0;
         uint any = 0u, mask = 0u, b = 0u, bandEnd = min(pc.nz, pc.band);
         bool bandAny = false;
-        for (uint k = 0u; k < pc.nz; ++k) {
-            const float v = q[column + layer * k];
-            sum += v;
-            bandAny = bandAny || v > 0.0;
-            if (pc.fromCld != 0u) any |= (cld[(i >> 5) + pc.words * (j + pc.ny * k)] >> (i & 31u)) & 1u;
-            if (k + 1u == bandEnd) {  // band b ends here
-                if (bandAny) mask |= 1u << (b & 31u);
-                if (((b & 31u) == 31u || bandEnd == pc.nz) && mask != 0u) {
-                    atomicOr(sBands[b >> 5], mask);
-                    mask = 0u;
+        // Slices in batches of kBatch: the batch's loads are issued before its
+        // adds (more loads in flight per invocation); the adds stay in k order.
+        for (uint k0 = 0u; k0 < pc.nz; k0 += kBatch) {
+            float v[kBatch];
+            [[unroll]] for (uint u = 0u; u < kBatch; ++u) v[u] = k0 + u < pc.nz ? q[column + layer * (k0 + u)] : 0.0;
+            [[unroll]] for (uint u = 0u; u < kBatch; ++u) {
+                const uint k = k0 + u;
+                if (k >= pc.nz) break;
+                sum += v[u];
+                bandAny = bandAny || v[u] > 0.0;
+                if (pc.fromCld != 0u) any |= (cld[(i >> 5) + pc.words * (j + pc.ny * k)] >> (i & 31u)) & 1u;
+                if (k + 1u == bandEnd) {  // band b ends here
+                    if (bandAny) mask |= 1u << (b & 31u);
+                    if (((b & 31u) == 31u || bandEnd == pc.nz) && mask != 0u) {
+                        atomicOr(sBands[b >> 5], mask);
+                        mask = 0u;
+                    }
+                    bandAny = false;
+                    ++b;
+                    bandEnd = min(pc.nz, bandEnd + pc.band);
                 }
-                bandAny = false;
-                ++b;
-                bandEnd = min(pc.nz, bandEnd + pc.band);
             }
         }
         if (pc.fromCld == 0u) any = sum > 0.0 ? 1u : 0u;
