@@ -302,6 +302,59 @@ TEST_P(Conformance, Density) {
     EXPECT_EQ(withoutCld[0].coveredColumns, withoutCld[1].coveredColumns);
 }
 
+// Tiles of 32 x 32 columns (more columns than a Vulkan workgroup has
+// invocations; partial tiles at the odd sizes) and 70 slices in bands of 1
+// (70 bands: more than one 32-band word of flags) and of 3 (a partial last
+// band). q mixes dense slices (every 5th: many terms per column, so the sum's
+// order shows in its rounding) with sparse ones (most tile x band boxes empty).
+TEST_P(Conformance, DensityLargeTilesAndManyBands) {
+    if (auto why = SkipReason(Stage::Density)) GTEST_SKIP() << *why;
+    const Extent3 e{Size().nx, Size().ny, 70};
+    Pcg32 rng(29);
+    std::vector<float> qData(e.Count(), 0.0f);
+    std::vector<uint8_t> cld(e.Count());
+    for (size_t v = 0; v < qData.size(); ++v) {
+        const size_t k = v / (size_t(e.nx) * e.ny);
+        if (rng.Below(k % 5 == 0 ? 2 : 2000) == 0) qData[v] = float(rng.NextU32() >> 8) * 0x1p-24f;
+        cld[v] = rng.Below(50) == 0;
+    }
+    auto refQ = test::MakeFilled(mCpu, BufferFormat::F32, e, qData);
+    auto refBits = test::MakeFilled(mCpu, BufferFormat::Bits, e, cld);
+    auto gotQ = test::MakeFilled(*mBackend, BufferFormat::F32, e, qData);
+    auto gotBits = test::MakeFilled(*mBackend, BufferFormat::Bits, e, cld);
+    for (const uint32_t band : {1u, 3u}) {
+        SCOPED_TRACE("band " + std::to_string(band));
+        const DensityParams params{32, band, {}};
+        const Extent3 tiles{CeilDiv(e.nx, 32), CeilDiv(e.ny, 32), 1}, bands{tiles.nx, tiles.ny, CeilDiv(e.nz, band)};
+        std::unique_ptr<Buffer> out[2][3];
+        Backend* backends[2] = {&mCpu, mBackend.get()};
+        DensityOutputs results[2];
+        for (int n = 0; n < 2; ++n) {
+            out[n][0] = test::MakeBuffer(*backends[n], BufferFormat::F32, {e.nx, e.ny, 1});
+            out[n][1] = test::MakeBuffer(*backends[n], BufferFormat::U8, tiles);
+            out[n][2] = test::MakeBuffer(*backends[n], BufferFormat::U8, bands);
+            results[n] = {out[n][0].get(), out[n][1].get(), out[n][2].get(), 0};
+        }
+        ASSERT_TRUE(mCpu.Density(params, *refQ, refBits.get(), results[0]));
+        Status s = mBackend->Density(params, *gotQ, gotBits.get(), results[1]);
+        ASSERT_TRUE(s.has_value()) << s.error().message;
+        const std::vector<uint8_t> refBands = test::Read<uint8_t>(mCpu, *out[0][2]);
+        if (band == 1) {  // the data holds both empty and occupied boxes
+            EXPECT_NE(std::count(refBands.begin(), refBands.end(), 0), 0);
+            EXPECT_NE(std::count(refBands.begin(), refBands.end(), 1), 0);
+        }
+        ExpectExact(test::Read<float>(mCpu, *out[0][0]), test::Read<float>(*mBackend, *out[1][0]), {e.nx, e.ny, 1},
+                    "D");
+        ExpectExact(test::Read<uint8_t>(mCpu, *out[0][1]), test::Read<uint8_t>(*mBackend, *out[1][1]), tiles, "tiles");
+        ExpectExact(refBands, test::Read<uint8_t>(*mBackend, *out[1][2]), bands, "bands");
+        EXPECT_EQ(results[0].coveredColumns, results[1].coveredColumns);
+        ASSERT_TRUE(mCpu.Density(params, *refQ, nullptr, results[0]));
+        s = mBackend->Density(params, *gotQ, nullptr, results[1]);
+        ASSERT_TRUE(s.has_value()) << s.error().message;
+        EXPECT_EQ(results[0].coveredColumns, results[1].coveredColumns) << "without cld";
+    }
+}
+
 // Largest |a - b| and where it is.
 template <typename T>
 std::pair<double, size_t> WorstDifference(const std::vector<T>& a, const std::vector<T>& b) {
