@@ -58,6 +58,10 @@ uint64_t BackendCpu::ScratchBytes(const Scene& scene) const {
         const uint64_t perRun = SaturatingAdd(SaturatingMul(slice, (2 * r + 1) * numeratorBytes + 1),
                                               uint64_t(e.nx) + 2 * r + 8 + 4 * uint64_t(e.nx));
         bytes = SaturatingAdd(bytes, SaturatingMul(runs, perRun));
+        // Time-sliced, the shares of one sweep keep their ring and a slice of x sums between calls
+        // (SmoothShareState).
+        if (scene.render.slicesPerFrame > 0)
+            bytes = SaturatingAdd(bytes, SaturatingMul(slice, (2 * r + 1) * numeratorBytes + 1));
     }
     if (scene.stages.Has(Stage::Shade)) {
         // The shaded grid: ceil(n / f) cells per axis (ShadePlan). Below full resolution the coarse q and T
