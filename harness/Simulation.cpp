@@ -241,7 +241,7 @@ std::vector<Simulation::FrameTasks> Simulation::PlanAhead(uint32_t slicesPerFram
         for (uint32_t b = 0; b < count; b += std::min(size, count - b)) {
             FrameTasks tasks;
             if (b == 0 && first) tasks.push_back(*first);
-            tasks.push_back({stage, d.shareCount ? SliceRange{b, b + std::min(size, count - b)} : SliceRange{}});
+            tasks.push_back({stage, d.shareCount ? SliceRange{b, b + std::min(size, count - b)} : SliceRange{}, count});
             frames.push_back(std::move(tasks));
         }
     };
@@ -298,9 +298,8 @@ Status Simulation::RunShares(const FrameTasks& tasks, StepRecord& record, std::s
         if (call.coveredColumns) target.coveredColumns = target.coveredColumns.value_or(0) + *call.coveredColumns;
         if (!describe) continue;
         char range[40] = "";
-        const uint32_t count = Describe(stage).shareCount ? Describe(stage).shareCount(mScene, step) : 1;
-        if (!task.slices.IsWhole(count))
-            std::snprintf(range, sizeof range, " %u-%u", task.slices.begin, task.slices.End(count) - 1);
+        if (!task.slices.IsWhole(task.shareCount))
+            std::snprintf(range, sizeof range, " %u-%u", task.slices.begin, task.slices.End(task.shareCount) - 1);
         *describe += (describe->empty() ? "" : ", ") + std::string(StageName(stage)) + range;
     }
     return {};

@@ -132,6 +132,7 @@ class Simulation {
     struct ShareTask {
         std::optional<Stage> stage;
         SliceRange slices;
+        uint32_t shareCount = 1;  // the stage's shares at the step it computes (StageDescriptor::shareCount)
     };
     using FrameTasks = std::vector<ShareTask>;
 
