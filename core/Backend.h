@@ -289,6 +289,17 @@ struct MarchStats {
 // In a backend's class: declares the override of one entry.
 #define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;
 
+// What a backend has asked of its device since it was made (pipelined timing,
+// issue 16). A backend without a device (the CPU) counts nothing.
+struct SubmissionCounts {
+    // Batches of commands handed to the device: vkQueueSubmit; on GL a flush or
+    // finish that ends a batch of draws.
+    uint64_t submissions = 0;
+    // Times the host blocked until the device had finished work: a fence wait,
+    // glFinish, a query result or a read back that must wait.
+    uint64_t hostWaits = 0;
+};
+
 class Backend {
   public:
     virtual ~Backend() = default;
@@ -301,6 +312,30 @@ class Backend {
     // Device time of the last stage call in ms, for backends that measure it
     // (GPU timestamp queries); nullopt where wall time is all there is.
     virtual std::optional<double> LastDeviceMs() const { return std::nullopt; }
+
+    // ---- Pipelined timing (docs/performance.md, "Two ways to time a step") ----
+    // Between BeginBatch and EndBatch a backend may record stage calls and
+    // return before their outputs are complete, submitting as few times as it
+    // can (ideally once, at EndBatch) and waiting once at EndBatch. Outside a
+    // batch every call completes before it returns, as the interface says.
+    // In a batch:
+    //  - Buffers named in a call must stay alive until EndBatch.
+    //  - Upload and Download keep their order with the recorded calls; a
+    //    Download waits for the work before it (a host wait).
+    //  - Host results of a call (DensityOutputs::coveredColumns, SplatStats,
+    //    MarchStats) are complete when it returns, as outside a batch; a backend
+    //    that must wait for them counts the wait in Submissions().
+    //  - MarkBatch() starts the batch's next interval. EndBatch returns, for each
+    //    interval in order, the device time of the work recorded in it (ms, the
+    //    sum over its commands' timestamp pairs, so host gaps between submissions
+    //    are not counted), or an empty vector where the backend has no device
+    //    clock. LastDeviceMs() is meaningless in a batch.
+    // Batches do not nest. A failed call inside a batch still needs EndBatch.
+    virtual Status BeginBatch() { return {}; }
+    virtual void MarkBatch() {}
+    virtual Result<std::vector<double>> EndBatch() { return std::vector<double>{}; }
+    // Cumulative; the harness reports the difference over a step.
+    virtual SubmissionCounts Submissions() const { return {}; }
 
     // ---- Buffers and transfers (timed apart from stages) ----
     virtual Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) = 0;
