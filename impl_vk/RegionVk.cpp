@@ -1,9 +1,9 @@
 // Stage `region` (SPEC 2) on Vulkan: the host bins the ellipsoids by 16x16 tile of
-// each slice; region.comp takes the max over a voxel's tile list.
+// each slice (RegionTileLists.h); region.comp takes the max over a voxel's tile list.
 #include <algorithm>
-#include <cmath>
 #include <vector>
 
+#include "impl_vk/RegionTileLists.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
@@ -19,39 +19,20 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
     auto list = ScratchHolding(VkScratch::EllipsoidList, std::as_bytes(ellipsoids), 32);
     if (!list) return std::unexpected(list.error());
-    // Per 16x16 tile of each slice of the share, the ellipsoids whose bounding box (the
-    // shader's rejection test, widened by a voxel) reaches a voxel centre of it.
-    constexpr uint32_t kTile = 16;
-    const uint32_t tilesX = CeilDiv(e.nx, kTile), tilesY = CeilDiv(e.ny, kTile);
-    std::vector<uint32_t> tileStart(size_t(tilesX) * tilesY * (k1 - k0) + 1, 0), tileList;
-    for (uint32_t k = k0, tile = 0; k < k1; ++k)
-        for (uint32_t ty = 0; ty < tilesY; ++ty)
-            for (uint32_t tx = 0; tx < tilesX; ++tx, ++tile) {
-                const float x0 = float(tx * kTile) + 0.5f, x1 = float(std::min(e.nx, (tx + 1) * kTile) - 1) + 0.5f;
-                const float y0 = float(ty * kTile) + 0.5f, y1 = float(std::min(e.ny, (ty + 1) * kTile) - 1) + 0.5f;
-                const float z = float(k) + 0.5f;
-                for (uint32_t n = 0; n < ellipsoids.size(); ++n) {
-                    const RasterEllipsoid& el = ellipsoids[n];
-                    const float reach = std::max(el.semiAxes[0], el.semiAxes[1]) + 2.0f;
-                    if (std::fabs(z - el.center[2]) > el.semiAxes[2] + 2.0f || el.center[0] + reach < x0 ||
-                        el.center[0] - reach > x1 || el.center[1] + reach < y0 || el.center[1] - reach > y1)
-                        continue;
-                    tileList.push_back(n);
-                }
-                tileStart[tile + 1] = uint32_t(tileList.size());
-            }
-    auto starts = Scratch(VkScratch::RegionTileStarts, tileStart.size() * 4);
+    // Per 16x16 tile of each slice of the share, the ellipsoids that can reach it (RegionTileLists.h).
+    const RegionTileLists lists = BuildRegionTileLists(ellipsoids, e, k0, k1);
+    auto starts = Scratch(VkScratch::RegionTileStarts, lists.starts.size() * 4);
     if (!starts) return std::unexpected(starts.error());
-    CB_TRY(mContext->Upload(**starts, std::as_bytes(std::span(tileStart))));
-    auto entries = Scratch(VkScratch::RegionTileEntries, std::max<size_t>(16, tileList.size() * 4));
+    CB_TRY(mContext->Upload(**starts, std::as_bytes(std::span(lists.starts))));
+    auto entries = Scratch(VkScratch::RegionTileEntries, std::max<size_t>(16, lists.entries.size() * 4));
     if (!entries) return std::unexpected(entries.error());
-    if (!tileList.empty()) CB_TRY(mContext->Upload(**entries, std::as_bytes(std::span(tileList))));
+    if (!lists.entries.empty()) CB_TRY(mContext->Upload(**entries, std::as_bytes(std::span(lists.entries))));
     auto pipeline =
         mContext->GetPipeline("region", 4, slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
     if (!pipeline) return std::unexpected(pipeline.error());
     struct {
         uint32_t nx, ny, k0, first, end, tilesX, tilesY;
-    } push{e.nx, e.ny, k0, e.nx * e.ny * k0, e.nx * e.ny * k1, tilesX, tilesY};
+    } push{e.nx, e.ny, k0, e.nx * e.ny * k0, e.nx * e.ny * k1, lists.tilesX, lists.tilesY};
     const DeviceBuffer* buffers[] = {*list, &Dev(region), *starts, *entries};
     return Record("region", [&](VulkanContext::Recorder& r) {
         r.DispatchRange(**pipeline, buffers, &push, sizeof push, push.first, push.end);
