@@ -110,12 +110,9 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
                 frames[std::string(StageName(renderer)) + " " + camera.name] = entry;
             }
         }
-        nlohmann::json m = {{"steps", steps.size()},
-                            {"step_ms", SummaryJson(stepMs)},
-                            {"submissions", CountJson(submissions)},
-                            {"host_waits", CountJson(waits)},
-                            {"batches", CountJson(batches)},
-                            {"stages", stages}};
+        nlohmann::json m = {
+            {"steps", steps.size()},          {"step_ms", SummaryJson(stepMs)}, {"submissions", CountJson(submissions)},
+            {"host_waits", CountJson(waits)}, {"batches", CountJson(batches)},  {"stages", stages}};
         if (!frames.empty()) m["frames"] = frames;
         timing[std::string(TimingModeName(mode))] = m;
     }
@@ -449,8 +446,8 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         // Pipelined, a stage's call time is the host's recording; its time is the device's.
         bool anyDevice = false;
         for (Stage stage : kAllStages)
-            anyDevice |= scene.stages.Has(stage) &&
-                         !StageSamples(scene, run, stage, true, TimingMode::Pipelined).empty();
+            anyDevice |=
+                scene.stages.Has(stage) && !StageSamples(scene, run, stage, true, TimingMode::Pipelined).empty();
         std::string stages = anyDevice ? "  pipelined per stage, median device ms (host recording ms):"
                                        : "  pipelined per stage, no device clock; median host recording ms:";
         const char* sep = " ";

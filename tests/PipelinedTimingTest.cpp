@@ -9,8 +9,8 @@
 // ended when a call fails, and the counts' differences per step.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <algorithm>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -430,7 +430,7 @@ TEST(PipelinedTiming, ResultsJsonReportsEachModeWithItsCounts) {
     EXPECT_EQ(pipe["stages"]["region"]["device"]["samples_ms"].get<std::vector<double>>(), regionDevicePipelined);
     EXPECT_EQ(pipe["stages"]["region"]["host"]["count"], 2);
     EXPECT_FALSE(pipe["stages"]["region"].contains("wall"));
-    EXPECT_EQ(pipe["frames"]["render_splat a"]["device"]["count"] .get<int>() +
+    EXPECT_EQ(pipe["frames"]["render_splat a"]["device"]["count"].get<int>() +
                   pipe["frames"]["render_splat b"]["device"]["count"].get<int>(),
               int(frameDevicePipelined.size()));
     EXPECT_EQ(sync["stages"]["region"]["wall"]["samples_ms"].get<std::vector<double>>(), regionSync);
