@@ -193,6 +193,8 @@ void ExpectDeviceTimesFromLog(const StepRecord& r, std::span<const BatchLoggingC
     }
 }
 
+// Test that a pipelined step is one batch with one mark before each call, in schedule order, and that each interval's
+// time goes to the stage and frame whose call followed the mark; stage call times are host time; 1 submission, 1 wait.
 TEST(PipelinedTiming, OneBatchPerStepOneMarkPerCallTimesToTheirStagesAndFrames) {
     const Scene scene = BatchScene();
     BatchLoggingCpu backend;
@@ -234,6 +236,8 @@ TEST(PipelinedTiming, OneBatchPerStepOneMarkPerCallTimesToTheirStagesAndFrames) 
     EXPECT_FALSE(backend.markOutside);
 }
 
+// Test that a synchronized step (the default) opens no batch, takes device times from LastDeviceMs and reports the
+// backend's counts over the step: here one submission and one wait per call.
 TEST(PipelinedTiming, SynchronizedStepsOpenNoBatchAndCountEveryCall) {
     const Scene scene = BatchScene();
     BatchLoggingCpu backend;
@@ -261,6 +265,8 @@ TEST(PipelinedTiming, SynchronizedStepsOpenNoBatchAndCountEveryCall) {
     EXPECT_FALSE(backend.markOutside);
 }
 
+// Test that an observer (dump, conform) sees no open batch: the step's stages and frames are one batch, the
+// automaton's advance after the observer another.
 TEST(PipelinedTiming, AnObserverEndsTheBatchBeforeItAndAnotherHoldsTheRest) {
     const Scene scene = BatchScene({{"steps", "2"}});
     BatchLoggingCpu backend;
@@ -293,6 +299,8 @@ TEST(PipelinedTiming, AnObserverEndsTheBatchBeforeItAndAnotherHoldsTheRest) {
     }
 }
 
+// Test that a time-sliced pipelined step opens one batch per frame (and step 0 one more for its own stages), each
+// frame's renders in its frame's batch with their own times.
 TEST(PipelinedTiming, TimeSlicedOneBatchPerFrame) {
     const Scene scene = BatchScene({{"render.slices_per_frame", "3"}, {"steps", "3"}});
     BatchLoggingCpu backend;
@@ -335,6 +343,7 @@ TEST(PipelinedTiming, TimeSlicedOneBatchPerFrame) {
     EXPECT_FALSE(backend.markOutside);
 }
 
+// Test that a stage that fails inside a batch still ends the batch, and the step reports the stage's error.
 TEST(PipelinedTiming, AFailedCallEndsItsBatchAndReportsTheStage) {
     const Scene scene = BatchScene();
     BatchLoggingCpu backend;
@@ -353,6 +362,8 @@ TEST(PipelinedTiming, AFailedCallEndsItsBatchAndReportsTheStage) {
     EXPECT_EQ(backend.ends, 2);
 }
 
+// Test that EndBatch may give one leading time (before the first mark), which is dropped, and that any other
+// count of times that is not one per mark fails the step, naming the counts.
 TEST(PipelinedTiming, EndBatchTimesMustMatchTheMarks) {
     const Scene scene = BatchScene({{"steps", "1"}});
     {
