@@ -319,18 +319,18 @@ class Backend {
     // can (ideally once, at EndBatch) and waiting once at EndBatch. Outside a
     // batch every call completes before it returns, as the interface says.
     // In a batch:
-    //  - Buffers named in a call must stay alive until EndBatch.
-    //  - Upload and Download keep their order with the recorded calls; a
-    //    Download waits for the work before it (a host wait).
+    //  - Buffers named in a call must stay alive until EndBatch (host data its
+    //    parameters point to, like spans, only until the call returns). Upload and
+    //    Download keep their order with the recorded calls; a Download waits (a host wait).
     //  - Host results of a call (DensityOutputs::coveredColumns, SplatStats,
     //    MarchStats) are complete when it returns, as outside a batch; a backend
     //    that must wait for them counts the wait in Submissions().
     //  - MarkBatch() starts the batch's next interval. EndBatch returns, for each
     //    interval in order, the device time of the work recorded in it (ms, the
     //    sum over its commands' timestamp pairs, so host gaps between submissions
-    //    are not counted), or an empty vector where the backend has no device
-    //    clock. LastDeviceMs() is meaningless in a batch.
-    // Batches do not nest. A failed call inside a batch still needs EndBatch.
+    //    are not counted), or an empty vector where the backend has no device clock:
+    //    one per MarkBatch (harness: a leading one, before the first mark, is dropped).
+    // Batches do not nest. A failed call inside a batch still needs EndBatch. LastDeviceMs() is meaningless in a batch.
     virtual Status BeginBatch() { return {}; }
     virtual void MarkBatch() {}
     virtual Result<std::vector<double>> EndBatch() { return std::vector<double>{}; }

@@ -61,6 +61,8 @@ struct CommonOptions {
     // report: --history FILE and -o FILE (docs/cli.md).
     std::string history;
     std::string outFile;
+    // run --timing: "synchronized", "pipelined" or "both" (docs/performance.md, "Two ways to time a step").
+    std::string timing = "synchronized";
     // argv as given, for the provenance of the outputs.
     std::vector<std::string> commandLine;
 

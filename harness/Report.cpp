@@ -23,14 +23,27 @@ double Quantile(const std::vector<double>& sorted, double p) {
     return sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - double(lo));
 }
 
-// Post-warm-up samples of one stage: wall time, or device time where the backend measured it.
-std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage, bool device = false) {
+// Post-warm-up samples of one stage measured in `mode`: synchronized, its wall
+// time; pipelined, its host recording time; or (device) its device time, where
+// the backend measured it, from the steps that measured the stage in `mode`.
+std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage, bool device = false,
+                                 TimingMode mode = TimingMode::Synchronized) {
     std::vector<double> out;
     for (const StepRecord& r : run.steps) {
-        const std::optional<double>& sample = device ? r.deviceMs[size_t(stage)] : r.stageMs[size_t(stage)];
-        if (r.step >= scene.warmupSteps && sample) out.push_back(*sample);
+        const std::optional<double>& wall =
+            mode == TimingMode::Pipelined ? r.hostMs[size_t(stage)] : r.stageMs[size_t(stage)];
+        const std::optional<double>& sample = device ? r.deviceMs[size_t(stage)] : wall;
+        if (r.step >= scene.warmupSteps && wall && sample) out.push_back(*sample);
     }
     return out;
+}
+
+// Post-warm-up frames of one renderer and camera, with their step, whatever mode drew them.
+template <typename Fn>
+void ForEachFrame(const BackendRun& run, Stage renderer, const std::string& camera, Fn&& fn) {
+    for (const StepRecord& r : run.steps)
+        for (const FrameRecord& f : r.frames)
+            if (f.renderer == renderer && f.camera == camera) fn(r, f);
 }
 
 double CoverFraction(const Scene& scene, uint32_t columns) {
@@ -43,7 +56,68 @@ nlohmann::json SummaryJson(const std::vector<double>& samples) {
             {"min_ms", s.min},       {"max_ms", s.max},       {"count", s.count}};
 }
 
+// The post-warm-up steps timed in `mode`.
+std::vector<const StepRecord*> StepsIn(const Scene& scene, const BackendRun& run, TimingMode mode) {
+    std::vector<const StepRecord*> out;
+    for (const StepRecord& r : run.steps)
+        if (r.step >= scene.warmupSteps && r.timing == mode) out.push_back(&r);
+    return out;
+}
+
+nlohmann::json CountJson(const std::vector<double>& counts) {
+    const Summary s = Summarize(counts);
+    return {{"median", s.median}, {"min", s.min}, {"max", s.max}};
+}
+
 }  // namespace
+
+nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
+    bool modes[2] = {false, false};
+    for (const StepRecord& r : run.steps) modes[size_t(r.timing)] = true;
+    nlohmann::json timing = {{"mode", modes[0] && modes[1] ? "both" : modes[1] ? "pipelined" : "synchronized"}};
+    for (TimingMode mode : {TimingMode::Synchronized, TimingMode::Pipelined}) {
+        if (!modes[size_t(mode)]) continue;
+        const std::vector<const StepRecord*> steps = StepsIn(scene, run, mode);
+        std::vector<double> stepMs, submissions, waits, batches;
+        for (const StepRecord* r : steps) {
+            stepMs.push_back(r->stepMs);
+            submissions.push_back(double(r->submissions));
+            waits.push_back(double(r->hostWaits));
+            batches.push_back(double(r->batches));
+        }
+        const bool pipelined = mode == TimingMode::Pipelined;
+        nlohmann::json stages = nlohmann::json::object();
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            nlohmann::json entry = {
+                {pipelined ? "host" : "wall", SummaryJson(StageSamples(scene, run, stage, false, mode))}};
+            const std::vector<double> device = StageSamples(scene, run, stage, true, mode);
+            if (!device.empty()) entry["device"] = SummaryJson(device);
+            stages[std::string(StageName(stage))] = entry;
+        }
+        nlohmann::json frames = nlohmann::json::object();
+        for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch}) {
+            if (!scene.stages.Has(renderer)) continue;
+            for (const CameraSettings& camera : scene.render.cameras) {
+                std::vector<double> wall, device;
+                ForEachFrame(run, renderer, camera.name, [&](const StepRecord& r, const FrameRecord& f) {
+                    if (r.step < scene.warmupSteps || f.pipelined != pipelined) return;
+                    wall.push_back(f.ms);
+                    if (f.deviceMs) device.push_back(*f.deviceMs);
+                });
+                nlohmann::json entry = {{pipelined ? "host" : "wall", SummaryJson(wall)}};
+                if (!device.empty()) entry["device"] = SummaryJson(device);
+                frames[std::string(StageName(renderer)) + " " + camera.name] = entry;
+            }
+        }
+        nlohmann::json m = {
+            {"steps", steps.size()},          {"step_ms", SummaryJson(stepMs)}, {"submissions", CountJson(submissions)},
+            {"host_waits", CountJson(waits)}, {"batches", CountJson(batches)},  {"stages", stages}};
+        if (!frames.empty()) m["frames"] = frames;
+        timing[std::string(TimingModeName(mode))] = m;
+    }
+    return timing;
+}
 
 Summary Summarize(std::vector<double> samples) {
     Summary s;
@@ -84,7 +158,7 @@ LoopFigures MeasureLoop(const Scene& scene, const BackendRun& run) {
 StageRunCount CountStageRuns(const BackendRun& run, Stage stage) {
     StageRunCount count;
     for (const StepRecord& r : run.steps) {
-        if (r.stageMs[size_t(stage)]) {
+        if (r.Ran(stage)) {
             ++count.ran;
             if (Describe(stage).renderer) count.frames += r.framesRendered;
         } else if (r.skippedUnchanged[size_t(stage)]) {
@@ -169,7 +243,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
                         if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
-                            ms.push_back(f.ms);
+                            if (!f.pipelined) ms.push_back(f.ms);  // a pipelined frame's call time is host time
                             steps.push_back(r.step);
                             splats.push_back(f.stats.splats);
                             visited.push_back(f.stats.voxelsVisited);
@@ -196,7 +270,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
                         if (f.renderer == Stage::RenderMarch && f.camera == camera.name) {
-                            ms.push_back(f.ms);
+                            if (!f.pipelined) ms.push_back(f.ms);  // a pipelined frame's call time is host time
                             steps.push_back(r.step);
                             alphas.push_back(f.alpha);
                             samples.push_back(f.march.samples);
@@ -231,6 +305,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                                   {"min", s.min},
                                   {"max", s.max}};
         }
+        b["timing"] = TimingJson(scene, run);
         doc["backends"][run.name] = b;
     }
     return doc;
@@ -347,6 +422,52 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
                     : "");
             section.blocks.push_back(report::Paragraph{line});
         }
+    }
+    // Each timing mode's step (median [q1, q3]) and what it asked of the device (medians over its steps).
+    std::string modes;
+    for (TimingMode mode : {TimingMode::Pipelined, TimingMode::Synchronized}) {
+        const std::vector<const StepRecord*> steps = StepsIn(scene, run, mode);
+        if (steps.empty()) continue;
+        std::vector<double> ms, submissions, waits;
+        for (const StepRecord* r : steps) {
+            ms.push_back(r->stepMs);
+            submissions.push_back(double(r->submissions));
+            waits.push_back(double(r->hostWaits));
+        }
+        const Summary st = Summarize(ms);
+        const double sub = Summarize(submissions).median, wait = Summarize(waits).median;
+        std::snprintf(line, sizeof line, "%s: step %.3f ms [%.3f, %.3f] (%.4g submission%s, %.4g wait%s)",
+                      std::string(TimingModeName(mode)).c_str(), st.median, st.q1, st.q3, sub, sub == 1 ? "" : "s",
+                      wait, wait == 1 ? "" : "s");
+        modes += (modes.empty() ? "  " : "; ") + std::string(line);
+    }
+    if (!modes.empty()) section.blocks.push_back(report::Paragraph{modes});
+    if (!StepsIn(scene, run, TimingMode::Pipelined).empty()) {
+        // Pipelined, a stage's call time is the host's recording; its time is the device's.
+        bool anyDevice = false;
+        for (Stage stage : kAllStages)
+            anyDevice |=
+                scene.stages.Has(stage) && !StageSamples(scene, run, stage, true, TimingMode::Pipelined).empty();
+        std::string stages = anyDevice ? "  pipelined per stage, median device ms (host recording ms):"
+                                       : "  pipelined per stage, no device clock; median host recording ms:";
+        const char* sep = " ";
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            const std::vector<double> host = StageSamples(scene, run, stage, false, TimingMode::Pipelined);
+            if (host.empty()) continue;
+            const std::vector<double> device = StageSamples(scene, run, stage, true, TimingMode::Pipelined);
+            const std::string name(StageName(stage));
+            if (!anyDevice)
+                std::snprintf(line, sizeof line, "%s %.3f", name.c_str(), Summarize(host).median);
+            else if (device.empty())
+                std::snprintf(line, sizeof line, "%s - (%.3f)", name.c_str(), Summarize(host).median);
+            else
+                std::snprintf(line, sizeof line, "%s %.3f (%.3f)", name.c_str(), Summarize(device).median,
+                              Summarize(host).median);
+            stages += sep + std::string(line);
+            sep = ", ";
+        }
+        section.blocks.push_back(report::Paragraph{stages});
     }
     if (!run.steps.empty()) {
         std::string runs = "  stage runs (" + std::to_string(run.steps.size()) + " steps):";

@@ -68,6 +68,11 @@ struct StageRunCount {
 StageRunCount CountStageRuns(const BackendRun& run, Stage stage);
 
 nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs);
+// One backend's "timing" object of results.json (docs/results.md): the modes
+// its steps ran in, and per mode the steps after warm-up, their wall time,
+// submissions, host waits and batches, each stage's wall (synchronized) or
+// host recording (pipelined) time and device time, and each frame's.
+nlohmann::json TimingJson(const Scene& scene, const BackendRun& run);
 
 // One backend's section of `run`'s report: its device and steps, the
 // per-stage timing table (with each camera's frames) and the cover line.

@@ -114,6 +114,82 @@ void ChargeRestToFirstFrame(StepRecord& record) {
 
 }  // namespace
 
+std::string_view TimingModeName(TimingMode mode) {
+    return mode == TimingMode::Pipelined ? "pipelined" : "synchronized";
+}
+
+// An open batch: Close() ends it and gives each marked interval's device time
+// to its owner; a scope left without Close() (a failed call, an exception)
+// still ends the batch, and drops its times.
+class Simulation::BatchScope {
+  public:
+    explicit BatchScope(Simulation& sim) : mSim(sim) {}
+    ~BatchScope() {
+        if (!mOpen) return;
+        (void)mSim.mBackend.EndBatch();
+        mSim.mMarks.clear();
+        mSim.mBatchOpen = false;
+    }
+    BatchScope(const BatchScope&) = delete;
+    BatchScope& operator=(const BatchScope&) = delete;
+
+    Status Open(StepRecord& record) {
+        if (mSim.mBatchOpen) return MakeError("the harness opened a batch inside a batch");
+        CB_TRY(mSim.mBackend.BeginBatch());
+        mOpen = mSim.mBatchOpen = true;
+        ++record.batches;
+        return {};
+    }
+
+    Status Close() {
+        mOpen = mSim.mBatchOpen = false;
+        std::vector<MarkOwner> marks = std::move(mSim.mMarks);
+        mSim.mMarks.clear();
+        auto times = mSim.mBackend.EndBatch();
+        if (!times) return MakeError("ending a batch: " + times.error().message);
+        if (times->empty()) return {};  // no device clock
+        // One time per MarkBatch(); a backend may also report the (empty) interval before the first mark.
+        size_t first = 0;
+        if (times->size() == marks.size() + 1) first = 1;
+        if (times->size() - first != marks.size())
+            return MakeError(mSim.mBackend.Name() + ": a batch of " + std::to_string(marks.size()) +
+                             " marked calls returned " + std::to_string(times->size()) + " device times");
+        for (size_t i = 0; i < marks.size(); ++i) {
+            const MarkOwner& owner = marks[i];
+            const double ms = (*times)[first + i];
+            std::optional<double>& total = owner.record->deviceMs[size_t(owner.stage)];
+            total = total.value_or(0) + ms;
+            if (owner.frame && *owner.frame < owner.record->frames.size())
+                owner.record->frames[*owner.frame].deviceMs = ms;
+        }
+        return {};
+    }
+
+  private:
+    Simulation& mSim;
+    bool mOpen = false;
+};
+
+Status Simulation::Batched(StepRecord& record, const std::function<Status()>& work) {
+    if (!Pipelined() || mBatchOpen) return work();
+    BatchScope batch(*this);
+    CB_TRY(batch.Open(record));
+    CB_TRY(work());  // on failure the scope ends the batch
+    return batch.Close();
+}
+
+void Simulation::AddCallTimes(Stage stage, const StageCallRecord& call, StepRecord& target, size_t firstFrame) {
+    // A stage's (a renderer's: over its frames) time in a step is the sum over its calls.
+    std::optional<double>& wall = Pipelined() ? target.hostMs[size_t(stage)] : target.stageMs[size_t(stage)];
+    wall = wall.value_or(0) + call.ms;
+    if (call.deviceMs) target.deviceMs[size_t(stage)] = target.deviceMs[size_t(stage)].value_or(0) + *call.deviceMs;
+    for (const std::optional<size_t>& frame : call.marks) {
+        std::optional<size_t> index;
+        if (frame) index = firstFrame + *frame;
+        mMarks.push_back({&target, stage, index});
+    }
+}
+
 Status Simulation::RunStepStages(StepRecord& record, bool outputStep) {
     for (Stage stage : mSchedule) {
         const StageDescriptor& d = Describe(stage);
@@ -149,9 +225,13 @@ Status Simulation::RenderFrames(StepRecord& record, uint32_t frames, std::span<c
     for (uint32_t f = 0; f < frames; ++f) {
         const auto start = std::chrono::steady_clock::now();
         if (!work.empty()) record.frameWork.emplace_back();
-        if (f < work.size()) CB_TRY(RunShares(work[f], record, &record.frameWork.back()));
-        for (Stage stage : mSchedule)
-            if (Describe(stage).renderer) CB_TRY(RunStage(stage, record, f, frames));
+        // Time-sliced and pipelined, each frame is one batch (in an unsliced step the step's batch is open).
+        CB_TRY(Batched(record, [&]() -> Status {
+            if (f < work.size()) CB_TRY(RunShares(work[f], record, &record.frameWork.back()));
+            for (Stage stage : mSchedule)
+                if (Describe(stage).renderer) CB_TRY(RunStage(stage, record, f, frames));
+            return {};
+        }));
         record.frameMs.push_back(MsSince(start));
     }
     record.framesRendered = frames;
@@ -161,50 +241,73 @@ Status Simulation::RenderFrames(StepRecord& record, uint32_t frames, std::span<c
 Status Simulation::Step(StepRecord& record, const Observer& observe) {
     if (mScene.render.slicesPerFrame > 0) return SlicedStep(record, observe);
     const auto stepStart = std::chrono::steady_clock::now();
+    const SubmissionCounts countsBefore = mBackend.Submissions();
     double observerMs = 0;
     record = StepRecord{};
     record.step = mStep;
+    record.timing = mTiming;
     const bool outputStep = IsOutputStep(mStep);
-    CB_TRY(RunStepStages(record, outputStep));
-    bool renders = false;
-    for (Stage stage : mSchedule) renders |= Describe(stage).renderer;
-    // The frames between steps t-1 and t (seed 000 section 6.3): one per alpha of render.frames_per_step.
-    if (renders && outputStep) CB_TRY(RenderFrames(record, std::max(mScene.render.framesPerStep, 1u), {}));
+    // Everything up to the observer: the stages, then the frames between steps t-1 and t (seed 000 section 6.3),
+    // one per alpha of render.frames_per_step.
+    auto beforeObserver = [&]() -> Status {
+        CB_TRY(RunStepStages(record, outputStep));
+        bool renders = false;
+        for (Stage stage : mSchedule) renders |= Describe(stage).renderer;
+        if (renders && outputStep) CB_TRY(RenderFrames(record, std::max(mScene.render.framesPerStep, 1u), {}));
+        return {};
+    };
+    // The state advances, and the host updates the ellipsoid list (inside the batch: it overlaps the device's work).
+    auto afterObserver = [&]() -> Status {
+        for (Stage stage : mSchedule) {
+            const StageDescriptor& d = Describe(stage);
+            if (!d.advancesState) continue;
+            CB_TRY(RunStage(stage, record));
+            for (Resource r : d.writes) {
+                Slot& slot = mSlots[size_t(r)];
+                std::swap(slot.current[0], slot.next);
+                ++slot.version;
+            }
+        }
+        if (mScene.stages.Has(Stage::Region)) {
+            auto start = std::chrono::steady_clock::now();
+            mEllipsoids.Update();
+            record.ellipsoidUpdateMs = MsSince(start);
+        }
+        return {};
+    };
     if (observe) {
+        // The observer reads complete buffers: the batch ends before it and another holds the rest of the step.
+        CB_TRY(Batched(record, beforeObserver));
         const auto start = std::chrono::steady_clock::now();
         CB_TRY(observe(*this));
         observerMs = MsSince(start);
-    }
-
-    for (Stage stage : mSchedule) {
-        const StageDescriptor& d = Describe(stage);
-        if (!d.advancesState) continue;
-        CB_TRY(RunStage(stage, record));
-        for (Resource r : d.writes) {
-            Slot& slot = mSlots[size_t(r)];
-            std::swap(slot.current[0], slot.next);
-            ++slot.version;
-        }
-    }
-    if (mScene.stages.Has(Stage::Region)) {
-        auto start = std::chrono::steady_clock::now();
-        mEllipsoids.Update();
-        record.ellipsoidUpdateMs = MsSince(start);
+        CB_TRY(Batched(record, afterObserver));
+    } else {
+        CB_TRY(Batched(record, [&]() -> Status {
+            CB_TRY(beforeObserver());
+            return afterObserver();
+        }));
     }
     ++mStep;
     record.stepMs = MsSince(stepStart) - observerMs;
     ChargeRestToFirstFrame(record);
+    const SubmissionCounts countsAfter = mBackend.Submissions();
+    record.submissions = countsAfter.submissions - countsBefore.submissions;
+    record.hostWaits = countsAfter.hostWaits - countsBefore.hostWaits;
     return {};
 }
 
 Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     const auto stepStart = std::chrono::steady_clock::now();
+    const SubmissionCounts countsBefore = mBackend.Submissions();
     double observerMs = 0;
     record = StepRecord{};
     record.step = mStep;
+    record.timing = mTiming;
     const bool outputStep = IsOutputStep(mStep);
     if (mStep == 0) {
-        CB_TRY(RunStepStages(record, outputStep));  // nothing was computed ahead of the first step
+        // Nothing was computed ahead of the first step (pipelined: one batch, before the frames').
+        CB_TRY(Batched(record, [&] { return RunStepStages(record, outputStep); }));
     } else {
         CommitAhead(record);
     }
@@ -216,8 +319,12 @@ Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     if (renders) {
         const uint32_t frames = std::max<uint32_t>(std::max(mScene.render.framesPerStep, 1u), uint32_t(work.size()));
         CB_TRY(RenderFrames(record, frames, work));
-    } else {
-        for (const FrameTasks& tasks : work) CB_TRY(RunShares(tasks, record));
+    } else if (!work.empty()) {
+        // No frames to measure: the next step's work is one batch.
+        CB_TRY(Batched(record, [&]() -> Status {
+            for (const FrameTasks& tasks : work) CB_TRY(RunShares(tasks, record));
+            return {};
+        }));
     }
     if (observe) {
         const auto start = std::chrono::steady_clock::now();
@@ -227,6 +334,9 @@ Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     ++mStep;
     record.stepMs = MsSince(stepStart) - observerMs;
     ChargeRestToFirstFrame(record);
+    const SubmissionCounts countsAfter = mBackend.Submissions();
+    record.submissions = countsAfter.submissions - countsBefore.submissions;
+    record.hostWaits = countsAfter.hostWaits - countsBefore.hostWaits;
     return {};
 }
 
@@ -288,12 +398,11 @@ Status Simulation::RunShares(const FrameTasks& tasks, StepRecord& record, std::s
         const bool advances = Describe(stage).advancesState;
         // The automaton's share of step t is step t's work; the rest computes step t+1.
         const uint32_t step = advances ? mStep : mStep + 1;
-        StageHostInputs host{step, mRasterAhead, 0, 0, task.slices};
+        StageHostInputs host{step, mRasterAhead, 0, 0, task.slices, mBatchOpen};
         StageCallRecord call;
         CB_TRY(CallStage(stage, mBackend, mScene, host, advances ? Buffers() : AheadBuffers(), call));
         StepRecord& target = advances ? record : mAhead;
-        target.stageMs[size_t(stage)] = target.stageMs[size_t(stage)].value_or(0) + call.ms;
-        if (call.deviceMs) target.deviceMs[size_t(stage)] = target.deviceMs[size_t(stage)].value_or(0) + *call.deviceMs;
+        AddCallTimes(stage, call, target, target.frames.size());
         // The shares of density count the covered columns of their rows of tiles.
         if (call.coveredColumns) target.coveredColumns = target.coveredColumns.value_or(0) + *call.coveredColumns;
         if (!describe) continue;
@@ -320,6 +429,7 @@ void Simulation::CommitAhead(StepRecord& record) {
     }
     if (mScene.stages.Has(Stage::Region)) mRaster = mRasterAhead;
     record.stageMs = mAhead.stageMs;
+    record.hostMs = mAhead.hostMs;
     record.deviceMs = mAhead.deviceMs;
     record.skippedUnchanged = mAhead.skippedUnchanged;
     if (mAhead.coveredColumns) mLastCoveredColumns = mAhead.coveredColumns;
@@ -351,14 +461,9 @@ StageBuffers Simulation::AheadBuffers() {
 Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame, uint32_t frames) {
     if (stage == Stage::Region) mRaster = mEllipsoids.Raster();
     StageCallRecord call;
-    StageHostInputs host{mStep, mRaster, frame, frames, {}};
+    StageHostInputs host{mStep, mRaster, frame, frames, {}, mBatchOpen};
     CB_TRY(CallStage(stage, mBackend, mScene, host, Buffers(), call));
-    // A renderer's time in a step is the sum over its frames.
-    auto add = [](std::optional<double>& total, const std::optional<double>& part) {
-        if (part) total = total.value_or(0) + *part;
-    };
-    add(record.stageMs[size_t(stage)], call.ms);
-    add(record.deviceMs[size_t(stage)], call.deviceMs);
+    AddCallTimes(stage, call, record, record.frames.size());
     if (call.coveredColumns) record.coveredColumns = mLastCoveredColumns = call.coveredColumns;
     for (FrameRecord& drawn : call.frames) record.frames.push_back(std::move(drawn));
     if (Describe(stage).renderer) mLastRendered = mStep;

@@ -47,11 +47,33 @@
 
 namespace cb {
 
+// How a step is timed (docs/performance.md, "Two ways to time a step").
+//   Synchronized  the thesis's way: every stage call completes before the next;
+//                 each stage has a wall time (and a device time where measured).
+//   Pipelined     the step (time-sliced: each frame) is one batch of the backend
+//                 (Backend::BeginBatch .. EndBatch): calls are recorded, the device
+//                 runs them at its pace and the host waits once, at the end.
+//                 A stage's wall time is then only the host's recording time
+//                 (StepRecord::hostMs); its device time comes from the batch's
+//                 marked intervals.
+enum class TimingMode : uint8_t { Synchronized, Pipelined };
+// "synchronized", "pipelined".
+std::string_view TimingModeName(TimingMode mode);
+
 struct StepRecord {
     uint32_t step = 0;
-    // Wall time of each stage in ms; empty for stages that did not run.
+    // How the step was timed.
+    TimingMode timing = TimingMode::Synchronized;
+    // Wall time of each stage in ms, measured synchronized; empty for stages
+    // that did not run, and for stages measured pipelined (see hostMs).
     std::array<std::optional<double>, kStageCount> stageMs{};
-    // Device time of each stage in ms, where the backend measures it.
+    // Pipelined: the host's time recording each stage's calls, ms (the calls
+    // return before their work is done, so this is not the stage's time).
+    // Exactly one of stageMs and hostMs is set for a stage that ran.
+    std::array<std::optional<double>, kStageCount> hostMs{};
+    // Device time of each stage in ms, where the backend measures it:
+    // synchronized, LastDeviceMs() after each call; pipelined, the batch's
+    // intervals (Backend::EndBatch) of the stage's calls.
     std::array<std::optional<double>, kStageCount> deviceMs{};
     // Stages that skipped this step because none of their inputs (the sun's
     // direction included) changed since they last ran (skipsUnchangedInputs).
@@ -66,7 +88,15 @@ struct StepRecord {
     // Time-sliced: what each frame computed, e.g. "ca 4-7" or "region 0-3, ellipsoids" ("" for none).
     std::vector<std::string> frameWork;
     // Wall time of the whole step (stages, frames and host work; not the observer), ms.
+    // Pipelined, it includes the wait at the end of each batch.
     double stepMs = 0;
+    // What the step asked of the device: the difference of Backend::Submissions()
+    // over the step (the observer's reads included), and the batches it opened.
+    uint64_t submissions = 0, hostWaits = 0;
+    uint32_t batches = 0;
+
+    // Whether the stage ran in this step (measured in either mode).
+    bool Ran(Stage stage) const { return stageMs[size_t(stage)] || hostMs[size_t(stage)]; }
 };
 
 class Simulation {
@@ -79,8 +109,17 @@ class Simulation {
                                                       bool everyStepOutputs = false);
 
     using Observer = std::function<Status(const Simulation&)>;
-    // Runs step CurrentStep() and advances to the next.
+    // Runs step CurrentStep() and advances to the next, timed as Timing() says.
+    // Pipelined: one batch per step (time-sliced: per frame, and one for the
+    // work outside frames); MarkBatch() before every backend call of a stage
+    // (a renderer's: each camera's frame); an observer ends the batch before it
+    // and opens another for the rest of the step. A failed call still ends its
+    // batch, and the step reports the call's error.
     Status Step(StepRecord& record, const Observer& observe = {});
+
+    // The timing of the following steps (default: synchronized).
+    void SetTiming(TimingMode mode) { mTiming = mode; }
+    TimingMode Timing() const { return mTiming; }
 
     uint32_t CurrentStep() const { return mStep; }
     const Scene& GetScene() const { return mScene; }
@@ -153,6 +192,20 @@ class Simulation {
     Status RunShares(const FrameTasks& tasks, StepRecord& record, std::string* describe = nullptr);
     // Makes the next step's values current (the start of a time-sliced step).
     void CommitAhead(StepRecord& record);
+    // Pipelined timing: one open batch and the owner of each of its marked
+    // intervals, in call order (a stage of a record, and its frame for a renderer).
+    struct MarkOwner {
+        StepRecord* record = nullptr;
+        Stage stage = Stage::Region;
+        std::optional<size_t> frame;  // index in record->frames
+    };
+    class BatchScope;
+    // Runs `work` inside one batch when the timing is pipelined, else as it is.
+    Status Batched(StepRecord& record, const std::function<Status()>& work);
+    // Records a call's times in `target`: its marks (pipelined) or its wall time
+    // (synchronized); `firstFrame` is where the call's frames start in target.frames.
+    void AddCallTimes(Stage stage, const StageCallRecord& call, StepRecord& target, size_t firstFrame);
+    bool Pipelined() const { return mTiming == TimingMode::Pipelined; }
     StageBuffers Buffers();
     // Buffers as the next step's stages see them: resources being computed ahead read and write their third set.
     StageBuffers AheadBuffers();
@@ -175,6 +228,9 @@ class Simulation {
     // Time-sliced: the next step's ellipsoids, and what its stages recorded (merged into its record when it starts).
     std::vector<RasterEllipsoid> mRasterAhead;
     StepRecord mAhead;
+    TimingMode mTiming = TimingMode::Synchronized;
+    bool mBatchOpen = false;
+    std::vector<MarkOwner> mMarks;
 };
 
 }  // namespace cb

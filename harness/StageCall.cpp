@@ -16,14 +16,23 @@ namespace {
 // Runs one backend call, adding its wall and device time to the record.
 // Under callgrind the call alone (not the clock reads) is counted as one dump
 // named by `label` (harness/perf/CallgrindRequests.h).
+// With host.markBatch (pipelined timing) it first starts the batch's next
+// interval, owned by `frame` (an index in record.frames, or the stage), and
+// takes no device time: LastDeviceMs() means nothing in a batch.
 template <typename Fn>
-Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& label, Fn&& call) {
+Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& label, bool markBatch,
+             std::optional<size_t> frame, Fn&& call) {
     const CallgrindStageBracket counted(label);
+    if (markBatch) {
+        backend.MarkBatch();
+        record.marks.push_back(frame);
+    }
     const auto start = std::chrono::steady_clock::now();
     counted.Begin();
     Status status = call();
     counted.End();
     record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (markBatch) return status;
     if (auto device = backend.LastDeviceMs()) record.deviceMs = record.deviceMs.value_or(0) + *device;
     return status;
 }
@@ -42,11 +51,15 @@ Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, const
         frame.camera = sc.render.cameras[n].name;
         frame.frame = host.frame;
         frame.alpha = sc.render.FrameAlpha(host.frame, host.frames);
+        frame.pipelined = host.markBatch;
         const double before = record.ms;
+        const std::optional<double> deviceBefore = record.deviceMs;
         const StageCountLabel label{StageName(renderer), backendName, step, frame.camera};
-        auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
+        const size_t index = record.frames.size();
+        auto timed = [&](auto&& call) { return Timed(backend, record, label, host.markBatch, index, call); };
         Status status = renderOne(n, frame, timed);
         frame.ms = record.ms - before;
+        if (record.deviceMs) frame.deviceMs = *record.deviceMs - deviceBefore.value_or(0);
         if (!status)
             return MakeError(std::string(StageName(renderer)) + " (" + frame.camera + "): " + status.error().message);
         record.frames.push_back(frame);
@@ -94,7 +107,7 @@ Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInput
             StageCallRecord& record) {
     const std::string backendName = backend.Name();
     const StageCountLabel label{StageName(stage), backendName, host.step, ""};
-    auto timed = [&](auto&& call) { return Timed(backend, record, label, call); };
+    auto timed = [&](auto&& call) { return Timed(backend, record, label, host.markBatch, std::nullopt, call); };
     switch (stage) {
         case Stage::Region:
             return timed([&] { return backend.Region(host.raster, *io.Current(Resource::Region), host.slices); });

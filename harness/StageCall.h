@@ -44,6 +44,8 @@ struct StageHostInputs {
     uint32_t frames = 0;
     // Region, ca, smooth, density and shade: the share of the stage to compute (time-slicing; core/Backend.h).
     SliceRange slices;
+    // Pipelined timing: call backend.MarkBatch() before each backend call (StageCallRecord::marks).
+    bool markBatch = false;
 };
 
 // One rendered image.
@@ -52,7 +54,10 @@ struct FrameRecord {
     std::string camera;
     uint32_t frame = 0;  // the frame of its step (render.frames_per_step)
     float alpha = 0;     // the interpolation weight it was drawn with
+    // Wall time of its call, ms; pipelined (markBatch), the host's recording time.
     double ms = 0;
+    bool pipelined = false;          // drawn in a batch (pipelined timing)
+    std::optional<double> deviceMs;  // its device time, where the backend measures it
     SplatStats stats;
     MarchStats march;  // render_march's counters
 };
@@ -60,9 +65,12 @@ struct FrameRecord {
 // What one call measured and returned besides its buffers.
 struct StageCallRecord {
     double ms = 0;                           // wall time of the backend's calls
-    std::optional<double> deviceMs;          // where the backend measures it
+    std::optional<double> deviceMs;          // where the backend measures it (not with markBatch)
     std::optional<uint32_t> coveredColumns;  // density
     std::vector<FrameRecord> frames;         // renderers, one per camera
+    // With markBatch: one entry per MarkBatch() the call made, in order: the
+    // index in `frames` of the frame it drew, or nullopt for a stage's own call.
+    std::vector<std::optional<size_t>> marks;
 };
 
 // Runs `stage` on `backend`. The buffers must hold every resource the stage's

@@ -51,9 +51,11 @@ ErrorStats ErrorStatsFromJson(const json& j) {
 }  // namespace
 
 json ToJson(const StepRecord& r) {
-    json stageMs = json::array(), deviceMs = json::array(), frames = json::array(), skipped = json::array();
+    json stageMs = json::array(), hostMs = json::array(), deviceMs = json::array(), frames = json::array(),
+         skipped = json::array();
     for (size_t s = 0; s < kStageCount; ++s) {
         stageMs.push_back(Optional(r.stageMs[s]));
+        hostMs.push_back(Optional(r.hostMs[s]));
         deviceMs.push_back(Optional(r.deviceMs[s]));
         skipped.push_back(r.skippedUnchanged[s]);
     }
@@ -63,6 +65,8 @@ json ToJson(const StepRecord& r) {
                           {"frame", f.frame},
                           {"alpha", D(f.alpha)},
                           {"ms", D(f.ms)},
+                          {"pipelined", f.pipelined},
+                          {"device_ms", Optional(f.deviceMs)},
                           {"splats", f.stats.splats},
                           {"voxels_visited", f.stats.voxelsVisited},
                           {"fragments", f.stats.fragments},
@@ -76,7 +80,12 @@ json ToJson(const StepRecord& r) {
     json frameMs = json::array();
     for (double ms : r.frameMs) frameMs.push_back(D(ms));
     return {{"step", r.step},
+            {"timing", TimingModeName(r.timing)},
             {"stage_ms", stageMs},
+            {"host_ms", hostMs},
+            {"submissions", r.submissions},
+            {"host_waits", r.hostWaits},
+            {"batches", r.batches},
             {"device_ms", deviceMs},
             {"ellipsoid_update_ms", D(r.ellipsoidUpdateMs)},
             {"covered_columns", Optional(r.coveredColumns)},
@@ -94,7 +103,12 @@ StepRecord StepFromJson(const json& j) {
     for (size_t s = 0; s < kStageCount; ++s) {
         r.stageMs[s] = OptionalFrom<double>(j.at("stage_ms").at(s));
         r.deviceMs[s] = OptionalFrom<double>(j.at("device_ms").at(s));
+        r.hostMs[s] = OptionalFrom<double>(j.at("host_ms").at(s));
     }
+    r.timing = j.at("timing").get<std::string>() == "pipelined" ? TimingMode::Pipelined : TimingMode::Synchronized;
+    r.submissions = j.at("submissions").get<uint64_t>();
+    r.hostWaits = j.at("host_waits").get<uint64_t>();
+    r.batches = j.at("batches").get<uint32_t>();
     r.ellipsoidUpdateMs = FromD(j.at("ellipsoid_update_ms"));
     r.coveredColumns = OptionalFrom<uint32_t>(j.at("covered_columns"));
     for (size_t s = 0; s < kStageCount; ++s) r.skippedUnchanged[s] = j.at("skipped_unchanged").at(s).get<bool>();
@@ -109,6 +123,8 @@ StepRecord StepFromJson(const json& j) {
         frame.frame = f.at("frame").get<uint32_t>();
         frame.alpha = float(FromD(f.at("alpha")));
         frame.ms = FromD(f.at("ms"));
+        frame.pipelined = f.at("pipelined").get<bool>();
+        frame.deviceMs = OptionalFrom<double>(f.at("device_ms"));
         frame.stats = {f.at("splats").get<uint64_t>(), f.at("voxels_visited").get<uint64_t>(),
                        f.at("fragments").get<uint64_t>()};
         if (const auto m = f.find("march"); m != f.end())

@@ -35,8 +35,35 @@ Options:
 )";
 constexpr const char* kHelpTail = R"(                     (the contexts and layouts: docs/cli.md; cloudbench devices)
   --quiet            no progress lines
+  --timing MODE      how a step is timed (docs/performance.md, "Two ways to time a
+                     step"): synchronized (default; the thesis's way: each stage
+                     completes before the next, per-stage wall and device times),
+                     pipelined (a step, time-sliced a frame, is one batch with one
+                     wait; per-stage device times from timestamps inside it), or
+                     both (even steps synchronized, odd steps pipelined, each
+                     reported apart)
 )";
 const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail + IsolationOptionsHelp();
+
+// The timing of step t under --timing `choice` (validated when parsed).
+TimingMode StepTiming(const std::string& choice, uint32_t t) {
+    if (choice == "pipelined") return TimingMode::Pipelined;
+    if (choice == "both") return t % 2 == 1 ? TimingMode::Pipelined : TimingMode::Synchronized;
+    return TimingMode::Synchronized;
+}
+
+std::vector<OptionSpec> RunOptions() {
+    std::vector<OptionSpec> options = IsolationOptions();
+    options.push_back({"--timing", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                           const std::string value = v ? v : "";
+                           if (value != "synchronized" && value != "pipelined" && value != "both")
+                               return "--timing: must be synchronized, pipelined or both" +
+                                      (v ? " (got '" + value + "')" : std::string());
+                           o.timing = value;
+                           return std::nullopt;
+                       }});
+    return options;
+}
 
 // Steps the simulation to the end, then writes the last frame of each camera
 // and the top view; whatever fails is recorded in `run` and the rest goes on.
@@ -56,6 +83,7 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
     Progress progress(run.name, scene.steps, session.Options().quiet);
     for (uint32_t t = 0; t < scene.steps; ++t) {
         StepRecord record;
+        (*sim)->SetTiming(StepTiming(session.Options().timing, t));
         if (Status status = (*sim)->Step(record); !status) {
             run.status = "failed";
             run.error = "step " + std::to_string(t) + ": " + status.error().message;
@@ -237,7 +265,7 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 0,
     .keepsWarmup = true,
-    .extraOptions = IsolationOptions(),
+    .extraOptions = RunOptions(),
     .run = Run,
 });
 
