@@ -26,7 +26,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     }
     const GLint y0 = GLint(t0 * params.tile);
     const GLsizei rows = GLsizei(std::min(e.ny, t1 * params.tile)) - y0;
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
 
     // D: additive blending of the slices, k ascending.
@@ -42,7 +42,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
     for (uint32_t k = 0; k < e.nz; ++k) {
         f.Uniform1i(sumLayer, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        Draw(GL_TRIANGLES, 0, 3);
     }
     f.Disable(GL_BLEND);
 
@@ -59,7 +59,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
     f.Uniform1i(f.GetUniformLocation(*cover, "fromCld"), cld ? 1 : 0);
     f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    Draw(GL_TRIANGLES, 0, 3);
 
     // Occupancy: max-downsampling to tiles (from D) and to tile x band (from q).
     f.UseProgram(*occupancy);
@@ -73,12 +73,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     CB_TRY(DrawLayers(*occupancy, bandCount, {Tex(*out.bands).Texture()}));
     f.Uniform1i(mode, 1);
     CB_TRY(BindTargets({{Tex(*out.tiles).Texture(), 0}}));
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    Draw(GL_TRIANGLES, 0, 3);
 
     f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     GLuint covered = 0;
-    f.GetNamedBufferSubData(counter, 0, sizeof covered, &covered);
+    WaitingRead(ReadKind::Buffer, counter, 0, 0, 0, sizeof covered, &covered);  // a host wait inside a batch
     out.coveredColumns = covered;
     return mContext->Check("density");
 }

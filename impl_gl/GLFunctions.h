@@ -64,6 +64,7 @@
     X(PFNGLDRAWARRAYSPROC, DrawArrays)                                         \
     X(PFNGLPIXELSTOREIPROC, PixelStorei)                                       \
     X(PFNGLFINISHPROC, Finish)                                                 \
+    X(PFNGLFLUSHPROC, Flush)                                                   \
     X(PFNGLGENQUERIESPROC, GenQueries)                                         \
     X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                   \
     X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \

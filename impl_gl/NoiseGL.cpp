@@ -25,14 +25,14 @@ Status BackendGL::Noise(const NoiseParams& params, Buffer& q) {
     }
     const std::array<float, 8> offsets = noise::GpuOffsets(mNoiseForm->Offsets(params.step));
     const Extent3 e = params.grid;
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ScratchBuffer(GlScratchBuffer::NoiseData, 0));
     f.Uniform1fv(f.GetUniformLocation(*program, "offsets"), 8, offsets.data());
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     CB_TRY(DrawLayers(*program, e.nz, {Tex(q).Texture()}));
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("noise");
 }
 

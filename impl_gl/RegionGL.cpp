@@ -12,7 +12,7 @@ Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     if (!program) return std::unexpected(program.error());
     const Extent3 e = region.Extent();
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
-    GpuTimer timer(f);
+    Timing timer(*this);
     const GLuint list = ScratchBuffer(GlScratchBuffer::EllipsoidList, ellipsoids.size_bytes());
     if (!ellipsoids.empty()) f.NamedBufferSubData(list, 0, GLsizeiptr(ellipsoids.size_bytes()), ellipsoids.data());
     const GLuint unorm =
@@ -36,13 +36,13 @@ Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     for (uint32_t k = k0; k < k1 && !ellipsoids.empty(); ++k) {
         CB_TRY(BindTargets({{unorm, int(k)}}));
         f.Uniform1i(layer, GLint(k));
-        f.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(ellipsoids.size()));
+        Draw(GL_TRIANGLE_STRIP, 0, 4, GLsizei(ellipsoids.size()));
     }
     f.Disable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
     f.CopyImageSubData(unorm, GL_TEXTURE_2D_ARRAY, 0, 0, 0, GLint(k0), Tex(region).Texture(), GL_TEXTURE_2D_ARRAY, 0, 0,
                        0, GLint(k0), GLsizei(e.nx), GLsizei(e.ny), GLsizei(k1 - k0));
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("region");
 }
 

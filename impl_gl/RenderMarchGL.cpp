@@ -57,7 +57,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t B = block.flags[3];
     const auto brickCounts = MarchBrickCounts(e, B);
 
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     const GLuint counters = ScratchBuffer(GlScratchBuffer::MarchCounters, 9 * 4);
     const uint32_t zero[9] = {};
@@ -130,14 +130,14 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
     f.BindTextureUnit(3, Tex(params.ground.on ? *in.G : *in.qCur).Texture());
     f.Viewport(0, 0, GLsizei(W), GLsizei(H));
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    Draw(GL_TRIANGLES, 0, 3);
 
     CopyTargetToImage(target, W, H, GlScratchBuffer::MarchImageCopy, image);
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     if (stats) {
         f.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         uint32_t words[9] = {};
-        f.GetNamedBufferSubData(counters, 0, sizeof words, words);
+        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof words, words);
         const auto wide = [&words](int n) { return uint64_t(words[2 * n]) | uint64_t(words[2 * n + 1]) << 32; };
         *stats = {};
         stats->rays = wide(0);

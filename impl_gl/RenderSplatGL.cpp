@@ -73,7 +73,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.GetFloatv(GL_POINT_SIZE_RANGE, pointRange);
     constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
 
-    GpuTimer timer(f);
+    Timing timer(*this);
     const GLuint orderBuffer = ScratchBuffer(GlScratchBuffer::SplatOrder, flat.indices.size() * 4);
     f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
     // The shared frame; this backend's lane: the largest point size.
@@ -96,7 +96,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
         f.BindTextureUnit(3, Tex(*in.G).Texture());
         f.Viewport(0, 0, GLsizei(W), GLsizei(H));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        Draw(GL_TRIANGLES, 0, 3);
     } else {
         const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
         f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
@@ -119,18 +119,17 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         f.GenQueries(1, &fragments);
         f.BeginQuery(GL_SAMPLES_PASSED, fragments);
     }
-    if (!firsts.empty()) f.MultiDrawArrays(GL_POINTS, firsts.data(), counts.data(), GLsizei(firsts.size()));
+    if (!firsts.empty()) MultiDraw(GL_POINTS, firsts.data(), counts.data(), GLsizei(firsts.size()));
     if (stats) f.EndQuery(GL_SAMPLES_PASSED);
     f.Disable(GL_BLEND);
     f.Disable(GL_PROGRAM_POINT_SIZE);
     CopyTargetToImage(target, W, H, GlScratchBuffer::ImageCopy, image);
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     if (stats) {
-        GLuint64 passed = 0;
-        f.GetQueryObjectui64v(fragments, GL_QUERY_RESULT, &passed);
+        const GLuint64 passed = QueryResult(fragments);
         f.DeleteQueries(1, &fragments);
         uint32_t drawn = 0;
-        f.GetNamedBufferSubData(counters, 0, sizeof drawn, &drawn);
+        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof drawn, &drawn);
         stats->splats = drawn;
         stats->voxelsVisited = visited;
         stats->fragments = passed;
@@ -151,6 +150,8 @@ void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScrat
     f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
     f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    // The pixel buffer keeps the canonical image: a Download reads it without a texture read back (issue 16).
+    KeepImageCopy(image, slot, imageBytes);
 }
 
 }  // namespace cb::gl
