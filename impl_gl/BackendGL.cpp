@@ -220,11 +220,36 @@ Status BackendGL::BindTargets(std::span<const std::pair<GLuint, int>> targets) {
 }
 
 Status BackendGL::DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures) {
-    return DrawLayers(program, layers, textures, [](uint32_t) {});
+    return DrawLayerRange(program, 0, layers, textures);
 }
 
 Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures) {
-    return DrawLayerRange(program, begin, end, textures, [](uint32_t) {});
+    if (!IsLayered(program)) return DrawLayerRange(program, begin, end, textures, [](uint32_t) {});
+    if (begin >= end) return {};
+    std::array<std::pair<GLuint, int>, 4> targets;
+    if (textures.size() > targets.size()) return MakeError("gl: a pass has more than 4 render targets");
+    size_t n = 0;
+    for (GLuint texture : textures) targets[n++] = {texture, -1};  // the whole array: a layered target
+    CB_TRY(BindTargets(std::span(targets.data(), n)));
+    const Functions& f = mContext->F();
+    f.Uniform1i(f.GetUniformLocation(program, "layer0"), GLint(begin));
+    Draw(GL_TRIANGLES, 0, 3, GLsizei(end - begin));
+    return {};
+}
+
+Result<GLuint> BackendGL::PassProgram(const std::string& name, const std::string& defines) {
+    if (Layered()) {
+        if (auto layered = mContext->LayeredProgram(name, defines)) {
+            if (!IsLayered(*layered)) mLayeredPrograms.push_back(*layered);
+            return layered;
+        }
+        mLayeredFailed = true;  // this driver cannot: every pass draws per slice from now on
+    }
+    return mContext->Program(name, defines);
+}
+
+bool BackendGL::IsLayered(GLuint program) const {
+    return std::find(mLayeredPrograms.begin(), mLayeredPrograms.end(), program) != mLayeredPrograms.end();
 }
 
 Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Extent3 extent) {

@@ -69,6 +69,11 @@ class BackendGL final : public Backend {
     // Draw calls issued since the backend was made (a multi-draw counts once):
     // the per-pass overhead of issue 16.
     uint64_t Draws() const { return mDraws; }
+    // Whether full-screen passes over slices are one layered, instanced draw
+    // (GLContext::LayeredProgram) where the driver can, or one draw per slice
+    // (the thesis's way; for comparison). On by default; both give the same bytes.
+    void SetLayered(bool layered) { mLayered = layered; }
+    bool Layered() const { return mLayered && !mLayeredFailed; }
 
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
@@ -213,8 +218,13 @@ class BackendGL final : public Backend {
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer) {
         return DrawLayerRange(program, 0, layers, textures, std::forward<PerLayer>(perLayer));
     }
+    // Without perLayer, a program from PassProgram may be layered: then one
+    // instanced draw into the whole textures covers the layers.
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures);
     Status DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures);
+    // The program of full-screen pass `name`: layered where Layered(), else per slice.
+    Result<GLuint> PassProgram(const std::string& name, const std::string& defines = "");
+    bool IsLayered(GLuint program) const;
     Status CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
     Status CaStepRgba8Share(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
 
@@ -222,6 +232,8 @@ class BackendGL final : public Backend {
     bool mRgba8 = false;
     std::optional<double> mLastDeviceMs;
     SubmissionCounts mCounts;
+    bool mLayered = true, mLayeredFailed = false;
+    std::vector<GLuint> mLayeredPrograms;
     uint64_t mDraws = 0;
     bool mPending = false;  // work recorded since the last submission
     bool mIdle = true;      // no work recorded since the host last waited for the device

@@ -16,6 +16,7 @@ inline const BufferGL& Tex(const Buffer& b) { return static_cast<const BufferGL&
 template <typename PerLayer>
 Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures,
                                  PerLayer&& perLayer) {
+    if (IsLayered(program)) return MakeError("gl: a layered pass cannot set uniforms per layer");
     const Functions& f = mContext->F();
     const GLint layerUniform = f.GetUniformLocation(program, "layer");
     std::array<std::pair<GLuint, int>, 4> targets;

@@ -8,7 +8,7 @@ namespace cb::gl {
 
 Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
     const Functions& f = mContext->F();
-    auto program = mContext->Program("ca_init");
+    auto program = PassProgram("ca_init");
     if (!program) return std::unexpected(program.error());
     const Extent3 e = out.hum->Extent();
     Timing timer(*this);
@@ -30,7 +30,7 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         return params.slices.IsWhole(in.hum->Extent().nz) ? CaStepRgba8(params, in, region, out)
                                                           : CaStepRgba8Share(params, in, region, out);
     const Functions& f = mContext->F();
-    auto rules = mContext->Program("ca");
+    auto rules = PassProgram("ca");
     if (!rules) return std::unexpected(rules.error());
     auto advect = mContext->Program("advect");
     if (!advect) return std::unexpected(advect.error());

@@ -7,11 +7,11 @@ namespace cb::gl {
 Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
     const Functions& f = mContext->F();
-    auto sum = mContext->Program("density_sum");
+    auto sum = PassProgram("density_sum");
     if (!sum) return std::unexpected(sum.error());
     auto cover = mContext->Program("density_cover");
     if (!cover) return std::unexpected(cover.error());
-    auto occupancy = mContext->Program("occupancy");
+    auto occupancy = PassProgram("occupancy");
     if (!occupancy) return std::unexpected(occupancy.error());
     const Extent3 e = q.Extent();
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
@@ -39,10 +39,17 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
     f.BlendFunc(GL_ONE, GL_ONE);
-    const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        f.Uniform1i(sumLayer, GLint(k));
-        Draw(GL_TRIANGLES, 0, 3);
+    if (IsLayered(*sum)) {
+        // One instance per slice into the one target (not layered: gl_Layer is
+        // ignored); blending follows the instances' order, k ascending.
+        f.Uniform1i(f.GetUniformLocation(*sum, "layer0"), 0);
+        Draw(GL_TRIANGLES, 0, 3, GLsizei(e.nz));
+    } else {
+        const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
+        for (uint32_t k = 0; k < e.nz; ++k) {
+            f.Uniform1i(sumLayer, GLint(k));
+            Draw(GL_TRIANGLES, 0, 3);
+        }
     }
     f.Disable(GL_BLEND);
 

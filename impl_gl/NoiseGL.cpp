@@ -13,7 +13,7 @@ Status BackendGL::Noise(const NoiseParams& params, Buffer& q) {
     if (q.Format() != BufferFormat::F32 || !(q.Extent() == params.grid))
         return MakeError("gl: noise: q must be an F32 volume of the grid's size");
     const Functions& f = mContext->F();
-    auto program = mContext->Program("noise");
+    auto program = PassProgram("noise");
     if (!program) return std::unexpected(program.error());
     if (!mNoiseForm || !(mNoiseForm->Settings() == *params.settings) || !(mNoiseForm->Grid() == params.grid)) {
         mNoiseForm.reset();

@@ -32,7 +32,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_march: the image is not (3, width, height)");
     const Functions& f = mContext->F();
-    auto volumeProgram = mContext->Program("march_volume");
+    auto volumeProgram = PassProgram("march_volume");
     if (!volumeProgram) return std::unexpected(volumeProgram.error());
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "gl: render_march"));
     const MarchGpu block = MakeMarchGpu(params, e);
@@ -43,7 +43,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     if (!marchProgram) return std::unexpected(marchProgram.error());
     Result<GLuint> bricksProgram = GLuint(0);
     if (params.skipping) {
-        bricksProgram = mContext->Program("march_bricks");
+        bricksProgram = PassProgram("march_bricks");
         if (!bricksProgram) return std::unexpected(bricksProgram.error());
     }
 

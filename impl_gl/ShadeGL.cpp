@@ -19,9 +19,9 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const Functions& f = mContext->F();
     auto slice = mContext->Program("shade_slice");
     if (!slice) return std::unexpected(slice.error());
-    auto up = mContext->Program("shade_up");
+    auto up = PassProgram("shade_up");
     if (!up) return std::unexpected(up.error());
-    auto down = mContext->Program("shade_down");
+    auto down = PassProgram("shade_down");
     if (!down) return std::unexpected(down.error());
     const Extent3 e = q.Extent();
     const ShadePlan plan = MakeShadePlan(params, e);

@@ -14,7 +14,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     GLuint passes[3];
     const char* names[3] = {"smooth_x", "smooth_y", "smooth_z"};
     for (int n = 0; n < 3; ++n) {
-        auto program = mContext->Program(names[n]);
+        auto program = PassProgram(names[n]);
         if (!program) return std::unexpected(program.error());
         passes[n] = *program;
     }

@@ -260,6 +260,58 @@ TEST(PipelinedGL, ImageDownloadFromThePixelBufferIsNeverStale) {
 }
 
 #if CLOUDBENCH_HAVE_GL
+// Layered passes (issue 16 item 3): one instanced draw over the slices gives
+// the bytes of one draw per slice, and the draws per call drop to what the
+// passes need: ca init 1 (not nz), a step without wind 1, smooth 3 (not 3 nz),
+// density 4 (sum, cover, bands, tiles; not nz + bands + 2), shade's
+// up-sampling 1 (not nz); region keeps one per slice.
+TEST(PipelinedGL, LayeredPassesGiveTheBytesOfOneDrawPerSlice) {
+    auto madeA = gl::BackendGL::Create(), madeB = gl::BackendGL::Create();
+    if (!madeA || !madeB) GTEST_SKIP() << "no gl backend here";
+    gl::BackendGL &layered = **madeA, &perSlice = **madeB;
+    perSlice.SetLayered(false);
+    const PipeInputs in;
+    PipeStep a = PipeBuffers(layered), s = PipeBuffers(perSlice);
+    std::vector<uint64_t> draws[2];
+    auto run = [&](gl::BackendGL& b, PipeStep& step, std::vector<uint64_t>& d) {
+        static gl::BackendGL* current = nullptr;
+        static std::vector<uint64_t>* out = nullptr;
+        static uint64_t last = 0;
+        current = &b, out = &d, last = b.Draws();
+        return PipeRun(b, in, step, true, [](Backend&) {
+            out->push_back(current->Draws() - last);
+            last = current->Draws();
+        });
+    };
+    ASSERT_TRUE(run(layered, a, draws[0]).has_value());
+    ASSERT_TRUE(run(perSlice, s, draws[1]).has_value());
+    EXPECT_TRUE(layered.Layered()) << "llvmpipe has ARB_shader_viewport_layer_array";
+    EXPECT_FALSE(perSlice.Layered());
+    const auto expected = PipeOutputs(perSlice, s, true), got = PipeOutputs(layered, a, true);
+    for (size_t n = 0; n < expected.size(); ++n) EXPECT_EQ(expected[n], got[n]) << "output " << n;
+    EXPECT_EQ(a.covered, s.covered);
+    EXPECT_EQ(a.stats.fragments, s.stats.fragments);
+    const uint32_t nz = kPipeGrid.nz, bandCount = CeilDiv(nz, 4u);
+    // Intervals: region, ca init, ca step, smooth, density, shade, shadow.
+    ASSERT_EQ(draws[0].size(), 7u);
+    ASSERT_EQ(draws[1].size(), 7u);
+    EXPECT_EQ(draws[1][0], nz);
+    EXPECT_EQ(draws[0][0], nz);
+    EXPECT_EQ(draws[1][1], nz);
+    EXPECT_EQ(draws[0][1], 1u);
+    EXPECT_EQ(draws[1][2], nz);
+    EXPECT_EQ(draws[0][2], 1u);
+    EXPECT_EQ(draws[1][3], 3 * nz);
+    EXPECT_EQ(draws[0][3], 3u);
+    EXPECT_EQ(draws[1][4], nz + 1 + bandCount + 1);
+    EXPECT_EQ(draws[0][4], 4u);
+    EXPECT_EQ(draws[1][5] - draws[0][5], nz - 1);
+    EXPECT_EQ(draws[0][6], 1u);
+    EXPECT_EQ(draws[1][6], 1u);
+}
+#endif
+
+#if CLOUDBENCH_HAVE_GL
 // Not a test: the numbers of docs/performance.md ("OpenGL: pipelined timing"),
 // run by hand with --gtest_also_run_disabled_tests. Thesis-medium after its
 // warm-up on gl: per stage, draws and host waits per call, and wall and
