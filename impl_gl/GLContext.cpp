@@ -171,7 +171,14 @@ Result<GLuint> GLContext::Program(const std::string& name, const std::string& de
     if (!fragment) return MakeError("gl: no shader named '" + name + "'");
     std::string source = *fragment;
     if (!defines.empty()) source.insert(source.find('\n') + 1, defines);
-    auto program = LinkProgram(name, FindShader(name + ".vert"), source);
+    const std::string* vertex = FindShader(name + ".vert");
+    std::string vertexSource;
+    if (vertex && !defines.empty()) {
+        vertexSource = *vertex;
+        vertexSource.insert(vertexSource.find('\n') + 1, defines);
+        vertex = &vertexSource;
+    }
+    auto program = LinkProgram(name, vertex, source);
     if (program) mPrograms[key] = *program;
     return program;
 }

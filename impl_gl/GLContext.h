@@ -31,8 +31,9 @@ class GLContext {
     // The linked program of pass `name`: shaders/<name>.frag with
     // shaders/<name>.vert, or the full-screen triangle where there is none; a
     // compile or link failure carries its log and the pass's name. `defines`
-    // (whole "#define ..." lines) go after the fragment shader's #version line:
-    // a specialised variant, linked on first use and cached apart.
+    // (whole "#define ..." lines) go after the #version line of the fragment
+    // shader, and of the pass's own vertex shader where it has one: a
+    // specialised variant, linked on first use and cached apart.
     Result<GLuint> Program(const std::string& name, const std::string& defines = "");
     // The layered variant of full-screen pass `name` (one without a .vert): one
     // instance per layer, the vertex stage writing gl_Layer = layer0 +
