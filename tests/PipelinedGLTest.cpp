@@ -316,7 +316,8 @@ TEST(PipelinedGL, LayeredPassesGiveTheBytesOfOneDrawPerSlice) {
 // run by hand with --gtest_also_run_disabled_tests. Thesis-medium after its
 // warm-up on gl: per stage, draws and host waits per call, and wall and
 // device ms per call, one by one (synchronised) and in one batch per step,
-// the two modes interleaved step by step; then the 1920 x 1080 image's
+// and one by one with one draw per slice (SetLayered(false)), the three modes
+// interleaved step by step; then the 1920 x 1080 image's
 // Download from the renderer's pixel buffer against one from the texture.
 double PipeMedian(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -351,11 +352,12 @@ TEST(PipelinedGL, DISABLED_ThesisMediumTiming) {
     struct Samples {
         std::vector<double> wall, device, waits, draws;
     };
-    std::map<std::string, Samples> sync, batch;
-    std::vector<double> stepSync, stepBatch, endBatch, waitsBatch;
-    const int warm = int(std::max(sc.warmupSteps, 2u)), measured = 2 * 12;
+    std::map<std::string, Samples> sync, batch, slices;
+    std::vector<double> stepSync, stepBatch, stepSlices, endBatch, waitsBatch;
+    const int warm = int(std::max(sc.warmupSteps, 2u)), measured = 3 * 12;
     for (int t = 0; t < warm + measured; ++t) {
-        const bool inBatch = t >= warm && t % 2 == 1, record = t >= warm;
+        const bool inBatch = t >= warm && t % 3 == 1, perSlice = t >= warm && t % 3 == 2, record = t >= warm;
+        b.SetLayered(!perSlice);
         const auto raster = list.Raster();
         CaStepParams cp = MakeCaStepParams(sc, uint32_t(t));
         ShadeParams shp = MakeShadeParams(sc);
@@ -391,7 +393,7 @@ TEST(PipelinedGL, DISABLED_ThesisMediumTiming) {
             const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             if (!s) FAIL() << names[n] << ": " << s.error().message;
             if (inBatch) b.MarkBatch();
-            Samples& x = (inBatch ? batch : sync)[names[n]];
+            Samples& x = (inBatch ? batch : perSlice ? slices : sync)[names[n]];
             if (!record) continue;
             x.wall.push_back(wall);
             if (!inBatch) x.device.push_back(b.LastDeviceMs().value_or(-1));
@@ -408,14 +410,15 @@ TEST(PipelinedGL, DISABLED_ThesisMediumTiming) {
             waitsBatch.push_back(double(b.Submissions().hostWaits - c0.hostWaits));
         }
         const double stepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - step0).count();
-        if (record) (inBatch ? stepBatch : stepSync).push_back(stepMs);
+        if (record) (inBatch ? stepBatch : perSlice ? stepSlices : stepSync).push_back(stepMs);
         cur = o;
         list.Update();
     }
     std::printf("thesis-medium on %s, %d steps per mode after %d, interleaved; median (min-max)\n",
-                b.Device().c_str(), measured / 2, warm);
-    std::printf("%-13s %6s | %6s %-22s %-22s | %6s %-22s %-22s\n", "stage", "draws", "waits", "sync wall", "sync device",
-                "waits", "batch wall (record)", "batch device");
+                b.Device().c_str(), measured / 3, warm);
+    std::printf("%-13s %6s %6s %-22s %-22s | %6s %-22s %-22s | %6s %-22s %-22s\n", "stage", "draws", "waits",
+                "sync wall", "sync device", "waits", "batch wall (record)", "batch device", "draws", "per-slice wall",
+                "per-slice device");
     auto span = [](const std::vector<double>& v) {
         char text[64];
         std::snprintf(text, sizeof text, "%.2f (%.2f-%.2f)", PipeMedian(v), *std::min_element(v.begin(), v.end()),
@@ -423,13 +426,16 @@ TEST(PipelinedGL, DISABLED_ThesisMediumTiming) {
         return std::string(text);
     };
     for (const char* n : names) {
-        const Samples &s = sync[n], &p = batch[n];
-        std::printf("%-13s %6.0f | %6.0f %-22s %-22s | %6.0f %-22s %-22s\n", n, PipeMedian(s.draws), PipeMedian(s.waits),
-                    span(s.wall).c_str(), span(s.device).c_str(), PipeMedian(p.waits), span(p.wall).c_str(),
-                    span(p.device).c_str());
+        const Samples &s = sync[n], &p = batch[n], &l = slices[n];
+        std::printf("%-13s %6.0f %6.0f %-22s %-22s | %6.0f %-22s %-22s | %6.0f %-22s %-22s\n", n, PipeMedian(s.draws),
+                    PipeMedian(s.waits), span(s.wall).c_str(), span(s.device).c_str(), PipeMedian(p.waits),
+                    span(p.wall).c_str(), span(p.device).c_str(), PipeMedian(l.draws), span(l.wall).c_str(),
+                    span(l.device).c_str());
     }
-    std::printf("EndBatch wall %s ms, its waits %.0f\nstep wall: sync %s ms, batch %s ms\n", span(endBatch).c_str(),
-                PipeMedian(waitsBatch), span(stepSync).c_str(), span(stepBatch).c_str());
+    std::printf("EndBatch wall %s ms, its waits %.0f\nstep wall: sync %s ms, batch %s ms, per-slice sync %s ms\n",
+                span(endBatch).c_str(), PipeMedian(waitsBatch), span(stepSync).c_str(), span(stepBatch).c_str(),
+                span(stepSlices).c_str());
+    b.SetLayered(true);
 
     // The 1080p image: Download from the pixel buffer vs from the texture (any write in between).
     SplatParams big = MakeSplatParams(sc, camera);
