@@ -28,7 +28,20 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         if (!groundProgram) return std::unexpected(groundProgram.error());
     }
 
-    auto visibility = DownloadSplatBoxVisibility(*this, p, in);
+    // In a batch, empty boxes are skipped in the vertex shader, which reads the
+    // bands on the device, instead of by runs the host derives from the bands
+    // read back: no host wait. The frustum's boxes stay host runs (camera data).
+    const bool deviceSkip = mBatch.active && p.skipping;
+    Result<std::vector<uint8_t>> visibility = std::vector<uint8_t>{};
+    if (deviceSkip) {
+        if (!in.bandsPrev || !in.bandsCur)
+            return MakeError("gl: render_splat with skipping needs both steps' occupancy");
+        SplatParams culled = p;
+        culled.skipping = false;
+        visibility = SplatBoxVisibility(culled, e, {}, {});
+    } else {
+        visibility = DownloadSplatBoxVisibility(*this, p, in);
+    }
     if (!visibility) return std::unexpected(visibility.error());
     const std::vector<uint8_t>& boxes = *visibility;
 
@@ -109,6 +122,10 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());
     f.BindTextureUnit(2, Tex(*in.T).Texture());
     f.Uniform1f(f.GetUniformLocation(*program, "guard"), kGuard);
+    f.Uniform1i(f.GetUniformLocation(*program, "deviceSkip"), deviceSkip ? 1 : 0);
+    f.Uniform2i(f.GetUniformLocation(*program, "tileBand"), GLint(p.tile), GLint(p.band));
+    f.BindTextureUnit(4, deviceSkip ? Tex(*in.bandsPrev).Texture() : 0);
+    f.BindTextureUnit(5, deviceSkip ? Tex(*in.bandsCur).Texture() : 0);
     f.Enable(GL_PROGRAM_POINT_SIZE);
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
@@ -123,15 +140,17 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (stats) f.EndQuery(GL_SAMPLES_PASSED);
     f.Disable(GL_BLEND);
     f.Disable(GL_PROGRAM_POINT_SIZE);
+    f.BindTextureUnit(4, 0);
+    f.BindTextureUnit(5, 0);
     CopyTargetToImage(target, W, H, GlScratchBuffer::ImageCopy, image);
     timer.Stop();
     if (stats) {
         const GLuint64 passed = QueryResult(fragments);
         f.DeleteQueries(1, &fragments);
-        uint32_t drawn = 0;
-        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof drawn, &drawn);
-        stats->splats = drawn;
-        stats->voxelsVisited = visited;
+        uint32_t counted[2] = {};  // splats drawn, voxels visited (deviceSkip)
+        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof counted, counted);
+        stats->splats = counted[0];
+        stats->voxelsVisited = deviceSkip ? counted[1] : visited;
         stats->fragments = passed;
     }
     return mContext->Check("render_splat");
