@@ -64,7 +64,6 @@
     X(PFNGLDRAWARRAYSPROC, DrawArrays)                                         \
     X(PFNGLPIXELSTOREIPROC, PixelStorei)                                       \
     X(PFNGLFINISHPROC, Finish)                                                 \
-    X(PFNGLFLUSHPROC, Flush)                                                   \
     X(PFNGLGENQUERIESPROC, GenQueries)                                         \
     X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                   \
     X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \
