@@ -37,10 +37,128 @@ Result<std::unique_ptr<BackendGL>> BackendGL::Create(ContextKind context, CaLayo
 
 BackendGL::~BackendGL() {
     const Functions& f = mContext->F();
+    if (!mAllQueries.empty()) f.DeleteQueries(GLsizei(mAllQueries.size()), mAllQueries.data());
     for (ScratchTexture& t : mScratch)
         if (t.texture) f.DeleteTextures(1, &t.texture);
     for (auto& [buffer, bytes] : mBuffers)
         if (buffer) f.DeleteBuffers(1, &buffer);
+}
+
+// ---- Synchronisation, counted (Submissions) ----
+
+void BackendGL::Finish() {
+    if (mPending) ++mCounts.submissions;
+    ++mCounts.hostWaits;
+    mContext->F().Finish();
+    mPending = false, mIdle = true;
+}
+
+void BackendGL::WaitingRead(ReadKind kind, GLuint object, GLenum format, GLenum type, size_t offset, size_t bytes,
+                            void* data) {
+    // GL runs commands in order: once the read returns, the work before it is
+    // done (taken as idle, so reads right after a wait count no second wait).
+    if (!mIdle) {
+        if (mPending) ++mCounts.submissions;
+        ++mCounts.hostWaits;
+    }
+    const Functions& f = mContext->F();
+    switch (kind) {
+        case ReadKind::Query:
+            f.GetQueryObjectui64v(object, GL_QUERY_RESULT, static_cast<GLuint64*>(data));
+            break;
+        case ReadKind::Texture:
+            f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+            f.GetTextureImage(object, 0, format, type, GLsizei(bytes), data);
+            break;
+        case ReadKind::Buffer:
+            f.GetNamedBufferSubData(object, GLintptr(offset), GLsizeiptr(bytes), data);
+            break;
+    }
+    mPending = false, mIdle = true;
+}
+
+GLuint BackendGL::AcquireQuery() {
+    if (mFreeQueries.empty()) {
+        GLuint queries[16] = {};
+        mContext->F().GenQueries(16, queries);
+        mFreeQueries.insert(mFreeQueries.end(), queries, queries + 16);
+        mAllQueries.insert(mAllQueries.end(), queries, queries + 16);
+    }
+    const GLuint query = mFreeQueries.back();
+    mFreeQueries.pop_back();
+    return query;
+}
+
+BackendGL::Timing::Timing(BackendGL& backend) : mB(backend) {
+    mB.Recorded();
+    ++mB.mWriteEpoch;
+    mStart = mB.AcquireQuery();
+    mB.mContext->F().QueryCounter(mStart, GL_TIMESTAMP);
+}
+
+BackendGL::Timing::~Timing() {
+    if (mStart) mB.ReleaseQuery(mStart);
+}
+
+void BackendGL::Timing::Stop() {
+    if (!mStart) return;
+    const GLuint end = mB.AcquireQuery();
+    mB.mContext->F().QueryCounter(end, GL_TIMESTAMP);
+    if (mB.mBatch.active) {
+        mB.mBatch.pairs.push_back({mStart, end, mB.mBatch.interval});
+        mB.mLastDeviceMs.reset();
+    } else {
+        mB.Finish();
+        const GLuint64 t0 = mB.QueryResult(mStart), t1 = mB.QueryResult(end);
+        mB.mLastDeviceMs = double(t1 - t0) * 1e-6;
+        mB.ReleaseQuery(mStart);
+        mB.ReleaseQuery(end);
+    }
+    mStart = 0;
+}
+
+Status BackendGL::BeginBatch() {
+    if (mBatch.active) return MakeError("gl: BeginBatch inside a batch (batches do not nest)");
+    mBatch = {};
+    mBatch.active = true;
+    return {};
+}
+
+void BackendGL::MarkBatch() {
+    if (mBatch.active) ++mBatch.interval;
+}
+
+Result<std::vector<double>> BackendGL::EndBatch() {
+    if (!mBatch.active) return MakeError("gl: EndBatch without BeginBatch");
+    Finish();
+    std::vector<double> ms(size_t(mBatch.interval) + 1, 0.0);
+    for (const BatchState::Pair& p : mBatch.pairs) {
+        const GLuint64 t0 = QueryResult(p.start), t1 = QueryResult(p.end);
+        ms[p.interval] += double(t1 - t0) * 1e-6;
+        ReleaseQuery(p.start);
+        ReleaseQuery(p.end);
+    }
+    mBatch = {};
+    CB_TRY(mContext->Check("ending a batch"));
+    return ms;
+}
+
+void BackendGL::Draw(GLenum mode, GLint first, GLsizei count, GLsizei instances) {
+    const Functions& f = mContext->F();
+    if (instances == 1)
+        f.DrawArrays(mode, first, count);
+    else
+        f.DrawArraysInstanced(mode, first, count, instances);
+    ++mDraws;
+}
+
+void BackendGL::MultiDraw(GLenum mode, const GLint* firsts, const GLsizei* counts, GLsizei draws) {
+    mContext->F().MultiDrawArrays(mode, firsts, counts, draws);
+    ++mDraws;
+}
+
+void BackendGL::KeepImageCopy(const Buffer& image, GlScratchBuffer slot, size_t bytes) {
+    mImageCopy = {Tex(image).Texture(), slot, bytes, mWriteEpoch};
 }
 
 std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
@@ -102,11 +220,36 @@ Status BackendGL::BindTargets(std::span<const std::pair<GLuint, int>> targets) {
 }
 
 Status BackendGL::DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures) {
-    return DrawLayers(program, layers, textures, [](uint32_t) {});
+    return DrawLayerRange(program, 0, layers, textures);
 }
 
 Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures) {
-    return DrawLayerRange(program, begin, end, textures, [](uint32_t) {});
+    if (!IsLayered(program)) return DrawLayerRange(program, begin, end, textures, [](uint32_t) {});
+    if (begin >= end) return {};
+    std::array<std::pair<GLuint, int>, 4> targets;
+    if (textures.size() > targets.size()) return MakeError("gl: a pass has more than 4 render targets");
+    size_t n = 0;
+    for (GLuint texture : textures) targets[n++] = {texture, -1};  // the whole array: a layered target
+    CB_TRY(BindTargets(std::span(targets.data(), n)));
+    const Functions& f = mContext->F();
+    f.Uniform1i(f.GetUniformLocation(program, "layer0"), GLint(begin));
+    Draw(GL_TRIANGLES, 0, 3, GLsizei(end - begin));
+    return {};
+}
+
+Result<GLuint> BackendGL::PassProgram(const std::string& name, const std::string& defines) {
+    if (Layered()) {
+        if (auto layered = mContext->LayeredProgram(name, defines)) {
+            if (!IsLayered(*layered)) mLayeredPrograms.push_back(*layered);
+            return layered;
+        }
+        mLayeredFailed = true;  // this driver cannot: every pass draws per slice from now on
+    }
+    return mContext->Program(name, defines);
+}
+
+bool BackendGL::IsLayered(GLuint program) const {
+    return std::find(mLayeredPrograms.begin(), mLayeredPrograms.end(), program) != mLayeredPrograms.end();
 }
 
 Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Extent3 extent) {
@@ -128,6 +271,7 @@ Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Ext
     f.TextureStorage3D(texture, 1, t.internal, width, GLsizei(extent.ny), GLsizei(extent.nz));
     f.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     f.TextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    ++mWriteEpoch;
     auto buffer = std::make_unique<BufferGL>(format, extent, f, texture);
     CB_TRY(mContext->Check("creating a texture"));
     return std::unique_ptr<Buffer>(std::move(buffer));
@@ -190,6 +334,8 @@ Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
         data = packed.data();
         ++mBitsWrites;
     }
+    ++mWriteEpoch;
+    Recorded();
     f.TextureSubImage3D(b.Texture(), 0, 0, 0, 0, GLsizei(b.Width()), GLsizei(e.ny), GLsizei(e.nz), t.format, t.type,
                         data);
     return mContext->Check("uploading a texture");
@@ -197,17 +343,21 @@ Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
 
 Status BackendGL::Download(const Buffer& buffer, std::span<std::byte> canonical) {
     if (canonical.size() != buffer.CanonicalBytes()) return MakeError("gl: download size does not match the buffer");
-    const Functions& f = mContext->F();
     const BufferGL& b = Tex(buffer);
     const Extent3 e = b.Extent();
     const TexelFormat t = FormatOf(b.Format());
-    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    // A renderer's image still in its pixel buffer: only the copy out of it.
+    const ImageCopy& kept = mImageCopy;
+    if (kept.texture == b.Texture() && kept.epoch == mWriteEpoch && kept.bytes == canonical.size()) {
+        WaitingRead(ReadKind::Buffer, mBuffers[kept.slot].first, 0, 0, 0, canonical.size(), canonical.data());
+        return mContext->Check("downloading an image from its pixel buffer");
+    }
     if (b.Format() != BufferFormat::Bits) {
-        f.GetTextureImage(b.Texture(), 0, t.format, t.type, GLsizei(canonical.size()), canonical.data());
+        WaitingRead(ReadKind::Texture, b.Texture(), t.format, t.type, 0, canonical.size(), canonical.data());
         return mContext->Check("downloading a texture");
     }
     std::vector<uint32_t> packed(size_t(b.Width()) * e.ny * e.nz);
-    f.GetTextureImage(b.Texture(), 0, t.format, t.type, GLsizei(packed.size() * 4), packed.data());
+    WaitingRead(ReadKind::Texture, b.Texture(), t.format, t.type, 0, packed.size() * 4, packed.data());
     CB_TRY(mContext->Check("downloading a texture"));
     UnpackBits32(packed, e, canonical);
     return {};

@@ -19,6 +19,7 @@
 #include <span>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/Backend.h"
 #include "core/Noise.h"
@@ -51,6 +52,28 @@ class BackendGL final : public Backend {
     std::string Device() const override;
     bool Supports(Stage stage) const override;
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
+
+    // Pipelined timing (core/Backend.h). In a batch a stage call records its
+    // passes between two GL_TIMESTAMP queries (from a pool) and returns without
+    // waiting; EndBatch waits once (glFinish) and reads the queries. Host values
+    // a call must return (density's cover count, render_splat's visibility and
+    // stats) still wait, and are counted.
+    Status BeginBatch() override;
+    void MarkBatch() override;
+    Result<std::vector<double>> EndBatch() override;
+    // Counted where the backend synchronises (Finish, WaitingRead): a submission
+    // for each glFinish, or read that must wait, that ends recorded work; a host
+    // wait for each glFinish, and each query result or read back into client
+    // memory while recorded work may be unfinished.
+    SubmissionCounts Submissions() const override { return mCounts; }
+    // Draw calls issued since the backend was made (a multi-draw counts once):
+    // the per-pass overhead of issue 16.
+    uint64_t Draws() const { return mDraws; }
+    // Whether full-screen passes over slices are one layered, instanced draw
+    // (GLContext::LayeredProgram) where the driver can, or one draw per slice
+    // (the thesis's way; for comparison). On by default; both give the same bytes.
+    void SetLayered(bool layered) { mLayered = layered; }
+    bool Layered() const { return mLayered && !mLayeredFailed; }
 
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
@@ -130,6 +153,46 @@ class BackendGL final : public Backend {
     };
 
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8) : mContext(std::move(context)), mRgba8(rgba8) {}
+
+    // A stage call's device time: a GL_TIMESTAMP query at construction and one
+    // at Stop(). Outside a batch Stop() waits (Finish) and sets mLastDeviceMs;
+    // in a batch it files the pair under the current interval. Construction
+    // also marks work as recorded (mPending) and advances mWriteEpoch.
+    class Timing {
+      public:
+        explicit Timing(BackendGL& backend);
+        ~Timing();
+        Timing(const Timing&) = delete;
+        Timing& operator=(const Timing&) = delete;
+        void Stop();
+
+      private:
+        BackendGL& mB;
+        GLuint mStart = 0;
+    };
+    // The only places the host synchronises with the device (counted in mCounts).
+    void Finish();
+    // A read that blocks until the work before it is done: a query result
+    // (buffer 0, data a GLuint64), a texture or a buffer into client memory.
+    enum class ReadKind { Query, Texture, Buffer };
+    void WaitingRead(ReadKind kind, GLuint object, GLenum format, GLenum type, size_t offset, size_t bytes,
+                     void* data);
+    GLuint64 QueryResult(GLuint query) {
+        GLuint64 value = 0;
+        WaitingRead(ReadKind::Query, query, 0, 0, 0, sizeof value, &value);
+        return value;
+    }
+    // Work was recorded: the device may be busy and a submission is pending.
+    void Recorded() { mPending = true, mIdle = false; }
+    GLuint AcquireQuery();
+    void ReleaseQuery(GLuint query) { mFreeQueries.push_back(query); }
+    // Draw calls, counted in mDraws.
+    void Draw(GLenum mode, GLint first, GLsizei count, GLsizei instances = 1);
+    void MultiDraw(GLenum mode, const GLint* firsts, const GLsizei* counts, GLsizei draws);
+    // A renderer's image whose canonical bytes its pixel buffer `slot` still
+    // holds: Download of it reads the buffer instead of the texture while
+    // nothing has been written since (mWriteEpoch).
+    void KeepImageCopy(const Buffer& image, GlScratchBuffer slot, size_t bytes);
     GLuint Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
     GLuint ScratchBuffer(GlScratchBuffer slot, size_t bytes);
     // Copies a renderer's W x H RGB(A) float target into `image` ((3, W, H) F32)
@@ -155,14 +218,45 @@ class BackendGL final : public Backend {
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures, PerLayer&& perLayer) {
         return DrawLayerRange(program, 0, layers, textures, std::forward<PerLayer>(perLayer));
     }
+    // Without perLayer, a program from PassProgram may be layered: then one
+    // instanced draw into the whole textures covers the layers.
     Status DrawLayers(GLuint program, uint32_t layers, std::initializer_list<GLuint> textures);
     Status DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures);
+    // The program of full-screen pass `name`: layered where Layered(), else per slice.
+    Result<GLuint> PassProgram(const std::string& name, const std::string& defines = "");
+    bool IsLayered(GLuint program) const;
     Status CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
     Status CaStepRgba8Share(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
 
     std::unique_ptr<GLContext> mContext;
     bool mRgba8 = false;
     std::optional<double> mLastDeviceMs;
+    SubmissionCounts mCounts;
+    bool mLayered = true, mLayeredFailed = false;
+    std::vector<GLuint> mLayeredPrograms;
+    uint64_t mDraws = 0;
+    bool mPending = false;  // work recorded since the last submission
+    bool mIdle = true;      // no work recorded since the host last waited for the device
+    std::vector<GLuint> mFreeQueries, mAllQueries;
+    struct BatchState {
+        bool active = false;
+        uint32_t interval = 0;
+        struct Pair {
+            GLuint start, end;
+            uint32_t interval;
+        };
+        std::vector<Pair> pairs;
+    };
+    BatchState mBatch;
+    // Advanced by every call that may write a buffer (CreateBuffer, Upload, each stage call).
+    uint64_t mWriteEpoch = 0;
+    struct ImageCopy {
+        GLuint texture = 0;
+        GlScratchBuffer slot{};
+        size_t bytes = 0;
+        uint64_t epoch = ~uint64_t(0);
+    };
+    ImageCopy mImageCopy;
     SlotArray<GlScratch, ScratchTexture> mScratch;
     SlotArray<GlScratchBuffer, std::pair<GLuint, size_t>> mBuffers;  // buffer, bytes
     // Noise: the scene whose data block is in the NoiseData buffer (NoiseGL.cpp).

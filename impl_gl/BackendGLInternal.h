@@ -13,35 +13,10 @@ namespace cb::gl {
 // The texture behind a buffer; every buffer this backend sees is one it created.
 inline const BufferGL& Tex(const Buffer& b) { return static_cast<const BufferGL&>(b); }
 
-// Device time from a GL_TIMESTAMP query at construction to one at StopMs(),
-// which waits for the work between them (glFinish).
-class GpuTimer {
-  public:
-    explicit GpuTimer(const Functions& f) : mF(f) {
-        mF.GenQueries(2, mQueries);
-        mF.QueryCounter(mQueries[0], GL_TIMESTAMP);
-    }
-    ~GpuTimer() { mF.DeleteQueries(2, mQueries); }
-    GpuTimer(const GpuTimer&) = delete;
-    GpuTimer& operator=(const GpuTimer&) = delete;
-
-    double StopMs() {
-        mF.QueryCounter(mQueries[1], GL_TIMESTAMP);
-        mF.Finish();
-        GLuint64 t0 = 0, t1 = 0;
-        mF.GetQueryObjectui64v(mQueries[0], GL_QUERY_RESULT, &t0);
-        mF.GetQueryObjectui64v(mQueries[1], GL_QUERY_RESULT, &t1);
-        return double(t1 - t0) * 1e-6;
-    }
-
-  private:
-    const Functions& mF;
-    GLuint mQueries[2] = {};
-};
-
 template <typename PerLayer>
 Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures,
                                  PerLayer&& perLayer) {
+    if (IsLayered(program)) return MakeError("gl: a layered pass cannot set uniforms per layer");
     const Functions& f = mContext->F();
     const GLint layerUniform = f.GetUniformLocation(program, "layer");
     std::array<std::pair<GLuint, int>, 4> targets;
@@ -52,7 +27,7 @@ Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, s
         CB_TRY(BindTargets(std::span(targets.data(), n)));
         f.Uniform1i(layerUniform, GLint(k));
         perLayer(k);
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        Draw(GL_TRIANGLES, 0, 3);
     }
     return {};
 }

@@ -8,10 +8,10 @@ namespace cb::gl {
 
 Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
     const Functions& f = mContext->F();
-    auto program = mContext->Program("ca_init");
+    auto program = PassProgram("ca_init");
     if (!program) return std::unexpected(program.error());
     const Extent3 e = out.hum->Extent();
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.Uniform3i(f.GetUniformLocation(*program, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
@@ -21,7 +21,7 @@ Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
     f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), GLsizei(e.ny));
     CB_TRY(DrawLayers(*program, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
     ++mBitsWrites;
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("ca initial state");
 }
 
@@ -30,7 +30,7 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         return params.slices.IsWhole(in.hum->Extent().nz) ? CaStepRgba8(params, in, region, out)
                                                           : CaStepRgba8Share(params, in, region, out);
     const Functions& f = mContext->F();
-    auto rules = mContext->Program("ca");
+    auto rules = PassProgram("ca");
     if (!rules) return std::unexpected(rules.error());
     auto advect = mContext->Program("advect");
     if (!advect) return std::unexpected(advect.error());
@@ -49,7 +49,7 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         next[1] = Scratch(GlScratch::CaAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
         next[2] = Scratch(GlScratch::CaCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
     }
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     f.Viewport(0, 0, words, GLsizei(e.ny));
     f.UseProgram(*rules);
@@ -76,7 +76,7 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
                               [&](uint32_t k) { f.Uniform2i(shift, params.shiftX[k], params.shiftY[k]); }));
     }
     ++mBitsWrites;
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("ca");
 }
 
@@ -102,7 +102,7 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     const bool packed = mStateOf == inputs && mStateWrites == mBitsWrites;
     const bool wind = !params.shiftX.empty();
     mShareState = {};  // this call rewrites Rgba8StateA
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     f.Viewport(0, 0, nx, ny);
     auto perSlice = [&](GLuint program, GLuint target, auto&& setLayer) -> Status {
@@ -140,7 +140,7 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     if (result == stateB) std::swap(mScratch[GlScratch::Rgba8StateA], mScratch[GlScratch::Rgba8StateB]);
     mStateOf = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
     mStateWrites = mBitsWrites;
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("ca (RGBA8 layout)");
 }
 
@@ -190,7 +190,7 @@ Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in,
     } else {
         held.packedBegin = lo, held.packedEnd = 0;
     }
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     f.Viewport(0, 0, nx, ny);
     if (pack0 < hi) {
@@ -229,7 +229,7 @@ Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in,
         mStateWrites = mBitsWrites;
         held = {};
     }
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("ca (RGBA8 layout, a share)");
 }
 

@@ -7,11 +7,11 @@ namespace cb::gl {
 Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
     const Functions& f = mContext->F();
-    auto sum = mContext->Program("density_sum");
+    auto sum = PassProgram("density_sum");
     if (!sum) return std::unexpected(sum.error());
     auto cover = mContext->Program("density_cover");
     if (!cover) return std::unexpected(cover.error());
-    auto occupancy = mContext->Program("occupancy");
+    auto occupancy = PassProgram("occupancy");
     if (!occupancy) return std::unexpected(occupancy.error());
     const Extent3 e = q.Extent();
     const uint32_t tilesX = CeilDiv(e.nx, params.tile), tilesY = CeilDiv(e.ny, params.tile);
@@ -26,7 +26,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     }
     const GLint y0 = GLint(t0 * params.tile);
     const GLsizei rows = GLsizei(std::min(e.ny, t1 * params.tile)) - y0;
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
 
     // D: additive blending of the slices, k ascending.
@@ -39,10 +39,17 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
     f.BlendFunc(GL_ONE, GL_ONE);
-    const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
-    for (uint32_t k = 0; k < e.nz; ++k) {
-        f.Uniform1i(sumLayer, GLint(k));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+    if (IsLayered(*sum)) {
+        // One instance per slice into the one target (not layered: gl_Layer is
+        // ignored); blending follows the instances' order, k ascending.
+        f.Uniform1i(f.GetUniformLocation(*sum, "layer0"), 0);
+        Draw(GL_TRIANGLES, 0, 3, GLsizei(e.nz));
+    } else {
+        const GLint sumLayer = f.GetUniformLocation(*sum, "layer");
+        for (uint32_t k = 0; k < e.nz; ++k) {
+            f.Uniform1i(sumLayer, GLint(k));
+            Draw(GL_TRIANGLES, 0, 3);
+        }
     }
     f.Disable(GL_BLEND);
 
@@ -59,7 +66,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.BindTextureUnit(1, Tex(*out.columnSum).Texture());
     f.Uniform1i(f.GetUniformLocation(*cover, "fromCld"), cld ? 1 : 0);
     f.Uniform3i(f.GetUniformLocation(*cover, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    Draw(GL_TRIANGLES, 0, 3);
 
     // Occupancy: max-downsampling to tiles (from D) and to tile x band (from q).
     f.UseProgram(*occupancy);
@@ -73,12 +80,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     CB_TRY(DrawLayers(*occupancy, bandCount, {Tex(*out.bands).Texture()}));
     f.Uniform1i(mode, 1);
     CB_TRY(BindTargets({{Tex(*out.tiles).Texture(), 0}}));
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    Draw(GL_TRIANGLES, 0, 3);
 
     f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     GLuint covered = 0;
-    f.GetNamedBufferSubData(counter, 0, sizeof covered, &covered);
+    WaitingRead(ReadKind::Buffer, counter, 0, 0, 0, sizeof covered, &covered);  // a host wait inside a batch
     out.coveredColumns = covered;
     return mContext->Check("density");
 }

@@ -34,6 +34,19 @@ void main() {
 }
 )";
 
+// The layered passes' vertex shader (GLContext::LayeredProgram).
+constexpr const char* kLayeredVertex = R"(#version 450 core
+#extension GL_ARB_shader_viewport_layer_array : require
+uniform int layer0;
+flat out int layer;
+void main() {
+    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+    layer = layer0 + gl_InstanceID;
+    gl_Layer = layer;
+}
+)";
+
 // The info log of a shader or program (getiv/getLog: glGetShaderiv/InfoLog or glGetProgramiv/InfoLog).
 template <typename GetIv, typename GetLog>
 std::string InfoLog(GLuint object, GetIv getiv, GetLog getLog) {
@@ -158,7 +171,32 @@ Result<GLuint> GLContext::Program(const std::string& name, const std::string& de
     if (!fragment) return MakeError("gl: no shader named '" + name + "'");
     std::string source = *fragment;
     if (!defines.empty()) source.insert(source.find('\n') + 1, defines);
-    auto program = LinkProgram(name, FindShader(name + ".vert"), source);
+    const std::string* vertex = FindShader(name + ".vert");
+    std::string vertexSource;
+    if (vertex && !defines.empty()) {
+        vertexSource = *vertex;
+        vertexSource.insert(vertexSource.find('\n') + 1, defines);
+        vertex = &vertexSource;
+    }
+    auto program = LinkProgram(name, vertex, source);
+    if (program) mPrograms[key] = *program;
+    return program;
+}
+
+Result<GLuint> GLContext::LayeredProgram(const std::string& name, const std::string& defines) {
+    const std::string key = "layered\n" + name + "\n" + defines;
+    if (auto it = mPrograms.find(key); it != mPrograms.end()) return it->second;
+    const std::string* fragment = FindShader(name + ".frag");
+    if (!fragment) return MakeError("gl: no shader named '" + name + "'");
+    if (FindShader(name + ".vert")) return MakeError("gl: pass '" + name + "' has its own vertex shader");
+    std::string source = *fragment;
+    const std::string uniform = "uniform int layer;";
+    const size_t at = source.find(uniform);
+    if (at == std::string::npos) return MakeError("gl: pass '" + name + "' has no uniform layer");
+    source.replace(at, uniform.size(), "flat in int layer;");
+    if (!defines.empty()) source.insert(source.find('\n') + 1, defines);
+    const std::string vertex = kLayeredVertex;
+    auto program = LinkProgram(name + " (layered)", &vertex, source);
     if (program) mPrograms[key] = *program;
     return program;
 }

@@ -31,9 +31,18 @@ class GLContext {
     // The linked program of pass `name`: shaders/<name>.frag with
     // shaders/<name>.vert, or the full-screen triangle where there is none; a
     // compile or link failure carries its log and the pass's name. `defines`
-    // (whole "#define ..." lines) go after the fragment shader's #version line:
-    // a specialised variant, linked on first use and cached apart.
+    // (whole "#define ..." lines) go after the #version line of the fragment
+    // shader, and of the pass's own vertex shader where it has one: a
+    // specialised variant, linked on first use and cached apart.
     Result<GLuint> Program(const std::string& name, const std::string& defines = "");
+    // The layered variant of full-screen pass `name` (one without a .vert): one
+    // instance per layer, the vertex stage writing gl_Layer = layer0 +
+    // gl_InstanceID (ARB_shader_viewport_layer_array) and passing that layer to
+    // the fragment stage, whose `uniform int layer;` becomes `flat in int
+    // layer;`. Set uniform "layer0" and draw the triangle with end - begin
+    // instances into layered targets (issue 16: one draw, not one per slice).
+    // An Error where the driver cannot (the caller draws per slice).
+    Result<GLuint> LayeredProgram(const std::string& name, const std::string& defines = "");
     // Compiles and links a program from full sources (vertex: nullptr for the
     // full-screen triangle); errors name `name` and carry the GL log.
     Result<GLuint> LinkProgram(const std::string& name, const std::string* vertex, const std::string& fragment);

@@ -13,7 +13,7 @@ Status BackendGL::Noise(const NoiseParams& params, Buffer& q) {
     if (q.Format() != BufferFormat::F32 || !(q.Extent() == params.grid))
         return MakeError("gl: noise: q must be an F32 volume of the grid's size");
     const Functions& f = mContext->F();
-    auto program = mContext->Program("noise");
+    auto program = PassProgram("noise");
     if (!program) return std::unexpected(program.error());
     if (!mNoiseForm || !(mNoiseForm->Settings() == *params.settings) || !(mNoiseForm->Grid() == params.grid)) {
         mNoiseForm.reset();
@@ -25,14 +25,14 @@ Status BackendGL::Noise(const NoiseParams& params, Buffer& q) {
     }
     const std::array<float, 8> offsets = noise::GpuOffsets(mNoiseForm->Offsets(params.step));
     const Extent3 e = params.grid;
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.UseProgram(*program);
     f.BindVertexArray(mContext->EmptyVao());
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ScratchBuffer(GlScratchBuffer::NoiseData, 0));
     f.Uniform1fv(f.GetUniformLocation(*program, "offsets"), 8, offsets.data());
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     CB_TRY(DrawLayers(*program, e.nz, {Tex(q).Texture()}));
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("noise");
 }
 

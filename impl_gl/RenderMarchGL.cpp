@@ -32,7 +32,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_march: the image is not (3, width, height)");
     const Functions& f = mContext->F();
-    auto volumeProgram = mContext->Program("march_volume");
+    auto volumeProgram = PassProgram("march_volume");
     if (!volumeProgram) return std::unexpected(volumeProgram.error());
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "gl: render_march"));
     const MarchGpu block = MakeMarchGpu(params, e);
@@ -43,7 +43,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     if (!marchProgram) return std::unexpected(marchProgram.error());
     Result<GLuint> bricksProgram = GLuint(0);
     if (params.skipping) {
-        bricksProgram = mContext->Program("march_bricks");
+        bricksProgram = PassProgram("march_bricks");
         if (!bricksProgram) return std::unexpected(bricksProgram.error());
     }
 
@@ -57,7 +57,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t B = block.flags[3];
     const auto brickCounts = MarchBrickCounts(e, B);
 
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     const GLuint counters = ScratchBuffer(GlScratchBuffer::MarchCounters, 9 * 4);
     const uint32_t zero[9] = {};
@@ -130,14 +130,14 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
     f.BindTextureUnit(3, Tex(params.ground.on ? *in.G : *in.qCur).Texture());
     f.Viewport(0, 0, GLsizei(W), GLsizei(H));
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
+    Draw(GL_TRIANGLES, 0, 3);
 
     CopyTargetToImage(target, W, H, GlScratchBuffer::MarchImageCopy, image);
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     if (stats) {
         f.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         uint32_t words[9] = {};
-        f.GetNamedBufferSubData(counters, 0, sizeof words, words);
+        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof words, words);
         const auto wide = [&words](int n) { return uint64_t(words[2 * n]) | uint64_t(words[2 * n + 1]) << 32; };
         *stats = {};
         stats->rays = wide(0);

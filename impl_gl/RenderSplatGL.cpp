@@ -28,7 +28,20 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         if (!groundProgram) return std::unexpected(groundProgram.error());
     }
 
-    auto visibility = DownloadSplatBoxVisibility(*this, p, in);
+    // In a batch, empty boxes are skipped in the vertex shader, which reads the
+    // bands on the device, instead of by runs the host derives from the bands
+    // read back: no host wait. The frustum's boxes stay host runs (camera data).
+    const bool deviceSkip = mBatch.active && p.skipping;
+    Result<std::vector<uint8_t>> visibility = std::vector<uint8_t>{};
+    if (deviceSkip) {
+        if (!in.bandsPrev || !in.bandsCur)
+            return MakeError("gl: render_splat with skipping needs both steps' occupancy");
+        SplatParams culled = p;
+        culled.skipping = false;
+        visibility = SplatBoxVisibility(culled, e, {}, {});
+    } else {
+        visibility = DownloadSplatBoxVisibility(*this, p, in);
+    }
     if (!visibility) return std::unexpected(visibility.error());
     const std::vector<uint8_t>& boxes = *visibility;
 
@@ -73,7 +86,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.GetFloatv(GL_POINT_SIZE_RANGE, pointRange);
     constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
 
-    GpuTimer timer(f);
+    Timing timer(*this);
     const GLuint orderBuffer = ScratchBuffer(GlScratchBuffer::SplatOrder, flat.indices.size() * 4);
     f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
     // The shared frame; this backend's lane: the largest point size.
@@ -96,7 +109,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
         f.BindTextureUnit(3, Tex(*in.G).Texture());
         f.Viewport(0, 0, GLsizei(W), GLsizei(H));
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        Draw(GL_TRIANGLES, 0, 3);
     } else {
         const float background[4] = {p.background[0], p.background[1], p.background[2], 1};
         f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
@@ -109,6 +122,10 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());
     f.BindTextureUnit(2, Tex(*in.T).Texture());
     f.Uniform1f(f.GetUniformLocation(*program, "guard"), kGuard);
+    f.Uniform1i(f.GetUniformLocation(*program, "deviceSkip"), deviceSkip ? 1 : 0);
+    f.Uniform2i(f.GetUniformLocation(*program, "tileBand"), GLint(p.tile), GLint(p.band));
+    f.BindTextureUnit(4, deviceSkip ? Tex(*in.bandsPrev).Texture() : 0);
+    f.BindTextureUnit(5, deviceSkip ? Tex(*in.bandsCur).Texture() : 0);
     f.Enable(GL_PROGRAM_POINT_SIZE);
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
@@ -119,20 +136,21 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         f.GenQueries(1, &fragments);
         f.BeginQuery(GL_SAMPLES_PASSED, fragments);
     }
-    if (!firsts.empty()) f.MultiDrawArrays(GL_POINTS, firsts.data(), counts.data(), GLsizei(firsts.size()));
+    if (!firsts.empty()) MultiDraw(GL_POINTS, firsts.data(), counts.data(), GLsizei(firsts.size()));
     if (stats) f.EndQuery(GL_SAMPLES_PASSED);
     f.Disable(GL_BLEND);
     f.Disable(GL_PROGRAM_POINT_SIZE);
+    f.BindTextureUnit(4, 0);
+    f.BindTextureUnit(5, 0);
     CopyTargetToImage(target, W, H, GlScratchBuffer::ImageCopy, image);
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     if (stats) {
-        GLuint64 passed = 0;
-        f.GetQueryObjectui64v(fragments, GL_QUERY_RESULT, &passed);
+        const GLuint64 passed = QueryResult(fragments);
         f.DeleteQueries(1, &fragments);
-        uint32_t drawn = 0;
-        f.GetNamedBufferSubData(counters, 0, sizeof drawn, &drawn);
-        stats->splats = drawn;
-        stats->voxelsVisited = visited;
+        uint32_t counted[2] = {};  // splats drawn, voxels visited (deviceSkip)
+        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof counted, counted);
+        stats->splats = counted[0];
+        stats->voxelsVisited = deviceSkip ? counted[1] : visited;
         stats->fragments = passed;
     }
     return mContext->Check("render_splat");
@@ -151,6 +169,8 @@ void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScrat
     f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
     f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    // The pixel buffer keeps the canonical image: a Download reads it without a texture read back (issue 16).
+    KeepImageCopy(image, slot, imageBytes);
 }
 
 }  // namespace cb::gl

@@ -19,9 +19,9 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const Functions& f = mContext->F();
     auto slice = mContext->Program("shade_slice");
     if (!slice) return std::unexpected(slice.error());
-    auto up = mContext->Program("shade_up");
+    auto up = PassProgram("shade_up");
     if (!up) return std::unexpected(up.error());
-    auto down = mContext->Program("shade_down");
+    auto down = PassProgram("shade_down");
     if (!down) return std::unexpected(down.error());
     const Extent3 e = q.Extent();
     const ShadePlan plan = MakeShadePlan(params, e);
@@ -34,7 +34,7 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         mLastDeviceMs = 0.0;
         return {};
     }
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     GLuint shadedQ = Tex(q).Texture();
     if (res > 1) shadedQ = Scratch(GlScratch::ShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
@@ -77,12 +77,12 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         f.BindTextureUnit(0, ping);
         f.Uniform1i(first, m == 0 ? 1 : 0);
         f.Uniform3i(previousW, previous * ew[0], previous * ew[1], previous * ew[2]);
-        f.DrawArrays(GL_TRIANGLES, 0, 3);
+        Draw(GL_TRIANGLES, 0, 3);
         std::swap(ping, pong);
         previous = w;
     }
     if (m1 < plan.nw) {
-        mLastDeviceMs = timer.StopMs();
+        timer.Stop();
         return mContext->Check("shade, a share");
     }
     f.UseProgram(*up);
@@ -92,7 +92,7 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     f.Uniform1i(f.GetUniformLocation(*up, "f"), res);
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     CB_TRY(DrawLayers(*up, e.nz, {Tex(T).Texture()}));
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("shade");
 }
 

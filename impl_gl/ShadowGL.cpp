@@ -22,9 +22,9 @@ Status BackendGL::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     f.Uniform1i(f.GetUniformLocation(*program, "noSun"), l.noSun ? 1 : 0);
     CB_TRY(BindTargets({{Tex(G).Texture(), 0}}));
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
-    GpuTimer timer(f);
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
-    mLastDeviceMs = timer.StopMs();
+    Timing timer(*this);
+    Draw(GL_TRIANGLES, 0, 3);
+    timer.Stop();
     return mContext->Check("shadow");
 }
 

@@ -14,7 +14,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     GLuint passes[3];
     const char* names[3] = {"smooth_x", "smooth_y", "smooth_z"};
     for (int n = 0; n < 3; ++n) {
-        auto program = mContext->Program(names[n]);
+        auto program = PassProgram(names[n]);
         if (!program) return std::unexpected(program.error());
         passes[n] = *program;
     }
@@ -45,7 +45,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     const GLuint sumXY = Scratch(GlScratch::SmoothXY, GL_TEXTURE_2D_ARRAY, GL_R16UI, nx, ny, nz);
     const GLuint input[3] = {cldTexture, sumX, sumXY};
     const GLuint output[3] = {sumX, sumXY, Tex(q).Texture()};
-    GpuTimer timer(f);
+    Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     f.Viewport(0, 0, nx, ny);
     for (int n = 0; n < 3; ++n) {
@@ -58,7 +58,7 @@ Status BackendGL::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
         CB_TRY(n == 2 ? DrawLayerRange(program, k0, k1, {output[n]}) : DrawLayerRange(program, s0, s1, {output[n]}));
     }
     mSmoothSums = held;
-    mLastDeviceMs = timer.StopMs();
+    timer.Stop();
     return mContext->Check("smooth");
 }
 

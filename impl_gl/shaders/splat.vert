@@ -2,9 +2,15 @@
 // GL_POINTS vertex per voxel, drawn in the shared back-to-front order (the
 // vertex id is the voxel's rank), so blending composites in that order. The
 // vertex shader reads the volumes and throws away voxels that make no splat
-// (section 6.2) by placing them outside the clip volume.
+// (section 6.2) by placing them outside the clip volume. With deviceSkip (in
+// a batch: issue 16) it also throws away the voxels of tile x band boxes empty
+// in both steps' bands, which the host's runs skip otherwise, and counts the rest.
 layout(std430, binding = 0) readonly buffer Order { uint orderIndex[]; };  // outer, middle, inner axis orders
-layout(std430, binding = 1) buffer Counters { uint splatCount; };
+layout(std430, binding = 1) buffer Counters { uint splatCount; uint visitedCount; };
+layout(binding = 4) uniform usampler2DArray bandsPrevMap;
+layout(binding = 5) uniform usampler2DArray bandsCurMap;
+uniform int deviceSkip;
+uniform ivec2 tileBand;
 layout(std430, binding = 2) readonly buffer Frame { SplatFrame F; };  // misc.z: the largest point size
 layout(binding = 0) uniform sampler2DArray qPrev;
 layout(binding = 1) uniform sampler2DArray qCur;
@@ -25,6 +31,14 @@ void main() {
     idx[F.axes.x] = int(orderIndex[F.orderBase.x + uint(rank / (nMid * nIn))]);
     idx[F.axes.y] = int(orderIndex[F.orderBase.y + uint((rank % (nMid * nIn)) / nIn)]);
     idx[F.axes.z] = int(orderIndex[F.orderBase.z + uint(rank % nIn)]);
+    if (deviceSkip != 0) {
+        const ivec3 box = ivec3(idx.x / tileBand.x, idx.y / tileBand.x, idx.z / tileBand.y);
+        if (texelFetch(bandsPrevMap, box, 0).r == 0u && texelFetch(bandsCurMap, box, 0).r == 0u) {
+            Reject();
+            return;
+        }
+        atomicAdd(visitedCount, 1u);
+    }
     const float qa = SplatQ(texelFetch(qPrev, idx, 0).r, texelFetch(qCur, idx, 0).r, F.misc.y);
     Splat s;
     if (!MakeSplat(F, uvec3(idx), qa, texelFetch(transmittance, idx, 0).r, s)) {
