@@ -21,7 +21,7 @@ const int kTile = 32;             // the tile each group writes, per axis
 const int kHalo = 16;             // the region's width beyond the tile at most: steps * (hi - lo) <= kHalo
 const int kRegion = kTile + kHalo;  // the widest region held (the slice before the first computed)
 
-layout(local_size_x = 256) in;
+layout(local_size_x = kRegion) in;  // one invocation per column of the region
 layout(std430, binding = 0) readonly buffer Q { float q[]; };
 layout(std430, binding = 1) buffer T { float t[]; };
 layout(push_constant) uniform Params {
@@ -48,7 +48,7 @@ float TapQ(uint base, int a, int b) {
 
 void main() {
     const int a0 = int(gl_WorkGroupID.x) * kTile, b0 = int(gl_WorkGroupID.y) * kTile;
-    const uint lid = gl_LocalInvocationIndex;
+    const int x = int(gl_LocalInvocationIndex);  // this invocation's column of the region
     // Per step back from the last slice, the region grows by -lo cells before the tile and hi after it.
     const int loU = min(pc.u0, 0), hiU = max(pc.u0 + 1, 0), loV = min(pc.v0, 0), hiV = max(pc.v0 + 1, 0);
     // From slice 0 itself (T = 1, written here) or from the slice before `begin` (read).
@@ -56,52 +56,59 @@ void main() {
     const int steps = int(pc.end - pc.begin) - (fromFirst ? 1 : 0);
     if (fromFirst) {
         const uint base = SliceBase(0u);
-        for (uint i = lid; i < uint(kTile * kTile); i += 256u) {
-            const int a = a0 + int(i) % kTile, b = b0 + int(i) / kTile;
+        const int a = a0 + x;
+        for (int b = b0; x < kTile && b < b0 + kTile; ++b)
             if (Inside(a, b)) t[base + uint(a) * pc.strideU + uint(b) * pc.strideV] = 1.0;
-        }
     }
-    {
-        // Step 0: the region from (a0, b0) + steps * (loU, loV), kTile + steps * (hi - lo) cells a side.
-        const int widthU = kTile + steps * (hiU - loU), widthV = kTile + steps * (hiV - loV);
-        const int ou = a0 + steps * loU, ov = b0 + steps * loV;
-        const uint base = fromFirst ? 0u : SliceBase(pc.begin - 1u);
-        for (uint i = lid; i < uint(widthU * widthV); i += 256u) {
-            const int x = int(i) % widthU, y = int(i) / widthU;
-            const int a = ou + x, b = ov + y;
-            float value = 1.0;
-            if (!fromFirst && Inside(a, b)) value = t[base + uint(a) * pc.strideU + uint(b) * pc.strideV];
-            held[y * kRegion + x] = value;
-        }
+    // Shared memory holds every step's region in one frame: local (x, y) is cell
+    // (ou + x, ov + y), the first region's corner. The regions nest (each step's
+    // within the step before), so a step's taps are at the same local positions
+    // one step earlier. Cells outside the plane are 1 in both buffers from here
+    // on, and only cells inside the plane are ever computed or written.
+    const int ou = a0 + steps * loU, ov = b0 + steps * loV;
+    for (int y = 0; x < kRegion && y < kRegion; ++y) {
+        held[y * kRegion + x] = 1.0;
+        held[kRegion * kRegion + y * kRegion + x] = 1.0;
+    }
+    memoryBarrierShared();
+    barrier();
+    // The part of step j's region inside the plane, in local coordinates: [xBegin, xEnd) x [yBegin, yEnd).
+    int xBegin, xEnd, yBegin, yEnd;
+    if (!fromFirst) {
+        // Step 0: the slice before `begin`, kTile + steps * (hi - lo) cells a side.
+        const uint base = SliceBase(pc.begin - 1u);
+        xBegin = max(0, -ou), xEnd = min(kTile + steps * (hiU - loU), int(pc.nu) - ou);
+        yBegin = max(0, -ov), yEnd = min(kTile + steps * (hiV - loV), int(pc.nv) - ov);
+        if (x >= xBegin && x < xEnd)
+            for (int y = yBegin; y < yEnd; ++y)
+                held[y * kRegion + x] = t[base + uint(ou + x) * pc.strideU + uint(ov + y) * pc.strideV];
     }
     for (int j = 1; j <= steps; ++j) {
         memoryBarrierShared();
         barrier();
-        // Step j computes slice m from slice m - 1, held at step j - 1 in a region
-        // that starts lo further: local (x, y) here taps local (x + u0 - loU, y + v0 - loV)
-        // and the cells after it there.
+        // Step j computes slice m from slice m - 1, held at step j - 1 in the
+        // other buffer: cell (a, b) taps (a + u0 .. a + u0 + 1, b + v0 .. b + v0 + 1).
         const uint m = pc.begin + uint(j) - (fromFirst ? 0u : 1u);
         const uint base = SliceBase(m), previousBase = SliceBase(m - 1u);
-        const int widthU = kTile + (steps - j) * (hiU - loU), widthV = kTile + (steps - j) * (hiV - loV);
-        const int ou = a0 + (steps - j) * loU, ov = b0 + (steps - j) * loV;
+        const int first = (steps - j) * loU - steps * loU, firstV = (steps - j) * loV - steps * loV;
+        xBegin = max(first, -ou), xEnd = min(first + kTile + (steps - j) * (hiU - loU), int(pc.nu) - ou);
+        yBegin = max(firstV, -ov), yEnd = min(firstV + kTile + (steps - j) * (hiV - loV), int(pc.nv) - ov);
         const int current = (j & 1) * kRegion * kRegion, previous = ((j - 1) & 1) * kRegion * kRegion;
-        for (uint i = lid; i < uint(widthU * widthV); i += 256u) {
-            const int x = int(i) % widthU, y = int(i) / widthU;
-            const int a = ou + x, b = ov + y;
-            float value = 1.0;
-            if (Inside(a, b)) {
-                const int p = previous + (y + pc.v0 - loV) * kRegion + x + pc.u0 - loU;
+        const int a = ou + x;
+        if (x >= xBegin && x < xEnd)
+            for (int y = yBegin; y < yEnd; ++y) {
+                const int b = ov + y;
+                const int p = previous + (y + pc.v0) * kRegion + x + pc.u0;
                 const float tt = Bilinear(held[p], held[p + 1], held[p + kRegion], held[p + kRegion + 1], pc.fu, pc.fv);
                 const int ua = a + pc.u0, vb = b + pc.v0;
                 const float qs = Bilinear(TapQ(previousBase, ua, vb), TapQ(previousBase, ua + 1, vb),
                                           TapQ(previousBase, ua, vb + 1), TapQ(previousBase, ua + 1, vb + 1), pc.fu,
                                           pc.fv);
-                value = StoreTransmittance(pc.storage, tt,
-                                           SliceFactor(pc.beer, pc.depthPerQ, pc.thesisAr, pc.scatterGain, qs));
+                const float value = StoreTransmittance(
+                    pc.storage, tt, SliceFactor(pc.beer, pc.depthPerQ, pc.thesisAr, pc.scatterGain, qs));
                 if (a >= a0 && a < a0 + kTile && b >= b0 && b < b0 + kTile)
                     t[base + uint(a) * pc.strideU + uint(b) * pc.strideV] = value;
+                held[current + y * kRegion + x] = value;
             }
-            held[current + y * kRegion + x] = value;
-        }
     }
 }
