@@ -171,13 +171,18 @@ TEST_F(ShadeBlockVk, SharesOfTheSweepSameAsPerSlice) {
 // Not a test: times both paths on thesis-medium's grid and sun (256 x 256 x 32,
 // 25 degrees high, azimuth 60: 256 slices of 256 x 32), interleaved, and prints
 // medians and quartiles of wall and device ms. Run with
-// --gtest_also_run_disabled_tests --gtest_filter=ShadeBlockVk.DISABLED_Bench.
+// --gtest_also_run_disabled_tests --gtest_filter=ShadeBlockVk.DISABLED_Bench
+// (SHADE_BENCH_ELEVATION=degrees for another sun).
 TEST_F(ShadeBlockVk, DISABLED_Bench) {
+    auto made = CreateBackend("vk", BackendOptions{});  // without the validation layer, which costs per dispatch
+    ASSERT_TRUE(made.has_value());
+    mBackend = std::move(*made);
     const Extent3 grid{256, 256, 32};
     auto q = test::MakeFilled(*mBackend, BufferFormat::F32, grid, ShadeBlockQ(grid, 7));
     auto T = test::MakeBuffer(*mBackend, BufferFormat::F32, grid);
     ShadeParams p;
-    p.sun = SunDirection(25 * 3.14159265358979 / 180, 60 * 3.14159265358979 / 180);
+    const char* elevation = std::getenv("SHADE_BENCH_ELEVATION");  // degrees; e.g. 70: z principal, 32 slices
+    p.sun = SunDirection((elevation ? std::atof(elevation) : 25) * 3.14159265358979 / 180, 60 * 3.14159265358979 / 180);
     std::vector<double> wall[2], device[2];
     for (int round = 0; round < 12; ++round)
         for (int perSlice : {0, 1}) {
