@@ -63,25 +63,22 @@ void main() {
     // Shared memory holds every step's region in one frame: local (x, y) is cell
     // (ou + x, ov + y), the first region's corner. The regions nest (each step's
     // within the step before), so a step's taps are at the same local positions
-    // one step earlier. Cells outside the plane are 1 in both buffers from here
-    // on, and only cells inside the plane are ever computed or written.
+    // one step earlier. Cells outside the plane are set to 1 here in both
+    // buffers and never written again; only cells inside the plane are computed.
     const int ou = a0 + steps * loU, ov = b0 + steps * loV;
-    for (int y = 0; x < kRegion && y < kRegion; ++y) {
-        held[y * kRegion + x] = 1.0;
-        held[kRegion * kRegion + y * kRegion + x] = 1.0;
-    }
-    memoryBarrierShared();
-    barrier();
-    // The part of step j's region inside the plane, in local coordinates: [xBegin, xEnd) x [yBegin, yEnd).
-    int xBegin, xEnd, yBegin, yEnd;
-    if (!fromFirst) {
-        // Step 0: the slice before `begin`, kTile + steps * (hi - lo) cells a side.
-        const uint base = SliceBase(pc.begin - 1u);
-        xBegin = max(0, -ou), xEnd = min(kTile + steps * (hiU - loU), int(pc.nu) - ou);
-        yBegin = max(0, -ov), yEnd = min(kTile + steps * (hiV - loV), int(pc.nv) - ov);
-        if (x >= xBegin && x < xEnd)
-            for (int y = yBegin; y < yEnd; ++y)
-                held[y * kRegion + x] = t[base + uint(ou + x) * pc.strideU + uint(ov + y) * pc.strideV];
+    {
+        // Step 0: slice 0 (all 1) or the slice before `begin`, kTile + steps * (hi - lo) cells a side.
+        const uint base = fromFirst ? 0u : SliceBase(pc.begin - 1u);
+        const int a = ou + x;
+        for (int y = 0; x < kTile + steps * (hiU - loU) && y < kTile + steps * (hiV - loV); ++y) {
+            const int b = ov + y;
+            if (!Inside(a, b)) {
+                held[y * kRegion + x] = 1.0;
+                held[kRegion * kRegion + y * kRegion + x] = 1.0;
+            } else {
+                held[y * kRegion + x] = fromFirst ? 1.0 : t[base + uint(a) * pc.strideU + uint(b) * pc.strideV];
+            }
+        }
     }
     for (int j = 1; j <= steps; ++j) {
         memoryBarrierShared();
@@ -91,8 +88,9 @@ void main() {
         const uint m = pc.begin + uint(j) - (fromFirst ? 0u : 1u);
         const uint base = SliceBase(m), previousBase = SliceBase(m - 1u);
         const int first = (steps - j) * loU - steps * loU, firstV = (steps - j) * loV - steps * loV;
-        xBegin = max(first, -ou), xEnd = min(first + kTile + (steps - j) * (hiU - loU), int(pc.nu) - ou);
-        yBegin = max(firstV, -ov), yEnd = min(firstV + kTile + (steps - j) * (hiV - loV), int(pc.nv) - ov);
+        // The part of this step's region inside the plane, local: [xBegin, xEnd) x [yBegin, yEnd).
+        const int xBegin = max(first, -ou), xEnd = min(first + kTile + (steps - j) * (hiU - loU), int(pc.nu) - ou);
+        const int yBegin = max(firstV, -ov), yEnd = min(firstV + kTile + (steps - j) * (hiV - loV), int(pc.nv) - ov);
         const int current = (j & 1) * kRegion * kRegion, previous = ((j - 1) & 1) * kRegion * kRegion;
         const int a = ou + x;
         if (x >= xBegin && x < xEnd)
