@@ -23,9 +23,13 @@ namespace {
 // (one cell of cone per slice) and 8 where one is +1 (a 45-degree tie: two).
 // Its shared memory holds two slices of the widest region, (32 + 16)^2 floats
 // each: 18 KiB of the 32 KiB that Vulkan guarantees (maxComputeSharedMemorySize).
-// 16 slices cut 256 dispatches to 16; the region is on average 1.5 times the
-// tile's cells (redundant work), which a larger tile would lower but with fewer
-// groups to spread over a GPU (a 256 x 32 plane is 8 groups already).
+// 16 slices cut 256 dispatches to 16; the regions hold on average up to 1.54
+// times the tile's cells (1.23 where the plane ends within one axis's halo), work
+// a larger tile would lower but with fewer groups to spread over a GPU (a 256 x 32
+// plane is 8 groups already). On lavapipe, where a dispatch is cheap next to the
+// cells, that extra work makes this path slower than the per-slice one
+// (docs/performance.md); it is for GPUs, where each dispatch and barrier is a few
+// microseconds of a dependent chain.
 constexpr uint32_t kShadeBlockTile = 32;
 constexpr int kShadeBlockHalo = 16;
 
