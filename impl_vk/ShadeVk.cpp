@@ -1,13 +1,51 @@
-// Stage `shade` (SPEC 6) on Vulkan: inverse shear-warp, one shade_slice.comp
-// dispatch per slice; at resolution 2 or 4 on a coarse grid (shade_down.comp,
-// shade_up.comp). A share [m0, m1) of the sweep (SPEC 13) dispatches the slices
+// Stage `shade` (SPEC 6) on Vulkan: inverse shear-warp, 16 slices (8 at a
+// 45-degree tie) per shade_block.comp dispatch (tiles of the slice plane that
+// carry the dependency cone in shared memory; issue 16), with a barrier between
+// dispatches; at resolution 2 or 4 on a coarse grid (shade_down.comp,
+// shade_up.comp). A share [m0, m1) of the sweep (SPEC 13) computes the slices
 // m0 .. m1 - 1 in visiting order; at f > 1 the share with m = 0 also down-samples
 // q and the share ending at nw up-samples into T. The coarse q and T
 // (VkScratch::ShadeCoarseQ/T) carry the sweep from one share to the next.
+// CLOUDBENCH_VK_SHADE=slice selects the reference path, one shade_slice.comp
+// dispatch per slice (the tests compare the two byte for byte).
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+
 #include "core/ShadePlan.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
+namespace {
+
+// shade_block.comp's kTile and kHalo: 32 x 32 tiles, and a region at most 16
+// cells wider, which is 16 slices a dispatch where the tap offsets are -1 or 0
+// (one cell of cone per slice) and 8 where one is +1 (a 45-degree tie: two).
+// Its shared memory holds two slices of the widest region, (32 + 16)^2 floats
+// each: 18 KiB of the 32 KiB that Vulkan guarantees (maxComputeSharedMemorySize).
+// 16 slices cut 256 dispatches to 16; the regions hold on average up to 1.54
+// times the tile's cells (1.23 where the plane ends within one axis's halo), work
+// a larger tile would lower but with fewer groups to spread over a GPU (a 256 x 32
+// plane is 8 groups already). On lavapipe, where a dispatch is cheap next to the
+// cells, that extra work makes this path slower than the per-slice one
+// (docs/performance.md); it is for GPUs, where each dispatch and barrier is a few
+// microseconds of a dependent chain.
+constexpr uint32_t kShadeBlockTile = 32;
+constexpr int kShadeBlockHalo = 16;
+
+// Slices a shade_block dispatch computes from the one before it: the cone grows
+// by max(o + 1, 0) - min(o, 0) cells a slice along an axis whose tap offset is o.
+uint32_t ShadeBlockSteps(int u0, int v0) {
+    auto growth = [](int o) { return std::max(o + 1, 0) - std::min(o, 0); };
+    return uint32_t(std::max(1, kShadeBlockHalo / std::max(growth(u0), growth(v0))));
+}
+
+bool ShadePerSlice() {
+    const char* value = std::getenv("CLOUDBENCH_VK_SHADE");
+    return value && std::strcmp(value, "slice") == 0;
+}
+
+}  // namespace
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const int f = params.resolution;
@@ -32,7 +70,8 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         shadeQ = *cq;
         shadeT = *ct;
     }
-    auto slice = mContext->GetPipeline("shade_slice", 2);
+    const bool perSlice = ShadePerSlice();
+    auto slice = mContext->GetPipeline(perSlice ? "shade_slice" : "shade_block", 2);
     if (!slice) return std::unexpected(slice.error());
     Pipeline* down = nullptr;
     Pipeline* up = nullptr;
@@ -73,6 +112,31 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
            a.scatterGain,
            uint32_t(params.storage)};
     struct {
+        uint32_t nu, nv, strideU, strideV, strideW, nw, sunAbove, begin, end;
+        int32_t u0, v0;
+        float fu, fv;
+        uint32_t beer;
+        float depthPerQ, thesisAr, scatterGain;
+        uint32_t storage;
+    } block{n[g.u],
+            n[g.v],
+            stride[g.u],
+            stride[g.v],
+            stride[g.w],
+            nw,
+            g.sunAbove ? 1u : 0u,
+            0,
+            0,
+            g.u0,
+            g.v0,
+            g.fu,
+            g.fv,
+            push.beer,
+            a.opticalDepthPerQ,
+            a.thesisAr,
+            a.scatterGain,
+            uint32_t(params.storage)};
+    struct {
         uint32_t nx, ny, nz, cx, cy, cz, f;
     } resample{e.nx, e.ny, e.nz, n[0], n[1], n[2], uint32_t(f)};
     const DeviceBuffer* sliceBuffers[] = {shadeQ, shadeT};
@@ -83,8 +147,20 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
             r.Dispatch(*down, downBuffers, &resample, sizeof resample, n[0] * n[1] * n[2]);
             r.Barrier();
         }
+        if (!perSlice) {
+            // A dispatch from slice 0 computes it and `steps` more.
+            const uint32_t steps = ShadeBlockSteps(g.u0, g.v0);
+            const uint32_t groupsU = (n[g.u] + kShadeBlockTile - 1) / kShadeBlockTile;
+            const uint32_t groupsV = (n[g.v] + kShadeBlockTile - 1) / kShadeBlockTile;
+            for (uint32_t m = m0; m < m1; m = block.end) {
+                block.begin = m;
+                block.end = std::min(m1, m + steps + (m == 0 ? 1u : 0u));
+                r.DispatchGroups(**slice, sliceBuffers, &block, sizeof block, groupsU, groupsV, 1);
+                r.Barrier();
+            }
+        }
         uint32_t previous = m0 > 0 ? plan.SliceW(m0 - 1) : 0;
-        for (uint32_t m = m0; m < m1; ++m) {
+        for (uint32_t m = perSlice ? m0 : m1; m < m1; ++m) {
             const uint32_t wIndex = plan.SliceW(m);
             push.first = m == 0 ? 1u : 0u;
             push.sliceBase = wIndex * stride[g.w];
