@@ -1,0 +1,42 @@
+#include "impl_cpu/ShadeSchedule.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/Grid.h"
+#include "core/ShadePlan.h"
+
+namespace cb::cpu {
+
+ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0, uint32_t m1) {
+    ShadeSchedule s;
+    m1 = std::min(m1, plan.nw);
+    if (m0 >= m1) return s;
+    const uint32_t slices = m1 - m0, nu = plan.nu, nv = plan.nv;
+    s.work = double(slices) * nu * nv;
+    s.span = s.work;
+    s.blockSlices = slices;
+    // Bands along v (whole rows) when each thread gets a few rows, else along u.
+    const uint32_t p = uint32_t(std::max(threads, 1));
+    s.axis = nv >= 4 * p ? 1 : 0;
+    const uint32_t n = s.axis == 1 ? nv : nu;
+    s.bands = std::max<uint32_t>(1, std::min(p, n / kMinBandCells));
+    if (s.bands == 1) return s;
+    const int o0 = s.axis == 1 ? plan.geometry.v0 : plan.geometry.u0;
+    s.towardHigher = o0 >= 0;
+    const double bandCells = double(nu) * nv / s.bands;
+    // Slices per tile: about kTileCells cells, but the pipeline's fill, (bands
+    // - 1) tiles, at most a quarter of the sweep.
+    const uint32_t byCells = uint32_t(std::max(1.0, std::ceil(kTileCells / bandCells)));
+    const uint32_t byFill = std::max<uint32_t>(1, slices / (4 * (s.bands - 1)));
+    s.blockSlices = std::min({byCells, byFill, slices});
+    s.blocks = CeilDiv(slices, s.blockSlices);
+    // Every longest chain of tiles has bands - 1 tiles of the first block
+    // (the pipeline's fill) and one tile of every block; a tile of the widest
+    // band holds `widest` cells per slice.
+    const double widest = double(CeilDiv(n, s.bands)) * (s.axis == 1 ? nu : nv);
+    s.span = (double(s.bands - 1) * s.blockSlices + slices) * widest;
+    return s;
+}
+
+}  // namespace cb::cpu
