@@ -22,6 +22,12 @@ namespace cb::cpu {
 namespace {
 
 constexpr uint32_t kMaxStackRow = 512;
+// The row kernel runs on whole vectors of this many cells; a shorter rest is
+// padded to it (the compiler's scalar epilogue costs ten times a lane).
+constexpr uint32_t kRowLanes = 16;
+
+uint32_t WholeVectors(uint32_t n) { return n / kRowLanes * kRowLanes; }
+uint32_t PaddedToVectors(uint32_t n) { return (n + kRowLanes - 1) / kRowLanes * kRowLanes; }
 
 // The per-voxel work of one slice, with the options fixed at compile time so
 // that the loop over a row vectorises (a switch per voxel stops it).
@@ -90,7 +96,13 @@ struct ShadeSweep {
         float t0[kMaxStackRow + 1], t1[kMaxStackRow + 1], q0[kMaxStackRow + 1], q1[kMaxStackRow + 1];
         float row[kMaxStackRow];
         for (uint32_t s = a0; s < a1; s += kMaxStackRow) {
+            // A few edge cells stay scalar; longer runs are padded to whole vectors.
             const uint32_t count = std::min(kMaxStackRow, a1 - s);
+            const uint32_t padded = count < kRowLanes / 2 ? count : PaddedToVectors(count);
+            for (uint32_t i = count + 1; i <= padded; ++i) {
+                t0[i] = t1[i] = 1.0f;
+                q0[i] = q1[i] = 0.0f;
+            }
             for (uint32_t i = 0; i <= count; ++i) {
                 const int64_t x = int64_t(s) + i + g.u0;
                 const bool inU = x >= 0 && x < nu;
@@ -102,38 +114,69 @@ struct ShadeSweep {
                 t1[i] = in1 ? T[at1] : 1.0f;
                 q1[i] = in1 ? Q[at1] : 0.0f;
             }
-            ShadeRow(kernel, t0, t1, q0, q1, g.fu, g.fv, row, count);
+            ShadeRow(kernel, t0, t1, q0, q1, g.fu, g.fv, row, padded);
             for (uint32_t i = 0; i < count; ++i) T[cur + su * (s + i)] = row[i];
         }
     }
 
-    // Cells [a0, a1) x [b0, b1) of slice m > 0 when u is not x (rows strided):
-    // the taps into slice m - 1 are copied once into a padded block of rows
-    // (outside: T = 1, q = 0), each row shaded from it, then scattered.
+    // Cells [a0, a1) x [b0, b1) of slice m > 0 from a copy: the taps into
+    // slice m - 1 are copied once into a padded block of rows (outside: T = 1,
+    // q = 0), then each row is shaded from it. For rows far apart in memory
+    // (u not x, or w = y: rows a slice of z apart), where reading them in
+    // place costs more than the copy.
     void Block(uint32_t m, uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1) const {
         const ShearWarp& g = plan.geometry;
         const size_t prev = sw * plan.SliceW(m - 1), cur = sw * plan.SliceW(m);
-        const uint32_t na = a1 - a0, pitch = na + 1, rows = b1 - b0 + 1;
+        const uint32_t na = a1 - a0, padded = PaddedToVectors(na), pitch = padded + 1, rows = b1 - b0 + 1;
         thread_local std::vector<float> scratch;
-        scratch.resize(size_t(pitch) * rows * 2 + na);
+        scratch.resize(size_t(pitch) * rows * 2 + padded);
         float* t = scratch.data();
         float* q = t + size_t(pitch) * rows;
         float* out = q + size_t(pitch) * rows;
+        // Taps x = a0 + u0 + i for i < pitch; inside the slice for i in [i0, i1) (and i <= na).
+        const int64_t xa = int64_t(a0) + g.u0;
+        const uint32_t i0 = uint32_t(std::clamp<int64_t>(-xa, 0, pitch));
+        const uint32_t i1 = uint32_t(std::clamp<int64_t>(int64_t(plan.nu) - xa, i0, na + 1));
         for (uint32_t r = 0; r < rows; ++r) {
+            float* tr = t + size_t(pitch) * r;
+            float* qr = q + size_t(pitch) * r;
             const int64_t y = int64_t(b0) + r + g.v0;
             const bool inV = y >= 0 && y < int64_t(plan.nv);
-            for (uint32_t i = 0; i < pitch; ++i) {
-                const int64_t x = int64_t(a0) + i + g.u0;
-                const bool in = inV && x >= 0 && x < int64_t(plan.nu);
-                const size_t at = in ? prev + su * size_t(x) + sv * size_t(y) : 0;
-                t[size_t(pitch) * r + i] = in ? T[at] : 1.0f;
-                q[size_t(pitch) * r + i] = in ? Q[at] : 0.0f;
+            const uint32_t c0 = inV ? i0 : pitch, c1 = inV ? i1 : pitch;
+            std::fill(tr, tr + c0, 1.0f);
+            std::fill(qr, qr + c0, 0.0f);
+            std::fill(tr + c1, tr + pitch, 1.0f);
+            std::fill(qr + c1, qr + pitch, 0.0f);
+            if (c0 >= c1) continue;
+            const size_t at = prev + sv * size_t(y) + su * size_t(xa + c0);
+            if (su == 1) {
+                std::copy(T + at, T + at + (c1 - c0), tr + c0);
+                std::copy(Q + at, Q + at + (c1 - c0), qr + c0);
+            } else {
+                for (uint32_t i = 0; i < c1 - c0; ++i) {
+                    tr[c0 + i] = T[at + su * i];
+                    qr[c0 + i] = Q[at + su * i];
+                }
             }
         }
+        // The next slice copies this slice's q rows: ask for them now (from
+        // L3, rows a slice of z apart, which the hardware does not prefetch).
+        if (su == 1)
+            for (uint32_t r = 0; r < rows; ++r) {
+                const int64_t y = int64_t(b0) + r + g.v0;
+                if (y < 0 || y >= int64_t(plan.nv) || i0 >= i1) continue;
+                const float* at = Q + cur + sv * size_t(y) + size_t(xa + i0);
+                for (uint32_t i = 0; i < i1 - i0; i += 16) __builtin_prefetch(at + i);
+            }
         for (uint32_t b = b0; b < b1; ++b) {
             const size_t r = size_t(pitch) * (b - b0);
-            ShadeRow(kernel, t + r, t + r + pitch, q + r, q + r + pitch, g.fu, g.fv, out, na);
-            for (uint32_t i = 0; i < na; ++i) T[cur + sv * b + su * (a0 + i)] = out[i];
+            float* row = T + cur + sv * b + su * a0;
+            const bool direct = su == 1 && padded == na;
+            ShadeRow(kernel, t + r, t + r + pitch, q + r, q + r + pitch, g.fu, g.fv, direct ? row : out, padded);
+            if (direct) continue;
+            if (su == 1) std::copy(out, out + na, row);
+            else
+                for (uint32_t i = 0; i < na; ++i) row[su * i] = out[i];
         }
     }
 
@@ -148,13 +191,23 @@ struct ShadeSweep {
         const size_t prev = sw * plan.SliceW(m - 1);
         const int64_t r0 = int64_t(b) + g.v0;
         // The interior: both taps a + u0 and a + u0 + 1 inside [0, nu).
-        const int64_t lo = std::max<int64_t>(a0, -g.u0), hi = std::min<int64_t>(a1, int64_t(plan.nu) - 1 - g.u0);
-        if (su != 1 || lo >= hi) return Gathered(prev, cur, r0, a0, a1);
+        const int64_t lo = std::max<int64_t>(a0, -g.u0);
+        const int64_t hi = std::min<int64_t>(a1, int64_t(plan.nu) - 1 - g.u0);
+        if (su != 1 || hi - lo < int64_t(kRowLanes)) return Gathered(prev, cur, r0, a0, a1);
         auto row = [&](int64_t r, const float* grid, const std::vector<float>& outside) {
             return r >= 0 && r < int64_t(plan.nv) ? grid + prev + sv * size_t(r) + size_t(lo + g.u0) : outside.data();
         };
-        ShadeRow(kernel, row(r0, T, ones), row(r0 + 1, T, ones), row(r0, Q, zeros), row(r0 + 1, Q, zeros), g.fu, g.fv,
-                 T + cur + size_t(lo), uint32_t(hi - lo));
+        // Taps of cell lo (the constant rows need no offset).
+        const float *t0 = row(r0, T, ones), *t1 = row(r0 + 1, T, ones), *q0 = row(r0, Q, zeros),
+                    *q1 = row(r0 + 1, Q, zeros);
+        // Whole vectors from lo, then the last vector again ending at hi (its
+        // cells written twice, the same bits), so no cell takes the scalar path.
+        const uint32_t whole = WholeVectors(uint32_t(hi - lo));
+        ShadeRow(kernel, t0, t1, q0, q1, g.fu, g.fv, T + cur + size_t(lo), whole);
+        if (whole < hi - lo) {
+            const size_t s = size_t(hi - lo) - kRowLanes;
+            ShadeRow(kernel, t0 + s, t1 + s, q0 + s, q1 + s, g.fu, g.fv, T + cur + size_t(lo) + s, kRowLanes);
+        }
         if (a0 < lo) Gathered(prev, cur, r0, a0, uint32_t(lo));
         if (hi < a1) Gathered(prev, cur, r0, uint32_t(hi), a1);
     }
@@ -178,17 +231,18 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     const ShadeSweep sweep(plan, storage, Q, T);
     const ShadeSchedule s = MakeShadeSchedule(plan, arena.max_concurrency(), m0, m1);
     const uint32_t n = s.axis == 1 ? plan.nv : plan.nu;
+    // Rows far apart (u not x; w = y, where v = z) are copied per slice (Block);
+    // else each row reads the previous slice in place (Row).
+    const bool copied = sweep.su != 1 || sweep.sv > sweep.sw;
     auto tile = [&](uint32_t band, uint32_t block) {
         const uint32_t c0 = uint32_t(uint64_t(n) * band / s.bands), c1 = uint32_t(uint64_t(n) * (band + 1) / s.bands);
+        const uint32_t ua = s.axis == 1 ? 0 : c0, ub = s.axis == 1 ? plan.nu : c1;
+        const uint32_t va = s.axis == 1 ? c0 : 0, vb = s.axis == 1 ? c1 : plan.nv;
         const uint32_t ma = m0 + block * s.blockSlices, mb = std::min(m1, ma + s.blockSlices);
         for (uint32_t m = ma; m < mb; ++m) {
-            if (sweep.su != 1 && m > 0) {
-                if (s.axis == 1) sweep.Block(m, 0, plan.nu, c0, c1);
-                else sweep.Block(m, c0, c1, 0, plan.nv);
-            } else if (s.axis == 1)
-                for (uint32_t b = c0; b < c1; ++b) sweep.Row(m, b, 0, plan.nu);
+            if (m > 0 && copied) sweep.Block(m, ua, ub, va, vb);
             else
-                for (uint32_t b = 0; b < plan.nv; ++b) sweep.Row(m, b, c0, c1);
+                for (uint32_t b = va; b < vb; ++b) sweep.Row(m, b, ua, ub);
         }
     };
     if (s.bands == 1) {
