@@ -253,6 +253,11 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     const uint32_t B = s.bands, blocks = s.blocks;
     const int dir = s.towardHigher ? 1 : -1;
     const uint32_t last = s.towardHigher ? B - 1 : 0;  // the band that waits for no other
+    if (arena.max_concurrency() == 1) {  // one thread: block by block, from the band that waits for none
+        for (uint32_t M = 0; M < blocks; ++M)
+            for (uint32_t k = 0; k < B; ++k) tile(s.towardHigher ? B - 1 - k : k, M);
+        return;
+    }
     std::vector<std::atomic<uint8_t>> pending(size_t(B) * blocks);
     for (uint32_t M = 0; M < blocks; ++M)
         for (uint32_t i = 0; i < B; ++i) pending[size_t(M) * B + i] = uint8_t((M > 0) + (i != last));

@@ -16,8 +16,22 @@ ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0,
     s.work = double(slices) * nu * nv;
     s.span = s.work;
     s.blockSlices = slices;
-    // Bands along v (whole rows) when each thread gets a few rows, else along u.
     const uint32_t p = uint32_t(std::max(threads, 1));
+    if (plan.geometry.w == 0 && nv >= 2 * kStridedRows) {
+        // u = y, v = z: a row's cells lie a grid row apart, and one slice's
+        // rows touch a cache line each per cell, too many to stay cached
+        // from one slice to the next. Tiles of kStridedRows rows and as many
+        // slices as a cache line holds floats use each line whole, on any
+        // number of threads.
+        s.axis = 1;
+        s.bands = nv / kStridedRows;
+        s.towardHigher = plan.geometry.v0 >= 0;
+        s.blockSlices = std::min(kLineFloats, slices);
+        s.blocks = CeilDiv(slices, s.blockSlices);
+        s.span = (double(s.bands - 1) * s.blockSlices + slices) * double(CeilDiv(nv, s.bands)) * nu;
+        return s;
+    }
+    // Bands along v (whole rows) when each thread gets a few rows, else along u.
     s.axis = nv >= 4 * p ? 1 : 0;
     const uint32_t n = s.axis == 1 ? nv : nu;
     s.bands = std::max<uint32_t>(1, std::min(p, n / kMinBandCells));

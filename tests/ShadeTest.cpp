@@ -479,15 +479,32 @@ TEST(Shade, CpuScheduleByHand) {
     const cpu::ShadeSchedule share = cpu::MakeShadeSchedule(plan, 2, 100, 140);
     EXPECT_EQ(share.blocks, 10u);
     EXPECT_EQ(share.span, (4.0 + 40.0) * 4096.0);
-    // The sun at -x (azimuth 180, low): w = x, u0 = -1 on u = y: bands read the lower band.
+    // The sun at -x (azimuth 180 + 11 degrees, 17 high): s = (-0.94, -0.19,
+    // 0.30), w = x, u = y, v = z, dv = 0.30 / 0.94 -> v0 = 0. Rows along y are
+    // strided: bands of 2 rows (16 of them, on any thread count), tiles of 16
+    // slices (a cache line of floats along x); the chain is 15 fill tiles of
+    // 16 slices plus 256 slices, of 2 x 256 cells.
     p.sun = SunDirection(0.3, std::numbers::pi + 0.2);
     const ShadePlan west = MakeShadePlan(p, Extent3{256, 256, 32});
-    // (s = (-0.94, -0.19, 0.30): du = -0.19 / 0.94 -> u0 = -1.)
     ASSERT_EQ(west.geometry.w, 0);
-    ASSERT_EQ(west.geometry.u0, -1);
-    const cpu::ShadeSchedule w16 = cpu::MakeShadeSchedule(west, 16, 0, 256);
-    EXPECT_EQ(w16.axis, 0);
-    EXPECT_FALSE(w16.towardHigher);
+    ASSERT_EQ(west.geometry.v0, 0);
+    for (int threads : {1, 16}) {
+        const cpu::ShadeSchedule x = cpu::MakeShadeSchedule(west, threads, 0, 256);
+        EXPECT_EQ(x.axis, 1);
+        EXPECT_EQ(x.bands, 16u);
+        EXPECT_EQ(x.blockSlices, 16u);
+        EXPECT_TRUE(x.towardHigher);
+        EXPECT_EQ(x.span, (15.0 * 16.0 + 256.0) * 512.0);
+    }
+    // Sun at azimuth -80 degrees, 60 high: s = (0.09, -0.49, 0.87), w = z,
+    // v = y, dv = -0.49 / 0.87 -> v0 = -1: each band reads the band below.
+    p.sun = SunDirection(60.0 * std::numbers::pi / 180.0, -80.0 * std::numbers::pi / 180.0);
+    const ShadePlan south = MakeShadePlan(p, Extent3{256, 256, 32});
+    ASSERT_EQ(south.geometry.w, 2);
+    ASSERT_EQ(south.geometry.v0, -1);
+    const cpu::ShadeSchedule z2 = cpu::MakeShadeSchedule(south, 2, 0, 32);
+    EXPECT_EQ(z2.axis, 1);
+    EXPECT_FALSE(z2.towardHigher);
 }
 
 std::vector<float> ShadowOnCpu(const Extent3& e, const std::vector<float>& D, const ShadowParams& p) {
