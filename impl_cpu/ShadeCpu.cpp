@@ -22,6 +22,8 @@ namespace cb::cpu {
 namespace {
 
 constexpr uint32_t kMaxStackRow = 512;
+// How many grid rows ahead a sweep along x asks for its cache lines.
+constexpr uint32_t kPrefetchRows = 8;
 // The row kernel runs on whole vectors of this many cells; a shorter rest is
 // padded to it (the compiler's scalar epilogue costs ten times a lane).
 constexpr uint32_t kRowLanes = 16;
@@ -180,6 +182,65 @@ struct ShadeSweep {
         }
     }
 
+    // A tile of a sweep along x (u = y, v = z): slices [ma, mb) of rows
+    // [b0, b1), every u. Along x the slices of one (y, z) are consecutive
+    // floats, so the tile reads each cache line once: it copies q and T of
+    // its slices, transposed, into rows per slice (ma - 1 first; T of rows
+    // outside the band, which another tile computed, for every slice), shades
+    // there, and writes its slices of T back the same way.
+    void TileAlongX(uint32_t ma, uint32_t mb, uint32_t b0, uint32_t b1) const {
+        const ShearWarp& g = plan.geometry;
+        if (ma == 0) {
+            for (uint32_t b = b0; b < b1; ++b) Row(0, b, 0, plan.nu);
+            ma = 1;
+        }
+        if (ma >= mb) return;
+        const uint32_t K = mb - ma, nu = plan.nu;
+        const int64_t x0 = plan.SliceW(ma - 1), dx = g.sunAbove ? -1 : 1;  // slice ma - 1 + k at x0 + dx k
+        const int64_t yLo = int64_t(b0) + std::min(g.v0, 0), yHi = int64_t(b1) + std::max(g.v0 + 1, 0);
+        const uint32_t R = uint32_t(yHi - yLo), padded = PaddedToVectors(nu), P = padded + 3;
+        const size_t plane = size_t(R) * P;  // one slice's rows; cell (r, u) at r P + u + 1
+        thread_local std::vector<float> scratch;
+        scratch.resize(plane * (2 * K + 1));
+        float* tc = scratch.data();          // K + 1 slices of T
+        float* qc = tc + plane * (K + 1);    // K slices of q
+        for (uint32_t r = 0; r < R; ++r) {
+            const int64_t y = yLo + r;
+            const bool inV = y >= 0 && y < int64_t(plan.nv), inBand = y >= int64_t(b0) && y < int64_t(b1);
+            const uint32_t tSlices = inBand ? 1 : K + 1;  // in the band, only slice ma - 1 is read
+            for (uint32_t k = 0; k <= K; ++k) {
+                std::fill(tc + plane * k + size_t(P) * r, tc + plane * k + size_t(P) * (r + 1), 1.0f);
+                if (k < K) std::fill(qc + plane * k + size_t(P) * r, qc + plane * k + size_t(P) * (r + 1), 0.0f);
+            }
+            if (!inV) continue;
+            for (uint32_t u = 0; u < nu; ++u) {
+                const size_t base = sv * size_t(y) + su * u;
+                const size_t cell = size_t(P) * r + u + 1;
+                // Lines a grid row apart: the hardware does not fetch them ahead.
+                const size_t ahead = sv * size_t(y) + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0);
+                __builtin_prefetch(Q + ahead);
+                __builtin_prefetch(Q + ahead + size_t(dx * int64_t(K - 1)));
+                if (!inBand) __builtin_prefetch(T + ahead);
+                for (uint32_t k = 0; k < K; ++k) qc[plane * k + cell] = Q[base + size_t(x0 + dx * k)];
+                for (uint32_t k = 0; k < tSlices; ++k) tc[plane * k + cell] = T[base + size_t(x0 + dx * k)];
+            }
+        }
+        for (uint32_t k = 1; k <= K; ++k)
+            for (uint32_t b = b0; b < b1; ++b) {
+                const size_t tap = plane * (k - 1) + size_t(P) * size_t(int64_t(b) + g.v0 - yLo) + size_t(g.u0 + 1);
+                float* out = tc + plane * k + size_t(P) * size_t(int64_t(b) - yLo);
+                ShadeRow(kernel, tc + tap, tc + tap + P, qc + tap, qc + tap + P, g.fu, g.fv, out + 1, padded);
+                std::fill(out + nu + 1, out + P, 1.0f);  // the padding wrote past the row: outside again
+            }
+        for (uint32_t b = b0; b < b1; ++b)
+            for (uint32_t u = 0; u < nu; ++u) {
+                const size_t base = sv * b + su * u;
+                __builtin_prefetch(T + sv * b + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0 + dx), 1);
+                const size_t cell = size_t(P) * size_t(int64_t(b) - yLo) + u + 1;
+                for (uint32_t k = 1; k <= K; ++k) T[base + size_t(x0 + dx * k)] = tc[plane * k + cell];
+            }
+    }
+
     // Cells [a0, a1) of row b of slice m.
     void Row(uint32_t m, uint32_t b, uint32_t a0, uint32_t a1) const {
         const size_t cur = sw * plan.SliceW(m) + sv * b;
@@ -234,11 +295,13 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     // Rows far apart (u not x; w = y, where v = z) are copied per slice (Block);
     // else each row reads the previous slice in place (Row).
     const bool copied = sweep.su != 1 || sweep.sv > sweep.sw;
+    const bool alongX = plan.geometry.w == 0 && s.axis == 1 && sweep.sw == 1;
     auto tile = [&](uint32_t band, uint32_t block) {
         const uint32_t c0 = uint32_t(uint64_t(n) * band / s.bands), c1 = uint32_t(uint64_t(n) * (band + 1) / s.bands);
         const uint32_t ua = s.axis == 1 ? 0 : c0, ub = s.axis == 1 ? plan.nu : c1;
         const uint32_t va = s.axis == 1 ? c0 : 0, vb = s.axis == 1 ? c1 : plan.nv;
         const uint32_t ma = m0 + block * s.blockSlices, mb = std::min(m1, ma + s.blockSlices);
+        if (alongX) return sweep.TileAlongX(ma, mb, va, vb);
         for (uint32_t m = ma; m < mb; ++m) {
             if (m > 0 && copied) sweep.Block(m, ua, ub, va, vb);
             else
