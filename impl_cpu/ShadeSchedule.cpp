@@ -31,10 +31,11 @@ ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0,
         s.span = (double(s.bands - 1) * s.blockSlices + slices) * double(CeilDiv(nv, s.bands)) * nu;
         return s;
     }
-    // Bands along v (whole rows) when each thread gets a few rows, else along u.
+    // Bands along v (whole rows) when each thread gets at least 4 rows, else
+    // along u, at least kMinBandCells wide.
     s.axis = nv >= 4 * p ? 1 : 0;
     const uint32_t n = s.axis == 1 ? nv : nu;
-    s.bands = std::max<uint32_t>(1, std::min(p, n / kMinBandCells));
+    s.bands = s.axis == 1 ? p : std::max<uint32_t>(1, std::min(p, n / kMinBandCells));
     if (s.bands == 1) return s;
     const int o0 = s.axis == 1 ? plan.geometry.v0 : plan.geometry.u0;
     s.towardHigher = o0 >= 0;

@@ -10,7 +10,7 @@ struct ShadePlan;
 
 namespace cb::cpu {
 
-// Bands narrower than this many cells are not split further.
+// Bands along u are at least this many cells wide.
 inline constexpr uint32_t kMinBandCells = 8;
 // A tile aims at about this many cells (a few microseconds of one core).
 inline constexpr double kTileCells = 16384;

@@ -470,6 +470,14 @@ TEST(Shade, CpuScheduleByHand) {
     EXPECT_TRUE(two.towardHigher);
     EXPECT_EQ(two.work, 2097152.0);
     EXPECT_EQ(two.span, (4.0 + 256.0) * 4096.0);
+    // 8 threads: 32 >= 4 * 8 rows, so 8 bands of 4 rows (1024 cells): 16 slices
+    // would fill 16384, the fill (7 tiles) allows 256 / 28 -> 9.
+    const cpu::ShadeSchedule eight = cpu::MakeShadeSchedule(plan, 8, 0, 256);
+    EXPECT_EQ(eight.axis, 1);
+    EXPECT_EQ(eight.bands, 8u);
+    EXPECT_EQ(eight.blockSlices, 9u);
+    EXPECT_EQ(eight.blocks, 29u);
+    EXPECT_EQ(eight.span, (7.0 * 9.0 + 256.0) * 1024.0);
     const cpu::ShadeSchedule sixteen = cpu::MakeShadeSchedule(plan, 16, 0, 256);
     EXPECT_EQ(sixteen.axis, 0);
     EXPECT_EQ(sixteen.bands, 16u);
