@@ -443,6 +443,36 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
     }
 }
 
+// Test that the CPU's sweep in shares ([0, 5), [5, 17), [17, end): tiles
+// that start mid-sweep read the slice an earlier share wrote) equals the plain
+// sweep on every principal axis, both sun signs, on 1, 2 and 16 threads.
+TEST(Shade, CpuSharesEqualPlainSweep) {
+    const Extent3 e{37, 29, 23};
+    Pcg32 rng(17);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = rng.Below(3) ? float(rng.Below(65)) / 64.0f : 0.0f;
+    int compared = 0;
+    for (const Vec3& sun : {SunDirection(0.3, 0.2), SunDirection(0.3, 3.3), SunDirection(0.4, 1.4),
+                            SunDirection(0.4, -1.7), SunDirection(1.1, 0.5), SunDirection(-1.2, 2.0)})
+        for (int threads : {1, 2, 16}) {
+            ShadeParams p;
+            p.sun = sun;
+            p.sigma = 0.004f;
+            cpu::BackendCpu backend(threads);
+            auto qb = test::MakeFilled(backend, BufferFormat::F32, e, q);
+            auto T = test::MakeFilled(backend, BufferFormat::F32, e, std::vector<float>(e.Count(), std::nanf("")));
+            for (SliceRange share : {SliceRange{0, 5}, SliceRange{5, 17}, SliceRange{17, UINT32_MAX}}) {
+                p.slices = share;
+                ASSERT_TRUE(backend.Shade(p, *qb, *T).has_value());
+            }
+            p.slices = {};
+            ASSERT_EQ(test::Read<float>(backend, *T), PlainShadeSweep(e, q, p)) << threads << " threads, sun "
+                                                                               << sun[0] << " " << sun[1];
+            ++compared;
+        }
+    EXPECT_EQ(compared, 18);
+}
+
 // Test the CPU sweep's schedule on thesis-medium's grid (256 x 256 x 32) by
 // hand. Sun at 25 degrees, azimuth 60: w = y, u = x (256), v = z (32), 256
 // slices, taps at u0 = v0 = 0 (one band toward higher indices). On 2 threads
