@@ -1,10 +1,13 @@
 // Stage `shade` on the CPU (SPEC 6): inverse shear-warp, one slice after another
-// from the sun side. Each slice reads the previous one in place (T and q rows
-// of the grid itself; taps outside the slice read T = 1, q = 0 from constant
-// rows or gathered edge cells), so the inner loop over u is plain loads and
-// vectorises. On several threads the slice plane is cut into bands that run
-// as a pipeline (ShadeGrid). At resolution f > 1 the same loop runs on the
-// mean of each f^3 block and the result is read back trilinearly.
+// from the sun side. On several threads the slice plane is cut into bands and
+// the sweep into blocks of slices, and the tiles run as a pipeline (ShadeGrid).
+// How a slice reads the previous one depends on where its rows lie: in place
+// when the slices are contiguous planes (w = z), copied per tile and slice
+// when rows are a z-slice apart (w = y), copied transposed per tile of 16
+// slices when a row is strided (w = x); taps outside the slice read T = 1,
+// q = 0. The row kernel runs on whole vectors. At resolution f > 1 the same
+// loop runs on the mean of each f^3 block and the result is read back
+// trilinearly.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -69,9 +72,9 @@ void ShadeRow(const ShadeKernel& k, const float* t0, const float* t1, const floa
 }
 
 // One sweep over slices of the plan's grid (full or coarse): Q in, T out,
-// both of plan.cells. Slice m > 0 reads slice m - 1 of T and Q in place; taps
-// outside the slice read T = 1, q = 0 (the constant rows below, or a gathered
-// row at the edges).
+// both of plan.cells. Slice m > 0 reads slice m - 1 of T and Q (Row: in place,
+// Block: copied, TileAlongX: copied transposed); taps outside the slice read
+// T = 1, q = 0 (the constant rows below, or gathered edge cells).
 struct ShadeSweep {
     const ShadePlan& plan;
     ShadeKernel kernel;
@@ -91,7 +94,8 @@ struct ShadeSweep {
     }
 
     // Cells [a0, a1) of row b of slice m > 0, gathered: the taps into slice
-    // m - 1 copied into padded rows first (u not x, or the row's edges).
+    // m - 1 copied into padded rows first (a row's edges, or rows too short
+    // for a whole vector).
     void Gathered(size_t prev, size_t cur, int64_t r0, uint32_t a0, uint32_t a1) const {
         const ShearWarp& g = plan.geometry;
         const int64_t nu = plan.nu, nv = plan.nv;
