@@ -65,13 +65,10 @@ uint64_t BackendCpu::ScratchBytes(const Scene& scene) const {
     }
     if (scene.stages.Has(Stage::Shade)) {
         // The shaded grid: ceil(n / f) cells per axis (ShadePlan). Below full resolution the coarse q and T
-        // (ShadeCpu.cpp); at any resolution the slice loop's padded previous T and q slices, (nu + 3) x (nv + 3)
-        // floats each, counted for the two longest axes (u and v depend on the sun).
+        // (ShadeCpu.cpp). The sweep reads the previous slice in place: its rows and tile counts are per call.
         const uint64_t f = uint64_t(std::max(scene.shade.resolution, 1));
-        uint64_t cells[3] = {CeilDiv(e.nx, uint32_t(f)), CeilDiv(e.ny, uint32_t(f)), CeilDiv(e.nz, uint32_t(f))};
+        const uint64_t cells[3] = {CeilDiv(e.nx, uint32_t(f)), CeilDiv(e.ny, uint32_t(f)), CeilDiv(e.nz, uint32_t(f))};
         if (f > 1) bytes = SaturatingAdd(bytes, SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4));
-        std::sort(cells, cells + 3);
-        bytes = SaturatingAdd(bytes, 2 * 4 * (cells[1] + 3) * (cells[2] + 3));
     }
     if (scene.stages.Has(Stage::RenderMarch)) {
         // The padded (q_alpha, T) volume and one byte per brick (RenderMarchCpu.cpp).

@@ -72,7 +72,7 @@ class BackendCpu : public Backend {
     // The host layout (HostBufferBytes).
     uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
     // The automaton's advection fields with wind, each thread's smoothing ring,
-    // shade's coarse grids and slice buffers; per-call rows and the renderer's
+    // shade's coarse grids; per-call rows and the renderer's
     // splat lists (which depend on the clouds) are not counted.
     uint64_t ScratchBytes(const Scene& scene) const override;
     // What this process may still allocate: available memory, cgroup and RLIMIT_AS (core/ProcessMemory.h).

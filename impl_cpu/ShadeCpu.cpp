@@ -1,22 +1,38 @@
 // Stage `shade` on the CPU (SPEC 6): inverse shear-warp, one slice after another
-// from the sun side. The previous slice's T and q live in padded 2-D buffers
-// whose border reads T = 1, q = 0, so every tap is a plain load and the inner
-// loop over u vectorises. At resolution f > 1 the same loop runs on the mean of
-// each f^3 block and the result is read back trilinearly.
+// from the sun side. On several threads the slice plane is cut into bands and
+// the sweep into blocks of slices, and the tiles run as a pipeline (ShadeGrid).
+// How a slice reads the previous one depends on where its rows lie: in place
+// when the slices are contiguous planes (w = z), copied per tile and slice
+// when rows are a z-slice apart (w = y), copied transposed per tile of 16
+// slices when a row is strided (w = x); taps outside the slice read T = 1,
+// q = 0. The row kernel runs on whole vectors. At resolution f > 1 the same
+// loop runs on the mean of each f^3 block and the result is read back
+// trilinearly.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_for_each.h>
 
 #include "core/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/ShadeSchedule.h"
 
 namespace cb::cpu {
 namespace {
 
 constexpr uint32_t kMaxStackRow = 512;
+// How many grid rows ahead a sweep along x asks for its cache lines.
+constexpr uint32_t kPrefetchRows = 8;
+// The row kernel runs on whole vectors of this many cells; a shorter rest is
+// padded to it (the compiler's scalar epilogue costs ten times a lane).
+constexpr uint32_t kRowLanes = 16;
+
+uint32_t WholeVectors(uint32_t n) { return n / kRowLanes * kRowLanes; }
+uint32_t PaddedToVectors(uint32_t n) { return (n + kRowLanes - 1) / kRowLanes * kRowLanes; }
 
 // The per-voxel work of one slice, with the options fixed at compile time so
 // that the loop over a row vectorises (a switch per voxel stops it).
@@ -55,71 +71,278 @@ void ShadeRow(const ShadeKernel& k, const float* t0, const float* t1, const floa
     }
 }
 
-// Shades the sweep's slices m in [m0, m1) of the plan's grid (full or coarse):
-// Q in, T out, both of plan.cells. With m0 > 0, slice m0 - 1 of T must hold
-// what this function wrote there (an earlier share): it is read back as the
-// previous slice, exactly the values the whole sweep would carry over.
-void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena,
-               uint32_t m0, uint32_t m1) {
-    const ShearWarp& g = plan.geometry;
-    const int w = g.w, u = g.u, v = g.v;
-    const uint32_t nu = plan.nu, nv = plan.nv, nw = plan.nw;
-    const size_t stride[3] = {1, plan.cells[0], size_t(plan.cells[0]) * plan.cells[1]};
-    const ShadeKernel kernel{plan.attenuation, storage};
-    const int u0 = g.u0, v0 = g.v0;
-    const float fu = g.fu, fv = g.fv;
+// One sweep over slices of the plan's grid (full or coarse): Q in, T out,
+// both of plan.cells. Slice m > 0 reads slice m - 1 of T and Q (Row: in place,
+// Block: copied, TileAlongX: copied transposed); taps outside the slice read
+// T = 1, q = 0 (the constant rows below, or gathered edge cells).
+struct ShadeSweep {
+    const ShadePlan& plan;
+    ShadeKernel kernel;
+    const float* Q;
+    float* T;
+    size_t su, sv, sw;               // strides of u, v, w in the grid
+    std::vector<float> ones, zeros;  // nu + 1 each: a row outside the slice
 
-    // Padded previous slice: index (a + 1) + pitch * (b + 1) holds (a, b), with
-    // one ring below and two above (taps reach u - 1 .. u + 2).
-    const uint32_t pitch = nu + 3;
-    std::vector<float> prevT(size_t(pitch) * (nv + 3), 1.0f), prevQ(size_t(pitch) * (nv + 3), 0.0f);
-    auto padded = [&](int64_t a, int64_t b) { return size_t(a + 1) + size_t(pitch) * size_t(b + 1); };
+    ShadeSweep(const ShadePlan& p, StorageFormat storage, const float* q, float* t)
+        : plan(p), kernel{p.attenuation, storage}, Q(q), T(t) {
+        const size_t stride[3] = {1, p.cells[0], size_t(p.cells[0]) * p.cells[1]};
+        su = stride[p.geometry.u];
+        sv = stride[p.geometry.v];
+        sw = stride[p.geometry.w];
+        ones.assign(size_t(p.nu) + 1, 1.0f);
+        zeros.assign(size_t(p.nu) + 1, 0.0f);
+    }
 
-    // Slice wIndex of T and Q becomes the previous one.
-    auto keep = [&](uint32_t wIndex) {
-        const size_t sliceBase = stride[w] * wIndex;
-        for (uint32_t b = 0; b < nv; ++b) {
-            float* pt = prevT.data() + padded(0, b);
-            float* pq = prevQ.data() + padded(0, b);
-            const float* t = T + sliceBase + stride[v] * b;
-            const float* q = Q + sliceBase + stride[v] * b;
-            for (uint32_t a = 0; a < nu; ++a) {
-                pt[a] = t[stride[u] * a];
-                pq[a] = q[stride[u] * a];
+    // Cells [a0, a1) of row b of slice m > 0, gathered: the taps into slice
+    // m - 1 copied into padded rows first (a row's edges, or rows too short
+    // for a whole vector).
+    void Gathered(size_t prev, size_t cur, int64_t r0, uint32_t a0, uint32_t a1) const {
+        const ShearWarp& g = plan.geometry;
+        const int64_t nu = plan.nu, nv = plan.nv;
+        float t0[kMaxStackRow + 1], t1[kMaxStackRow + 1], q0[kMaxStackRow + 1], q1[kMaxStackRow + 1];
+        float row[kMaxStackRow];
+        for (uint32_t s = a0; s < a1; s += kMaxStackRow) {
+            // A few edge cells stay scalar; longer runs are padded to whole vectors.
+            const uint32_t count = std::min(kMaxStackRow, a1 - s);
+            const uint32_t padded = count < kRowLanes / 2 ? count : PaddedToVectors(count);
+            for (uint32_t i = count + 1; i <= padded; ++i) {
+                t0[i] = t1[i] = 1.0f;
+                q0[i] = q1[i] = 0.0f;
+            }
+            for (uint32_t i = 0; i <= count; ++i) {
+                const int64_t x = int64_t(s) + i + g.u0;
+                const bool inU = x >= 0 && x < nu;
+                const bool in0 = inU && r0 >= 0 && r0 < nv, in1 = inU && r0 + 1 >= 0 && r0 + 1 < nv;
+                const size_t at0 = prev + su * size_t(inU ? x : 0) + sv * size_t(in0 ? r0 : 0);
+                const size_t at1 = prev + su * size_t(inU ? x : 0) + sv * size_t(in1 ? r0 + 1 : 0);
+                t0[i] = in0 ? T[at0] : 1.0f;
+                q0[i] = in0 ? Q[at0] : 0.0f;
+                t1[i] = in1 ? T[at1] : 1.0f;
+                q1[i] = in1 ? Q[at1] : 0.0f;
+            }
+            ShadeRow(kernel, t0, t1, q0, q1, g.fu, g.fv, row, padded);
+            for (uint32_t i = 0; i < count; ++i) T[cur + su * (s + i)] = row[i];
+        }
+    }
+
+    // Cells [a0, a1) x [b0, b1) of slice m > 0 from a copy: the taps into
+    // slice m - 1 are copied once into a padded block of rows (outside: T = 1,
+    // q = 0), then each row is shaded from it. For rows far apart in memory
+    // (u not x, or w = y: rows a slice of z apart), where reading them in
+    // place costs more than the copy.
+    void Block(uint32_t m, uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1) const {
+        const ShearWarp& g = plan.geometry;
+        const size_t prev = sw * plan.SliceW(m - 1), cur = sw * plan.SliceW(m);
+        const uint32_t na = a1 - a0, padded = PaddedToVectors(na), pitch = padded + 1, rows = b1 - b0 + 1;
+        thread_local std::vector<float> scratch;
+        scratch.resize(size_t(pitch) * rows * 2 + padded);
+        float* t = scratch.data();
+        float* q = t + size_t(pitch) * rows;
+        float* out = q + size_t(pitch) * rows;
+        // Taps x = a0 + u0 + i for i < pitch; inside the slice for i in [i0, i1) (and i <= na).
+        const int64_t xa = int64_t(a0) + g.u0;
+        const uint32_t i0 = uint32_t(std::clamp<int64_t>(-xa, 0, pitch));
+        const uint32_t i1 = uint32_t(std::clamp<int64_t>(int64_t(plan.nu) - xa, i0, na + 1));
+        for (uint32_t r = 0; r < rows; ++r) {
+            float* tr = t + size_t(pitch) * r;
+            float* qr = q + size_t(pitch) * r;
+            const int64_t y = int64_t(b0) + r + g.v0;
+            const bool inV = y >= 0 && y < int64_t(plan.nv);
+            const uint32_t c0 = inV ? i0 : pitch, c1 = inV ? i1 : pitch;
+            std::fill(tr, tr + c0, 1.0f);
+            std::fill(qr, qr + c0, 0.0f);
+            std::fill(tr + c1, tr + pitch, 1.0f);
+            std::fill(qr + c1, qr + pitch, 0.0f);
+            if (c0 >= c1) continue;
+            const size_t at = prev + sv * size_t(y) + su * size_t(xa + c0);
+            if (su == 1) {
+                std::copy(T + at, T + at + (c1 - c0), tr + c0);
+                std::copy(Q + at, Q + at + (c1 - c0), qr + c0);
+            } else {
+                for (uint32_t i = 0; i < c1 - c0; ++i) {
+                    tr[c0 + i] = T[at + su * i];
+                    qr[c0 + i] = Q[at + su * i];
+                }
             }
         }
-    };
-    if (m0 > 0) keep(plan.SliceW(m0 - 1));
-    for (uint32_t m = m0; m < std::min(m1, nw); ++m) {
-        const uint32_t wIndex = plan.SliceW(m);
-        const size_t sliceBase = stride[w] * wIndex;
-        if (m == 0) {
-            for (uint32_t b = 0; b < nv; ++b)
-                for (uint32_t a = 0; a < nu; ++a) T[sliceBase + stride[u] * a + stride[v] * b] = 1.0f;
-        } else {
-            auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
-                for (uint32_t b = range.begin(); b != range.end(); ++b) {
-                    const float* t0 = prevT.data() + padded(u0, int64_t(b) + v0);
-                    const float* q0 = prevQ.data() + padded(u0, int64_t(b) + v0);
-                    float* out = T + sliceBase + stride[v] * b;
-                    if (stride[u] == 1) ShadeRow(kernel, t0, t0 + pitch, q0, q0 + pitch, fu, fv, out, nu);
-                    else {
-                        // u is not x: shade into a contiguous row, then scatter.
-                        float row[kMaxStackRow];
-                        for (uint32_t a0 = 0; a0 < nu; a0 += kMaxStackRow) {
-                            const uint32_t count = std::min(kMaxStackRow, nu - a0);
-                            ShadeRow(kernel, t0 + a0, t0 + pitch + a0, q0 + a0, q0 + pitch + a0, fu, fv, row, count);
-                            for (uint32_t a = 0; a < count; ++a) out[stride[u] * (a0 + a)] = row[a];
-                        }
-                    }
-                }
-            };
-            const uint32_t grain = std::max<uint32_t>(1, 16384 / std::max<uint32_t>(nu, 1));
-            if (nv > grain) arena.execute([&] { tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nv, grain), rows); });
-            else rows(tbb::blocked_range<uint32_t>(0, nv));
+        // The next slice copies this slice's q rows: ask for them now (from
+        // L3, rows a slice of z apart, which the hardware does not prefetch).
+        if (su == 1)
+            for (uint32_t r = 0; r < rows; ++r) {
+                const int64_t y = int64_t(b0) + r + g.v0;
+                if (y < 0 || y >= int64_t(plan.nv) || i0 >= i1) continue;
+                const float* at = Q + cur + sv * size_t(y) + size_t(xa + i0);
+                for (uint32_t i = 0; i < i1 - i0; i += 16) __builtin_prefetch(at + i);
+            }
+        for (uint32_t b = b0; b < b1; ++b) {
+            const size_t r = size_t(pitch) * (b - b0);
+            float* row = T + cur + sv * b + su * a0;
+            const bool direct = su == 1 && padded == na;
+            ShadeRow(kernel, t + r, t + r + pitch, q + r, q + r + pitch, g.fu, g.fv, direct ? row : out, padded);
+            if (direct) continue;
+            if (su == 1) std::copy(out, out + na, row);
+            else
+                for (uint32_t i = 0; i < na; ++i) row[su * i] = out[i];
         }
-        if (m + 1 < m1) keep(wIndex);
     }
+
+    // A tile of a sweep along x (u = y, v = z): slices [ma, mb) of rows
+    // [b0, b1), every u. Along x the slices of one (y, z) are consecutive
+    // floats, so the tile reads each cache line once: it copies q and T of
+    // its slices, transposed, into rows per slice (ma - 1 first; T of rows
+    // outside the band, which another tile computed, for every slice), shades
+    // there, and writes its slices of T back the same way.
+    void TileAlongX(uint32_t ma, uint32_t mb, uint32_t b0, uint32_t b1) const {
+        const ShearWarp& g = plan.geometry;
+        if (ma == 0) {
+            for (uint32_t b = b0; b < b1; ++b) Row(0, b, 0, plan.nu);
+            ma = 1;
+        }
+        if (ma >= mb) return;
+        const uint32_t K = mb - ma, nu = plan.nu;
+        const int64_t x0 = plan.SliceW(ma - 1), dx = g.sunAbove ? -1 : 1;  // slice ma - 1 + k at x0 + dx k
+        const int64_t yLo = int64_t(b0) + std::min(g.v0, 0), yHi = int64_t(b1) + std::max(g.v0 + 1, 0);
+        const uint32_t R = uint32_t(yHi - yLo), padded = PaddedToVectors(nu), P = padded + 3;
+        const size_t plane = size_t(R) * P;  // one slice's rows; cell (r, u) at r P + u + 1
+        thread_local std::vector<float> scratch;
+        scratch.resize(plane * (2 * K + 1));
+        float* tc = scratch.data();          // K + 1 slices of T
+        float* qc = tc + plane * (K + 1);    // K slices of q
+        for (uint32_t r = 0; r < R; ++r) {
+            const int64_t y = yLo + r;
+            const bool inV = y >= 0 && y < int64_t(plan.nv), inBand = y >= int64_t(b0) && y < int64_t(b1);
+            const uint32_t tSlices = inBand ? 1 : K + 1;  // in the band, only slice ma - 1 is read
+            for (uint32_t k = 0; k <= K; ++k) {
+                std::fill(tc + plane * k + size_t(P) * r, tc + plane * k + size_t(P) * (r + 1), 1.0f);
+                if (k < K) std::fill(qc + plane * k + size_t(P) * r, qc + plane * k + size_t(P) * (r + 1), 0.0f);
+            }
+            if (!inV) continue;
+            for (uint32_t u = 0; u < nu; ++u) {
+                const size_t base = sv * size_t(y) + su * u;
+                const size_t cell = size_t(P) * r + u + 1;
+                // Lines a grid row apart: the hardware does not fetch them ahead.
+                const size_t ahead = sv * size_t(y) + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0);
+                __builtin_prefetch(Q + ahead);
+                __builtin_prefetch(Q + ahead + size_t(dx * int64_t(K - 1)));
+                if (!inBand) __builtin_prefetch(T + ahead);
+                for (uint32_t k = 0; k < K; ++k) qc[plane * k + cell] = Q[base + size_t(x0 + dx * k)];
+                for (uint32_t k = 0; k < tSlices; ++k) tc[plane * k + cell] = T[base + size_t(x0 + dx * k)];
+            }
+        }
+        for (uint32_t k = 1; k <= K; ++k)
+            for (uint32_t b = b0; b < b1; ++b) {
+                const size_t tap = plane * (k - 1) + size_t(P) * size_t(int64_t(b) + g.v0 - yLo) + size_t(g.u0 + 1);
+                float* out = tc + plane * k + size_t(P) * size_t(int64_t(b) - yLo);
+                ShadeRow(kernel, tc + tap, tc + tap + P, qc + tap, qc + tap + P, g.fu, g.fv, out + 1, padded);
+                std::fill(out + nu + 1, out + P, 1.0f);  // the padding wrote past the row: outside again
+            }
+        for (uint32_t b = b0; b < b1; ++b)
+            for (uint32_t u = 0; u < nu; ++u) {
+                const size_t base = sv * b + su * u;
+                __builtin_prefetch(T + sv * b + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0 + dx), 1);
+                const size_t cell = size_t(P) * size_t(int64_t(b) - yLo) + u + 1;
+                for (uint32_t k = 1; k <= K; ++k) T[base + size_t(x0 + dx * k)] = tc[plane * k + cell];
+            }
+    }
+
+    // Cells [a0, a1) of row b of slice m.
+    void Row(uint32_t m, uint32_t b, uint32_t a0, uint32_t a1) const {
+        const size_t cur = sw * plan.SliceW(m) + sv * b;
+        if (m == 0) {
+            for (uint32_t a = a0; a < a1; ++a) T[cur + su * a] = 1.0f;
+            return;
+        }
+        const ShearWarp& g = plan.geometry;
+        const size_t prev = sw * plan.SliceW(m - 1);
+        const int64_t r0 = int64_t(b) + g.v0;
+        // The interior: both taps a + u0 and a + u0 + 1 inside [0, nu).
+        const int64_t lo = std::max<int64_t>(a0, -g.u0);
+        const int64_t hi = std::min<int64_t>(a1, int64_t(plan.nu) - 1 - g.u0);
+        if (su != 1 || hi - lo < int64_t(kRowLanes)) return Gathered(prev, cur, r0, a0, a1);
+        auto row = [&](int64_t r, const float* grid, const std::vector<float>& outside) {
+            return r >= 0 && r < int64_t(plan.nv) ? grid + prev + sv * size_t(r) + size_t(lo + g.u0) : outside.data();
+        };
+        // Taps of cell lo (the constant rows need no offset).
+        const float *t0 = row(r0, T, ones), *t1 = row(r0 + 1, T, ones), *q0 = row(r0, Q, zeros),
+                    *q1 = row(r0 + 1, Q, zeros);
+        // Whole vectors from lo, then the last vector again ending at hi (its
+        // cells written twice, the same bits), so no cell takes the scalar path.
+        const uint32_t whole = WholeVectors(uint32_t(hi - lo));
+        ShadeRow(kernel, t0, t1, q0, q1, g.fu, g.fv, T + cur + size_t(lo), whole);
+        if (whole < hi - lo) {
+            const size_t s = size_t(hi - lo) - kRowLanes;
+            ShadeRow(kernel, t0 + s, t1 + s, q0 + s, q1 + s, g.fu, g.fv, T + cur + size_t(lo) + s, kRowLanes);
+        }
+        if (a0 < lo) Gathered(prev, cur, r0, a0, uint32_t(lo));
+        if (hi < a1) Gathered(prev, cur, r0, uint32_t(hi), a1);
+    }
+};
+
+// Shades the sweep's slices m in [m0, m1) of the plan's grid (full or coarse).
+// With m0 > 0, slice m0 - 1 of T must hold what an earlier share wrote there:
+// it is read as the previous slice, exactly as the whole sweep would.
+//
+// In parallel, the slice plane is cut into bands along one axis and the sweep
+// into blocks of slices; tile (band i, block M) covers both. Its taps reach
+// one band toward the sun's side (o0 = u0 or v0 >= 0: the higher band; else
+// the lower), so it waits for tiles (i, M - 1) and (i + dir, M), and runs as
+// soon as both are done: a pipeline over the bands, no barriers. Every cell
+// is computed once with the same arithmetic, so T does not depend on the
+// schedule.
+void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena,
+               uint32_t m0, uint32_t m1) {
+    m1 = std::min(m1, plan.nw);
+    if (m0 >= m1) return;
+    const ShadeSweep sweep(plan, storage, Q, T);
+    const ShadeSchedule s = MakeShadeSchedule(plan, arena.max_concurrency(), m0, m1);
+    const uint32_t n = s.axis == 1 ? plan.nv : plan.nu;
+    // Rows far apart (u not x; w = y, where v = z) are copied per slice (Block);
+    // else each row reads the previous slice in place (Row).
+    const bool copied = sweep.su != 1 || sweep.sv > sweep.sw;
+    const bool alongX = plan.geometry.w == 0 && s.axis == 1 && sweep.sw == 1;
+    auto tile = [&](uint32_t band, uint32_t block) {
+        const uint32_t c0 = uint32_t(uint64_t(n) * band / s.bands), c1 = uint32_t(uint64_t(n) * (band + 1) / s.bands);
+        const uint32_t ua = s.axis == 1 ? 0 : c0, ub = s.axis == 1 ? plan.nu : c1;
+        const uint32_t va = s.axis == 1 ? c0 : 0, vb = s.axis == 1 ? c1 : plan.nv;
+        const uint32_t ma = m0 + block * s.blockSlices, mb = std::min(m1, ma + s.blockSlices);
+        if (alongX) return sweep.TileAlongX(ma, mb, va, vb);
+        for (uint32_t m = ma; m < mb; ++m) {
+            if (m > 0 && copied) sweep.Block(m, ua, ub, va, vb);
+            else
+                for (uint32_t b = va; b < vb; ++b) sweep.Row(m, b, ua, ub);
+        }
+    };
+    if (s.bands == 1) {
+        tile(0, 0);
+        return;
+    }
+    // Tile (i, M) waits for (i, M - 1) and (i + dir, M); pending counts those not done.
+    const uint32_t B = s.bands, blocks = s.blocks;
+    const int dir = s.towardHigher ? 1 : -1;
+    const uint32_t last = s.towardHigher ? B - 1 : 0;  // the band that waits for no other
+    if (arena.max_concurrency() == 1) {  // one thread: block by block, from the band that waits for none
+        for (uint32_t M = 0; M < blocks; ++M)
+            for (uint32_t k = 0; k < B; ++k) tile(s.towardHigher ? B - 1 - k : k, M);
+        return;
+    }
+    std::vector<std::atomic<uint8_t>> pending(size_t(B) * blocks);
+    for (uint32_t M = 0; M < blocks; ++M)
+        for (uint32_t i = 0; i < B; ++i) pending[size_t(M) * B + i] = uint8_t((M > 0) + (i != last));
+    struct Tile {
+        uint32_t band, block;
+    };
+    const Tile root{last, 0};
+    arena.execute([&] {
+        tbb::parallel_for_each(&root, &root + 1, [&](const Tile& t, tbb::feeder<Tile>& feeder) {
+            tile(t.band, t.block);
+            auto done = [&](uint32_t band, uint32_t block) {
+                if (pending[size_t(block) * B + band].fetch_sub(1, std::memory_order_acq_rel) == 1)
+                    feeder.add(Tile{band, block});
+            };
+            if (t.block + 1 < blocks) done(t.band, t.block + 1);
+            if (t.band != (s.towardHigher ? 0u : B - 1)) done(uint32_t(int(t.band) - dir), t.block);
+        });
+    });
 }
 
 // cell[I] += sum of row[I*f .. I*f + f) (the last block may be short), with

@@ -10,15 +10,18 @@
 #include "core/ShadePlan.h"
 #include "core/Shading.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/ShadeSchedule.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
 namespace {
 
-std::vector<float> ShadeOnCpu(const Extent3& e, const std::vector<float>& q, const ShadeParams& p, int threads = 0) {
+// T starts as `initialT` everywhere (NaN: a cell read before it is written shows).
+std::vector<float> ShadeOnCpu(const Extent3& e, const std::vector<float>& q, const ShadeParams& p, int threads = 0,
+                              float initialT = 0.0f) {
     cpu::BackendCpu backend(threads);
     auto qb = test::MakeFilled(backend, BufferFormat::F32, e, q);
-    auto T = test::MakeBuffer(backend, BufferFormat::F32, e);
+    auto T = test::MakeFilled(backend, BufferFormat::F32, e, std::vector<float>(e.Count(), initialT));
     Status s = backend.Shade(p, *qb, *T);
     EXPECT_TRUE(s.has_value()) << (s ? "" : s.error().message);
     return test::Read<float>(backend, *T);
@@ -393,12 +396,14 @@ std::vector<float> PlainShadeSweep(const Extent3& e, const std::vector<float>& q
     return T;
 }
 
-// Test that the CPU's shade on 16 threads (rows of a slice split across
-// tasks) equals a plain per-voxel sweep written separately, bit for bit, on
-// odd sizes: each principal axis, both sun signs, the 45 degree ties, both
-// filters and every storage; and that the coarse resolutions do not depend on
-// the thread count either. A parallel sweep (bands with halos, a wavefront;
-// issue 16 item 4) must keep passing it.
+// Test that the CPU's shade on 2, 5 and 16 threads (the slice plane in bands
+// along v on 2 and 5, along u on 16, run as a pipeline of tiles) equals a
+// plain per-voxel sweep written separately, bit for bit, on odd sizes: each
+// principal axis, both sun signs, the 45 degree ties, both filters and every
+// storage; and that the coarse resolutions do not depend on the thread count
+// either. T starts as NaN, so a tile that read a cell of another band before
+// that band wrote it would show here even on one core (the tiles' order
+// comes from their dependencies, not from the cores).
 TEST(Shade, ParallelSweepEqualsPlainSweep) {
     const Extent3 e{67, 53, 41};
     Pcg32 rng(16);
@@ -420,8 +425,10 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
                 p.storage = storage;
                 p.sigma = 0.004f;
                 const std::vector<float> plain = PlainShadeSweep(e, q, p);
-                const std::vector<float> banded = ShadeOnCpu(e, q, p, 16);
-                ASSERT_EQ(banded, plain) << sun[0] << " " << sun[1] << " " << sun[2];
+                for (int threads : {1, 2, 5, 16}) {
+                    const std::vector<float> banded = ShadeOnCpu(e, q, p, threads, std::nanf(""));
+                    ASSERT_EQ(banded, plain) << threads << " threads, sun " << sun[0] << " " << sun[1] << " " << sun[2];
+                }
                 // Light must reach the far side partly: else the test is blind.
                 ASSERT_GT(std::count_if(plain.begin(), plain.end(), [](float t) { return t > 0 && t < 1; }), 1000);
                 ++compared;
@@ -432,8 +439,110 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
         p.sun = SunDirection(0.3, 0.2);
         p.resolution = f;
         p.sigma = 0.004f;
-        EXPECT_EQ(ShadeOnCpu(e, q, p, 16), ShadeOnCpu(e, q, p, 1)) << f;
+        EXPECT_EQ(ShadeOnCpu(e, q, p, 16, std::nanf("")), ShadeOnCpu(e, q, p, 1)) << f;
     }
+}
+
+// Test that the CPU's sweep in shares ([0, 5), [5, 17), [17, end): tiles
+// that start mid-sweep read the slice an earlier share wrote) equals the plain
+// sweep on every principal axis, both sun signs, on 1, 2 and 16 threads.
+TEST(Shade, CpuSharesEqualPlainSweep) {
+    const Extent3 e{37, 29, 23};
+    Pcg32 rng(17);
+    std::vector<float> q(e.Count());
+    for (float& v : q) v = rng.Below(3) ? float(rng.Below(65)) / 64.0f : 0.0f;
+    int compared = 0;
+    for (const Vec3& sun : {SunDirection(0.3, 0.2), SunDirection(0.3, 3.3), SunDirection(0.4, 1.4),
+                            SunDirection(0.4, -1.7), SunDirection(1.1, 0.5), SunDirection(-1.2, 2.0)})
+        for (int threads : {1, 2, 16}) {
+            ShadeParams p;
+            p.sun = sun;
+            p.sigma = 0.004f;
+            cpu::BackendCpu backend(threads);
+            auto qb = test::MakeFilled(backend, BufferFormat::F32, e, q);
+            auto T = test::MakeFilled(backend, BufferFormat::F32, e, std::vector<float>(e.Count(), std::nanf("")));
+            for (SliceRange share : {SliceRange{0, 5}, SliceRange{5, 17}, SliceRange{17, UINT32_MAX}}) {
+                p.slices = share;
+                ASSERT_TRUE(backend.Shade(p, *qb, *T).has_value());
+            }
+            p.slices = {};
+            ASSERT_EQ(test::Read<float>(backend, *T), PlainShadeSweep(e, q, p)) << threads << " threads, sun "
+                                                                               << sun[0] << " " << sun[1];
+            ++compared;
+        }
+    EXPECT_EQ(compared, 18);
+}
+
+// Test the CPU sweep's schedule on thesis-medium's grid (256 x 256 x 32) by
+// hand. Sun at 25 degrees, azimuth 60: w = y, u = x (256), v = z (32), 256
+// slices, taps at u0 = v0 = 0 (one band toward higher indices). On 2 threads
+// v has 32 >= 4 * 2 rows: 2 bands of 16 rows, 4096 cells a slice, so 16384 /
+// 4096 = 4 slices a tile; the longest chain is 1 fill tile plus all 256
+// slices of one band: (4 + 256) * 4096 cells of 2^21. On 16 threads 32 < 64
+// rows: 16 bands along u of 16 x 32 = 512 cells; 32 slices would fill 16384,
+// but the fill (15 tiles) may take at most a quarter of the sweep, 256 / 60
+// -> 4 slices; the chain is (15 * 4 + 256) * 512.
+TEST(Shade, CpuScheduleByHand) {
+    ShadeParams p;
+    p.sun = SunDirection(25.0 * std::numbers::pi / 180.0, 60.0 * std::numbers::pi / 180.0);
+    const ShadePlan plan = MakeShadePlan(p, Extent3{256, 256, 32});
+    ASSERT_EQ(plan.geometry.w, 1);
+    ASSERT_EQ(plan.geometry.u0, 0);
+    ASSERT_EQ(plan.geometry.v0, 0);
+    const cpu::ShadeSchedule one = cpu::MakeShadeSchedule(plan, 1, 0, 256);
+    EXPECT_EQ(one.bands, 1u);
+    EXPECT_EQ(one.span, one.work);
+    const cpu::ShadeSchedule two = cpu::MakeShadeSchedule(plan, 2, 0, 256);
+    EXPECT_EQ(two.axis, 1);
+    EXPECT_EQ(two.bands, 2u);
+    EXPECT_EQ(two.blockSlices, 4u);
+    EXPECT_EQ(two.blocks, 64u);
+    EXPECT_TRUE(two.towardHigher);
+    EXPECT_EQ(two.work, 2097152.0);
+    EXPECT_EQ(two.span, (4.0 + 256.0) * 4096.0);
+    // 8 threads: 32 >= 4 * 8 rows, so 8 bands of 4 rows (1024 cells): 16 slices
+    // would fill 16384, the fill (7 tiles) allows 256 / 28 -> 9.
+    const cpu::ShadeSchedule eight = cpu::MakeShadeSchedule(plan, 8, 0, 256);
+    EXPECT_EQ(eight.axis, 1);
+    EXPECT_EQ(eight.bands, 8u);
+    EXPECT_EQ(eight.blockSlices, 9u);
+    EXPECT_EQ(eight.blocks, 29u);
+    EXPECT_EQ(eight.span, (7.0 * 9.0 + 256.0) * 1024.0);
+    const cpu::ShadeSchedule sixteen = cpu::MakeShadeSchedule(plan, 16, 0, 256);
+    EXPECT_EQ(sixteen.axis, 0);
+    EXPECT_EQ(sixteen.bands, 16u);
+    EXPECT_EQ(sixteen.blockSlices, 4u);
+    EXPECT_EQ(sixteen.span, (15.0 * 4.0 + 256.0) * 512.0);
+    // A share of the sweep: slices [100, 140) on 2 threads, 40 slices, fill 1 tile of 4.
+    const cpu::ShadeSchedule share = cpu::MakeShadeSchedule(plan, 2, 100, 140);
+    EXPECT_EQ(share.blocks, 10u);
+    EXPECT_EQ(share.span, (4.0 + 40.0) * 4096.0);
+    // The sun at -x (azimuth 180 + 11 degrees, 17 high): s = (-0.94, -0.19,
+    // 0.30), w = x, u = y, v = z, dv = 0.30 / 0.94 -> v0 = 0. Rows along y are
+    // strided: bands of 2 rows (16 of them, on any thread count), tiles of 16
+    // slices (a cache line of floats along x); the chain is 15 fill tiles of
+    // 16 slices plus 256 slices, of 2 x 256 cells.
+    p.sun = SunDirection(0.3, std::numbers::pi + 0.2);
+    const ShadePlan west = MakeShadePlan(p, Extent3{256, 256, 32});
+    ASSERT_EQ(west.geometry.w, 0);
+    ASSERT_EQ(west.geometry.v0, 0);
+    for (int threads : {1, 16}) {
+        const cpu::ShadeSchedule x = cpu::MakeShadeSchedule(west, threads, 0, 256);
+        EXPECT_EQ(x.axis, 1);
+        EXPECT_EQ(x.bands, 16u);
+        EXPECT_EQ(x.blockSlices, 16u);
+        EXPECT_TRUE(x.towardHigher);
+        EXPECT_EQ(x.span, (15.0 * 16.0 + 256.0) * 512.0);
+    }
+    // Sun at azimuth -80 degrees, 60 high: s = (0.09, -0.49, 0.87), w = z,
+    // v = y, dv = -0.49 / 0.87 -> v0 = -1: each band reads the band below.
+    p.sun = SunDirection(60.0 * std::numbers::pi / 180.0, -80.0 * std::numbers::pi / 180.0);
+    const ShadePlan south = MakeShadePlan(p, Extent3{256, 256, 32});
+    ASSERT_EQ(south.geometry.w, 2);
+    ASSERT_EQ(south.geometry.v0, -1);
+    const cpu::ShadeSchedule z2 = cpu::MakeShadeSchedule(south, 2, 0, 32);
+    EXPECT_EQ(z2.axis, 1);
+    EXPECT_FALSE(z2.towardHigher);
 }
 
 std::vector<float> ShadowOnCpu(const Extent3& e, const std::vector<float>& D, const ShadowParams& p) {

@@ -1,0 +1,36 @@
+// How the CPU's shade sweep is cut into tiles for threads (ShadeCpu.cpp), as
+// numbers: the benchmark reports its work and span, the tests check it.
+#pragma once
+
+#include <cstdint>
+
+namespace cb {
+struct ShadePlan;
+}
+
+namespace cb::cpu {
+
+// Bands along u are at least this many cells wide.
+inline constexpr uint32_t kMinBandCells = 8;
+// A tile aims at about this many cells (a few microseconds of one core).
+inline constexpr double kTileCells = 16384;
+// Sweeps along x (rows along y, strided): rows per band, and slices per tile
+// (the floats of a 64-byte cache line).
+inline constexpr uint32_t kStridedRows = 2;
+inline constexpr uint32_t kLineFloats = 16;
+
+// Tile (band i, block M) covers band i of the slice plane (along u or v) over
+// the block's slices; it runs once tiles (i, M - 1) and (i + dir, M) are done.
+struct ShadeSchedule {
+    int axis = 0;               // the banded axis: 0 = u, 1 = v
+    uint32_t bands = 1;         // 1: the sweep runs on the calling thread as one tile
+    uint32_t blockSlices = 1;   // slices per tile
+    uint32_t blocks = 1;
+    bool towardHigher = true;   // dir = +1: band i reads band i + 1
+    double work = 0, span = 0;  // cells in all, and on the longest chain of tiles
+};
+
+// The schedule for slices [m0, m1) of `plan` on `threads` threads.
+ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0, uint32_t m1);
+
+}  // namespace cb::cpu
