@@ -300,6 +300,16 @@ struct SubmissionCounts {
     uint64_t hostWaits = 0;
 };
 
+// A host result a call in a batch delivered after EndBatch instead of on
+// return (Backend::TakeDeferredResults).
+struct DeferredHostResult {
+    // The MarkBatch() calls made in the batch before the call: 1 for a call
+    // after the first mark.
+    uint32_t mark = 0;
+    std::optional<uint32_t> coveredColumns;  // Density: DensityOutputs::coveredColumns
+    std::optional<SplatStats> splat;         // RenderSplat: *stats
+};
+
 class Backend {
   public:
     virtual ~Backend() = default;
@@ -323,8 +333,11 @@ class Backend {
     //    parameters point to, like spans, only until the call returns). Upload and
     //    Download keep their order with the recorded calls; a Download waits (a host wait).
     //  - Host results of a call (DensityOutputs::coveredColumns, SplatStats,
-    //    MarchStats) are complete when it returns, as outside a batch; a backend
-    //    that must wait for them counts the wait in Submissions().
+    //    MarchStats) are complete when it returns, as outside a batch, except
+    //    that a backend may defer the cover and SplatStats: it leaves them as
+    //    the caller set them and, after EndBatch, TakeDeferredResults() gives
+    //    their values, each with the mark of its call. A backend that must wait
+    //    for a host result counts the wait in Submissions().
     //  - MarkBatch() starts the batch's next interval. EndBatch returns, for each
     //    interval in order, the device time of the work recorded in it (ms, the
     //    sum over its commands' timestamp pairs, so host gaps between submissions
@@ -334,6 +347,9 @@ class Backend {
     virtual Status BeginBatch() { return {}; }
     virtual void MarkBatch() {}
     virtual Result<std::vector<double>> EndBatch() { return std::vector<double>{}; }
+    // The host results the last batch's calls deferred, in call order; each
+    // call once (a second call returns nothing).
+    virtual std::vector<DeferredHostResult> TakeDeferredResults() { return {}; }
     // Cumulative; the harness reports the difference over a step.
     virtual SubmissionCounts Submissions() const { return {}; }
 

@@ -127,6 +127,7 @@ class Simulation::BatchScope {
     ~BatchScope() {
         if (!mOpen) return;
         (void)mSim.mBackend.EndBatch();
+        (void)mSim.mBackend.TakeDeferredResults();
         mSim.mMarks.clear();
         mSim.mBatchOpen = false;
     }
@@ -147,6 +148,7 @@ class Simulation::BatchScope {
         mSim.mMarks.clear();
         auto times = mSim.mBackend.EndBatch();
         if (!times) return MakeError("ending a batch: " + times.error().message);
+        CB_TRY(DeliverDeferredResults(marks));
         if (times->empty()) return {};  // no device clock
         // One time per MarkBatch(); a backend may also report the (empty) interval before the first mark.
         size_t first = 0;
@@ -166,6 +168,26 @@ class Simulation::BatchScope {
     }
 
   private:
+    // The host results the backend deferred to the batch's end, to the records
+    // their calls wrote: a cover adds to its record's (the calls left it as the
+    // record had it; shares add up), splat counters replace their frame's.
+    Status DeliverDeferredResults(const std::vector<MarkOwner>& marks) {
+        for (const DeferredHostResult& result : mSim.mBackend.TakeDeferredResults()) {
+            if (result.mark == 0 || result.mark > marks.size())
+                return MakeError(mSim.mBackend.Name() + ": a deferred result names mark " +
+                                 std::to_string(result.mark) + " of a batch of " + std::to_string(marks.size()));
+            const MarkOwner& owner = marks[result.mark - 1];
+            if (result.coveredColumns) {
+                std::optional<uint32_t>& cover = owner.record->coveredColumns;
+                cover = cover.value_or(0) + *result.coveredColumns;
+                if (owner.record != &mSim.mAhead) mSim.mLastCoveredColumns = cover;
+            }
+            if (result.splat && owner.frame && *owner.frame < owner.record->frames.size())
+                owner.record->frames[*owner.frame].stats = *result.splat;
+        }
+        return {};
+    }
+
     Simulation& mSim;
     bool mOpen = false;
 };

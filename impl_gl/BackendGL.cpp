@@ -121,6 +121,7 @@ Status BackendGL::BeginBatch() {
     if (mBatch.active) return MakeError("gl: BeginBatch inside a batch (batches do not nest)");
     mBatch = {};
     mBatch.active = true;
+    mDeferredResults.clear();
     return {};
 }
 
@@ -137,6 +138,28 @@ Result<std::vector<double>> BackendGL::EndBatch() {
         ms[p.interval] += double(t1 - t0) * 1e-6;
         ReleaseQuery(p.start);
         ReleaseQuery(p.end);
+    }
+    // The deferred results: read after the wait above, so no read waits again.
+    const Functions& f = mContext->F();
+    for (const BatchState::Deferred& d : mBatch.deferred) {
+        uint32_t counted[2] = {};
+        WaitingRead(ReadKind::Buffer, d.counters, 0, 0, 0, sizeof counted, counted);
+        DeferredHostResult result;
+        result.mark = d.mark;
+        if (d.cover) {
+            result.coveredColumns = counted[0];
+        } else {
+            SplatStats stats;
+            stats.splats = counted[0];
+            stats.voxelsVisited = d.deviceSkip ? counted[1] : d.visited;
+            if (d.fragments) {
+                stats.fragments = QueryResult(d.fragments);
+                f.DeleteQueries(1, &d.fragments);
+            }
+            result.splat = stats;
+        }
+        f.DeleteBuffers(1, &d.counters);
+        mDeferredResults.push_back(result);
     }
     mBatch = {};
     CB_TRY(mContext->Check("ending a batch"));
@@ -163,7 +186,8 @@ void BackendGL::KeepImageCopy(const Buffer& image, GlScratchBuffer slot, size_t 
 
 std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
 
-bool BackendGL::Supports(Stage stage) const { return IsSplatPipelineStage(stage) || stage == Stage::Noise || stage == Stage::RenderMarch;
+bool BackendGL::Supports(Stage stage) const {
+    return IsSplatPipelineStage(stage) || stage == Stage::Noise || stage == Stage::RenderMarch;
 }
 
 GLuint BackendGL::Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
@@ -193,6 +217,16 @@ GLuint BackendGL::ScratchBuffer(GlScratchBuffer slot, size_t bytes) {
     f.CreateBuffers(1, &buffer);
     f.NamedBufferData(buffer, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_DRAW);
     size = bytes;
+    return buffer;
+}
+
+GLuint BackendGL::CounterBuffer(GlScratchBuffer slot, size_t bytes) {
+    if (!mBatch.active) return ScratchBuffer(slot, bytes);
+    const Functions& f = mContext->F();
+    GLuint buffer = 0;
+    f.CreateBuffers(1, &buffer);
+    const std::vector<uint8_t> zeros(std::max<size_t>(bytes, 16), 0);
+    f.NamedBufferData(buffer, GLsizeiptr(zeros.size()), zeros.data(), GL_DYNAMIC_DRAW);
     return buffer;
 }
 
@@ -303,7 +337,7 @@ uint64_t BackendGL::ScratchBytes(const Scene& scene) const {
         bytes += (f > 1 ? 2 : 1) * grid + 2 * cells[1] * cells[2] * 4;
     }
     if (scene.stages.Has(Stage::RenderSplat))
-        bytes += uint64_t(scene.render.width) * scene.render.height * 16;  // SplatTarget: RGBA32F
+        bytes += uint64_t(scene.render.width) * scene.render.height * 16;              // SplatTarget: RGBA32F
     if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);  // NoiseData
     if (scene.stages.Has(Stage::RenderMarch)) {
         // MarchVolume (RG32F) and its storage-buffer copy; with skipping MarchBricks (R32UI) and its copy;

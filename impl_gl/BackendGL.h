@@ -55,12 +55,14 @@ class BackendGL final : public Backend {
 
     // Pipelined timing (core/Backend.h). In a batch a stage call records its
     // passes between two GL_TIMESTAMP queries (from a pool) and returns without
-    // waiting; EndBatch waits once (glFinish) and reads the queries. Host values
-    // a call must return (density's cover count, render_splat's visibility and
-    // stats) still wait, and are counted.
+    // waiting; EndBatch waits once (glFinish) and reads the queries. Density's
+    // cover and render_splat's stats are deferred: each call writes them to a
+    // buffer (and a query) of its own, read after EndBatch's wait
+    // (TakeDeferredResults). Other host reads in a batch wait, and are counted.
     Status BeginBatch() override;
     void MarkBatch() override;
     Result<std::vector<double>> EndBatch() override;
+    std::vector<DeferredHostResult> TakeDeferredResults() override { return std::exchange(mDeferredResults, {}); }
     // Counted where the backend synchronises (Finish, WaitingRead): a submission
     // for each glFinish, or read that must wait, that ends recorded work; a host
     // wait for each glFinish, and each query result or read back into client
@@ -119,14 +121,14 @@ class BackendGL final : public Backend {
     };
     // The scratch buffer objects, each used by one stage only, grown as needed.
     enum class GlScratchBuffer {
-        EllipsoidList,  // Region: the ellipsoids, read by the vertex shader
-        CoverCounter,   // Density: the atomic counter of covered columns
-        SplatOrder,     // RenderSplat: the flattened shared order
-        SplatFrame,     // RenderSplat: the shared frame block (core/Splat.h)
-        SplatCounters,  // RenderSplat: the shader's counters (splats drawn)
-        ImageCopy,      // RenderSplat: the pixel buffer the image passes through
-        NoiseData,      // Noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
-        MarchBlock,     // RenderMarch: the MarchGpu uniform block (core/MarchGpu.h)
+        EllipsoidList,    // Region: the ellipsoids, read by the vertex shader
+        CoverCounter,     // Density: the atomic counter of covered columns
+        SplatOrder,       // RenderSplat: the flattened shared order
+        SplatFrame,       // RenderSplat: the shared frame block (core/Splat.h)
+        SplatCounters,    // RenderSplat: the shader's counters (splats drawn)
+        ImageCopy,        // RenderSplat: the pixel buffer the image passes through
+        NoiseData,        // Noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
+        MarchBlock,       // RenderMarch: the MarchGpu uniform block (core/MarchGpu.h)
         MarchVolumeCopy,  // RenderMarch: the padded volume as a storage buffer of (q_alpha, T) pairs
         MarchBricksCopy,  // RenderMarch, skipping: the brick flags as a storage buffer
         MarchPhaseTable,  // RenderMarch, phase mie: kMieCloudTable's values, uploaded once (mMieUploaded)
@@ -175,8 +177,7 @@ class BackendGL final : public Backend {
     // A read that blocks until the work before it is done: a query result
     // (buffer 0, data a GLuint64), a texture or a buffer into client memory.
     enum class ReadKind { Query, Texture, Buffer };
-    void WaitingRead(ReadKind kind, GLuint object, GLenum format, GLenum type, size_t offset, size_t bytes,
-                     void* data);
+    void WaitingRead(ReadKind kind, GLuint object, GLenum format, GLenum type, size_t offset, size_t bytes, void* data);
     GLuint64 QueryResult(GLuint query) {
         GLuint64 value = 0;
         WaitingRead(ReadKind::Query, query, 0, 0, 0, sizeof value, &value);
@@ -195,6 +196,9 @@ class BackendGL final : public Backend {
     void KeepImageCopy(const Buffer& image, GlScratchBuffer slot, size_t bytes);
     GLuint Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
     GLuint ScratchBuffer(GlScratchBuffer slot, size_t bytes);
+    // In a batch, a zeroed buffer of `bytes` for one call's counters, read and
+    // deleted at EndBatch (deferred results); outside one, ScratchBuffer(slot).
+    GLuint CounterBuffer(GlScratchBuffer slot, size_t bytes);
     // Copies a renderer's W x H RGB(A) float target into `image` ((3, W, H) F32)
     // on the device, through the pixel buffer in `slot`: the target's rows, top
     // first, in RGB floats are exactly the canonical layout.
@@ -246,8 +250,19 @@ class BackendGL final : public Backend {
             uint32_t interval;
         };
         std::vector<Pair> pairs;
+        // A deferred host result (core/Backend.h): a buffer of counters this
+        // call alone wrote, and for render_splat its fragment query.
+        struct Deferred {
+            uint32_t mark = 0;
+            GLuint counters = 0, fragments = 0;
+            bool cover = false;       // density: counters[0] is the cover
+            bool deviceSkip = false;  // render_splat: counters[1] is the voxels visited
+            uint64_t visited = 0;     // render_splat without deviceSkip: counted on the host
+        };
+        std::vector<Deferred> deferred;
     };
     BatchState mBatch;
+    std::vector<DeferredHostResult> mDeferredResults;
     // Advanced by every call that may write a buffer (CreateBuffer, Upload, each stage call).
     uint64_t mWriteEpoch = 0;
     struct ImageCopy {

@@ -54,7 +54,7 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Disable(GL_BLEND);
 
     // Cover: an atomic counter over the columns; the column flags land in a scratch R8UI layer.
-    const GLuint counter = ScratchBuffer(GlScratchBuffer::CoverCounter, sizeof(GLuint));
+    const GLuint counter = CounterBuffer(GlScratchBuffer::CoverCounter, sizeof(GLuint));
     const GLuint initial = 0;
     f.NamedBufferSubData(counter, 0, sizeof initial, &initial);
     f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
@@ -84,8 +84,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
 
     f.MemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     timer.Stop();
+    if (mBatch.active) {  // read after EndBatch's wait (TakeDeferredResults)
+        mBatch.deferred.push_back({mBatch.interval, counter, 0, true, false, 0});
+        return mContext->Check("density");
+    }
     GLuint covered = 0;
-    WaitingRead(ReadKind::Buffer, counter, 0, 0, 0, sizeof covered, &covered);  // a host wait inside a batch
+    WaitingRead(ReadKind::Buffer, counter, 0, 0, 0, sizeof covered, &covered);
     out.coveredColumns = covered;
     return mContext->Check("density");
 }

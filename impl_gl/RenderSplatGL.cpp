@@ -94,7 +94,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     frame.misc[2] = pointRange[1];
     const GLuint frameBuffer = ScratchBuffer(GlScratchBuffer::SplatFrame, sizeof frame);
     f.NamedBufferSubData(frameBuffer, 0, sizeof frame, &frame);
-    const GLuint counters = ScratchBuffer(GlScratchBuffer::SplatCounters, 16);
+    const GLuint counters = CounterBuffer(GlScratchBuffer::SplatCounters, 16);
     const uint32_t zero[4] = {};
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
     const GLuint target = Scratch(GlScratch::SplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
@@ -144,6 +144,13 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindTextureUnit(5, 0);
     CopyTargetToImage(target, W, H, GlScratchBuffer::ImageCopy, image);
     timer.Stop();
+    if (mBatch.active) {  // read after EndBatch's wait (TakeDeferredResults); the buffer is this call's own
+        if (stats)
+            mBatch.deferred.push_back({mBatch.interval, counters, fragments, false, deviceSkip, visited});
+        else
+            mContext->F().DeleteBuffers(1, &counters);
+        return mContext->Check("render_splat");
+    }
     if (stats) {
         const GLuint64 passed = QueryResult(fragments);
         f.DeleteQueries(1, &fragments);

@@ -14,6 +14,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <utility>
 
 #include "core/Scene.h"
 #include "harness/Report.h"
@@ -44,6 +45,9 @@ class BatchLoggingCpu : public cpu::BackendCpu {
     // EndBatch returns this many extra times (after the intervals'), or, with leading, one time in front.
     int extraTimes = 0;
     bool leading = false;
+    // In a batch, density's cover and render_splat's stats are deferred (core/Backend.h): the call leaves
+    // the caller's values and TakeDeferredResults gives them, by mark, after EndBatch.
+    bool deferResults = false;
 
     Status BeginBatch() override {
         nested |= open;
@@ -69,6 +73,7 @@ class BatchLoggingCpu : public cpu::BackendCpu {
         for (int i = 0; i < extraTimes; ++i) times.push_back(1e6);
         return times;
     }
+    std::vector<DeferredHostResult> TakeDeferredResults() override { return std::exchange(mDeferred, {}); }
     SubmissionCounts Submissions() const override { return {submissions, waits}; }
     std::optional<double> LastDeviceMs() const override { return mLast; }
 
@@ -86,7 +91,12 @@ class BatchLoggingCpu : public cpu::BackendCpu {
     }
     Status Density(const DensityParams& p, const Buffer& q, const Buffer* cld, DensityOutputs& out) override {
         CB_TRY(Note("density"));
-        return cpu::BackendCpu::Density(p, q, cld, out);
+        if (!Deferring()) return cpu::BackendCpu::Density(p, q, cld, out);
+        const uint32_t callers = out.coveredColumns;
+        CB_TRY(cpu::BackendCpu::Density(p, q, cld, out));
+        mDeferred.push_back({uint32_t(mIntervals.size()), out.coveredColumns, std::nullopt});
+        out.coveredColumns = callers;
+        return {};
     }
     Status Shade(const ShadeParams& p, const Buffer& q, Buffer& T) override {
         CB_TRY(Note("shade"));
@@ -98,10 +108,15 @@ class BatchLoggingCpu : public cpu::BackendCpu {
     }
     Status RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) override {
         CB_TRY(Note("render_splat"));
-        return cpu::BackendCpu::RenderSplat(p, in, image, stats);
+        if (!Deferring() || !stats) return cpu::BackendCpu::RenderSplat(p, in, image, stats);
+        SplatStats counted;
+        CB_TRY(cpu::BackendCpu::RenderSplat(p, in, image, &counted));
+        mDeferred.push_back({uint32_t(mIntervals.size()), std::nullopt, counted});
+        return {};
     }
 
   private:
+    bool Deferring() const { return deferResults && open; }
     Status Note(const std::string& stage) {
         Call call{stage, open ? begins - 1 : -1, open ? int(mIntervals.size()) - 1 : -1, double(calls.size() + 1)};
         calls.push_back(call);
@@ -116,6 +131,7 @@ class BatchLoggingCpu : public cpu::BackendCpu {
     }
     std::vector<double> mIntervals;
     std::optional<double> mLast;
+    std::vector<DeferredHostResult> mDeferred;
 };
 
 // scenes/ci-small.json, small: 4 steps, no warm-up, a render every step of 2 frames, two cameras.
@@ -234,6 +250,39 @@ TEST(PipelinedTiming, OneBatchPerStepOneMarkPerCallTimesToTheirStagesAndFrames) 
     }
     EXPECT_FALSE(backend.nested);
     EXPECT_FALSE(backend.markOutside);
+}
+
+// Test that host results a backend defers to the batch's end (the cover, each frame's splat stats) reach the
+// records of their calls: a pipelined run with deferral reports what a synchronized run reports, unsliced (one
+// whole density a step) and time-sliced (density in shares whose covers add up, one batch a frame).
+TEST(PipelinedTiming, DeferredCoverAndSplatStatsReachTheirRecords) {
+    for (const char* slices : {"0", "2"}) {
+        const Scene scene = BatchScene({{"render.slices_per_frame", slices}, {"density.tile", "4"}});
+        BatchLoggingCpu deferring, plain;
+        deferring.deferResults = true;
+        auto a = Simulation::Create(scene, deferring), b = Simulation::Create(scene, plain);
+        ASSERT_TRUE(a.has_value() && b.has_value());
+        (*a)->SetTiming(TimingMode::Pipelined);
+        bool anyCover = false, anySplats = false;
+        for (uint32_t t = 0; t < scene.steps; ++t) {
+            StepRecord ra, rb;
+            ASSERT_TRUE((*a)->Step(ra).has_value());
+            ASSERT_TRUE((*b)->Step(rb).has_value());
+            ASSERT_TRUE(rb.coveredColumns.has_value());
+            anyCover |= *rb.coveredColumns > 0;
+            EXPECT_EQ(ra.coveredColumns, rb.coveredColumns) << "slices " << slices << ", step " << t;
+            ASSERT_EQ(ra.frames.size(), rb.frames.size());
+            for (size_t f = 0; f < ra.frames.size(); ++f) {
+                anySplats |= rb.frames[f].stats.splats > 0;
+                EXPECT_EQ(ra.frames[f].stats.splats, rb.frames[f].stats.splats) << "frame " << f;
+                EXPECT_EQ(ra.frames[f].stats.voxelsVisited, rb.frames[f].stats.voxelsVisited) << "frame " << f;
+                EXPECT_EQ(ra.frames[f].stats.fragments, rb.frames[f].stats.fragments) << "frame " << f;
+            }
+        }
+        EXPECT_GT(deferring.begins, 0);
+        // Zeros everywhere would not tell a lost result.
+        EXPECT_TRUE(anyCover && anySplats) << "slices " << slices;
+    }
 }
 
 // Test that a synchronized step (the default) opens no batch, takes device times from LastDeviceMs and reports the
