@@ -401,7 +401,7 @@ std::string PipeSpread(std::vector<double> v) {
 }
 
 TEST_P(PipelinedVk, DISABLED_ThesisMediumNumbers) {
-    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/thesis-medium.json", {{"render.every_steps", "1"}});
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/thesis-medium.json", {{"render.every_steps", "1"}, {"warmup_steps", "0"}});
     ASSERT_TRUE(scene.has_value()) << scene.error().message;
     // Without the validation layer: it costs host time per call.
     auto plain = CreateBackend("vk", {});
@@ -417,6 +417,7 @@ TEST_P(PipelinedVk, DISABLED_ThesisMediumNumbers) {
     };
     std::map<Stage, Samples> perStage[2];
     Samples perStep[2];
+    std::vector<double> gaps[2];  // per step: wall minus device, ms
     for (int n = 0; n < 2 * steps + 2; ++n) {
         const int mode = n % 2;
         counting.calls.clear();
@@ -458,9 +459,21 @@ TEST_P(PipelinedVk, DISABLED_ThesisMediumNumbers) {
             out.device.push_back(s[3]);
         }
         perStep[mode].device.push_back(deviceTotal);
+        gaps[mode].push_back(stepWall - deviceTotal);
+    }
+    // The cost of one host round trip with nothing else to wait for: a 4-byte read back.
+    auto word = counting.CreateBuffer(BufferFormat::U8, {4, 1, 1});
+    ASSERT_TRUE(word.has_value());
+    std::vector<double> roundTrips;
+    for (int n = 0; n < 200; ++n) {
+        std::array<std::byte, 4> bytes{};
+        const auto t0 = std::chrono::steady_clock::now();
+        ASSERT_TRUE(counting.Download(**word, bytes).has_value());
+        roundTrips.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     std::printf("thesis-medium on %s, %d steps per mode, alternating; median [min..max]\n",
                 counting.Device().c_str(), steps);
+    std::printf("one submit + wait + 4-byte read back: %s ms\n", PipeSpread(roundTrips).c_str());
     for (int mode = 0; mode < 2; ++mode) {
         std::printf("%s:\n", mode ? "batched (one batch per step)" : "one by one");
         for (const auto& [stage, s] : perStage[mode])
@@ -471,6 +484,7 @@ TEST_P(PipelinedVk, DISABLED_ThesisMediumNumbers) {
         std::printf("  %-12s submissions %s waits %s wall ms %s device ms %s\n", "step",
                     PipeSpread(s.submissions).c_str(), PipeSpread(s.waits).c_str(), PipeSpread(s.wall).c_str(),
                     PipeSpread(s.device).c_str());
+        std::printf("  step wall minus device ms %s\n", PipeSpread(gaps[mode]).c_str());
     }
 }
 
