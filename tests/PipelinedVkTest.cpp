@@ -25,6 +25,8 @@
 #include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 
+#if CLOUDBENCH_HAVE_VK
+
 namespace cb {
 namespace {
 
@@ -310,6 +312,35 @@ TEST_P(PipelinedVk, ManyCallsInABatchRunOutOfTimestampsAndSubmitOnce) {
     }
 }
 
+TEST_P(PipelinedVk, AScratchSlotThatGrowsInABatchKeepsTheOldOneForTheCallsBefore) {
+    // The second region call lists far more ellipsoids per tile, so its scratch
+    // slots (the ellipsoids, the tile entries) grow while the first call's
+    // recorded dispatch still reads the smaller ones.
+    const std::vector<RasterEllipsoid> few(mEllipsoids.begin(), mEllipsoids.begin() + 1);
+    std::vector<RasterEllipsoid> many;
+    for (int n = 0; n < 8; ++n) many.insert(many.end(), mEllipsoids.begin(), mEllipsoids.end());
+    auto r1 = test::MakeBuffer(*mBackend, BufferFormat::U8, kPipeGrid);
+    auto r2 = test::MakeBuffer(*mBackend, BufferFormat::U8, kPipeGrid);
+    ASSERT_TRUE(mBackend->Region(few, *r1).has_value());
+    const auto expectedFew = test::Read<uint8_t>(*mBackend, *r1);
+    ASSERT_TRUE(mBackend->Region(many, *r2).has_value());
+    const auto expectedMany = test::Read<uint8_t>(*mBackend, *r2);
+    ASSERT_NE(expectedFew, expectedMany);
+    // Shrink the slots back to the small list's size: a fresh backend.
+    auto fresh = test::MakeTestBackend("vk");
+    ASSERT_TRUE(fresh.has_value());
+    Backend& b = **fresh;
+    auto s1 = test::MakeBuffer(b, BufferFormat::U8, kPipeGrid);
+    auto s2 = test::MakeBuffer(b, BufferFormat::U8, kPipeGrid);
+    ASSERT_TRUE(b.BeginBatch().has_value());
+    ASSERT_TRUE(b.Region(few, *s1).has_value());
+    ASSERT_TRUE(b.Region(many, *s2).has_value());
+    ASSERT_TRUE(b.EndBatch().has_value());
+    EXPECT_EQ(test::Read<uint8_t>(b, *s1), expectedFew);
+    EXPECT_EQ(test::Read<uint8_t>(b, *s2), expectedMany);
+    test::ExpectNoValidationMessages(&b);
+}
+
 // ---- Numbers, not a test: thesis-medium (every step rendered), steps in
 // alternation one by one and batched (one batch per step, MarkBatch before each
 // stage call). Per stage: submissions, host waits, wall and device ms, medians
@@ -493,3 +524,5 @@ INSTANTIATE_TEST_SUITE_P(Vk, PipelinedVk, ::testing::Values(std::string("vk")),
 
 }  // namespace
 }  // namespace cb
+
+#endif  // CLOUDBENCH_HAVE_VK
