@@ -98,6 +98,15 @@ class BackendVk final : public Backend {
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
+    // Pipelined timing (core/Backend.h): the context records the batch into one
+    // command buffer (VulkanContext::BeginBatch); a Download inside it, and the
+    // host results that need one (density's cover, render_splat's counts),
+    // submit and wait once each.
+    Status BeginBatch() override { return mContext->BeginBatch(); }
+    void MarkBatch() override { mContext->MarkBatch(); }
+    Result<std::vector<double>> EndBatch() override { return mContext->EndBatch(); }
+    SubmissionCounts Submissions() const override { return {mContext->Submissions(), mContext->HostWaits()}; }
+
     // Device time of the last stage call (timestamp queries), in ms.
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
     uint32_t ValidationMessages() const { return mContext->ValidationMessages(); }

@@ -20,10 +20,18 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(CheckGroundInput(p.ground, in.G, e, "vk: render_splat"));
 
     // Which tile x band boxes can hold a splat: the frustum (host geometry,
-    // shared with the CPU) and, when skipping, the two steps' band occupancy.
-    auto visibility = DownloadSplatBoxVisibility(*this, p, in);
-    if (!visibility) return std::unexpected(visibility.error());
-    const std::vector<uint8_t>& boxes = *visibility;
+    // shared with the CPU, core/Backend.h SplatBoxVisibility) and, when
+    // skipping, the two steps' band occupancy, ORed on the device
+    // (splat_boxes.comp), so nothing is read back for it.
+    SplatParams frustumOnly = p;
+    frustumOnly.skipping = false;
+    const std::vector<uint8_t> boxes = SplatBoxVisibility(frustumOnly, e, {}, {});
+    if (p.skipping) {
+        if (!in.bandsPrev || !in.bandsCur)
+            return MakeError("vk: render_splat with skipping needs both steps' occupancy");
+        if (in.bandsPrev->CanonicalBytes() != boxes.size() || in.bandsCur->CanonicalBytes() != boxes.size())
+            return MakeError("vk: render_splat's band occupancy does not match its tile and band");
+    }
     // The shared order, outer axis first.
     const SplatOrder& order = *p.order;
     const FlatSplatOrder flat = FlattenSplatOrder(order);
@@ -57,10 +65,10 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
     CB_TRY(mContext->Upload(*scratch.order, std::as_bytes(std::span(flat.indices))));
     CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
-    Pipeline* pipes[5] = {};
-    const char* names[5] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite"};
-    const uint32_t bindings[5] = {8, 2, 8, 5, 6};
-    for (int n = 0; n < 5; ++n) {
+    Pipeline* pipes[6] = {};
+    const char* names[6] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite", "splat_boxes"};
+    const uint32_t bindings[6] = {8, 2, 8, 5, 6, 3};
+    for (int n = 0; n < 6; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
         pipes[n] = *pipe;
@@ -78,7 +86,14 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2],           common[3],
                                           common[4], common[5], scratch.chunkSplats, scratch.chunkVisited};
     const DeviceBuffer* scanChunks[] = {scratch.chunkSplats, scratch.chunkOffsets};
+    const uint32_t boxWords = CeilDiv(uint32_t(boxes.size()), 4);
+    const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
+                                        p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
     CB_TRY(run("render_splat: counting splats", [&](VulkanContext::Recorder& r) {
+        if (p.skipping) {
+            r.Dispatch(*pipes[5], boxBuffers, &boxWords, sizeof boxWords, boxWords);
+            r.Barrier();
+        }
         r.Dispatch(*pipes[0], countBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
         r.Dispatch(*pipes[1], scanChunks, &chunkPush, sizeof chunkPush, 1);

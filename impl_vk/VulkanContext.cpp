@@ -229,32 +229,31 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
     if (ctx->mTimestamps) {
         VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
         q.queryType = VK_QUERY_TYPE_TIMESTAMP;
-        q.queryCount = 2;
+        q.queryCount = 2 * kBatchStampPairs;
         CB_TRY(CheckVk(vkCreateQueryPool(ctx->mDevice, &q, nullptr, &ctx->mQueries), "creating the timestamp queries"));
     }
-    // Enough sets for one stage call: shading records one dispatch per slice.
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 32768};
-    VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    dp.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
-    dp.maxSets = 8192;
-    dp.poolSizeCount = 1;
-    dp.pPoolSizes = &size;
-    CB_TRY(CheckVk(vkCreateDescriptorPool(ctx->mDevice, &dp, nullptr, &ctx->mDescriptors),
-                   "creating the descriptor pool"));
+    CB_TRY(ctx->AddDescriptorPool());
     return ctx;
 }
 
 VulkanContext::~VulkanContext() {
     if (mDevice) {
         vkDeviceWaitIdle(mDevice);
+        ++mHostWaits;
         for (auto& [name, p] : mPipelines) {
             vkDestroyPipeline(mDevice, p.pipeline, nullptr);
             vkDestroyPipelineLayout(mDevice, p.layout, nullptr);
             vkDestroyDescriptorSetLayout(mDevice, p.setLayout, nullptr);
         }
+        mRecording = false;  // DestroyBuffer destroys at once from here on
+        for (DeviceBuffer& b : mRetired) DestroyBuffer(b);
         if (mStagingMap) vkUnmapMemory(mDevice, mStaging.memory);
         DestroyBuffer(mStaging);
-        if (mDescriptors) vkDestroyDescriptorPool(mDevice, mDescriptors, nullptr);
+        for (ArenaChunk& chunk : mArena) {
+            vkUnmapMemory(mDevice, chunk.buffer.memory);
+            DestroyBuffer(chunk.buffer);
+        }
+        for (VkDescriptorPool pool : mDescriptors) vkDestroyDescriptorPool(mDevice, pool, nullptr);
         if (mQueries) vkDestroyQueryPool(mDevice, mQueries, nullptr);
         if (mFence) vkDestroyFence(mDevice, mFence, nullptr);
         if (mPool) vkDestroyCommandPool(mDevice, mPool, nullptr);
@@ -315,6 +314,11 @@ VkDeviceSize VulkanContext::LargestDeviceLocalHeap() const {
 }
 
 void VulkanContext::DestroyBuffer(DeviceBuffer& buffer) {
+    if (mRecording && buffer.buffer) {
+        mRetired.push_back(buffer);
+        buffer = {};
+        return;
+    }
     if (buffer.buffer) vkDestroyBuffer(mDevice, buffer.buffer, nullptr);
     if (buffer.memory) vkFreeMemory(mDevice, buffer.memory, nullptr);
     buffer = {};
@@ -333,27 +337,79 @@ Status VulkanContext::EnsureStaging(VkDeviceSize size) {
                    "mapping the staging buffer");
 }
 
-Status VulkanContext::CopyBuffer(VkBuffer from, VkBuffer to, VkDeviceSize size, const char* what) {
-    CB_TRY(Begin());
-    VkBufferCopy region{0, 0, size};
-    vkCmdCopyBuffer(mCmd, from, to, 1, &region);
-    Recorder none(*this, mCmd);
-    auto done = Submit(what, none);
-    if (!done) return std::unexpected(done.error());
-    return {};
+Result<std::pair<const DeviceBuffer*, VkDeviceSize>> VulkanContext::ArenaSpace(VkDeviceSize size, void*& mapped) {
+    constexpr VkDeviceSize kAlign = 16, kChunk = VkDeviceSize(4) << 20;
+    while (mArenaChunk < mArena.size()) {
+        ArenaChunk& chunk = mArena[mArenaChunk];
+        const VkDeviceSize at = (mArenaOffset + kAlign - 1) & ~(kAlign - 1);
+        if (at + size <= chunk.buffer.size) {
+            mArenaOffset = at + size;
+            mapped = static_cast<std::byte*>(chunk.mapped) + at;
+            return std::pair<const DeviceBuffer*, VkDeviceSize>{&chunk.buffer, at};
+        }
+        ++mArenaChunk;
+        mArenaOffset = 0;
+    }
+    // A further chunk; chunks stay for later batches (the arena keeps its high-water mark).
+    auto created = CreateRawBuffer(std::max(size, kChunk), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    if (!created) return std::unexpected(created.error());
+    ArenaChunk chunk{*created, nullptr};
+    if (Status mappedOk = CheckVk(vkMapMemory(mDevice, chunk.buffer.memory, 0, VK_WHOLE_SIZE, 0, &chunk.mapped),
+                                  "mapping the upload arena");
+        !mappedOk) {
+        DestroyBuffer(chunk.buffer);
+        return std::unexpected(mappedOk.error());
+    }
+    mArena.push_back(chunk);
+    mArenaChunk = mArena.size() - 1;
+    mArenaOffset = size;
+    mapped = chunk.mapped;
+    return std::pair<const DeviceBuffer*, VkDeviceSize>{&mArena.back().buffer, 0};
 }
 
 Status VulkanContext::Upload(const DeviceBuffer& buffer, std::span<const std::byte> data) {
     if (data.empty()) return {};
-    CB_TRY(EnsureStaging(data.size()));
-    std::memcpy(mStagingMap, data.data(), data.size());
-    return CopyBuffer(mStaging.buffer, buffer.buffer, data.size(), "uploading a buffer");
+    if (!mInBatch) {
+        CB_TRY(EnsureStaging(data.size()));
+        std::memcpy(mStagingMap, data.data(), data.size());
+        CB_TRY(BeginSegment("uploading a buffer"));
+        const VkBufferCopy region{0, 0, data.size()};
+        vkCmdCopyBuffer(mCmd, mStaging.buffer, buffer.buffer, 1, &region);
+        auto done = EndSegment("uploading a buffer");
+        if (!done) return std::unexpected(done.error());
+        return {};
+    }
+    // In a batch: the bytes go to arena memory no recorded command reads yet;
+    // the copy runs in order with the recorded commands.
+    void* mapped = nullptr;
+    auto space = ArenaSpace(data.size(), mapped);
+    if (!space) return std::unexpected(space.error());
+    std::memcpy(mapped, data.data(), data.size());
+    CB_TRY(BeginSegment("uploading a buffer"));
+    const VkBufferCopy region{space->second, 0, data.size()};
+    vkCmdCopyBuffer(mCmd, space->first->buffer, buffer.buffer, 1, &region);
+    auto done = EndSegment("uploading a buffer");
+    if (!done) return std::unexpected(done.error());
+    return {};
 }
 
 Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> data) {
     if (data.empty()) return {};
+    // The staging buffer is read by no recorded command (batch uploads use the
+    // arena, earlier downloads have completed), so it may grow here.
     CB_TRY(EnsureStaging(data.size()));
-    CB_TRY(CopyBuffer(buffer.buffer, mStaging.buffer, data.size(), "downloading a buffer"));
+    CB_TRY(BeginSegment("downloading a buffer"));
+    const VkBufferCopy region{0, 0, data.size()};
+    vkCmdCopyBuffer(mCmd, buffer.buffer, mStaging.buffer, 1, &region);
+    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(mCmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr,
+                         0, nullptr);
+    auto done = EndSegment("downloading a buffer");
+    if (!done) return std::unexpected(done.error());
+    if (mInBatch) CB_TRY(Flush("downloading a buffer"));
     std::memcpy(data.data(), mStagingMap, data.size());
     return {};
 }
@@ -417,37 +473,147 @@ Result<Pipeline*> VulkanContext::CreatePipeline(const std::string& name, uint32_
     return &(mPipelines[name] = p);
 }
 
-Status VulkanContext::Begin() {
-    CB_TRY(CheckVk(vkResetCommandBuffer(mCmd, 0), "resetting the command buffer"));
+Status VulkanContext::AddDescriptorPool() {
+    // Enough sets for a few stage calls: shading records one dispatch per slice.
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 32768};
+    VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    dp.maxSets = 8192;
+    dp.poolSizeCount = 1;
+    dp.pPoolSizes = &size;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    CB_TRY(CheckVk(vkCreateDescriptorPool(mDevice, &dp, nullptr, &pool), "creating a descriptor pool"));
+    mDescriptors.push_back(pool);
+    return {};
+}
+
+Result<VkDescriptorSet> VulkanContext::AllocateSet(VkDescriptorSetLayout layout) {
+    for (;;) {
+        VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        alloc.descriptorPool = mDescriptors[mDescriptorPool];
+        alloc.descriptorSetCount = 1;
+        alloc.pSetLayouts = &layout;
+        VkDescriptorSet set = VK_NULL_HANDLE;
+        const VkResult r = vkAllocateDescriptorSets(mDevice, &alloc, &set);
+        if (r == VK_SUCCESS) return set;
+        if (r != VK_ERROR_OUT_OF_POOL_MEMORY && r != VK_ERROR_FRAGMENTED_POOL)
+            return std::unexpected(CheckVk(r, "allocating a descriptor set").error());
+        // This pool is full until the next wait: go on in the next one.
+        if (++mDescriptorPool == mDescriptors.size()) CB_TRY(AddDescriptorPool());
+    }
+}
+
+Status VulkanContext::EnsureRecording(const char* what) {
+    if (mRecording) return {};
+    CB_TRY(CheckVk(vkResetCommandBuffer(mCmd, 0), what));
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    CB_TRY(CheckVk(vkBeginCommandBuffer(mCmd, &begin), "beginning the command buffer"));
+    CB_TRY(CheckVk(vkBeginCommandBuffer(mCmd, &begin), what));
+    mRecording = true;
+    return {};
+}
+
+Status VulkanContext::BeginSegment(const char* what) {
+    if (mTimestamps && mRecording && mPairInterval.size() == kBatchStampPairs) CB_TRY(Flush(what));
+    CB_TRY(EnsureRecording(what));
     if (mTimestamps) {
-        vkCmdResetQueryPool(mCmd, mQueries, 0, 2);
-        vkCmdWriteTimestamp(mCmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, mQueries, 0);
+        const uint32_t first = uint32_t(2 * mPairInterval.size());
+        vkCmdResetQueryPool(mCmd, mQueries, first, 2);
+        // Bottom of pipe: written once every earlier command has completed, so the
+        // pair spans this segment's work alone, also when it follows others in a batch.
+        vkCmdWriteTimestamp(mCmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, mQueries, first);
+        mPairInterval.push_back(mInterval);
     }
     return {};
 }
 
-Result<double> VulkanContext::Submit(const char* what, Recorder& recorder) {
-    if (mTimestamps) vkCmdWriteTimestamp(mCmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, mQueries, 1);
+Result<double> VulkanContext::EndSegment(const char* what) {
+    if (mTimestamps)
+        vkCmdWriteTimestamp(mCmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, mQueries,
+                            uint32_t(2 * mPairInterval.size() - 1));
+    if (mInBatch) {
+        RecordFullBarrier();
+    } else {
+        CB_TRY(Flush(what));
+    }
+    if (mRecordError) {
+        Error e = std::move(*mRecordError);
+        mRecordError.reset();
+        return std::unexpected(Error{std::string(what) + ": " + e.message});
+    }
+    return mInBatch ? 0.0 : mLastPairMs;
+}
+
+void VulkanContext::RecordFullBarrier() {
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                            VK_ACCESS_TRANSFER_WRITE_BIT;
+    const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    vkCmdPipelineBarrier(mCmd, stages, stages, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+}
+
+Status VulkanContext::Flush(const char* what) {
+    if (!mRecording) return {};
+    mRecording = false;
+    // This submission's pairs; the next command buffer starts at pair 0 whatever happens below.
+    const size_t pairs = mPairInterval.size();
+    std::vector<uint32_t> intervals = std::move(mPairInterval);
+    mPairInterval.clear();
     CB_TRY(CheckVk(vkEndCommandBuffer(mCmd), what));
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &mCmd;
     CB_TRY(CheckVk(vkResetFences(mDevice, 1, &mFence), what));
     CB_TRY(CheckVk(vkQueueSubmit(mQueue, 1, &submit, mFence), what));
-    CB_TRY(CheckVk(vkWaitForFences(mDevice, 1, &mFence, VK_TRUE, UINT64_MAX), what));
-    if (!recorder.mSets.empty())
-        vkFreeDescriptorSets(mDevice, mDescriptors, uint32_t(recorder.mSets.size()), recorder.mSets.data());
-    double ms = 0;
-    if (mTimestamps) {
-        uint64_t stamps[2] = {};
-        CB_TRY(CheckVk(vkGetQueryPoolResults(mDevice, mQueries, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
-                                             VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+    ++mSubmissions;
+    const VkResult waited = vkWaitForFences(mDevice, 1, &mFence, VK_TRUE, UINT64_MAX);
+    ++mHostWaits;
+    CB_TRY(CheckVk(waited, what));
+    for (VkDescriptorPool pool : mDescriptors) vkResetDescriptorPool(mDevice, pool, 0);
+    mDescriptorPool = 0;
+    for (DeviceBuffer& b : mRetired) DestroyBuffer(b);
+    mRetired.clear();
+    mArenaChunk = 0;
+    mArenaOffset = 0;
+    if (mTimestamps && pairs > 0) {
+        // The fence has signalled, so every stamp is available: one read, no wait.
+        std::vector<uint64_t> stamps(2 * pairs);
+        CB_TRY(CheckVk(vkGetQueryPoolResults(mDevice, mQueries, 0, uint32_t(2 * pairs), stamps.size() * 8,
+                                             stamps.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT),
                        what));
-        ms = double(stamps[1] - stamps[0]) * mTimestampPeriodNs * 1e-6;
+        for (size_t n = 0; n < pairs; ++n) {
+            const double ms = double(stamps[2 * n + 1] - stamps[2 * n]) * mTimestampPeriodNs * 1e-6;
+            if (intervals[n] < mIntervalMs.size()) mIntervalMs[intervals[n]] += ms;
+            mLastPairMs = ms;
+        }
     }
+    return {};
+}
+
+Status VulkanContext::BeginBatch() {
+    if (mInBatch) return MakeError("vk: batches do not nest");
+    // Nothing is pending outside a batch: every call there has waited.
+    mInBatch = true;
+    mInterval = 0;
+    mIntervalMs.assign(1, 0.0);
+    return {};
+}
+
+void VulkanContext::MarkBatch() {
+    if (!mInBatch) return;
+    ++mInterval;
+    mIntervalMs.push_back(0.0);
+}
+
+Result<std::vector<double>> VulkanContext::EndBatch() {
+    if (!mInBatch) return MakeError("vk: EndBatch without BeginBatch");
+    Status flushed = Flush("ending a batch");
+    mInBatch = false;
+    std::vector<double> ms = std::move(mIntervalMs);
+    mIntervalMs.clear();
+    mInterval = 0;
+    if (!flushed) return std::unexpected(flushed.error());
+    if (!mTimestamps) return std::vector<double>{};
     return ms;
 }
 
@@ -461,26 +627,26 @@ void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const 
     assert((pipeline.ranged || first < 64) && first < end);
     const uint32_t base = first / 64, groups = (end + 63) / 64 - base;
     if (base == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groups, 1, 1);
-    Bind(pipeline, buffers, push, pushBytes);
+    if (!Bind(pipeline, buffers, push, pushBytes)) return;
     vkCmdDispatchBase(mCmd, base, 0, 0, groups, 1, 1);
 }
 
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
                                              const void* push, uint32_t pushBytes, uint32_t groupsX, uint32_t groupsY,
                                              uint32_t groupsZ) {
-    Bind(pipeline, buffers, push, pushBytes);
+    if (!Bind(pipeline, buffers, push, pushBytes)) return;
     vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
 }
 
-void VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+bool VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                                    uint32_t pushBytes) {
-    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    alloc.descriptorPool = mContext.mDescriptors;
-    alloc.descriptorSetCount = 1;
-    alloc.pSetLayouts = &pipeline.setLayout;
-    VkDescriptorSet set = VK_NULL_HANDLE;
-    vkAllocateDescriptorSets(mContext.mDevice, &alloc, &set);
-    mSets.push_back(set);
+    auto allocated = mContext.AllocateSet(pipeline.setLayout);
+    if (!allocated) {
+        // Reported by the segment's end (EndSegment); nothing is bound or dispatched.
+        if (!mContext.mRecordError) mContext.mRecordError = allocated.error();
+        return false;
+    }
+    const VkDescriptorSet set = *allocated;
     std::vector<VkDescriptorBufferInfo> infos(buffers.size());
     std::vector<VkWriteDescriptorSet> writes(buffers.size());
     for (size_t n = 0; n < buffers.size(); ++n) {
@@ -496,6 +662,7 @@ void VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuf
     vkCmdBindPipeline(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
     vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout, 0, 1, &set, 0, nullptr);
     if (pushBytes) vkCmdPushConstants(mCmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes, push);
+    return true;
 }
 
 void VulkanContext::Recorder::Barrier() {

@@ -1,7 +1,8 @@
 // The Vulkan objects a backend needs: instance, one device and its compute
-// queue, memory, compute pipelines from the build's SPIR-V, and a synchronous
-// submit with timestamp queries. Every Vulkan call is checked and its failure
-// says what was being done (CheckVk).
+// queue, memory, compute pipelines from the build's SPIR-V, and submission with
+// timestamp queries: synchronous per call, or recorded into one command buffer
+// per batch (BeginBatch .. EndBatch, core/Backend.h "Pipelined timing"). Every
+// Vulkan call is checked and its failure says what was being done (CheckVk).
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -9,6 +10,8 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <span>
 #include <string>
 #include <vector>
@@ -72,9 +75,35 @@ class VulkanContext {
     static VkDeviceSize StorageBufferBytes(VkDeviceSize size) { return (size + 3) & ~VkDeviceSize(3); }
     // The size of the largest device-local memory heap.
     VkDeviceSize LargestDeviceLocalHeap() const;
+    // Destroys the buffer now, or, while commands are recorded and not yet
+    // complete, once they are (a scratch slot that grows in a batch).
     void DestroyBuffer(DeviceBuffer& buffer);
+    // Outside a batch: copies through a host-visible buffer, submits and waits.
+    // In a batch, Upload copies the bytes into the batch's host-visible arena
+    // now and records a device copy plus a barrier, so that it keeps its order
+    // with the recorded commands; Download records the copy, submits what is
+    // recorded, waits (a counted host wait), reads, and the batch continues in
+    // a fresh command buffer.
     Status Upload(const DeviceBuffer& buffer, std::span<const std::byte> data);
     Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);
+
+    // ---- Batches (core/Backend.h, "Pipelined timing") ----
+    // BeginBatch starts interval 0; MarkBatch the next one. Between BeginBatch
+    // and EndBatch, Run records (each call bracketed by a timestamp pair of the
+    // current interval and followed by a barrier that orders it before every
+    // later command) and returns 0 ms; EndBatch submits once, waits once and
+    // returns the device ms of each interval (empty without timestamps). When
+    // the timestamp pairs of one submission run out (kBatchStampPairs), the
+    // batch submits what it has and waits (counted) before going on.
+    Status BeginBatch();
+    void MarkBatch();
+    Result<std::vector<double>> EndBatch();
+    bool InBatch() const { return mInBatch; }
+    static constexpr uint32_t kBatchStampPairs = 1024;
+    // Cumulative: vkQueueSubmit calls, and host blocks on the device (fence
+    // waits; the query reads follow a fence wait and never block).
+    uint64_t Submissions() const { return mSubmissions; }
+    uint64_t HostWaits() const { return mHostWaits; }
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
     // PipelineRange::Share: the variant for shares (SPEC 13): made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT
@@ -86,8 +115,8 @@ class VulkanContext {
     // The pipeline of SPIR-V compiled elsewhere (tests), cached under `name`.
     Result<Pipeline*> GetPipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv);
 
-    // Records with `record`, submits, waits; returns the device time between
-    // the first and last timestamp in ms.
+    // Records with `record`; outside a batch submits, waits and returns the
+    // device time between its timestamp pair in ms; in a batch returns 0.
     class Recorder {
       public:
         // Binds `buffers` to a fresh descriptor set and dispatches ceil(invocations/64) groups.
@@ -109,30 +138,46 @@ class VulkanContext {
       private:
         friend class VulkanContext;
         explicit Recorder(VulkanContext& context, VkCommandBuffer cmd) : mContext(context), mCmd(cmd) {}
-        // Binds the pipeline, a fresh descriptor set of `buffers` and the push constants.
-        void Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
+        // Binds the pipeline, a fresh descriptor set of `buffers` and the push constants;
+        // false (the error kept for EndSegment) when no set could be had.
+        bool Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,
                   uint32_t pushBytes);
         VulkanContext& mContext;
         VkCommandBuffer mCmd;
-        std::vector<VkDescriptorSet> mSets;
     };
     template <typename Fn>
     Result<double> Run(const char* what, Fn&& record) {
-        CB_TRY(Begin());
+        CB_TRY(BeginSegment(what));
         Recorder recorder(*this, mCmd);
         record(recorder);
-        return Submit(what, recorder);
+        return EndSegment(what);
     }
 
   private:
     VulkanContext() = default;
-    Status Begin();
-    Result<double> Submit(const char* what, Recorder& recorder);
+    // Begins the command buffer unless it is recording.
+    Status EnsureRecording(const char* what);
+    // Ensures recording and a free timestamp pair (submitting first when a
+    // batch has used them all) and writes the pair's first stamp.
+    Status BeginSegment(const char* what);
+    // Writes the pair's second stamp; in a batch records the barrier after the
+    // segment and returns 0, else submits, waits and returns the pair's ms.
+    Result<double> EndSegment(const char* what);
+    // Submits what is recorded, waits, adds the timestamps to their intervals,
+    // then frees what the submission needed (descriptor sets, arena, retired buffers).
+    Status Flush(const char* what);
+    // A barrier from every earlier transfer and shader write to every later
+    // transfer and shader access.
+    void RecordFullBarrier();
+    // A fresh descriptor set; a further pool when the current one is full.
+    Result<VkDescriptorSet> AllocateSet(VkDescriptorSetLayout layout);
+    Status AddDescriptorPool();
+    // `size` bytes of host-visible arena for an upload in a batch: the buffer and offset.
+    Result<std::pair<const DeviceBuffer*, VkDeviceSize>> ArenaSpace(VkDeviceSize size, void*& mapped);
     Result<Pipeline*> CreatePipeline(const std::string& name, uint32_t bindings, std::span<const uint32_t> spirv,
                                      bool ranged);
     Result<DeviceBuffer> CreateRawBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags properties);
     Status EnsureStaging(VkDeviceSize size);
-    Status CopyBuffer(VkBuffer from, VkBuffer to, VkDeviceSize size, const char* what);
 
     static VKAPI_ATTR VkBool32 VKAPI_CALL OnValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                               VkDebugUtilsMessageTypeFlagsEXT type,
@@ -149,7 +194,9 @@ class VulkanContext {
     VkCommandBuffer mCmd = VK_NULL_HANDLE;
     VkFence mFence = VK_NULL_HANDLE;
     VkQueryPool mQueries = VK_NULL_HANDLE;
-    VkDescriptorPool mDescriptors = VK_NULL_HANDLE;
+    // Descriptor pools: sets come from pool mDescriptorPool on; all are reset after each wait.
+    std::vector<VkDescriptorPool> mDescriptors;
+    size_t mDescriptorPool = 0;
     VkPhysicalDeviceMemoryProperties mMemory{};
     float mTimestampPeriodNs = 1;
     bool mTimestamps = false;
@@ -159,6 +206,27 @@ class VulkanContext {
     VkDeviceMemory mStagingMemory = VK_NULL_HANDLE;
     void* mStagingMap = nullptr;
     std::map<std::string, Pipeline> mPipelines;
+
+    // Submission state: the command buffer is recording; its timestamp pairs so
+    // far and the interval of each; buffers to destroy once it completes.
+    bool mRecording = false;
+    std::vector<uint32_t> mPairInterval;
+    double mLastPairMs = 0;
+    std::vector<DeviceBuffer> mRetired;
+    // A failure while recording (a descriptor set that could not be had), reported by EndSegment.
+    std::optional<Error> mRecordError;
+    // Batch state.
+    bool mInBatch = false;
+    uint32_t mInterval = 0;
+    std::vector<double> mIntervalMs;
+    struct ArenaChunk {
+        DeviceBuffer buffer;
+        void* mapped = nullptr;
+    };
+    std::vector<ArenaChunk> mArena;
+    size_t mArenaChunk = 0;
+    VkDeviceSize mArenaOffset = 0;
+    uint64_t mSubmissions = 0, mHostWaits = 0;
 };
 
 }  // namespace cb::vk
