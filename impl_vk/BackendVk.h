@@ -99,13 +99,27 @@ class BackendVk final : public Backend {
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     // Pipelined timing (core/Backend.h): the context records the batch into one
-    // command buffer (VulkanContext::BeginBatch); a Download inside it, and the
-    // host results that need one (density's cover, render_splat's counts),
-    // submit and wait once each.
-    Status BeginBatch() override { return mContext->BeginBatch(); }
+    // command buffer (VulkanContext::BeginBatch); a Download inside it, and
+    // render_splat's counts (which size its next passes), submit and wait once
+    // each. Density's cover is deferred: read after the batch's wait.
+    Status BeginBatch() override {
+        mDeferredResults.clear();
+        return mContext->BeginBatch();
+    }
     void MarkBatch() override { mContext->MarkBatch(); }
     Result<std::vector<double>> EndBatch() override { return mContext->EndBatch(); }
+    std::vector<DeferredHostResult> TakeDeferredResults() override { return std::exchange(mDeferredResults, {}); }
     SubmissionCounts Submissions() const override { return {mContext->Submissions(), mContext->HostWaits()}; }
+
+    // How shade sweeps its slices (ShadeVk.cpp): one dispatch per slice (the
+    // reference), or blocks of slices per dispatch. Auto: per slice on a CPU
+    // device (lavapipe, where the blocks' extra cells cost more than the
+    // dispatches they save; docs/performance.md), blocks on a GPU. Both give the
+    // same T, bit for bit.
+    enum class ShadeSweep : uint8_t { Auto, PerSlice, Blocks };
+    void SetShadeSweep(ShadeSweep sweep) { mShadeSweep = sweep; }
+    // Dispatches recorded since the backend was made.
+    uint64_t Dispatches() const { return mContext->Dispatches(); }
 
     // Device time of the last stage call (timestamp queries), in ms.
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
@@ -126,6 +140,8 @@ class BackendVk final : public Backend {
 
     std::unique_ptr<VulkanContext> mContext;
     std::optional<double> mLastDeviceMs;
+    ShadeSweep mShadeSweep = ShadeSweep::Auto;
+    std::vector<DeferredHostResult> mDeferredResults;  // this batch's, so far (TakeDeferredResults)
     // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
     // while others grow.
     std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};

@@ -4,6 +4,7 @@
 // its part of the cover count. A share (SPEC 13) is a range of rows of tiles:
 // the dispatch covers those rows' tiles only, and the cover counts their columns.
 #include <algorithm>
+#include <cstring>
 #include <string>
 
 #include "impl_vk/StageVk.h"
@@ -45,6 +46,14 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
         r.Barrier();
         r.DispatchGroups(**pass, buffers, &push, sizeof push, tilesX, row1 - row0, 1);
     }));
+    if (mContext->InBatch()) {  // the cover after the batch's wait (core/Backend.h, deferred host results)
+        const uint32_t mark = mContext->Interval();
+        return mContext->DownloadLater(**counter, 4, [this, mark](std::span<const std::byte> bytes) {
+            uint32_t covered = 0;
+            std::memcpy(&covered, bytes.data(), sizeof covered);
+            mDeferredResults.push_back({mark, covered, std::nullopt});
+        });
+    }
     const double deviceMs = mLastDeviceMs.value_or(0);
     uint32_t covered = 0;
     CB_TRY(mContext->Download(**counter, std::as_writable_bytes(std::span(&covered, 1))));

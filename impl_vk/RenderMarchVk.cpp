@@ -82,8 +82,8 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const DeviceBuffer* groundBlock = *frameBuffer;
     const DeviceBuffer* groundG = *frameBuffer;
     if (params.ground.on) {
-        const GroundGpu block = MakeGroundGpu(params.camera, params.origin, params.setup.voxelSize,
-                                              MakeGroundLight(params), e.nx, e.ny);
+        const GroundGpu block =
+            MakeGroundGpu(params.camera, params.origin, params.setup.voxelSize, MakeGroundLight(params), e.nx, e.ny);
         auto b = Scratch(VkScratch::GroundFrame, sizeof block);
         if (!b) return std::unexpected(b.error());
         CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(&block, 1))));
@@ -101,7 +101,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),
                                            *volume};
     const DeviceBuffer* brickBuffers[] = {*volume, bricks, *statsBuffer};
-    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,       bricks,     table,
+    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,      bricks,      table,
                                           &Dev(image),  *statsBuffer, groundBlock, groundG};
     CB_TRY(Record("render_march", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);

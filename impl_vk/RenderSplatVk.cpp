@@ -153,8 +153,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         groundBlock = *b;
         groundG = &Dev(*in.G);
     }
-    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.tileList, &Dev(image),
-                                              groundBlock,    groundG};
+    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.tileList,
+                                              &Dev(image),    groundBlock,       groundG};
     CB_TRY(run("render_splat: compositing", [&](VulkanContext::Recorder& r) {
         bin.mode = 2;
         r.Dispatch(*pipes[3], fillBuffers, &bin, sizeof bin, splatChunks);

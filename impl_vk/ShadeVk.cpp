@@ -6,11 +6,10 @@
 // m0 .. m1 - 1 in visiting order; at f > 1 the share with m = 0 also down-samples
 // q and the share ending at nw up-samples into T. The coarse q and T
 // (VkScratch::ShadeCoarseQ/T) carry the sweep from one share to the next.
-// CLOUDBENCH_VK_SHADE=slice selects the reference path, one shade_slice.comp
-// dispatch per slice (the tests compare the two byte for byte).
+// The reference path, one shade_slice.comp dispatch per slice, is what a CPU
+// device (lavapipe) runs by default (BackendVk::ShadeSweep; the tests compare the
+// two byte for byte).
 #include <algorithm>
-#include <cstdlib>
-#include <cstring>
 
 #include "core/ShadePlan.h"
 #include "impl_vk/StageVk.h"
@@ -40,11 +39,6 @@ uint32_t ShadeBlockSteps(int u0, int v0) {
     return uint32_t(std::max(1, kShadeBlockHalo / std::max(growth(u0), growth(v0))));
 }
 
-bool ShadePerSlice() {
-    const char* value = std::getenv("CLOUDBENCH_VK_SHADE");
-    return value && std::strcmp(value, "slice") == 0;
-}
-
 }  // namespace
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
@@ -70,7 +64,8 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         shadeQ = *cq;
         shadeT = *ct;
     }
-    const bool perSlice = ShadePerSlice();
+    const bool perSlice =
+        mShadeSweep == ShadeSweep::PerSlice || (mShadeSweep == ShadeSweep::Auto && mContext->CpuDevice());
     auto slice = mContext->GetPipeline(perSlice ? "shade_slice" : "shade_block", 2);
     if (!slice) return std::unexpected(slice.error());
     Pipeline* down = nullptr;

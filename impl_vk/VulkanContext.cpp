@@ -176,6 +176,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
     VkPhysicalDeviceProperties props;
     vkGetPhysicalDeviceProperties(ctx->mPhysical, &props);
     ctx->mDeviceName = props.deviceName;
+    ctx->mCpuDevice = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     ctx->mTimestampPeriodNs = props.limits.timestampPeriod;
     if (props.apiVersion < VK_API_VERSION_1_2) return MakeError(ctx->mDeviceName + " supports Vulkan below 1.2");
     vkGetPhysicalDeviceMemoryProperties(ctx->mPhysical, &ctx->mMemory);
@@ -351,8 +352,9 @@ Result<std::pair<const DeviceBuffer*, VkDeviceSize>> VulkanContext::ArenaSpace(V
         mArenaOffset = 0;
     }
     // A further chunk; chunks stay for later batches (the arena keeps its high-water mark).
-    auto created = CreateRawBuffer(std::max(size, kChunk), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    auto created =
+        CreateRawBuffer(std::max(size, kChunk), VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     if (!created) return std::unexpected(created.error());
     ArenaChunk chunk{*created, nullptr};
     if (Status mappedOk = CheckVk(vkMapMemory(mDevice, chunk.buffer.memory, 0, VK_WHOLE_SIZE, 0, &chunk.mapped),
@@ -405,12 +407,36 @@ Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> 
     VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(mCmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr,
-                         0, nullptr);
+    vkCmdPipelineBarrier(mCmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0,
+                         nullptr);
     auto done = EndSegment("downloading a buffer");
     if (!done) return std::unexpected(done.error());
     if (mInBatch) CB_TRY(Flush("downloading a buffer"));
     std::memcpy(data.data(), mStagingMap, data.size());
+    return {};
+}
+
+Status VulkanContext::DownloadLater(const DeviceBuffer& buffer, VkDeviceSize bytes, ReadDone done) {
+    if (!mInBatch) {
+        std::vector<std::byte> data(bytes);
+        CB_TRY(Download(buffer, data));
+        done(data);
+        return {};
+    }
+    void* mapped = nullptr;
+    auto space = ArenaSpace(bytes, mapped);
+    if (!space) return std::unexpected(space.error());
+    CB_TRY(BeginSegment("reading a result back later"));
+    const VkBufferCopy region{0, space->second, bytes};
+    vkCmdCopyBuffer(mCmd, buffer.buffer, space->first->buffer, 1, &region);
+    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(mCmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0,
+                         nullptr);
+    auto recorded = EndSegment("reading a result back later");
+    if (!recorded) return std::unexpected(recorded.error());
+    mLaterReads.push_back({mapped, bytes, std::move(done)});
     return {};
 }
 
@@ -573,6 +599,9 @@ Status VulkanContext::Flush(const char* what) {
     mDescriptorPool = 0;
     for (DeviceBuffer& b : mRetired) DestroyBuffer(b);
     mRetired.clear();
+    // The arena's bytes stay until the next batch writes them: read the later reads first.
+    for (LaterRead& read : std::exchange(mLaterReads, {}))
+        read.done(std::span(static_cast<const std::byte*>(read.mapped), read.bytes));
     mArenaChunk = 0;
     mArenaOffset = 0;
     if (mTimestamps && pairs > 0) {
@@ -629,6 +658,7 @@ void VulkanContext::Recorder::DispatchRange(Pipeline& pipeline, std::span<const 
     if (base == 0) return DispatchGroups(pipeline, buffers, push, pushBytes, groups, 1, 1);
     if (!Bind(pipeline, buffers, push, pushBytes)) return;
     vkCmdDispatchBase(mCmd, base, 0, 0, groups, 1, 1);
+    ++mContext.mDispatches;
 }
 
 void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers,
@@ -636,6 +666,7 @@ void VulkanContext::Recorder::DispatchGroups(Pipeline& pipeline, std::span<const
                                              uint32_t groupsZ) {
     if (!Bind(pipeline, buffers, push, pushBytes)) return;
     vkCmdDispatch(mCmd, groupsX, groupsY, groupsZ);
+    ++mContext.mDispatches;
 }
 
 bool VulkanContext::Recorder::Bind(Pipeline& pipeline, std::span<const DeviceBuffer* const> buffers, const void* push,

@@ -8,12 +8,13 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
-#include <utility>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/Error.h"
@@ -66,6 +67,8 @@ class VulkanContext {
     VulkanContext& operator=(const VulkanContext&) = delete;
 
     const std::string& DeviceName() const { return mDeviceName; }
+    // Whether the device is the host's CPU (lavapipe): dispatches are cheap there, cells dear.
+    bool CpuDevice() const { return mCpuDevice; }
     uint32_t ValidationMessages() const { return mValidationMessages; }
 
     // A device-local storage buffer of StorageBufferBytes(size) bytes.
@@ -86,6 +89,13 @@ class VulkanContext {
     // a fresh command buffer.
     Status Upload(const DeviceBuffer& buffer, std::span<const std::byte> data);
     Status Download(const DeviceBuffer& buffer, std::span<std::byte> data);
+    // In a batch: records a copy of the first `bytes` of `buffer` into the
+    // batch's host-visible arena and gives them to `done` after the batch's
+    // next wait (EndBatch's, or an earlier one), without a wait of its own
+    // (deferred host results, core/Backend.h). Outside a batch: a Download,
+    // then `done`.
+    using ReadDone = std::function<void(std::span<const std::byte>)>;
+    Status DownloadLater(const DeviceBuffer& buffer, VkDeviceSize bytes, ReadDone done);
 
     // ---- Batches (core/Backend.h, "Pipelined timing") ----
     // BeginBatch starts interval 0; MarkBatch the next one. Between BeginBatch
@@ -99,11 +109,15 @@ class VulkanContext {
     void MarkBatch();
     Result<std::vector<double>> EndBatch();
     bool InBatch() const { return mInBatch; }
+    // The MarkBatch() calls since BeginBatch: the mark of a call recorded now.
+    uint32_t Interval() const { return mInterval; }
     static constexpr uint32_t kBatchStampPairs = 1024;
     // Cumulative: vkQueueSubmit calls, and host blocks on the device (fence
     // waits; the query reads follow a fence wait and never block).
     uint64_t Submissions() const { return mSubmissions; }
     uint64_t HostWaits() const { return mHostWaits; }
+    // Cumulative: dispatches recorded (the per-dispatch overhead of issue 16).
+    uint64_t Dispatches() const { return mDispatches; }
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).
     // PipelineRange::Share: the variant for shares (SPEC 13): made with VK_PIPELINE_CREATE_DISPATCH_BASE_BIT
@@ -218,6 +232,15 @@ class VulkanContext {
     // Batch state.
     bool mInBatch = false;
     uint32_t mInterval = 0;
+    bool mCpuDevice = false;
+    uint64_t mDispatches = 0;
+    // DownloadLater's copies waiting for the next wait: arena bytes and who gets them.
+    struct LaterRead {
+        const void* mapped = nullptr;
+        VkDeviceSize bytes = 0;
+        ReadDone done;
+    };
+    std::vector<LaterRead> mLaterReads;
     std::vector<double> mIntervalMs;
     struct ArenaChunk {
         DeviceBuffer buffer;

@@ -1,6 +1,6 @@
 // Vulkan shade in blocks of slices (issue 16; impl_vk/shaders/shade_block.comp):
 // T must be byte for byte the per-slice reference path's (shade_slice.comp, one
-// dispatch per slice, selected with CLOUDBENCH_VK_SHADE=slice) at every
+// dispatch per slice, BackendVk::ShadeSweep::PerSlice) at every
 // principal axis and sign, fractional and whole taps (45-degree ties: a tap
 // offset of +1 or -1 with weight 0), nearest taps, odd grids that are not
 // multiples of the 32-cell tile and sweeps longer than a 16-slice block,
@@ -20,6 +20,9 @@
 #include "core/ShadePlan.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
+
+#if CLOUDBENCH_HAVE_VK
+#include "impl_vk/BackendVk.h"
 
 namespace cb {
 namespace {
@@ -44,16 +47,15 @@ class ShadeBlockVk : public ::testing::Test {
         if (!backend) GTEST_SKIP() << "unsupported here: " << backend.error().message;
         mBackend = std::move(*backend);
     }
+    vk::BackendVk& Vk() { return static_cast<vk::BackendVk&>(*mBackend); }
     void TearDown() override {
-        unsetenv("CLOUDBENCH_VK_SHADE");
         if (mBackend) test::ExpectNoValidationMessages(mBackend.get());
     }
 
     // T from `shares` calls (an empty list: one whole call) on the block path or the per-slice path.
     std::vector<float> RunShade(const ShadeParams& p, const Buffer& q, Buffer& T, bool perSlice,
                                 const std::vector<SliceRange>& shares = {}) {
-        if (perSlice) setenv("CLOUDBENCH_VK_SHADE", "slice", 1);
-        else unsetenv("CLOUDBENCH_VK_SHADE");
+        Vk().SetShadeSweep(perSlice ? vk::BackendVk::ShadeSweep::PerSlice : vk::BackendVk::ShadeSweep::Blocks);
         std::vector<float> minusOne(T.Extent().Count(), -1.0f);  // a value shade never writes
         EXPECT_TRUE(mBackend->Upload(T, std::as_bytes(std::span(minusOne))));
         std::vector<SliceRange> calls = shares.empty() ? std::vector<SliceRange>{SliceRange{}} : shares;
@@ -63,7 +65,7 @@ class ShadeBlockVk : public ::testing::Test {
             Status status = mBackend->Shade(share, q, T);
             EXPECT_TRUE(status.has_value()) << (status ? "" : status.error().message);
         }
-        unsetenv("CLOUDBENCH_VK_SHADE");
+        Vk().SetShadeSweep(vk::BackendVk::ShadeSweep::Auto);
         return test::Read<float>(*mBackend, T);
     }
 
@@ -77,8 +79,8 @@ class ShadeBlockVk : public ::testing::Test {
             if (std::memcmp(&got[n], &reference[n], 4) != 0) {
                 if (differ++ == 0) first = n;
             }
-        EXPECT_EQ(differ, 0u) << what << ": " << differ << " of " << got.size() << " differ, first at " << first
-                              << ": " << (first < got.size() ? got[first] : 0) << " against "
+        EXPECT_EQ(differ, 0u) << what << ": " << differ << " of " << got.size() << " differ, first at " << first << ": "
+                              << (first < got.size() ? got[first] : 0) << " against "
                               << (first < got.size() ? reference[first] : 0);
         // The test must see the sweep do something: some T well below 1, none left unwritten.
         size_t dark = 0, unwritten = 0;
@@ -97,9 +99,9 @@ class ShadeBlockVk : public ::testing::Test {
 // Suns: each principal axis, both signs, above and below; fractional taps; ties
 // (du = +1 or -1 exactly: tap offset +1 or -1, weight 0).
 const Vec3 kShadeBlockSuns[] = {
-    Unit(0.3f, 0.2f, 0.93f),   Unit(-0.3f, 0.45f, -0.9f), Unit(0.9f, 0.35f, -0.25f), Unit(-0.9f, -0.6f, 0.25f),
-    Unit(0.3f, 0.9f, 0.1f),    Unit(0.2f, -0.9f, -0.7f),  Unit(1.0f, 0.5f, 1.0f),    Unit(1.0f, -1.0f, 0.4f),
-    Unit(-1.0f, 1.0f, -1.0f),  Unit(0.0f, 0.0f, 1.0f),
+    Unit(0.3f, 0.2f, 0.93f),  Unit(-0.3f, 0.45f, -0.9f), Unit(0.9f, 0.35f, -0.25f), Unit(-0.9f, -0.6f, 0.25f),
+    Unit(0.3f, 0.9f, 0.1f),   Unit(0.2f, -0.9f, -0.7f),  Unit(1.0f, 0.5f, 1.0f),    Unit(1.0f, -1.0f, 0.4f),
+    Unit(-1.0f, 1.0f, -1.0f), Unit(0.0f, 0.0f, 1.0f),
 };
 
 std::string SunName(const Vec3& s) {
@@ -119,10 +121,37 @@ TEST_F(ShadeBlockVk, SameAsPerSliceAtEverySunStorageAndAttenuation) {
                 p.attenuation = thesis ? AttenuationKind::Thesis : AttenuationKind::Beer;
                 p.scattering = thesis;
                 p.sigma = 0.004f;
-                const std::string what = SunName(sun) + " storage " + std::to_string(int(storage)) +
-                                         (thesis ? " thesis" : " beer");
+                const std::string what =
+                    SunName(sun) + " storage " + std::to_string(int(storage)) + (thesis ? " thesis" : " beer");
                 if (!ExpectSame(what, p, *q, *T)) return;
             }
+}
+
+// The dispatches of a whole sweep of nw = 40 slices (w = x; a 40 x 24 x 6 grid,
+// f = 1): one per slice per slice; in blocks, the first dispatch computes slices
+// 0 .. 16 from slice 0's T = 1 and each further one 16 more, so 1 + ceil((40 -
+// 17) / 16) = 3. On a CPU device (lavapipe) Auto is per slice.
+TEST_F(ShadeBlockVk, BlocksCutTheDispatchesAndAutoFollowsTheDevice) {
+    const Extent3 grid{40, 24, 6};
+    auto q = test::MakeFilled(*mBackend, BufferFormat::F32, grid, ShadeBlockQ(grid, 3));
+    auto T = test::MakeBuffer(*mBackend, BufferFormat::F32, grid);
+    ShadeParams p;
+    p.sun = Unit(0.9f, 0.35f, 0.25f);
+    ASSERT_EQ(MakeShadePlan(p, grid).nw, 40u);
+    auto dispatches = [&](vk::BackendVk::ShadeSweep sweep) {
+        Vk().SetShadeSweep(sweep);
+        const uint64_t before = Vk().Dispatches();
+        EXPECT_TRUE(mBackend->Shade(p, *q, *T).has_value());
+        return Vk().Dispatches() - before;
+    };
+    EXPECT_EQ(dispatches(vk::BackendVk::ShadeSweep::PerSlice), 40u);
+    EXPECT_EQ(dispatches(vk::BackendVk::ShadeSweep::Blocks), 3u);
+    const auto devices = vk::ListDevices();
+    ASSERT_TRUE(devices.has_value());
+    if (devices->front().type == "cpu") {
+        EXPECT_EQ(dispatches(vk::BackendVk::ShadeSweep::Auto), 40u);
+    }
+    Vk().SetShadeSweep(vk::BackendVk::ShadeSweep::Auto);
 }
 
 TEST_F(ShadeBlockVk, SameAsPerSliceWithNearestTaps) {
@@ -145,8 +174,8 @@ TEST_F(ShadeBlockVk, SameAsPerSliceAtCoarseResolutions) {
             for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Unorm8}) {
                 ShadeParams p;
                 p.sun = sun, p.resolution = f, p.storage = storage, p.sigma = 0.01f;
-                const std::string what = SunName(sun) + " f " + std::to_string(f) + " storage " +
-                                         std::to_string(int(storage));
+                const std::string what =
+                    SunName(sun) + " f " + std::to_string(f) + " storage " + std::to_string(int(storage));
                 if (!ExpectSame(what, p, *q, *T)) return;
             }
 }
@@ -186,25 +215,25 @@ TEST_F(ShadeBlockVk, DISABLED_Bench) {
     std::vector<double> wall[2], device[2];
     for (int round = 0; round < 12; ++round)
         for (int perSlice : {0, 1}) {
-            if (perSlice) setenv("CLOUDBENCH_VK_SHADE", "slice", 1);
-            else unsetenv("CLOUDBENCH_VK_SHADE");
+            Vk().SetShadeSweep(perSlice ? vk::BackendVk::ShadeSweep::PerSlice : vk::BackendVk::ShadeSweep::Blocks);
             const auto start = std::chrono::steady_clock::now();
             ASSERT_TRUE(mBackend->Shade(p, *q, *T).has_value());
-            const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            const double ms =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             if (round < 2) continue;  // warm-up: pipelines, scratch
             wall[perSlice].push_back(ms);
             device[perSlice].push_back(mBackend->LastDeviceMs().value_or(-1));
         }
-    unsetenv("CLOUDBENCH_VK_SHADE");
     auto quartiles = [](std::vector<double> v) {
         std::sort(v.begin(), v.end());
         const size_t n = v.size();
         return std::to_string(v[n / 2]) + " [" + std::to_string(v[n / 4]) + "-" + std::to_string(v[3 * n / 4]) + "]";
     };
     for (int perSlice : {0, 1})
-        std::printf("%s: wall %s ms, device %s ms\n", perSlice ? "per slice" : "blocks", quartiles(wall[perSlice]).c_str(),
-                    quartiles(device[perSlice]).c_str());
+        std::printf("%s: wall %s ms, device %s ms\n", perSlice ? "per slice" : "blocks",
+                    quartiles(wall[perSlice]).c_str(), quartiles(device[perSlice]).c_str());
 }
 
 }  // namespace
 }  // namespace cb
+#endif

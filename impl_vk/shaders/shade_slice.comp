@@ -2,8 +2,8 @@
 // Stage `shade` (SPEC 6): one slice of the inverse shear-warp; one invocation
 // per (u, v). Dispatched once per slice, from the sun's side, with a barrier
 // between slices. Taps outside the previous slice read T = 1, q = 0. The
-// reference path (CLOUDBENCH_VK_SHADE=slice); shade_block.comp, 16 slices a
-// dispatch, is the default and must give the same T bit for bit.
+// reference path, and the default on a CPU device (BackendVk::ShadeSweep);
+// shade_block.comp, 16 slices a dispatch, must give the same T bit for bit.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
 
