@@ -507,5 +507,54 @@ TEST(SharedFormula, EllipsoidListMatchesIndependentPort) {
     EXPECT_EQ(born.age, 0u);
 }
 
+
+// Test eight updates against the same independent port (extended): deaths by age
+// and by leaving the bounds, the adaption limit (step 5: two die, one is born),
+// lifetimes 4 +- 1.5 rounded, wind (1.5, -0.25), jitter 0.3. Grid 16 x 8 x 4, seed 11,
+// target 3, adaption 1. The list never exceeds its target (births stop there), so
+// the random-removal branch of Update is unreachable with fixed settings.
+TEST(SharedFormula, EllipsoidListEightStepsMatchIndependentPort) {
+    EllipsoidSettings s;
+    s.seed = 11;
+    s.targetCount = 3;
+    s.densityAdaption = 1;
+    s.sizeMean = {4, 4, 2};
+    s.sizeVariance = {1, 1, 0.5};
+    s.lifetimeMean = 4;
+    s.lifetimeVariance = 1.5;
+    s.margin = 2;
+    s.heightRange = {0.25, 0.5};
+    s.wind.vector = {1.5, -0.25};
+    s.jitter = 0.3;
+    EllipsoidList list(s, {16, 8, 4});
+    const size_t sizes[8] = {3, 3, 3, 3, 2, 3, 3, 3};
+    for (int step = 0; step < 8; ++step) {
+        list.Update();
+        ASSERT_EQ(list.Items().size(), sizes[step]) << "after update " << step + 1;
+    }
+    struct Want {
+        double c[3], a[3], yaw;
+        uint32_t lifetime, age;
+    };
+    const Want want[3] = {
+        {{16.187713976803423, 2.922479746306546, 1.5737939093375688},
+         {3.9551018893237666, 3.041143230778137, 2.1140194433291652}, 3.163178085419022, 5, 4},
+        {{6.8857179595580815, 3.3323839830016366, 1.5075957481709525},
+         {4.091237242737663, 3.178188343552854, 2.4919092225744564}, 1.7318439345947823, 5, 3},
+        {{11.23366752200793, 4.973939751060113, 1.3974873608361391},
+         {3.9283606596839293, 3.418020187303883, 2.0144997152103103}, 0.8151843802905121, 3, 2},
+    };
+    for (int n = 0; n < 3; ++n) {
+        const Ellipsoid& e = list.Items()[n];
+        for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_DOUBLE_EQ(e.center[axis], want[n].c[axis]) << "item " << n << " axis " << axis;
+            EXPECT_DOUBLE_EQ(e.semiAxes[axis], want[n].a[axis]) << "item " << n << " axis " << axis;
+        }
+        EXPECT_DOUBLE_EQ(e.yaw, want[n].yaw) << n;
+        EXPECT_EQ(e.lifetime, want[n].lifetime) << n;
+        EXPECT_EQ(e.age, want[n].age) << n;
+    }
+}
+
 }  // namespace
 }  // namespace cb
