@@ -20,6 +20,21 @@ namespace cb::test {
 std::vector<TwinCase> Cases() {
     std::vector<TwinCase> c;
     const uint32_t kQ1 = 1u << 24;  // probability 1
+    // The floats v where float(255 v) is exactly k + 0.5, for every k in 0..254
+    // (found by search near (k + 0.5)/255), and one ulp outside the first and
+    // last of each k: the ties of unorm8 and of the region's quantisation.
+    std::vector<float> unormTies;
+    for (int k = 0; k <= 254; ++k) {
+        float v = (float(k) + 0.5f) / 255.0f;
+        for (int n = 0; n < 16; ++n) v = std::nextafter(v, 0.0f);
+        std::vector<float> ties;
+        for (int n = 0; n < 33; ++n, v = std::nextafter(v, 1.0f))
+            if (255.0f * v == float(k) + 0.5f) ties.push_back(v);
+        if (ties.empty()) continue;  // SharedFormulaTest asserts there is one for every k
+        unormTies.push_back(std::nextafter(ties.front(), 0.0f));
+        unormTies.insert(unormTies.end(), ties.begin(), ties.end());
+        unormTies.push_back(std::nextafter(ties.back(), 1.0f));
+    }
 
     // ---- random.glsl ----
     c.push_back({"LowBias32",
@@ -92,6 +107,7 @@ std::vector<TwinCase> Cases() {
         for (float w : {0.0f, 1.0f, 1e-9f, 2.0f}) edges.push_back(WF({w}));
         for (int k : {0, 1, 127, 253, 254})  // w where 255 w + 0.5 is near an integer
             for (float w : AndNeighbours((float(k) + 0.5f) / 255.0f)) edges.push_back(WF({w}));
+        for (float w : unormTies) edges.push_back(WF({w}));  // 255 w = k + 0.5 exactly
         c.push_back({"QuantizeRegion",
                      5,
                      {Kind::U},
@@ -139,6 +155,20 @@ std::vector<TwinCase> Cases() {
             halfEdges.push_back(WF({-y}));
         }
     for (float x : AndNeighbours(Float(0x477ff000u))) halfEdges.push_back(WF({x}));
+    // Every fp16 tie in [0, 1): the midpoint of codes h and h + 1 (exact in float) and
+    // one ulp either side, and the negated midpoint (issue 17: sparse GPU ties let a
+    // wrong tie rounding survive).
+    std::vector<Words> halfTies;
+    for (uint32_t h = 0; h < 0x3C00u; ++h) {
+        auto value = [](uint32_t code) {
+            const uint32_t exponent = code >> 10, mantissa = code & 0x3ffu;
+            return exponent == 0 ? std::ldexp(double(mantissa), -24)
+                                 : std::ldexp(1.0 + mantissa / 1024.0, int(exponent) - 15);
+        };
+        const float m = float((value(h) + value(h + 1)) / 2);
+        for (float x : AndNeighbours(m)) halfTies.push_back(WF({x}));
+        halfTies.push_back(WF({-m}));
+    }
     c.push_back({"RoundToHalf",
                  8,
                  {Kind::F},
@@ -147,12 +177,17 @@ std::vector<TwinCase> Cases() {
                      const uint32_t bits = (r.NextU32() & 0x807fffffu) | (r.Below(145) << 23);
                      in = r.Below(2) ? W({bits}) : WF({Uniform(r, 0, 1)});
                  },
-                 halfEdges,
+                 [&] {
+                     std::vector<Words> edges = halfEdges;
+                     edges.insert(edges.end(), halfTies.begin(), halfTies.end());
+                     return edges;
+                 }(),
                  [](const Words& in, Words& out) { out[0] = Bits(RoundToHalf(Float(in[0]))); }});
     std::vector<Words> unormEdges;
     for (float x : {0.0f, -0.0f, 1.0f, -0.5f, 1.5f}) unormEdges.push_back(WF({x}));
     for (int k = 0; k < 255; k += 3)  // 255 v = k + 0.5: the ties
         for (float v : AndNeighbours((float(k) + 0.5f) / 255.0f)) unormEdges.push_back(WF({v}));
+    for (float v : unormTies) unormEdges.push_back(WF({v}));  // every k: 255 v = k + 0.5 exactly
     c.push_back({"RoundToUnorm8",
                  9,
                  {Kind::F},
@@ -165,6 +200,7 @@ std::vector<TwinCase> Cases() {
             for (const Words& e : halfEdges) edges.push_back(W({storage, e[0]}));
             for (const Words& e : unormEdges) edges.push_back(W({storage, e[0]}));
         }
+        for (const Words& e : halfTies) edges.push_back(W({uint32_t(StorageFormat::Fp16), e[0]}));
         c.push_back(
             {"RoundToStorage",
              10,

@@ -587,6 +587,39 @@ TEST(Shadow, HandWorked) {
     for (float g : ShadowOnCpu(e, D, p)) EXPECT_TRUE(std::isfinite(g));
 }
 
+// Test the lookup height where the hand-worked case above cannot (issue 17):
+// an odd nz = 7 at 45 degrees along +x reads 3.5 cells over, so with only
+// D(5, 2) = 2, cells 1 and 2 of row 2 read halfway between columns 4|5 and 5|6:
+// D = 1 for both, G = exp(-sigma h / s_z); a lookup with nz/2 in integers reads
+// 3 over (G = exp(-2 sigma h / s_z) at cell 2, 1 at cell 1). A sun along -y
+// (nz = 8) reads 4 cells toward -y: cell (5, 6) reads D(5, 2).
+TEST(Shadow, OddHeightAndMinusYHandWorked) {
+    const Extent3 e{10, 8, 7};
+    std::vector<float> D(80, 0.0f);
+    D[5 + 10 * 2] = 2.0f;
+    ShadowParams p;
+    p.sigma = 0.01f;
+    p.voxelSize = 50;
+    p.nz = e.nz;
+    const float r = std::sqrt(0.5f);
+    p.sun = {r, 0, r};
+    std::vector<float> G = ShadowOnCpu(e, D, p);
+    const float half = std::exp(-0.01f * 50 * 1.0f / r);
+    EXPECT_NEAR(G[1 + 10 * 2], half, 1e-5);
+    EXPECT_NEAR(G[2 + 10 * 2], half, 1e-5);
+    EXPECT_NEAR(G[0 + 10 * 2], 1.0f, 1e-6);
+    EXPECT_NEAR(G[3 + 10 * 2], 1.0f, 1e-6);
+    EXPECT_NEAR(G[2 + 10 * 3], 1.0f, 1e-6);  // another row
+    p.nz = 8;
+    p.sun = {0, -r, r};
+    G = ShadowOnCpu(e, D, p);
+    EXPECT_NEAR(G[5 + 10 * 6], std::exp(-0.01f * 50 * 2.0f / r), 1e-5);
+    EXPECT_NEAR(G[5 + 10 * 2], 1.0f, 1e-6);
+    EXPECT_NEAR(G[5 + 10 * 5], 1.0f, 1e-5);
+    EXPECT_NEAR(G[5 + 10 * 7], 1.0f, 1e-5);
+    EXPECT_NEAR(G[4 + 10 * 6], 1.0f, 1e-6);
+}
+
 // Test Wang's form (seed 002 eq. 19, S = 1 - D_w max(T_S - (T_2D + 1 - C), 0))
 // by hand, with T_S the column's opacity 1 - exp(-sigma h D / s_z) and T_2D = 0
 // (docs/pipeline.md). D = 2, sigma h = 0.5: overhead tau = 1, opacity
