@@ -17,34 +17,25 @@
 #include "core/Rules.h"
 #include "core/Shading.h"
 #include "core/Splat.h"
+#include "tests/LowBias32Inverse.h"
 
 namespace cb {
 namespace {
 
 // ---- 1a. lowbias32 and the stream keys -----------------------------------------
 
-// The published inverse of lowbias32 (Wellons, hash-prospector README, `lowbias32_r`).
-uint32_t SfLowBias32Inverse(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x43021123u;
-    x ^= x >> 15 ^ x >> 30;
-    x *= 0x1d69e2a5u;
-    x ^= x >> 16;
-    return x;
-}
-
 // Test that the published inverse undoes LowBias32 (and the reverse) on a
 // spread of inputs: any change of a constant or a shift breaks it.
 TEST(SharedFormula, LowBias32InvertsWithThePublishedInverse) {
     Pcg32 rng(17);
     for (uint32_t x : {0u, 1u, 2u, 0x7fffffffu, 0x80000000u, 0xffffffffu, 0x9E3779B9u}) {
-        EXPECT_EQ(SfLowBias32Inverse(LowBias32(x)), x);
-        EXPECT_EQ(LowBias32(SfLowBias32Inverse(x)), x);
+        EXPECT_EQ(test::LowBias32Inverse(LowBias32(x)), x);
+        EXPECT_EQ(LowBias32(test::LowBias32Inverse(x)), x);
     }
     for (int n = 0; n < 200000; ++n) {
         const uint32_t x = rng.NextU32();
-        ASSERT_EQ(SfLowBias32Inverse(LowBias32(x)), x) << x;
-        ASSERT_EQ(LowBias32(SfLowBias32Inverse(x)), x) << x;
+        ASSERT_EQ(test::LowBias32Inverse(LowBias32(x)), x) << x;
+        ASSERT_EQ(LowBias32(test::LowBias32Inverse(x)), x) << x;
     }
 }
 
@@ -62,7 +53,7 @@ TEST(SharedFormula, StreamKeysByHand) {
     EXPECT_EQ(StreamKey(0xFFFFFFFFu, 0xFFFFFFFFu, 3), 0xca4d4754u);
     // rand24 is the top 24 bits of LB(voxel ^ key): with the inverse, a chosen draw at a chosen voxel.
     const uint32_t key = StreamKey(123, 7, kStreamHumidity);
-    const uint32_t voxel = SfLowBias32Inverse((128000u << 8) | 0x5au) ^ key;
+    const uint32_t voxel = test::LowBias32Inverse((128000u << 8) | 0x5au) ^ key;
     EXPECT_EQ(Rand24FromKey(key, voxel), 128000u);
     EXPECT_EQ(Rand24(123, 7, kStreamHumidity, voxel), 128000u);
 }
