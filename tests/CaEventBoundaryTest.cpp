@@ -201,8 +201,8 @@ class CaEventBoundaryBackend : public test::BackendTest {
                         state.act[v] = 0;
                     }
                     // All three events on, with the same q (the other two draw whatever the seed gives).
-                    test::ByteStepParams p{test::SeedForDraw(d.draw, step, stream, v, rng.Below(256)), step, t.q, t.q,
-                                           t.q, {}, {}};
+                    test::ByteStepParams p{
+                        test::SeedForDraw(d.draw, step, stream, v, rng.Below(256)), step, t.q, t.q, t.q, {}, {}};
                     ASSERT_EQ(Rand24(p.seed, step, stream, v), d.draw);
                     ASSERT_TRUE(b.Upload(*region, std::as_bytes(std::span(regionBytes))).has_value());
                     const std::vector<uint8_t>* fields[3] = {&state.hum, &state.act, &state.cld};
@@ -215,12 +215,13 @@ class CaEventBoundaryBackend : public test::BackendTest {
                     const Status s = b.CaStep(params, {in[0].get(), in[1].get(), in[2].get()}, *region,
                                               {out[0].get(), out[1].get(), out[2].get()});
                     ASSERT_TRUE(s.has_value()) << s.error().message;
-                    const std::vector<uint8_t> got[3] = {test::Read<uint8_t>(b, *out[0]), test::Read<uint8_t>(b, *out[1]),
+                    const std::vector<uint8_t> got[3] = {test::Read<uint8_t>(b, *out[0]),
+                                                         test::Read<uint8_t>(b, *out[1]),
                                                          test::Read<uint8_t>(b, *out[2])};
                     const std::string where = "voxel (" + std::to_string(at.i) + ", " + std::to_string(at.j) + ", " +
                                               std::to_string(at.k) + "), region " + std::to_string(r) + ", q " +
-                                              std::to_string(t.q) + ", draw " + std::to_string(d.draw) + " (P = " +
-                                              std::to_string(t.p) + ")";
+                                              std::to_string(t.q) + ", draw " + std::to_string(d.draw) +
+                                              " (P = " + std::to_string(t.p) + ")";
                     // SPEC 3: extinction clears cld iff it fires; humidity and activation set their bit iff it fires.
                     if (event == EbEvent::Extinction) {
                         ASSERT_EQ(got[2][v], d.fires ? 0 : 1) << "cld at " << where;
@@ -245,8 +246,8 @@ class CaEventBoundaryBackend : public test::BackendTest {
         for (int f = 0; f < 3; ++f) out[f] = test::MakeBuffer(b, BufferFormat::Bits, mExtent);
         Pcg32 rng(200 + stream);
         // Q(0.35) = round(5872025.6) = 5872026; Q(0.001) = round(16777.216) = 16777.
-        for (const auto& [qHum0, qAct0] : {std::pair{5872026u, 16777u}, std::pair{16777u, 5872026u},
-                                          std::pair{1u, 16777215u}})
+        for (const auto& [qHum0, qAct0] :
+             {std::pair{5872026u, 16777u}, std::pair{16777u, 5872026u}, std::pair{1u, 16777215u}})
             for (const EbVoxel& at : kEbVoxels) {
                 const uint32_t q = stream == kStreamHumidity ? qHum0 : qAct0;
                 for (const EbDraw& d : EbDrawsAround(q)) {
@@ -255,7 +256,8 @@ class CaEventBoundaryBackend : public test::BackendTest {
                     ASSERT_EQ(Rand24(seed, 0xFFFFFFFFu, stream, v), d.draw);
                     const Status s = b.CaInitialize({seed, qHum0, qAct0}, {out[0].get(), out[1].get(), out[2].get()});
                     ASSERT_TRUE(s.has_value()) << s.error().message;
-                    const std::vector<uint8_t> got[3] = {test::Read<uint8_t>(b, *out[0]), test::Read<uint8_t>(b, *out[1]),
+                    const std::vector<uint8_t> got[3] = {test::Read<uint8_t>(b, *out[0]),
+                                                         test::Read<uint8_t>(b, *out[1]),
                                                          test::Read<uint8_t>(b, *out[2])};
                     const std::string where = "voxel (" + std::to_string(at.i) + ", " + std::to_string(at.j) + ", " +
                                               std::to_string(at.k) + "), draw " + std::to_string(d.draw) +
