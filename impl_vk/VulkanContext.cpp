@@ -401,18 +401,24 @@ Status VulkanContext::Download(const DeviceBuffer& buffer, std::span<std::byte> 
     // The staging buffer is read by no recorded command (batch uploads use the
     // arena, earlier downloads have completed), so it may grow here.
     CB_TRY(EnsureStaging(data.size()));
-    CB_TRY(BeginSegment("downloading a buffer"));
-    const VkBufferCopy region{0, 0, data.size()};
-    vkCmdCopyBuffer(mCmd, buffer.buffer, mStaging.buffer, 1, &region);
+    CB_TRY(RecordCopyToHost(buffer, mStaging, 0, data.size(), "downloading a buffer"));
+    if (mInBatch) CB_TRY(Flush("downloading a buffer"));
+    std::memcpy(data.data(), mStagingMap, data.size());
+    return {};
+}
+
+Status VulkanContext::RecordCopyToHost(const DeviceBuffer& from, const DeviceBuffer& to, VkDeviceSize offset,
+                                       VkDeviceSize bytes, const char* what) {
+    CB_TRY(BeginSegment(what));
+    const VkBufferCopy region{0, offset, bytes};
+    vkCmdCopyBuffer(mCmd, from.buffer, to.buffer, 1, &region);
     VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
     vkCmdPipelineBarrier(mCmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0,
                          nullptr);
-    auto done = EndSegment("downloading a buffer");
+    auto done = EndSegment(what);
     if (!done) return std::unexpected(done.error());
-    if (mInBatch) CB_TRY(Flush("downloading a buffer"));
-    std::memcpy(data.data(), mStagingMap, data.size());
     return {};
 }
 
@@ -426,16 +432,7 @@ Status VulkanContext::DownloadLater(const DeviceBuffer& buffer, VkDeviceSize byt
     void* mapped = nullptr;
     auto space = ArenaSpace(bytes, mapped);
     if (!space) return std::unexpected(space.error());
-    CB_TRY(BeginSegment("reading a result back later"));
-    const VkBufferCopy region{0, space->second, bytes};
-    vkCmdCopyBuffer(mCmd, buffer.buffer, space->first->buffer, 1, &region);
-    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(mCmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0,
-                         nullptr);
-    auto recorded = EndSegment("reading a result back later");
-    if (!recorded) return std::unexpected(recorded.error());
+    CB_TRY(RecordCopyToHost(buffer, *space->first, space->second, bytes, "reading a result back later"));
     mLaterReads.push_back({mapped, bytes, std::move(done)});
     return {};
 }

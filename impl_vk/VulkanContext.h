@@ -177,6 +177,10 @@ class VulkanContext {
     // Writes the pair's second stamp; in a batch records the barrier after the
     // segment and returns 0, else submits, waits and returns the pair's ms.
     Result<double> EndSegment(const char* what);
+    // Records a copy of `bytes` of `from` to `to` at `offset`, made visible to the
+    // host, as one segment (in a batch, read after the next wait).
+    Status RecordCopyToHost(const DeviceBuffer& from, const DeviceBuffer& to, VkDeviceSize offset, VkDeviceSize bytes,
+                            const char* what);
     // Submits what is recorded, waits, adds the timestamps to their intervals,
     // then frees what the submission needed (descriptor sets, arena, retired buffers).
     Status Flush(const char* what);
