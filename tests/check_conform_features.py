@@ -8,6 +8,7 @@ usage: check_conform_features.py CLI OUTDIR BACKEND CASE"""
 import csv
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -69,6 +70,20 @@ def expect(proc, code, want):
         fail("rows other than %s should pass: %s" % (list(want), others), proc)
 
 
+def report_exit(proc):
+    """The exit code of the verdict `cloudbench report` shows for this conform.json: it must follow conform's."""
+    html = os.path.join(folder, "report.html")
+    r = subprocess.run([cli, "report", os.path.join(folder, "conform.json"), "-o", html], capture_output=True,
+                       text=True, timeout=300)
+    if r.returncode != 0:
+        fail("report exited %d: %s" % (r.returncode, r.stderr), proc)
+    with open(html) as f:
+        verdict = re.search(r"Verdict: [^<]*\(exit code (\d+)\)", f.read())
+    if not verdict:
+        fail("no verdict in " + html, proc)
+    return int(verdict.group(1))
+
+
 if case == "csv":
     # No mismatch: every row passes, the cover row among them, and the CSV matches the JSON.
     p = conform()
@@ -86,11 +101,19 @@ elif case == "cover":
 elif case == "baseline-expected":
     # A listed failure is expected-fail and the exit is 0; comments and a CSV header are allowed.
     path = baseline("# known failures\nstage,backend,status\n\nshade,%s,fail\n" % backend)
-    expect(conform(["--baseline", path], backend + ":shade"), 0, {"shade": "expected-fail"})
+    p = conform(["--baseline", path], backend + ":shade")
+    expect(p, 0, {"shade": "expected-fail"})
+    if report_exit(p) != 0:
+        fail("the report's verdict on an expected failure should be exit 0", p)
 elif case == "baseline-new":
     # A failure not listed still fails (5); the listed row that passes is unexpected-pass.
     path = baseline("shadow,%s,fail\n" % backend)
     expect(conform(["--baseline", path], backend + ":shade"), 5, {"shade": "fail", "shadow": "unexpected-pass"})
+    # An unexpected pass alone also exits 5, in conform and in report.
+    p = conform(["--baseline", path])
+    expect(p, 5, {"shadow": "unexpected-pass"})
+    if report_exit(p) != 5:
+        fail("the report's verdict on an unexpected pass should be exit 5", p)
 elif case == "baseline-from-csv":
     # A failing run's own conform.csv as the next run's baseline: the same failure is expected.
     first = conform(mismatch=backend + ":smooth")
@@ -116,6 +139,12 @@ elif case == "flaky":
     # Fails on the first attempt only: with reruns it is flaky (exit 0), without it fails.
     p = conform(["--flake-reruns", "2"], backend + ":shade:1")
     expect(p, 0, {"shade": "flaky"})
+    if report_exit(p) != 0:
+        fail("the report's verdict on a flaky row should be exit 0", p)
+    with open(os.path.join(folder, "conform.json")) as f:
+        doc = json.load(f)
+    if doc.get("flake_reruns") != 2:
+        fail("conform.json should record flake_reruns 2", p)
     if "rerun 1 of 2" not in p.stdout or "rerun 2" in p.stdout:
         fail("expected exactly one rerun", p)
     expect(conform([], backend + ":shade:1"), 5, {"shade": "fail"})

@@ -20,9 +20,7 @@ Runs SCENE on the CPU and, at every step, feeds each other backend's stages
 the CPU's inputs of that step (stage-isolated conformance), and compares their
 outputs by SPEC's rule for the stage (core/StageDescriptors.cpp):
 )";
-constexpr const char* kHelpOptions = R"(  density.cover   bit-exact (density's count of covered columns)
-
-Prints stage x backend with the result, the rule and the worst error with where
+constexpr const char* kHelpOptions = R"(Prints stage x backend with the result, the rule and the worst error with where
 it is, writes DIR/conform.json and DIR/conform.csv, and exits 5 if any check
 fails. Stages a backend lacks are listed as skipped.
 
@@ -50,6 +48,11 @@ std::string RulesHelp() {
         line += d.rule(defaults).Text(d.symbol);
         if (!d.ruleNote.empty()) line += " (" + std::string(d.ruleNote) + ")";
         text += line + "\n";
+        if (stage == Stage::Density) {
+            line = "  " + std::string(kCoverRowStage);
+            line.resize(16, ' ');
+            text += line + "bit-exact (density's count of covered columns)\n";
+        }
     }
     return text + "\n";
 }
@@ -190,6 +193,8 @@ int Conform(const CommonOptions& options) {
     report.sections.push_back({"", {ConformTable(rows)}});
     std::printf("%s", report::RenderText(report.sections[0]).c_str());
     nlohmann::json doc = ConformJson(scene, rows);
+    doc["flake_reruns"] = options.flakeReruns;
+    doc["baseline"] = options.baseline;
     doc["report"] = report::RenderJson(report);
     const std::string path = (*session)->OutDir() + "/conform.json";
     if (Status s = (*session)->WriteJson(path, doc); !s) {
