@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/SceneNames.h"
 #include "core/StageDescriptors.h"
 #include "harness/Command.h"
 #include "harness/Report.h"
@@ -37,6 +38,11 @@ std::string Where(const Extent3& e, size_t v) {
     std::ostringstream s;
     s << "(" << v % e.nx << ", " << (v / e.nx) % e.ny << ", " << v / (size_t(e.nx) * e.ny) << ")";
     return s.str();
+}
+
+// A backend that could not run its stages, or whose process died (ChildFailure::status).
+bool IsBrokenStatus(const std::string& status) {
+    return status == "failed" || status == "crashed" || status == "timed out" || status == "out of memory";
 }
 
 // The test-only switch CLOUDBENCH_TEST_CONFORM_MISMATCH=<backend>:<row stage>[:<attempts>]
@@ -428,7 +434,44 @@ nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& ro
                         {"tolerance", r.tolerance},
                         {"detail", r.detail},
                         {"difference_image", r.differenceImage}});
-    return {{"format", "cloudbench-conform/1"}, {"scene", scene.name}, {"steps", scene.steps}, {"results", list}};
+    return {{"format", "cloudbench-conform/1"},
+            {"scene", scene.name},
+            {"steps", scene.steps},
+            {"results", list},
+            {"coverage", ConformCoverage(scene, rows)}};
+}
+
+nlohmann::json ConformCoverage(const Scene& scene, const std::vector<ConformRow>& rows) {
+    auto options = [&](const std::string& stage) -> nlohmann::json {
+        if (stage == "ca") return {{"wind", scene.ca.HasWind()}};
+        if (stage == "smooth") return {{"radius", scene.smooth.radius}};
+        if (stage == "density" || stage == kCoverRowStage)
+            return {{"tile", scene.density.tile}, {"band", scene.density.band}, {"cld", scene.stages.Has(Stage::Ca)}};
+        if (stage == "shade")
+            return {{"attenuation", AttenuationKindName(scene.shade.attenuation)},
+                    {"filter", SampleFilterName(scene.shade.filter)},
+                    {"resolution", scene.shade.resolution},
+                    {"storage", StorageFormatName(scene.shade.storage)},
+                    {"scattering", scene.shade.scattering},
+                    {"phase", scene.shade.scattering ? PhaseKindName(scene.phase.kind) : "none"}};
+        if (stage == "shadow") return {{"form", ShadowFormName(scene.shadow.form)}};
+        if (stage == "render_splat")
+            return {{"phase", PhaseKindName(scene.phase.kind)},
+                    {"culling", scene.splat.culling},
+                    {"skipping", scene.splat.skipping},
+                    {"storage", StorageFormatName(scene.shade.storage)},
+                    {"cameras", scene.render.cameras.size()},
+                    {"frames_per_step", std::max(scene.render.framesPerStep, 1u)}};
+        return nlohmann::json::object();
+    };
+    nlohmann::json coverage = nlohmann::json::object();
+    for (const ConformRow& r : rows) {
+        if (r.stage == "(all)" || r.status == "skipped" || IsBrokenStatus(r.status)) continue;
+        if (!coverage.contains(r.stage))
+            coverage[r.stage] = {{"options", options(r.stage)}, {"compared_on", nlohmann::json::array()}};
+        coverage[r.stage]["compared_on"].push_back(r.backend);
+    }
+    return coverage;
 }
 
 void FoldCoverComparison(ConformRow& row, uint32_t step, uint32_t cpuCover, uint32_t backendCover) {
@@ -441,13 +484,6 @@ void FoldCoverComparison(ConformRow& row, uint32_t step, uint32_t cpuCover, uint
     }
     if (diff > 0) row.status = "fail";
 }
-
-namespace {
-// A backend that could not run its stages, or whose process died (ChildFailure::status).
-bool IsBrokenStatus(const std::string& status) {
-    return status == "failed" || status == "crashed" || status == "timed out" || status == "out of memory";
-}
-}  // namespace
 
 bool IsConformFailure(const ConformRow& row) { return row.status == "fail" || IsBrokenStatus(row.status); }
 

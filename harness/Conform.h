@@ -81,6 +81,12 @@ std::string ConformCsv(const std::vector<ConformRow>& rows);
 
 // stage x backend: result, rule, worst error and where, as `conform` prints it.
 report::Table ConformTable(const std::vector<ConformRow>& rows);
+// conform.json: the rows, and "coverage" (ConformCoverage).
 nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& rows);
+// Which options each stage was compared under: {stage: {"options": {...},
+// "compared_on": [backends]}} for every row stage some backend compared (a
+// row neither skipped nor a crash), with the scene's settings that change what
+// the stage computes (docs/results.md lists them).
+nlohmann::json ConformCoverage(const Scene& scene, const std::vector<ConformRow>& rows);
 
 }  // namespace cb

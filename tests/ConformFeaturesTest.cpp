@@ -189,5 +189,35 @@ TEST(ConformFeatures, Csv) {
     EXPECT_FALSE(b->Lists("ca", "gl"));
 }
 
+// Test the coverage summary: the options each compared stage ran under, from
+// the scene as set here, and only the backends that compared it.
+TEST(ConformFeatures, CoverageSummary) {
+    Scene scene;
+    scene.smooth.radius = 2;
+    scene.shade.storage = StorageFormat::Unorm8;
+    scene.shade.scattering = false;
+    scene.shadow.form = ShadowForm::Thesis;
+    scene.splat.culling = false;
+    std::vector<ConformRow> rows = {Row("smooth", "pass"), Row("shade", "fail"),  Row("shadow", "skipped"),
+                                    Row("(all)", "crashed"), Row("ca", "flaky"), Row(kCoverRowStage, "pass")};
+    rows.push_back({"smooth", "gl", "expected-fail", "", 0, 0, "", ""});
+    const nlohmann::json c = ConformCoverage(scene, rows);
+    EXPECT_EQ(c["smooth"]["options"]["radius"], 2);
+    EXPECT_EQ(c["smooth"]["compared_on"], nlohmann::json({"vk", "gl"}));
+    EXPECT_EQ(c["shade"]["options"]["storage"], "unorm8");
+    EXPECT_EQ(c["shade"]["options"]["phase"], "none");
+    EXPECT_TRUE(c.contains("ca"));
+    EXPECT_TRUE(c.contains(kCoverRowStage));
+    EXPECT_FALSE(c.contains("shadow"));  // skipped: not compared
+    EXPECT_FALSE(c.contains("(all)"));
+    EXPECT_EQ(c.size(), 4u);
+    rows.push_back(Row("shadow", "pass"));
+    rows.push_back(Row("render_splat", "pass"));
+    const nlohmann::json d = ConformCoverage(scene, rows);
+    EXPECT_EQ(d["shadow"]["options"]["form"], "thesis");
+    EXPECT_EQ(d["render_splat"]["options"]["culling"], false);
+    EXPECT_EQ(d["render_splat"]["options"]["skipping"], true);
+}
+
 }  // namespace
 }  // namespace cb

@@ -70,6 +70,13 @@ def expect(proc, code, want):
         fail("rows other than %s should pass: %s" % (list(want), others), proc)
 
 
+def scene_field(section, field, default):
+    """A field of scenes/ci-small.json, read independently of the binary."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "ci-small.json")
+    with open(path) as f:
+        return json.load(f).get(section, {}).get(field, default)
+
+
 def report_exit(proc):
     """The exit code of the verdict `cloudbench report` shows for this conform.json: it must follow conform's."""
     html = os.path.join(folder, "report.html")
@@ -90,6 +97,19 @@ if case == "csv":
     expect(p, 0, {"density.cover": "pass"})
     if "conform.csv" not in p.stdout:
         fail("the results line should name conform.csv", p)
+    # The coverage summary names every compared row's stage, compared on this backend, with its options.
+    with open(os.path.join(folder, "conform.json")) as f:
+        doc = json.load(f)
+    coverage = doc["coverage"]
+    compared = {r["stage"] for r in doc["results"] if r["status"] == "pass"}
+    if set(coverage) != compared:
+        fail("coverage %s should name the compared stages %s" % (sorted(coverage), sorted(compared)), p)
+    for stage, entry in coverage.items():
+        if entry["compared_on"] != [backend]:
+            fail("coverage of %s: compared_on %s" % (stage, entry["compared_on"]), p)
+    # ci-small's own settings (scenes/ci-small.json).
+    if coverage["smooth"]["options"]["radius"] != scene_field("smooth", "radius", 1):
+        fail("coverage of smooth: radius %s" % coverage["smooth"]["options"], p)
 elif case == "cover":
     # The cover count one higher on the backend: only density.cover fails (exit 5), worst 1.
     p = conform(mismatch=backend + ":density.cover")

@@ -193,6 +193,10 @@ int Conform(const CommonOptions& options) {
     report.sections.push_back({"", {ConformTable(rows)}});
     std::printf("%s", report::RenderText(report.sections[0]).c_str());
     nlohmann::json doc = ConformJson(scene, rows);
+    // The automaton layout is gl's command-line option, not the scene's.
+    if (doc["coverage"].contains("ca"))
+        for (const nlohmann::json& backend : doc["coverage"]["ca"]["compared_on"])
+            if (backend == "gl") doc["coverage"]["ca"]["options"]["gl_ca_layout"] = gl::CaLayoutName(options.glCaLayout);
     doc["flake_reruns"] = options.flakeReruns;
     doc["baseline"] = options.baseline;
     doc["report"] = report::RenderJson(report);
