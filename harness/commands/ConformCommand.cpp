@@ -1,5 +1,6 @@
 // `cloudbench conform`: stage-isolated conformance of every backend against
-// the CPU on a scene (harness/Conform.h); writes conform.json, exits 5 on a failure.
+// the CPU on a scene (harness/Conform.h); writes conform.json and conform.csv,
+// exits 5 on a failure; --baseline and --flake-reruns as deqp-runner's (docs/cli.md).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
