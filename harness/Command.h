@@ -42,6 +42,9 @@ struct CommonOptions {
     // Crash isolation (harness/Isolation.h): --no-isolation, --backend-timeout SECONDS (0 = none).
     bool noIsolation = false;
     double backendTimeout = 3600;
+    // conform: --baseline FILE (known failures) and --flake-reruns N (docs/cli.md).
+    std::string baseline;
+    uint32_t flakeReruns = 0;
     // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
     // timed calls per measurement; accuracy --switches; sweep --metric.
     bool reference = false;

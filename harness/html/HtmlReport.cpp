@@ -490,8 +490,12 @@ Verdict VerdictOf(const ReportInput& input) {
             bool compared = false;
             for (const json& r : Arr(doc, "results")) {
                 const std::string status = Str(r, "status"), what = Str(r, "stage") + " on " + Str(r, "backend");
-                if (status == "fail") failed += (failed.empty() ? "" : ", ") + what;
-                if (status != "pass" && status != "fail" && status != "skipped")
+                // As conform's exit code (harness/Conform.h ConformExitCode): flaky and expected-fail rows
+                // (--flake-reruns, --baseline) are not failures; an unexpected pass is.
+                if (status == "fail" || status == "unexpected-pass")
+                    failed += (failed.empty() ? "" : ", ") + what + (status == "fail" ? "" : " " + status);
+                if (status != "pass" && status != "fail" && status != "skipped" && status != "flaky" &&
+                    status != "expected-fail" && status != "unexpected-pass")
                     broken += (broken.empty() ? "" : ", ") + what + " " + status;
                 compared |= status != "skipped";
             }

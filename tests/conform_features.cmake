@@ -1,0 +1,19 @@
+# conform's deqp-runner features (issue 17, item 4): the cover count, conform.csv,
+# --baseline and --flake-reruns, against the first non-CPU backend built, with a
+# mismatch planted through the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH switch.
+# Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
+if(CLOUDBENCH_HAVE_VK)
+  set(conform_features_backend vk)
+elseif(CLOUDBENCH_HAVE_GL)
+  set(conform_features_backend gl)
+endif()
+if(DEFINED conform_features_backend)
+  foreach(case IN ITEMS csv cover baseline-expected baseline-new baseline-from-csv baseline-bad flaky flake-persistent
+                        flaky-baseline usage)
+    add_test(NAME Cli.ConformFeatures.${case}
+             COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_conform_features.py ${cli}
+                     ${cli_out}/conform-features ${conform_features_backend} ${case})
+    set_tests_properties(Cli.ConformFeatures.${case} PROPERTIES PASS_REGULAR_EXPRESSION
+                         "conform features ${case}: ok" TIMEOUT 300)
+  endforeach()
+endif()
