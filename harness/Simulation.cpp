@@ -114,6 +114,12 @@ void ChargeRestToFirstFrame(StepRecord& record) {
 
 }  // namespace
 
+TimingMode TimingOfStep(std::string_view choice, uint32_t step) {
+    if (choice == "pipelined") return TimingMode::Pipelined;
+    if (choice == "both") return step % 4 == 1 || step % 4 == 2 ? TimingMode::Pipelined : TimingMode::Synchronized;
+    return TimingMode::Synchronized;
+}
+
 std::string_view TimingModeName(TimingMode mode) {
     return mode == TimingMode::Pipelined ? "pipelined" : "synchronized";
 }

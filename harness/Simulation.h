@@ -59,6 +59,11 @@ namespace cb {
 enum class TimingMode : uint8_t { Synchronized, Pipelined };
 // "synchronized", "pipelined".
 std::string_view TimingModeName(TimingMode mode);
+// The timing of step t under `run --timing choice` ("synchronized", "pipelined"
+// or "both"; validated when parsed). "both" alternates the two in the order
+// S P P S, repeated: a cost that drifts linearly over the run (clouds that
+// grow) weighs the same on each within every four steps, which S P would not.
+TimingMode TimingOfStep(std::string_view choice, uint32_t step);
 
 struct StepRecord {
     uint32_t step = 0;

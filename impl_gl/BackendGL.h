@@ -75,6 +75,15 @@ class BackendGL final : public Backend {
     // (GLContext::LayeredProgram) where the driver can, or one draw per slice
     // (the thesis's way; for comparison). On by default; both give the same bytes.
     void SetLayered(bool layered) { mLayered = layered; }
+    // How render_splat skips the boxes empty in both steps' bands (SPEC 8) in a
+    // batch: by draw runs the host derives from the bands read back (a host
+    // wait, as outside a batch), or in the vertex shader, which reads the bands
+    // on the device (no wait, but every voxel of the frustum's boxes becomes a
+    // vertex). Auto: the host's runs on a software rasterizer (llvmpipe, where
+    // those vertices cost the CPU far more than the wait; docs/performance.md),
+    // the vertex shader on a GPU. The same image and stats either way.
+    enum class SplatSkip : uint8_t { Auto, HostRuns, Device };
+    void SetSplatSkip(SplatSkip skip) { mSplatSkip = skip; }
     bool Layered() const { return mLayered && !mLayeredFailed; }
 
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
@@ -237,6 +246,7 @@ class BackendGL final : public Backend {
     std::optional<double> mLastDeviceMs;
     SubmissionCounts mCounts;
     bool mLayered = true, mLayeredFailed = false;
+    SplatSkip mSplatSkip = SplatSkip::Auto;
     std::vector<GLuint> mLayeredPrograms;
     uint64_t mDraws = 0;
     bool mPending = false;  // work recorded since the last submission

@@ -31,9 +31,13 @@ namespace {
 
 constexpr Extent3 kPipeGrid{40, 36, 12};
 
+// A gl backend whose render_splat skips empty boxes in the vertex shader in a batch (SplatSkip::Device), the path
+// these tests check whatever the rasterizer; PipelinedGL.SplatSkipAutoFollowsTheRasterizer checks Auto.
 std::unique_ptr<Backend> PipeMakeGl() {
-    auto b = CreateBackend("gl", BackendOptions{});
-    return b ? std::move(*b) : nullptr;
+    auto b = gl::BackendGL::Create();
+    if (!b) return nullptr;
+    (*b)->SetSplatSkip(gl::BackendGL::SplatSkip::Device);
+    return std::move(*b);
 }
 
 // The buffers and host results of one step on the splat pipeline.
@@ -250,6 +254,35 @@ TEST(PipelinedGL, AStepWaitsOnceAndEachReadBackInABatchOnceMore) {
     d = PipeDelta(before, b->Submissions());
     EXPECT_EQ(d.hostWaits, 3u);
     EXPECT_EQ(d.submissions, 3u);
+}
+
+// Auto skips by the host's runs on a software rasterizer (one read back of the bands in the batch: a second wait)
+// and in the vertex shader on a GPU (one wait); the same image and stats either way.
+TEST(PipelinedGL, SplatSkipAutoFollowsTheRasterizer) {
+    auto autoMade = gl::BackendGL::Create();
+    auto device = PipeMakeGl();
+    if (!autoMade || !device) GTEST_SKIP() << "no gl backend here";
+    gl::BackendGL& automatic = **autoMade;
+    const bool software = automatic.Device().find("llvmpipe") != std::string::npos ||
+                          automatic.Device().find("softpipe") != std::string::npos;
+    const PipeInputs in;
+    PipeStep a = PipeBuffers(automatic), d = PipeBuffers(*device);
+    const SubmissionCounts before = automatic.Submissions();
+    ASSERT_TRUE(automatic.BeginBatch().has_value());
+    ASSERT_TRUE(PipeRun(automatic, in, a, true, PipeMark).has_value());
+    ASSERT_TRUE(automatic.EndBatch().has_value());
+    EXPECT_EQ(PipeDelta(before, automatic.Submissions()).hostWaits, software ? 2u : 1u);
+    ASSERT_TRUE(device->BeginBatch().has_value());
+    ASSERT_TRUE(PipeRun(*device, in, d, true, PipeMark).has_value());
+    ASSERT_TRUE(device->EndBatch().has_value());
+    EXPECT_EQ(test::Read<uint8_t>(automatic, *a.image), test::Read<uint8_t>(*device, *d.image));
+    const auto statsA = automatic.TakeDeferredResults(), statsD = device->TakeDeferredResults();
+    ASSERT_EQ(statsA.size(), 2u);
+    ASSERT_EQ(statsD.size(), 2u);
+    ASSERT_TRUE(statsA[1].splat && statsD[1].splat);
+    EXPECT_EQ(statsA[1].splat->splats, statsD[1].splat->splats);
+    EXPECT_EQ(statsA[1].splat->voxelsVisited, statsD[1].splat->voxelsVisited);
+    EXPECT_EQ(statsA[1].splat->fragments, statsD[1].splat->fragments);
 }
 
 TEST(PipelinedGL, BatchesDoNotNestAndEndNeedsABegin) {

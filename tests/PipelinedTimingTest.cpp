@@ -439,7 +439,26 @@ TEST(PipelinedTiming, EndBatchTimesMustMatchTheMarks) {
     }
 }
 
-// `run --timing both`: even steps synchronized, odd pipelined; results.json reports each mode apart.
+// Test the order of `run --timing both`, S P P S repeated, worked by hand, and why: over every four steps the
+// mean step index of each mode is the same, so a cost that grows linearly with the step weighs the same on both.
+TEST(PipelinedTiming, BothAlternatesSPPSSoADriftWeighsTheSame) {
+    const char* expected = "SPPSSPPSSPPS";
+    for (uint32_t t = 0; t < 12; ++t)
+        EXPECT_EQ(TimingOfStep("both", t), expected[t] == 'P' ? TimingMode::Pipelined : TimingMode::Synchronized)
+            << "step " << t;
+    for (uint32_t blocks = 1; blocks <= 5; ++blocks) {
+        double sumS = 0, sumP = 0;
+        for (uint32_t t = 0; t < 4 * blocks; ++t) (TimingOfStep("both", t) == TimingMode::Pipelined ? sumP : sumS) += t;
+        EXPECT_EQ(sumS, sumP) << blocks << " blocks";
+    }
+    for (uint32_t t = 0; t < 8; ++t) {
+        EXPECT_EQ(TimingOfStep("pipelined", t), TimingMode::Pipelined);
+        EXPECT_EQ(TimingOfStep("synchronized", t), TimingMode::Synchronized);
+    }
+}
+
+// `run --timing both` (here even steps synchronized, odd pipelined, set by the test); results.json reports each mode
+// apart.
 TEST(PipelinedTiming, ResultsJsonReportsEachModeWithItsCounts) {
     const Scene scene = BatchScene({{"steps", "6"}, {"warmup_steps", "2"}});
     BatchLoggingCpu backend;

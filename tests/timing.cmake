@@ -4,7 +4,7 @@
 # ci-small on every built backend (exit 4, no GPU backend here: the others still run), 8 steps of which 2 warm-up,
 # under --timing pipelined and --timing both. results.json's "timing" names the mode; pipelined, every step after
 # warm-up opened one batch, a stage's call time is "host" (never "wall") and the thesis's per-stage fields hold no
-# sample; both: steps 2, 4, 6 synchronized and 3, 5, 7 pipelined, and a pipelined step waits no more often than a
+# sample; both: steps 3, 4, 7 synchronized and 2, 5, 6 pipelined (S P P S from step 0), and a pipelined step waits no more often than a
 # synchronized one. The CPU has no device: it counts nothing.
 set(cli_timing_script [=[d="$1"; rm -rf "$d"; mkdir -p "$d"; set -e
 for mode in pipelined both synchronized; do

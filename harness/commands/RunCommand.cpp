@@ -40,17 +40,10 @@ constexpr const char* kHelpTail = R"(                     (the contexts and layo
                      completes before the next, per-stage wall and device times),
                      pipelined (a step, time-sliced a frame, is one batch with one
                      wait; per-stage device times from timestamps inside it), or
-                     both (even steps synchronized, odd steps pipelined, each
-                     reported apart)
+                     both (the two alternated in the order S P P S, so that a
+                     drift over the run weighs the same on each; reported apart)
 )";
 const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail + IsolationOptionsHelp();
-
-// The timing of step t under --timing `choice` (validated when parsed).
-TimingMode StepTiming(const std::string& choice, uint32_t t) {
-    if (choice == "pipelined") return TimingMode::Pipelined;
-    if (choice == "both") return t % 2 == 1 ? TimingMode::Pipelined : TimingMode::Synchronized;
-    return TimingMode::Synchronized;
-}
 
 std::vector<OptionSpec> RunOptions() {
     std::vector<OptionSpec> options = IsolationOptions();
@@ -83,7 +76,7 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
     Progress progress(run.name, scene.steps, session.Options().quiet);
     for (uint32_t t = 0; t < scene.steps; ++t) {
         StepRecord record;
-        (*sim)->SetTiming(StepTiming(session.Options().timing, t));
+        (*sim)->SetTiming(TimingOfStep(session.Options().timing, t));
         if (Status status = (*sim)->Step(record); !status) {
             run.status = "failed";
             run.error = "step " + std::to_string(t) + ": " + status.error().message;
@@ -112,7 +105,8 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
             const std::string stem = outDir + "/" + FrameFileStem(renderer, scene.render.cameras[n].name, run.name);
             // The ray marcher's frames are HDR: its PNG is tone-mapped with the scene's exposure.
             std::optional<FrameToneMap> toneMap;
-            if (renderer == Stage::RenderMarch) toneMap = FrameToneMap{scene.march.toneMap, float(scene.march.exposure)};
+            if (renderer == Stage::RenderMarch)
+                toneMap = FrameToneMap{scene.march.toneMap, float(scene.march.exposure)};
             auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, true, toneMap);
             if (paths)
                 written.insert(written.end(), paths->begin(), paths->end());
