@@ -104,6 +104,12 @@ double MsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The step's submissions and host waits: the backend's counts since `before`.
+void CountSubmissions(const SubmissionCounts& before, const SubmissionCounts& after, StepRecord& record) {
+    record.submissions = after.submissions - before.submissions;
+    record.hostWaits = after.hostWaits - before.hostWaits;
+}
+
 // Charges the step's time outside its frames to frame 0 (StepRecord::frameMs).
 void ChargeRestToFirstFrame(StepRecord& record) {
     if (record.frameMs.empty()) return;
@@ -319,9 +325,7 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     ++mStep;
     record.stepMs = MsSince(stepStart) - observerMs;
     ChargeRestToFirstFrame(record);
-    const SubmissionCounts countsAfter = mBackend.Submissions();
-    record.submissions = countsAfter.submissions - countsBefore.submissions;
-    record.hostWaits = countsAfter.hostWaits - countsBefore.hostWaits;
+    CountSubmissions(countsBefore, mBackend.Submissions(), record);
     return {};
 }
 
@@ -362,9 +366,7 @@ Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     ++mStep;
     record.stepMs = MsSince(stepStart) - observerMs;
     ChargeRestToFirstFrame(record);
-    const SubmissionCounts countsAfter = mBackend.Submissions();
-    record.submissions = countsAfter.submissions - countsBefore.submissions;
-    record.hostWaits = countsAfter.hostWaits - countsBefore.hostWaits;
+    CountSubmissions(countsBefore, mBackend.Submissions(), record);
     return {};
 }
 

@@ -84,6 +84,10 @@ class BackendGL final : public Backend {
     // the vertex shader on a GPU. The same image and stats either way.
     enum class SplatSkip : uint8_t { Auto, HostRuns, Device };
     void SetSplatSkip(SplatSkip skip) { mSplatSkip = skip; }
+    // Whether a batched render_splat skips in the vertex shader (SetSplatSkip).
+    bool SplatSkipOnDevice() const {
+        return mSplatSkip == SplatSkip::Device || (mSplatSkip == SplatSkip::Auto && !mSoftwareRasterizer);
+    }
     bool Layered() const { return mLayered && !mLayeredFailed; }
 
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
@@ -163,7 +167,8 @@ class BackendGL final : public Backend {
         GLsizei width = 0, height = 0, depth = 0;
     };
 
-    BackendGL(std::unique_ptr<GLContext> context, bool rgba8) : mContext(std::move(context)), mRgba8(rgba8) {}
+    BackendGL(std::unique_ptr<GLContext> context, bool rgba8)
+        : mContext(std::move(context)), mRgba8(rgba8), mSoftwareRasterizer(mContext->SoftwareRasterizer()) {}
 
     // A stage call's device time: a GL_TIMESTAMP query at construction and one
     // at Stop(). Outside a batch Stop() waits (Finish) and sets mLastDeviceMs;
@@ -247,6 +252,7 @@ class BackendGL final : public Backend {
     SubmissionCounts mCounts;
     bool mLayered = true, mLayeredFailed = false;
     SplatSkip mSplatSkip = SplatSkip::Auto;
+    bool mSoftwareRasterizer = false;  // GLContext::SoftwareRasterizer, read once when made
     std::vector<GLuint> mLayeredPrograms;
     uint64_t mDraws = 0;
     bool mPending = false;  // work recorded since the last submission

@@ -149,6 +149,11 @@ GLContext::~GLContext() {
     }
 }
 
+bool GLContext::SoftwareRasterizer() const {
+    const std::string renderer = String(GL_RENDERER);
+    return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
+}
+
 std::string GLContext::Renderer() const {
     return String(GL_RENDERER) + (mKind == ContextKind::OSMesa ? " (OSMesa)" : " (EGL)");
 }

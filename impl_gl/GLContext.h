@@ -24,6 +24,9 @@ class GLContext {
     const Functions& F() const { return mF; }
     // GL_RENDERER, then the context kind: "llvmpipe (...) (OSMesa)".
     std::string Renderer() const;
+    // Whether the renderer is a software rasterizer (llvmpipe, softpipe), where
+    // vertices and fragments cost the host's CPU.
+    bool SoftwareRasterizer() const;
     // glGetString(name) as the driver spells it; "?" when it returns null.
     std::string String(GLenum name) const;
     // "doing X: GL_INVALID_OPERATION" for a pending GL error; ok otherwise.

@@ -32,10 +32,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // the bands on the device, instead of by runs the host derives from the
     // bands read back: no host wait (SetSplatSkip). The frustum's boxes stay
     // host runs (camera data).
-    const bool software = mContext->Renderer().find("llvmpipe") != std::string::npos ||
-                          mContext->Renderer().find("softpipe") != std::string::npos;
-    const bool deviceSkip = mBatch.active && p.skipping &&
-                            (mSplatSkip == SplatSkip::Device || (mSplatSkip == SplatSkip::Auto && !software));
+    const bool deviceSkip = mBatch.active && p.skipping && SplatSkipOnDevice();
     Result<std::vector<uint8_t>> visibility = std::vector<uint8_t>{};
     if (deviceSkip) {
         if (!in.bandsPrev || !in.bandsCur)

@@ -263,8 +263,10 @@ TEST(PipelinedGL, SplatSkipAutoFollowsTheRasterizer) {
     auto device = PipeMakeGl();
     if (!autoMade || !device) GTEST_SKIP() << "no gl backend here";
     gl::BackendGL& automatic = **autoMade;
+    // The renderer's name, read apart from the backend's own test.
     const bool software = automatic.Device().find("llvmpipe") != std::string::npos ||
                           automatic.Device().find("softpipe") != std::string::npos;
+    EXPECT_EQ(automatic.SplatSkipOnDevice(), !software);
     const PipeInputs in;
     PipeStep a = PipeBuffers(automatic), d = PipeBuffers(*device);
     const SubmissionCounts before = automatic.Submissions();

@@ -14,6 +14,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <span>
 #include <utility>
 
 #include "core/Scene.h"
@@ -35,6 +36,8 @@ class BatchLoggingCpu : public cpu::BackendCpu {
         double cost = 0;    // its device time: its number in the log, from 1
     };
     std::vector<Call> calls;
+    // The calls logged from index `first` on (a step's, when `first` was the size before it).
+    std::span<const Call> CallsSince(size_t first) const { return std::span(calls).subspan(first); }
     int begins = 0, ends = 0;
     bool open = false, nested = false, markOutside = false;
     std::vector<int> marksPerBatch;
@@ -222,7 +225,7 @@ TEST(PipelinedTiming, OneBatchPerStepOneMarkPerCallTimesToTheirStagesAndFrames) 
         const int begins = backend.begins;
         StepRecord r;
         ASSERT_TRUE((*sim)->Step(r).has_value());
-        const std::span<const BatchLoggingCpu::Call> calls(backend.calls.data() + first, backend.calls.size() - first);
+        const std::span<const BatchLoggingCpu::Call> calls = backend.CallsSince(first);
         EXPECT_EQ(backend.begins, begins + 1) << "one batch per step";
         EXPECT_EQ(backend.ends, backend.begins);
         EXPECT_EQ(r.batches, 1u);
@@ -297,7 +300,7 @@ TEST(PipelinedTiming, SynchronizedStepsOpenNoBatchAndCountEveryCall) {
         const size_t first = backend.calls.size();
         StepRecord r;
         ASSERT_TRUE((*sim)->Step(r).has_value());
-        const std::span<const BatchLoggingCpu::Call> calls(backend.calls.data() + first, backend.calls.size() - first);
+        const std::span<const BatchLoggingCpu::Call> calls = backend.CallsSince(first);
         EXPECT_EQ(r.batches, 0u);
         EXPECT_EQ(Names(calls), ExpectedOrder(**sim, r)) << "step " << t;
         // Outside a batch each call is a submission and a wait (the fake's counts); LastDeviceMs gives its time.
@@ -337,7 +340,7 @@ TEST(PipelinedTiming, AnObserverEndsTheBatchBeforeItAndAnotherHoldsTheRest) {
         EXPECT_EQ(r.batches, 2u);
         EXPECT_EQ(r.submissions, 2u);
         EXPECT_EQ(r.hostWaits, 2u);
-        const std::span<const BatchLoggingCpu::Call> calls(backend.calls.data() + first, backend.calls.size() - first);
+        const std::span<const BatchLoggingCpu::Call> calls = backend.CallsSince(first);
         for (size_t i = 0; i < calls.size(); ++i) {
             // Before the observer: the first batch; after it (the automaton): the second.
             const bool before = first + i < callsBeforeObserver;
@@ -361,7 +364,7 @@ TEST(PipelinedTiming, TimeSlicedOneBatchPerFrame) {
         const int begins = backend.begins;
         StepRecord r;
         ASSERT_TRUE((*sim)->Step(r).has_value());
-        const std::span<const BatchLoggingCpu::Call> calls(backend.calls.data() + first, backend.calls.size() - first);
+        const std::span<const BatchLoggingCpu::Call> calls = backend.CallsSince(first);
         // Step 0 computes its own stages first, in a batch of their own; then one batch per frame.
         const int before = t == 0 ? 1 : 0;
         EXPECT_GE(r.frameMs.size(), 2u);
