@@ -1,0 +1,118 @@
+// The plumbing the `cloudbench perf` subcommands share (harness/commands/PerfCommon.h).
+#include "harness/commands/PerfCommon.h"
+
+#include <unistd.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "harness/perf/Spawn.h"
+
+namespace cb::perf_command {
+
+namespace fs = std::filesystem;
+
+std::optional<std::string> Parse(const std::vector<std::string>& args, const std::set<std::string>& valueOptions,
+                                 const std::set<std::string>& flagOptions, ParsedArgs& out) {
+    for (size_t n = 1; n < args.size(); ++n) {
+        const std::string& arg = args[n];
+        if (valueOptions.count(arg)) {
+            if (n + 1 >= args.size()) return arg + " needs a value";
+            if (args[n + 1].empty()) return arg + ": must not be empty";
+            out.values[arg].push_back(args[++n]);
+        } else if (flagOptions.count(arg)) {
+            out.flags.insert(arg);
+        } else if (arg.size() > 1 && arg[0] == '-' && !std::isdigit(static_cast<unsigned char>(arg[1]))) {
+            return "unknown option '" + arg + "' for perf " + args[0];
+        } else {
+            out.positional.push_back(arg);
+        }
+    }
+    return std::nullopt;
+}
+
+std::string Num(const char* format, double v) {
+    if (std::isnan(v)) return "";
+    char text[64];
+    std::snprintf(text, sizeof text, format, v);
+    return text;
+}
+
+std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& name, double low, double high,
+                                        double& value) {
+    if (!a.values.count(name)) return std::nullopt;
+    const std::string text = a.Value(name);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !(v >= low && v <= high))
+        return name + ": needs a number in [" + Num("%g", low) + ", " + Num("%g", high) + "], got '" + text + "'";
+    value = v;
+    return std::nullopt;
+}
+
+bool WriteJsonFile(const std::string& path, const json& doc) {
+    const std::string temporary = path + ".partial";
+    {
+        std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
+        file << doc.dump(1) << "\n";
+        file.flush();
+        if (!file) {
+            std::fprintf(stderr, "%s: cannot write\n", path.c_str());
+            std::remove(temporary.c_str());
+            return false;
+        }
+    }
+    std::error_code ec;
+    fs::rename(temporary, path, ec);
+    if (ec) std::fprintf(stderr, "%s: cannot write: %s\n", path.c_str(), ec.message().c_str());
+    return !ec;
+}
+
+TemporaryFolder::TemporaryFolder() {
+    const char* base = std::getenv("TMPDIR");
+    std::string pattern = std::string(base && *base ? base : "/tmp") + "/cloudbench-perf-XXXXXX";
+    if (char* made = ::mkdtemp(pattern.data())) path = made;
+}
+
+TemporaryFolder::~TemporaryFolder() {
+    std::error_code ec;
+    if (!path.empty()) fs::remove_all(path, ec);
+}
+
+std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
+                           const std::string& out, const std::string& log, perf::Side& side, bool& failed) {
+    std::vector<std::string> argv = {binary, "run", scene, "--out", out, "--quiet"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    auto rc = perf::RunChild(argv, log);
+    if (!rc) {
+        std::fprintf(stderr, "%s\n", rc.error().message.c_str());
+        return kExitFailed;
+    }
+    if (*rc == kExitUsage || *rc == kExitBadScene) {
+        std::fprintf(stderr, "perf: %s run %s exited %d (see its message above)\n", binary.c_str(), scene.c_str(), *rc);
+        return *rc;
+    }
+    std::ifstream file(out + "/results.json");
+    const json results = json::parse(file, nullptr, /*allow_exceptions=*/false);
+    if (results.is_discarded()) {
+        std::fprintf(stderr, "perf: %s run %s exited %d and wrote no results.json\n", binary.c_str(), scene.c_str(),
+                     *rc);
+        failed = true;
+        return std::nullopt;
+    }
+    if (*rc != kExitOk) {
+        std::fprintf(stderr, "perf: %s run %s exited %d\n", binary.c_str(), scene.c_str(), *rc);
+        failed = true;
+    }
+    if (Status s = perf::AddResults(side, results); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    return std::nullopt;
+}
+
+}  // namespace cb::perf_command

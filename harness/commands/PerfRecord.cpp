@@ -1,0 +1,164 @@
+// `cloudbench perf record` (docs/cli.md, "perf"): runs a suite of scenes, each
+// as `cloudbench run` in a child process, counts their CPU instructions where
+// this build can, and appends one record to a history.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "harness/commands/PerfCommon.h"
+#include "harness/perf/CallgrindCount.h"
+#include "harness/perf/History.h"
+#include "harness/perf/Spawn.h"
+
+namespace cb::perf_command {
+namespace {
+
+struct SuiteEntry {
+    std::string scene;
+    std::vector<std::string> set;  // PATH=VALUE overrides
+};
+
+// The default suite: the thesis scenes as `run` runs them.
+std::vector<SuiteEntry> DefaultSuite() { return {{"thesis-low", {}}, {"thesis-medium", {}}, {"thesis-high", {}}}; }
+
+// {"scenes": [{"scene": NAME_OR_PATH, "set": ["PATH=VALUE", ...]}, ...]}
+Result<std::vector<SuiteEntry>> LoadSuite(const std::string& path) {
+    std::ifstream file(path);
+    if (!file) return MakeError(path + ": cannot read");
+    const json doc = json::parse(file, nullptr, /*allow_exceptions=*/false);
+    if (doc.is_discarded() || !doc.is_object()) return MakeError(path + ": not a JSON object");
+    if (!doc.contains("scenes") || !doc["scenes"].is_array() || doc["scenes"].empty())
+        return MakeError(path + ": scenes: must be a non-empty array");
+    std::vector<SuiteEntry> suite;
+    for (size_t i = 0; i < doc["scenes"].size(); ++i) {
+        const json& e = doc["scenes"][i];
+        const std::string where = path + ": scenes[" + std::to_string(i) + "]";
+        if (!e.is_object() || !e.contains("scene") || !e["scene"].is_string() || e["scene"].get<std::string>().empty())
+            return MakeError(where + ".scene: must be a scene name or path");
+        SuiteEntry entry{e["scene"].get<std::string>(), {}};
+        if (e.contains("set")) {
+            if (!e["set"].is_array()) return MakeError(where + ".set: must be an array of \"PATH=VALUE\"");
+            for (const json& s : e["set"]) {
+                if (!s.is_string() || s.get<std::string>().find('=') == std::string::npos)
+                    return MakeError(where + ".set: must be an array of \"PATH=VALUE\"");
+                entry.set.push_back(s.get<std::string>());
+            }
+        }
+        suite.push_back(entry);
+    }
+    return suite;
+}
+
+}  // namespace
+
+int Record(const std::vector<std::string>& args, const CommonOptions& options) {
+    ParsedArgs a;
+    if (auto m = Parse(args, {"--suite", "--history", "--repeat", "--backend", "--instructions"}, {"--quiet"}, a))
+        return Usage(*m);
+    if (!a.positional.empty()) return Usage("perf record: unexpected argument '" + a.positional[0] + "'");
+    double repeat = 1;
+    if (auto m = NumberOption(a, "--repeat", 1, 1000, repeat)) return Usage(*m);
+    if (repeat != std::floor(repeat)) return Usage("--repeat: needs a whole number");
+    std::vector<SuiteEntry> suite = DefaultSuite();
+    if (a.Has("--suite")) {
+        auto loaded = LoadSuite(a.Value("--suite"));
+        if (!loaded) {
+            std::fprintf(stderr, "%s\n", loaded.error().message.c_str());
+            return kExitBadScene;
+        }
+        suite = *loaded;
+    }
+    const std::string historyPath = a.Value("--history", perf::DefaultHistoryPath());
+    perf::Side side;
+    side.label = "record";
+    if (a.Has("--instructions")) {
+        const std::string path = a.Value("--instructions");
+        std::ifstream file(path);
+        const json doc = json::parse(file, nullptr, /*allow_exceptions=*/false);
+        side.label = path;
+        Status s = doc.is_object() ? perf::AddInstructions(side, doc) : Status(MakeError(path + ": not a JSON object"));
+        if (!s) {
+            std::fprintf(stderr, "%s\n", s.error().message.c_str());
+            return kExitBadScene;
+        }
+    }
+    std::vector<std::string> extra;
+    if (a.Has("--backend")) extra = {"--backend", a.Value("--backend")};
+    TemporaryFolder temporary;
+    if (temporary.path.empty()) {
+        std::fprintf(stderr, "perf record: cannot create a temporary folder\n");
+        return kExitFailed;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    bool failed = false;
+    json suiteJson = json::array();
+    const std::string self = perf::SelfPath();
+    for (const SuiteEntry& entry : suite) {
+        std::vector<std::string> runArgs = extra;
+        for (const std::string& s : entry.set) runArgs.insert(runArgs.end(), {"--set", s});
+        suiteJson.push_back({{"scene", entry.scene}, {"set", entry.set}});
+        for (int r = 0; r < int(repeat); ++r) {
+            const std::string out = temporary.path + "/" + std::to_string(suiteJson.size()) + "-" + std::to_string(r);
+            const auto runStart = std::chrono::steady_clock::now();
+            if (!a.Has("--quiet"))
+                std::fprintf(stderr, "perf record: %s (%d of %d)\n", entry.scene.c_str(), r + 1, int(repeat));
+            if (auto code = RunInto(self, entry.scene, runArgs, out, temporary.path + "/runs.log", side, failed))
+                return *code;
+            if (!a.Has("--quiet"))
+                std::fprintf(stderr, "perf record: %s took %.1f s\n", entry.scene.c_str(),
+                             std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count());
+        }
+    }
+    // Exact mode: each suite scene's CPU instruction counts, when this build can count them
+    // (no -march=native, valgrind present); otherwise the record says why not.
+    std::string notCounted;
+    if (a.Has("--instructions")) {
+        notCounted = "";  // given by the caller
+    } else if (auto why = WhyCannotCount(side.provenance.value("build", json::object()).value("flags", ""))) {
+        notCounted = *why;
+    } else {
+        for (size_t i = 0; i < suite.size(); ++i) {
+            const std::string out = temporary.path + "/count-" + std::to_string(i) + ".json";
+            std::vector<std::string> argv = {self, "count", suite[i].scene, "--out", out, "--quiet"};
+            for (const std::string& set : suite[i].set) argv.insert(argv.end(), {"--set", set});
+            if (!a.Has("--quiet")) std::fprintf(stderr, "perf record: counting %s\n", suite[i].scene.c_str());
+            auto rc = perf::RunChild(argv, temporary.path + "/runs.log");
+            std::ifstream file(out);
+            const json counts = json::parse(file, nullptr, /*allow_exceptions=*/false);
+            if (!rc || *rc != kExitOk || !counts.is_object() || !perf::AddInstructions(side, counts)) {
+                std::fprintf(stderr, "perf record: counting %s failed (exit %d)\n", suite[i].scene.c_str(),
+                             rc ? *rc : -1);
+                notCounted += (notCounted.empty() ? "" : "; ") + suite[i].scene + ": count failed";
+                failed = true;
+            }
+        }
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    json provenance = side.provenance;
+    if (provenance.is_object()) {
+        provenance.erase("scene");  // one per scene; the suite says which
+        provenance["command_line"] = options.commandLine;
+    }
+    const json sections = perf::RecordSections(side);
+    json record = {{"format", perf::kRecordFormat},
+                   {"id", perf::NewRecordId()},
+                   {"time", side.date},
+                   {"provenance", provenance},
+                   {"suite", suiteJson},
+                   {"repeat", int(repeat)},
+                   {"seconds", std::round(seconds * 10) / 10},
+                   {"results", sections["results"]},
+                   {"failures", sections["failures"]},
+                   {"instructions", sections["instructions"]}};
+    if (!notCounted.empty()) record["instructions_not_counted"] = notCounted;
+    if (Status s = perf::AppendRecord(historyPath, record); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    std::printf("perf record: appended %s to %s (%zu scenes, %.1f s)\n", record["id"].get<std::string>().c_str(),
+                historyPath.c_str(), suite.size(), seconds);
+    return failed ? kExitFailed : kExitOk;
+}
+
+}  // namespace cb::perf_command
