@@ -1,0 +1,148 @@
+// The inputs of `cloudbench report` (harness/html/HtmlReport.h): reading
+// results, conform, accuracy and sweep files or a folder of them, and the
+// verdict each records.
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "harness/html/HtmlReport.h"
+#include "harness/html/ReportJson.h"
+
+namespace cb::html {
+namespace {
+
+Result<ReportInput> ReadOne(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return MakeError(path + ": cannot read: " + std::strerror(errno));
+    std::stringstream text;
+    text << in.rdbuf();
+    if (in.bad()) return MakeError(path + ": cannot read: " + std::strerror(errno));
+    ReportInput input{path, InputKind::Results, {}};
+    try {
+        input.doc = json::parse(text.str());
+    } catch (const json::exception& e) {
+        return MakeError(path + ": not JSON: " + e.what());
+    }
+    const std::string format = Str(input.doc, "format");
+    static const std::array<std::pair<std::string_view, InputKind>, 4> kFormats = {{
+        {"cloudbench-results/1", InputKind::Results},
+        {"cloudbench-conform/1", InputKind::Conform},
+        {"cloudbench-accuracy/1", InputKind::Accuracy},
+        {"cloudbench-sweep/1", InputKind::Sweep},
+    }};
+    for (const auto& [name, kind] : kFormats)
+        if (format == name) {
+            input.kind = kind;
+            // The report block is read back into the page: check its shape here, where the file can be named.
+            if (input.doc.contains("report")) try {
+                    (void)report::ReportFromJson(input.doc["report"]);
+                } catch (const json::exception& e) {
+                    return MakeError(path + ": report: " + e.what());
+                }
+            return input;
+        }
+    return MakeError(path + ": not a cloudbench results, conform, accuracy or sweep file (\"format\" is " +
+                     (format.empty() ? std::string("missing") : "'" + format + "'") + ")");
+}
+
+bool Finished(const std::string& status) { return status == "ok" || status == "unavailable" || status == "unsupported"; }
+
+}  // namespace
+
+std::string_view InputKindName(InputKind kind) {
+    switch (kind) {
+        case InputKind::Results: return "results";
+        case InputKind::Conform: return "conform";
+        case InputKind::Accuracy: return "accuracy";
+        case InputKind::Sweep: return "sweep";
+    }
+    return "";
+}
+
+Result<std::vector<ReportInput>> ReadReportInput(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(path, ec)) {
+        auto one = ReadOne(path);
+        if (!one) return std::unexpected(one.error());
+        return std::vector<ReportInput>{std::move(*one)};
+    }
+    std::vector<ReportInput> inputs;
+    for (const char* name : {"results.json", "conform.json", "accuracy.json", "sweep.json"}) {
+        const std::string file = (std::filesystem::path(path) / name).string();
+        if (!std::filesystem::exists(file, ec)) continue;
+        auto one = ReadOne(file);
+        if (!one) return std::unexpected(one.error());
+        inputs.push_back(std::move(*one));
+    }
+    if (inputs.empty())
+        return MakeError(path + ": no results.json, conform.json, accuracy.json or sweep.json in this folder");
+    return inputs;
+}
+
+Verdict VerdictOf(const ReportInput& input) {
+    const json& doc = input.doc;
+    switch (input.kind) {
+        case InputKind::Results: {
+            bool anyAvailable = false;
+            std::string broken;
+            for (const auto& [name, b] : Obj(doc, "backends").items()) {
+                const std::string status = Str(b, "status");
+                if (!Finished(status)) broken += (broken.empty() ? "" : ", ") + name + " " + status;
+                anyAvailable |= status != "unavailable" && status != "unsupported";
+            }
+            if (!broken.empty()) return {1, "backend " + broken};
+            if (doc.contains("complete") && !doc.value("complete", true))
+                return {1, "the run did not finish (complete: false)"};
+            if (!anyAvailable) return {4, "no backend was available"};
+            return {};
+        }
+        case InputKind::Conform: {
+            std::string broken, failed;
+            bool compared = false;
+            for (const json& r : Arr(doc, "results")) {
+                const std::string status = Str(r, "status"), what = Str(r, "stage") + " on " + Str(r, "backend");
+                // As conform's exit code (harness/Conform.h ConformExitCode): flaky and expected-fail rows
+                // (--flake-reruns, --baseline) are not failures; an unexpected pass is.
+                if (status == "fail" || status == "unexpected-pass")
+                    failed += (failed.empty() ? "" : ", ") + what + (status == "fail" ? "" : " " + status);
+                if (status != "pass" && status != "fail" && status != "skipped" && status != "flaky" &&
+                    status != "expected-fail" && status != "unexpected-pass")
+                    broken += (broken.empty() ? "" : ", ") + what + " " + status;
+                compared |= status != "skipped";
+            }
+            if (!broken.empty()) return {1, broken};
+            if (!failed.empty()) return {5, "failed: " + failed};
+            if (!compared) return {4, "nothing was compared"};
+            return {};
+        }
+        case InputKind::Accuracy:
+        case InputKind::Sweep: {
+            std::string broken;
+            bool measured = false;
+            for (const json& r : Arr(doc, "rows")) {
+                const std::string status = Str(r, "status");
+                measured |= status == "ok";
+                if (!Finished(status))
+                    broken += (broken.empty() ? "" : ", ") + Str(r, "stage") + " on " + Str(r, "backend") + " " + status;
+            }
+            if (!broken.empty()) return {1, broken};
+            if (!measured) return {4, "no row was measured"};
+            return {};
+        }
+    }
+    return {};
+}
+
+int CombinedExitCode(const std::vector<Verdict>& verdicts) {
+    for (int code : {1, 5, 4})
+        for (const Verdict& v : verdicts)
+            if (v.exitCode == code) return code;
+    for (const Verdict& v : verdicts)
+        if (v.exitCode != 0) return v.exitCode;
+    return 0;
+}
+
+}  // namespace cb::html
