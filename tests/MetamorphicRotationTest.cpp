@@ -485,10 +485,12 @@ TEST_P(Rotation, ShadeWithinTolerance) {
                                             << int(att) << " filter " << int(filter) << " f " << f << " scattering "
                                             << scattering;
                         // (The thesis form with scattering at f > 1 gains more than it loses: T = 1, clamped.)
-                        if (att == AttenuationKind::Beer || !scattering)
+                        if (att == AttenuationKind::Beer || !scattering) {
                             EXPECT_LT(*std::min_element(plain.begin(), plain.end()), 1.0f)
-                            << "no shadow: tests nothing; sun " << sun[0] << "," << sun[1] << "," << sun[2] << " att "
-                            << int(att) << " filter " << int(filter) << " f " << f << " scattering " << scattering;
+                                << "no shadow: tests nothing; sun " << sun[0] << "," << sun[1] << "," << sun[2]
+                                << " att " << int(att) << " filter " << int(filter) << " f " << f << " scattering "
+                                << scattering;
+                        }
                         minT = std::min(minT, *std::min_element(plain.begin(), plain.end()));
                         worst = std::max(worst, d);
                     }
@@ -524,7 +526,9 @@ TEST_P(Rotation, ShadowWithinTolerance) {
             const std::vector<float> plain = test::Read<float>(b, *g0);
             const float d = RotMaxDiff(RotUnrotate(flat, test::Read<float>(b, *g1)), plain);
             EXPECT_LE(d, 1e-5f) << "sun " << sun[0] << "," << sun[1] << "," << sun[2] << " form " << int(form);
-            if (sun[2] > 0) EXPECT_LT(*std::min_element(plain.begin(), plain.end()), 0.9f) << "no shadow: tests nothing";
+            if (sun[2] > 0) {
+                EXPECT_LT(*std::min_element(plain.begin(), plain.end()), 0.9f) << "no shadow: tests nothing";
+            }
             worst = std::max(worst, d);
         }
     std::printf("[ rotation ] %s shadow: max |dG| %.3g\n", b.Name().c_str(), double(worst));
@@ -607,6 +611,15 @@ TEST_P(Rotation, RenderSplatSameImage) {
         EXPECT_TRUE(c.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << ": max "
                                 << c.maxError << " at (" << c.worstX << ", " << c.worstY << "), "
                                 << c.pixelsOverTolerance << " pixels over";
+        // Tighter, since one backend renders both: the same splats in the same order,
+        // projected with different rounding (measured: at most 2e-6). A coverage tie
+        // that flips (SPEC 8 allows it) may still move a few pixels; an order that
+        // changes with the turn moves many by more than 1e-4.
+        CompareRule same = c.rule;
+        same.tolerance = 1e-4;
+        const ImageComparison tight = CompareImages(plain, turned, W, H, same);
+        EXPECT_TRUE(tight.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << ": "
+                                    << tight.pixelsOverTolerance << " pixels over 1e-4";
         size_t lit = 0;  // pixels other than the background
         for (size_t n = 0; n < plain.size(); n += 3) lit += plain[n] != 0.3f;
         EXPECT_GT(lit, size_t(W) * H / 20) << "eye " << cam.eye[0] << ": the cloud is hardly in view";
