@@ -111,7 +111,8 @@ float RotMaxDiff(const std::vector<float>& a, const std::vector<float>& b) {
 class Rotation : public test::BackendTest {
   protected:
     void Need(Stage stage) {
-        if (!mBackend->Supports(stage)) GTEST_SKIP() << "unsupported here: " << mBackend->Name() << " has no " << StageName(stage);
+        if (!mBackend->Supports(stage))
+            GTEST_SKIP() << "unsupported here: " << mBackend->Name() << " has no " << StageName(stage);
     }
 };
 class RotationCa : public Rotation {};
@@ -231,7 +232,8 @@ RotDensity RotRunDensity(Backend& b, const Extent3& e, const std::vector<float>&
     DensityOutputs out{D.get(), tiles.get(), bands.get(), 0};
     const Status s = b.Density({T, B, {}}, *qb, cb.get(), out);
     EXPECT_TRUE(s.has_value()) << s.error().message;
-    return {test::Read<float>(b, *D), test::Read<uint8_t>(b, *tiles), test::Read<uint8_t>(b, *bands), out.coveredColumns};
+    return {test::Read<float>(b, *D), test::Read<uint8_t>(b, *tiles), test::Read<uint8_t>(b, *bands),
+            out.coveredColumns};
 }
 
 // Test that D, the cover, and (with nx and ny multiples of the tile) the tile
@@ -258,8 +260,10 @@ TEST_P(Rotation, DensityIsExact) {
         for (bool withCld : {true, false}) {
             const std::vector<uint8_t> c = withCld ? cld : std::vector<uint8_t>{};
             const RotDensity plain = RotRunDensity(b, e, q, c, 8, 4);
-            const RotDensity turned = RotRunDensity(b, RotExtent(e), RotRotate(e, q), withCld ? RotRotate(e, cld) : c, 8, 4);
-            const std::string where = std::to_string(e.nx) + "x" + std::to_string(e.ny) + (withCld ? " cld" : " no cld");
+            const RotDensity turned =
+                RotRunDensity(b, RotExtent(e), RotRotate(e, q), withCld ? RotRotate(e, cld) : c, 8, 4);
+            const std::string where =
+                std::to_string(e.nx) + "x" + std::to_string(e.ny) + (withCld ? " cld" : " no cld");
             EXPECT_EQ(RotUnrotate({e.nx, e.ny, 1}, turned.D), plain.D) << where;
             EXPECT_EQ(turned.covered, plain.covered) << where;
             EXPECT_GT(plain.covered, 0u) << where;
@@ -481,9 +485,8 @@ TEST_P(Rotation, ShadeWithinTolerance) {
                         ASSERT_TRUE(b.Shade(p, *q1, *T1).has_value());
                         const std::vector<float> plain = test::Read<float>(b, *T0);
                         const float d = RotMaxDiff(RotUnrotate(e, test::Read<float>(b, *T1)), plain);
-                        EXPECT_LE(d, 1e-5f) << "sun " << sun[0] << "," << sun[1] << "," << sun[2] << " att "
-                                            << int(att) << " filter " << int(filter) << " f " << f << " scattering "
-                                            << scattering;
+                        EXPECT_LE(d, 1e-5f) << "sun " << sun[0] << "," << sun[1] << "," << sun[2] << " att " << int(att)
+                                            << " filter " << int(filter) << " f " << f << " scattering " << scattering;
                         // (The thesis form with scattering at f > 1 gains more than it loses: T = 1, clamped.)
                         if (att == AttenuationKind::Beer || !scattering) {
                             EXPECT_LT(*std::min_element(plain.begin(), plain.end()), 1.0f)
@@ -605,8 +608,8 @@ TEST_P(Rotation, RenderSplatSameImage) {
     };
     for (const CameraSettings& cam : RotCameras()) {
         const std::vector<float> plain = render(e, qp, qc, T, cam, sun);
-        const std::vector<float> turned = render(er, RotRotate(e, qp), RotRotate(e, qc), RotRotate(e, T),
-                                                 RotCamera(e, cam), RotVec(sun));
+        const std::vector<float> turned =
+            render(er, RotRotate(e, qp), RotRotate(e, qc), RotRotate(e, T), RotCamera(e, cam), RotVec(sun));
         const ImageComparison c = CompareImages(plain, turned, W, H);
         EXPECT_TRUE(c.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << ": max "
                                 << c.maxError << " at (" << c.worstX << ", " << c.worstY << "), "
@@ -681,16 +684,15 @@ TEST_P(Rotation, RenderMarchSameImage) {
                 const std::vector<float> turned = render(er, RotRotate(e, qp), RotRotate(e, qc), RotRotate(e, T),
                                                          RotCamera(e, cam), RotVec(sun), light, jitter);
                 const ImageComparison c = CompareImages(plain, turned, W, H, rule);
-                EXPECT_TRUE(c.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2]
-                                        << " light " << int(light) << " jitter " << jitter << ": max " << c.maxError
-                                        << " at (" << c.worstX << ", " << c.worstY << "), " << c.pixelsOverTolerance
+                EXPECT_TRUE(c.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << " light "
+                                        << int(light) << " jitter " << jitter << ": max " << c.maxError << " at ("
+                                        << c.worstX << ", " << c.worstY << "), " << c.pixelsOverTolerance
                                         << " pixels over";
                 size_t lit = 0;
                 for (size_t n = 0; n < plain.size(); n += 3) lit += plain[n] != 0.3f;
                 EXPECT_GT(lit, size_t(W) * H / 20) << "eye " << cam.eye[0] << ": the cloud is hardly in view";
                 std::printf("[ rotation ] %s march, eye (%.2f, %.2f, %.2f), light %d, jitter %d: max %.3g\n",
-                            b.Name().c_str(), cam.eye[0], cam.eye[1], cam.eye[2], int(light), int(jitter),
-                            c.maxError);
+                            b.Name().c_str(), cam.eye[0], cam.eye[1], cam.eye[2], int(light), int(jitter), c.maxError);
             }
 }
 

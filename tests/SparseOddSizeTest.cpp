@@ -52,7 +52,7 @@ std::string SoWhere(const Extent3& e, const SoVoxel& v) {
 std::vector<SoVoxel> SoVoxels(const SoGrid& g) {
     std::vector<SoVoxel> out;
     const uint32_t nx = g.e.nx, ny = g.e.ny, nz = g.e.nz;
-    std::vector<uint32_t> rows = {0, ny - 2};  // row j; j + 1 <= ny - 1
+    std::vector<uint32_t> rows = {0, ny - 2};     // row j; j + 1 <= ny - 1
     if (g.tile < ny) rows.push_back(g.tile - 1);  // j + 1 starts the next row of tiles
     for (uint32_t j : rows)
         for (uint32_t k : {0u, nz / 2, nz - 1}) {
@@ -109,8 +109,7 @@ TEST_P(SparseOddSize, SmoothOfOneVoxel) {
     Backend& b = *mBackend;
     if (!b.Supports(Stage::Smooth)) GTEST_SKIP() << "unsupported here: no smooth stage";
     const std::array<std::vector<float>, 3> weights = {std::vector<float>{1},  // r = 0: q = cld
-                                                       std::vector<float>{1, 2, 1},
-                                                       std::vector<float>{1, 4, 6, 4, 1}};
+                                                       std::vector<float>{1, 2, 1}, std::vector<float>{1, 4, 6, 4, 1}};
     const float W[3] = {1, 64, 4096};
     for (const SoGrid& g : kSoGrids) {
         const Extent3 e = g.e;
@@ -147,17 +146,18 @@ TEST_P(SparseOddSizeCa, GrowthFromOneActBit) {
     Backend& b = *mBackend;
     if (!b.Supports(Stage::Ca)) GTEST_SKIP() << "unsupported here: no ca stage";
     // The voxels v that the bit at a activates: a - d for each growth offset d.
-    constexpr std::array<std::array<int, 3>, 11> kActivated = {{{-1, 0, 0},
-                                                                {1, 0, 0},
-                                                                {-2, 0, 0},
-                                                                {2, 0, 0},
-                                                                {0, -1, 0},
-                                                                {0, 1, 0},
-                                                                {0, -2, 0},
-                                                                {0, 2, 0},
-                                                                {0, 0, -1},
-                                                                {0, 0, 1},
-                                                                {0, 0, 2}}};  // k + 2 reads the bit as its k - 2 neighbour
+    constexpr std::array<std::array<int, 3>, 11> kActivated = {
+        {{-1, 0, 0},
+         {1, 0, 0},
+         {-2, 0, 0},
+         {2, 0, 0},
+         {0, -1, 0},
+         {0, 1, 0},
+         {0, -2, 0},
+         {0, 2, 0},
+         {0, 0, -1},
+         {0, 0, 1},
+         {0, 0, 2}}};  // k + 2 reads the bit as its k - 2 neighbour
     for (const SoGrid& g : kSoGrids) {
         const Extent3 e = g.e;
         const size_t n = e.Count();
@@ -174,7 +174,8 @@ TEST_P(SparseOddSizeCa, GrowthFromOneActBit) {
             CaStepParams p;  // q* = 0: P_ext = (0 + 127) / 255 = 0, P_hum = P_act = 127 / 255 = 0
             p.seed = 12345;
             p.step = 3;
-            const Status s = b.CaStep(p, {hb.get(), ab.get(), cb.get()}, *region, {out[0].get(), out[1].get(), out[2].get()});
+            const Status s =
+                b.CaStep(p, {hb.get(), ab.get(), cb.get()}, *region, {out[0].get(), out[1].get(), out[2].get()});
             ASSERT_TRUE(s.has_value()) << s.error().message;
             std::vector<uint8_t> wantHum(n, 1), wantAct(n, 0), wantCld(n, 0);
             wantHum[va] = 0;
@@ -192,7 +193,8 @@ TEST_P(SparseOddSizeCa, GrowthFromOneActBit) {
                 EXPECT_EQ(gotAct[VoxelIndex(e, 0, a.j + 1, a.k)], 0) << "(0, j+1, k) activated from " << where;
             }
             if (a.i == 0 && a.j >= 1) {
-                EXPECT_EQ(gotAct[VoxelIndex(e, e.nx - 1, a.j - 1, a.k)], 0) << "(nx-1, j-1, k) activated from " << where;
+                EXPECT_EQ(gotAct[VoxelIndex(e, e.nx - 1, a.j - 1, a.k)], 0)
+                    << "(nx-1, j-1, k) activated from " << where;
             }
             EXPECT_EQ(gotAct, wantAct) << "act from " << where;
             EXPECT_EQ(test::Read<uint8_t>(b, *out[0]), wantHum) << "hum from " << where;
