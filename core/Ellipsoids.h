@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/Random.h"
@@ -34,6 +35,9 @@ class EllipsoidList {
     void Update();
 
     const std::vector<Ellipsoid>& Items() const { return mItems; }
+    // Test hook (tests/MetamorphicRotationTest.cpp): replaces the items, e.g.
+    // with a turned copy; the generator's state is kept.
+    void ReplaceItemsForTest(std::vector<Ellipsoid> items) { mItems = std::move(items); }
 
     // What the backends rasterise: shrunk semi-axes, cos/sin of the yaw.
     std::vector<RasterEllipsoid> Raster() const;
