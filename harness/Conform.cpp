@@ -41,12 +41,17 @@ std::string Where(const Extent3& e, size_t v) {
     return s.str();
 }
 
-// The test-only switch CLOUDBENCH_TEST_CONFORM_MISMATCH=<backend>:<row stage>[:<attempts>]
-// (harness/Conform.h): whether this backend's output of this row is to be perturbed on this attempt.
-bool ConformTestMismatch(const std::string& backend, const std::string& stage, uint32_t attempt) {
+// The test-only switch CLOUDBENCH_TEST_CONFORM_MISMATCH=<backend>:<row stage>[:<attempts>][@<case>]
+// (harness/Conform.h): whether this backend's output of this row is to be perturbed on this attempt, in this case.
+bool ConformTestMismatch(const std::string& backend, const std::string& stage, uint32_t attempt,
+                         const std::string& caseName) {
     const char* value = std::getenv("CLOUDBENCH_TEST_CONFORM_MISMATCH");
     if (!value || !*value) return false;
-    const std::string text(value);
+    std::string text(value);
+    if (const size_t at = text.find('@'); at != std::string::npos) {
+        if (text.substr(at + 1) != caseName) return false;
+        text.resize(at);
+    }
     const size_t colon = text.find(':');
     if (colon == std::string::npos || text.substr(0, colon) != backend) return false;
     const std::string rest = text.substr(colon + 1);
@@ -61,6 +66,7 @@ class Tally {
   public:
     std::string differenceDir;  // where renderer rows write their worst frame's difference image; "" = nowhere
     uint32_t attempt = 0;       // 0 first, 1.. for --flake-reruns (the test-only mismatch switch)
+    std::string caseName;       // the case (--matrix), for the test-only mismatch switch
     ConformRow& Row(const std::string& stage, const std::string& backend, const std::string& rule, double tolerance) {
         auto key = stage + "/" + backend;
         auto [it, inserted] = mRows.try_emplace(key);
@@ -144,7 +150,7 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
         auto r = Read<uint8_t>(cpu, ref);
         auto g = Read<uint8_t>(b, got);
         if (!r || !g) return MakeError(stageName + ": download failed");
-        if (!g->empty() && ConformTestMismatch(name, stageName, tally.attempt)) (*g)[0] ^= 1;
+        if (!g->empty() && ConformTestMismatch(name, stageName, tally.attempt, tally.caseName)) (*g)[0] ^= 0x80;
         if (rule.kind == CompareRule::Kind::BitExact) {
             tally.Exact(stageName, name, t, e, *r, *g);
             return {};
@@ -169,7 +175,7 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
     auto r = Read<float>(cpu, ref);
     auto g = Read<float>(b, got);
     if (!r || !g) return MakeError(stageName + ": download failed");
-    if (!g->empty() && ConformTestMismatch(name, stageName, tally.attempt)) (*g)[0] += 1.0f;
+    if (!g->empty() && ConformTestMismatch(name, stageName, tally.attempt, tally.caseName)) (*g)[0] += 1.0f;
     switch (rule.kind) {
         case CompareRule::Kind::BitExact:
             tally.Exact(stageName, name, t, e, *r, *g);
@@ -290,7 +296,8 @@ Status RunOnCopies(Stage stage, const Scene& scene, Backend& b, const Simulation
 
 Result<std::vector<ConformRow>> RunConformance(const Scene& requested, Backend& cpu,
                                                std::span<const OpenedBackend> others, const ConformProgress& afterStep,
-                                               const std::string& differenceDir, uint32_t attempt) {
+                                               const std::string& differenceDir, uint32_t attempt,
+                                               const std::string& caseName) {
     // Stages are compared whole: time-slicing changes when a stage's work is done, not what it computes
     // (tests/TimeSlice*Test.cpp check that), and unsliced every step draws render.frames_per_step frames.
     Scene scene = requested;
@@ -298,6 +305,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& requested, Backend& 
     Tally tally;
     tally.differenceDir = differenceDir;
     tally.attempt = attempt;
+    tally.caseName = caseName;
     auto sim = Simulation::Create(scene, cpu, /*everyStepOutputs=*/true);
     if (!sim) return std::unexpected(sim.error());
 
@@ -380,7 +388,7 @@ Result<std::vector<ConformRow>> RunConformance(const Scene& requested, Backend& 
                                              " returned no cover count";
                             } else {
                                 uint32_t cover = *got.coveredColumns;
-                                if (ConformTestMismatch(c.name, kCoverRowStage, attempt)) ++cover;
+                                if (ConformTestMismatch(c.name, kCoverRowStage, attempt, caseName)) ++cover;
                                 FoldCoverComparison(row, t, *ref.coveredColumns, cover);
                             }
                         }
@@ -414,8 +422,8 @@ void FoldCoverComparison(ConformRow& row, uint32_t step, uint32_t cpuCover, uint
     // The detail names the step of the worst difference (the latest step while all agree).
     if (row.detail.empty() || diff > row.worst || (diff == 0 && row.worst == 0)) {
         row.worst = diff;
-        row.detail = "step " + std::to_string(step) + ": cpu " + std::to_string(cpuCover) + " columns, " +
-                     row.backend + " " + std::to_string(backendCover);
+        row.detail = "step " + std::to_string(step) + ": cpu " + std::to_string(cpuCover) + " columns, " + row.backend +
+                     " " + std::to_string(backendCover);
     }
     if (diff > 0) row.status = "fail";
 }
