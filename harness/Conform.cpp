@@ -175,7 +175,8 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
     auto r = Read<float>(cpu, ref);
     auto g = Read<float>(b, got);
     if (!r || !g) return MakeError(stageName + ": download failed");
-    if (!g->empty() && ConformTestMismatch(name, stageName, tally.attempt, tally.caseName)) (*g)[0] += 1.0f;
+    if (!g->empty() && ConformTestMismatch(name, stageName, tally.attempt, tally.caseName))
+        (*g)[0] += (*g)[0] >= 0.5f ? -1.0f : 1.0f;
     switch (rule.kind) {
         case CompareRule::Kind::BitExact:
             tally.Exact(stageName, name, t, e, *r, *g);
