@@ -111,7 +111,8 @@ nlohmann::json ConformStageOptions(const Scene& scene, const std::string& stage)
 // some backend compared, {"options": {option: {value: [backends]}}, "compared_on":
 // [backends], "cases": [case names]}: every value each option was compared under,
 // and on which backends. `caseScenes` holds each case's name and scene; a
-// case's gl automaton layout, when set, is the option "gl_ca_layout" of "ca" on gl.
+// case's gl automaton layout, when set, is the option "gl_ca_layout" of "ca" on gl,
+// and shade also lists "principal_axis" ("x", "y" or "z": the sun's at step 0).
 struct ConformCaseScene {
     std::string name;
     const Scene* scene = nullptr;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/SceneNames.h"
+#include "core/Shading.h"
 #include "harness/Command.h"
 #include "harness/Conform.h"
 
@@ -123,6 +124,9 @@ nlohmann::json ConformMatrixCoverage(const std::vector<ConformCaseScene>& caseSc
         addOnce(entry["cases"], r.caseName);
         nlohmann::json options = ConformStageOptions(*c->scene, r.stage);
         if (r.stage == "ca" && r.backend == "gl" && !c->glCaLayout.empty()) options["gl_ca_layout"] = c->glCaLayout;
+        // The axis shade marches along, which the matrix's sun cases vary (step 0's sun).
+        if (r.stage == "shade")
+            options["principal_axis"] = std::string(1, "xyz"[PrincipalAxis(c->scene->sun.Direction())]);
         for (const auto& [option, value] : options.items()) {
             const std::string text = value.is_string() ? value.get<std::string>() : value.dump();
             nlohmann::json& backends = entry["options"][option][text];
