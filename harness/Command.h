@@ -45,6 +45,8 @@ struct CommonOptions {
     // conform: --baseline FILE (known failures) and --flake-reruns N (docs/cli.md).
     std::string baseline;
     uint32_t flakeReruns = 0;
+    // conform --matrix: compare over the built-in option set (harness/ConformMatrix.h).
+    bool matrix = false;
     // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
     // timed calls per measurement; accuracy --switches; sweep --metric.
     bool reference = false;

@@ -21,11 +21,13 @@ struct ConformRow {
     // "pass", "fail", "skipped"; "failed" (the backend crashed or could not run); after
     // --flake-reruns: "flaky"; after --baseline: "expected-fail", "unexpected-pass".
     std::string status = "pass";
-    std::string rule;             // the comparison, e.g. "bit-exact" or "|dT| <= 1e-05"
-    double worst = 0;             // largest error seen (absolute; voxels differing for exact stages)
+    std::string rule;  // the comparison, e.g. "bit-exact" or "|dT| <= 1e-05"
+    double worst = 0;  // largest error seen (absolute; voxels differing for exact stages)
     double tolerance = 0;
     std::string detail;           // worst place and both values, or why it was skipped
     std::string differenceImage;  // renderers: |cpu - backend| of the worst frame (EXR), when written
+    // conform --matrix / --vary: the case (harness/ConformMatrix.h) the row was compared in; "" without.
+    std::string caseName;
 };
 
 // Called after each step's comparisons with the rows so far (each row's worst over steps 0..step).
@@ -35,13 +37,15 @@ using ConformProgress = std::function<void(uint32_t step, const std::vector<Conf
 // steps; one that did not open is a row "(all)" skipped with the reason.
 // With `differenceDir`, each renderer row's worst frame is written there as
 // diff-<stage>-<backend>.exr, |cpu - backend| per channel (linear float).
-// `attempt` (0 first, 1.. for --flake-reruns) only feeds the test-only switch
-// CLOUDBENCH_TEST_CONFORM_MISMATCH=<backend>:<row stage>[:<attempts>], which
-// perturbs that backend's output of that row (its first element; the cover by 1)
-// before it is compared, on attempts below <attempts> (default: every attempt).
+// `attempt` (0 first, 1.. for --flake-reruns) and `caseName` (--matrix) only feed
+// the test-only switch CLOUDBENCH_TEST_CONFORM_MISMATCH=<backend>:<row stage>[:<attempts>][@<case>],
+// which perturbs that backend's output of that row (its first element: a float by 1, down from 0.5 up, so that a code
+// stored clamped to [0, 1] changes too; a byte by flipping its top bit; the cover by 1) before it is compared, on
+// attempts below <attempts> (default: every attempt), in the case named after '@' (default: every case).
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
                                                const ConformProgress& afterStep = {},
-                                               const std::string& differenceDir = "", uint32_t attempt = 0);
+                                               const std::string& differenceDir = "", uint32_t attempt = 0,
+                                               const std::string& caseName = "");
 
 // The row of density's cover count (DensityOutputs::coveredColumns), compared
 // bit-exactly: its stage name, and one step's comparison folded into `row`
@@ -59,10 +63,18 @@ bool IsConformFailure(const ConformRow& row);
 // why the first failed. Rows that still fail, or that passed, are kept.
 void MergeRerun(std::vector<ConformRow>& first, const std::vector<ConformRow>& rerun, uint32_t attempt);
 
-// --baseline FILE: known failures, one "stage,backend,status" a line (docs/cli.md).
+// --baseline FILE: known failures, one "stage,backend,status" a line, or, after a
+// header line "case,stage,backend,status" (a --matrix conform.csv's), one
+// "case,stage,backend,status" a line (docs/cli.md). Fields may be quoted as in
+// conform.csv. An entry matches the rows of its case only ("" = no --matrix).
 struct ConformBaseline {
-    std::vector<std::pair<std::string, std::string>> knownFailures;  // (stage, backend)
-    bool Lists(const std::string& stage, const std::string& backend) const;
+    struct Entry {
+        std::string caseName, stage, backend;
+        bool operator==(const Entry&) const = default;
+    };
+    std::vector<Entry> knownFailures;
+    bool Lists(const std::string& stage, const std::string& backend) const { return Lists("", stage, backend); }
+    bool Lists(const std::string& caseName, const std::string& stage, const std::string& backend) const;
 };
 // Parses the text of `file`; errors read "file: line N: reason".
 Result<ConformBaseline> ParseConformBaseline(const std::string& file, const std::string& text);
@@ -76,17 +88,37 @@ void ApplyBaseline(std::vector<ConformRow>& rows, const ConformBaseline& baselin
 int ConformExitCode(const std::vector<ConformRow>& rows);
 
 // conform.csv: a header and one row per (stage, backend):
-// stage,backend,status,rule,worst,tolerance,detail (RFC 4180 quoting).
+// stage,backend,status,rule,worst,tolerance,detail (RFC 4180 quoting); when a
+// row has a case (--matrix), every row starts with its case: case,stage,...
 std::string ConformCsv(const std::vector<ConformRow>& rows);
 
-// stage x backend: result, rule, worst error and where, as `conform` prints it.
+// stage x backend: result, rule, worst error and where, as `conform` prints it
+// (a first column "case" when a row has one).
 report::Table ConformTable(const std::vector<ConformRow>& rows);
-// conform.json: the rows, and "coverage" (ConformCoverage).
+// conform.json: the rows (each with "case" when it has one), and "coverage" (ConformCoverage).
 nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& rows);
 // Which options each stage was compared under: {stage: {"options": {...},
 // "compared_on": [backends]}} for every row stage some backend compared (a
 // row neither skipped nor a crash), with the scene's settings that change what
 // the stage computes (docs/results.md lists them).
 nlohmann::json ConformCoverage(const Scene& scene, const std::vector<ConformRow>& rows);
+
+// The scene settings of one stage that conform's coverage lists, e.g. for
+// shade {"attenuation": "beer", "filter": ..., "phase": ...}; {} for a stage with none.
+nlohmann::json ConformStageOptions(const Scene& scene, const std::string& stage);
+
+// The coverage of a run over several cases (--matrix, --vary): for each row stage
+// some backend compared, {"options": {option: {value: [backends]}}, "compared_on":
+// [backends], "cases": [case names]}: every value each option was compared under,
+// and on which backends. `caseScenes` holds each case's name and scene; a
+// case's gl automaton layout, when set, is the option "gl_ca_layout" of "ca" on gl,
+// and shade also lists "principal_axis" ("x", "y" or "z": the sun's at step 0).
+struct ConformCaseScene {
+    std::string name;
+    const Scene* scene = nullptr;
+    std::string glCaLayout;  // the gl automaton layout's name
+};
+nlohmann::json ConformMatrixCoverage(const std::vector<ConformCaseScene>& caseScenes,
+                                     const std::vector<ConformRow>& rows);
 
 }  // namespace cb

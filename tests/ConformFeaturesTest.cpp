@@ -68,7 +68,7 @@ TEST(ConformFeatures, CoverCountIsComparedBitExactly) {
 // Test the comparison itself: equal counts pass; the worst difference over the
 // steps is kept with its step and both counts, and one differing step fails the row.
 TEST(ConformFeatures, FoldCoverComparison) {
-    ConformRow row{kCoverRowStage, "x", "pass", "bit-exact", 0, 0, "", ""};
+    ConformRow row{kCoverRowStage, "x", "pass", "bit-exact", 0, 0, "", "", ""};
     FoldCoverComparison(row, 0, 100, 100);
     FoldCoverComparison(row, 1, 90, 90);
     EXPECT_EQ(row.status, "pass");
@@ -81,14 +81,14 @@ TEST(ConformFeatures, FoldCoverComparison) {
     EXPECT_EQ(row.worst, 2.0);
     EXPECT_EQ(row.detail, "step 2: cpu 10 columns, x 12");
     // Counts too large for a float's 24-bit mantissa still differ by one.
-    ConformRow big{kCoverRowStage, "x", "pass", "bit-exact", 0, 0, "", ""};
+    ConformRow big{kCoverRowStage, "x", "pass", "bit-exact", 0, 0, "", "", ""};
     FoldCoverComparison(big, 0, 16777217u, 16777216u);
     EXPECT_EQ(big.status, "fail");
     EXPECT_EQ(big.worst, 1.0);
 }
 
 ConformRow Row(const std::string& stage, const std::string& status) {
-    return {stage, "vk", status, "bit-exact", 0, 0, "why", ""};
+    return {stage, "vk", status, "bit-exact", 0, 0, "why", "", ""};
 }
 
 TEST(ConformFeatures, BaselineParses) {
@@ -176,8 +176,8 @@ TEST(ConformFeatures, RerunMerge) {
 
 // Test conform.csv: a header, one line per row, fields with commas or quotes quoted (RFC 4180).
 TEST(ConformFeatures, Csv) {
-    std::vector<ConformRow> rows = {{"shade", "vk", "fail", "|dT| <= 1e-05", 0.25, 1e-5, "at (1, 2, 3): \"x\"", ""},
-                                    {"ca", "gl", "pass", "bit-exact", 0, 0, "", ""}};
+    std::vector<ConformRow> rows = {{"shade", "vk", "fail", "|dT| <= 1e-05", 0.25, 1e-5, "at (1, 2, 3): \"x\"", "", ""},
+                                    {"ca", "gl", "pass", "bit-exact", 0, 0, "", "", ""}};
     EXPECT_EQ(ConformCsv(rows),
               "stage,backend,status,rule,worst,tolerance,detail\n"
               "shade,vk,fail,|dT| <= 1e-05,0.25,1e-05,\"at (1, 2, 3): \"\"x\"\"\"\n"
@@ -198,9 +198,9 @@ TEST(ConformFeatures, CoverageSummary) {
     scene.shade.scattering = false;
     scene.shadow.form = ShadowForm::Thesis;
     scene.splat.culling = false;
-    std::vector<ConformRow> rows = {Row("smooth", "pass"), Row("shade", "fail"),  Row("shadow", "skipped"),
-                                    Row("(all)", "crashed"), Row("ca", "flaky"), Row(kCoverRowStage, "pass")};
-    rows.push_back({"smooth", "gl", "expected-fail", "", 0, 0, "", ""});
+    std::vector<ConformRow> rows = {Row("smooth", "pass"),   Row("shade", "fail"), Row("shadow", "skipped"),
+                                    Row("(all)", "crashed"), Row("ca", "flaky"),   Row(kCoverRowStage, "pass")};
+    rows.push_back({"smooth", "gl", "expected-fail", "", 0, 0, "", "", ""});
     const nlohmann::json c = ConformCoverage(scene, rows);
     EXPECT_EQ(c["smooth"]["options"]["radius"], 2);
     EXPECT_EQ(c["smooth"]["compared_on"], nlohmann::json({"vk", "gl"}));

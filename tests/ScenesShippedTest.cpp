@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
+#include "core/Ellipsoids.h"
 #include "core/Noise.h"
 #include "core/Scene.h"
 #include "harness/Report.h"
@@ -24,6 +27,43 @@ TEST(ScenesShipped, AllLoad) {
         ++count;
     }
     EXPECT_GE(count, 8u);
+}
+
+// Test that ci-small-wind is ci-small in every field but its description and the
+// ellipsoids' wind: a 3x2 grid of distinct vectors, none equal to another's (or
+// its own) mirror (wx, wy) -> (wy, wx); and that the grid is read x fastest: far
+// outside the region the lookup clamps to a corner cell, (2, 0) = [0.8, 0.05] and
+// (0, 1) = [-0.2, 0.4], where a transposed lookup (index y + 2x) reads [0.1, 0.6]
+// and [0.5, -0.2].
+TEST(ScenesShipped, CiSmallWindIsCiSmallWithAWindGrid) {
+    auto read = [](const char* name) {
+        std::ifstream in(std::string(CLOUDBENCH_SCENES_DIR) + "/" + name);
+        return nlohmann::json::parse(in);
+    };
+    nlohmann::json wind = read("ci-small-wind.json"), small = read("ci-small.json");
+    EXPECT_EQ(wind["ellipsoids"]["wind"]["grid"], nlohmann::json({3, 2}));
+    for (nlohmann::json* doc : {&wind, &small}) {
+        doc->erase("description");
+        (*doc)["ellipsoids"].erase("wind");
+    }
+    EXPECT_EQ(wind, small);
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small-wind.json");
+    ASSERT_TRUE(scene.has_value()) << scene.error().message;
+    const EllipsoidWind& w = scene->ellipsoids.wind;
+    ASSERT_EQ(w.gridNx, 3u);
+    ASSERT_EQ(w.gridNy, 2u);
+    ASSERT_EQ(w.grid.size(), 6u);
+    for (size_t i = 0; i < 6; ++i)
+        for (size_t j = 0; j < 6; ++j) {
+            if (i != j) {
+                EXPECT_NE(w.grid[i], w.grid[j]) << i << " " << j;
+            }
+            EXPECT_NE(w.grid[i], (std::array<double, 2>{w.grid[j][1], w.grid[j][0]})) << i << " " << j;
+        }
+    const EllipsoidList list(scene->ellipsoids, scene->grid.size);
+    EXPECT_EQ(list.WindAt(1e4, -1e4), (std::array<double, 2>{0.8, 0.05}));
+    EXPECT_EQ(list.WindAt(-1e4, 1e4), (std::array<double, 2>{-0.2, 0.4}));
+    EXPECT_EQ(list.WindAt(1e4, 1e4), (std::array<double, 2>{0.4, -0.5}));
 }
 
 // Test that the thesis scenes use the thesis's 256x32x256 volume (32 slices high, so

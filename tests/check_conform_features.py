@@ -4,6 +4,10 @@ conform.csv, --baseline and --flake-reruns, on ci-small against one backend.
 A mismatch is planted with the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH
 switch (harness/Conform.h): <backend>:<row stage>[:<attempts it fails on>].
 
+With --matrix (cases "matrix" and "matrix-baseline"), every case of the built-in
+set must appear, worked out by hand from scenes/ci-small.json (tests/ConformMatrixTest.cpp
+says how), and a mismatch planted in one case (<...>@<case>) fails that case only.
+
 usage: check_conform_features.py CLI OUTDIR BACKEND CASE"""
 import csv
 import json
@@ -26,11 +30,64 @@ def fail(message, proc=None):
     sys.exit(1)
 
 
-def conform(extra=(), mismatch=""):
+def conform(extra=(), mismatch="", steps="2"):
     env = dict(os.environ, CLOUDBENCH_TEST_CONFORM_MISMATCH=mismatch)
     env.pop("CLOUDBENCH_TEST_FAULT", None)
-    return subprocess.run([cli, "conform", "ci-small", "--backend", backend, "--steps", "2", "--out", folder]
+    return subprocess.run([cli, "conform", "ci-small", "--backend", backend, "--steps", steps, "--out", folder]
                           + list(extra), env=env, capture_output=True, text=True, timeout=600)
+
+
+# The built-in cases of ci-small (--matrix), by hand from scenes/ci-small.json.
+MATRIX_CASES = [
+    "scene", "smooth.radius=0", "smooth.radius=2", "shade.attenuation=thesis", "shade.filter=nearest",
+    "shade.resolution=2", "shade.resolution=4", "shade.storage=fp16", "shade.storage=unorm8",
+    "shade.scattering.enabled=true", "phase.function=none+shade.scattering.enabled=true",
+    "phase.function=cornette-shanks+shade.scattering.enabled=true",
+    'phase.function=mie+shade.scattering.enabled=true+stages=["region","ca","smooth","density","shade","shadow"]',
+    "shadow.form=thesis", "shadow.form=wang", "render.culling=false", "render.skipping=false",
+    "sun.elevation_deg=20+sun.azimuth_deg=10", "sun.elevation_deg=70+sun.azimuth_deg=30", "ca.wind_shift=[[1,-1]]",
+] + (["gl-ca-layout=rgba8"] if backend == "gl" else [])
+PLANTED = "shade.storage=fp16"
+
+
+def matrix_rows(proc):
+    """(case, stage) -> status from conform.json and conform.csv (case first), which must agree row for row."""
+    with open(os.path.join(folder, "conform.json")) as f:
+        doc = json.load(f)
+    from_json = [(r.get("case"), r["stage"], r["backend"], r["status"]) for r in doc["results"]]
+    with open(os.path.join(folder, "conform.csv"), newline="") as f:
+        rows = list(csv.reader(f))
+    if rows[0] != ["case", "stage", "backend", "status", "rule", "worst", "tolerance", "detail"]:
+        fail("conform.csv header: %s" % rows[0], proc)
+    if [tuple(r[:4]) for r in rows[1:]] != from_json:
+        fail("conform.csv differs from conform.json", proc)
+    if [c["name"] for c in doc["cases"]] != MATRIX_CASES:
+        fail("cases %s, expected %s" % ([c["name"] for c in doc["cases"]], MATRIX_CASES), proc)
+    got = {}
+    for c, stage, b, status in from_json:
+        if b != backend:
+            fail("a row of backend %s" % b, proc)
+        got[(c, stage)] = status
+    for c in MATRIX_CASES:
+        if not any(k[0] == c for k in got):
+            fail("no row of case " + c, proc)
+        if "case %d/%d: %s\n" % (MATRIX_CASES.index(c) + 1, len(MATRIX_CASES), c) not in proc.stdout:
+            fail("no progress line for case " + c, proc)
+    return doc, got
+
+
+def expect_matrix(proc, code, want):
+    """Exit `code`; the (case, stage) rows of `want` have their status, every other row passes."""
+    if proc.returncode != code:
+        fail("expected exit %d" % code, proc)
+    doc, got = matrix_rows(proc)
+    for key, status in want.items():
+        if got.get(key) != status:
+            fail("%s: expected %s, got %s" % (key, status, got.get(key)), proc)
+    others = {k: v for k, v in got.items() if k not in want and v != "pass"}
+    if others:
+        fail("rows other than %s should pass: %s" % (list(want), others), proc)
+    return doc
 
 
 def baseline(text):
@@ -178,8 +235,46 @@ elif case == "flaky-baseline":
     # Flaky beats the baseline: a listed row that is flaky stays flaky, not unexpected-pass (exit 0).
     path = baseline("shade,%s,fail\n" % backend)
     expect(conform(["--flake-reruns", "1", "--baseline", path], backend + ":shade:1"), 0, {"shade": "flaky"})
+elif case == "matrix":
+    # The built-in set: every case runs, a mismatch planted in one case fails that case's row only (exit 5).
+    p = conform(["--matrix"], backend + ":shade@" + PLANTED, steps="1")
+    doc = expect_matrix(p, 5, {(PLANTED, "shade"): "fail"})
+    if "1 of %d cases with a failing row" % len(MATRIX_CASES) not in p.stdout:
+        fail("the summary should name one failing case", p)
+    # The coverage lists every value compared on this backend: Cornette-Shanks in shade and render_splat,
+    # every storage, radius, shadow form and attenuation.
+    cov = doc["coverage"]
+    want = {("shade", "phase"): ["none", "henyey-greenstein", "cornette-shanks", "mie"],
+            ("render_splat", "phase"): ["none", "henyey-greenstein", "cornette-shanks"],
+            ("shade", "storage"): ["fp32", "fp16", "unorm8"], ("shade", "attenuation"): ["beer", "thesis"],
+            ("shade", "resolution"): ["1", "2", "4"], ("shade", "filter"): ["bilinear", "nearest"],
+            ("smooth", "radius"): ["0", "1", "2"], ("shadow", "form"): ["beer", "thesis", "wang"],
+            ("render_splat", "culling"): ["true", "false"], ("render_splat", "skipping"): ["true", "false"],
+            ("ca", "wind"): ["false", "true"]}
+    if backend == "gl":
+        want[("ca", "gl_ca_layout")] = ["packed", "rgba8"]
+    for (stage, option), values in want.items():
+        got = cov.get(stage, {}).get("options", {}).get(option, {})
+        if sorted(got) != sorted(values) or any(b != [backend] for b in got.values()):
+            fail("coverage of %s %s: %s, expected %s on %s" % (stage, option, got, values, backend), p)
+    # The mismatch's row names its case; the difference images of a case are in its folder.
+    if not os.path.isdir(os.path.join(folder, "shade.storage=fp16")):
+        fail("no folder for the case " + PLANTED, p)
+elif case == "matrix-baseline":
+    # The failing run's conform.csv as the next run's baseline: the same failure in the same case is expected
+    # (exit 0); planted in another case it is new (exit 5) and the listed case's row is an unexpected pass.
+    first = conform(["--matrix"], backend + ":shade@" + PLANTED, steps="1")
+    expect_matrix(first, 5, {(PLANTED, "shade"): "fail"})
+    path = os.path.join(out, case + ".csv")
+    shutil.copy(os.path.join(folder, "conform.csv"), path)
+    expect_matrix(conform(["--matrix", "--baseline", path], backend + ":shade@" + PLANTED, steps="1"), 0,
+                  {(PLANTED, "shade"): "expected-fail"})
+    other = "shade.storage=unorm8"
+    expect_matrix(conform(["--matrix", "--baseline", path], backend + ":shade@" + other, steps="1"), 5,
+                  {(PLANTED, "shade"): "unexpected-pass", (other, "shade"): "fail"})
 elif case == "usage":
-    for bad in (["--flake-reruns", "-1"], ["--flake-reruns", "x"], ["--flake-reruns"], ["--baseline", ""]):
+    for bad in (["--flake-reruns", "-1"], ["--flake-reruns", "x"], ["--flake-reruns"], ["--baseline", ""],
+                ["--vary", "smooth.radius"], ["--vary", "smooth.radius=0,"]):
         p = conform(bad)
         if p.returncode != 2:
             fail("expected exit 2 for %s" % bad, p)

@@ -1,5 +1,5 @@
 # conform's deqp-runner features (issue 17, item 4): the cover count, conform.csv,
-# --baseline and --flake-reruns, against the first non-CPU backend built, with a
+# --baseline, --flake-reruns and --matrix, against the first non-CPU backend built, with a
 # mismatch planted through the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH switch.
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
 if(CLOUDBENCH_HAVE_VK)
@@ -9,7 +9,7 @@ elseif(CLOUDBENCH_HAVE_GL)
 endif()
 if(DEFINED conform_features_backend)
   foreach(case IN ITEMS csv cover baseline-expected baseline-new baseline-from-csv baseline-bad flaky flake-persistent
-                        flaky-baseline usage)
+                        flaky-baseline usage matrix matrix-baseline)
     add_test(NAME Cli.ConformFeatures.${case}
              COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_conform_features.py ${cli}
                      ${cli_out}/conform-features ${conform_features_backend} ${case})
@@ -17,3 +17,8 @@ if(DEFINED conform_features_backend)
                          "conform features ${case}: ok" TIMEOUT 300)
   endforeach()
 endif()
+# ci-small-wind (a 3x2 wind grid of distinct, asymmetric vectors; issue 17 item 3f) on every built
+# backend, with the Khronos validation layer on; exit 4 (no backend besides the CPU could start) is a skip.
+add_test(NAME Cli.ConformCiSmallWind COMMAND ${cli} conform ci-small-wind --steps 4 --out ${cli_out}/conform-wind)
+set_tests_properties(Cli.ConformCiSmallWind PROPERTIES ENVIRONMENT CLOUDBENCH_VK_VALIDATION=1 SKIP_RETURN_CODE 4
+                     FAIL_REGULAR_EXPRESSION "vk validation|fail ")

@@ -1,6 +1,7 @@
 // `cloudbench conform`: stage-isolated conformance of every backend against
 // the CPU on a scene (harness/Conform.h); writes conform.json and conform.csv,
-// exits 5 on a failure; --baseline and --flake-reruns as deqp-runner's (docs/cli.md).
+// exits 5 on a failure; --baseline and --flake-reruns as deqp-runner's, and
+// --matrix / --vary to compare over cases of options (harness/ConformMatrix.h, docs/cli.md).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -8,9 +9,11 @@
 
 #include "core/StageDescriptors.h"
 #include "harness/Conform.h"
+#include "harness/ConformMatrix.h"
 #include "harness/Isolation.h"
 #include "harness/Session.h"
 #include "harness/Transfer.h"
+#include "harness/commands/SweepOutput.h"
 
 namespace cb {
 namespace {
@@ -36,6 +39,17 @@ Options:
                      the command; a listed row that passes is unexpected-pass (exit 5)
   --flake-reruns N   rerun a backend with a failing row up to N times (its whole
                      comparison); a row that then passes is flaky, not a failure
+  --matrix           compare over the built-in option set, one option at a time
+                     from the scene's own settings: each case is the scene with
+                     the overrides it is named by ("shade.storage=fp16", ...;
+                     "scene" for none). Every value of smooth.radius, shade.*,
+                     phase.function, shadow.form, render.culling/skipping, the
+                     sun on each principal axis, ca.wind_shift on/off and gl's
+                     other automaton layout (docs/cli.md lists them). Rows,
+                     conform.csv and the baseline carry the case; difference
+                     images go to DIR/<case>/
+  --vary PATH=V1,... cases of a cartesian product, as sweep's (with --matrix:
+                     added after the built-in cases)
 )";
 
 // One line per stage: its rule in a default scene, and what changes it.
@@ -65,26 +79,27 @@ const std::string kHelp = kHelpIntro + RulesHelp() + kHelpOptions + GlOptionsHel
 // or {"error": ...} when the CPU reference cannot be opened.
 // After each step it sends {"step": t, "rows": [...]}, the rows so far, so that a
 // backend whose process dies later keeps the comparisons it finished.
-nlohmann::json IsolatedConformance(Session& session, const std::string& name, const SendMessage& send,
-                                   uint32_t attempt) {
+nlohmann::json IsolatedConformance(Session& session, const std::string& name, const SendMessage& send, uint32_t attempt,
+                                   const std::string& caseName) {
     MarkPhase("opening backend");
     std::vector<OpenedBackend> cpu = session.OpenBackends({"cpu"}, nullptr, /*report=*/false);
     std::vector<OpenedBackend> other = session.OpenBackends({name}, nullptr, /*report=*/false);
     nlohmann::json backends = nlohmann::json::array();
     for (const BackendProvenance& record : session.BackendRecords()) backends.push_back(transfer::ToJson(record));
     if (!cpu[0].backend) return {{"error", cpu[0].reason}, {"backends", backends}};
-    auto rows = RunConformance(session.GetScene(), *cpu[0].backend, other,
-                               [&](uint32_t step, const std::vector<ConformRow>& soFar) {
-                                   nlohmann::json list = nlohmann::json::array();
-                                   for (const ConformRow& row : soFar) list.push_back(transfer::ToJson(row));
-                                   send({{"step", step}, {"rows", list}});
-                               },
-                               session.OutDir(), attempt);
+    auto rows = RunConformance(
+        session.GetScene(), *cpu[0].backend, other,
+        [&](uint32_t step, const std::vector<ConformRow>& soFar) {
+            nlohmann::json list = nlohmann::json::array();
+            for (const ConformRow& row : soFar) list.push_back(transfer::ToJson(row));
+            send({{"step", step}, {"rows", list}});
+        },
+        session.OutDir(), attempt, caseName);
     nlohmann::json list = nlohmann::json::array();
     if (rows)
         for (const ConformRow& row : *rows) list.push_back(transfer::ToJson(row));
     else
-        list.push_back(transfer::ToJson(ConformRow{"(all)", name, "failed", "", 0, 0, rows.error().message, ""}));
+        list.push_back(transfer::ToJson(ConformRow{"(all)", name, "failed", "", 0, 0, rows.error().message, "", ""}));
     MarkPhase("closing backends");
     return {{"rows", list}, {"backends", backends}};
 }
@@ -100,17 +115,45 @@ int Conform(const CommonOptions& options) {
         }
         baseline = std::move(*loaded);
     }
+    std::vector<ConformAxis> axes;
+    if (!options.vary.empty()) {
+        auto parsed = ParseVaryAxes(options.vary);
+        if (!parsed) {
+            std::fprintf(stderr, "conform: %s\n", parsed.error().c_str());
+            return kExitUsage;
+        }
+        for (SweepAxis& a : *parsed) axes.push_back({std::move(a.path), std::move(a.values)});
+    }
     auto session = Session::Open(options, "conform");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
-    if (!(*session)->MakeOutDir()) return kExitFailed;
-    std::printf("conformance of scene %s (%ux%ux%u, %u steps) against the cpu backend\n", scene.name.c_str(),
-                scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps);
     // The CPU is the reference; the others are opened as asked, less the CPU,
     // each in a process of its own with a CPU reference of its own.
     std::vector<std::string> names;
     for (const std::string& name : (*session)->RequestedBackends(BuiltBackends()))
         if (name != "cpu") names.push_back(name);
+    // The cases: the scene alone, or --matrix's and --vary's, each validated before anything runs.
+    const bool byCase = options.matrix || !axes.empty();
+    std::vector<ConformCase> cases;
+    if (options.matrix)
+        cases = ConformMatrixCases(scene, options.glCaLayout, std::ranges::find(names, "gl") != names.end());
+    for (ConformCase& c : ConformVaryCases(axes))
+        if (std::ranges::none_of(cases, [&](const ConformCase& k) { return k.name == c.name; }))
+            cases.push_back(std::move(c));
+    if (!byCase) cases.push_back({"", {}, std::nullopt, {}});
+    std::vector<Scene> caseScenes;
+    for (const ConformCase& c : cases) {
+        auto variant = (*session)->LoadVariant(c.overrides);
+        if (!variant) {
+            std::fprintf(stderr, "conform: case %s:\n%s\n", c.name.c_str(), variant.error().message.c_str());
+            return kExitBadScene;
+        }
+        caseScenes.push_back(std::move(*variant));
+    }
+    if (!(*session)->MakeOutDir()) return kExitFailed;
+    std::printf("conformance of scene %s (%ux%ux%u, %u steps) against the cpu backend\n", scene.name.c_str(),
+                scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps);
+    if (byCase) std::printf("%zu cases\n", cases.size());
     std::vector<ConformRow> rows;
     if (names.empty()) {
         // Nothing to compare; the CPU is still opened (in a child) for the provenance.
@@ -120,14 +163,13 @@ int Conform(const CommonOptions& options) {
         });
         if (outcome.result) (*session)->AddBackendRecord(transfer::ProvenanceFromJson(*outcome.result));
     }
-    // One backend's rows, from its own process; `crashed` when the process died.
-    auto runBackend = [&](const std::string& name, uint32_t attempt, bool& crashed) -> std::optional<
-                          std::vector<ConformRow>> {
+    // One backend's rows in one case, from its own process; `crashed` when the process died.
+    auto runBackend = [&](Session& caseSession, const std::string& caseName, const std::string& name, uint32_t attempt,
+                          bool& crashed) -> std::optional<std::vector<ConformRow>> {
         std::vector<ConformRow> got;
-        IsolatedOutcome outcome = RunIsolated("backend " + name, IsolationFrom(options),
-                                              [&](const SendMessage& send) {
-                                                  return IsolatedConformance(**session, name, send, attempt);
-                                              });
+        IsolatedOutcome outcome = RunIsolated("backend " + name, IsolationFrom(options), [&](const SendMessage& send) {
+            return IsolatedConformance(caseSession, name, send, attempt, caseName);
+        });
         if (!outcome.result) {
             const ChildFailure& failure = *outcome.failure;
             std::fprintf(stderr, "backend %s %s\n", name.c_str(), failure.Describe().c_str());
@@ -141,7 +183,7 @@ int Conform(const CommonOptions& options) {
                 for (const nlohmann::json& row : last["rows"]) got.push_back(transfer::ConformRowFromJson(row));
                 kept = "; rows above cover steps 0-" + std::to_string(last["step"].get<uint32_t>());
             }
-            got.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe() + kept, ""});
+            got.push_back({"(all)", name, failure.status, "", 0, 0, failure.Describe() + kept, "", ""});
             crashed = true;
             return got;
         }
@@ -156,48 +198,98 @@ int Conform(const CommonOptions& options) {
         for (const nlohmann::json& row : r["rows"]) got.push_back(transfer::ConformRowFromJson(row));
         return got;
     };
-    for (const std::string& name : names) {
-        bool crashed = false;
-        auto got = runBackend(name, 0, crashed);
-        if (!got) return kExitFailed;
-        // --flake-reruns: the backend's whole comparison again (a single stage cannot be rerun alone: its
-        // inputs are the CPU's of that step), until no row fails. A crash that then passes is flaky too.
-        for (uint32_t attempt = 1; attempt <= options.flakeReruns && std::ranges::any_of(*got, IsConformFailure);
-             ++attempt) {
-            std::printf("backend %s: rerun %u of %u for its failing rows\n", name.c_str(), attempt,
-                        options.flakeReruns);
-            bool crashedAgain = false;
-            auto again = runBackend(name, attempt, crashedAgain);
-            if (!again) return kExitFailed;
-            // A first run that crashed: its rows of the steps it finished are merged, the rerun's other rows
-            // added, and the crash row "(all)" is flaky.
-            auto all = std::ranges::find_if(*got, [](const ConformRow& r) { return r.stage == "(all)"; });
-            if (all != got->end() && !crashedAgain) {
-                ConformRow flaky = *all;
-                flaky.status = "flaky";
-                flaky.detail = "passed on rerun " + std::to_string(attempt) + "; the first run: " + all->status +
-                               ", " + all->detail;
-                got->erase(all);
-                MergeRerun(*got, *again, attempt);
-                for (const ConformRow& r : *again)
-                    if (std::ranges::none_of(*got, [&](const ConformRow& g) { return g.stage == r.stage; }))
-                        got->push_back(r);
-                got->push_back(flaky);
-                continue;
+    for (size_t k = 0; k < cases.size(); ++k) {
+        const ConformCase& c = cases[k];
+        // A case runs in a session of its own: the scene with the case's overrides, gl's layout, and its
+        // difference images in DIR/<case>/.
+        CommonOptions caseOptions = options;
+        caseOptions.overrides.insert(caseOptions.overrides.end(), c.overrides.begin(), c.overrides.end());
+        if (c.glCaLayout) caseOptions.glCaLayout = *c.glCaLayout;
+        std::unique_ptr<Session> ownSession;
+        Session* caseSession = session->get();
+        if (byCase) {
+            caseOptions.outDir = (*session)->OutDir() + "/" + ConformCaseFolder(c.name);
+            auto opened = Session::Open(caseOptions, "conform");
+            if (!opened) return opened.error();
+            ownSession = std::move(*opened);
+            caseSession = ownSession.get();
+            if (Status made = MakeFolder(caseSession->OutDir()); !made) {
+                std::fprintf(stderr, "%s\n", made.error().message.c_str());
+                return kExitFailed;
             }
-            MergeRerun(*got, *again, attempt);
+            std::printf("case %zu/%zu: %s\n", k + 1, cases.size(), c.name.c_str());
+            std::fflush(stdout);
         }
-        rows.insert(rows.end(), got->begin(), got->end());
+        for (const std::string& name : names) {
+            if (!c.onlyBackends.empty() && std::ranges::find(c.onlyBackends, name) == c.onlyBackends.end()) continue;
+            bool crashed = false;
+            auto got = runBackend(*caseSession, c.name, name, 0, crashed);
+            if (!got) return kExitFailed;
+            // --flake-reruns: the backend's whole comparison in this case again (a single stage cannot be rerun
+            // alone: its inputs are the CPU's of that step), until no row fails. A crash that then passes is
+            // flaky too.
+            for (uint32_t attempt = 1; attempt <= options.flakeReruns && std::ranges::any_of(*got, IsConformFailure);
+                 ++attempt) {
+                std::printf("backend %s%s: rerun %u of %u for its failing rows\n", name.c_str(),
+                            byCase ? (" in case " + c.name).c_str() : "", attempt, options.flakeReruns);
+                bool crashedAgain = false;
+                auto again = runBackend(*caseSession, c.name, name, attempt, crashedAgain);
+                if (!again) return kExitFailed;
+                // A first run that crashed: its rows of the steps it finished are merged, the rerun's other rows
+                // added, and the crash row "(all)" is flaky.
+                auto all = std::ranges::find_if(*got, [](const ConformRow& r) { return r.stage == "(all)"; });
+                if (all != got->end() && !crashedAgain) {
+                    ConformRow flaky = *all;
+                    flaky.status = "flaky";
+                    flaky.detail = "passed on rerun " + std::to_string(attempt) + "; the first run: " + all->status +
+                                   ", " + all->detail;
+                    got->erase(all);
+                    MergeRerun(*got, *again, attempt);
+                    for (const ConformRow& r : *again)
+                        if (std::ranges::none_of(*got, [&](const ConformRow& g) { return g.stage == r.stage; }))
+                            got->push_back(r);
+                    got->push_back(flaky);
+                    continue;
+                }
+                MergeRerun(*got, *again, attempt);
+            }
+            for (ConformRow& r : *got) r.caseName = c.name;
+            rows.insert(rows.end(), got->begin(), got->end());
+        }
     }
     if (baseline) ApplyBaseline(rows, *baseline);
     report::Report report("Conformance of " + scene.name);
     report.sections.push_back({"", {ConformTable(rows)}});
     std::printf("%s", report::RenderText(report.sections[0]).c_str());
     nlohmann::json doc = ConformJson(scene, rows);
-    // The automaton layout is gl's command-line option, not the scene's.
-    if (doc["coverage"].contains("ca"))
+    if (byCase) {
+        // Each case's overrides, and the coverage over all of them: every value each option was compared under.
+        std::vector<ConformCaseScene> scenes;
+        nlohmann::json list = nlohmann::json::array();
+        for (size_t k = 0; k < cases.size(); ++k) {
+            const gl::CaLayout layout = cases[k].glCaLayout.value_or(options.glCaLayout);
+            scenes.push_back({cases[k].name, &caseScenes[k], std::string(gl::CaLayoutName(layout))});
+            nlohmann::json overrides = nlohmann::json::object();
+            for (const SceneOverride& o : cases[k].overrides) overrides[o.path] = o.value;
+            nlohmann::json entry = {{"name", cases[k].name}, {"overrides", overrides}};
+            if (cases[k].glCaLayout) entry["gl_ca_layout"] = gl::CaLayoutName(*cases[k].glCaLayout);
+            if (!cases[k].onlyBackends.empty()) entry["backends"] = cases[k].onlyBackends;
+            list.push_back(entry);
+        }
+        doc["cases"] = list;
+        doc["coverage"] = ConformMatrixCoverage(scenes, rows);
+        size_t failing = 0;
+        for (const ConformCase& c : cases)
+            failing += std::ranges::any_of(rows, [&](const ConformRow& r) {
+                return r.caseName == c.name && (IsConformFailure(r) || r.status == "unexpected-pass");
+            });
+        std::printf("%zu of %zu cases with a failing row\n", failing, cases.size());
+    } else if (doc["coverage"].contains("ca")) {
+        // The automaton layout is gl's command-line option, not the scene's.
         for (const nlohmann::json& backend : doc["coverage"]["ca"]["compared_on"])
-            if (backend == "gl") doc["coverage"]["ca"]["options"]["gl_ca_layout"] = gl::CaLayoutName(options.glCaLayout);
+            if (backend == "gl")
+                doc["coverage"]["ca"]["options"]["gl_ca_layout"] = gl::CaLayoutName(options.glCaLayout);
+    }
     doc["flake_reruns"] = options.flakeReruns;
     doc["baseline"] = options.baseline;
     doc["report"] = report::RenderJson(report);
@@ -222,6 +314,8 @@ const CommandRegistration kRegistration({
     .helpOrder = 2,
     .extraOptions = WithIsolationOptions({
         TextOption("--baseline", &CommonOptions::baseline, "--baseline needs a file of known failures"),
+        FlagOption("--matrix", &CommonOptions::matrix),
+        ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary smooth.radius=0,2"),
         {"--flake-reruns", "", true,
          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
              char* end = nullptr;

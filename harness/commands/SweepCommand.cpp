@@ -80,10 +80,11 @@ std::vector<std::string> SplitValues(const std::string& text) {
     return out;
 }
 
+}  // namespace
+
 using Axis = SweepAxis;
 
-// The --vary arguments as axes; a usage message when one is malformed.
-std::expected<std::vector<Axis>, std::string> ParseAxes(const std::vector<std::string>& vary) {
+std::expected<std::vector<Axis>, std::string> ParseVaryAxes(const std::vector<std::string>& vary) {
     std::vector<Axis> axes;
     for (const std::string& arg : vary) {
         const size_t eq = arg.find('=');
@@ -99,6 +100,8 @@ std::expected<std::vector<Axis>, std::string> ParseAxes(const std::vector<std::s
     }
     return axes;
 }
+
+namespace {
 
 // The cartesian product of the axes' values, every point validated against the
 // scene before anything runs; kExitBadScene (after the message) on a bad point.
@@ -134,7 +137,7 @@ int Sweep(const CommonOptions& options) {
         std::fprintf(stderr, "sweep: --metric: must be max, mean or p99, got '%s'\n", options.metric.c_str());
         return kExitUsage;
     }
-    auto axes = ParseAxes(options.vary);
+    auto axes = ParseVaryAxes(options.vary);
     if (!axes) {
         std::fprintf(stderr, "sweep: %s\n", axes.error().c_str());
         return kExitUsage;

@@ -3,6 +3,7 @@
 // sweep.json, sweep.md and sweep.png writer.
 #pragma once
 
+#include <expected>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -18,6 +19,11 @@ struct SweepAxis {
     std::string path;
     std::vector<std::string> values;
 };
+
+// The --vary PATH=V1,V2,... arguments as axes (values split at commas outside
+// brackets, braces and quotes); a usage message when one is malformed. Used by
+// sweep and conform.
+std::expected<std::vector<SweepAxis>, std::string> ParseVaryAxes(const std::vector<std::string>& vary);
 
 // Pareto front per stage: no other ok row is at least as fast and as accurate
 // (on `metric`: max, mean or p99) and strictly better in one.
