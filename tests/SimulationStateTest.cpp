@@ -87,6 +87,9 @@ struct SavedRunView {
     std::optional<uint32_t> cover;
     std::array<bool, kStageCount> skipped{};
     uint32_t frames = 0;
+    // Every frame's splat counters: the frames before the step's last (alpha < 1) show Previous; the observer
+    // sees only the last frame's image.
+    std::vector<std::array<uint64_t, 3>> frameStats;
 };
 
 // Steps `sim` until `to` (exclusive), keeping each step's view.
@@ -111,6 +114,8 @@ std::vector<SavedRunView> StepAndKeep(Simulation& sim, Backend& backend, uint32_
         view.cover = record.coveredColumns;
         view.skipped = record.skippedUnchanged;
         view.frames = record.framesRendered;
+        for (const FrameRecord& f : record.frames)
+            view.frameStats.push_back({f.stats.splats, f.stats.voxelsVisited, f.stats.fragments});
         views.push_back(std::move(view));
     }
     return views;
@@ -163,6 +168,7 @@ void ExpectSameSteps(const std::vector<SavedRunView>& expected, const std::vecto
         }
         EXPECT_EQ(b.cover, a.cover);
         EXPECT_EQ(b.frames, a.frames);
+        if (same == SameAs::Bits || t > split) EXPECT_EQ(b.frameStats, a.frameStats) << "splats, voxels visited, fragments";
         for (Stage stage : kAllStages)
             EXPECT_EQ(b.skipped[size_t(stage)], a.skipped[size_t(stage)]) << StageName(stage) << " skipped";
     }
@@ -211,6 +217,43 @@ TEST_P(SimulationStateSplit, SplitRunEqualsTheUnsplitRun) {
                 const auto got = SplitRun(scene, split, atEnd, *mBackend, *mBackend, StateTestDir(GetParam()));
                 ExpectSameSteps(expected, got, split, scene, SameAs::Bits);
             }
+    }
+}
+
+// A still field: noise forms q once (step 0) and skips after, so q, D, tiles and bands keep their step-0 values and
+// the renderer interpolates Previous (q_0) and current (q_0) at every step. The saved Previous is read at every
+// resumed step here (in the automaton scene each step's smooth overwrites it first).
+TEST_P(SimulationStateSplit, SplitRunOfAStillFieldKeepsPrevious) {
+    if (!mBackend->Supports(Stage::Noise)) GTEST_SKIP() << GetParam() << " has no noise stage";
+    const Scene scene = SavedRunScene({
+        {"stages", R"(["noise", "density", "shade", "shadow", "render_splat"])"},
+        {"noise", R"({"seed": 3, "basis": "perlin", "frequency": [4, 4, 2], "octaves": 2, "threshold": 0.1})"},
+        {"grid.size", "[32, 32, 8]"},
+        {"steps", "5"},
+    });
+    auto whole = MakeSim(scene, *mBackend);
+    ASSERT_TRUE(whole);
+    const std::vector<SavedRunView> expected = StepAndKeep(*whole, *mBackend, scene.steps);
+    ASSERT_EQ(expected.size(), scene.steps);
+    EXPECT_TRUE(expected[3].skipped[size_t(Stage::Noise)]) << "the test needs noise to skip";
+    ASSERT_FALSE(expected[3].frameStats.empty());
+    EXPECT_GT(expected[3].frameStats[0][0], 0u) << "the test needs splats";
+    for (bool atEnd : {false, true}) {
+        SCOPED_TRACE(atEnd ? "saved at the end of a run" : "saved mid-run");
+        const uint32_t split = 2;
+        Scene first = scene;
+        if (atEnd) first.steps = split;
+        auto a = MakeSim(first, *mBackend);
+        ASSERT_TRUE(a);
+        StepAndKeep(*a, *mBackend, split);
+        const std::string dir = StateTestDir("still_" + GetParam());
+        ASSERT_TRUE(SaveSimulationState(*a, dir, kStateTestHash).has_value());
+        auto state = ReadSimulationState(dir, scene, kStateTestHash);
+        ASSERT_TRUE(state.has_value()) << state.error().message;
+        auto b = MakeSim(scene, *mBackend);
+        ASSERT_TRUE(b);
+        ASSERT_TRUE(RestoreSimulationState(*b, *state).has_value());
+        ExpectSameSteps(expected, StepAndKeep(*b, *mBackend, scene.steps), split, scene, SameAs::Bits);
     }
 }
 
