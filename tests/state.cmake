@@ -1,7 +1,7 @@
 # Save and resume through the CLI (issue 17 item 3; docs/cli.md, run --save-state / --resume; harness/SimulationState.h).
 # Included from tests/CMakeLists.txt where `cli`, `cli_out` and `expect_exit` are set.
 #
-# ci-small for 9 steps (rendered every step after 1 warm-up, jittered, short-lived ellipsoids so some are born after
+# ci-small (on a 32 x 32 x 8 grid) for 9 steps (rendered every step after 1 warm-up, jittered, short-lived ellipsoids so some are born after
 # the split), once whole, and once as 5 steps saved with --save-state then resumed with --resume up to 9, on the CPU;
 # again time-sliced (2 slices a frame), saved every 2 steps; and, where a GPU backend opens, saved on the CPU and
 # resumed there. The resumed run's last frame (.exr and .png) and top view must equal the whole run's byte for byte (the EXR's capture date aside)
@@ -10,7 +10,7 @@
 set(cli_state_script [=[d="$1"; rm -rf "$d"; mkdir -p "$d"; set -e
 sets="--set warmup_steps=1 --set render.every_steps=1 --set render.frames_per_step=2 --set ellipsoids.lifetime_mean=3 \
   --set ellipsoids.lifetime_variance=1 --set ellipsoids.shrink_steps=1 --set ellipsoids.jitter=0.5 \
-  --set render.width=64 --set render.height=48"
+  --set render.width=64 --set render.height=48 --set grid.size=[32,32,8] --set density.tile=8 --set density.band=2"
 run() { "$0" run ci-small --quiet $sets "$@"; }
 for sliced in 0 2; do
   s="--set render.slices_per_frame=$sliced"
