@@ -35,9 +35,13 @@ class EllipsoidList {
     void Update();
 
     const std::vector<Ellipsoid>& Items() const { return mItems; }
-    // Test hook (tests/MetamorphicRotationTest.cpp): replaces the items, e.g.
-    // with a turned copy; the generator's state is kept.
-    void ReplaceItemsForTest(std::vector<Ellipsoid> items) { mItems = std::move(items); }
+    // The generator of births, removals and jitter; with Items(), the list's whole state.
+    const Pcg32& Rng() const { return mRng; }
+    // Puts back a state that Items() and Rng() gave (a saved run, harness/SimulationState.h).
+    void Restore(std::vector<Ellipsoid> items, const Pcg32& rng) {
+        mItems = std::move(items);
+        mRng = rng;
+    }
 
     // What the backends rasterise: shrunk semi-axes, cos/sin of the yaw.
     std::vector<RasterEllipsoid> Raster() const;

@@ -81,6 +81,14 @@ class Pcg32 {
         }
     }
 
+    // The whole generator state, to save and restore a run (harness/SimulationState.h).
+    uint64_t StateWord() const { return mState; }
+    uint64_t Increment() const { return mIncrement; }
+    void Restore(uint64_t state, uint64_t increment) {
+        mState = state;
+        mIncrement = increment;
+    }
+
   private:
     uint64_t mState = 0;
     uint64_t mIncrement = 0;

@@ -68,6 +68,9 @@ struct CommonOptions {
     std::string outFile;
     // run --timing: "synchronized", "pipelined" or "both" (docs/performance.md, "Two ways to time a step").
     std::string timing = "synchronized";
+    // run --save-state DIR, --save-state-every N (0 = only at the end), --resume DIR (harness/SimulationState.h).
+    std::string saveState, resumeState;
+    uint32_t saveStateEvery = 0;
     // argv as given, for the provenance of the outputs.
     std::vector<std::string> commandLine;
 

@@ -337,9 +337,13 @@ Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     record.step = mStep;
     record.timing = mTiming;
     const bool outputStep = IsOutputStep(mStep);
-    if (mStep == 0) {
-        // Nothing was computed ahead of the first step (pipelined: one batch, before the frames').
-        CB_TRY(Batched(record, [&] { return RunStepStages(record, outputStep); }));
+    if (!mAheadComputed) {
+        // Nothing was computed ahead of the first step, nor of the first step of a run resumed after the
+        // last step of another (pipelined: one batch, before the frames'). That one first advances the state.
+        CB_TRY(Batched(record, [&]() -> Status {
+            if (mAdvanceOwed) CB_TRY(RunOwedAdvance(record));
+            return RunStepStages(record, outputStep);
+        }));
     } else {
         CommitAhead(record);
     }
@@ -347,7 +351,9 @@ Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     for (Stage stage : mSchedule) renders |= Describe(stage).renderer && outputStep;
     // A step without frames (warm-up, or not a render step) computes the next one whole.
     std::vector<FrameTasks> work;
-    if (mStep + 1 < mScene.steps) work = PlanAhead(renders ? mScene.render.slicesPerFrame : UINT32_MAX);
+    mAheadComputed = mStep + 1 < mScene.steps;
+    mAdvanceOwed = !mAheadComputed;
+    if (mAheadComputed) work = PlanAhead(renders ? mScene.render.slicesPerFrame : UINT32_MAX);
     if (renders) {
         const uint32_t frames = std::max<uint32_t>(std::max(mScene.render.framesPerStep, 1u), uint32_t(work.size()));
         CB_TRY(RenderFrames(record, frames, work));
@@ -367,6 +373,30 @@ Status Simulation::SlicedStep(StepRecord& record, const Observer& observe) {
     record.stepMs = MsSince(stepStart) - observerMs;
     ChargeRestToFirstFrame(record);
     CountSubmissions(countsBefore, mBackend.Submissions(), record);
+    return {};
+}
+
+Status Simulation::RunOwedAdvance(StepRecord& record) {
+    // What an unsliced step mStep-1 does after its observer: state_{t} -> state_{t+1} from R_{t}, then the list.
+    for (Stage stage : mSchedule) {
+        const StageDescriptor& d = Describe(stage);
+        if (!d.advancesState) continue;
+        StageCallRecord call;
+        StageHostInputs host{mStep - 1, mRaster, 0, 0, {}, mBatchOpen};
+        CB_TRY(CallStage(stage, mBackend, mScene, host, Buffers(), call));
+        AddCallTimes(stage, call, record, record.frames.size());
+        for (Resource r : d.writes) {
+            Slot& slot = mSlots[size_t(r)];
+            std::swap(slot.current[0], slot.next);
+            ++slot.version;
+        }
+    }
+    if (mScene.stages.Has(Stage::Region)) {
+        const auto start = std::chrono::steady_clock::now();
+        mEllipsoids.Update();
+        record.ellipsoidUpdateMs += MsSince(start);
+    }
+    mAdvanceOwed = false;
     return {};
 }
 

@@ -161,6 +161,9 @@ class Simulation {
     const std::vector<Stage>& Schedule() const { return mSchedule; }
 
   private:
+    // Saves and restores the whole state between steps (harness/SimulationState.h).
+    friend struct SimulationStateAccess;
+
     // A resource's buffers: this step's (one per camera for images), the next
     // step's for a state-advancing writer, the previous step's where a
     // renderer interpolates; and a count of writes, to skip stages whose
@@ -191,6 +194,8 @@ class Simulation {
     // `frames` frames of every renderer; frame f first runs work[f] where there is one.
     Status RenderFrames(StepRecord& record, uint32_t frames, std::span<const FrameTasks> work);
     Status SlicedStep(StepRecord& record, const Observer& observe);
+    // Time-sliced: the state advance of step mStep-1 (ca, the list update) that its sliced step left owed.
+    Status RunOwedAdvance(StepRecord& record);
     // The next step's work split into frames of `slicesPerFrame` slices; marks its outputs ahead.
     std::vector<FrameTasks> PlanAhead(uint32_t slicesPerFrame);
     // Runs one frame's shares; `describe`, if given, gets what they computed ("smooth 4-7").
@@ -233,6 +238,11 @@ class Simulation {
     // Time-sliced: the next step's ellipsoids, and what its stages recorded (merged into its record when it starts).
     std::vector<RasterEllipsoid> mRasterAhead;
     StepRecord mAhead;
+    // Time-sliced: whether the step before computed this one ahead (else this step computes its stages whole,
+    // as step 0 does), and whether it ended without advancing the state (the scene's last step computes no
+    // next step: a run resumed from there advances first; harness/SimulationState.h).
+    bool mAheadComputed = false;
+    bool mAdvanceOwed = false;
     TimingMode mTiming = TimingMode::Synchronized;
     bool mBatchOpen = false;
     std::vector<MarkOwner> mMarks;

@@ -403,8 +403,8 @@ TEST_P(Rotation, EllipsoidListUpdateTurnsWithTheGrid) {
         itemsTurned.push_back(t);
     }
     EllipsoidList plain(RotListSettings(false, 10), e), turned(RotListSettings(true, 10), er);
-    plain.ReplaceItemsForTest(items);
-    turned.ReplaceItemsForTest(itemsTurned);
+    plain.Restore(items, plain.Rng());
+    turned.Restore(itemsTurned, turned.Rng());
     for (int step = 1; step <= 6; ++step) {
         plain.Update();
         turned.Update();

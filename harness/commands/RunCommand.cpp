@@ -8,6 +8,7 @@
 #include "harness/Report.h"
 #include "harness/Session.h"
 #include "harness/Simulation.h"
+#include "harness/SimulationState.h"
 #include "harness/Transfer.h"
 
 namespace cb {
@@ -42,6 +43,13 @@ constexpr const char* kHelpTail = R"(                     (the contexts and layo
                      wait; per-stage device times from timestamps inside it), or
                      both (the two alternated in the order S P P S, so that a
                      drift over the run weighs the same on each; reported apart)
+  --save-state DIR   save the simulation's state in folder DIR at the end of the
+                     run (one backend only; replaced atomically; docs/results.md)
+  --save-state-every N  also save it to DIR after every N steps
+  --resume DIR       continue the run saved in DIR, on any backend: steps
+                     SAVED .. steps-1 (--steps is the total, as without --resume);
+                     the scene and --set options must be those it was saved with,
+                     steps aside (a bad or mismatched state exits 3)
 )";
 const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail + IsolationOptionsHelp();
 
@@ -55,28 +63,63 @@ std::vector<OptionSpec> RunOptions() {
                            o.timing = value;
                            return std::nullopt;
                        }});
+    options.push_back(TextOption("--save-state", &CommonOptions::saveState, "--save-state needs a folder"));
+    options.push_back(TextOption("--resume", &CommonOptions::resumeState, "--resume needs a saved state's folder"));
+    options.push_back({"--save-state-every", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                           char* end = nullptr;
+                           const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
+                           if (!v || !*v || *end || v[0] == '-' || n == 0 || n > UINT32_MAX)
+                               return "--save-state-every needs a step count > 0";
+                           o.saveStateEvery = uint32_t(n);
+                           return std::nullopt;
+                       }});
     return options;
 }
+
+// What --save-state and --resume carry into a backend's run.
+struct StateOptions {
+    std::string sceneHash;                   // SceneSettingsHash of the resolved scene
+    const SimulationState* resume = nullptr;  // read and checked before any backend opened
+};
 
 // Steps the simulation to the end, then writes the last frame of each camera
 // and the top view; whatever fails is recorded in `run` and the rest goes on.
 // Each step's record is sent (to the parent, when isolated) as it is done.
 // Returns false when an output could not be written.
 bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::vector<std::string>& written,
-                const SendMessage& send) {
+                const SendMessage& send, const StateOptions& state) {
     const Scene& scene = session.GetScene();
     const std::string& outDir = session.OutDir();
+    const CommonOptions& options = session.Options();
     MarkPhase("creating the simulation");
     auto sim = Simulation::Create(scene, backend);
+    if (sim && state.resume) {
+        MarkPhase("restoring the saved state");
+        if (Status s = RestoreSimulationState(**sim, *state.resume); !s)
+            sim = std::unexpected(Error{options.resumeState + ": " + s.error().message});
+    }
     if (!sim) {
         run.status = "failed";
         run.error = sim.error().message;
         return true;
     }
-    Progress progress(run.name, scene.steps, session.Options().quiet);
-    for (uint32_t t = 0; t < scene.steps; ++t) {
+    bool allWritten = true;
+    auto failed = [&](const Error& error) {
+        std::fprintf(stderr, "%s\n", error.message.c_str());
+        allWritten = false;
+    };
+    // The state after the steps so far, in --save-state's folder (written whole or not at all).
+    auto saveState = [&]() {
+        MarkPhase("saving the state");
+        if (Status s = SaveSimulationState(**sim, options.saveState, state.sceneHash); !s)
+            failed(s.error());
+        else if (!options.quiet)
+            std::fprintf(stderr, "%s: state saved at step %u\n", options.saveState.c_str(), (*sim)->CurrentStep());
+    };
+    Progress progress(run.name, scene.steps, options.quiet);
+    for (uint32_t t = (*sim)->CurrentStep(); t < scene.steps; ++t) {
         StepRecord record;
-        (*sim)->SetTiming(TimingOfStep(session.Options().timing, t));
+        (*sim)->SetTiming(TimingOfStep(options.timing, t));
         if (Status status = (*sim)->Step(record); !status) {
             run.status = "failed";
             run.error = "step " + std::to_string(t) + ": " + status.error().message;
@@ -85,13 +128,11 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
         send({{"step", transfer::ToJson(record)}});
         run.steps.push_back(record);
         progress.Update(t + 1);
+        if (options.saveStateEvery && (t + 1) % options.saveStateEvery == 0 && t + 1 < scene.steps) saveState();
     }
+    // A failed step leaves no state to save: the last one saved (if any) stays.
+    if (!options.saveState.empty() && run.status == "ok") saveState();
     MarkPhase("writing frames");
-    bool allWritten = true;
-    auto failed = [&](const Error& error) {
-        std::fprintf(stderr, "%s\n", error.message.c_str());
-        allWritten = false;
-    };
     // The last frame of each renderer and camera.
     for (Resource image : kAllResources) {
         if (!IsPerCamera(image) || !(*sim)->Get(image) || !(*sim)->LastRenderedStep()) continue;
@@ -132,7 +173,8 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
 // One backend's whole run, in its own process when isolated: opens it (so no
 // GL, Vulkan or TBB state exists in the parent), runs it, writes its frames.
 // Sends {"opened": ...} and each {"step": ...}; returns the rest.
-nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, const SendMessage& send) {
+nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, const SendMessage& send,
+                                  const StateOptions& state) {
     MarkPhase("opening backend");
     std::vector<OpenedBackend> opened = session.OpenBackends({name}, &session.GetScene());
     OpenedBackend& slot = opened[0];
@@ -151,7 +193,7 @@ nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, con
             {"planned_bytes", planned}}}});
     std::vector<std::string> written;
     bool allWritten = true;
-    if (slot.backend) allWritten = RunBackend(session, *slot.backend, run, written, send);
+    if (slot.backend) allWritten = RunBackend(session, *slot.backend, run, written, send, state);
     MarkPhase("closing backend");
     slot.backend.reset();
     return {{"status", run.status},
@@ -165,11 +207,36 @@ int Run(const CommonOptions& options) {
     auto session = Session::Open(options, "");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
+    const std::vector<std::string> names = (*session)->RequestedBackends(BuiltBackends());
+    // --save-state and --resume: one backend's run; a saved state is read and checked whole before anything else.
+    StateOptions state;
+    std::optional<SimulationState> resumed;
+    if (!options.saveState.empty() || !options.resumeState.empty()) {
+        if (names.size() != 1) {
+            std::fprintf(stderr, "%s: a saved state is one backend's run: name one with --backend\n",
+                         options.saveState.empty() ? "--resume" : "--save-state");
+            return kExitUsage;
+        }
+        state.sceneHash = SceneSettingsHash(SceneWithOverrides((*session)->ScenePath(), options.overrides));
+    }
+    if (options.saveStateEvery && options.saveState.empty()) {
+        std::fprintf(stderr, "--save-state-every: needs --save-state DIR\n");
+        return kExitUsage;
+    }
+    if (!options.resumeState.empty()) {
+        auto loaded = ReadSimulationState(options.resumeState, scene, state.sceneHash);
+        if (!loaded) {
+            std::fprintf(stderr, "%s\n", loaded.error().message.c_str());
+            return kExitBadScene;
+        }
+        resumed = std::move(*loaded);
+        state.resume = &*resumed;
+    }
     if (!(*session)->MakeOutDir()) return kExitFailed;
     std::printf("scene %s: %ux%ux%u voxels, %u steps (%u warm-up)\n", scene.name.c_str(), scene.grid.size.nx,
                 scene.grid.size.ny, scene.grid.size.nz, scene.steps, scene.warmupSteps);
 
-    const std::vector<std::string> names = (*session)->RequestedBackends(BuiltBackends());
+    if (resumed) std::printf("resuming %s at step %u\n", options.resumeState.c_str(), resumed->step);
     std::vector<BackendRun> runs;
     std::map<std::string, nlohmann::json> failures;  // by backend: why its process gave no result
     std::vector<std::string> written;
@@ -198,7 +265,7 @@ int Run(const CommonOptions& options) {
     const IsolationSettings isolation = IsolationFrom(options);
     for (size_t i = 0; i < names.size(); ++i) {
         IsolatedOutcome outcome = RunIsolated("backend " + names[i], isolation, [&](const SendMessage& send) {
-            return IsolatedBackendRun(**session, names[i], send);
+            return IsolatedBackendRun(**session, names[i], send, state);
         });
         // What the backend's process sent before it ended is kept, whatever became of it.
         BackendRun run;
