@@ -1,0 +1,549 @@
+// Metamorphic invariants of the renderers (issue 17 item 3; docs/testing.md,
+// "Metamorphic invariants: culling, skipping, origin"): culling and empty-space
+// skipping on or off give the same image bit for bit, on scenes built to
+// stress them (splats at the frustum's edges, cloud that appears and dissolves
+// between the two interpolated steps, cameras inside the volume and on its
+// faces and tile edges); and moving the world origin and the cameras by an
+// exactly representable offset changes no pixel. Every backend, both renderers.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/Backend.h"
+#include "core/Camera.h"
+#include "core/Random.h"
+#include "core/Splat.h"
+#include "tests/BackendTestUtil.h"
+#include "tests/TestUtil.h"
+#if CLOUDBENCH_HAVE_GL
+#include "impl_gl/BackendGL.h"
+#endif
+
+namespace cb {
+namespace {
+
+// A scene of both steps' q, T and (non-empty: ground on) G on a grid of voxel
+// size h whose corner (0, 0, 0) sits at `origin`.
+struct MetaScene {
+    Extent3 grid{16, 16, 8};
+    std::vector<float> qPrev, qCur, T, G;
+    std::array<float, 3> origin{0, 0, 0};
+    float h = 1;
+    uint32_t tile = 4, band = 2;
+    float splatDiameter = 1.5f, alpha = 0.5f;
+};
+
+constexpr Vec3 kMetaBackground{0.4f, 0.6f, 0.9f};
+
+struct MetaImage {
+    std::vector<float> rgb;
+    SplatStats splat;  // not read in a batch
+};
+
+// The splat renderer's parameters of scene s seen by `camera` (culling and skipping on).
+SplatParams MetaSplatParams(const MetaScene& s, const CameraFrame& camera) {
+    SplatParams p;
+    p.camera = camera;
+    p.sun = SunDirection(0.7, 0.5);
+    p.sunRadiance = {1.0f, 0.9f, 0.8f};
+    p.ambient = {0.2f, 0.25f, 0.3f};
+    p.background = kMetaBackground;
+    p.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
+    p.qMin = 0.3f;
+    p.splatDiameter = s.splatDiameter;
+    p.opacity = 0.6f;
+    p.alpha = s.alpha;
+    p.origin = s.origin;
+    p.voxelSize = s.h;
+    p.tile = s.tile;
+    p.band = s.band;
+    p.ground = {!s.G.empty(), {0.3f, 0.35f, 0.25f}};
+    return p;
+}
+
+// Renders scene s with render_splat on backend b; the occupancy of both steps
+// comes from b's density stage. `batch`: the call is recorded in a batch (gl
+// then skips in the vertex shader, see MetaMakeBackend).
+MetaImage MetaRenderSplat(Backend& b, const MetaScene& s, const CameraSettings& cam, uint32_t W, uint32_t H,
+                          bool culling, bool skipping, bool batch = false) {
+    const Extent3 e = s.grid;
+    auto qp = test::MakeFilled(b, BufferFormat::F32, e, s.qPrev);
+    auto qc = test::MakeFilled(b, BufferFormat::F32, e, s.qCur);
+    auto T = test::MakeFilled(b, BufferFormat::F32, e, s.T);
+    const Extent3 tiles{CeilDiv(e.nx, s.tile), CeilDiv(e.ny, s.tile), 1}, bands{tiles.nx, tiles.ny, CeilDiv(e.nz, s.band)};
+    std::unique_ptr<Buffer> occ[2][2], D[2];
+    for (int step = 0; step < 2; ++step) {
+        D[step] = test::MakeBuffer(b, BufferFormat::F32, {e.nx, e.ny, 1});
+        occ[step][0] = test::MakeBuffer(b, BufferFormat::U8, tiles);
+        occ[step][1] = test::MakeBuffer(b, BufferFormat::U8, bands);
+        DensityOutputs out{D[step].get(), occ[step][0].get(), occ[step][1].get(), 0};
+        Status st = b.Density({s.tile, s.band, {}}, step == 0 ? *qp : *qc, nullptr, out);
+        EXPECT_TRUE(st.has_value()) << (st ? "" : st.error().message);
+    }
+    std::unique_ptr<Buffer> G;
+    if (!s.G.empty()) G = test::MakeFilled(b, BufferFormat::F32, {e.nx, e.ny, 1}, s.G);
+    auto image = test::MakeBuffer(b, BufferFormat::F32, {3, W, H});
+    SplatParams p = MetaSplatParams(s, MakeCameraFrame(cam, W, H));
+    const SplatOrder order =
+        MakeSplatOrder(p.camera, e, {double(s.origin[0]), double(s.origin[1]), double(s.origin[2])}, s.h);
+    p.order = &order;
+    p.culling = culling;
+    p.skipping = skipping;
+    SplatInputs in{qp.get(), qc.get(), T.get(), occ[0][0].get(), occ[1][0].get(), occ[0][1].get(), occ[1][1].get()};
+    in.G = G.get();
+    MetaImage r;
+    if (batch) {
+        EXPECT_TRUE(b.BeginBatch().has_value());
+    }
+    Status st = b.RenderSplat(p, in, *image, &r.splat);
+    if (batch) {
+        auto times = b.EndBatch();
+        EXPECT_TRUE(times.has_value()) << (times ? "" : times.error().message);
+        b.TakeDeferredResults();
+    }
+    EXPECT_TRUE(st.has_value()) << b.Name() << ": " << (st ? "" : st.error().message);
+    r.rgb = st ? test::Read<float>(b, *image) : std::vector<float>{};
+    return r;
+}
+
+// Renders scene s with render_march on backend b (light from T).
+std::vector<float> MetaRenderMarch(Backend& b, const MetaScene& s, const CameraSettings& cam, uint32_t W, uint32_t H,
+                                   bool skipping, uint32_t brick) {
+    const Extent3 e = s.grid;
+    auto qp = test::MakeFilled(b, BufferFormat::F32, e, s.qPrev);
+    auto qc = test::MakeFilled(b, BufferFormat::F32, e, s.qCur);
+    auto T = test::MakeFilled(b, BufferFormat::F32, e, s.T);
+    std::unique_ptr<Buffer> G;
+    if (!s.G.empty()) G = test::MakeFilled(b, BufferFormat::F32, {e.nx, e.ny, 1}, s.G);
+    auto image = test::MakeBuffer(b, BufferFormat::F32, {3, W, H});
+    MarchParams p;
+    p.camera = MakeCameraFrame(cam, W, H);
+    p.setup.size = {float(e.nx), float(e.ny), float(e.nz)};
+    p.setup.voxelSize = s.h;
+    p.setup.step = 0.5f;
+    p.setup.sigmaH = 0.6f;
+    p.setup.epsilon = 0;
+    p.setup.sun = SunDirection(0.7, 0.5);
+    p.setup.sunRadiance = {1.0f, 0.9f, 0.8f};
+    p.setup.ambient = {0.2f, 0.25f, 0.3f};
+    p.setup.background = kMetaBackground;
+    p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
+    p.origin = s.origin;
+    p.alpha = s.alpha;
+    p.skipping = skipping;
+    p.brick = brick;
+    p.ground = {!s.G.empty(), {0.3f, 0.35f, 0.25f}};
+    MarchInputs in{qp.get(), qc.get(), T.get()};
+    in.G = G.get();
+    MarchStats stats;
+    Status st = b.RenderMarch(p, in, *image, &stats);
+    EXPECT_TRUE(st.has_value()) << b.Name() << ": " << (st ? "" : st.error().message);
+    return st ? test::Read<float>(b, *image) : std::vector<float>{};
+}
+
+CameraSettings MetaCamera(std::array<double, 3> eye, std::array<double, 3> target, double fov = 60,
+                          std::array<double, 3> up = {0, 0, 1}, double nearPlane = 0.25) {
+    CameraSettings c;
+    c.eye = eye;
+    c.target = target;
+    c.up = up;
+    c.fovDeg = fov;
+    c.nearPlane = nearPlane;
+    return c;
+}
+
+// Pixels (not channels) that differ from the flat background.
+size_t MetaNonBackground(const std::vector<float>& rgb) {
+    size_t n = 0;
+    for (size_t i = 0; i + 2 < rgb.size(); i += 3)
+        n += rgb[i] != kMetaBackground[0] || rgb[i + 1] != kMetaBackground[1] || rgb[i + 2] != kMetaBackground[2];
+    return n;
+}
+
+// Where the images first differ, for a failure message.
+std::string MetaFirstDifference(const std::vector<float>& a, const std::vector<float>& b, uint32_t W) {
+    if (a.size() != b.size()) return "sizes " + std::to_string(a.size()) + " and " + std::to_string(b.size());
+    size_t count = 0, first = a.size();
+    float worst = 0;
+    for (size_t i = 0; i < a.size(); ++i)
+        if (a[i] != b[i]) {
+            if (first == a.size()) first = i;
+            ++count;
+            worst = std::max(worst, std::fabs(a[i] - b[i]));
+        }
+    if (!count) return "equal";
+    const size_t pixel = first / 3;
+    return std::to_string(count) + " channels differ (worst " + std::to_string(worst) + "), first at pixel (" +
+           std::to_string(pixel % W) + ", " + std::to_string(pixel / W) + ")";
+}
+
+// ---- The frustum's edges, worked by hand (docs/issue17-audit.md 1g) -------------------
+//
+// Grid 40 x 40 x 1, h = 1, origin 0, tile = band = 1. The eye (0.5, 20.5, 0.5)
+// looks along +x (target (10.5, 20.5, 0.5)), fov 90 on 64 x 64: f = 32. With
+// up = +z: right = forward x up = (0, -1, 0). Splat diameter d = 4 (radius 2),
+// near plane 1. Voxel (16, 3, 0) has its centre at (16.5, 3.5, 0.5): depth 16,
+// x_cam = 17, so px = 32 + 17 * 32/16 = 66 (2 px right of the image), py = 32,
+// size 4 * 32/16 = 8: it covers 62 <= x + 0.5 < 70, pixels x = 62..63 on the
+// image, y = 28..35. The right side plane widened by a pixel has the normal
+// 32 right - 33 forward = (-33, -32, 0) / 45.967; n.(16, -17, 0) = 16/45.967
+// = 0.348: outside the plane, yet within the radius 2, so the box stays.
+// Voxel (16, 0, 0): x_cam = 20, px = 72, covers 68..75 (off the image); its
+// distance (-528 + 640)/45.967 = 2.437 > 2, so the box is culled.
+// Mirrors: (16, 37, 0) has x_cam = -17 (left edge, pixels 0..1); with up = +y
+// (right = +z, image up = +y) (16, 3, 0) sits at y_cam = -17: bottom edge
+// (rows 62..63), (16, 37, 0) at the top (rows 0..1).
+
+struct EdgeCase {
+    const char* name;
+    uint32_t i, j;
+    std::array<double, 3> up;
+    bool visible;  // the box stays (and the splat covers pixels)
+    int x0, x1, y0, y1;  // the covered pixels, worked by hand (visible only)
+};
+
+const EdgeCase kEdgeCases[] = {
+    {"right", 16, 3, {0, 0, 1}, true, 62, 63, 28, 35},
+    {"left", 16, 37, {0, 0, 1}, true, 0, 1, 28, 35},
+    {"bottom", 16, 3, {0, 1, 0}, true, 28, 35, 62, 63},
+    {"top", 16, 37, {0, 1, 0}, true, 28, 35, 0, 1},
+    {"beyond the radius, right", 16, 0, {0, 0, 1}, false, 0, 0, 0, 0},
+    {"beyond the radius, bottom", 16, 0, {0, 1, 0}, false, 0, 0, 0, 0},
+    // Depth 0 and 1 (the near plane is 1): not beyond the near plane.
+    {"behind the near plane", 0, 20, {0, 0, 1}, false, 0, 0, 0, 0},
+    {"on the near plane", 1, 20, {0, 0, 1}, false, 0, 0, 0, 0},
+};
+
+MetaScene EdgeScene(const EdgeCase& c) {
+    MetaScene s;
+    s.grid = {40, 40, 1};
+    s.tile = s.band = 1;
+    s.splatDiameter = 4;
+    s.qPrev.assign(s.grid.Count(), 0.0f);
+    s.qPrev[VoxelIndex(s.grid, c.i, c.j, 0)] = 1.0f;
+    s.qCur = s.qPrev;
+    s.T.assign(s.grid.Count(), 1.0f);
+    return s;
+}
+
+CameraSettings EdgeCamera(const EdgeCase& c) { return MetaCamera({0.5, 20.5, 0.5}, {10.5, 20.5, 0.5}, 90, c.up, 1); }
+
+// Test the host's boxes and splat footprint against the hand-worked numbers.
+TEST(MetamorphicRender, FrustumEdgeBoxesHandWorked) {
+    for (const EdgeCase& c : kEdgeCases) {
+        const MetaScene s = EdgeScene(c);
+        SplatParams p = MetaSplatParams(s, MakeCameraFrame(EdgeCamera(c), 64, 64));
+        ASSERT_EQ(p.camera.focalPx, 32.0f);
+        const std::vector<uint8_t> boxes =
+            FrustumVisibleBoxes(p.camera, s.grid, s.origin, s.h, s.tile, s.band, s.splatDiameter);
+        ASSERT_EQ(boxes.size(), s.grid.Count());
+        EXPECT_EQ(boxes[VoxelIndex(s.grid, c.i, c.j, 0)], c.visible ? 1 : 0) << c.name;
+        // SplatBoxVisibility with culling: the frustum's boxes, less the empty bands when skipping.
+        const std::vector<uint8_t> none(boxes.size(), 0), all(boxes.size(), 1);
+        EXPECT_EQ(SplatBoxVisibility(p, s.grid, all, all), boxes) << c.name;
+        EXPECT_EQ(SplatBoxVisibility(p, s.grid, none, none), none) << c.name;
+        p.skipping = false;
+        EXPECT_EQ(SplatBoxVisibility(p, s.grid, {}, {}), boxes) << c.name;
+        p.culling = false;
+        EXPECT_EQ(SplatBoxVisibility(p, s.grid, {}, {}), all) << c.name;
+        if (!c.visible) continue;
+        const SplatOrder order = MakeSplatOrder(p.camera, s.grid, {0, 0, 0}, 1.0);
+        p.order = &order;
+        const SplatFrame F = MakeSplatFrame(p, s.grid, FlattenSplatOrder(order), 64, 64);
+        Splat splat;
+        ASSERT_TRUE(MakeSplat(F, c.i, c.j, 0, 1.0f, 1.0f, splat)) << c.name;
+        EXPECT_EQ(splat.size, 8.0f) << c.name;
+        EXPECT_EQ(splat.x0, c.x0) << c.name;
+        EXPECT_EQ(splat.x1, c.x1) << c.name;
+        EXPECT_EQ(splat.y0, c.y0) << c.name;
+        EXPECT_EQ(splat.y1, c.y1) << c.name;
+    }
+}
+
+// The backend under test; gl records render_splat in a batch with skipping in
+// the vertex shader (SplatSkip::Device), the path a GPU takes.
+class MetamorphicRenderBackend : public test::BackendTest {
+  protected:
+    void SetUp() override {
+        test::BackendTest::SetUp();
+        if (IsSkipped()) return;
+#if CLOUDBENCH_HAVE_GL
+        if (auto* gl = dynamic_cast<gl::BackendGL*>(mBackend.get())) gl->SetSplatSkip(gl::BackendGL::SplatSkip::Device);
+#endif
+    }
+    bool HasMarch() const { return mBackend->Supports(Stage::RenderMarch); }
+
+    // The image with culling and skipping off, and expects every other
+    // combination (and skipping in a batch) to equal it bit for bit.
+    std::vector<float> ExpectSplatUnchanged(const MetaScene& s, const CameraSettings& cam, uint32_t W, uint32_t H,
+                                            const std::string& what) {
+        const MetaImage off = MetaRenderSplat(*mBackend, s, cam, W, H, false, false);
+        uint64_t culledSplats = 0;  // splats drawn with culling on (skipping must not change it)
+        for (int combo = 1; combo < 5; ++combo) {
+            const bool culling = combo & 1, skipping = combo & 2, batch = combo == 4;
+            const MetaImage on = MetaRenderSplat(*mBackend, s, cam, W, H, culling || batch, skipping || batch, batch);
+            EXPECT_TRUE(on.rgb == off.rgb) << what << ": culling " << (culling || batch) << ", skipping "
+                                           << (skipping || batch) << (batch ? " in a batch" : "") << ": "
+                                           << MetaFirstDifference(off.rgb, on.rgb, W);
+            if (combo == 1) culledSplats = on.splat.splats;
+            if (combo == 2) {
+                EXPECT_EQ(on.splat.splats, off.splat.splats) << what << ": skipping lost splats";
+            }
+            if (combo == 3) {
+                EXPECT_EQ(on.splat.splats, culledSplats) << what << ": skipping lost splats (culling on)";
+            }
+        }
+        return off.rgb;
+    }
+    void ExpectMarchUnchanged(const MetaScene& s, const CameraSettings& cam, uint32_t W, uint32_t H,
+                              const std::string& what) {
+        if (!HasMarch()) return;
+        const std::vector<float> off = MetaRenderMarch(*mBackend, s, cam, W, H, false, 4);
+        for (uint32_t brick : {1u, 4u, 8u}) {
+            const std::vector<float> on = MetaRenderMarch(*mBackend, s, cam, W, H, true, brick);
+            EXPECT_TRUE(on == off) << what << ": march brick " << brick << ": " << MetaFirstDifference(off, on, W);
+        }
+    }
+};
+
+// Test that the splats at the frustum's edges are drawn (the pixels worked by
+// hand differ from the background) and the image is the same with culling and
+// skipping on or off; splats beyond the radius and behind the near plane are
+// not drawn at all.
+TEST_P(MetamorphicRenderBackend, FrustumEdgeSplatsSurviveCulling) {
+    for (const EdgeCase& c : kEdgeCases) {
+        const MetaScene s = EdgeScene(c);
+        const std::vector<float> rgb = ExpectSplatUnchanged(s, EdgeCamera(c), 64, 64, c.name);
+        ASSERT_EQ(rgb.size(), size_t(3) * 64 * 64);
+        if (c.visible) {
+            // kappa > 0 on 10 pixels of the footprint: on the right edge, x = 62
+            // and 63 are at 2a - 1 = -7/8 and -5/8, rows 28..35 at 2b - 1 = -7/8
+            // .. 7/8 in steps of 1/4; (7/8)^2 + y^2 < 1 for |y| <= 3/8 (4 rows),
+            // (5/8)^2 + y^2 < 1 for |y| <= 5/8 (6 rows). The other edges mirror it.
+            size_t inside = 0;
+            for (int y = c.y0; y <= c.y1; ++y)
+                for (int x = c.x0; x <= c.x1; ++x) {
+                    const size_t n = 3 * (x + 64 * size_t(y));
+                    inside += rgb[n] != kMetaBackground[0] || rgb[n + 1] != kMetaBackground[1] ||
+                              rgb[n + 2] != kMetaBackground[2];
+                }
+            EXPECT_EQ(inside, 10u) << c.name;
+            EXPECT_EQ(MetaNonBackground(rgb), 10u) << c.name;
+        } else {
+            EXPECT_EQ(MetaNonBackground(rgb), 0u) << c.name;
+        }
+    }
+}
+
+// ---- Cloud that appears and dissolves between the two steps -----------------------
+//
+// 16 x 16 x 8, tile 4, band 2, alpha 1/2, q_min 0.3. q_prev = 1 only in box
+// A (tile (0, 0), band 0), q_cur = 1 only in box B (tile (2, 2), band 2): at
+// alpha 1/2 every one of those voxels has q_alpha = 1/2 > q_min, so all four
+// splats are drawn; skipping that read one step's bands alone would lose two.
+MetaScene AppearDissolveScene() {
+    MetaScene s;
+    s.qPrev.assign(s.grid.Count(), 0.0f);
+    s.qCur = s.qPrev;
+    s.qPrev[VoxelIndex(s.grid, 1, 1, 0)] = 1.0f;
+    s.qPrev[VoxelIndex(s.grid, 2, 2, 1)] = 1.0f;
+    s.qCur[VoxelIndex(s.grid, 9, 9, 4)] = 1.0f;
+    s.qCur[VoxelIndex(s.grid, 10, 10, 5)] = 1.0f;
+    s.T.assign(s.grid.Count(), 0.8f);
+    return s;
+}
+
+TEST_P(MetamorphicRenderBackend, AppearAndDissolveSurviveSkipping) {
+    const MetaScene s = AppearDissolveScene();
+    const uint32_t W = 64, H = 48;
+    for (const CameraSettings& cam : {MetaCamera({-6, -6, 14}, {8, 8, 3}), MetaCamera({20, 3, 4}, {0, 12, 4})}) {
+        const std::vector<float> rgb = ExpectSplatUnchanged(s, cam, W, H, "appear/dissolve");
+        for (bool culling : {false, true})
+            for (bool skipping : {false, true})
+                EXPECT_EQ(MetaRenderSplat(*mBackend, s, cam, W, H, culling, skipping).splat.splats, 4u)
+                    << culling << skipping;
+        // Each step's pair alone is on the image: both show.
+        MetaScene prevOnly = s, curOnly = s;
+        prevOnly.qCur.assign(s.grid.Count(), 0.0f);
+        curOnly.qPrev.assign(s.grid.Count(), 0.0f);
+        EXPECT_GT(MetaNonBackground(MetaRenderSplat(*mBackend, prevOnly, cam, W, H, false, false).rgb), 0u);
+        EXPECT_GT(MetaNonBackground(MetaRenderSplat(*mBackend, curOnly, cam, W, H, false, false).rgb), 0u);
+        EXPECT_GT(MetaNonBackground(rgb), 0u);
+    }
+}
+
+// The march forms q_alpha and builds its bricks from it: with blobs of q_prev
+// and of q_cur apart (each brick of q_alpha > 0 holds one step only), skipping
+// on and off give the same image for bricks of 1, 4 and 8.
+TEST_P(MetamorphicRenderBackend, MarchAppearAndDissolveSurviveSkipping) {
+    if (!HasMarch()) GTEST_SKIP() << mBackend->Name() << " has no render_march";
+    MetaScene s;
+    s.grid = {24, 16, 8};
+    s.qPrev = test::GaussianBlobField(s.grid, {{4, 4, 2, 1.2}});
+    s.qCur = test::GaussianBlobField(s.grid, {{19, 12, 5, 1.2}});
+    s.T.assign(s.grid.Count(), 0.7f);
+    const CameraSettings cam = MetaCamera({-8, -6, 12}, {12, 8, 4});
+    const uint32_t W = 48, H = 32;
+    ExpectMarchUnchanged(s, cam, W, H, "march appear/dissolve");
+    // Both blobs are seen: each alone changes the image.
+    MetaScene prevOnly = s, curOnly = s;
+    prevOnly.qCur.assign(s.grid.Count(), 0.0f);
+    curOnly.qPrev.assign(s.grid.Count(), 0.0f);
+    const std::vector<float> both = MetaRenderMarch(*mBackend, s, cam, W, H, true, 4);
+    EXPECT_FALSE(MetaRenderMarch(*mBackend, prevOnly, cam, W, H, true, 4) == both);
+    EXPECT_FALSE(MetaRenderMarch(*mBackend, curOnly, cam, W, H, true, 4) == both);
+    EXPECT_GT(MetaNonBackground(both), 0u);
+}
+
+// ---- Cameras inside the volume and on its faces and tile edges --------------------
+//
+// Blobs that move between the steps; T varies. Eyes: inside, exactly on the
+// x = 0 face, on the top face, on a tile and band edge (x = 4, y = 8, z = 2),
+// on a corner; each looking several ways.
+TEST_P(MetamorphicRenderBackend, CamerasInsideAndOnFacesChangeNothing) {
+    MetaScene s;
+    s.qPrev = test::GaussianBlobField(s.grid, {{4, 4, 2, 1.5}, {12, 5, 5, 1.5}});
+    s.qCur = test::GaussianBlobField(s.grid, {{5, 11, 3, 1.5}, {11, 12, 6, 1.5}});
+    s.T.resize(s.grid.Count());
+    for (size_t n = 0; n < s.T.size(); ++n) s.T[n] = 0.3f + 0.7f * float((n * 2654435761u) % 1000) / 1000.0f;
+    struct Eye {
+        const char* name;
+        std::array<double, 3> eye, target;
+    };
+    const Eye eyes[] = {
+        {"inside", {8, 8, 4}, {0, 0, 2}},          {"inside, looking up", {8, 8, 2}, {11, 12, 8}},
+        {"inside, other way", {8, 8, 4}, {16, 14, 6}},
+        {"on x = 0", {0, 6, 3}, {16, 10, 4}},       {"on x = 0, along it", {0, 6, 3}, {0, 16, 3}},
+        {"on the top", {7, 9, 8}, {3, 3, 0}},       {"on the top, across", {7, 9, 8}, {12, 5, 4}},
+        {"on a tile edge", {4, 8, 2}, {14, 2, 6}},  {"on a tile edge, back", {4, 8, 2}, {2, 16, 3}},
+        {"on a corner", {0, 0, 0}, {16, 16, 8}},
+    };
+    const uint32_t W = 48, H = 40;
+    for (const Eye& e : eyes) {
+        const CameraSettings cam = MetaCamera(e.eye, e.target, 75);
+        const std::vector<float> rgb = ExpectSplatUnchanged(s, cam, W, H, e.name);
+        EXPECT_GT(MetaNonBackground(rgb), 0u) << e.name;
+        ExpectMarchUnchanged(s, cam, W, H, e.name);
+    }
+}
+
+// ---- The property: no culled box holds a voxel with a splat on the image ----------
+
+// 200 seeded random cameras (inside, near and around a 20 x 16 x 10 grid, h
+// 1/2, 1 or 2, random field of view, image size, splat diameter and near
+// plane): for each box FrustumVisibleBoxes culls, MakeSplat of each of its
+// voxels (q = 1) gives no splat or an empty footprint.
+TEST(MetamorphicRender, CulledBoxesHoldNoVisibleSplat) {
+    const Extent3 e{20, 16, 10};
+    Pcg32 rng(1717);
+    uint64_t culledVoxels = 0, nearMisses = 0, drawnVoxels = 0;
+    for (int camera = 0; camera < 200; ++camera) {
+        MetaScene s;
+        s.grid = e;
+        s.h = std::array<float, 3>{0.5f, 1.0f, 2.0f}[rng.Below(3)];
+        s.origin = {float(rng.Uniform(-20, 20)), float(rng.Uniform(-20, 20)), float(rng.Uniform(-5, 5))};
+        s.tile = 1 + rng.Below(6);
+        s.band = 1 + rng.Below(4);
+        s.splatDiameter = float(rng.Uniform(0.2, 6)) * s.h;
+        auto point = [&](double margin) {
+            std::array<double, 3> p;
+            const uint32_t n[3] = {e.nx, e.ny, e.nz};
+            for (int a = 0; a < 3; ++a)
+                p[a] = s.origin[a] + s.h * rng.Uniform(-margin, n[a] + margin);
+            return p;
+        };
+        CameraSettings cam = MetaCamera(point(12), point(0), rng.Uniform(15, 120), {0, 0, 1}, rng.Uniform(0.05, 4));
+        if (rng.Below(5) == 0) cam.up = {rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1)};
+        const uint32_t W = 8 + rng.Below(90), H = 8 + rng.Below(70);
+        SplatParams p = MetaSplatParams(s, MakeCameraFrame(cam, W, H));
+        const SplatOrder order = MakeSplatOrder(p.camera, e, {s.origin[0], s.origin[1], s.origin[2]}, s.h);
+        p.order = &order;
+        const SplatFrame F = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
+        const std::vector<uint8_t> boxes = FrustumVisibleBoxes(p.camera, e, s.origin, s.h, s.tile, s.band, s.splatDiameter);
+        const uint32_t tilesX = CeilDiv(e.nx, s.tile), tilesY = CeilDiv(e.ny, s.tile);
+        for (uint32_t k = 0; k < e.nz; ++k)
+            for (uint32_t j = 0; j < e.ny; ++j)
+                for (uint32_t i = 0; i < e.nx; ++i) {
+                    Splat splat;
+                    const bool drawn = MakeSplat(F, i, j, k, 1.0f, 1.0f, splat) && splat.x0 <= splat.x1 &&
+                                       splat.y0 <= splat.y1;
+                    const bool visible = boxes[i / s.tile + size_t(tilesX) * (j / s.tile + size_t(tilesY) * (k / s.band))];
+                    drawnVoxels += drawn;
+                    if (visible) continue;
+                    ++culledVoxels;
+                    ASSERT_FALSE(drawn) << "camera " << camera << ": voxel (" << i << ", " << j << ", " << k
+                                        << ") in a culled box covers pixels " << splat.x0 << ".." << splat.x1 << " x "
+                                        << splat.y0 << ".." << splat.y1;
+                    // A splat whose centre is off the image but in reach of it.
+                    nearMisses += MakeSplat(F, i, j, k, 1.0f, 1.0f, splat) &&
+                                  (splat.px > -0.5f * splat.size - 2 && splat.px < W + 0.5f * splat.size + 2) &&
+                                  (splat.py > -0.5f * splat.size - 2 && splat.py < H + 0.5f * splat.size + 2);
+                }
+    }
+    // The cameras exercise both sides: many culled voxels, many drawn, and culled
+    // ones within two pixels of touching the image.
+    EXPECT_GT(culledVoxels, 100000u);
+    EXPECT_GT(drawnVoxels, 100000u);
+    EXPECT_GT(nearMisses, 100u);
+}
+
+// ---- Moving the world origin -------------------------------------------------------
+//
+// h = 2 (a power of two); the grid's corner and the cameras move by Delta =
+// (2048, -4096, 1024) = 2^k h. Every coordinate (corner, voxel centres
+// corner + (i + 1/2) h, eyes, targets) is a float with spare bits before and
+// after the move, so each difference the renderers form (centre - eye,
+// (eye - corner)/h) is exact and the same: the images must be equal bit for
+// bit, ground on (the plane z = corner z moves with it).
+TEST_P(MetamorphicRenderBackend, MovingTheOriginChangesNothing) {
+    MetaScene s;
+    s.grid = {16, 12, 6};
+    s.h = 2;
+    s.origin = {-8, 4, 0};
+    s.qPrev = test::GaussianBlobField(s.grid, {{4, 4, 2, 1.5}, {12, 7, 3, 1.8}});
+    s.qCur = test::GaussianBlobField(s.grid, {{5, 5, 2.5, 1.5}, {11, 8, 3, 1.8}});
+    s.T.resize(s.grid.Count());
+    for (size_t n = 0; n < s.T.size(); ++n) s.T[n] = 0.3f + 0.7f * float((n * 2654435761u) % 1000) / 1000.0f;
+    s.G.resize(size_t(s.grid.nx) * s.grid.ny);
+    for (uint32_t j = 0; j < s.grid.ny; ++j)
+        for (uint32_t i = 0; i < s.grid.nx; ++i) s.G[i + s.grid.nx * j] = 0.2f + 0.8f * float((i * 7 + j * 3) % 11) / 10.0f;
+    s.splatDiameter = 3;
+    const std::array<double, 3> delta{2048, -4096, 1024};
+    const std::array<std::array<std::array<double, 3>, 2>, 3> views = {{
+        {{{-20.5, -14.25, 18}, {8, 16, 2}}},  // oblique: sky, ground, clouds
+        {{{8.5, 12, 40}, {9, 12.5, 0}}},      // from above
+        {{{10, 14, 5}, {30, 2, 3}}},          // inside, looking out over the ground
+    }};
+    const uint32_t W = 56, H = 40;
+    for (const auto& v : views) {
+        MetaScene moved = s;
+        std::array<double, 3> eye = v[0], target = v[1];
+        for (int a = 0; a < 3; ++a) {
+            moved.origin[a] = float(s.origin[a] + delta[a]);
+            ASSERT_EQ(double(moved.origin[a]), s.origin[a] + delta[a]);  // exact
+            eye[a] += delta[a];
+            target[a] += delta[a];
+            ASSERT_EQ(double(float(eye[a])), eye[a]);
+        }
+        const CameraSettings here = MetaCamera(v[0], v[1], 70), there = MetaCamera(eye, target, 70);
+        const std::vector<float> a = MetaRenderSplat(*mBackend, s, here, W, H, true, true).rgb;
+        const std::vector<float> b = MetaRenderSplat(*mBackend, moved, there, W, H, true, true).rgb;
+        EXPECT_GT(MetaNonBackground(a), size_t(W) * H / 4);
+        EXPECT_TRUE(a == b) << "splat: " << MetaFirstDifference(a, b, W);
+        if (!HasMarch()) continue;
+        const std::vector<float> c = MetaRenderMarch(*mBackend, s, here, W, H, true, 4);
+        const std::vector<float> d = MetaRenderMarch(*mBackend, moved, there, W, H, true, 4);
+        EXPECT_GT(MetaNonBackground(c), size_t(W) * H / 4);
+        EXPECT_TRUE(c == d) << "march: " << MetaFirstDifference(c, d, W);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, MetamorphicRenderBackend, ::testing::Values("cpu", "vk", "gl"),
+                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+
+}  // namespace
+}  // namespace cb
