@@ -25,7 +25,6 @@
 namespace cb {
 namespace {
 
-
 // A scene of both steps' q, T and (non-empty: ground on) G on a grid of voxel
 // size h whose corner (0, 0, 0) sits at `origin`.
 struct MetaScene {
@@ -74,7 +73,8 @@ MetaImage MetaRenderSplat(Backend& b, const MetaScene& s, const CameraSettings& 
     auto qp = test::MakeFilled(b, BufferFormat::F32, e, s.qPrev);
     auto qc = test::MakeFilled(b, BufferFormat::F32, e, s.qCur);
     auto T = test::MakeFilled(b, BufferFormat::F32, e, s.T);
-    const Extent3 tiles{CeilDiv(e.nx, s.tile), CeilDiv(e.ny, s.tile), 1}, bands{tiles.nx, tiles.ny, CeilDiv(e.nz, s.band)};
+    const Extent3 tiles{CeilDiv(e.nx, s.tile), CeilDiv(e.ny, s.tile), 1},
+        bands{tiles.nx, tiles.ny, CeilDiv(e.nz, s.band)};
     std::unique_ptr<Buffer> occ[2][2], D[2];
     for (int step = 0; step < 2; ++step) {
         D[step] = test::MakeBuffer(b, BufferFormat::F32, {e.nx, e.ny, 1});
@@ -203,9 +203,9 @@ class MetamorphicRenderBackend : public test::BackendTest {
         for (int combo = 1; combo < 5; ++combo) {
             const bool culling = combo & 1, skipping = combo & 2, batch = combo == 4;
             const MetaImage on = MetaRenderSplat(*mBackend, s, cam, W, H, culling || batch, skipping || batch, batch);
-            EXPECT_TRUE(on.rgb == off.rgb) << what << ": culling " << (culling || batch) << ", skipping "
-                                           << (skipping || batch) << (batch ? " in a batch" : "") << ": "
-                                           << MetaFirstDifference(off.rgb, on.rgb, W);
+            EXPECT_TRUE(on.rgb == off.rgb)
+                << what << ": culling " << (culling || batch) << ", skipping " << (skipping || batch)
+                << (batch ? " in a batch" : "") << ": " << MetaFirstDifference(off.rgb, on.rgb, W);
             if (combo == 1) culledSplats = on.splat.splats;
             if (combo == 2) {
                 EXPECT_EQ(on.splat.splats, off.splat.splats) << what << ": skipping lost splats";

@@ -36,7 +36,8 @@ TEST_P(MetamorphicOrigin, MovingTheOriginChangesNothing) {
     for (size_t n = 0; n < s.T.size(); ++n) s.T[n] = 0.3f + 0.7f * float((n * 2654435761u) % 1000) / 1000.0f;
     s.G.resize(size_t(s.grid.nx) * s.grid.ny);
     for (uint32_t j = 0; j < s.grid.ny; ++j)
-        for (uint32_t i = 0; i < s.grid.nx; ++i) s.G[i + s.grid.nx * j] = 0.2f + 0.8f * float((i * 7 + j * 3) % 11) / 10.0f;
+        for (uint32_t i = 0; i < s.grid.nx; ++i)
+            s.G[i + s.grid.nx * j] = 0.2f + 0.8f * float((i * 7 + j * 3) % 11) / 10.0f;
     s.splatDiameter = 3;
     const std::array<double, 3> delta{2048, -4096, 1024};
     const std::array<std::array<std::array<double, 3>, 2>, 3> views = {{

@@ -41,7 +41,7 @@ struct EdgeCase {
     const char* name;
     uint32_t i, j;
     std::array<double, 3> up;
-    bool visible;  // the box stays (and the splat covers pixels)
+    bool visible;        // the box stays (and the splat covers pixels)
     int x0, x1, y0, y1;  // the covered pixels, worked by hand (visible only)
     float size = 8;      // the splat's edge in pixels
 };
@@ -107,7 +107,6 @@ TEST(MetamorphicRender, FrustumEdgeBoxesHandWorked) {
         EXPECT_EQ(splat.y1, c.y1) << c.name;
     }
 }
-
 
 // Test that the splats at the frustum's edges are drawn (the pixels worked by
 // hand differ from the background) and the image is the same with culling and
@@ -218,11 +217,15 @@ TEST_P(MetamorphicRenderBackend, CamerasInsideAndOnFacesChangeNothing) {
         std::array<double, 3> eye, target;
     };
     const Eye eyes[] = {
-        {"inside", {8, 8, 4}, {0, 0, 2}},          {"inside, looking up", {8, 8, 2}, {11, 12, 8}},
+        {"inside", {8, 8, 4}, {0, 0, 2}},
+        {"inside, looking up", {8, 8, 2}, {11, 12, 8}},
         {"inside, other way", {8, 8, 4}, {16, 14, 6}},
-        {"on x = 0", {0, 6, 3}, {16, 10, 4}},       {"on x = 0, along it", {0, 6, 3}, {0, 16, 3}},
-        {"on the top", {7, 9, 8}, {3, 3, 0}},       {"on the top, across", {7, 9, 8}, {12, 5, 4}},
-        {"on a tile edge", {4, 8, 2}, {14, 2, 6}},  {"on a tile edge, back", {4, 8, 2}, {2, 16, 3}},
+        {"on x = 0", {0, 6, 3}, {16, 10, 4}},
+        {"on x = 0, along it", {0, 6, 3}, {0, 16, 3}},
+        {"on the top", {7, 9, 8}, {3, 3, 0}},
+        {"on the top, across", {7, 9, 8}, {12, 5, 4}},
+        {"on a tile edge", {4, 8, 2}, {14, 2, 6}},
+        {"on a tile edge, back", {4, 8, 2}, {2, 16, 3}},
         {"on a corner", {0, 0, 0}, {16, 16, 8}},
     };
     const uint32_t W = 48, H = 40;
@@ -255,8 +258,7 @@ TEST(MetamorphicRender, CulledBoxesHoldNoVisibleSplat) {
         auto point = [&](double margin) {
             std::array<double, 3> p;
             const uint32_t n[3] = {e.nx, e.ny, e.nz};
-            for (int a = 0; a < 3; ++a)
-                p[a] = s.origin[a] + s.h * rng.Uniform(-margin, n[a] + margin);
+            for (int a = 0; a < 3; ++a) p[a] = s.origin[a] + s.h * rng.Uniform(-margin, n[a] + margin);
             return p;
         };
         CameraSettings cam = MetaCamera(point(12), point(0), rng.Uniform(15, 120), {0, 0, 1}, rng.Uniform(0.05, 4));
@@ -266,15 +268,17 @@ TEST(MetamorphicRender, CulledBoxesHoldNoVisibleSplat) {
         const SplatOrder order = MakeSplatOrder(p.camera, e, {s.origin[0], s.origin[1], s.origin[2]}, s.h);
         p.order = &order;
         const SplatFrame F = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
-        const std::vector<uint8_t> boxes = FrustumVisibleBoxes(p.camera, e, s.origin, s.h, s.tile, s.band, s.splatDiameter);
+        const std::vector<uint8_t> boxes =
+            FrustumVisibleBoxes(p.camera, e, s.origin, s.h, s.tile, s.band, s.splatDiameter);
         const uint32_t tilesX = CeilDiv(e.nx, s.tile), tilesY = CeilDiv(e.ny, s.tile);
         for (uint32_t k = 0; k < e.nz; ++k)
             for (uint32_t j = 0; j < e.ny; ++j)
                 for (uint32_t i = 0; i < e.nx; ++i) {
                     Splat splat;
-                    const bool drawn = MakeSplat(F, i, j, k, 1.0f, 1.0f, splat) && splat.x0 <= splat.x1 &&
-                                       splat.y0 <= splat.y1;
-                    const bool visible = boxes[i / s.tile + size_t(tilesX) * (j / s.tile + size_t(tilesY) * (k / s.band))];
+                    const bool drawn =
+                        MakeSplat(F, i, j, k, 1.0f, 1.0f, splat) && splat.x0 <= splat.x1 && splat.y0 <= splat.y1;
+                    const bool visible =
+                        boxes[i / s.tile + size_t(tilesX) * (j / s.tile + size_t(tilesY) * (k / s.band))];
                     drawnVoxels += drawn;
                     if (visible) continue;
                     ++culledVoxels;
