@@ -31,7 +31,7 @@ const Buffer* Simulation::Get(Resource resource, size_t n) const {
     return n < slot.current.size() ? slot.current[n].get() : nullptr;
 }
 
-const Buffer* Simulation::Previous(Resource resource) const { return mSlots[size_t(resource)].previous.get(); }
+const Buffer* Simulation::Previous(Resource resource) const { return mSlots[size_t(resource)].PreviousValue(); }
 
 Buffer& Simulation::Out(Resource resource, size_t n) { return *mSlots[size_t(resource)].current.at(n); }
 
@@ -230,25 +230,20 @@ Status Simulation::RunStepStages(StepRecord& record, bool outputStep) {
         if (d.advancesState || d.renderer || (d.outputStepsOnly && !outputStep)) continue;
         if (d.skipsUnchangedInputs && !InputsChangedSinceLastRun(stage, mStep)) {
             record.skippedUnchanged[size_t(stage)] = true;
+            // Unchanged since step t-1: the renderer interpolates the current value with itself.
+            for (Resource r : d.writes) mSlots[size_t(r)].previousIsCurrent = true;
             continue;
         }
         // Keep step t-1's values for the renderer before they are overwritten.
         for (Resource r : d.writes) {
             Slot& slot = mSlots[size_t(r)];
             if (slot.previous && mStep > 0) std::swap(slot.current[0], slot.previous);
+            // No previous step yet: step 0 is interpolated with itself.
+            slot.previousIsCurrent = mStep == 0;
         }
         CB_TRY(RunStage(stage, record));
         mInputsAtLastRun[size_t(stage)] = InputVersions(stage, mStep);
-        for (Resource r : d.writes) {
-            Slot& slot = mSlots[size_t(r)];
-            ++slot.version;
-            if (slot.previous && mStep == 0) {
-                // No previous step yet: interpolate between step 0 and itself.
-                std::vector<std::byte> copy(slot.previous->CanonicalBytes());
-                CB_TRY(mBackend.Download(*slot.current[0], copy));
-                CB_TRY(mBackend.Upload(*slot.previous, copy));
-            }
-        }
+        for (Resource r : d.writes) ++mSlots[size_t(r)].version;
     }
     // A density stage that skipped (q unchanged) left the cover as it was.
     if (!record.coveredColumns) record.coveredColumns = mLastCoveredColumns;
@@ -476,8 +471,13 @@ Status Simulation::RunShares(const FrameTasks& tasks, StepRecord& record, std::s
 
 void Simulation::CommitAhead(StepRecord& record) {
     for (Slot& slot : mSlots) {
-        if (!slot.ahead) continue;
+        if (!slot.ahead) {
+            // Not computed for this step (its writer skipped): unchanged since the step before.
+            slot.previousIsCurrent = true;
+            continue;
+        }
         slot.ahead = false;
+        slot.previousIsCurrent = false;
         if (slot.next) {
             std::swap(slot.current[0], slot.next);
         } else if (slot.previous) {  // previous <- current <- pending
@@ -502,7 +502,7 @@ StageBuffers Simulation::Buffers() {
     for (Resource r : kAllResources) {
         Slot& slot = mSlots[size_t(r)];
         for (auto& b : slot.current) buffers.current[size_t(r)].push_back(b.get());
-        buffers.previous[size_t(r)] = slot.previous.get();
+        buffers.previous[size_t(r)] = slot.PreviousValue();
         buffers.next[size_t(r)] = slot.next.get();
     }
     return buffers;

@@ -174,6 +174,10 @@ class Simulation {
         uint64_t version = 0;
         // Time-sliced: the next step's value is being computed (in `next` or `pending`); committed when it starts.
         bool ahead = false;
+        // Not written since the step before (its writer skipped, or this is step 0): the previous step's value is
+        // the current one, and `previous` holds nothing a renderer may read.
+        bool previousIsCurrent = false;
+        Buffer* PreviousValue() const { return previous && previousIsCurrent ? current[0].get() : previous.get(); }
     };
     // One share of the next step's work in a frame; no stage: the ellipsoid list update.
     struct ShareTask {

@@ -232,6 +232,7 @@ struct SimulationStateAccess {
             }
             s.versions[size_t(r)] = slot.version;
             s.ahead[size_t(r)] = slot.ahead;
+            s.previousIsCurrent[size_t(r)] = slot.previousIsCurrent;
         }
         s.ellipsoids = sim.mEllipsoids.Items();
         s.rngState = sim.mEllipsoids.Rng().StateWord();
@@ -272,6 +273,7 @@ struct SimulationStateAccess {
         for (Resource r : kAllResources) {
             sim.mSlots[size_t(r)].version = s.versions[size_t(r)];
             sim.mSlots[size_t(r)].ahead = s.ahead[size_t(r)];
+            sim.mSlots[size_t(r)].previousIsCurrent = s.previousIsCurrent[size_t(r)];
         }
         Pcg32 rng(0);
         rng.Restore(s.rngState, s.rngIncrement);
@@ -309,7 +311,9 @@ json ManifestOf(const SimulationState& s) {
                          {"lifetime", e.lifetime}});
     json resources = json::object();
     for (Resource r : kAllResources)
-        resources[std::string(ResourceName(r))] = {{"version", s.versions[size_t(r)]}, {"ahead", s.ahead[size_t(r)]}};
+        resources[std::string(ResourceName(r))] = {{"version", s.versions[size_t(r)]},
+                                                   {"ahead", s.ahead[size_t(r)]},
+                                                   {"previous_is_current", s.previousIsCurrent[size_t(r)]}};
     json inputs = json::object();
     for (Stage stage : kAllStages)
         if (const auto& v = s.inputsAtLastRun[size_t(stage)]) inputs[std::string(StageName(stage))] = *v;
@@ -495,6 +499,8 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
                 s.versions[size_t(r)] = read.Unsigned(*v, field + ".version").value_or(0);
             if (const json* v = read.Find(*entry, "ahead", field + ".ahead"))
                 s.ahead[size_t(r)] = read.Bool(*v, field + ".ahead").value_or(false);
+            if (const json* v = read.Find(*entry, "previous_is_current", field + ".previous_is_current"))
+                s.previousIsCurrent[size_t(r)] = read.Bool(*v, field + ".previous_is_current").value_or(false);
         }
     }
     if (const json* inputs = read.Find(m, "inputs_at_last_run", "inputs_at_last_run")) {

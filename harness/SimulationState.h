@@ -64,6 +64,7 @@ struct SimulationState {
     std::array<std::optional<std::vector<uint64_t>>, kStageCount> inputsAtLastRun{};
     std::array<uint64_t, kResourceCount> versions{};
     std::array<bool, kResourceCount> ahead{};
+    std::array<bool, kResourceCount> previousIsCurrent{};  // not written since the step before
     bool aheadComputed = false, advanceOwed = false;
     StepRecord aheadRecord;  // time-sliced: what the next step's stages recorded so far
 };
