@@ -183,12 +183,18 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                     const uint32_t* rankFast = middleFast ? rankMiddle.data() : rankInner.data();
                     const uint32_t* rankSlow = middleFast ? rankInner.data() : rankMiddle.data();
                     const size_t scaleFast = middleFast ? nInner : 1, scaleSlow = middleFast ? 1 : nInner;
+                    const uint32_t* boxFast = middleFast ? boxMiddle : boxInner;
+                    const uint32_t* boxSlow = middleFast ? boxInner : boxMiddle;
+                    // Only what the walk below reads: q_alpha in visible boxes, T where q_alpha > q_min.
                     for (uint32_t h = 0; h < nSlow; ++h) {
                         const size_t vSlow = vOuter + strideSlow * h, pSlow = scaleSlow * rankSlow[h];
+                        const uint32_t bSlow = bOuter + boxSlow[h];
                         for (uint32_t l = 0; l < nFast; ++l) {
+                            if (!visible[bSlow + boxFast[l]]) continue;
                             const size_t v = vSlow + strideFast * l, at = pSlow + scaleFast * rankFast[l];
-                            qaPlane[at] = SplatQ(qPrev[v], qCur[v], alpha);
-                            tPlane[at] = T[v];
+                            const float qa = SplatQ(qPrev[v], qCur[v], alpha);
+                            qaPlane[at] = qa;
+                            if (qa > qMin) tPlane[at] = T[v];
                         }
                     }
                 }
