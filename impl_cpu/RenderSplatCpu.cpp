@@ -64,6 +64,8 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
     const __m512 vpx = _mm512_set1_ps(s.px), vsize = _mm512_set1_ps(s.size), scale = _mm512_set1_ps(s.alphaScale);
     const __m512 cr = _mm512_set1_ps(s.colour[0]), cg = _mm512_set1_ps(s.colour[1]), cb = _mm512_set1_ps(s.colour[2]);
     const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    float yy[kSplatCpuRowsPerBand];  // y1 - y0 < kSplatCpuRowsPerBand: the rows lie in one band
+    for (int32_t y = y0; y <= y1; ++y) yy[y - y0] = SplatCpuKernelSquare(float(y) + 0.5f, s.py, s.size);
     for (int32_t xb = s.x0 & ~15; xb <= s.x1; xb += 16) {
         const __m512i column = _mm512_add_epi32(_mm512_set1_epi32(xb), iota);
         const __mmask16 m = _mm512_cmpge_epi32_mask(column, _mm512_set1_epi32(s.x0)) &
@@ -73,7 +75,7 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
         const __m512 c = _mm512_sub_ps(_mm512_mul_ps(two, a), one);
         const __m512 xx = _mm512_mul_ps(c, c);
         for (int32_t y = y0; y <= y1; ++y) {
-            const __m512 vyy = _mm512_set1_ps(SplatCpuKernelSquare(float(y) + 0.5f, s.py, s.size));
+            const __m512 vyy = _mm512_set1_ps(yy[y - y0]);
             const __m512 u = _mm512_sub_ps(one, _mm512_add_ps(xx, vyy));
             const __m512 t = _mm512_max_ps(u, zero);
             const __m512 v = _mm512_mul_ps(scale, _mm512_mul_ps(t, t));
@@ -272,10 +274,15 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                 const uint32_t rowLo = b * kSplatCpuRowsPerBand, rowHi = std::min(H, rowLo + kSplatCpuRowsPerBand) - 1;
                 for (uint32_t y = rowLo; y <= rowHi; ++y) {
                     const size_t o = stride * (y - rowLo);
+                    if (!G) {
+                        std::fill_n(pr + o, W, p.background[0]);
+                        std::fill_n(pg + o, W, p.background[1]);
+                        std::fill_n(pb + o, W, p.background[2]);
+                        continue;
+                    }
                     for (uint32_t x = 0; x < W; ++x) {
                         const Vec3 background =
-                            G ? GroundBackground(p.camera, eyeVoxel, p.voxelSize, groundLight, G, e.nx, e.ny, x, y)
-                              : p.background;
+                            GroundBackground(p.camera, eyeVoxel, p.voxelSize, groundLight, G, e.nx, e.ny, x, y);
                         pr[o + x] = background[0];
                         pg[o + x] = background[1];
                         pb[o + x] = background[2];
