@@ -224,38 +224,63 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
         });
     });
 
-    // 3. Bin by bands of rows, keeping the order (counting sort over the
-    // slices in order); the fragments are counted on the way.
+    // 3. Bin by bands of rows, keeping the order: a counting sort in parallel
+    // over runs of consecutive slices (each run counts, then writes from its
+    // own offsets, which follow the earlier runs'), so every band's list is in
+    // slice order; the fragments are counted on the way.
     const std::span<const std::vector<Splat>> slices(mSplatSlices.data(), outerIdx.size());
     const uint32_t bands = CeilDiv(H, kSplatCpuRowsPerBand);
-    std::vector<uint32_t> count(bands + 1, 0);
+    const size_t runs = std::clamp<size_t>(slices.size(), 1, 64), perRun = (slices.size() + runs - 1) / runs;
+    std::vector<uint32_t> runCount(runs * bands, 0);  // runCount[run * bands + band]
+    std::vector<uint64_t> runFragments(runs, 0);
+    mArena.execute([&] {
+        tbb::parallel_for(size_t(0), runs, [&](size_t r) {
+            uint32_t* c = runCount.data() + r * bands;
+            uint64_t f = 0;
+            for (size_t n = r * perRun; n < std::min(slices.size(), (r + 1) * perRun); ++n)
+                for (const Splat& s : slices[n]) {
+                    if (s.x0 > s.x1 || s.y0 > s.y1) continue;
+                    f += uint64_t(s.x1 - s.x0 + 1) * uint64_t(s.y1 - s.y0 + 1);
+                    for (uint32_t b = uint32_t(s.y0) / kSplatCpuRowsPerBand; b <= uint32_t(s.y1) / kSplatCpuRowsPerBand; ++b)
+                        ++c[b];
+                }
+            runFragments[r] = f;
+        });
+    });
     uint64_t splatCount = 0, visited = 0, fragments = 0;
     for (size_t n = 0; n < slices.size(); ++n) {
         visited += visitedPerSlice[n];
         splatCount += slices[n].size();
-        for (const Splat& s : slices[n]) {
-            if (s.x0 > s.x1 || s.y0 > s.y1) continue;
-            fragments += uint64_t(s.x1 - s.x0 + 1) * uint64_t(s.y1 - s.y0 + 1);
-            for (uint32_t b = uint32_t(s.y0) / kSplatCpuRowsPerBand; b <= uint32_t(s.y1) / kSplatCpuRowsPerBand; ++b)
-                ++count[b + 1];
-        }
     }
+    for (uint64_t f : runFragments) fragments += f;
     if (stats) {
         stats->splats = splatCount;
         stats->voxelsVisited = visited;
         stats->fragments = fragments;
     }
-    for (uint32_t b = 0; b < bands; ++b) count[b + 1] += count[b];
-    std::vector<const Splat*> binned(count[bands]);
-    {
-        std::vector<uint32_t> cursor(count.begin(), count.end() - 1);
-        for (const std::vector<Splat>& slice : slices)
-            for (const Splat& s : slice) {
-                if (s.x0 > s.x1 || s.y0 > s.y1) continue;
-                for (uint32_t b = uint32_t(s.y0) / kSplatCpuRowsPerBand; b <= uint32_t(s.y1) / kSplatCpuRowsPerBand; ++b)
-                    binned[cursor[b]++] = &s;
-            }
+    // count[b]: where band b's list starts; runCount becomes each run's cursor.
+    std::vector<uint32_t> count(bands + 1, 0);
+    for (uint32_t b = 0; b < bands; ++b) {
+        uint32_t at = count[b];
+        for (size_t r = 0; r < runs; ++r) {
+            const uint32_t c = runCount[r * bands + b];
+            runCount[r * bands + b] = at;
+            at += c;
+        }
+        count[b + 1] = at;
     }
+    std::vector<const Splat*> binned(count[bands]);
+    mArena.execute([&] {
+        tbb::parallel_for(size_t(0), runs, [&](size_t r) {
+            uint32_t* cursor = runCount.data() + r * bands;
+            for (size_t n = r * perRun; n < std::min(slices.size(), (r + 1) * perRun); ++n)
+                for (const Splat& s : slices[n]) {
+                    if (s.x0 > s.x1 || s.y0 > s.y1) continue;
+                    for (uint32_t b = uint32_t(s.y0) / kSplatCpuRowsPerBand; b <= uint32_t(s.y1) / kSplatCpuRowsPerBand; ++b)
+                        binned[cursor[b]++] = &s;
+                }
+        });
+    });
 
     // 4. Composite each band: C <- alpha c + (1 - alpha) C, from the background,
     // into planar rows of the band (one per channel), then interleave them into
