@@ -10,6 +10,7 @@
 #include "core/Backend.h"
 #include "core/MemoryPlan.h"
 #include "core/Noise.h"
+#include "core/Splat.h"
 #include "impl_cpu/BitField.h"
 
 namespace cb::cpu {
@@ -92,6 +93,7 @@ class BackendCpu : public Backend {
     std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
     std::vector<MarchQT> mMarchVolume;                // render_march: padded (q_alpha, T)
     std::vector<uint8_t> mMarchBricks;                // render_march: empty bricks
+    std::vector<std::vector<Splat>> mSplatSlices;     // render_splat: each outer slice's splats
     // Noise: what does not change per step (permutations, the detail volume),
     // made on the first call and again only when the settings or grid change;
     // and the weather map of one call (coverage only).

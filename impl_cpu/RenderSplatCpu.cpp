@@ -4,12 +4,22 @@
 //      its voxels can make a visible splat (conservatively: the image is the
 //      same with both off).
 //   2. Splats are generated in the shared back-to-front order, one outer-axis
-//      slice per task, and concatenated in order.
-//   3. A counting sort bins them by bands of image rows, keeping their order.
-//   4. Each row band composites its splats in order, in parallel.
-// Every pixel sees its splats in the same order for any thread count.
+//      slice per task; each slice keeps its own list (no concatenation).
+//   3. A counting sort bins pointers to them by bands of image rows, keeping
+//      their order.
+//   4. Each row band composites its splats in order, in parallel, into planar
+//      R, G, B rows (then interleaved into the image once).
+// Every pixel sees its splats in the same order for any thread count, and
+// every pixel's arithmetic is the scalar formula's (SplatCoord, SplatKernel,
+// SplatAlpha, Lerp) operation for operation, so the image is the same bit for
+// bit as one pixel at a time (docs/performance.md, "render_splat on 2 cores").
 #include <algorithm>
 #include <cmath>
+#include <vector>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -20,7 +30,78 @@
 namespace cb::cpu {
 namespace {
 
-constexpr uint32_t kRowsPerBand = 8;
+constexpr uint32_t kSplatCpuRowsPerBand = 8;
+
+// The squared kernel coordinate (2 a - 1)^2 of a splat's pixel whose centre is
+// at `pixelCentre`, as SplatCoord and SplatKernel compute it: a depends only on
+// the pixel's column (or row), so it is worked out once per column (row) of a
+// splat, not once per pixel.
+inline float SplatCpuKernelSquare(float pixelCentre, float centre, float size) {
+    const float x = 2.0f * SplatCoord(pixelCentre, centre, size) - 1.0f;
+    return x * x;
+}
+
+// Blends the rows y0 .. y1 of splat `s` into the band's planar channel rows
+// (R, G, B: rows of `stride` floats, row 0 = image row `rowLo`). Per pixel:
+// alpha = clamp(alphaScale t^2, 0, 1) with t = max(0, 1 - (xx + yy)), xx and
+// yy the squared kernel coordinates of its column and row, then
+// C <- C (1 - alpha) + colour alpha (Lerp).
+inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo, size_t stride, float* R, float* G,
+                          float* B) {
+#if defined(__AVX512F__)
+    // Aligned blocks of sixteen columns, each block's xx kept in a register for
+    // all rows. Loads and stores are whole aligned vectors (the rows are
+    // 64-byte aligned and a multiple of 16 floats long), lanes outside the
+    // splat storing back what they loaded, so that every load meets an earlier
+    // store of exactly the same vector and can be forwarded from it (a load
+    // that overlaps a store only in part waits until the store reaches the
+    // cache; the splats of a band overlap their neighbours' columns). max_ps(a, b)
+    // is a > b ? a : b and min_ps(a, b) is a < b ? a : b, so the operand order
+    // below is std::max(0, u) and std::clamp(v, 0, 1) (std::min(std::max(v, 0),
+    // 1)) as <algorithm> defines them, signed zeros included.
+    const __m512 half = _mm512_set1_ps(0.5f), two = _mm512_set1_ps(2.0f), one = _mm512_set1_ps(1.0f);
+    const __m512 zero = _mm512_setzero_ps();
+    const __m512 vpx = _mm512_set1_ps(s.px), vsize = _mm512_set1_ps(s.size), scale = _mm512_set1_ps(s.alphaScale);
+    const __m512 cr = _mm512_set1_ps(s.colour[0]), cg = _mm512_set1_ps(s.colour[1]), cb = _mm512_set1_ps(s.colour[2]);
+    const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    float yy[kSplatCpuRowsPerBand];  // y1 - y0 < kSplatCpuRowsPerBand: the rows lie in one band
+    for (int32_t y = y0; y <= y1; ++y) yy[y - y0] = SplatCpuKernelSquare(float(y) + 0.5f, s.py, s.size);
+    for (int32_t xb = s.x0 & ~15; xb <= s.x1; xb += 16) {
+        const __m512i column = _mm512_add_epi32(_mm512_set1_epi32(xb), iota);
+        const __mmask16 m = _mm512_cmpge_epi32_mask(column, _mm512_set1_epi32(s.x0)) &
+                            _mm512_cmple_epi32_mask(column, _mm512_set1_epi32(s.x1));
+        // SplatCoord and SplatKernel's x: exact int -> float (|x| < 2^24), then the same operations.
+        const __m512 a = _mm512_add_ps(_mm512_div_ps(_mm512_sub_ps(_mm512_add_ps(_mm512_cvtepi32_ps(column), half), vpx), vsize), half);
+        const __m512 c = _mm512_sub_ps(_mm512_mul_ps(two, a), one);
+        const __m512 xx = _mm512_mul_ps(c, c);
+        for (int32_t y = y0; y <= y1; ++y) {
+            const __m512 vyy = _mm512_set1_ps(yy[y - y0]);
+            const __m512 u = _mm512_sub_ps(one, _mm512_add_ps(xx, vyy));
+            const __m512 t = _mm512_max_ps(u, zero);
+            const __m512 v = _mm512_mul_ps(scale, _mm512_mul_ps(t, t));
+            const __m512 alpha = _mm512_min_ps(one, _mm512_max_ps(zero, v));
+            const __m512 keep = _mm512_sub_ps(one, alpha);
+            const size_t o = stride * uint32_t(y - int32_t(rowLo)) + uint32_t(xb);
+            const __m512 r = _mm512_load_ps(R + o), g = _mm512_load_ps(G + o), b = _mm512_load_ps(B + o);
+            _mm512_store_ps(R + o, _mm512_mask_blend_ps(m, r, _mm512_add_ps(_mm512_mul_ps(r, keep), _mm512_mul_ps(cr, alpha))));
+            _mm512_store_ps(G + o, _mm512_mask_blend_ps(m, g, _mm512_add_ps(_mm512_mul_ps(g, keep), _mm512_mul_ps(cg, alpha))));
+            _mm512_store_ps(B + o, _mm512_mask_blend_ps(m, b, _mm512_add_ps(_mm512_mul_ps(b, keep), _mm512_mul_ps(cb, alpha))));
+        }
+    }
+#else
+    // The per-pixel formula itself.
+    for (int32_t y = y0; y <= y1; ++y) {
+        const float bCoord = SplatCoord(float(y) + 0.5f, s.py, s.size);
+        const size_t o = stride * uint32_t(y - int32_t(rowLo));
+        for (int32_t x = s.x0; x <= s.x1; ++x) {
+            const float alpha = SplatAlpha(s.alphaScale, SplatCoord(float(x) + 0.5f, s.px, s.size), bCoord);
+            R[o + x] = Lerp(R[o + x], s.colour[0], alpha);
+            G[o + x] = Lerp(G[o + x], s.colour[1], alpha);
+            B[o + x] = Lerp(B[o + x], s.colour[2], alpha);
+        }
+    }
+#endif
+}
 
 }  // namespace
 
@@ -51,129 +132,201 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
         bandsCur = {static_cast<const BufferCpu&>(*in.bandsCur).U8(), boxCount};
     }
     const std::vector<uint8_t> boxVisible = SplatBoxVisibility(p, e, bandsPrev, bandsCur);
+    // Per axis: a voxel index's part of its box index and of its voxel index,
+    // so that the walk below adds three numbers instead of dividing per voxel.
+    const uint32_t extent[3] = {e.nx, e.ny, e.nz};
+    const size_t voxelStride[3] = {1, size_t(e.nx), size_t(e.nx) * e.ny};
+    std::vector<uint32_t> boxPart[3];
+    for (int a = 0; a < 3; ++a) {
+        boxPart[a].resize(extent[a]);
+        for (uint32_t n = 0; n < extent[a]; ++n)
+            boxPart[a][n] = a == 0 ? n / p.tile : a == 1 ? tilesX * (n / p.tile) : tilesX * tilesY * (n / p.band);
+    }
 
     // 2. Splats in the shared order: task `n` makes those of the n-th outer slice.
+    // When the inner axis is not x, walking it steps through memory by whole
+    // rows or slices (the view from above: inner z, 256 KiB a step), so each
+    // slice's q_alpha and T are first gathered in memory order into a plane
+    // laid out in the order's ranks, and the walk reads that plane.
     const SplatOrder& order = *p.order;
     const int outer = order.axes[0], middle = order.axes[1], inner = order.axes[2];
     const std::vector<uint32_t>& outerIdx = order.indices[outer];
-    std::vector<std::vector<Splat>> perSlice(outerIdx.size());
+    const std::vector<uint32_t>& middleIdx = order.indices[middle];
+    const std::vector<uint32_t>& innerIdx = order.indices[inner];
+    const uint32_t nMiddle = uint32_t(middleIdx.size()), nInner = uint32_t(innerIdx.size());
+    const bool gather = voxelStride[inner] != 1;
+    std::vector<uint32_t> rankMiddle(nMiddle), rankInner(nInner);
+    for (uint32_t r = 0; r < nMiddle; ++r) rankMiddle[middleIdx[r]] = r;
+    for (uint32_t r = 0; r < nInner; ++r) rankInner[innerIdx[r]] = r;
+    if (mSplatSlices.size() < outerIdx.size()) mSplatSlices.resize(outerIdx.size());
     std::vector<uint64_t> visitedPerSlice(outerIdx.size(), 0);
     const SplatFrame frame = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
+    const float qMin = frame.ambient[3], alpha = p.alpha;
+    const uint8_t* const visible = boxVisible.data();
+    const uint32_t *const boxMiddle = boxPart[middle].data(), *const boxInner = boxPart[inner].data();
+    const size_t strideMiddle = voxelStride[middle], strideInner = voxelStride[inner];
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<float> qaPlane(gather ? size_t(nMiddle) * nInner : 0), tPlane(qaPlane.size());
             for (size_t n = range.begin(); n != range.end(); ++n) {
-                std::vector<Splat>& out = perSlice[n];
+                std::vector<Splat>& out = mSplatSlices[n];
+                out.clear();
+                uint64_t visited = 0;
                 uint32_t idx[3];
                 idx[outer] = outerIdx[n];
-                for (uint32_t mIndex : order.indices[middle]) {
-                    idx[middle] = mIndex;
-                    for (uint32_t iIndex : order.indices[inner]) {
-                        idx[inner] = iIndex;
-                        const uint32_t i = idx[0], j = idx[1], k = idx[2];
-                        if (!boxVisible[i / p.tile + size_t(tilesX) * (j / p.tile + size_t(tilesY) * (k / p.band))])
-                            continue;
-                        ++visitedPerSlice[n];
-                        const uint32_t v = VoxelIndex(e, i, j, k);
-                        Splat s;
-                        if (MakeSplat(frame, i, j, k, SplatQ(qPrev[v], qCur[v], p.alpha), T[v], s)) out.push_back(s);
+                const size_t vOuter = voxelStride[outer] * idx[outer];
+                const uint32_t bOuter = boxPart[outer][idx[outer]];
+                if (gather) {
+                    // Memory order: the axis of the smaller stride innermost.
+                    const bool middleFast = strideMiddle < strideInner;
+                    const uint32_t nFast = middleFast ? nMiddle : nInner, nSlow = middleFast ? nInner : nMiddle;
+                    const size_t strideFast = middleFast ? strideMiddle : strideInner;
+                    const size_t strideSlow = middleFast ? strideInner : strideMiddle;
+                    const uint32_t* rankFast = middleFast ? rankMiddle.data() : rankInner.data();
+                    const uint32_t* rankSlow = middleFast ? rankInner.data() : rankMiddle.data();
+                    const size_t scaleFast = middleFast ? nInner : 1, scaleSlow = middleFast ? 1 : nInner;
+                    const uint32_t* boxFast = middleFast ? boxMiddle : boxInner;
+                    const uint32_t* boxSlow = middleFast ? boxInner : boxMiddle;
+                    // Only what the walk below reads: q_alpha in visible boxes, T where q_alpha > q_min.
+                    for (uint32_t h = 0; h < nSlow; ++h) {
+                        const size_t vSlow = vOuter + strideSlow * h, pSlow = scaleSlow * rankSlow[h];
+                        const uint32_t bSlow = bOuter + boxSlow[h];
+                        for (uint32_t l = 0; l < nFast; ++l) {
+                            if (!visible[bSlow + boxFast[l]]) continue;
+                            const size_t v = vSlow + strideFast * l, at = pSlow + scaleFast * rankFast[l];
+                            const float qa = SplatQ(qPrev[v], qCur[v], alpha);
+                            qaPlane[at] = qa;
+                            if (qa > qMin) tPlane[at] = T[v];
+                        }
                     }
                 }
+                for (uint32_t mr = 0; mr < nMiddle; ++mr) {
+                    const uint32_t mIndex = middleIdx[mr];
+                    idx[middle] = mIndex;
+                    const size_t vMiddle = vOuter + strideMiddle * mIndex;
+                    const uint32_t bMiddle = bOuter + boxMiddle[mIndex];
+                    const float* qaRow = gather ? qaPlane.data() + size_t(nInner) * mr : nullptr;
+                    const float* tRow = gather ? tPlane.data() + size_t(nInner) * mr : nullptr;
+                    for (uint32_t ir = 0; ir < nInner; ++ir) {
+                        const uint32_t iIndex = innerIdx[ir];
+                        if (!visible[bMiddle + boxInner[iIndex]]) continue;
+                        ++visited;
+                        const size_t v = vMiddle + strideInner * iIndex;
+                        const float qa = gather ? qaRow[ir] : SplatQ(qPrev[v], qCur[v], alpha);
+                        if (!(qa > qMin)) continue;  // MakeSplat's first test
+                        idx[inner] = iIndex;
+                        Splat s;
+                        if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, gather ? tRow[ir] : T[v], s)) out.push_back(s);
+                    }
+                }
+                visitedPerSlice[n] = visited;
             }
         });
     });
-    std::vector<Splat> splats;
-    uint64_t visited = 0;
-    {
-        size_t total = 0;
-        for (const auto& slice : perSlice) total += slice.size();
-        splats.reserve(total);
-        for (size_t n = 0; n < perSlice.size(); ++n) {
-            splats.insert(splats.end(), perSlice[n].begin(), perSlice[n].end());
-            visited += visitedPerSlice[n];
-            std::vector<Splat>().swap(perSlice[n]);
-        }
+
+    // 3. Bin by bands of rows, keeping the order: a counting sort in parallel
+    // over runs of consecutive slices (each run counts, then writes from its
+    // own offsets, which follow the earlier runs'), so every band's list is in
+    // slice order; the fragments are counted on the way.
+    const std::span<const std::vector<Splat>> slices(mSplatSlices.data(), outerIdx.size());
+    const uint32_t bands = CeilDiv(H, kSplatCpuRowsPerBand);
+    const size_t runs = std::clamp<size_t>(slices.size(), 1, 64), perRun = (slices.size() + runs - 1) / runs;
+    std::vector<uint32_t> runCount(runs * bands, 0);  // runCount[run * bands + band]
+    std::vector<uint64_t> runFragments(runs, 0);
+    mArena.execute([&] {
+        tbb::parallel_for(size_t(0), runs, [&](size_t r) {
+            uint32_t* c = runCount.data() + r * bands;
+            uint64_t f = 0;
+            for (size_t n = r * perRun; n < std::min(slices.size(), (r + 1) * perRun); ++n)
+                for (const Splat& s : slices[n]) {
+                    if (s.x0 > s.x1 || s.y0 > s.y1) continue;
+                    f += uint64_t(s.x1 - s.x0 + 1) * uint64_t(s.y1 - s.y0 + 1);
+                    for (uint32_t b = uint32_t(s.y0) / kSplatCpuRowsPerBand; b <= uint32_t(s.y1) / kSplatCpuRowsPerBand; ++b)
+                        ++c[b];
+                }
+            runFragments[r] = f;
+        });
+    });
+    uint64_t splatCount = 0, visited = 0, fragments = 0;
+    for (size_t n = 0; n < slices.size(); ++n) {
+        visited += visitedPerSlice[n];
+        splatCount += slices[n].size();
     }
+    for (uint64_t f : runFragments) fragments += f;
     if (stats) {
-        stats->splats = splats.size();
+        stats->splats = splatCount;
         stats->voxelsVisited = visited;
+        stats->fragments = fragments;
     }
-
-    // 3. Bin by bands of rows, keeping the order (counting sort).
-    const uint32_t bands = CeilDiv(H, kRowsPerBand);
+    // count[b]: where band b's list starts; runCount becomes each run's cursor.
     std::vector<uint32_t> count(bands + 1, 0);
-    auto bandRange = [&](const Splat& s, uint32_t& b0, uint32_t& b1) {
-        if (s.x0 > s.x1 || s.y0 > s.y1) return false;
-        b0 = uint32_t(s.y0) / kRowsPerBand;
-        b1 = uint32_t(s.y1) / kRowsPerBand;
-        return true;
-    };
-    for (const Splat& s : splats) {
-        uint32_t b0, b1;
-        if (bandRange(s, b0, b1))
-            for (uint32_t b = b0; b <= b1; ++b) ++count[b + 1];
-    }
-    for (uint32_t b = 0; b < bands; ++b) count[b + 1] += count[b];
-    if (stats) {
-        stats->fragments = 0;
-        for (const Splat& s : splats)
-            if (s.x0 <= s.x1 && s.y0 <= s.y1) stats->fragments += uint64_t(s.x1 - s.x0 + 1) * uint64_t(s.y1 - s.y0 + 1);
-    }
-    std::vector<uint32_t> binned(count[bands]);
-    {
-        std::vector<uint32_t> cursor(count.begin(), count.end() - 1);
-        for (uint32_t n = 0; n < splats.size(); ++n) {
-            uint32_t b0, b1;
-            if (bandRange(splats[n], b0, b1))
-                for (uint32_t b = b0; b <= b1; ++b) binned[cursor[b]++] = n;
+    for (uint32_t b = 0; b < bands; ++b) {
+        uint32_t at = count[b];
+        for (size_t r = 0; r < runs; ++r) {
+            const uint32_t c = runCount[r * bands + b];
+            runCount[r * bands + b] = at;
+            at += c;
         }
+        count[b + 1] = at;
     }
+    std::vector<const Splat*> binned(count[bands]);
+    mArena.execute([&] {
+        tbb::parallel_for(size_t(0), runs, [&](size_t r) {
+            uint32_t* cursor = runCount.data() + r * bands;
+            for (size_t n = r * perRun; n < std::min(slices.size(), (r + 1) * perRun); ++n)
+                for (const Splat& s : slices[n]) {
+                    if (s.x0 > s.x1 || s.y0 > s.y1) continue;
+                    for (uint32_t b = uint32_t(s.y0) / kSplatCpuRowsPerBand; b <= uint32_t(s.y1) / kSplatCpuRowsPerBand; ++b)
+                        binned[cursor[b]++] = &s;
+                }
+        });
+    });
 
-    // 4. Composite each band: C <- alpha c + (1 - alpha) C, from the background.
-    // A splat row is blended as one run of floats (RGB interleaved): first the
-    // alphas of its pixels, spread to their three channels, and the splat's
-    // colour repeated, then one contiguous loop the compiler vectorises. The
-    // arithmetic per channel is the scalar formula's, so the image is the same.
+    // 4. Composite each band: C <- alpha c + (1 - alpha) C, from the background,
+    // into planar rows of the band (one per channel), then interleave them into
+    // the image. Per splat the squared kernel coordinate of each of its columns
+    // is worked out once (the division), per row once more; each pixel then
+    // adds, clamps and blends (SplatCpuBlendRow).
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, bands), [&](const tbb::blocked_range<uint32_t>& range) {
-            std::vector<float> alphaRun(3 * size_t(W)), colourRun(3 * size_t(W));
+            // Rows of `stride` floats, 64-byte aligned (SplatCpuBlend's aligned blocks).
+            const size_t stride = (size_t(W) + 15) & ~size_t(15), plane = kSplatCpuRowsPerBand * stride;
+            std::vector<float> planes(3 * plane + 16);
+            float* const pr = planes.data() + (16 - (reinterpret_cast<uintptr_t>(planes.data()) / sizeof(float)) % 16) % 16;
+            float* const pg = pr + plane;
+            float* const pb = pg + plane;
             for (uint32_t b = range.begin(); b != range.end(); ++b) {
-                const uint32_t rowLo = b * kRowsPerBand, rowHi = std::min(H, rowLo + kRowsPerBand) - 1;
+                const uint32_t rowLo = b * kSplatCpuRowsPerBand, rowHi = std::min(H, rowLo + kSplatCpuRowsPerBand) - 1;
                 for (uint32_t y = rowLo; y <= rowHi; ++y) {
-                    float* row = image + size_t(3) * W * y;
+                    const size_t o = stride * (y - rowLo);
+                    if (!G) {
+                        std::fill_n(pr + o, W, p.background[0]);
+                        std::fill_n(pg + o, W, p.background[1]);
+                        std::fill_n(pb + o, W, p.background[2]);
+                        continue;
+                    }
                     for (uint32_t x = 0; x < W; ++x) {
                         const Vec3 background =
-                            G ? GroundBackground(p.camera, eyeVoxel, p.voxelSize, groundLight, G, e.nx, e.ny, x, y)
-                              : p.background;
-                        for (int c = 0; c < 3; ++c) row[3 * x + c] = background[c];
+                            GroundBackground(p.camera, eyeVoxel, p.voxelSize, groundLight, G, e.nx, e.ny, x, y);
+                        pr[o + x] = background[0];
+                        pg[o + x] = background[1];
+                        pb[o + x] = background[2];
                     }
                 }
-                float* alphas = alphaRun.data();
-                float* colours = colourRun.data();
-                for (uint32_t n = count[b]; n < count[b + 1]; ++n) {
-                    const Splat& s = splats[binned[n]];
+                const uint32_t end = count[b + 1];
+                for (uint32_t n = count[b]; n < end; ++n) {
+                    if (n + 8 < end) __builtin_prefetch(binned[n + 8]);  // the splats of a band lie apart in memory
+                    const Splat& s = *binned[n];
                     const int32_t y0 = std::max<int32_t>(s.y0, int32_t(rowLo)), y1 = std::min<int32_t>(s.y1, int32_t(rowHi));
-                    if (y0 > y1) continue;
-                    const int32_t width = s.x1 - s.x0 + 1;  // <= W: MakeSplat clamps the range to the image
-                    const float r = s.colour[0], g = s.colour[1], bl = s.colour[2];
-                    for (int32_t i = 0; i < width; ++i) {
-                        colours[3 * i] = r;
-                        colours[3 * i + 1] = g;
-                        colours[3 * i + 2] = bl;
-                    }
-                    const float px = s.px, size = s.size, alphaScale = s.alphaScale;
-                    const int32_t x0 = s.x0;
-                    for (int32_t y = y0; y <= y1; ++y) {
-                        const float bCoord = SplatCoord(float(y) + 0.5f, s.py, size);
-                        for (int32_t i = 0; i < width; ++i) {
-                            const float alpha =
-                                SplatAlpha(alphaScale, SplatCoord(float(x0 + i) + 0.5f, px, size), bCoord);
-                            alphas[3 * i] = alpha;
-                            alphas[3 * i + 1] = alpha;
-                            alphas[3 * i + 2] = alpha;
-                        }
-                        float* run = image + size_t(3) * (size_t(W) * uint32_t(y) + uint32_t(x0));
-                        for (int32_t j = 0; j < 3 * width; ++j)
-                            run[j] = Lerp(run[j], colours[j], alphas[j]);
+                    if (y0 <= y1) SplatCpuBlend(s, y0, y1, rowLo, stride, pr, pg, pb);
+                }
+                for (uint32_t y = rowLo; y <= rowHi; ++y) {
+                    const size_t o = stride * (y - rowLo);
+                    float* row = image + size_t(3) * W * y;
+                    for (uint32_t x = 0; x < W; ++x) {
+                        row[3 * x] = pr[o + x];
+                        row[3 * x + 1] = pg[o + x];
+                        row[3 * x + 2] = pb[o + x];
                     }
                 }
             }

@@ -275,7 +275,7 @@ void Register() {
                 ->ArgsProduct({{1, 2, 4, 8, 16}, {25, 45}, {0}})
                 ->Unit(benchmark::kMillisecond)->UseRealTime();
         benchmark::RegisterBenchmark(("RenderSplat/" + s).c_str(), BM_RenderSplat, s)
-            ->ArgsProduct({{2}, {0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+            ->ArgsProduct({{2}, {0, 1}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
     }
     for (PhaseKind kind : {PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie})
         benchmark::RegisterBenchmark(("PhaseValue/" + std::string(PhaseKindName(kind))).c_str(), BM_PhaseValue, kind);
