@@ -41,6 +41,16 @@ SCRIPT_DIR = os.path.dirname(os.path.abspath(__file__))
 CALLER_ROOT = os.path.dirname(SCRIPT_DIR)
 
 
+SCENES = {"conform": "ci-small", "medium": "thesis-medium"}
+
+
+def timeout_of(args, oracle, baseline=None):
+    """The oracle's timeout: its option, or three times its time on the unmutated tree when that is longer."""
+    limit = {"conform": args.conform_timeout, "ctest": args.ctest_timeout, "medium": args.medium_timeout}[oracle]
+    seconds = ((baseline or {}).get("oracles", {}).get(oracle) or {}).get("seconds")
+    return max(limit, 3 * seconds + 30) if seconds else limit
+
+
 def log(msg):
     print(f"mutate: {msg}", flush=True)
 
@@ -231,10 +241,16 @@ def oracle_ctest(args, build, logs, mid, exclude, env):
     if os.path.exists(junit):
         os.remove(junit)
     cmd = ctest_cmd(build, exclude, args.jobs, junit, args.test_timeout, not args.all_oracles)
-    rc, secs = run(cmd, None, log_path, args.ctest_timeout, env)
+    # Without cost data CTest runs the tests in their declared order, unit tests before the long CLI runs, so a
+    # stop at the first failure comes sooner; the data of the last run would put the longest tests first.
+    cost = os.path.join(build, "Testing", "Temporary", "CTestCostData.txt")
+    if os.path.exists(cost):
+        os.remove(cost)
+    limit = timeout_of(args, "ctest", getattr(args, "baseline", None))
+    rc, secs = run(cmd, None, log_path, limit, env)
     result = {"seconds": round(secs, 1), "exit": rc}
     if rc is None:
-        result.update(caught=True, timeout=True, failed=[f"ctest ran past {args.ctest_timeout} s (a hang counts as caught)"])
+        result.update(caught=True, timeout=True, failed=[f"ctest ran past {limit:.0f} s (a hang counts as caught)"])
     elif rc == 0:
         result.update(caught=False)
     else:
@@ -339,7 +355,8 @@ def apply_and_test(m, args, tree, build_dir, out, logs, exclude, env):
                 for oracle in ("conform",):
                     if oracle not in args.oracles:
                         continue
-                    o = oracle_conform("ci-small", tree, build_dir, out, logs, m["id"], args.conform_timeout, env)
+                    o = oracle_conform("ci-small", tree, build_dir, out, logs, m["id"],
+                                       timeout_of(args, "conform", args.baseline), env)
                     result["oracles"][oracle] = o
                     if o["caught"] and "caught_by" not in result:
                         result.update(caught_by=oracle, failed=o["failed"])
@@ -349,7 +366,8 @@ def apply_and_test(m, args, tree, build_dir, out, logs, exclude, env):
             if oracle == "ctest":
                 o = oracle_ctest(args, build_dir, logs, m["id"], exclude, env)
             else:
-                o = oracle_conform("thesis-medium", tree, build_dir, out, logs, m["id"], args.medium_timeout, env)
+                o = oracle_conform("thesis-medium", tree, build_dir, out, logs, m["id"],
+                                   timeout_of(args, "medium", args.baseline), env)
             result["oracles"][oracle] = o
             if o["caught"] and "caught_by" not in result:
                 result.update(caught_by=oracle, failed=o["failed"])
@@ -450,31 +468,37 @@ def main():
     try:
         configure(tree, build_dir, logs, env)
         log(f"tree {tree} at {commit[:10]}, build {build_dir}")
-        if not results.get("baseline"):
+        baseline = results.get("baseline") or {}
+        if "build_seconds" not in baseline:
             log("baseline build (all targets)")
             rc, secs = build(build_dir, ["all"], args.jobs, os.path.join(logs, "baseline.build.log"), env,
                              args.build_timeout)
             if rc != 0:
                 sys.exit(f"mutate: the unmutated tree does not build; see {logs}/baseline.build.log")
             baseline = {"build_seconds": round(secs, 1), "oracles": {}, "ctest_baseline_failures": []}
-            if not args.skip_baseline:
-                for oracle in args.oracles:
-                    if oracle == "ctest":
-                        o = oracle_ctest(argparse.Namespace(**{**vars(args), "all_oracles": True}), build_dir, logs,
-                                         "baseline", ALWAYS_EXCLUDED if not args.ctest_exclude else
-                                         f"{args.ctest_exclude}|{ALWAYS_EXCLUDED}", env)
-                        baseline["ctest_baseline_failures"] = o.get("failed", []) if o["caught"] else []
-                    else:
-                        o = oracle_conform("ci-small" if oracle == "conform" else "thesis-medium", tree, build_dir,
-                                           out, logs, "baseline", args.conform_timeout if oracle == "conform"
-                                           else args.medium_timeout, env)
-                        if o["caught"]:
-                            sys.exit(f"mutate: {oracle} fails on the unmutated tree: {o['failed'][:3]}; "
-                                     f"see {logs}/baseline.*.log")
-                    baseline["oracles"][oracle] = o
-                    log(f"baseline {oracle}: {o['seconds']} s" + (f", failing {o.get('failed')}" if o["caught"] else ""))
-            results["baseline"] = baseline
+        results["baseline"] = baseline
+        for oracle in ([] if args.skip_baseline else args.oracles):
+            if oracle in baseline["oracles"]:
+                continue
+            limit = timeout_of(args, oracle)
+            if oracle == "ctest":
+                # The whole suite, not stopping at a failure, to learn which tests fail without any mutant.
+                o = oracle_ctest(argparse.Namespace(**{**vars(args), "all_oracles": True}), build_dir, logs,
+                                 "baseline", f"{args.ctest_exclude}|{ALWAYS_EXCLUDED}" if args.ctest_exclude
+                                 else ALWAYS_EXCLUDED, env)
+                baseline["ctest_baseline_failures"] = o.get("failed", []) if o["caught"] else []
+            else:
+                o = oracle_conform(SCENES[oracle], tree, build_dir, out, logs, "baseline", limit, env)
+            if o.get("timeout") and oracle != "ctest" or (oracle == "ctest" and o["exit"] is None):
+                sys.exit(f"mutate: {oracle} ran past its {limit:.0f} s on the unmutated tree: raise "
+                         f"--{oracle}-timeout or leave it out with --oracles")
+            if o["caught"] and oracle != "ctest":
+                sys.exit(f"mutate: {oracle} fails on the unmutated tree: {o['failed'][:3]}; see {logs}/baseline.*.log")
+            baseline["oracles"][oracle] = o
             write_json(results_path, results)
+            log(f"baseline {oracle}: {o['seconds']} s" + (f", failing {o.get('failed')}" if o["caught"] else ""))
+        write_json(results_path, results)
+        args.baseline = results["baseline"]
         # Tests that fail on the unmutated tree cannot tell us anything: leave them out, by exact name.
         known = [re.escape(n) for n in results["baseline"].get("ctest_baseline_failures", []) if not n.startswith("ctest ")]
         exclude = "|".join(x for x in [args.ctest_exclude, ALWAYS_EXCLUDED] + [f"^{n}$" for n in known] if x)
