@@ -348,6 +348,7 @@ def apply_and_test(m, args, tree, build_dir, out, logs, exclude, env):
                              args.build_timeout)
             build_secs += secs
             result["build_seconds"] = round(build_secs, 1)
+            result[f"build_{stage}_seconds"] = round(secs, 1)
             if rc != 0:
                 result.update(status="build-broken", build_error=tail(os.path.join(logs, f"{m['id']}.build.log"), 25))
                 return result
