@@ -469,13 +469,15 @@ def main():
     try:
         configure(tree, build_dir, logs, env)
         log(f"tree {tree} at {commit[:10]}, build {build_dir}")
+        # Always rebuild the unmutated tree first: the build folder still holds the objects of the last mutant of an
+        # earlier run (its source was restored, so this rebuild is incremental), and the baseline must not see them.
         baseline = results.get("baseline") or {}
+        log("baseline build (all targets)")
+        rc, secs = build(build_dir, ["all"], args.jobs, os.path.join(logs, "baseline.build.log"), env,
+                         args.build_timeout)
+        if rc != 0:
+            sys.exit(f"mutate: the unmutated tree does not build; see {logs}/baseline.build.log")
         if "build_seconds" not in baseline:
-            log("baseline build (all targets)")
-            rc, secs = build(build_dir, ["all"], args.jobs, os.path.join(logs, "baseline.build.log"), env,
-                             args.build_timeout)
-            if rc != 0:
-                sys.exit(f"mutate: the unmutated tree does not build; see {logs}/baseline.build.log")
             baseline = {"build_seconds": round(secs, 1), "oracles": {}, "ctest_baseline_failures": []}
         results["baseline"] = baseline
         for oracle in ([] if args.skip_baseline else args.oracles):
