@@ -224,7 +224,8 @@ struct SimulationStateAccess {
                 return {};
             };
             for (size_t n = 0; n < slot.current.size(); ++n) CB_TRY(add(slot.current[n], BufferRole::Current, uint32_t(n)));
-            CB_TRY(add(slot.previous, BufferRole::Previous, 0));
+            // `previous` is not saved: the next step either rewrites it (its writer runs and swaps the current value
+            // in) or does not read it (the writer skips: previous_is_current).
             // The next step's third set holds a value only while time-sliced work is ahead.
             if (slot.ahead) {
                 CB_TRY(add(slot.next, BufferRole::Next, 0));
@@ -546,7 +547,8 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
     };
     std::vector<Expected> expected;
     for (const PlannedBuffer& p : PlanBuffers(scene)) {
-        const bool needed = p.role == BufferRole::Current || p.role == BufferRole::Previous || s.ahead[size_t(p.resource)];
+        const bool thirdSet = p.role == BufferRole::Next || p.role == BufferRole::Pending;
+        const bool needed = p.role == BufferRole::Current || (thirdSet && s.ahead[size_t(p.resource)]);
         if (needed) expected.push_back({p});
     }
     const json* list = read.Array(m, "buffers", "buffers");

@@ -221,9 +221,9 @@ TEST_P(SimulationStateSplit, SplitRunEqualsTheUnsplitRun) {
 }
 
 // A still field: noise forms q once (step 0) and skips after, so q, D, tiles and bands keep their step-0 values and
-// the renderer interpolates Previous (q_0) and current (q_0) at every step. The saved Previous is read at every
-// resumed step here (in the automaton scene each step's smooth overwrites it first).
-TEST_P(SimulationStateSplit, SplitRunOfAStillFieldKeepsPrevious) {
+// the renderer interpolates the current value (q_0) with itself at every step: the saved previous_is_current flags
+// and skip state are read at every resumed step here (in the automaton scene each step's smooth runs).
+TEST_P(SimulationStateSplit, SplitRunOfAStillField) {
     if (!mBackend->Supports(Stage::Noise)) GTEST_SKIP() << GetParam() << " has no noise stage";
     const Scene scene = SavedRunScene({
         {"stages", R"(["noise", "density", "shade", "shadow", "render_splat"])"},
@@ -335,14 +335,17 @@ TEST_F(SimulationStateFiles, ReadsBackWhatWasSaved) {
     auto state = ReadSimulationState(mDir, mScene, kStateTestHash);
     ASSERT_TRUE(state.has_value()) << state.error().message;
     EXPECT_EQ(state->step, 3u);
-    // q_t and q_{t-1} for the interpolating renderer, the state, the image; no third set unsliced.
+    // q_t, the state, the image; not q_{t-1} (the next step rewrites or does not read it); no third set unsliced.
     std::set<std::string> files;
     for (const auto& entry : fs::directory_iterator(mDir)) files.insert(entry.path().filename().string());
     for (const char* f : {"manifest.json", "hum.current.npy", "act.current.npy", "cld.current.npy", "q.current.npy",
-                          "q.previous.npy", "region.current.npy", "T.current.npy", "G.current.npy",
+                          "region.current.npy", "T.current.npy", "G.current.npy",
                           "image_splat.current.0.npy"})
         EXPECT_TRUE(files.count(f)) << f;
-    for (const std::string& f : files) EXPECT_EQ(f.find("pending"), std::string::npos) << f;
+    for (const std::string& f : files) {
+        EXPECT_EQ(f.find("pending"), std::string::npos) << f;
+        EXPECT_EQ(f.find("previous"), std::string::npos) << f;
+    }
     // The .npy files are plain NumPy arrays shaped (nz, ny, nx).
     auto q = ReadNpy(mDir + "/q.current.npy");
     ASSERT_TRUE(q.has_value());
@@ -439,10 +442,10 @@ TEST_F(SimulationStateFiles, MissingBufferEntry) {
     nlohmann::json m = ReadManifest();
     nlohmann::json kept = nlohmann::json::array();
     for (const auto& b : m["buffers"])
-        if (b["file"] != "q.previous.npy") kept.push_back(b);
+        if (b["file"] != "q.current.npy") kept.push_back(b);
     m["buffers"] = kept;
     WriteManifest(m);
-    EXPECT_EQ(ErrorOfRead(), Manifest() + ": buffers: no entry for q.previous.npy");
+    EXPECT_EQ(ErrorOfRead(), Manifest() + ": buffers: no entry for q.current.npy");
 }
 
 TEST_F(SimulationStateFiles, TruncatedNpy) {
