@@ -116,21 +116,10 @@ std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sce
     return cases;
 }
 
-std::vector<ConformCase> ConformVaryCases(const std::vector<ConformAxis>& axes) {
+std::vector<ConformCase> ConformVaryCases(const std::vector<SweepAxis>& axes) {
     if (axes.empty()) return {};
-    std::vector<std::vector<SceneOverride>> points = {{}};
-    for (const ConformAxis& axis : axes) {
-        std::vector<std::vector<SceneOverride>> next;
-        for (const auto& p : points)
-            for (const std::string& v : axis.values) {
-                auto q = p;
-                q.push_back({axis.path, v});
-                next.push_back(std::move(q));
-            }
-        points = std::move(next);
-    }
     std::vector<ConformCase> cases;
-    for (auto& p : points) cases.push_back({ConformCaseName(p, std::nullopt), std::move(p), std::nullopt, {}});
+    for (auto& p : VaryPoints(axes)) cases.push_back({ConformCaseName(p, std::nullopt), std::move(p), std::nullopt, {}});
     return cases;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/Scene.h"
+#include "harness/commands/SweepOutput.h"
 #include "registry/Registry.h"
 
 namespace cb {
@@ -44,11 +45,7 @@ std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sce
 
 // The cartesian product of --vary PATH=V1,V2 axes as cases, in sweep's order
 // (the last axis fastest); no axes: none.
-struct ConformAxis {
-    std::string path;
-    std::vector<std::string> values;
-};
-std::vector<ConformCase> ConformVaryCases(const std::vector<ConformAxis>& axes);
+std::vector<ConformCase> ConformVaryCases(const std::vector<SweepAxis>& axes);
 
 // The scene's value of a path the built-in set varies, as --set writes it
 // ("2", "true", "fp16", ...); nullopt for any other path.

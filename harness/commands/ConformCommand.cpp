@@ -115,14 +115,14 @@ int Conform(const CommonOptions& options) {
         }
         baseline = std::move(*loaded);
     }
-    std::vector<ConformAxis> axes;
+    std::vector<SweepAxis> axes;
     if (!options.vary.empty()) {
         auto parsed = ParseVaryAxes(options.vary);
         if (!parsed) {
             std::fprintf(stderr, "conform: %s\n", parsed.error().c_str());
             return kExitUsage;
         }
-        for (SweepAxis& a : *parsed) axes.push_back({std::move(a.path), std::move(a.values)});
+        axes = std::move(*parsed);
     }
     auto session = Session::Open(options, "conform");
     if (!session) return session.error();

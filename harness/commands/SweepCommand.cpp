@@ -107,17 +107,7 @@ namespace {
 // scene before anything runs; kExitBadScene (after the message) on a bad point.
 std::expected<std::vector<std::vector<SceneOverride>>, int> Points(const Session& session,
                                                                    const std::vector<Axis>& axes) {
-    std::vector<std::vector<SceneOverride>> points = {{}};
-    for (const Axis& axis : axes) {
-        std::vector<std::vector<SceneOverride>> next;
-        for (const auto& p : points)
-            for (const std::string& v : axis.values) {
-                auto q = p;
-                q.push_back({axis.path, v});
-                next.push_back(std::move(q));
-            }
-        points = std::move(next);
-    }
+    std::vector<std::vector<SceneOverride>> points = VaryPoints(axes);
     for (const auto& point : points) {
         if (auto s = session.LoadVariant(point); !s) {
             std::fprintf(stderr, "sweep: --vary point %s:\n%s\n", SettingsLabel(point).c_str(),

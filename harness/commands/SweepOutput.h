@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/Error.h"
+#include "core/Scene.h"
 #include "harness/Measurement.h"
 
 namespace cb {
@@ -24,6 +25,10 @@ struct SweepAxis {
 // brackets, braces and quotes); a usage message when one is malformed. Used by
 // sweep and conform.
 std::expected<std::vector<SweepAxis>, std::string> ParseVaryAxes(const std::vector<std::string>& vary);
+
+// The cartesian product of the axes' values, the last axis fastest: one list of
+// overrides per point; no axes: one empty point.
+std::vector<std::vector<SceneOverride>> VaryPoints(const std::vector<SweepAxis>& axes);
 
 // Pareto front per stage: no other ok row is at least as fast and as accurate
 // (on `metric`: max, mean or p99) and strictly better in one.
