@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/Scene.h"
-#include "harness/commands/SweepOutput.h"
+#include "harness/VaryAxes.h"
 #include "registry/Registry.h"
 
 namespace cb {

@@ -145,19 +145,4 @@ int WriteSweepOutputs(json doc, const std::string& sceneName, const std::string&
     return kExitOk;
 }
 
-std::vector<std::vector<SceneOverride>> VaryPoints(const std::vector<SweepAxis>& axes) {
-    std::vector<std::vector<SceneOverride>> points = {{}};
-    for (const SweepAxis& axis : axes) {
-        std::vector<std::vector<SceneOverride>> next;
-        for (const auto& p : points)
-            for (const std::string& v : axis.values) {
-                auto q = p;
-                q.push_back({axis.path, v});
-                next.push_back(std::move(q));
-            }
-        points = std::move(next);
-    }
-    return points;
-}
-
 }  // namespace cb

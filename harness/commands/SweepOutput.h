@@ -10,25 +10,15 @@
 #include <vector>
 
 #include "core/Error.h"
-#include "core/Scene.h"
 #include "harness/Measurement.h"
+#include "harness/VaryAxes.h"
 
 namespace cb {
-
-// One --vary field and its values, in the order given.
-struct SweepAxis {
-    std::string path;
-    std::vector<std::string> values;
-};
 
 // The --vary PATH=V1,V2,... arguments as axes (values split at commas outside
 // brackets, braces and quotes); a usage message when one is malformed. Used by
 // sweep and conform.
 std::expected<std::vector<SweepAxis>, std::string> ParseVaryAxes(const std::vector<std::string>& vary);
-
-// The cartesian product of the axes' values, the last axis fastest: one list of
-// overrides per point; no axes: one empty point.
-std::vector<std::vector<SceneOverride>> VaryPoints(const std::vector<SweepAxis>& axes);
 
 // Pareto front per stage: no other ok row is at least as fast and as accurate
 // (on `metric`: max, mean or p99) and strictly better in one.
