@@ -119,7 +119,8 @@ std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sce
 std::vector<ConformCase> ConformVaryCases(const std::vector<SweepAxis>& axes) {
     if (axes.empty()) return {};
     std::vector<ConformCase> cases;
-    for (auto& p : VaryPoints(axes)) cases.push_back({ConformCaseName(p, std::nullopt), std::move(p), std::nullopt, {}});
+    for (auto& p : VaryPoints(axes))
+        cases.push_back({ConformCaseName(p, std::nullopt), std::move(p), std::nullopt, {}});
     return cases;
 }
 
