@@ -8,8 +8,9 @@
 // current buffers, per-camera images included; the next step's third set
 // while time-sliced work is ahead; not the previous step's, which the next
 // step rewrites before a renderer reads it, or does not read at all), read
-// back in the canonical layout of SPEC 0, so any backend can upload it; the ellipsoid list with its Pcg32 state; the ellipsoids step t's
-// region came from (and, time-sliced, step t+1's); the last rendered step
+// back in the canonical layout of SPEC 0, so any backend can upload it; the
+// ellipsoid list with its Pcg32 state; the ellipsoids step t's region came
+// from (and, time-sliced, step t+1's); the last rendered step
 // and cover; each resource's write count and each stage's input versions at
 // its last run (so that stages skip exactly as in the unsplit run); and the
 // time-slicing state. A run resumed from it continues exactly as the unsplit
