@@ -135,7 +135,16 @@ Result<std::unique_ptr<GLContext>> GLContext::Create(ContextKind kind) {
     return ctx;
 }
 
+void GLContext::MakeCurrent() const {
+    if (mOsmesa && OSMesaGetCurrentContext() != mOsmesa)
+        OSMesaMakeCurrent(static_cast<OSMesaContext>(mOsmesa), mOsmesaBuffer.get(), GL_UNSIGNED_BYTE, 4, 4);
+    if (mEglContext && eglGetCurrentContext() != mEglContext)
+        eglMakeCurrent(mEglDisplay, EGL_NO_SURFACE, EGL_NO_SURFACE, mEglContext);
+}
+
 GLContext::~GLContext() {
+    // The objects are this context's: delete them with it current, not another's of the same names.
+    MakeCurrent();
     if (mF.DeleteProgram) {
         for (auto& [name, program] : mPrograms) mF.DeleteProgram(program);
         if (mVao) mF.DeleteVertexArrays(1, &mVao);
@@ -159,12 +168,12 @@ std::string GLContext::Renderer() const {
 }
 
 std::string GLContext::String(GLenum name) const {
-    const char* text = reinterpret_cast<const char*>(mF.GetString(name));
+    const char* text = reinterpret_cast<const char*>(F().GetString(name));
     return text ? text : "?";
 }
 
 Status GLContext::Check(const char* what) const {
-    const GLenum e = mF.GetError();
+    const GLenum e = F().GetError();
     if (e == GL_NO_ERROR) return {};
     return MakeError(std::string("gl: ") + what + ": " + ErrorName(e));
 }
@@ -207,6 +216,7 @@ Result<GLuint> GLContext::LayeredProgram(const std::string& name, const std::str
 }
 
 Result<GLuint> GLContext::LinkProgram(const std::string& name, const std::string* vertex, const std::string& fragment) {
+    MakeCurrent();
     auto vs = Compile(mF, GL_VERTEX_SHADER, vertex ? *vertex : std::string(kFullScreenVertex), name + " vertex");
     if (!vs) return std::unexpected(vs.error());
     auto fs = Compile(mF, GL_FRAGMENT_SHADER, fragment, name + " fragment");

@@ -21,7 +21,16 @@ class GLContext {
     GLContext(const GLContext&) = delete;
     GLContext& operator=(const GLContext&) = delete;
 
-    const Functions& F() const { return mF; }
+    // The GL functions, with this context made current on the calling thread
+    // first: a process may hold several contexts (backends, tests), and GL
+    // calls go to whichever is current.
+    const Functions& F() const {
+        MakeCurrent();
+        return mF;
+    }
+    // Makes this context current where another one, or none, is (cheap when it
+    // already is).
+    void MakeCurrent() const;
     // GL_RENDERER, then the context kind: "llvmpipe (...) (OSMesa)".
     std::string Renderer() const;
     // Whether the renderer is a software rasterizer (llvmpipe, softpipe), where

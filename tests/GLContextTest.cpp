@@ -5,6 +5,7 @@
 
 #if CLOUDBENCH_HAVE_GL
 #include "impl_gl/GLContext.h"
+#include "registry/Registry.h"
 
 namespace cb::gl {
 namespace {
@@ -47,6 +48,51 @@ TEST_F(GLContextTest, EveryEmbeddedPassLinks) {
         EXPECT_TRUE(program.has_value()) << pass << ": " << program.error().message;
     }
     EXPECT_FALSE(mContext->Program("no_such_pass").has_value());
+}
+
+// Several gl backends in one process (tests, a library user): each call goes to
+// its own context, whichever was made or destroyed last. Before GLContext made
+// itself current, a backend used after another one was destroyed ran its calls
+// with no context (its limits read 0 x 0, every buffer refused), and one used
+// after another was created wrote into that one's objects of the same names.
+std::vector<std::byte> GlPattern(size_t count, uint8_t seed) {
+    std::vector<std::byte> bytes(count);
+    for (size_t n = 0; n < count; ++n) bytes[n] = std::byte(uint8_t(seed + 7 * n));
+    return bytes;
+}
+
+TEST(GLContextsInOneProcess, EachBackendKeepsItsOwnContext) {
+    auto first = CreateBackend("gl");
+    if (!first) GTEST_SKIP() << "unsupported here: " << first.error().message;
+    const Extent3 extent{5, 4, 3};
+    auto firstBuffer = (*first)->CreateBuffer(BufferFormat::U8, extent);
+    ASSERT_TRUE(firstBuffer.has_value()) << firstBuffer.error().message;
+    const std::vector<std::byte> firstBytes = GlPattern(extent.Count(), 1);
+    ASSERT_TRUE((*first)->Upload(**firstBuffer, firstBytes));
+    {
+        // A second backend, used between the first's calls, then destroyed.
+        auto second = CreateBackend("gl");
+        ASSERT_TRUE(second.has_value()) << second.error().message;
+        auto secondBuffer = (*second)->CreateBuffer(BufferFormat::U8, extent);
+        ASSERT_TRUE(secondBuffer.has_value()) << secondBuffer.error().message;
+        const std::vector<std::byte> secondBytes = GlPattern(extent.Count(), 100);
+        ASSERT_TRUE((*second)->Upload(**secondBuffer, secondBytes));
+        std::vector<std::byte> back(extent.Count());
+        ASSERT_TRUE((*first)->Download(**firstBuffer, back));
+        EXPECT_EQ(back, firstBytes) << "the first backend read the second one's texture";
+        ASSERT_TRUE((*second)->Download(**secondBuffer, back));
+        EXPECT_EQ(back, secondBytes);
+    }
+    // The second context is gone: the first must still work, old buffers and new.
+    std::vector<std::byte> back(extent.Count());
+    ASSERT_TRUE((*first)->Download(**firstBuffer, back));
+    EXPECT_EQ(back, firstBytes);
+    auto later = (*first)->CreateBuffer(BufferFormat::U8, extent);
+    ASSERT_TRUE(later.has_value()) << later.error().message;
+    const std::vector<std::byte> laterBytes = GlPattern(extent.Count(), 50);
+    ASSERT_TRUE((*first)->Upload(**later, laterBytes));
+    ASSERT_TRUE((*first)->Download(**later, back));
+    EXPECT_EQ(back, laterBytes);
 }
 
 }  // namespace

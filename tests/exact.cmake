@@ -69,8 +69,13 @@ set_tests_properties(Exact.CountsIdenticalAcrossRuns Exact.TwiceTheVoxelsCountsM
                      FIXTURES_REQUIRED exact_counts DEPENDS "Exact.CountCiSmallA;Exact.CountCiSmallB;Exact.CountCiSmallWide")
 
 # perf record counts the suite's instructions itself when the build can (item 1 of issue 12): its record holds
-# ci-small's per-stage counts, within 0.1 % of a separate `count` of the same 14 steps (not identical: the two
-# command lines differ, which shifts the heap and the alignment of vectorised loops by about 0.02 %).
+# ci-small's per-stage counts, within 1 % of a separate `count` of the same 14 steps. Not identical: the two
+# command lines allocate differently, and where the heap puts the buffers moves the counts of the vectorised
+# stages. Measured 2026-11-30 with one `count` binary under three glibc heap layouts (default, mmap_threshold=4096,
+# top_pad=65536): density 1104240..1113124 (0.80 %), render_splat 8359530..8389788 (0.36 %), smooth 0.06 %,
+# shade 0.01 %, ca, region and shadow identical; record vs count differed by 0.31 % on density. 64-byte-aligned
+# CPU buffers did not remove it (tried: density still 0.80 %). 1 % still fails a record that counts another
+# number of steps (1/14 = 7 %) or another scene.
 file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/exact-suite.json [=[{"scenes": [{"scene": "ci-small", "set": ["steps=14"]}]}]=])
 add_test(NAME Exact.PerfRecordCountsInstructions COMMAND /bin/sh -c [=[
 rm -f "$2" && "$0" perf record --suite "$1" --history "$2" --backend cpu --quiet && exec /usr/bin/python3 -c '
@@ -81,7 +86,7 @@ got = record["instructions"].get("ci-small", {}).get("cpu", {})
 assert "instructions_not_counted" not in record, record.get("instructions_not_counted")
 assert set(got) == set(counted), (sorted(got), sorted(counted))
 for stage, n in counted.items():
-    assert abs(got[stage] - n) <= 1e-3 * n, (stage, got[stage], n)
+    assert abs(got[stage] - n) <= 1e-2 * n, (stage, got[stage], n)
 print("record counts match count for", len(counted), "stages")' "$2" "$3"]=]
          ${exact_cli} ${CMAKE_CURRENT_BINARY_DIR}/exact-suite.json ${cli_out}/exact-history.jsonl ${cli_out}/count-a.json)
 set_tests_properties(Exact.PerfRecordCountsInstructions PROPERTIES FIXTURES_REQUIRED "exact_build;exact_counts"
