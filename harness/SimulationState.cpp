@@ -111,7 +111,7 @@ struct SimulationStateAccess {
                     if (saved.camera < slot.current.size()) target = slot.current[saved.camera].get();
                     break;
                 case BufferRole::Next: target = slot.next.get(); break;
-                case BufferRole::Previous: target = slot.previous.get(); break;
+                case BufferRole::Previous: break;  // never saved: the next step rewrites it or does not read it
                 case BufferRole::Pending: target = slot.pending.get(); break;
             }
             const std::string file = FileOf(saved.resource, saved.role, saved.camera);
