@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -33,6 +34,48 @@ constexpr uint32_t kRowLanes = 16;
 
 uint32_t WholeVectors(uint32_t n) { return n / kRowLanes * kRowLanes; }
 uint32_t PaddedToVectors(uint32_t n) { return (n + kRowLanes - 1) / kRowLanes * kRowLanes; }
+
+// Sixteen floats (a cache line along x, or sixteen cells of a row) in GCC's
+// generic vectors: one AVX-512 register here, split on narrower CPUs.
+typedef float Lanes16 __attribute__((vector_size(64)));
+typedef int32_t LaneIndex16 __attribute__((vector_size(64)));
+
+Lanes16 LoadLanes(const float* p) {
+    Lanes16 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+void StoreLanes(float* p, const Lanes16& v) { std::memcpy(p, &v, sizeof v); }
+
+// The two-input shuffles that swap bit B of the row index with bit B of the
+// lane: row r (bit B clear) takes lanes with bit B clear from itself and the
+// rest from row r + B; row r + B the other halves.
+template <int B, bool kRowWithBit>
+constexpr LaneIndex16 SwapBitShuffle() {
+    int32_t m[16] = {};
+    for (int c = 0; c < 16; ++c)
+        m[c] = (c & B) == 0 ? (kRowWithBit ? c + B : c) : (kRowWithBit ? 16 + c : 16 + c - B);
+    return LaneIndex16{m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11], m[12], m[13], m[14], m[15]};
+}
+
+template <int B>
+void SwapIndexBit(Lanes16 (&v)[16]) {
+    constexpr LaneIndex16 clear = SwapBitShuffle<B, false>(), set = SwapBitShuffle<B, true>();
+    for (int r = 0; r < 16; ++r)
+        if ((r & B) == 0) {
+            const Lanes16 a = v[r], b = v[r + B];
+            v[r] = __builtin_shuffle(a, b, clear);
+            v[r + B] = __builtin_shuffle(a, b, set);
+        }
+}
+
+// v[i][j] becomes v[j][i]: the four bits of the row index swapped with the lane's.
+void Transpose16(Lanes16 (&v)[16]) {
+    SwapIndexBit<1>(v);
+    SwapIndexBit<2>(v);
+    SwapIndexBit<4>(v);
+    SwapIndexBit<8>(v);
+}
 
 // The per-voxel work of one slice, with the options fixed at compile time so
 // that the loop over a row vectorises (a switch per voxel stops it).
@@ -190,8 +233,10 @@ struct ShadeSweep {
     // [b0, b1), every u. Along x the slices of one (y, z) are consecutive
     // floats, so the tile reads each cache line once: it copies q and T of
     // its slices, transposed, into rows per slice (ma - 1 first; T of rows
-    // outside the band, which another tile computed, for every slice), shades
-    // there, and writes its slices of T back the same way.
+    // outside the band, which another tile computed, for every slice read), shades
+    // there, and writes its slices of T back the same way. A tile of 16 slices
+    // moves 16 cells' lines at a time through a 16 x 16 transpose in
+    // registers; shorter tiles and the last cells of a row go one float at a time.
     void TileAlongX(uint32_t ma, uint32_t mb, uint32_t b0, uint32_t b1) const {
         const ShearWarp& g = plan.geometry;
         if (ma == 0) {
@@ -206,22 +251,62 @@ struct ShadeSweep {
         const size_t plane = size_t(R) * P;  // one slice's rows; cell (r, u) at r P + u + 1
         thread_local std::vector<float> scratch;
         scratch.resize(plane * (2 * K + 1));
-        float* tc = scratch.data();          // K + 1 slices of T
-        float* qc = tc + plane * (K + 1);    // K slices of q
+        float* tc = scratch.data();        // K + 1 slices of T: ma - 1 .. mb - 1
+        float* qc = tc + plane * (K + 1);  // K slices of q: ma - 1 .. mb - 2
+        // With 16 slices, the lines x0 .. x0 + 15 dx (q and T of the slices
+        // read, ma - 1 + k for k < 16) lie inside the grid and start at xLine;
+        // T of the slices written starts at xOut (slice ma at x0 + dx). Cells
+        // [0, uLines) go by lines.
+        const bool lines = K == kLineFloats;
+        const uint32_t uLines = lines ? nu / kLineFloats * kLineFloats : 0;
+        const int64_t xLine = dx > 0 ? x0 : x0 - 15, xOut = dx > 0 ? x0 + 1 : x0 - 16;
+        auto plane16 = [&](int j) { return uint32_t(dx > 0 ? j : 15 - j); };  // the slice k of lane j
         for (uint32_t r = 0; r < R; ++r) {
             const int64_t y = yLo + r;
             const bool inV = y >= 0 && y < int64_t(plan.nv), inBand = y >= int64_t(b0) && y < int64_t(b1);
-            const uint32_t tSlices = inBand ? 1 : K + 1;  // in the band, only slice ma - 1 is read
+            // Cells the copies below do not write: outside T = 1, q = 0.
             for (uint32_t k = 0; k <= K; ++k) {
-                std::fill(tc + plane * k + size_t(P) * r, tc + plane * k + size_t(P) * (r + 1), 1.0f);
-                if (k < K) std::fill(qc + plane * k + size_t(P) * r, qc + plane * k + size_t(P) * (r + 1), 0.0f);
+                float* t = tc + plane * k + size_t(P) * r;
+                float* q = k < K ? qc + plane * k + size_t(P) * r : nullptr;
+                const uint32_t c0 = inV ? 1 : P;
+                std::fill(t, t + c0, 1.0f);
+                std::fill(t + std::max(c0, nu + 1), t + P, 1.0f);
+                if (q) {
+                    std::fill(q, q + c0, 0.0f);
+                    std::fill(q + std::max(c0, nu + 1), q + P, 0.0f);
+                }
             }
             if (!inV) continue;
-            for (uint32_t u = 0; u < nu; ++u) {
-                const size_t base = sv * size_t(y) + su * u;
-                const size_t cell = size_t(P) * r + u + 1;
+            // Outside the band, slices ma - 1 .. mb - 2 are read; in it, only ma - 1.
+            const uint32_t tSlices = inBand ? 1 : K;
+            const size_t rowBase = sv * size_t(y), cell0 = size_t(P) * r + 1;
+            for (uint32_t u = 0; u < uLines; u += kLineFloats) {
                 // Lines a grid row apart: the hardware does not fetch them ahead.
-                const size_t ahead = sv * size_t(y) + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0);
+                if (u + kLineFloats < uLines)
+                    for (uint32_t i = 0; i < kLineFloats; ++i) {
+                        const float* next = Q + rowBase + su * (u + kLineFloats + i) + size_t(xLine);
+                        __builtin_prefetch(next);
+                        __builtin_prefetch(next + 15);
+                        if (!inBand) {
+                            __builtin_prefetch(T + (next - Q));
+                            __builtin_prefetch(T + (next - Q) + 15);
+                        }
+                    }
+                Lanes16 v[16];
+                for (uint32_t i = 0; i < kLineFloats; ++i) v[i] = LoadLanes(Q + rowBase + su * (u + i) + size_t(xLine));
+                Transpose16(v);
+                for (int j = 0; j < 16; ++j) StoreLanes(qc + plane * plane16(j) + cell0 + u, v[j]);
+                if (inBand) {
+                    for (uint32_t i = 0; i < kLineFloats; ++i) tc[cell0 + u + i] = T[rowBase + su * (u + i) + size_t(x0)];
+                    continue;
+                }
+                for (uint32_t i = 0; i < kLineFloats; ++i) v[i] = LoadLanes(T + rowBase + su * (u + i) + size_t(xLine));
+                Transpose16(v);
+                for (int j = 0; j < 16; ++j) StoreLanes(tc + plane * plane16(j) + cell0 + u, v[j]);
+            }
+            for (uint32_t u = uLines; u < nu; ++u) {
+                const size_t base = rowBase + su * u, cell = cell0 + u;
+                const size_t ahead = rowBase + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0);
                 __builtin_prefetch(Q + ahead);
                 __builtin_prefetch(Q + ahead + size_t(dx * int64_t(K - 1)));
                 if (!inBand) __builtin_prefetch(T + ahead);
@@ -236,13 +321,22 @@ struct ShadeSweep {
                 ShadeRow(kernel, tc + tap, tc + tap + P, qc + tap, qc + tap + P, g.fu, g.fv, out + 1, padded);
                 std::fill(out + nu + 1, out + P, 1.0f);  // the padding wrote past the row: outside again
             }
-        for (uint32_t b = b0; b < b1; ++b)
-            for (uint32_t u = 0; u < nu; ++u) {
-                const size_t base = sv * b + su * u;
-                __builtin_prefetch(T + sv * b + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0 + dx), 1);
-                const size_t cell = size_t(P) * size_t(int64_t(b) - yLo) + u + 1;
+        for (uint32_t b = b0; b < b1; ++b) {
+            const size_t rowBase = sv * b, cell0 = size_t(P) * size_t(int64_t(b) - yLo) + 1;
+            for (uint32_t u = 0; u < uLines; u += kLineFloats) {
+                Lanes16 v[16];
+                // Row j: the slice at x = xOut + j; transposed, lane j of cell u + i's line.
+                for (int j = 0; j < 16; ++j) v[j] = LoadLanes(tc + plane * (plane16(j) + 1) + cell0 + u);
+                Transpose16(v);
+                for (uint32_t i = 0; i < kLineFloats; ++i) StoreLanes(T + rowBase + su * (u + i) + size_t(xOut), v[i]);
+            }
+            for (uint32_t u = uLines; u < nu; ++u) {
+                const size_t base = rowBase + su * u;
+                __builtin_prefetch(T + rowBase + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0 + dx), 1);
+                const size_t cell = cell0 + u;
                 for (uint32_t k = 1; k <= K; ++k) T[base + size_t(x0 + dx * k)] = tc[plane * k + cell];
             }
+        }
     }
 
     // Cells [a0, a1) of row b of slice m.

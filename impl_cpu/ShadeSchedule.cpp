@@ -20,11 +20,11 @@ ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0,
     if (plan.geometry.w == 0 && nv >= 2 * kStridedRows) {
         // u = y, v = z: a row's cells lie a grid row apart, and one slice's
         // rows touch a cache line each per cell, too many to stay cached
-        // from one slice to the next. Tiles of kStridedRows rows and as many
-        // slices as a cache line holds floats use each line whole, on any
-        // number of threads.
+        // from one slice to the next. Tiles of as many slices as a cache line
+        // holds floats use each line whole. Bands of nv / 2p rows (two bands
+        // a thread, for the pipeline's fill), within [kStridedRows, kMaxStridedRows].
         s.axis = 1;
-        s.bands = nv / kStridedRows;
+        s.bands = nv / std::clamp(nv / (2 * p), kStridedRows, kMaxStridedRows);
         s.towardHigher = plan.geometry.v0 >= 0;
         s.blockSlices = std::min(kLineFloats, slices);
         s.blocks = CeilDiv(slices, s.blockSlices);

@@ -14,9 +14,12 @@ namespace cb::cpu {
 inline constexpr uint32_t kMinBandCells = 8;
 // A tile aims at about this many cells (a few microseconds of one core).
 inline constexpr double kTileCells = 16384;
-// Sweeps along x (rows along y, strided): rows per band, and slices per tile
-// (the floats of a 64-byte cache line).
+// Sweeps along x (rows along y, strided): rows per band, from kStridedRows
+// (many threads) to kMaxStridedRows (few: a band's halo row is copied for
+// every slice, so wider bands copy less), and slices per tile (the floats of
+// a 64-byte cache line).
 inline constexpr uint32_t kStridedRows = 2;
+inline constexpr uint32_t kMaxStridedRows = 8;
 inline constexpr uint32_t kLineFloats = 16;
 
 // Tile (band i, block M) covers band i of the slice plane (along u or v) over

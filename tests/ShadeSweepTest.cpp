@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "core/ShadePlan.h"
 #include "core/Shading.h"
@@ -65,6 +66,7 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
     for (float& v : q) v = rng.Below(3) ? float(rng.Below(65)) / 64.0f : 0.0f;
     const float d45 = std::numbers::pi_v<float> / 4;
     const std::vector<Vec3> suns = {SunDirection(0.3, 0.2),      SunDirection(0.3, 3.3),  // x, both signs
+                                    SunDirection(-0.3, -0.2),  // x, the other sign of v0 (bands wait the other way)
                                     SunDirection(0.4, 1.4),      SunDirection(0.4, -1.7),  // y
                                     SunDirection(1.1, 0.5),      SunDirection(-1.2, 2.0),  // z
                                     SunDirection(d45, 0.0),      SunDirection(0.3, d45),
@@ -87,7 +89,7 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
                 ASSERT_GT(std::count_if(plain.begin(), plain.end(), [](float t) { return t > 0 && t < 1; }), 1000);
                 ++compared;
             }
-    EXPECT_EQ(compared, 54);
+    EXPECT_EQ(compared, 60);
     for (int f : {2, 4}) {
         ShadeParams p;
         p.sun = SunDirection(0.3, 0.2);
@@ -173,20 +175,22 @@ TEST(Shade, CpuScheduleByHand) {
     EXPECT_EQ(share.span, (4.0 + 40.0) * 4096.0);
     // The sun at -x (azimuth 180 + 11 degrees, 17 high): s = (-0.94, -0.19,
     // 0.30), w = x, u = y, v = z, dv = 0.30 / 0.94 -> v0 = 0. Rows along y are
-    // strided: bands of 2 rows (16 of them, on any thread count), tiles of 16
-    // slices (a cache line of floats along x); the chain is 15 fill tiles of
-    // 16 slices plus 256 slices, of 2 x 256 cells.
+    // strided: tiles of 16 slices (a cache line of floats along x), bands of
+    // 32 / 2p rows clamped to [2, 8]: 8 rows (4 bands) on 1 and 2 threads, 4
+    // on 4, 2 (16 bands) on 8 and 16. The chain is bands - 1 fill tiles of 16
+    // slices plus 256 slices, of rows x 256 cells.
     p.sun = SunDirection(0.3, std::numbers::pi + 0.2);
     const ShadePlan west = MakeShadePlan(p, Extent3{256, 256, 32});
     ASSERT_EQ(west.geometry.w, 0);
     ASSERT_EQ(west.geometry.v0, 0);
-    for (int threads : {1, 16}) {
+    for (auto [threads, rows] : {std::pair{1, 8}, {2, 8}, {4, 4}, {8, 2}, {16, 2}}) {
         const cpu::ShadeSchedule x = cpu::MakeShadeSchedule(west, threads, 0, 256);
+        const uint32_t bands = 32 / rows;
         EXPECT_EQ(x.axis, 1);
-        EXPECT_EQ(x.bands, 16u);
+        EXPECT_EQ(x.bands, bands) << threads;
         EXPECT_EQ(x.blockSlices, 16u);
         EXPECT_TRUE(x.towardHigher);
-        EXPECT_EQ(x.span, (15.0 * 16.0 + 256.0) * 512.0);
+        EXPECT_EQ(x.span, ((bands - 1) * 16.0 + 256.0) * rows * 256.0) << threads;
     }
     // Sun at azimuth -80 degrees, 60 high: s = (0.09, -0.49, 0.87), w = z,
     // v = y, dv = -0.49 / 0.87 -> v0 = -1: each band reads the band below.
