@@ -4,7 +4,9 @@
 //      its voxels can make a visible splat (conservatively: the image is the
 //      same with both off).
 //   2. Splats are generated in the shared back-to-front order, one outer-axis
-//      slice per task; each slice keeps its own list (no concatenation).
+//      slice per task; each slice keeps its own list (no concatenation). When
+//      the order's inner axis is not x, the candidates are first marked in
+//      one pass over memory, and each slice walks only its marks.
 //   3. A counting sort bins pointers to them by bands of image rows, keeping
 //      their order.
 //   4. Each row band composites its splats in order, in parallel, into planar
@@ -14,7 +16,10 @@
 // SplatAlpha, Lerp) operation for operation, so the image is the same bit for
 // bit as one pixel at a time (docs/performance.md, "render_splat on 2 cores").
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #if defined(__AVX512F__)
@@ -145,19 +150,24 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
 
     // 2. Splats in the shared order: task `n` makes those of the n-th outer slice.
     // When the inner axis is not x, walking it steps through memory by whole
-    // rows or slices (the view from above: inner z, 256 KiB a step), so each
-    // slice's q_alpha and T are first gathered in memory order into a plane
-    // laid out in the order's ranks, and the walk reads that plane.
+    // rows or slices (the view from above: inner z, 256 KiB a step). Then one
+    // pass over the grid in memory order first marks the candidates (a visible
+    // box and q_alpha > q_min) in a bit mask per outer slice, at bit
+    // rankMiddle * nInner + rankInner, and the walk visits the marked voxels
+    // in that bit order, which is the order's; it counts the visited voxels
+    // (all of the visible boxes') box by box.
     const SplatOrder& order = *p.order;
     const int outer = order.axes[0], middle = order.axes[1], inner = order.axes[2];
     const std::vector<uint32_t>& outerIdx = order.indices[outer];
     const std::vector<uint32_t>& middleIdx = order.indices[middle];
     const std::vector<uint32_t>& innerIdx = order.indices[inner];
     const uint32_t nMiddle = uint32_t(middleIdx.size()), nInner = uint32_t(innerIdx.size());
-    const bool gather = voxelStride[inner] != 1;
-    std::vector<uint32_t> rankMiddle(nMiddle), rankInner(nInner);
-    for (uint32_t r = 0; r < nMiddle; ++r) rankMiddle[middleIdx[r]] = r;
-    for (uint32_t r = 0; r < nInner; ++r) rankInner[innerIdx[r]] = r;
+    const bool marked = voxelStride[inner] != 1;
+    std::vector<uint32_t> rank[3];
+    for (int a = 0; a < 3; ++a) {
+        rank[a].resize(order.indices[a].size());
+        for (uint32_t r = 0; r < rank[a].size(); ++r) rank[a][order.indices[a][r]] = r;
+    }
     if (mSplatSlices.size() < outerIdx.size()) mSplatSlices.resize(outerIdx.size());
     std::vector<uint64_t> visitedPerSlice(outerIdx.size(), 0);
     const SplatFrame frame = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
@@ -165,9 +175,51 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const uint8_t* const visible = boxVisible.data();
     const uint32_t *const boxMiddle = boxPart[middle].data(), *const boxInner = boxPart[inner].data();
     const size_t strideMiddle = voxelStride[middle], strideInner = voxelStride[inner];
+    const size_t sliceWords = marked ? (size_t(nMiddle) * nInner + 63) / 64 : 0;
+    std::vector<uint64_t> marks(sliceWords * outerIdx.size(), 0);
+    if (marked) {
+        mArena.execute([&] {
+            tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz), [&](const tbb::blocked_range<uint32_t>& rows) {
+                std::vector<uint8_t> candidate(size_t(e.nx) + 8, 0);
+                uint32_t idx[3];
+                for (uint32_t row = rows.begin(); row != rows.end(); ++row) {
+                    idx[1] = row % e.ny;
+                    idx[2] = row / e.ny;
+                    const float *a = qPrev + size_t(e.nx) * row, *b = qCur + size_t(e.nx) * row;
+                    for (uint32_t x = 0; x < e.nx; ++x) candidate[x] = SplatQ(a[x], b[x], alpha) > qMin;
+                    const uint32_t rowBox = boxPart[1][idx[1]] + boxPart[2][idx[2]];
+                    for (uint32_t x0 = 0; x0 < e.nx; x0 += 8) {
+                        uint64_t eight;
+                        std::memcpy(&eight, candidate.data() + x0, 8);
+                        if (eight == 0) continue;
+                        for (uint32_t x = x0; x < std::min(e.nx, x0 + 8); ++x) {
+                            if (!candidate[x] || !visible[rowBox + boxPart[0][x]]) continue;
+                            idx[0] = x;
+                            const size_t bit = size_t(rank[middle][idx[middle]]) * nInner + rank[inner][idx[inner]];
+                            std::atomic_ref<uint64_t>(marks[sliceWords * rank[outer][idx[outer]] + bit / 64])
+                                .fetch_or(uint64_t(1) << (bit % 64), std::memory_order_relaxed);
+                        }
+                    }
+                }
+            });
+        });
+    }
+    // Voxels of an outer slice in visible boxes, box by box: runs of middle
+    // and inner indices with the same box part (ascending index, so a part's
+    // indices are consecutive).
+    struct PartRun {
+        uint32_t part, voxels;
+    };
+    auto partRuns = [&](int axis) {
+        std::vector<PartRun> runs;
+        for (uint32_t n = 0; n < extent[axis]; ++n)
+            if (runs.empty() || runs.back().part != boxPart[axis][n]) runs.push_back({boxPart[axis][n], 1});
+            else ++runs.back().voxels;
+        return runs;
+    };
+    const std::vector<PartRun> middleRuns = partRuns(middle), innerRuns = partRuns(inner);
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) {
-            std::vector<float> qaPlane(gather ? size_t(nMiddle) * nInner : 0), tPlane(qaPlane.size());
             for (size_t n = range.begin(); n != range.end(); ++n) {
                 std::vector<Splat>& out = mSplatSlices[n];
                 out.clear();
@@ -176,47 +228,39 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                 idx[outer] = outerIdx[n];
                 const size_t vOuter = voxelStride[outer] * idx[outer];
                 const uint32_t bOuter = boxPart[outer][idx[outer]];
-                if (gather) {
-                    // Memory order: the axis of the smaller stride innermost.
-                    const bool middleFast = strideMiddle < strideInner;
-                    const uint32_t nFast = middleFast ? nMiddle : nInner, nSlow = middleFast ? nInner : nMiddle;
-                    const size_t strideFast = middleFast ? strideMiddle : strideInner;
-                    const size_t strideSlow = middleFast ? strideInner : strideMiddle;
-                    const uint32_t* rankFast = middleFast ? rankMiddle.data() : rankInner.data();
-                    const uint32_t* rankSlow = middleFast ? rankInner.data() : rankMiddle.data();
-                    const size_t scaleFast = middleFast ? nInner : 1, scaleSlow = middleFast ? 1 : nInner;
-                    const uint32_t* boxFast = middleFast ? boxMiddle : boxInner;
-                    const uint32_t* boxSlow = middleFast ? boxInner : boxMiddle;
-                    // Only what the walk below reads: q_alpha in visible boxes, T where q_alpha > q_min.
-                    for (uint32_t h = 0; h < nSlow; ++h) {
-                        const size_t vSlow = vOuter + strideSlow * h, pSlow = scaleSlow * rankSlow[h];
-                        const uint32_t bSlow = bOuter + boxSlow[h];
-                        for (uint32_t l = 0; l < nFast; ++l) {
-                            if (!visible[bSlow + boxFast[l]]) continue;
-                            const size_t v = vSlow + strideFast * l, at = pSlow + scaleFast * rankFast[l];
-                            const float qa = SplatQ(qPrev[v], qCur[v], alpha);
-                            qaPlane[at] = qa;
-                            if (qa > qMin) tPlane[at] = T[v];
+                if (marked) {
+                    for (const PartRun& m : middleRuns)
+                        for (const PartRun& i : innerRuns)
+                            if (visible[bOuter + m.part + i.part]) visited += uint64_t(m.voxels) * i.voxels;
+                    const uint64_t* sliceMarks = marks.data() + sliceWords * n;
+                    for (size_t w = 0; w < sliceWords; ++w)
+                        for (uint64_t bits = sliceMarks[w]; bits != 0; bits &= bits - 1) {
+                            const size_t bit = 64 * w + size_t(std::countr_zero(bits));
+                            idx[middle] = middleIdx[bit / nInner];
+                            idx[inner] = innerIdx[bit % nInner];
+                            const size_t v = vOuter + strideMiddle * idx[middle] + strideInner * idx[inner];
+                            Splat s;
+                            if (MakeSplat(frame, idx[0], idx[1], idx[2], SplatQ(qPrev[v], qCur[v], alpha), T[v], s))
+                                out.push_back(s);
                         }
-                    }
+                    visitedPerSlice[n] = visited;
+                    continue;
                 }
                 for (uint32_t mr = 0; mr < nMiddle; ++mr) {
                     const uint32_t mIndex = middleIdx[mr];
                     idx[middle] = mIndex;
                     const size_t vMiddle = vOuter + strideMiddle * mIndex;
                     const uint32_t bMiddle = bOuter + boxMiddle[mIndex];
-                    const float* qaRow = gather ? qaPlane.data() + size_t(nInner) * mr : nullptr;
-                    const float* tRow = gather ? tPlane.data() + size_t(nInner) * mr : nullptr;
                     for (uint32_t ir = 0; ir < nInner; ++ir) {
                         const uint32_t iIndex = innerIdx[ir];
                         if (!visible[bMiddle + boxInner[iIndex]]) continue;
                         ++visited;
                         const size_t v = vMiddle + strideInner * iIndex;
-                        const float qa = gather ? qaRow[ir] : SplatQ(qPrev[v], qCur[v], alpha);
+                        const float qa = SplatQ(qPrev[v], qCur[v], alpha);
                         if (!(qa > qMin)) continue;  // MakeSplat's first test
                         idx[inner] = iIndex;
                         Splat s;
-                        if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, gather ? tRow[ir] : T[v], s)) out.push_back(s);
+                        if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, T[v], s)) out.push_back(s);
                     }
                 }
                 visitedPerSlice[n] = visited;
