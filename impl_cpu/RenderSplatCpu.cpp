@@ -204,9 +204,8 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
             });
         });
     }
-    // Voxels of an outer slice in visible boxes, box by box: runs of middle
-    // and inner indices with the same box part (ascending index, so a part's
-    // indices are consecutive).
+    // Voxels of an outer slice in visible boxes, box by box: the middle and
+    // inner indices cut into runs of consecutive indices with one box part.
     struct PartRun {
         uint32_t part, voxels;
     };
