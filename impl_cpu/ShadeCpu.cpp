@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -35,10 +36,10 @@ constexpr uint32_t kRowLanes = 16;
 uint32_t WholeVectors(uint32_t n) { return n / kRowLanes * kRowLanes; }
 uint32_t PaddedToVectors(uint32_t n) { return (n + kRowLanes - 1) / kRowLanes * kRowLanes; }
 
-// Sixteen floats (a cache line along x, or sixteen cells of a row) in GCC's
-// generic vectors: one AVX-512 register here, split on narrower CPUs.
+// Sixteen floats (a cache line along x, or sixteen cells of a row) in the
+// compilers' generic vectors (GCC and Clang): one AVX-512 register here,
+// split on narrower CPUs.
 typedef float Lanes16 __attribute__((vector_size(64)));
-typedef int32_t LaneIndex16 __attribute__((vector_size(64)));
 
 Lanes16 LoadLanes(const float* p) {
     Lanes16 v;
@@ -47,25 +48,26 @@ Lanes16 LoadLanes(const float* p) {
 }
 void StoreLanes(float* p, const Lanes16& v) { std::memcpy(p, &v, sizeof v); }
 
-// The two-input shuffles that swap bit B of the row index with bit B of the
-// lane: row r (bit B clear) takes lanes with bit B clear from itself and the
-// rest from row r + B; row r + B the other halves.
-template <int B, bool kRowWithBit>
-constexpr LaneIndex16 SwapBitShuffle() {
-    int32_t m[16] = {};
-    for (int c = 0; c < 16; ++c)
-        m[c] = (c & B) == 0 ? (kRowWithBit ? c + B : c) : (kRowWithBit ? 16 + c : 16 + c - B);
-    return LaneIndex16{m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11], m[12], m[13], m[14], m[15]};
+// Lane c of the two-input shuffle that swaps bit B of the row index with bit
+// B of the lane: row r (bit B clear) takes lanes with bit B clear from itself
+// and the rest from row r + B; row r + B the other halves.
+constexpr int SwapBitLane(int B, bool rowWithBit, int c) {
+    return (c & B) == 0 ? (rowWithBit ? c + B : c) : (rowWithBit ? 16 + c : 16 + c - B);
+}
+
+template <int B, bool kRowWithBit, int... C>
+Lanes16 SwapBitShuffle(const Lanes16& a, const Lanes16& b, std::integer_sequence<int, C...>) {
+    return __builtin_shufflevector(a, b, SwapBitLane(B, kRowWithBit, C)...);
 }
 
 template <int B>
 void SwapIndexBit(Lanes16 (&v)[16]) {
-    constexpr LaneIndex16 clear = SwapBitShuffle<B, false>(), set = SwapBitShuffle<B, true>();
+    constexpr auto lanes = std::make_integer_sequence<int, 16>();
     for (int r = 0; r < 16; ++r)
         if ((r & B) == 0) {
             const Lanes16 a = v[r], b = v[r + B];
-            v[r] = __builtin_shuffle(a, b, clear);
-            v[r + B] = __builtin_shuffle(a, b, set);
+            v[r] = SwapBitShuffle<B, false>(a, b, lanes);
+            v[r + B] = SwapBitShuffle<B, true>(a, b, lanes);
         }
 }
 
