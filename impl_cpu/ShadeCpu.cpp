@@ -231,26 +231,29 @@ struct ShadeSweep {
         }
     }
 
-    // A tile of a sweep along x (u = y, v = z): slices [ma, mb) of rows
-    // [b0, b1), every u. Along x the slices of one (y, z) are consecutive
-    // floats, so the tile reads each cache line once: it copies q and T of
-    // its slices, transposed, into rows per slice (ma - 1 first; T of rows
-    // outside the band, which another tile computed, for every slice read), shades
-    // there, and writes its slices of T back the same way. A tile of 16 slices
-    // moves 16 cells' lines at a time through a 16 x 16 transpose in
-    // registers; shorter tiles and the last cells of a row go one float at a time.
-    void TileAlongX(uint32_t ma, uint32_t mb, uint32_t b0, uint32_t b1) const {
+    // A tile of a sweep along x (u = y, v = z): slices [ma, mb) of cells
+    // [a0, a1) of rows [b0, b1). Along x the slices of one (y, z) are
+    // consecutive floats, so the tile reads each cache line once: it copies q
+    // and T of its slices, transposed, into rows per slice (ma - 1 first; T of
+    // the halo, the row and the cell beyond the tile that its taps reach, which
+    // other tiles computed, for every slice read), shades there, and writes its
+    // slices of T back the same way. A tile of 16 slices moves 16 cells' lines
+    // at a time through a 16 x 16 transpose in registers; shorter tiles, the
+    // halo and the last cells of a row go one float at a time.
+    void TileAlongX(uint32_t ma, uint32_t mb, uint32_t b0, uint32_t b1, uint32_t a0, uint32_t a1) const {
         const ShearWarp& g = plan.geometry;
         if (ma == 0) {
-            for (uint32_t b = b0; b < b1; ++b) Row(0, b, 0, plan.nu);
+            for (uint32_t b = b0; b < b1; ++b) Row(0, b, a0, a1);
             ma = 1;
         }
         if (ma >= mb) return;
-        const uint32_t K = mb - ma, nu = plan.nu;
+        const uint32_t K = mb - ma, nu = plan.nu, na = a1 - a0;
         const int64_t x0 = plan.SliceW(ma - 1), dx = g.sunAbove ? -1 : 1;  // slice ma - 1 + k at x0 + dx k
         const int64_t yLo = int64_t(b0) + std::min(g.v0, 0), yHi = int64_t(b1) + std::max(g.v0 + 1, 0);
-        const uint32_t R = uint32_t(yHi - yLo), padded = PaddedToVectors(nu), P = padded + 3;
-        const size_t plane = size_t(R) * P;  // one slice's rows; cell (r, u) at r P + u + 1
+        // The taps' cells: [uLo, uHi) of rows [yLo, yHi).
+        const int64_t uLo = int64_t(a0) + std::min(g.u0, 0), uHi = int64_t(a1) + std::max(g.u0 + 1, 0);
+        const uint32_t R = uint32_t(yHi - yLo), padded = PaddedToVectors(na), P = padded + 3;
+        const size_t plane = size_t(R) * P;  // one slice's rows; cell (r, u) at r P + u - a0 + 1
         thread_local std::vector<float> scratch;
         scratch.resize(plane * (2 * K + 1));
         float* tc = scratch.data();        // K + 1 slices of T: ma - 1 .. mb - 1
@@ -260,7 +263,7 @@ struct ShadeSweep {
         // T of the slices written starts at xOut (slice ma at x0 + dx). Cells
         // [0, uLines) go by lines.
         const bool lines = K == kLineFloats;
-        const uint32_t uLines = lines ? nu / kLineFloats * kLineFloats : 0;
+        const uint32_t uLines = a0 + (lines ? na / kLineFloats * kLineFloats : 0);
         const int64_t xLine = dx > 0 ? x0 : x0 - 15, xOut = dx > 0 ? x0 + 1 : x0 - 16;
         auto plane16 = [&](int j) { return uint32_t(dx > 0 ? j : 15 - j); };  // the slice k of lane j
         for (uint32_t r = 0; r < R; ++r) {
@@ -272,17 +275,17 @@ struct ShadeSweep {
                 float* q = k < K ? qc + plane * k + size_t(P) * r : nullptr;
                 const uint32_t c0 = inV ? 1 : P;
                 std::fill(t, t + c0, 1.0f);
-                std::fill(t + std::max(c0, nu + 1), t + P, 1.0f);
+                std::fill(t + std::max(c0, na + 1), t + P, 1.0f);
                 if (q) {
                     std::fill(q, q + c0, 0.0f);
-                    std::fill(q + std::max(c0, nu + 1), q + P, 0.0f);
+                    std::fill(q + std::max(c0, na + 1), q + P, 0.0f);
                 }
             }
             if (!inV) continue;
-            // Outside the band, slices ma - 1 .. mb - 2 are read; in it, only ma - 1.
+            // In the halo, slices ma - 1 .. mb - 2 are read; in the tile, only ma - 1.
             const uint32_t tSlices = inBand ? 1 : K;
-            const size_t rowBase = sv * size_t(y), cell0 = size_t(P) * r + 1;
-            for (uint32_t u = 0; u < uLines; u += kLineFloats) {
+            const size_t rowBase = sv * size_t(y), cell0 = size_t(P) * r + 1 - a0;  // cell0 + u: cell u
+            for (uint32_t u = a0; u < uLines; u += kLineFloats) {
                 // Lines a grid row apart: the hardware does not fetch them ahead.
                 if (u + kLineFloats < uLines)
                     for (uint32_t i = 0; i < kLineFloats; ++i) {
@@ -306,33 +309,41 @@ struct ShadeSweep {
                 Transpose16(v);
                 for (int j = 0; j < 16; ++j) StoreLanes(tc + plane * plane16(j) + cell0 + u, v[j]);
             }
-            for (uint32_t u = uLines; u < nu; ++u) {
+            auto copyCell = [&](uint32_t u, uint32_t tCopies) {
                 const size_t base = rowBase + su * u, cell = cell0 + u;
                 const size_t ahead = rowBase + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0);
                 __builtin_prefetch(Q + ahead);
                 __builtin_prefetch(Q + ahead + size_t(dx * int64_t(K - 1)));
-                if (!inBand) __builtin_prefetch(T + ahead);
+                if (tCopies > 1) __builtin_prefetch(T + ahead);
                 for (uint32_t k = 0; k < K; ++k) qc[plane * k + cell] = Q[base + size_t(x0 + dx * k)];
-                for (uint32_t k = 0; k < tSlices; ++k) tc[plane * k + cell] = T[base + size_t(x0 + dx * k)];
-            }
+                for (uint32_t k = 0; k < tCopies; ++k) tc[plane * k + cell] = T[base + size_t(x0 + dx * k)];
+            };
+            for (uint32_t u = uLines; u < a1; ++u) copyCell(u, tSlices);
+            // The halo cell of the row beyond the chunk (the previous or the next chunk's, inside the grid).
+            for (int64_t u = uLo; u < uHi; ++u)
+                if ((u < int64_t(a0) || u >= int64_t(a1)) && u >= 0 && u < int64_t(nu)) copyCell(uint32_t(u), K);
         }
         for (uint32_t k = 1; k <= K; ++k)
             for (uint32_t b = b0; b < b1; ++b) {
                 const size_t tap = plane * (k - 1) + size_t(P) * size_t(int64_t(b) + g.v0 - yLo) + size_t(g.u0 + 1);
                 float* out = tc + plane * k + size_t(P) * size_t(int64_t(b) - yLo);
+                // The padding may write past the row's na cells; the cell after
+                // them (the halo, or outside) is what the next slice's taps read
+                // there, so it is kept.
+                const float after = out[na + 1];
                 ShadeRow(kernel, tc + tap, tc + tap + P, qc + tap, qc + tap + P, g.fu, g.fv, out + 1, padded);
-                std::fill(out + nu + 1, out + P, 1.0f);  // the padding wrote past the row: outside again
+                out[na + 1] = after;
             }
         for (uint32_t b = b0; b < b1; ++b) {
-            const size_t rowBase = sv * b, cell0 = size_t(P) * size_t(int64_t(b) - yLo) + 1;
-            for (uint32_t u = 0; u < uLines; u += kLineFloats) {
+            const size_t rowBase = sv * b, cell0 = size_t(P) * size_t(int64_t(b) - yLo) + 1 - a0;
+            for (uint32_t u = a0; u < uLines; u += kLineFloats) {
                 Lanes16 v[16];
                 // Row j: the slice at x = xOut + j; transposed, lane j of cell u + i's line.
                 for (int j = 0; j < 16; ++j) v[j] = LoadLanes(tc + plane * (plane16(j) + 1) + cell0 + u);
                 Transpose16(v);
                 for (uint32_t i = 0; i < kLineFloats; ++i) StoreLanes(T + rowBase + su * (u + i) + size_t(xOut), v[i]);
             }
-            for (uint32_t u = uLines; u < nu; ++u) {
+            for (uint32_t u = uLines; u < a1; ++u) {
                 const size_t base = rowBase + su * u;
                 __builtin_prefetch(T + rowBase + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0 + dx), 1);
                 const size_t cell = cell0 + u;
@@ -378,13 +389,14 @@ struct ShadeSweep {
 // With m0 > 0, slice m0 - 1 of T must hold what an earlier share wrote there:
 // it is read as the previous slice, exactly as the whole sweep would.
 //
-// In parallel, the slice plane is cut into bands along one axis and the sweep
-// into blocks of slices; tile (band i, block M) covers both. Its taps reach
-// one band toward the sun's side (o0 = u0 or v0 >= 0: the higher band; else
-// the lower), so it waits for tiles (i, M - 1) and (i + dir, M), and runs as
-// soon as both are done: a pipeline over the bands, no barriers. Every cell
-// is computed once with the same arithmetic, so T does not depend on the
-// schedule.
+// In parallel, the slice plane is cut into bands along one axis (and, along
+// x, its rows into chunks) and the sweep into blocks of slices; tile (band i,
+// chunk j, block M) covers them. Its taps reach one band and one chunk toward
+// the sun's side (o0 = u0 or v0 >= 0: the higher one; else the lower), so it
+// waits for tiles (i, j, M - 1), (i + dir, j, M) and (i, j + chunkDir, M)
+// (the corner tile is done before the last two), and runs as soon as they
+// are done: a pipeline, no barriers. Every cell is computed once with the same
+// arithmetic, so T does not depend on the schedule.
 void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, float* T, tbb::task_arena& arena,
                uint32_t m0, uint32_t m1) {
     m1 = std::min(m1, plan.nw);
@@ -396,47 +408,56 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     // else each row reads the previous slice in place (Row).
     const bool copied = sweep.su != 1 || sweep.sv > sweep.sw;
     const bool alongX = plan.geometry.w == 0 && s.axis == 1 && sweep.sw == 1;
-    auto tile = [&](uint32_t band, uint32_t block) {
+    auto tile = [&](uint32_t band, uint32_t chunk, uint32_t block) {
         const uint32_t c0 = uint32_t(uint64_t(n) * band / s.bands), c1 = uint32_t(uint64_t(n) * (band + 1) / s.bands);
         const uint32_t ua = s.axis == 1 ? 0 : c0, ub = s.axis == 1 ? plan.nu : c1;
         const uint32_t va = s.axis == 1 ? c0 : 0, vb = s.axis == 1 ? c1 : plan.nv;
         const uint32_t ma = m0 + block * s.blockSlices, mb = std::min(m1, ma + s.blockSlices);
-        if (alongX) return sweep.TileAlongX(ma, mb, va, vb);
+        if (alongX) {
+            const uint32_t a0 = chunk * s.chunkCells, a1 = s.chunks == 1 ? plan.nu : std::min(plan.nu, a0 + s.chunkCells);
+            return sweep.TileAlongX(ma, mb, va, vb, a0, a1);
+        }
         for (uint32_t m = ma; m < mb; ++m) {
             if (m > 0 && copied) sweep.Block(m, ua, ub, va, vb);
             else
                 for (uint32_t b = va; b < vb; ++b) sweep.Row(m, b, ua, ub);
         }
     };
-    if (s.bands == 1) {
-        tile(0, 0);
+    const uint32_t B = s.bands, C = s.chunks, blocks = s.blocks;
+    if (B == 1 && C == 1) {
+        for (uint32_t M = 0; M < blocks; ++M) tile(0, 0, M);
         return;
     }
-    // Tile (i, M) waits for (i, M - 1) and (i + dir, M); pending counts those not done.
-    const uint32_t B = s.bands, blocks = s.blocks;
-    const int dir = s.towardHigher ? 1 : -1;
-    const uint32_t last = s.towardHigher ? B - 1 : 0;  // the band that waits for no other
-    if (arena.max_concurrency() == 1) {  // one thread: block by block, from the band that waits for none
+    // Pending counts the tiles a tile waits for that are not done.
+    const int dir = s.towardHigher ? 1 : -1, chunkDir = s.chunkTowardHigher ? 1 : -1;
+    const uint32_t lastBand = s.towardHigher ? B - 1 : 0;  // the band that waits for no other
+    const uint32_t lastChunk = s.chunkTowardHigher ? C - 1 : 0;
+    auto at = [&](uint32_t band, uint32_t chunk, uint32_t block) { return (size_t(block) * C + chunk) * B + band; };
+    if (arena.max_concurrency() == 1) {  // one thread: block by block, from the tile that waits for none
         for (uint32_t M = 0; M < blocks; ++M)
-            for (uint32_t k = 0; k < B; ++k) tile(s.towardHigher ? B - 1 - k : k, M);
+            for (uint32_t i = 0; i < B; ++i)
+                for (uint32_t j = 0; j < C; ++j)
+                    tile(s.towardHigher ? B - 1 - i : i, s.chunkTowardHigher ? C - 1 - j : j, M);
         return;
     }
-    std::vector<std::atomic<uint8_t>> pending(size_t(B) * blocks);
+    std::vector<std::atomic<uint8_t>> pending(size_t(B) * C * blocks);
     for (uint32_t M = 0; M < blocks; ++M)
-        for (uint32_t i = 0; i < B; ++i) pending[size_t(M) * B + i] = uint8_t((M > 0) + (i != last));
+        for (uint32_t j = 0; j < C; ++j)
+            for (uint32_t i = 0; i < B; ++i) pending[at(i, j, M)] = uint8_t((M > 0) + (i != lastBand) + (j != lastChunk));
     struct Tile {
-        uint32_t band, block;
+        uint32_t band, chunk, block;
     };
-    const Tile root{last, 0};
+    const Tile root{lastBand, lastChunk, 0};
     arena.execute([&] {
         tbb::parallel_for_each(&root, &root + 1, [&](const Tile& t, tbb::feeder<Tile>& feeder) {
-            tile(t.band, t.block);
-            auto done = [&](uint32_t band, uint32_t block) {
-                if (pending[size_t(block) * B + band].fetch_sub(1, std::memory_order_acq_rel) == 1)
-                    feeder.add(Tile{band, block});
+            tile(t.band, t.chunk, t.block);
+            auto done = [&](uint32_t band, uint32_t chunk, uint32_t block) {
+                if (pending[at(band, chunk, block)].fetch_sub(1, std::memory_order_acq_rel) == 1)
+                    feeder.add(Tile{band, chunk, block});
             };
-            if (t.block + 1 < blocks) done(t.band, t.block + 1);
-            if (t.band != (s.towardHigher ? 0u : B - 1)) done(uint32_t(int(t.band) - dir), t.block);
+            if (t.block + 1 < blocks) done(t.band, t.chunk, t.block + 1);
+            if (t.band != (s.towardHigher ? 0u : B - 1)) done(uint32_t(int(t.band) - dir), t.chunk, t.block);
+            if (t.chunk != (s.chunkTowardHigher ? 0u : C - 1)) done(t.band, uint32_t(int(t.chunk) - chunkDir), t.block);
         });
     });
 }

@@ -21,14 +21,20 @@ ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0,
         // u = y, v = z: a row's cells lie a grid row apart, and one slice's
         // rows touch a cache line each per cell, too many to stay cached
         // from one slice to the next. Tiles of as many slices as a cache line
-        // holds floats use each line whole. Bands of nv / 2p rows (two bands
-        // a thread, for the pipeline's fill), within [kStridedRows, kMaxStridedRows].
+        // holds floats use each line whole. Bands of kStridedBandRows rows;
+        // the rows cut into chunks (at least kMinChunkCells, whole lines)
+        // until each block has two tiles a thread.
         s.axis = 1;
-        s.bands = nv / std::clamp(nv / (2 * p), kStridedRows, kMaxStridedRows);
+        s.bands = std::max<uint32_t>(1, nv / kStridedBandRows);
         s.towardHigher = plan.geometry.v0 >= 0;
+        s.chunkTowardHigher = plan.geometry.u0 >= 0;
+        const uint32_t wanted = std::clamp(CeilDiv(2 * p, s.bands), 1u, std::max(1u, nu / kMinChunkCells));
+        s.chunkCells = CeilDiv(CeilDiv(nu, wanted), kLineFloats) * kLineFloats;
+        s.chunks = CeilDiv(nu, s.chunkCells);
         s.blockSlices = std::min(kLineFloats, slices);
         s.blocks = CeilDiv(slices, s.blockSlices);
-        s.span = (double(s.bands - 1) * s.blockSlices + slices) * double(CeilDiv(nv, s.bands)) * nu;
+        s.span = (double(s.bands - 1 + s.chunks - 1) * s.blockSlices + slices) * double(CeilDiv(nv, s.bands)) *
+                 std::min(nu, s.chunkCells);
         return s;
     }
     // Bands along v (whole rows) when each thread gets at least 4 rows, else

@@ -90,6 +90,34 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
                 ++compared;
             }
     EXPECT_EQ(compared, 60);
+    // Sweeps along x cut into chunks of rows (100 cells along y: on 2 threads 2
+    // chunks of 64 and 36, on 5 and 16 threads 3 of 48, 48 and 4; 2 bands of 10
+    // rows along z), both signs of u0 and v0, tiles of 15, 16 and 8 slices.
+    const Extent3 wide{40, 100, 20};
+    std::vector<float> qw(wide.Count());
+    for (float& v : qw) v = rng.Below(3) ? float(rng.Below(65)) / 64.0f : 0.0f;
+    int comparedX = 0;
+    for (const Vec3& sun : {SunDirection(0.3, 0.2), SunDirection(0.3, 3.3), SunDirection(-0.3, -0.2), SunDirection(0.3, -0.2)})
+        for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Unorm8}) {
+            ShadeParams p;
+            p.sun = sun;
+            p.storage = storage;
+            p.sigma = 0.004f;
+            ASSERT_EQ(MakeShadePlan(p, wide).geometry.w, 0);
+            const std::vector<float> plain = PlainShadeSweep(wide, qw, p);
+            for (int threads : {1, 2, 5, 16})
+                ASSERT_EQ(test::ShadeOnCpu(wide, qw, p, threads, std::nanf("")), plain)
+                    << threads << " threads, sun " << sun[0] << " " << sun[1] << " " << sun[2];
+            ++comparedX;
+        }
+    EXPECT_EQ(comparedX, 8);
+    // The cut those runs took on 16 threads, so the chunks were exercised.
+    ShadeParams px;
+    px.sun = SunDirection(0.3, 0.2);
+    const cpu::ShadeSchedule wide16 = cpu::MakeShadeSchedule(MakeShadePlan(px, wide), 16, 0, 40);
+    EXPECT_EQ(wide16.bands, 2u);
+    EXPECT_EQ(wide16.chunks, 3u);
+    EXPECT_EQ(wide16.chunkCells, 48u);
     for (int f : {2, 4}) {
         ShadeParams p;
         p.sun = SunDirection(0.3, 0.2);
@@ -174,24 +202,33 @@ TEST(Shade, CpuScheduleByHand) {
     EXPECT_EQ(share.blocks, 10u);
     EXPECT_EQ(share.span, (4.0 + 40.0) * 4096.0);
     // The sun at -x (azimuth 180 + 11 degrees, 17 high): s = (-0.94, -0.19,
-    // 0.30), w = x, u = y, v = z, dv = 0.30 / 0.94 -> v0 = 0. Rows along y are
-    // strided: tiles of 16 slices (a cache line of floats along x), bands of
-    // 32 / 2p rows clamped to [2, 8]: 8 rows (4 bands) on 1 and 2 threads, 4
-    // on 4, 2 (16 bands) on 8 and 16. The chain is bands - 1 fill tiles of 16
-    // slices plus 256 slices, of rows x 256 cells.
+    // 0.30), w = x, u = y, v = z, dv = 0.30 / 0.94 -> v0 = 0, du = -0.19 /
+    // 0.94 -> u0 = -1. Rows along y are strided: tiles of 16 slices (a cache
+    // line of floats along x), 4 bands of 8 rows, and the rows cut into chunks
+    // until a block has 2 tiles a thread (at least 32 cells wide, whole lines):
+    // ceil(2p / 4) chunks, so 1 on 1 and 2 threads, 2 of 128 cells on 4, 4 of 64
+    // on 8, 8 of 32 on 16. The chain is 3 + (chunks - 1) fill tiles of 16
+    // slices plus 256 slices, of 8 x (chunk) cells.
     p.sun = SunDirection(0.3, std::numbers::pi + 0.2);
     const ShadePlan west = MakeShadePlan(p, Extent3{256, 256, 32});
     ASSERT_EQ(west.geometry.w, 0);
     ASSERT_EQ(west.geometry.v0, 0);
-    for (auto [threads, rows] : {std::pair{1, 8}, {2, 8}, {4, 4}, {8, 2}, {16, 2}}) {
+    ASSERT_EQ(west.geometry.u0, -1);
+    for (auto [threads, chunks] : {std::pair{1, 1}, {2, 1}, {4, 2}, {8, 4}, {16, 8}}) {
         const cpu::ShadeSchedule x = cpu::MakeShadeSchedule(west, threads, 0, 256);
-        const uint32_t bands = 32 / rows;
+        const uint32_t cells = 256 / chunks;
         EXPECT_EQ(x.axis, 1);
-        EXPECT_EQ(x.bands, bands) << threads;
+        EXPECT_EQ(x.bands, 4u) << threads;
+        EXPECT_EQ(x.chunks, uint32_t(chunks)) << threads;
+        EXPECT_EQ(x.chunkCells, cells) << threads;
         EXPECT_EQ(x.blockSlices, 16u);
         EXPECT_TRUE(x.towardHigher);
-        EXPECT_EQ(x.span, ((bands - 1) * 16.0 + 256.0) * rows * 256.0) << threads;
+        EXPECT_FALSE(x.chunkTowardHigher);
+        EXPECT_EQ(x.span, ((3.0 + chunks - 1) * 16.0 + 256.0) * 8.0 * cells) << threads;
     }
+    // 16 threads: 2.1 M cells over a chain of 416 x 256: parallelism 19.7.
+    EXPECT_NEAR(cpu::MakeShadeSchedule(west, 16, 0, 256).work / cpu::MakeShadeSchedule(west, 16, 0, 256).span,
+                2097152.0 / (416.0 * 256.0), 1e-9);
     // Sun at azimuth -80 degrees, 60 high: s = (0.09, -0.49, 0.87), w = z,
     // v = y, dv = -0.49 / 0.87 -> v0 = -1: each band reads the band below.
     p.sun = SunDirection(60.0 * std::numbers::pi / 180.0, -80.0 * std::numbers::pi / 180.0);

@@ -163,6 +163,7 @@ void BM_ShadeSun(benchmark::State& state, const std::string& scene) {
     const ShadePlan plan = MakeShadePlan(p, w.scene.grid.size);
     const cpu::ShadeSchedule s = cpu::MakeShadeSchedule(plan, int(state.range(0)), 0, plan.nw);
     state.counters["bands"] = double(s.bands);
+    state.counters["chunks"] = double(s.chunks);
     state.counters["tile_slices"] = double(s.blockSlices);
     state.counters["parallelism"] = s.work / s.span;
 }
