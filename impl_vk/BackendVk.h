@@ -56,6 +56,7 @@ enum class VkScratch {
     SplatTileTotals,    // render_splat: splats per screen tile
     SplatTileBases,     // render_splat: SplatTileTotals scanned, and the total
     SplatTileList,      // render_splat: splat indices, screen tile by screen tile
+    SplatScanSums,      // render_splat: the block sums of its scans (scan.comp)
     NoiseData,          // noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
     MarchFrame,         // render_march: the constants (core/MarchGpu.h), 256 bytes
     MarchVolume,        // render_march: the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha

@@ -35,6 +35,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // The shared order, outer axis first.
     const SplatOrder& order = *p.order;
     const FlatSplatOrder flat = FlattenSplatOrder(order);
+    // kTileSize: splat_composite.comp runs a workgroup of 64 per 8 x 8 tile.
     constexpr uint32_t kVoxelsPerChunk = 1024, kSplatsPerChunk = 256, kTileSize = 8;
     const uint32_t voxels = uint32_t(e.Count());
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
@@ -47,7 +48,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
     struct {
         DeviceBuffer *frame, *order, *boxes, *chunkSplats, *chunkVisited, *chunkOffsets;
-        DeviceBuffer *splats, *binCounts, *tileTotals, *tileBases, *tileList;
+        DeviceBuffer *splats, *binCounts, *tileTotals, *tileBases, *tileList, *scanSums;
     } scratch{};
     // At least 16 bytes: a binding needs a buffer even when nothing is in it.
     auto need = [&](DeviceBuffer*& buffer, VkScratch slot, VkDeviceSize bytes) -> Status {
@@ -62,12 +63,15 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(need(scratch.chunkSplats, VkScratch::SplatChunkSplats, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkVisited, VkScratch::SplatChunkVisited, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
+    // The scans' block sums (scan.comp): 256 entries a block, for the longer of the two scans.
+    constexpr uint32_t kScanBlock = 256;
+    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(CeilDiv(std::max(chunks, screenTiles), kScanBlock)) * 4));
     CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
     CB_TRY(mContext->Upload(*scratch.order, std::as_bytes(std::span(flat.indices))));
     CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
     Pipeline* pipes[6] = {};
     const char* names[6] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite", "splat_boxes"};
-    const uint32_t bindings[6] = {8, 2, 8, 5, 6, 3};
+    const uint32_t bindings[6] = {8, 3, 8, 5, 6, 3};
     for (int n = 0; n < 6; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -81,11 +85,25 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         deviceMs += mLastDeviceMs.value_or(0);
         return {};
     };
+    // out = the exclusive prefix sum of n entries of in, and out[n] the total: three passes (scan.comp).
+    auto scan = [&](VulkanContext::Recorder& r, const DeviceBuffer* in, const DeviceBuffer* out, uint32_t n) {
+        struct {
+            uint32_t n, mode;
+        } push{n, 0};
+        const DeviceBuffer* buffers[] = {in, out, scratch.scanSums};
+        const uint32_t blocks = CeilDiv(n, kScanBlock);
+        r.Dispatch(*pipes[1], buffers, &push, sizeof push, blocks);
+        r.Barrier();
+        push.mode = 1;
+        r.Dispatch(*pipes[1], buffers, &push, sizeof push, 1);
+        r.Barrier();
+        push.mode = 2;
+        r.Dispatch(*pipes[1], buffers, &push, sizeof push, blocks);
+    };
     // 1. Splats per chunk of ranks, and their offsets.
     const uint32_t chunkPush = chunks;
     const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2],           common[3],
                                           common[4], common[5], scratch.chunkSplats, scratch.chunkVisited};
-    const DeviceBuffer* scanChunks[] = {scratch.chunkSplats, scratch.chunkOffsets};
     const uint32_t boxWords = CeilDiv(uint32_t(boxes.size()), 4);
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
@@ -96,7 +114,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         }
         r.Dispatch(*pipes[0], countBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
-        r.Dispatch(*pipes[1], scanChunks, &chunkPush, sizeof chunkPush, 1);
+        scan(r, scratch.chunkSplats, scratch.chunkOffsets, chunks);
     }));
     std::vector<uint32_t> chunkOffsets(chunks + 1);
     CB_TRY(mContext->Download(*scratch.chunkOffsets, std::as_writable_bytes(std::span(chunkOffsets))));
@@ -113,8 +131,6 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     } bin{0, splatCount, kSplatsPerChunk, splatChunks, tilesX, tilesY, kTileSize};
     const DeviceBuffer* writeBuffers[] = {
         common[0], common[1], common[2], common[3], common[4], common[5], scratch.chunkOffsets, scratch.splats};
-    const uint32_t tilesPush = screenTiles;
-    const DeviceBuffer* scanTiles[] = {scratch.tileTotals, scratch.tileBases};
     // The list is sized in step 3; splat_bin's binding 4 needs a buffer in the first passes.
     CB_TRY(need(scratch.tileList, VkScratch::SplatTileList, 16));
     const DeviceBuffer* binBuffers[] = {scratch.splats, scratch.binCounts, scratch.tileTotals, scratch.tileBases,
@@ -122,13 +138,15 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(run("render_splat: binning", [&](VulkanContext::Recorder& r) {
         r.Dispatch(*pipes[2], writeBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
+        r.Fill(*scratch.binCounts, 0);  // splat_bin's counts start at 0
+        r.Barrier();
         bin.mode = 0;
         r.Dispatch(*pipes[3], binBuffers, &bin, sizeof bin, splatChunks);
         r.Barrier();
         bin.mode = 1;
         r.Dispatch(*pipes[3], binBuffers, &bin, sizeof bin, screenTiles);
         r.Barrier();
-        r.Dispatch(*pipes[1], scanTiles, &tilesPush, sizeof tilesPush, 1);
+        scan(r, scratch.tileTotals, scratch.tileBases, screenTiles);
     }));
     std::vector<uint32_t> bases(screenTiles + 1);
     CB_TRY(mContext->Download(*scratch.tileBases, std::as_writable_bytes(std::span(bases))));
@@ -159,7 +177,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         bin.mode = 2;
         r.Dispatch(*pipes[3], fillBuffers, &bin, sizeof bin, splatChunks);
         r.Barrier();
-        r.Dispatch(*pipes[4], compositeBuffers, &composite, sizeof composite, W * H);
+        r.DispatchGroups(*pipes[4], compositeBuffers, &composite, sizeof composite, tilesX, tilesY, 1);
     }));
     mLastDeviceMs = deviceMs;
     if (stats) {

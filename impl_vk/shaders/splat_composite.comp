@@ -2,6 +2,9 @@
 // Splat compositing: one invocation per pixel walks its screen tile's splats
 // in the shared back-to-front order: C <- alpha c + (1 - alpha) C, from the
 // flat background, or with `ground` from the pixel's ground (ground.glsl).
+// One workgroup per 8 x 8 screen tile (tileSize must be 8; workgroup (i, j)
+// is tile (i, j)), so that all its invocations walk the same list: the same
+// loads and the same trip count.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
 #include "splat.glsl"
@@ -18,10 +21,11 @@ layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec
 float GroundFetchG(uint i, uint j) { return groundG[i + ground.grid.x * j]; }
 
 void main() {
-    const uint id = gl_GlobalInvocationID.x;
-    if (id >= pc.width * pc.height) return;
-    const int x = int(id % pc.width), y = int(id / pc.width);
-    const uint tile = uint(x) / pc.tileSize + pc.tilesX * (uint(y) / pc.tileSize);
+    const uint tile = gl_WorkGroupID.x + pc.tilesX * gl_WorkGroupID.y, lane = gl_LocalInvocationID.x;
+    const int x = int(pc.tileSize * gl_WorkGroupID.x + lane % pc.tileSize);
+    const int y = int(pc.tileSize * gl_WorkGroupID.y + lane / pc.tileSize);
+    if (uint(x) >= pc.width || uint(y) >= pc.height) return;
+    const uint id = uint(x) + pc.width * uint(y);
     vec3 c = pc.ground != 0u ? GroundBackground(ground, uint(x), uint(y)) : pc.background.rgb;
     for (uint n = bases[tile]; n < bases[tile + 1u]; ++n) {
         const Splat s = splats[list[n]];
