@@ -319,20 +319,21 @@ struct ShadeSweep {
                 for (uint32_t k = 0; k < tCopies; ++k) tc[plane * k + cell] = T[base + size_t(x0 + dx * k)];
             };
             for (uint32_t u = uLines; u < a1; ++u) copyCell(u, tSlices);
-            // The halo cell of the row beyond the chunk (the previous or the next chunk's, inside the grid).
-            for (int64_t u = uLo; u < uHi; ++u)
-                if ((u < int64_t(a0) || u >= int64_t(a1)) && u >= 0 && u < int64_t(nu)) copyCell(uint32_t(u), K);
+            // The halo cells of the row beyond the chunk (the previous or the next chunk's, inside the grid).
+            for (int64_t u = std::max<int64_t>(uLo, 0); u < std::min<int64_t>(a0, nu); ++u) copyCell(uint32_t(u), K);
+            for (int64_t u = a1; u < std::min<int64_t>(uHi, nu); ++u) copyCell(uint32_t(u), K);
         }
         for (uint32_t k = 1; k <= K; ++k)
             for (uint32_t b = b0; b < b1; ++b) {
                 const size_t tap = plane * (k - 1) + size_t(P) * size_t(int64_t(b) + g.v0 - yLo) + size_t(g.u0 + 1);
                 float* out = tc + plane * k + size_t(P) * size_t(int64_t(b) - yLo);
-                // The padding may write past the row's na cells; the cell after
-                // them (the halo, or outside) is what the next slice's taps read
-                // there, so it is kept.
-                const float after = out[na + 1];
+                // The padding may write past the row's na cells; the cells after
+                // them (the halo, or outside: one, or two when u0 = 1) are what
+                // the next slice's taps read there, so they are kept.
+                const float after[2] = {out[na + 1], out[na + 2]};
                 ShadeRow(kernel, tc + tap, tc + tap + P, qc + tap, qc + tap + P, g.fu, g.fv, out + 1, padded);
-                out[na + 1] = after;
+                out[na + 1] = after[0];
+                out[na + 2] = after[1];
             }
         for (uint32_t b = b0; b < b1; ++b) {
             const size_t rowBase = sv * b, cell0 = size_t(P) * size_t(int64_t(b) - yLo) + 1 - a0;

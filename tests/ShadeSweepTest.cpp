@@ -96,21 +96,29 @@ TEST(Shade, ParallelSweepEqualsPlainSweep) {
     const Extent3 wide{40, 100, 20};
     std::vector<float> qw(wide.Count());
     for (float& v : qw) v = rng.Below(3) ? float(rng.Below(65)) / 64.0f : 0.0f;
-    int comparedX = 0;
-    for (const Vec3& sun : {SunDirection(0.3, 0.2), SunDirection(0.3, 3.3), SunDirection(-0.3, -0.2), SunDirection(0.3, -0.2)})
-        for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Unorm8}) {
-            ShadeParams p;
-            p.sun = sun;
-            p.storage = storage;
-            p.sigma = 0.004f;
-            ASSERT_EQ(MakeShadePlan(p, wide).geometry.w, 0);
-            const std::vector<float> plain = PlainShadeSweep(wide, qw, p);
-            for (int threads : {1, 2, 5, 16})
-                ASSERT_EQ(test::ShadeOnCpu(wide, qw, p, threads, std::nanf("")), plain)
-                    << threads << " threads, sun " << sun[0] << " " << sun[1] << " " << sun[2];
-            ++comparedX;
-        }
-    EXPECT_EQ(comparedX, 8);
+    // Azimuth +-0.55 rad with the nearest filter: du = +-0.61 rounds to u0 = +-1, so the taps reach two
+    // cells beyond a chunk (the second with weight 0) or one before it.
+    int comparedX = 0, reachTwo = 0;
+    for (const Vec3& sun : {SunDirection(0.3, 0.2), SunDirection(0.3, 3.3), SunDirection(-0.3, -0.2), SunDirection(0.3, -0.2),
+                            SunDirection(0.3, 0.55), SunDirection(0.3, -0.55)})
+        for (SampleFilter filter : {SampleFilter::Bilinear, SampleFilter::Nearest})
+            for (StorageFormat storage : {StorageFormat::Fp32, StorageFormat::Unorm8}) {
+                ShadeParams p;
+                p.sun = sun;
+                p.filter = filter;
+                p.storage = storage;
+                p.sigma = 0.004f;
+                const ShadePlan plan = MakeShadePlan(p, wide);
+                ASSERT_EQ(plan.geometry.w, 0);
+                reachTwo += plan.geometry.u0 == 1;
+                const std::vector<float> plain = PlainShadeSweep(wide, qw, p);
+                for (int threads : {1, 2, 5, 16})
+                    ASSERT_EQ(test::ShadeOnCpu(wide, qw, p, threads, std::nanf("")), plain)
+                        << threads << " threads, sun " << sun[0] << " " << sun[1] << " " << sun[2];
+                ++comparedX;
+            }
+    EXPECT_EQ(comparedX, 24);
+    EXPECT_EQ(reachTwo, 2);
     // The cut those runs took on 16 threads, so the chunks were exercised.
     ShadeParams px;
     px.sun = SunDirection(0.3, 0.2);
