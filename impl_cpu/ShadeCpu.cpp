@@ -284,7 +284,7 @@ struct ShadeSweep {
             if (!inV) continue;
             // In the halo, slices ma - 1 .. mb - 2 are read; in the tile, only ma - 1.
             const uint32_t tSlices = inBand ? 1 : K;
-            const size_t rowBase = sv * size_t(y), cell0 = size_t(P) * r + 1 - a0;  // cell0 + u: cell u
+            const size_t rowBase = sv * size_t(y), cell0 = size_t(P) * r + 1;  // cell a0 of row r
             for (uint32_t u = a0; u < uLines; u += kLineFloats) {
                 // Lines a grid row apart: the hardware does not fetch them ahead.
                 if (u + kLineFloats < uLines)
@@ -300,17 +300,18 @@ struct ShadeSweep {
                 Lanes16 v[16];
                 for (uint32_t i = 0; i < kLineFloats; ++i) v[i] = LoadLanes(Q + rowBase + su * (u + i) + size_t(xLine));
                 Transpose16(v);
-                for (int j = 0; j < 16; ++j) StoreLanes(qc + plane * plane16(j) + cell0 + u, v[j]);
+                for (int j = 0; j < 16; ++j) StoreLanes(qc + plane * plane16(j) + cell0 + (u - a0), v[j]);
                 if (inBand) {
-                    for (uint32_t i = 0; i < kLineFloats; ++i) tc[cell0 + u + i] = T[rowBase + su * (u + i) + size_t(x0)];
+                    for (uint32_t i = 0; i < kLineFloats; ++i)
+                        tc[cell0 + (u - a0) + i] = T[rowBase + su * (u + i) + size_t(x0)];
                     continue;
                 }
                 for (uint32_t i = 0; i < kLineFloats; ++i) v[i] = LoadLanes(T + rowBase + su * (u + i) + size_t(xLine));
                 Transpose16(v);
-                for (int j = 0; j < 16; ++j) StoreLanes(tc + plane * plane16(j) + cell0 + u, v[j]);
+                for (int j = 0; j < 16; ++j) StoreLanes(tc + plane * plane16(j) + cell0 + (u - a0), v[j]);
             }
             auto copyCell = [&](uint32_t u, uint32_t tCopies) {
-                const size_t base = rowBase + su * u, cell = cell0 + u;
+                const size_t base = rowBase + su * u, cell = cell0 + u - a0;  // u >= a0 - 1: no wrap
                 const size_t ahead = rowBase + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0);
                 __builtin_prefetch(Q + ahead);
                 __builtin_prefetch(Q + ahead + size_t(dx * int64_t(K - 1)));
@@ -336,18 +337,18 @@ struct ShadeSweep {
                 out[na + 2] = after[1];
             }
         for (uint32_t b = b0; b < b1; ++b) {
-            const size_t rowBase = sv * b, cell0 = size_t(P) * size_t(int64_t(b) - yLo) + 1 - a0;
+            const size_t rowBase = sv * b, cell0 = size_t(P) * size_t(int64_t(b) - yLo) + 1;  // cell a0 of row b
             for (uint32_t u = a0; u < uLines; u += kLineFloats) {
                 Lanes16 v[16];
                 // Row j: the slice at x = xOut + j; transposed, lane j of cell u + i's line.
-                for (int j = 0; j < 16; ++j) v[j] = LoadLanes(tc + plane * (plane16(j) + 1) + cell0 + u);
+                for (int j = 0; j < 16; ++j) v[j] = LoadLanes(tc + plane * (plane16(j) + 1) + cell0 + (u - a0));
                 Transpose16(v);
                 for (uint32_t i = 0; i < kLineFloats; ++i) StoreLanes(T + rowBase + su * (u + i) + size_t(xOut), v[i]);
             }
             for (uint32_t u = uLines; u < a1; ++u) {
                 const size_t base = rowBase + su * u;
                 __builtin_prefetch(T + rowBase + su * std::min(u + kPrefetchRows, nu - 1) + size_t(x0 + dx), 1);
-                const size_t cell = cell0 + u;
+                const size_t cell = cell0 + (u - a0);
                 for (uint32_t k = 1; k <= K; ++k) T[base + size_t(x0 + dx * k)] = tc[plane * k + cell];
             }
         }
@@ -415,7 +416,8 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
         const uint32_t va = s.axis == 1 ? c0 : 0, vb = s.axis == 1 ? c1 : plan.nv;
         const uint32_t ma = m0 + block * s.blockSlices, mb = std::min(m1, ma + s.blockSlices);
         if (alongX) {
-            const uint32_t a0 = chunk * s.chunkCells, a1 = s.chunks == 1 ? plan.nu : std::min(plan.nu, a0 + s.chunkCells);
+            const uint32_t a0 = chunk * s.chunkCells;
+            const uint32_t a1 = s.chunks == 1 ? plan.nu : std::min(plan.nu, a0 + s.chunkCells);
             return sweep.TileAlongX(ma, mb, va, vb, a0, a1);
         }
         for (uint32_t m = ma; m < mb; ++m) {
@@ -444,7 +446,8 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     std::vector<std::atomic<uint8_t>> pending(size_t(B) * C * blocks);
     for (uint32_t M = 0; M < blocks; ++M)
         for (uint32_t j = 0; j < C; ++j)
-            for (uint32_t i = 0; i < B; ++i) pending[at(i, j, M)] = uint8_t((M > 0) + (i != lastBand) + (j != lastChunk));
+            for (uint32_t i = 0; i < B; ++i)
+                pending[at(i, j, M)] = uint8_t((M > 0) + (i != lastBand) + (j != lastChunk));
     struct Tile {
         uint32_t band, chunk, block;
     };
