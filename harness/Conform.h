@@ -41,7 +41,8 @@ using ConformProgress = std::function<void(uint32_t step, const std::vector<Conf
 // the test-only switch CLOUDBENCH_TEST_CONFORM_MISMATCH=<backend>:<row stage>[:<attempts>][@<case>],
 // which perturbs that backend's output of that row (its first element: a float by 1, down from 0.5 up, so that a code
 // stored clamped to [0, 1] changes too; a byte by flipping its top bit; the cover by 1) before it is compared, on
-// attempts below <attempts> (default: every attempt), in the case named after '@' (default: every case).
+// attempts below <attempts> (default: every attempt), in the case named after '@' (default: every case). With
+// CLOUDBENCH_TEST_CONFORM_MISMATCH_EVERY=1 a byte row has every element one code off instead.
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
                                                const ConformProgress& afterStep = {},
                                                const std::string& differenceDir = "", uint32_t attempt = 0,

@@ -30,8 +30,9 @@ def fail(message, proc=None):
     sys.exit(1)
 
 
-def conform(extra=(), mismatch="", steps="2"):
-    env = dict(os.environ, CLOUDBENCH_TEST_CONFORM_MISMATCH=mismatch)
+def conform(extra=(), mismatch="", steps="2", every=False):
+    env = dict(os.environ, CLOUDBENCH_TEST_CONFORM_MISMATCH=mismatch,
+               CLOUDBENCH_TEST_CONFORM_MISMATCH_EVERY="1" if every else "")
     env.pop("CLOUDBENCH_TEST_FAULT", None)
     return subprocess.run([cli, "conform", "ci-small", "--backend", backend, "--steps", steps, "--out", folder]
                           + list(extra), env=env, capture_output=True, text=True, timeout=600)
@@ -175,6 +176,15 @@ elif case == "cover":
         row = [r for r in json.load(f)["results"] if r["stage"] == "density.cover"][0]
     if row["worst"] != 1:
         fail("density.cover worst should be 1, got %s" % row["worst"], p)
+elif case == "share":
+    # Every region code one off on the backend: within the rule's |dR| <= 1, but 100 % of the elements
+    # differ against the 0.5 % allowed, so region fails (exit 5) with worst 1, on the share alone.
+    p = conform(mismatch=backend + ":region", every=True)
+    expect(p, 5, {"region": "fail"})
+    with open(os.path.join(folder, "conform.json")) as f:
+        row = [r for r in json.load(f)["results"] if r["stage"] == "region"][0]
+    if row["worst"] != 1:
+        fail("region worst should be 1 (within the tolerance), got %s" % row["worst"], p)
 elif case == "baseline-expected":
     # A listed failure is expected-fail and the exit is 0; comments and a CSV header are allowed.
     path = baseline("# known failures\nstage,backend,status\n\nshade,%s,fail\n" % backend)

@@ -8,7 +8,7 @@ elseif(CLOUDBENCH_HAVE_GL)
   set(conform_features_backend gl)
 endif()
 if(DEFINED conform_features_backend)
-  foreach(case IN ITEMS csv cover baseline-expected baseline-new baseline-from-csv baseline-bad flaky flake-persistent
+  foreach(case IN ITEMS csv cover share baseline-expected baseline-new baseline-from-csv baseline-bad flaky flake-persistent
                         flaky-baseline usage matrix matrix-baseline)
     add_test(NAME Cli.ConformFeatures.${case}
              COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_conform_features.py ${cli}
