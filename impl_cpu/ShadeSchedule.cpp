@@ -17,7 +17,7 @@ ShadeSchedule MakeShadeSchedule(const ShadePlan& plan, int threads, uint32_t m0,
     s.span = s.work;
     s.blockSlices = slices;
     const uint32_t p = uint32_t(std::max(threads, 1));
-    if (plan.geometry.w == 0 && nv >= 2 * kStridedRows) {
+    if (plan.geometry.w == 0 && nv >= kMinStridedRows) {
         // u = y, v = z: a row's cells lie a grid row apart, and one slice's
         // rows touch a cache line each per cell, too many to stay cached
         // from one slice to the next. Tiles of as many slices as a cache line

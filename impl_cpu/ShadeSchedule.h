@@ -14,11 +14,12 @@ namespace cb::cpu {
 inline constexpr uint32_t kMinBandCells = 8;
 // A tile aims at about this many cells (a few microseconds of one core).
 inline constexpr double kTileCells = 16384;
-// Sweeps along x (rows along y, strided): rows per band (a tile copies its
-// halo row and column for every slice, so larger tiles copy less), the
-// narrowest chunk of a row, and slices per tile (the floats of a 64-byte
+// Sweeps along x (rows along y, strided): the fewest rows (z) for which they
+// are tiled as below (fewer take the generic path), rows per band (a tile
+// copies its halo row and column for every slice, so larger tiles copy less),
+// the narrowest chunk of a row, and slices per tile (the floats of a 64-byte
 // cache line).
-inline constexpr uint32_t kStridedRows = 2;
+inline constexpr uint32_t kMinStridedRows = 4;
 inline constexpr uint32_t kStridedBandRows = 8;
 inline constexpr uint32_t kMinChunkCells = 32;
 inline constexpr uint32_t kLineFloats = 16;
