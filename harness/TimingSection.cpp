@@ -48,38 +48,26 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         table.rows.push_back(TimingRow(std::string(StageName(stage)), StageSamples(scene, run, stage),
                                        StageSamples(scene, run, stage, true)));
     }
-    if (scene.stages.Has(Stage::RenderSplat)) {
+    // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's count of `what`.
+    auto frameRows = [&](Stage renderer, const std::string& label, const char* what, auto count) {
+        if (!scene.stages.Has(renderer)) return;
         for (const CameraSettings& camera : scene.render.cameras) {
             std::vector<double> ms;
-            uint64_t lastSplats = 0;
+            uint64_t last = 0;
             for (const StepRecord& r : run.steps)
                 for (const FrameRecord& f : r.frames)
-                    if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
+                    if (f.renderer == renderer && f.camera == camera.name) {
                         ms.push_back(f.ms);
-                        lastSplats = f.stats.splats;
+                        last = count(f);
                     }
             const Summary s = Summarize(ms);
-            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu splats", s.count,
-                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(lastSplats));
-            table.rows.push_back(TimingRow(("  frame " + camera.name).substr(0, 18), ms, {}, line));
+            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu %s", s.count,
+                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(last), what);
+            table.rows.push_back(TimingRow(("  " + label + " " + camera.name).substr(0, 18), ms, {}, line));
         }
-    }
-    if (scene.stages.Has(Stage::RenderMarch)) {
-        for (const CameraSettings& camera : scene.render.cameras) {
-            std::vector<double> ms;
-            uint64_t lastSamples = 0;
-            for (const StepRecord& r : run.steps)
-                for (const FrameRecord& f : r.frames)
-                    if (f.renderer == Stage::RenderMarch && f.camera == camera.name) {
-                        ms.push_back(f.ms);
-                        lastSamples = f.march.samples;
-                    }
-            const Summary s = Summarize(ms);
-            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu samples", s.count,
-                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(lastSamples));
-            table.rows.push_back(TimingRow(("  march " + camera.name).substr(0, 18), ms, {}, line));
-        }
-    }
+    };
+    frameRows(Stage::RenderSplat, "frame", "splats", [](const FrameRecord& f) { return uint64_t(f.stats.splats); });
+    frameRows(Stage::RenderMarch, "march", "samples", [](const FrameRecord& f) { return uint64_t(f.march.samples); });
     if (scene.stages.Has(Stage::Region)) {
         std::vector<double> host;
         for (const StepRecord& r : run.steps)
