@@ -46,16 +46,24 @@ enum class VkScratch {
     ShadeCoarseQ,       // shade: q on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
     ShadeCoarseT,       // shade: T on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
     SplatFrame,         // render_splat: grid, camera and light (the shaders' Frame)
-    SplatOrder,         // render_splat: the flattened shared order
+    SplatRankParts,     // render_splat: per position of each axis order, its coordinate and index shares
     SplatBoxes,         // render_splat: visibility of each tile x band box, one byte each
+    SplatCandidates,    // render_splat: a bit per rank, 1 where it makes a splat
     SplatChunkSplats,   // render_splat: splats per chunk of ranks
-    SplatChunkVisited,  // render_splat: voxels visited per chunk of ranks
+    SplatChunkPairs,    // render_splat: (screen tile, splat) pairs per chunk of ranks
     SplatChunkOffsets,  // render_splat: SplatChunkSplats scanned, and the total
+    SplatChunkPairOffsets,  // render_splat: SplatChunkPairs scanned, and the total
+    SplatTotals,        // render_splat: the splats and the pairs, two words read by the host
     Splats,             // render_splat: the splats in the shared order, 48 bytes each
-    SplatBinCounts,     // render_splat: splats per chunk x screen tile
-    SplatTileTotals,    // render_splat: splats per screen tile
-    SplatTileBases,     // render_splat: SplatTileTotals scanned, and the total
-    SplatTileList,      // render_splat: splat indices, screen tile by screen tile
+    SplatTiles,         // render_splat: screen tiles per splat
+    SplatPairOffsets,   // render_splat: SplatTiles scanned, and the total
+    SplatKeys,          // render_splat: the pairs' screen tiles (radix sort ping)
+    SplatValues,        // render_splat: the pairs' splat indices (radix sort ping)
+    SplatKeysSwap,      // render_splat: the pairs' screen tiles (radix sort pong)
+    SplatValuesSwap,    // render_splat: the pairs' splat indices (radix sort pong)
+    SplatSortCounts,    // render_splat: pairs per radix digit x sort block
+    SplatSortOffsets,   // render_splat: SplatSortCounts scanned, and the total
+    SplatTileBases,     // render_splat: the first sorted pair of each screen tile, and the pairs
     SplatScanSums,      // render_splat: the block sums of its scans (scan.comp)
     NoiseData,          // noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
     MarchFrame,         // render_march: the constants (core/MarchGpu.h), 256 bytes

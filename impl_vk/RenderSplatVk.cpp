@@ -1,5 +1,7 @@
 // Stage `render_splat` (SPEC 8) on Vulkan: count, write, bin and composite the
-// splats in the shared order (splat_*.comp, scan.comp).
+// splats in the shared order (splat_*.comp, scan.comp, radix_sort.comp): bins
+// are (screen tile, splat) pairs sorted stably by tile, so memory and every
+// invocation's loop grow with the pairs, never with splats x tiles.
 #include <algorithm>
 #include <vector>
 
@@ -7,6 +9,33 @@
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
+namespace {
+
+// splat_ranks.glsl's RankParts entry: a position of one axis order.
+struct RankPart {
+    uint32_t coordinate, voxelShare, boxShare, pad;
+};
+
+// Per position of the outer, middle and inner axis orders (at flat.base): the
+// coordinate, its share of the voxel index x + nx (y + ny z) and of the box index
+// x / tile + tilesAcross (y / tile + tilesDown z / band) (SplatFrame.boxes).
+std::vector<RankPart> MakeRankParts(const SplatFrame& F, const FlatSplatOrder& flat) {
+    const uint32_t voxelStride[3] = {1, F.grid[0], F.grid[0] * F.grid[1]};
+    const uint32_t boxSize[3] = {F.boxes[0], F.boxes[0], F.boxes[1]};
+    const uint32_t boxStride[3] = {1, F.boxes[2], F.boxes[2] * F.boxes[3]};
+    std::vector<RankPart> parts(flat.indices.size());
+    for (uint32_t level = 0; level < 3; ++level) {
+        const uint32_t axis = F.axes[level];
+        const uint32_t end = level < 2 ? flat.base[level + 1] : uint32_t(flat.indices.size());
+        for (uint32_t n = flat.base[level]; n < end; ++n) {
+            const uint32_t x = flat.indices[n];
+            parts[n] = {x, x * voxelStride[axis], x / boxSize[axis] * boxStride[axis], 0};
+        }
+    }
+    return parts;
+}
+
+}  // namespace
 
 Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
     // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
@@ -33,10 +62,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
             return MakeError("vk: render_splat's band occupancy does not match its tile and band");
     }
     // The shared order, outer axis first.
-    const SplatOrder& order = *p.order;
-    const FlatSplatOrder flat = FlattenSplatOrder(order);
+    const FlatSplatOrder flat = FlattenSplatOrder(*p.order);
     // kTileSize: splat_composite.comp runs a workgroup of 64 per 8 x 8 tile.
-    constexpr uint32_t kVoxelsPerChunk = 1024, kSplatsPerChunk = 256, kTileSize = 8;
+    constexpr uint32_t kVoxelsPerChunk = 1024, kTileSize = 8;
     const uint32_t voxels = uint32_t(e.Count());
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
     // The shared frame; this backend's lanes: voxels per chunk of ranks, screen tiles.
@@ -45,10 +73,12 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     frame.image[2] = tilesX;
     frame.image[3] = tilesY;
     const uint32_t chunks = CeilDiv(voxels, kVoxelsPerChunk);
+    const std::vector<RankPart> rankParts = MakeRankParts(frame, flat);
     // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
     struct {
-        DeviceBuffer *frame, *order, *boxes, *chunkSplats, *chunkVisited, *chunkOffsets;
-        DeviceBuffer *splats, *binCounts, *tileTotals, *tileBases, *tileList, *scanSums;
+        DeviceBuffer *frame, *rankParts, *boxes, *candidates, *chunkSplats, *chunkPairs, *chunkOffsets, *chunkPairOffsets, *totals;
+        DeviceBuffer *splats, *splatTiles, *pairOffsets, *keys[2], *values[2], *sortCounts, *sortOffsets, *tileBases;
+        DeviceBuffer* scanSums;
     } scratch{};
     // At least 16 bytes: a binding needs a buffer even when nothing is in it.
     auto need = [&](DeviceBuffer*& buffer, VkScratch slot, VkDeviceSize bytes) -> Status {
@@ -58,27 +88,32 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         return {};
     };
     CB_TRY(need(scratch.frame, VkScratch::SplatFrame, sizeof frame));
-    CB_TRY(need(scratch.order, VkScratch::SplatOrder, flat.indices.size() * 4));
+    CB_TRY(need(scratch.rankParts, VkScratch::SplatRankParts, rankParts.size() * sizeof(RankPart)));
     CB_TRY(need(scratch.boxes, VkScratch::SplatBoxes, boxes.size()));
+    CB_TRY(need(scratch.candidates, VkScratch::SplatCandidates, VkDeviceSize(chunks) * kVoxelsPerChunk / 8));
     CB_TRY(need(scratch.chunkSplats, VkScratch::SplatChunkSplats, VkDeviceSize(chunks) * 4));
-    CB_TRY(need(scratch.chunkVisited, VkScratch::SplatChunkVisited, VkDeviceSize(chunks) * 4));
+    CB_TRY(need(scratch.chunkPairs, VkScratch::SplatChunkPairs, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
-    // The scans' block sums (scan.comp): 256 entries a block, for the longer of the two scans.
+    CB_TRY(need(scratch.chunkPairOffsets, VkScratch::SplatChunkPairOffsets, VkDeviceSize(chunks + 1) * 4));
+    CB_TRY(need(scratch.totals, VkScratch::SplatTotals, 8));
+    // The scans' block sums (scan.comp): 256 entries a block; sized again for the later, longer scans.
     constexpr uint32_t kScanBlock = 256;
-    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(CeilDiv(std::max(chunks, screenTiles), kScanBlock)) * 4));
+    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(CeilDiv(chunks, kScanBlock)) * 4));
     CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
-    CB_TRY(mContext->Upload(*scratch.order, std::as_bytes(std::span(flat.indices))));
+    CB_TRY(mContext->Upload(*scratch.rankParts, std::as_bytes(std::span(rankParts))));
     CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
-    Pipeline* pipes[6] = {};
-    const char* names[6] = {"splat_count", "scan", "splat_write", "splat_bin", "splat_composite", "splat_boxes"};
-    const uint32_t bindings[6] = {8, 3, 8, 5, 6, 3};
-    for (int n = 0; n < 6; ++n) {
+    enum { kCount, kScan, kWrite, kPairs, kSort, kRanges, kComposite, kBoxes, kPipes };
+    Pipeline* pipes[kPipes] = {};
+    const char* names[kPipes] = {"splat_count",  "scan",           "splat_write",    "splat_pairs",
+                                 "radix_sort",   "splat_ranges",   "splat_composite", "splat_boxes"};
+    const uint32_t bindings[kPipes] = {9, 3, 10, 4, 5, 2, 6, 3};
+    for (int n = 0; n < kPipes; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
         pipes[n] = *pipe;
     }
     const DeviceBuffer* common[6] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T),
-                                     scratch.order,   scratch.boxes,  scratch.frame};
+                                     scratch.rankParts, scratch.boxes, scratch.frame};
     double deviceMs = 0;
     auto run = [&](const char* what, auto&& record) -> Status {
         CB_TRY(Record(what, record));
@@ -92,69 +127,79 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         } push{n, 0};
         const DeviceBuffer* buffers[] = {in, out, scratch.scanSums};
         const uint32_t blocks = CeilDiv(n, kScanBlock);
-        r.Dispatch(*pipes[1], buffers, &push, sizeof push, blocks);
+        r.Dispatch(*pipes[kScan], buffers, &push, sizeof push, blocks);
         r.Barrier();
         push.mode = 1;
-        r.Dispatch(*pipes[1], buffers, &push, sizeof push, 1);
+        r.Dispatch(*pipes[kScan], buffers, &push, sizeof push, 1);
         r.Barrier();
         push.mode = 2;
-        r.Dispatch(*pipes[1], buffers, &push, sizeof push, blocks);
+        r.Dispatch(*pipes[kScan], buffers, &push, sizeof push, blocks);
     };
-    // 1. Splats per chunk of ranks, and their offsets.
-    const uint32_t chunkPush = chunks;
-    const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2],           common[3],
-                                          common[4], common[5], scratch.chunkSplats, scratch.chunkVisited};
+    // 1. Splats and (screen tile, splat) pairs per chunk of ranks, their offsets,
+    //    and both totals, which size everything after: the one host wait.
+    struct {
+        uint32_t chunks, tileSize;
+    } chunkPush{chunks, kTileSize};
+    const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2],          common[3],         common[4],
+                                          common[5], scratch.chunkSplats, scratch.chunkPairs, scratch.candidates};
     const uint32_t boxWords = CeilDiv(uint32_t(boxes.size()), 4);
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
     CB_TRY(run("render_splat: counting splats", [&](VulkanContext::Recorder& r) {
         if (p.skipping) {
-            r.Dispatch(*pipes[5], boxBuffers, &boxWords, sizeof boxWords, boxWords);
+            r.Dispatch(*pipes[kBoxes], boxBuffers, &boxWords, sizeof boxWords, boxWords);
             r.Barrier();
         }
-        r.Dispatch(*pipes[0], countBuffers, &chunkPush, sizeof chunkPush, chunks);
+        r.Dispatch(*pipes[kCount], countBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
         scan(r, scratch.chunkSplats, scratch.chunkOffsets, chunks);
+        r.Barrier();
+        scan(r, scratch.chunkPairs, scratch.chunkPairOffsets, chunks);
+        r.Copy(*scratch.chunkOffsets, VkDeviceSize(chunks) * 4, *scratch.totals, 0, 4);
+        r.Copy(*scratch.chunkPairOffsets, VkDeviceSize(chunks) * 4, *scratch.totals, 4, 4);
     }));
-    std::vector<uint32_t> chunkOffsets(chunks + 1);
-    CB_TRY(mContext->Download(*scratch.chunkOffsets, std::as_writable_bytes(std::span(chunkOffsets))));
-    const uint32_t splatCount = chunkOffsets[chunks];
+    uint32_t totals[2] = {};
+    CB_TRY(mContext->Download(*scratch.totals, std::as_writable_bytes(std::span(totals))));
+    const uint32_t splatCount = totals[0], pairCount = totals[1];
 
-    // 2. Write the splats in order; bin them by screen tile, keeping the order.
-    const uint32_t splatChunks = std::max(1u, CeilDiv(splatCount, kSplatsPerChunk));
+    // 2. Write the splats in order, their pairs in order, and sort the pairs by
+    //    screen tile, stably (radix_sort.comp: 8-bit digits, as many as the
+    //    largest tile index has), so that each tile's splats keep the order.
+    //    Sort blocks hold at least 256 pairs, more when there are so many that
+    //    the scan of the digit counts would pass scan.comp's limit.
+    const uint32_t sortBlock = std::max(kScanBlock, CeilDiv(pairCount, 65535u));
+    const uint32_t sortBlocks = std::max(1u, CeilDiv(pairCount, sortBlock));
+    uint32_t digits = 0;
+    for (uint32_t largest = screenTiles - 1; largest != 0; largest >>= 8) ++digits;
     CB_TRY(need(scratch.splats, VkScratch::Splats, VkDeviceSize(splatCount) * sizeof(Splat)));
-    CB_TRY(need(scratch.binCounts, VkScratch::SplatBinCounts, VkDeviceSize(splatChunks) * screenTiles * 4));
-    CB_TRY(need(scratch.tileTotals, VkScratch::SplatTileTotals, VkDeviceSize(screenTiles) * 4));
+    CB_TRY(need(scratch.splatTiles, VkScratch::SplatTiles, VkDeviceSize(splatCount) * 4));
+    CB_TRY(need(scratch.pairOffsets, VkScratch::SplatPairOffsets, VkDeviceSize(splatCount + 1) * 4));
+    CB_TRY(need(scratch.keys[0], VkScratch::SplatKeys, VkDeviceSize(pairCount) * 4));
+    CB_TRY(need(scratch.values[0], VkScratch::SplatValues, VkDeviceSize(pairCount) * 4));
+    CB_TRY(need(scratch.keys[1], VkScratch::SplatKeysSwap, digits ? VkDeviceSize(pairCount) * 4 : 0));
+    CB_TRY(need(scratch.values[1], VkScratch::SplatValuesSwap, digits ? VkDeviceSize(pairCount) * 4 : 0));
+    CB_TRY(need(scratch.sortCounts, VkScratch::SplatSortCounts, VkDeviceSize(256) * sortBlocks * 4));
+    CB_TRY(need(scratch.sortOffsets, VkScratch::SplatSortOffsets, (VkDeviceSize(256) * sortBlocks + 1) * 4));
     CB_TRY(need(scratch.tileBases, VkScratch::SplatTileBases, VkDeviceSize(screenTiles + 1) * 4));
+    const uint32_t longestScan = std::max({chunks, splatCount, 256 * sortBlocks});
+    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(CeilDiv(longestScan, kScanBlock)) * 4));
+    const DeviceBuffer* writeBuffers[] = {common[0],            common[1],      common[2],
+                                          common[3],            common[4],      common[5],
+                                          scratch.chunkOffsets, scratch.splats, scratch.splatTiles,
+                                          scratch.candidates};
     struct {
-        uint32_t mode, splatCount, chunkSize, chunks, tilesX, tilesY, tileSize;
-    } bin{0, splatCount, kSplatsPerChunk, splatChunks, tilesX, tilesY, kTileSize};
-    const DeviceBuffer* writeBuffers[] = {
-        common[0], common[1], common[2], common[3], common[4], common[5], scratch.chunkOffsets, scratch.splats};
-    // The list is sized in step 3; splat_bin's binding 4 needs a buffer in the first passes.
-    CB_TRY(need(scratch.tileList, VkScratch::SplatTileList, 16));
-    const DeviceBuffer* binBuffers[] = {scratch.splats, scratch.binCounts, scratch.tileTotals, scratch.tileBases,
-                                        scratch.tileList};
-    CB_TRY(run("render_splat: binning", [&](VulkanContext::Recorder& r) {
-        r.Dispatch(*pipes[2], writeBuffers, &chunkPush, sizeof chunkPush, chunks);
-        r.Barrier();
-        r.Fill(*scratch.binCounts, 0);  // splat_bin's counts start at 0
-        r.Barrier();
-        bin.mode = 0;
-        r.Dispatch(*pipes[3], binBuffers, &bin, sizeof bin, splatChunks);
-        r.Barrier();
-        bin.mode = 1;
-        r.Dispatch(*pipes[3], binBuffers, &bin, sizeof bin, screenTiles);
-        r.Barrier();
-        scan(r, scratch.tileTotals, scratch.tileBases, screenTiles);
-    }));
-    std::vector<uint32_t> bases(screenTiles + 1);
-    CB_TRY(mContext->Download(*scratch.tileBases, std::as_writable_bytes(std::span(bases))));
-
-    // 3. Fill the tile lists; composite every pixel.
-    CB_TRY(need(scratch.tileList, VkScratch::SplatTileList, VkDeviceSize(bases[screenTiles]) * 4));
-    const DeviceBuffer* fillBuffers[] = {scratch.splats, scratch.binCounts, scratch.tileTotals, scratch.tileBases,
-                                         scratch.tileList};
+        uint32_t splatCount, tilesX, tileSize;
+    } pairPush{splatCount, tilesX, kTileSize};
+    const DeviceBuffer* pairBuffers[] = {scratch.splats, scratch.pairOffsets, scratch.keys[0], scratch.values[0]};
+    // One invocation per splat, in rows of kRowGroups workgroups (splat_tiles.glsl LinearInvocation).
+    constexpr uint32_t kRowGroups = 32768;
+    const uint32_t splatGroups = std::max(1u, CeilDiv(splatCount, 64u));
+    struct {
+        uint32_t n, shift, block, blocks, mode;
+    } sortPush{pairCount, 0, sortBlock, sortBlocks, 0};
+    struct {
+        uint32_t pairs, tiles;
+    } rangePush{pairCount, screenTiles};
     struct {
         uint32_t width, height, tilesX, tileSize;
         float background[4];
@@ -171,13 +216,37 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         groundBlock = *b;
         groundG = &Dev(*in.G);
     }
-    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.tileList,
+    const uint32_t sorted = digits % 2;  // which of keys/values holds the sorted pairs
+    const DeviceBuffer* rangeBuffers[] = {scratch.keys[sorted], scratch.tileBases};
+    const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.values[sorted],
                                               &Dev(image),    groundBlock,       groundG};
-    CB_TRY(run("render_splat: compositing", [&](VulkanContext::Recorder& r) {
-        bin.mode = 2;
-        r.Dispatch(*pipes[3], fillBuffers, &bin, sizeof bin, splatChunks);
+    // 3. Each tile's first pair, by binary search; composite every pixel.
+    CB_TRY(run("render_splat: binning and compositing", [&](VulkanContext::Recorder& r) {
+        r.Dispatch(*pipes[kWrite], writeBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
-        r.DispatchGroups(*pipes[4], compositeBuffers, &composite, sizeof composite, tilesX, tilesY, 1);
+        scan(r, scratch.splatTiles, scratch.pairOffsets, splatCount);
+        r.Barrier();
+        r.DispatchGroups(*pipes[kPairs], pairBuffers, &pairPush, sizeof pairPush, std::min(splatGroups, kRowGroups),
+                         CeilDiv(splatGroups, kRowGroups), 1);
+        for (uint32_t digit = 0; digit < digits; ++digit) {
+            const DeviceBuffer* from[2] = {scratch.keys[digit % 2], scratch.values[digit % 2]};
+            const DeviceBuffer* to[2] = {scratch.keys[1 - digit % 2], scratch.values[1 - digit % 2]};
+            const DeviceBuffer* countPass[] = {from[0], from[1], scratch.sortCounts, to[0], to[1]};
+            const DeviceBuffer* scatterPass[] = {from[0], from[1], scratch.sortOffsets, to[0], to[1]};
+            sortPush.shift = 8 * digit;
+            sortPush.mode = 0;
+            r.Barrier();
+            r.Dispatch(*pipes[kSort], countPass, &sortPush, sizeof sortPush, sortBlocks);
+            r.Barrier();
+            scan(r, scratch.sortCounts, scratch.sortOffsets, 256 * sortBlocks);
+            r.Barrier();
+            sortPush.mode = 1;
+            r.Dispatch(*pipes[kSort], scatterPass, &sortPush, sizeof sortPush, sortBlocks);
+        }
+        r.Barrier();
+        r.Dispatch(*pipes[kRanges], rangeBuffers, &rangePush, sizeof rangePush, screenTiles + 1);
+        r.Barrier();
+        r.DispatchGroups(*pipes[kComposite], compositeBuffers, &composite, sizeof composite, tilesX, tilesY, 1);
     }));
     mLastDeviceMs = deviceMs;
     if (stats) {

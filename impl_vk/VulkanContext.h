@@ -148,6 +148,10 @@ class VulkanContext {
         // Makes every earlier shader write visible to later shader reads and writes.
         void Barrier();
         void Fill(const DeviceBuffer& buffer, uint32_t value);
+        // Copies `bytes` from `from` at `fromOffset` to `to` at `toOffset`, after every
+        // earlier write; a later Barrier() or the segment's end orders it before what follows.
+        void Copy(const DeviceBuffer& from, VkDeviceSize fromOffset, const DeviceBuffer& to, VkDeviceSize toOffset,
+                  VkDeviceSize bytes);
 
       private:
         friend class VulkanContext;

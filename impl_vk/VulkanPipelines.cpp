@@ -158,4 +158,11 @@ void VulkanContext::Recorder::Fill(const DeviceBuffer& buffer, uint32_t value) {
     vkCmdFillBuffer(mCmd, buffer.buffer, 0, VK_WHOLE_SIZE, value);
 }
 
+void VulkanContext::Recorder::Copy(const DeviceBuffer& from, VkDeviceSize fromOffset, const DeviceBuffer& to,
+                                   VkDeviceSize toOffset, VkDeviceSize bytes) {
+    mContext.RecordFullBarrier();  // the copy reads what shaders wrote
+    const VkBufferCopy region{fromOffset, toOffset, bytes};
+    vkCmdCopyBuffer(mCmd, from.buffer, to.buffer, 1, &region);
+}
+
 }  // namespace cb::vk

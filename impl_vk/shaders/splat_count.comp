@@ -1,22 +1,35 @@
 #version 450
-// Splat pass 1: per chunk of ranks, how many splats it makes and how many
-// voxels it visits (boxes not culled or skipped).
+// Splat pass 1: per chunk of ranks (F.grid.w, a multiple of 32), how many
+// splats it makes, how many (screen tile, splat) pairs they make, and which
+// ranks make one: a bit per rank, 32 to a word (splat_write.comp walks them).
 #extension GL_GOOGLE_include_directive : require
 #include "splat_ranks.glsl"
+#include "splat_tiles.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 6) writeonly buffer Counts { uint chunkSplats[]; };
-layout(std430, binding = 7) writeonly buffer Visited { uint chunkVisited[]; };
-layout(push_constant) uniform Params { uint chunks; } pc;
+layout(std430, binding = 7) writeonly buffer Pairs { uint chunkPairs[]; };
+layout(std430, binding = 8) writeonly buffer Candidates { uint candidates[]; };
+layout(push_constant) uniform Params { uint chunks, tileSize; } pc;
 
 void main() {
     const uint c = gl_GlobalInvocationID.x;
     if (c >= pc.chunks) return;
     const uint first = c * F.grid.w, last = min(F.axes.w, first + F.grid.w);
-    uint splats = 0u;
-    for (uint r = first; r < last; ++r) {
+    const uint nMid = AxisSize(F.axes.y), nIn = AxisSize(F.axes.z);
+    uint splats = 0u, pairs = 0u, word = 0u;
+    uvec3 cursor = RankCursor(first);
+    for (uint r = first; r < last; ++r, cursor = NextRank(cursor, nMid, nIn)) {
         Splat s;
-        if (MakeRankSplat(r, s)) ++splats;
+        if (MakeRankSplat(cursor, s)) {
+            ++splats;
+            pairs += SplatTileCount(s, pc.tileSize);
+            word |= 1u << (r % 32u);
+        }
+        if (r % 32u == 31u || r + 1u == last) {
+            candidates[r / 32u] = word;
+            word = 0u;
+        }
     }
     chunkSplats[c] = splats;
-    chunkVisited[c] = 0u;
+    chunkPairs[c] = pairs;
 }

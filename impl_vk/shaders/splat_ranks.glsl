@@ -1,6 +1,7 @@
-// Shared by the splat passes that walk ranks (SPEC 8): the bindings and
-// MakeRankSplat, which turns the voxel of a given rank in the shared
-// back-to-front order into a splat (core/glsl/splat.glsl MakeSplat).
+// Shared by the splat passes that walk ranks (SPEC 8): the bindings, and the
+// splat of the voxel of a given rank in the shared back-to-front order
+// (core/glsl/splat.glsl MakeSplat). A rank is (o, m, i): its positions in the
+// outer, middle and inner axis orders, r = (o nMid + m) nIn + i.
 #ifndef CLOUDBENCH_SPLAT_RANKS_GLSL
 #define CLOUDBENCH_SPLAT_RANKS_GLSL
 #extension GL_EXT_shader_8bit_storage : require
@@ -10,24 +11,46 @@
 layout(std430, binding = 0) readonly buffer QPrev { float qPrev[]; };
 layout(std430, binding = 1) readonly buffer QCur { float qCur[]; };
 layout(std430, binding = 2) readonly buffer Transmittance { float transmittance[]; };
-layout(std430, binding = 3) readonly buffer Order { uint orderIndex[]; };  // outer, middle, inner axis orders
+// Per position of each axis order, from F.orderBase (RenderSplatVk.cpp
+// MakeRankParts): the voxel coordinate along the axis, and that coordinate's
+// share of the voxel index and of the box index, so a rank's voxel and box
+// are sums, with no division.
+layout(std430, binding = 3) readonly buffer RankParts { uvec4 rankPart[]; };
 layout(std430, binding = 4) readonly buffer Boxes { uint8_t boxVisible[]; };
 // grid.w: voxels per chunk of ranks; image.zw: screen tiles across and down.
 layout(std430, binding = 5) readonly buffer Frame { SplatFrame F; };
 
 uint AxisSize(uint axis) { return axis == 0u ? F.grid.x : (axis == 1u ? F.grid.y : F.grid.z); }
 
-bool MakeRankSplat(uint rank, out Splat s) {
-    s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
+// (o, m, i) of a rank: divisions, so once per chunk or per splat.
+uvec3 RankCursor(uint rank) {
     const uint nMid = AxisSize(F.axes.y), nIn = AxisSize(F.axes.z);
-    const uint o = rank / (nMid * nIn), rest = rank % (nMid * nIn);
+    const uint rest = rank % (nMid * nIn);
+    return uvec3(rank / (nMid * nIn), rest / nIn, rest % nIn);
+}
+
+// The cursor of the next rank.
+uvec3 NextRank(uvec3 c, uint nMid, uint nIn) {
+    if (++c.z < nIn) return c;
+    c.z = 0u;
+    if (++c.y < nMid) return c;
+    c.y = 0u;
+    ++c.x;
+    return c;
+}
+
+// The splat of the voxel at cursor c; false (no splat) when its box is not
+// visible or MakeSplat makes none.
+bool MakeRankSplat(uvec3 c, out Splat s) {
+    s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
+    const uvec4 outer = rankPart[F.orderBase.x + c.x], mid = rankPart[F.orderBase.y + c.y],
+                inner = rankPart[F.orderBase.z + c.z];
+    if (uint(boxVisible[outer.z + mid.z + inner.z]) == 0u) return false;
+    const uint v = outer.y + mid.y + inner.y;
     uvec3 idx;
-    idx[F.axes.x] = orderIndex[F.orderBase.x + o];
-    idx[F.axes.y] = orderIndex[F.orderBase.y + rest / nIn];
-    idx[F.axes.z] = orderIndex[F.orderBase.z + rest % nIn];
-    const uint box = idx.x / F.boxes.x + F.boxes.z * (idx.y / F.boxes.x + F.boxes.w * (idx.z / F.boxes.y));
-    if (uint(boxVisible[box]) == 0u) return false;
-    const uint v = idx.x + F.grid.x * (idx.y + F.grid.y * idx.z);
+    idx[F.axes.x] = outer.x;
+    idx[F.axes.y] = mid.x;
+    idx[F.axes.z] = inner.x;
     return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.misc.y), transmittance[v], s);
 }
 
