@@ -3,9 +3,11 @@
 // are (screen tile, splat) pairs sorted stably by tile, so memory and every
 // invocation's loop grow with the pairs, never with splats x tiles.
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "core/Splat.h"
+#include "impl_vk/PairSortVk.h"
 #include "impl_vk/StageVk.h"
 
 namespace cb::vk {
@@ -96,9 +98,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
     CB_TRY(need(scratch.chunkPairOffsets, VkScratch::SplatChunkPairOffsets, VkDeviceSize(chunks + 1) * 4));
     CB_TRY(need(scratch.totals, VkScratch::SplatTotals, 8));
-    // The scans' block sums (scan.comp): 256 entries a block; sized again for the later, longer scans.
-    constexpr uint32_t kScanBlock = 256;
-    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(CeilDiv(chunks, kScanBlock)) * 4));
+    // The scans' block sums; sized again for the later, longer scans.
+    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(ScanSumsEntries(chunks)) * 4));
     CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
     CB_TRY(mContext->Upload(*scratch.rankParts, std::as_bytes(std::span(rankParts))));
     CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
@@ -120,20 +121,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         deviceMs += mLastDeviceMs.value_or(0);
         return {};
     };
-    // out = the exclusive prefix sum of n entries of in, and out[n] the total: three passes (scan.comp).
     auto scan = [&](VulkanContext::Recorder& r, const DeviceBuffer* in, const DeviceBuffer* out, uint32_t n) {
-        struct {
-            uint32_t n, mode;
-        } push{n, 0};
-        const DeviceBuffer* buffers[] = {in, out, scratch.scanSums};
-        const uint32_t blocks = CeilDiv(n, kScanBlock);
-        r.Dispatch(*pipes[kScan], buffers, &push, sizeof push, blocks);
-        r.Barrier();
-        push.mode = 1;
-        r.Dispatch(*pipes[kScan], buffers, &push, sizeof push, 1);
-        r.Barrier();
-        push.mode = 2;
-        r.Dispatch(*pipes[kScan], buffers, &push, sizeof push, blocks);
+        RecordScan(r, *pipes[kScan], *in, *out, *scratch.scanSums, n);
     };
     // 1. Splats and (screen tile, splat) pairs per chunk of ranks, their offsets,
     //    and both totals, which size everything after: the one host wait.
@@ -165,24 +154,23 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // 2. Write the splats in order, their pairs in order, and sort the pairs by
     //    screen tile, stably (radix_sort.comp: 8-bit digits, as many as the
     //    largest tile index has), so that each tile's splats keep the order.
-    //    Sort blocks hold at least 256 pairs, more when there are so many that
-    //    the scan of the digit counts would pass scan.comp's limit.
-    const uint32_t sortBlock = std::max(kScanBlock, CeilDiv(pairCount, 65535u));
-    const uint32_t sortBlocks = std::max(1u, CeilDiv(pairCount, sortBlock));
-    uint32_t digits = 0;
-    for (uint32_t largest = screenTiles - 1; largest != 0; largest >>= 8) ++digits;
+    const PairSortPlan sortPlan = PlanPairSort(pairCount, screenTiles - 1);
+    if (splatCount > kScanMaxEntries)
+        return MakeError("vk: render_splat makes " + std::to_string(splatCount) + " splats, over the " +
+                         std::to_string(kScanMaxEntries) + " its scan of their tiles can take");
     CB_TRY(need(scratch.splats, VkScratch::Splats, VkDeviceSize(splatCount) * sizeof(Splat)));
     CB_TRY(need(scratch.splatTiles, VkScratch::SplatTiles, VkDeviceSize(splatCount) * 4));
     CB_TRY(need(scratch.pairOffsets, VkScratch::SplatPairOffsets, VkDeviceSize(splatCount + 1) * 4));
     CB_TRY(need(scratch.keys[0], VkScratch::SplatKeys, VkDeviceSize(pairCount) * 4));
     CB_TRY(need(scratch.values[0], VkScratch::SplatValues, VkDeviceSize(pairCount) * 4));
-    CB_TRY(need(scratch.keys[1], VkScratch::SplatKeysSwap, digits ? VkDeviceSize(pairCount) * 4 : 0));
-    CB_TRY(need(scratch.values[1], VkScratch::SplatValuesSwap, digits ? VkDeviceSize(pairCount) * 4 : 0));
-    CB_TRY(need(scratch.sortCounts, VkScratch::SplatSortCounts, VkDeviceSize(256) * sortBlocks * 4));
-    CB_TRY(need(scratch.sortOffsets, VkScratch::SplatSortOffsets, (VkDeviceSize(256) * sortBlocks + 1) * 4));
+    const VkDeviceSize swapBytes = sortPlan.digits ? VkDeviceSize(pairCount) * 4 : 0;
+    CB_TRY(need(scratch.keys[1], VkScratch::SplatKeysSwap, swapBytes));
+    CB_TRY(need(scratch.values[1], VkScratch::SplatValuesSwap, swapBytes));
+    CB_TRY(need(scratch.sortCounts, VkScratch::SplatSortCounts, VkDeviceSize(sortPlan.CountEntries()) * 4));
+    CB_TRY(need(scratch.sortOffsets, VkScratch::SplatSortOffsets, (VkDeviceSize(sortPlan.CountEntries()) + 1) * 4));
     CB_TRY(need(scratch.tileBases, VkScratch::SplatTileBases, VkDeviceSize(screenTiles + 1) * 4));
-    const uint32_t longestScan = std::max({chunks, splatCount, 256 * sortBlocks});
-    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(CeilDiv(longestScan, kScanBlock)) * 4));
+    const uint32_t longestScan = std::max({chunks, splatCount, sortPlan.CountEntries()});
+    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(ScanSumsEntries(longestScan)) * 4));
     const DeviceBuffer* writeBuffers[] = {common[0],            common[1],      common[2],
                                           common[3],            common[4],      common[5],
                                           scratch.chunkOffsets, scratch.splats, scratch.splatTiles,
@@ -194,9 +182,6 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // One invocation per splat, in rows of kRowGroups workgroups (splat_tiles.glsl LinearInvocation).
     constexpr uint32_t kRowGroups = 32768;
     const uint32_t splatGroups = std::max(1u, CeilDiv(splatCount, 64u));
-    struct {
-        uint32_t n, shift, block, blocks, mode;
-    } sortPush{pairCount, 0, sortBlock, sortBlocks, 0};
     struct {
         uint32_t pairs, tiles;
     } rangePush{pairCount, screenTiles};
@@ -216,7 +201,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         groundBlock = *b;
         groundG = &Dev(*in.G);
     }
-    const uint32_t sorted = digits % 2;  // which of keys/values holds the sorted pairs
+    const uint32_t sorted = sortPlan.Sorted();
     const DeviceBuffer* rangeBuffers[] = {scratch.keys[sorted], scratch.tileBases};
     const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.values[sorted],
                                               &Dev(image),    groundBlock,       groundG};
@@ -228,21 +213,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         r.Barrier();
         r.DispatchGroups(*pipes[kPairs], pairBuffers, &pairPush, sizeof pairPush, std::min(splatGroups, kRowGroups),
                          CeilDiv(splatGroups, kRowGroups), 1);
-        for (uint32_t digit = 0; digit < digits; ++digit) {
-            const DeviceBuffer* from[2] = {scratch.keys[digit % 2], scratch.values[digit % 2]};
-            const DeviceBuffer* to[2] = {scratch.keys[1 - digit % 2], scratch.values[1 - digit % 2]};
-            const DeviceBuffer* countPass[] = {from[0], from[1], scratch.sortCounts, to[0], to[1]};
-            const DeviceBuffer* scatterPass[] = {from[0], from[1], scratch.sortOffsets, to[0], to[1]};
-            sortPush.shift = 8 * digit;
-            sortPush.mode = 0;
-            r.Barrier();
-            r.Dispatch(*pipes[kSort], countPass, &sortPush, sizeof sortPush, sortBlocks);
-            r.Barrier();
-            scan(r, scratch.sortCounts, scratch.sortOffsets, 256 * sortBlocks);
-            r.Barrier();
-            sortPush.mode = 1;
-            r.Dispatch(*pipes[kSort], scatterPass, &sortPush, sizeof sortPush, sortBlocks);
-        }
+        r.Barrier();
+        RecordPairSort(r, *pipes[kSort], *pipes[kScan], sortPlan, scratch.keys, scratch.values, *scratch.sortCounts,
+                       *scratch.sortOffsets, *scratch.scanSums);
         r.Barrier();
         r.Dispatch(*pipes[kRanges], rangeBuffers, &rangePush, sizeof rangePush, screenTiles + 1);
         r.Barrier();
