@@ -34,6 +34,10 @@ for name in ok:
     assert tb["pipelined"]["host_waits"]["median"] <= tb["synchronized"]["host_waits"]["median"], (name, tb)
     s = runs["synchronized"]["backends"][name]["timing"]
     assert s["mode"] == "synchronized" and "pipelined" not in s and s["synchronized"]["steps"] == 6, (name, s)
+    if name == "vk":
+        # The batch's one wait and render_splat's one read-back of its splat and pair totals for ci-small's one
+        # camera (docs/performance.md, "vk render_splat: pairs sorted by tile"); 3 while it read back twice.
+        assert tp["host_waits"]["max"] <= 2, (name, tp["host_waits"])
     if name == "cpu":
         for mode in ("synchronized", "pipelined"):
             assert tb[mode]["submissions"] == {"median": 0, "min": 0, "max": 0}, (mode, tb[mode])
