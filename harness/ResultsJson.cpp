@@ -3,6 +3,9 @@
 // ran, the loop, the frames, the cover, and the timing of each mode.
 #include "harness/ReportSamples.h"
 
+#include <initializer_list>
+#include <utility>
+
 namespace cb {
 namespace {
 
@@ -138,61 +141,43 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                 hostSamples.push_back(r.ellipsoidUpdateMs);
         b["host"] = {{"ellipsoid_update", SummaryJson(hostSamples)}};
         b["transfers"] = {{"download", SummaryJson(run.downloadMs)}};
-        if (scene.stages.Has(Stage::RenderSplat)) {
-            // Per camera: every frame's time and splat count, and their summary.
+        // Per camera of a renderer: every frame's time (not a pipelined frame's: its call
+        // time is host time), step and alpha, the renderer's counters (`counters`: a
+        // field name and a value of a frame each), and their summary.
+        using FrameCounter = std::pair<const char*, uint64_t (*)(const FrameRecord&)>;
+        auto framesJson = [&](Stage renderer, std::initializer_list<FrameCounter> counters) {
             nlohmann::json cameras = nlohmann::json::object();
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> ms;
-                nlohmann::json steps = nlohmann::json::array(), splats = nlohmann::json::array(),
-                               alphas = nlohmann::json::array(), visited = nlohmann::json::array();
+                nlohmann::json c = nlohmann::json::object(), steps = nlohmann::json::array(), alphas = nlohmann::json::array();
+                for (const auto& counter : counters) c[counter.first] = nlohmann::json::array();
                 for (const StepRecord& r : run.steps)
                     for (const FrameRecord& f : r.frames)
-                        if (f.renderer == Stage::RenderSplat && f.camera == camera.name) {
-                            if (!f.pipelined) ms.push_back(f.ms);  // a pipelined frame's call time is host time
+                        if (f.renderer == renderer && f.camera == camera.name) {
+                            if (!f.pipelined) ms.push_back(f.ms);
                             steps.push_back(r.step);
-                            splats.push_back(f.stats.splats);
-                            visited.push_back(f.stats.voxelsVisited);
                             alphas.push_back(f.alpha);
+                            for (const auto& counter : counters) c[counter.first].push_back(counter.second(f));
                         }
-                nlohmann::json c = SummaryJson(ms);
+                c.update(SummaryJson(ms));
                 c["steps"] = steps;
                 c["alphas"] = alphas;
-                c["splats"] = splats;
-                c["voxels_visited"] = visited;
                 c["fps_median"] = ms.empty() ? 0.0 : 1000.0 / Summarize(ms).median;
                 cameras[camera.name] = c;
             }
-            b["frames"] = cameras;
-        }
-        if (scene.stages.Has(Stage::RenderMarch)) {
-            // Per camera: every march frame's time and counters (MarchStats), and their summary.
-            nlohmann::json cameras = nlohmann::json::object();
-            for (const CameraSettings& camera : scene.render.cameras) {
-                std::vector<double> ms;
-                nlohmann::json steps = nlohmann::json::array(), samples = nlohmann::json::array(),
-                               lightSamples = nlohmann::json::array(), skipped = nlohmann::json::array(),
-                               alphas = nlohmann::json::array();
-                for (const StepRecord& r : run.steps)
-                    for (const FrameRecord& f : r.frames)
-                        if (f.renderer == Stage::RenderMarch && f.camera == camera.name) {
-                            if (!f.pipelined) ms.push_back(f.ms);  // a pipelined frame's call time is host time
-                            steps.push_back(r.step);
-                            alphas.push_back(f.alpha);
-                            samples.push_back(f.march.samples);
-                            lightSamples.push_back(f.march.lightSamples);
-                            skipped.push_back(f.march.bricksSkipped);
-                        }
-                nlohmann::json c = SummaryJson(ms);
-                c["steps"] = steps;
-                c["alphas"] = alphas;
-                c["samples"] = samples;
-                c["light_samples"] = lightSamples;
-                c["bricks_skipped"] = skipped;
-                c["fps_median"] = ms.empty() ? 0.0 : 1000.0 / Summarize(ms).median;
-                cameras[camera.name] = c;
-            }
-            b["march_frames"] = cameras;
-        }
+            return cameras;
+        };
+        if (scene.stages.Has(Stage::RenderSplat))
+            b["frames"] = framesJson(
+                Stage::RenderSplat,
+                {{"splats", [](const FrameRecord& f) { return f.stats.splats; }},
+                 {"voxels_visited", [](const FrameRecord& f) { return f.stats.voxelsVisited; }}});
+        if (scene.stages.Has(Stage::RenderMarch))
+            b["march_frames"] = framesJson(
+                Stage::RenderMarch,
+                {{"samples", [](const FrameRecord& f) { return f.march.samples; }},
+                 {"light_samples", [](const FrameRecord& f) { return f.march.lightSamples; }},
+                 {"bricks_skipped", [](const FrameRecord& f) { return f.march.bricksSkipped; }}});
         if (scene.stages.Has(Stage::Density)) {
             nlohmann::json cover = nlohmann::json::array();
             std::vector<double> after;
