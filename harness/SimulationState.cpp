@@ -57,6 +57,27 @@ std::string SceneSettingsHash(json resolved) {
 
 // The friend of Simulation that reads and writes its private state.
 struct SimulationStateAccess {
+    // The members saved as they are, each simulation member beside its state field: the one
+    // list Capture (copy(from sim, to state)) and Restore (copy(to sim, from state)) share.
+    template <typename Sim, typename State, typename Copy>
+    static void PlainFields(Sim& sim, State& s, Copy&& copy) {
+        copy(sim.mRaster, s.raster);
+        copy(sim.mRasterAhead, s.rasterAhead);
+        copy(sim.mLastRendered, s.lastRendered);
+        copy(sim.mLastCoveredColumns, s.lastCoveredColumns);
+        copy(sim.mInputsAtLastRun, s.inputsAtLastRun);
+        copy(sim.mAheadComputed, s.aheadComputed);
+        copy(sim.mAdvanceOwed, s.advanceOwed);
+        copy(sim.mAhead, s.aheadRecord);
+    }
+    // The same for one resource's slot.
+    template <typename Slot, typename State, typename Copy>
+    static void SlotFields(Slot& slot, State& s, Resource r, Copy&& copy) {
+        copy(slot.version, s.versions[size_t(r)]);
+        copy(slot.ahead, s.ahead[size_t(r)]);
+        copy(slot.previousIsCurrent, s.previousIsCurrent[size_t(r)]);
+    }
+
     static Result<SimulationState> Capture(const Simulation& sim, std::string_view sceneHash) {
         if (sim.mBatchOpen) return MakeError("saving the state: a batch is open (save between steps)");
         SimulationState s;
@@ -81,21 +102,12 @@ struct SimulationStateAccess {
                 CB_TRY(add(slot.next, BufferRole::Next, 0));
                 CB_TRY(add(slot.pending, BufferRole::Pending, 0));
             }
-            s.versions[size_t(r)] = slot.version;
-            s.ahead[size_t(r)] = slot.ahead;
-            s.previousIsCurrent[size_t(r)] = slot.previousIsCurrent;
+            SlotFields(slot, s, r, [](const auto& from, auto& to) { to = from; });
         }
         s.ellipsoids = sim.mEllipsoids.Items();
         s.rngState = sim.mEllipsoids.Rng().StateWord();
         s.rngIncrement = sim.mEllipsoids.Rng().Increment();
-        s.raster = sim.mRaster;
-        s.rasterAhead = sim.mRasterAhead;
-        s.lastRendered = sim.mLastRendered;
-        s.lastCoveredColumns = sim.mLastCoveredColumns;
-        s.inputsAtLastRun = sim.mInputsAtLastRun;
-        s.aheadComputed = sim.mAheadComputed;
-        s.advanceOwed = sim.mAdvanceOwed;
-        s.aheadRecord = sim.mAhead;
+        PlainFields(sim, s, [](const auto& from, auto& to) { to = from; });
         return s;
     }
 
@@ -121,22 +133,12 @@ struct SimulationStateAccess {
                 return MakeError("restoring a state: " + file + ": its format or extent differs from this simulation's");
             CB_TRY(sim.mBackend.Upload(*target, saved.data));
         }
-        for (Resource r : kAllResources) {
-            sim.mSlots[size_t(r)].version = s.versions[size_t(r)];
-            sim.mSlots[size_t(r)].ahead = s.ahead[size_t(r)];
-            sim.mSlots[size_t(r)].previousIsCurrent = s.previousIsCurrent[size_t(r)];
-        }
+        for (Resource r : kAllResources)
+            SlotFields(sim.mSlots[size_t(r)], s, r, [](auto& to, const auto& from) { to = from; });
         Pcg32 rng(0);
         rng.Restore(s.rngState, s.rngIncrement);
         sim.mEllipsoids.Restore(s.ellipsoids, rng);
-        sim.mRaster = s.raster;
-        sim.mRasterAhead = s.rasterAhead;
-        sim.mLastRendered = s.lastRendered;
-        sim.mLastCoveredColumns = s.lastCoveredColumns;
-        sim.mInputsAtLastRun = s.inputsAtLastRun;
-        sim.mAheadComputed = s.aheadComputed;
-        sim.mAdvanceOwed = s.advanceOwed;
-        sim.mAhead = s.aheadRecord;
+        PlainFields(sim, s, [](auto& to, const auto& from) { to = from; });
         sim.mStep = s.step;
         return {};
     }
