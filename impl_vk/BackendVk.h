@@ -127,6 +127,11 @@ class BackendVk final : public Backend {
     // same T, bit for bit.
     enum class ShadeSweep : uint8_t { Auto, PerSlice, Blocks };
     void SetShadeSweep(ShadeSweep sweep) { mShadeSweep = sweep; }
+    // Ranks per invocation of render_splat's count and write passes (RenderSplatVk.cpp),
+    // a multiple of 32; 0 (the default): 1024 on a CPU device, where an invocation's
+    // loop is cheap and dispatch slots dear, 32 on a GPU, for 32 x more invocations.
+    // The image is the same, bit for bit.
+    void SetSplatChunkRanks(uint32_t ranks) { mSplatChunkRanks = ranks; }
     // Dispatches recorded since the backend was made.
     uint64_t Dispatches() const { return mContext->Dispatches(); }
 
@@ -150,6 +155,7 @@ class BackendVk final : public Backend {
     std::unique_ptr<VulkanContext> mContext;
     std::optional<double> mLastDeviceMs;
     ShadeSweep mShadeSweep = ShadeSweep::Auto;
+    uint32_t mSplatChunkRanks = 0;
     std::vector<DeferredHostResult> mDeferredResults;  // this batch's, so far (TakeDeferredResults)
     // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
     // while others grow.

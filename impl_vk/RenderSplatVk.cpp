@@ -66,15 +66,19 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // The shared order, outer axis first.
     const FlatSplatOrder flat = FlattenSplatOrder(*p.order);
     // kTileSize: splat_composite.comp runs a workgroup of 64 per 8 x 8 tile.
-    constexpr uint32_t kVoxelsPerChunk = 1024, kTileSize = 8;
+    constexpr uint32_t kTileSize = 8;
+    uint32_t ranksPerChunk = mSplatChunkRanks ? mSplatChunkRanks : mContext->CpuDevice() ? 1024 : 32;
+    if (ranksPerChunk % 32 != 0) return MakeError("vk: render_splat's chunks must be a multiple of 32 ranks");
+    // One invocation per chunk, in at most 65535 workgroups of 64.
+    while (CeilDiv(CeilDiv(uint32_t(e.Count()), ranksPerChunk), 64u) > 65535u) ranksPerChunk *= 2;
     const uint32_t voxels = uint32_t(e.Count());
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
     // The shared frame; this backend's lanes: voxels per chunk of ranks, screen tiles.
     SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
-    frame.grid[3] = kVoxelsPerChunk;
+    frame.grid[3] = ranksPerChunk;
     frame.image[2] = tilesX;
     frame.image[3] = tilesY;
-    const uint32_t chunks = CeilDiv(voxels, kVoxelsPerChunk);
+    const uint32_t chunks = CeilDiv(voxels, ranksPerChunk);
     const std::vector<RankPart> rankParts = MakeRankParts(frame, flat);
     // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
     struct {
@@ -92,7 +96,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(need(scratch.frame, VkScratch::SplatFrame, sizeof frame));
     CB_TRY(need(scratch.rankParts, VkScratch::SplatRankParts, rankParts.size() * sizeof(RankPart)));
     CB_TRY(need(scratch.boxes, VkScratch::SplatBoxes, boxes.size()));
-    CB_TRY(need(scratch.candidates, VkScratch::SplatCandidates, VkDeviceSize(chunks) * kVoxelsPerChunk / 8));
+    CB_TRY(need(scratch.candidates, VkScratch::SplatCandidates, VkDeviceSize(chunks) * ranksPerChunk / 8));
     CB_TRY(need(scratch.chunkSplats, VkScratch::SplatChunkSplats, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkPairs, VkScratch::SplatChunkPairs, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));

@@ -17,17 +17,27 @@ void main() {
     const uint first = c * F.grid.w, last = min(F.axes.w, first + F.grid.w);
     const uint nMid = AxisSize(F.axes.y), nIn = AxisSize(F.axes.z);
     uint splats = 0u, pairs = 0u, word = 0u;
+    // Run by run along the inner axis: the outer and middle entries hold for a run.
     uvec3 cursor = RankCursor(first);
-    for (uint r = first; r < last; ++r, cursor = NextRank(cursor, nMid, nIn)) {
-        Splat s;
-        if (MakeRankSplat(cursor, s)) {
-            ++splats;
-            pairs += SplatTileCount(s, pc.tileSize);
-            word |= 1u << (r % 32u);
+    for (uint r = first; r < last;) {
+        const uvec4 outer = rankPart[F.orderBase.x + cursor.x], mid = rankPart[F.orderBase.y + cursor.y];
+        const uint runEnd = min(last, r + (nIn - cursor.z));
+        for (uint i = F.orderBase.z + cursor.z; r < runEnd; ++r, ++i) {
+            Splat s;
+            if (MakePartsSplat(outer, mid, rankPart[i], s)) {
+                ++splats;
+                pairs += SplatTileCount(s, pc.tileSize);
+                word |= 1u << (r % 32u);
+            }
+            if (r % 32u == 31u || r + 1u == last) {
+                candidates[r / 32u] = word;
+                word = 0u;
+            }
         }
-        if (r % 32u == 31u || r + 1u == last) {
-            candidates[r / 32u] = word;
-            word = 0u;
+        cursor.z = 0u;
+        if (++cursor.y == nMid) {
+            cursor.y = 0u;
+            ++cursor.x;
         }
     }
     chunkSplats[c] = splats;

@@ -29,22 +29,11 @@ uvec3 RankCursor(uint rank) {
     return uvec3(rank / (nMid * nIn), rest / nIn, rest % nIn);
 }
 
-// The cursor of the next rank.
-uvec3 NextRank(uvec3 c, uint nMid, uint nIn) {
-    if (++c.z < nIn) return c;
-    c.z = 0u;
-    if (++c.y < nMid) return c;
-    c.y = 0u;
-    ++c.x;
-    return c;
-}
-
-// The splat of the voxel at cursor c; false (no splat) when its box is not
+// The splat of the voxel whose positions in the outer, middle and inner axis
+// orders have these rankPart entries; false (no splat) when its box is not
 // visible or MakeSplat makes none.
-bool MakeRankSplat(uvec3 c, out Splat s) {
+bool MakePartsSplat(uvec4 outer, uvec4 mid, uvec4 inner, out Splat s) {
     s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
-    const uvec4 outer = rankPart[F.orderBase.x + c.x], mid = rankPart[F.orderBase.y + c.y],
-                inner = rankPart[F.orderBase.z + c.z];
     if (uint(boxVisible[outer.z + mid.z + inner.z]) == 0u) return false;
     const uint v = outer.y + mid.y + inner.y;
     uvec3 idx;
@@ -52,6 +41,12 @@ bool MakeRankSplat(uvec3 c, out Splat s) {
     idx[F.axes.y] = mid.x;
     idx[F.axes.z] = inner.x;
     return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.misc.y), transmittance[v], s);
+}
+
+// The splat of the voxel at cursor c (RankCursor).
+bool MakeRankSplat(uvec3 c, out Splat s) {
+    return MakePartsSplat(rankPart[F.orderBase.x + c.x], rankPart[F.orderBase.y + c.y],
+                          rankPart[F.orderBase.z + c.z], s);
 }
 
 #endif
