@@ -82,7 +82,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const std::vector<RankPart> rankParts = MakeRankParts(frame, flat);
     // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
     struct {
-        DeviceBuffer *frame, *rankParts, *boxes, *candidates, *chunkSplats, *chunkPairs, *chunkOffsets, *chunkPairOffsets, *totals;
+        DeviceBuffer *frame, *rankParts, *boxes, *candidates, *chunkSplats, *chunkPairs, *chunkOffsets, *chunkPairOffsets;
+        DeviceBuffer *stats, *totals;
         DeviceBuffer *splats, *splatTiles, *pairOffsets, *keys[2], *values[2], *sortCounts, *sortOffsets, *tileBases;
         DeviceBuffer* scanSums;
     } scratch{};
@@ -101,7 +102,10 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(need(scratch.chunkPairs, VkScratch::SplatChunkPairs, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
     CB_TRY(need(scratch.chunkPairOffsets, VkScratch::SplatChunkPairOffsets, VkDeviceSize(chunks + 1) * 4));
-    CB_TRY(need(scratch.totals, VkScratch::SplatTotals, 8));
+    // splat_count.comp's 64 slots of (visited, fragments low, high); the totals: splats, pairs, then the slots.
+    constexpr uint32_t kStatSlots = 64;
+    CB_TRY(need(scratch.stats, VkScratch::SplatStats, kStatSlots * 3 * 4));
+    CB_TRY(need(scratch.totals, VkScratch::SplatTotals, (2 + kStatSlots * 3) * 4));
     // The scans' block sums; sized again for the later, longer scans.
     CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(ScanSumsEntries(chunks)) * 4));
     CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
@@ -111,7 +115,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     Pipeline* pipes[kPipes] = {};
     const char* names[kPipes] = {"splat_count",  "scan",           "splat_write",    "splat_pairs",
                                  "radix_sort",   "splat_ranges",   "splat_composite", "splat_boxes"};
-    const uint32_t bindings[kPipes] = {9, 3, 10, 4, 5, 2, 6, 3};
+    const uint32_t bindings[kPipes] = {10, 3, 10, 4, 5, 2, 6, 3};
     for (int n = 0; n < kPipes; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -133,8 +137,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     struct {
         uint32_t chunks, tileSize;
     } chunkPush{chunks, kTileSize};
-    const DeviceBuffer* countBuffers[] = {common[0], common[1], common[2],          common[3],         common[4],
-                                          common[5], scratch.chunkSplats, scratch.chunkPairs, scratch.candidates};
+    const DeviceBuffer* countBuffers[] = {common[0],           common[1],          common[2],          common[3],
+                                          common[4],           common[5],          scratch.chunkSplats, scratch.chunkPairs,
+                                          scratch.candidates, scratch.stats};
     const uint32_t boxWords = CeilDiv(uint32_t(boxes.size()), 4);
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
@@ -143,6 +148,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
             r.Dispatch(*pipes[kBoxes], boxBuffers, &boxWords, sizeof boxWords, boxWords);
             r.Barrier();
         }
+        r.Fill(*scratch.stats, 0);
+        r.Barrier();
         r.Dispatch(*pipes[kCount], countBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
         scan(r, scratch.chunkSplats, scratch.chunkOffsets, chunks);
@@ -150,10 +157,17 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         scan(r, scratch.chunkPairs, scratch.chunkPairOffsets, chunks);
         r.Copy(*scratch.chunkOffsets, VkDeviceSize(chunks) * 4, *scratch.totals, 0, 4);
         r.Copy(*scratch.chunkPairOffsets, VkDeviceSize(chunks) * 4, *scratch.totals, 4, 4);
+        r.Copy(*scratch.stats, 0, *scratch.totals, 8, kStatSlots * 3 * 4);
     }));
-    uint32_t totals[2] = {};
+    uint32_t totals[2 + kStatSlots * 3] = {};
     CB_TRY(mContext->Download(*scratch.totals, std::as_writable_bytes(std::span(totals))));
     const uint32_t splatCount = totals[0], pairCount = totals[1];
+    uint64_t visited = 0, fragments = 0;
+    for (uint32_t slot = 0; slot < kStatSlots; ++slot) {
+        const uint32_t* stat = totals + 2 + 3 * slot;
+        visited += stat[0];
+        fragments += uint64_t(stat[2]) << 32 | stat[1];
+    }
 
     // 2. Write the splats in order, their pairs in order, and sort the pairs by
     //    screen tile, stably (radix_sort.comp: 8-bit digits, as many as the
@@ -228,8 +242,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     mLastDeviceMs = deviceMs;
     if (stats) {
         stats->splats = splatCount;
-        stats->voxelsVisited = 0;  // not counted on this backend
-        stats->fragments = 0;
+        stats->voxelsVisited = visited;
+        stats->fragments = fragments;
     }
     return {};
 }

@@ -29,12 +29,15 @@ uvec3 RankCursor(uint rank) {
     return uvec3(rank / (nMid * nIn), rest / nIn, rest % nIn);
 }
 
+// Whether the box of the voxel with these rankPart entries is visible (not culled or skipped).
+bool PartsBoxVisible(uvec4 outer, uvec4 mid, uvec4 inner) {
+    return uint(boxVisible[outer.z + mid.z + inner.z]) != 0u;
+}
+
 // The splat of the voxel whose positions in the outer, middle and inner axis
-// orders have these rankPart entries; false (no splat) when its box is not
-// visible or MakeSplat makes none.
+// orders have these rankPart entries, whose box is visible; false when
+// MakeSplat makes none.
 bool MakePartsSplat(uvec4 outer, uvec4 mid, uvec4 inner, out Splat s) {
-    s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
-    if (uint(boxVisible[outer.z + mid.z + inner.z]) == 0u) return false;
     const uint v = outer.y + mid.y + inner.y;
     uvec3 idx;
     idx[F.axes.x] = outer.x;
@@ -43,7 +46,7 @@ bool MakePartsSplat(uvec4 outer, uvec4 mid, uvec4 inner, out Splat s) {
     return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.misc.y), transmittance[v], s);
 }
 
-// The splat of the voxel at cursor c (RankCursor).
+// The splat of the voxel at cursor c (RankCursor), whose box is visible.
 bool MakeRankSplat(uvec3 c, out Splat s) {
     return MakePartsSplat(rankPart[F.orderBase.x + c.x], rankPart[F.orderBase.y + c.y],
                           rankPart[F.orderBase.z + c.z], s);
