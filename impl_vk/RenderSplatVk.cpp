@@ -67,13 +67,15 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const FlatSplatOrder flat = FlattenSplatOrder(*p.order);
     // kTileSize: splat_composite.comp runs a workgroup of 64 per 8 x 8 tile.
     constexpr uint32_t kTileSize = 8;
+    const uint32_t voxels = uint32_t(e.Count());
+    // Ranks per invocation of the count and write passes (SetSplatChunkRanks), a
+    // multiple of 32 (a word of candidate bits); one invocation per chunk, in at
+    // most 65535 workgroups of 64.
     uint32_t ranksPerChunk = mSplatChunkRanks ? mSplatChunkRanks : mContext->CpuDevice() ? 1024 : 32;
     if (ranksPerChunk % 32 != 0) return MakeError("vk: render_splat's chunks must be a multiple of 32 ranks");
-    // One invocation per chunk, in at most 65535 workgroups of 64.
-    while (CeilDiv(CeilDiv(uint32_t(e.Count()), ranksPerChunk), 64u) > 65535u) ranksPerChunk *= 2;
-    const uint32_t voxels = uint32_t(e.Count());
+    while (CeilDiv(CeilDiv(voxels, ranksPerChunk), 64u) > 65535u) ranksPerChunk *= 2;
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
-    // The shared frame; this backend's lanes: voxels per chunk of ranks, screen tiles.
+    // The shared frame; this backend's lanes: ranks per chunk, screen tiles.
     SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
     frame.grid[3] = ranksPerChunk;
     frame.image[2] = tilesX;
@@ -223,7 +225,6 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const DeviceBuffer* rangeBuffers[] = {scratch.keys[sorted], scratch.tileBases};
     const DeviceBuffer* compositeBuffers[] = {scratch.splats, scratch.tileBases, scratch.values[sorted],
                                               &Dev(image),    groundBlock,       groundG};
-    // 3. Each tile's first pair, by binary search; composite every pixel.
     CB_TRY(run("render_splat: binning and compositing", [&](VulkanContext::Recorder& r) {
         r.Dispatch(*pipes[kWrite], writeBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
@@ -235,6 +236,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         RecordPairSort(r, *pipes[kSort], *pipes[kScan], sortPlan, scratch.keys, scratch.values, *scratch.sortCounts,
                        *scratch.sortOffsets, *scratch.scanSums);
         r.Barrier();
+        // 3. Each tile's first pair, by binary search; composite every pixel.
         r.Dispatch(*pipes[kRanges], rangeBuffers, &rangePush, sizeof rangePush, screenTiles + 1);
         r.Barrier();
         r.DispatchGroups(*pipes[kComposite], compositeBuffers, &composite, sizeof composite, tilesX, tilesY, 1);
