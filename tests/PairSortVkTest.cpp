@@ -109,7 +109,8 @@ std::vector<uint32_t> RandomKeys(uint32_t n, uint32_t largest, uint64_t seed) {
 }
 
 TEST_F(PairSortVk, ScanEqualsExclusiveScan) {
-    for (uint32_t n : {0u, 1u, 255u, 256u, 257u, 1000u, 70000u}) {
+    // Up to 1172 block sums: the middle pass scans them 256 at a time, in 5 rounds.
+    for (uint32_t n : {0u, 1u, 255u, 256u, 257u, 1000u, 65536u, 65537u, 70000u, 300000u}) {
         Pcg32 rng(n + 1);
         std::vector<uint32_t> in(n);
         for (uint32_t& x : in) x = rng.Below(1000);
