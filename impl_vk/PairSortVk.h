@@ -14,7 +14,7 @@ namespace cb::vk {
 
 // scan.comp's block: the entries one invocation sums in series.
 constexpr uint32_t kScanBlock = 256;
-// scan.comp's limit: its first and last passes dispatch one invocation per block.
+// scan.comp's limit: at most 65535 blocks, so that its middle pass takes at most 256 rounds.
 constexpr uint32_t kScanMaxEntries = kScanBlock * 65535u;
 
 // The block sums a scan of n entries needs (its scratch buffer, in uints).
