@@ -270,6 +270,18 @@ elif case == "matrix":
     # The mismatch's row names its case; the difference images of a case are in its folder.
     if not os.path.isdir(os.path.join(folder, "shade.storage=fp16")):
         fail("no folder for the case " + PLANTED, p)
+    # The HTML report's matrix has a row per case and stage: the failing case shows, though later cases pass
+    # shade (one row per stage, the last case's status, hid it).
+    page = os.path.join(folder, "report.html")
+    r = subprocess.run([cli, "report", os.path.join(folder, "conform.json"), "-o", page], capture_output=True,
+                       text=True, timeout=120)
+    with open(page) as f:
+        html = f.read()
+    cells = re.findall(r"<tr><td>([^<]*)</td><td>([^<]*)</td><td[^>]*>([^<]*)</td></tr>", html)
+    statuses = {(c, s): st for c, s, st in cells}
+    if statuses.get((PLANTED, "shade")) != "fail" or statuses.get(("scene", "shade")) != "pass":
+        fail("the report's matrix should show %s shade failing and scene shade passing: %s" %
+             (PLANTED, {k: v for k, v in statuses.items() if k[1] == "shade"}), r)
 elif case == "matrix-baseline":
     # The failing run's conform.csv as the next run's baseline: the same failure in the same case is expected
     # (exit 0); planted in another case it is new (exit 5) and the listed case's row is an unexpected pass.

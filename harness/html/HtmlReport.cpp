@@ -88,24 +88,33 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
     }
     out.sections.push_back(std::move(verdict));
 
-    // Conformance: stage x backend.
+    // Conformance: stage x backend, and with conform --matrix one row per case and stage, so that
+    // a failure in one case is not hidden by another case's pass.
     for (const ReportInput& input : inputs) {
         if (input.kind != InputKind::Conform) continue;
-        std::vector<std::string> stages, backends;
-        std::map<std::pair<std::string, std::string>, std::string> status;
-        for (const json& r : Arr(input.doc, "results")) {
-            const std::string stage = Str(r, "stage"), backend = Str(r, "backend");
-            if (std::ranges::find(stages, stage) == stages.end()) stages.push_back(stage);
+        const json& results = Arr(input.doc, "results");
+        const bool cases = std::ranges::any_of(results, [](const json& r) { return r.contains("case"); });
+        std::vector<std::pair<std::string, std::string>> rowKeys;  // (case, stage), in order of appearance
+        std::vector<std::string> backends;
+        std::map<std::pair<std::pair<std::string, std::string>, std::string>, std::string> status;
+        for (const json& r : results) {
+            const std::pair<std::string, std::string> key{Str(r, "case"), Str(r, "stage")};
+            const std::string backend = Str(r, "backend");
+            if (std::ranges::find(rowKeys, key) == rowKeys.end()) rowKeys.push_back(key);
             if (std::ranges::find(backends, backend) == backends.end()) backends.push_back(backend);
-            status[{stage, backend}] = Str(r, "status");
+            status[{key, backend}] = Str(r, "status");
         }
-        std::vector<Column> columns = {Column("stage")};
+        std::vector<Column> columns;
+        if (cases) columns.push_back(Column("case"));
+        columns.push_back(Column("stage"));
         for (const std::string& b : backends) columns.push_back(Column(b));
         Table matrix(columns);
-        for (const std::string& stage : stages) {
-            std::vector<Cell> row = {stage};
+        for (const auto& key : rowKeys) {
+            std::vector<Cell> row;
+            if (cases) row.push_back(key.first);
+            row.push_back(key.second);
             for (const std::string& b : backends) {
-                auto it = status.find({stage, b});
+                auto it = status.find({key, b});
                 row.push_back(it == status.end() ? Cell() : Cell(it->second));
             }
             matrix.rows.push_back(std::move(row));
