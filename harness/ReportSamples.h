@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "harness/Report.h"
@@ -21,5 +22,14 @@ double CoverFraction(const Scene& scene, uint32_t columns);
 
 // The post-warm-up steps timed in `mode`.
 std::vector<const StepRecord*> StepsIn(const Scene& scene, const BackendRun& run, TimingMode mode);
+
+// fn(step, frame) for the post-warm-up frames of one renderer and camera, in
+// order, whatever mode drew them.
+template <typename Fn>
+void ForEachFrame(const BackendRun& run, Stage renderer, const std::string& camera, Fn&& fn) {
+    for (const StepRecord& r : run.steps)
+        for (const FrameRecord& f : r.frames)
+            if (f.renderer == renderer && f.camera == camera) fn(r, f);
+}
 
 }  // namespace cb

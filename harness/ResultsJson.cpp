@@ -9,14 +9,6 @@
 namespace cb {
 namespace {
 
-// Post-warm-up frames of one renderer and camera, with their step, whatever mode drew them.
-template <typename Fn>
-void ForEachFrame(const BackendRun& run, Stage renderer, const std::string& camera, Fn&& fn) {
-    for (const StepRecord& r : run.steps)
-        for (const FrameRecord& f : r.frames)
-            if (f.renderer == renderer && f.camera == camera) fn(r, f);
-}
-
 nlohmann::json SummaryJson(const std::vector<double>& samples) {
     Summary s = Summarize(samples);
     return {{"samples_ms", samples}, {"median_ms", s.median}, {"q1_ms", s.q1},   {"q3_ms", s.q3},
@@ -151,14 +143,12 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                 std::vector<double> ms;
                 nlohmann::json c = nlohmann::json::object(), steps = nlohmann::json::array(), alphas = nlohmann::json::array();
                 for (const auto& counter : counters) c[counter.first] = nlohmann::json::array();
-                for (const StepRecord& r : run.steps)
-                    for (const FrameRecord& f : r.frames)
-                        if (f.renderer == renderer && f.camera == camera.name) {
-                            if (!f.pipelined) ms.push_back(f.ms);
-                            steps.push_back(r.step);
-                            alphas.push_back(f.alpha);
-                            for (const auto& counter : counters) c[counter.first].push_back(counter.second(f));
-                        }
+                ForEachFrame(run, renderer, camera.name, [&](const StepRecord& r, const FrameRecord& f) {
+                    if (!f.pipelined) ms.push_back(f.ms);
+                    steps.push_back(r.step);
+                    alphas.push_back(f.alpha);
+                    for (const auto& counter : counters) c[counter.first].push_back(counter.second(f));
+                });
                 c.update(SummaryJson(ms));
                 c["steps"] = steps;
                 c["alphas"] = alphas;

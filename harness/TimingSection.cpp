@@ -54,12 +54,10 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         for (const CameraSettings& camera : scene.render.cameras) {
             std::vector<double> ms;
             uint64_t last = 0;
-            for (const StepRecord& r : run.steps)
-                for (const FrameRecord& f : r.frames)
-                    if (f.renderer == renderer && f.camera == camera.name) {
-                        ms.push_back(f.ms);
-                        last = count(f);
-                    }
+            ForEachFrame(run, renderer, camera.name, [&](const StepRecord&, const FrameRecord& f) {
+                ms.push_back(f.ms);
+                last = count(f);
+            });
             const Summary s = Summarize(ms);
             std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu %s", s.count,
                           s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(last), what);
