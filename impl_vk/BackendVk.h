@@ -53,8 +53,7 @@ enum class VkScratch {
     SplatChunkPairs,    // render_splat: (screen tile, splat) pairs per chunk of ranks
     SplatChunkOffsets,  // render_splat: SplatChunkSplats scanned, and the total
     SplatChunkPairOffsets,  // render_splat: SplatChunkPairs scanned, and the total
-    SplatStats,         // render_splat: voxels visited and fragments, in 64 slots the host sums
-    SplatTotals,        // render_splat: the splats, the pairs and SplatStats' slots, read by the host
+    SplatTotals,        // render_splat: the splats, the pairs, and 64 slots of voxels visited and fragments, read by the host
     Splats,             // render_splat: the splats in the shared order, 48 bytes each
     SplatTiles,         // render_splat: screen tiles per splat
     SplatPairOffsets,   // render_splat: SplatTiles scanned, and the total

@@ -85,7 +85,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
     struct {
         DeviceBuffer *frame, *rankParts, *boxes, *candidates, *chunkSplats, *chunkPairs, *chunkOffsets, *chunkPairOffsets;
-        DeviceBuffer *stats, *totals;
+        DeviceBuffer* totals;
         DeviceBuffer *splats, *splatTiles, *pairOffsets, *keys[2], *values[2], *sortCounts, *sortOffsets, *tileBases;
         DeviceBuffer* scanSums;
     } scratch{};
@@ -104,9 +104,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(need(scratch.chunkPairs, VkScratch::SplatChunkPairs, VkDeviceSize(chunks) * 4));
     CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
     CB_TRY(need(scratch.chunkPairOffsets, VkScratch::SplatChunkPairOffsets, VkDeviceSize(chunks + 1) * 4));
-    // splat_count.comp's 64 slots of (visited, fragments low, high); the totals: splats, pairs, then the slots.
+    // What the host reads back: the splats, the pairs, then splat_count.comp's 64 slots of
+    // (visited, fragments low, high), which it adds into.
     constexpr uint32_t kStatSlots = 64;
-    CB_TRY(need(scratch.stats, VkScratch::SplatStats, kStatSlots * 3 * 4));
     CB_TRY(need(scratch.totals, VkScratch::SplatTotals, (2 + kStatSlots * 3) * 4));
     // The scans' block sums; sized again for the later, longer scans.
     CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(ScanSumsEntries(chunks)) * 4));
@@ -141,7 +141,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     } chunkPush{chunks, kTileSize};
     const DeviceBuffer* countBuffers[] = {common[0],           common[1],          common[2],          common[3],
                                           common[4],           common[5],          scratch.chunkSplats, scratch.chunkPairs,
-                                          scratch.candidates, scratch.stats};
+                                          scratch.candidates, scratch.totals};
     const uint32_t boxWords = CeilDiv(uint32_t(boxes.size()), 4);
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
@@ -150,7 +150,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
             r.Dispatch(*pipes[kBoxes], boxBuffers, &boxWords, sizeof boxWords, boxWords);
             r.Barrier();
         }
-        r.Fill(*scratch.stats, 0);
+        r.Fill(*scratch.totals, 0);
         r.Barrier();
         r.Dispatch(*pipes[kCount], countBuffers, &chunkPush, sizeof chunkPush, chunks);
         r.Barrier();
@@ -159,7 +159,6 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         scan(r, scratch.chunkPairs, scratch.chunkPairOffsets, chunks);
         r.Copy(*scratch.chunkOffsets, VkDeviceSize(chunks) * 4, *scratch.totals, 0, 4);
         r.Copy(*scratch.chunkPairOffsets, VkDeviceSize(chunks) * 4, *scratch.totals, 4, 4);
-        r.Copy(*scratch.stats, 0, *scratch.totals, 8, kStatSlots * 3 * 4);
     }));
     uint32_t totals[2 + kStatSlots * 3] = {};
     CB_TRY(mContext->Download(*scratch.totals, std::as_writable_bytes(std::span(totals))));

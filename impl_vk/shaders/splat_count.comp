@@ -4,7 +4,8 @@
 // ranks make one: a bit per rank, 32 to a word (splat_write.comp walks them).
 // Also SplatStats' voxels visited (ranks whose box is visible) and fragments
 // (covered pixels summed over splats), added into one of 64 slots of (visited,
-// fragments' low word, high word), zeroed by the host; the host sums the slots.
+// fragments' low word, high word) after the totals' first two words (zeroed by
+// the host, which sums the slots).
 #extension GL_GOOGLE_include_directive : require
 #include "splat_ranks.glsl"
 #include "splat_tiles.glsl"
@@ -12,7 +13,7 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 6) writeonly buffer Counts { uint chunkSplats[]; };
 layout(std430, binding = 7) writeonly buffer Pairs { uint chunkPairs[]; };
 layout(std430, binding = 8) writeonly buffer Candidates { uint candidates[]; };
-layout(std430, binding = 9) buffer Stats { uint stats[]; };  // 64 x (visited, fragments low, fragments high)
+layout(std430, binding = 9) buffer Totals { uint totals[]; };  // splats, pairs, 64 x (visited, fragments low, high)
 layout(push_constant) uniform Params { uint chunks, tileSize; } pc;
 
 void main() {
@@ -51,8 +52,8 @@ void main() {
     }
     chunkSplats[c] = splats;
     chunkPairs[c] = pairs;
-    const uint slot = 3u * (c % 64u);
-    if (visited != 0u) atomicAdd(stats[slot], visited);
-    if (fragments != 0u && atomicAdd(stats[slot + 1u], fragments) + fragments < fragments)
-        atomicAdd(stats[slot + 2u], 1u);  // the low word wrapped
+    const uint slot = 2u + 3u * (c % 64u);
+    if (visited != 0u) atomicAdd(totals[slot], visited);
+    if (fragments != 0u && atomicAdd(totals[slot + 1u], fragments) + fragments < fragments)
+        atomicAdd(totals[slot + 2u], 1u);  // the low word wrapped
 }

@@ -1,6 +1,6 @@
 // Shared by the splat passes that bin splats into screen tiles (SPEC 8): the
 // tiles a splat covers, and the linear invocation id of a 2-D dispatch
-// (RenderSplatVk.cpp LinearGroups: rows of kLinearRowGroups workgroups of 64).
+// (RenderSplatVk.cpp: rows of kRowGroups workgroups of 64).
 #ifndef CLOUDBENCH_SPLAT_TILES_GLSL
 #define CLOUDBENCH_SPLAT_TILES_GLSL
 
