@@ -260,7 +260,7 @@ struct ShadeSweep {
         // With 16 slices, the lines x0 .. x0 + 15 dx (q and T of the slices
         // read, ma - 1 + k for k < 16) lie inside the grid and start at xLine;
         // T of the slices written starts at xOut (slice ma at x0 + dx). Cells
-        // [0, uLines) go by lines.
+        // [a0, uLines) go by lines.
         const bool lines = K == kLineFloats;
         const uint32_t uLines = a0 + (lines ? na / kLineFloats * kLineFloats : 0);
         const int64_t xLine = dx > 0 ? x0 : x0 - 15, xOut = dx > 0 ? x0 + 1 : x0 - 16;
