@@ -8,12 +8,23 @@
 namespace cb::scene_io {
 namespace {
 
+// How a duplicate key's field is spelled: dotted for scenes ("noise.towers[0].center"), a JSON pointer for the
+// harness's input files ("/backends/cpu/stages").
+enum class FieldStyle { Dotted, Pointer };
+
 // Builds the document like nlohmann's own DOM parser, recording the field paths of duplicate keys and the
 // details of a failure. Each level keeps only its own key or index: a full path is built only for a duplicate, so
 // memory stays linear in the depth, which kMaxJsonDepth bounds anyway.
+template <typename Json, typename Dom, FieldStyle kStyle>
 class DomBuilder final : public nlohmann::json_sax<Json> {
   public:
-    explicit DomBuilder(JsonDom& dom) : mDom(dom) {}
+    using typename nlohmann::json_sax<Json>::number_integer_t;
+    using typename nlohmann::json_sax<Json>::number_unsigned_t;
+    using typename nlohmann::json_sax<Json>::number_float_t;
+    using typename nlohmann::json_sax<Json>::string_t;
+    using typename nlohmann::json_sax<Json>::binary_t;
+
+    explicit DomBuilder(Dom& dom) : mDom(dom) {}
 
     bool null() override { return Put(nullptr); }
     bool boolean(bool value) override { return Put(value); }
@@ -29,12 +40,13 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
 
     bool key(string_t& name) override {
         Frame& top = mStack.back();
-        if (top.node->contains(name)) mDom.duplicates.push_back(JoinField(FieldOf(mStack.size()), name));
+        if (top.node->contains(name)) mDom.duplicates.push_back(Join(FieldOf(mStack.size()), name));
         top.key = std::move(name);
         return true;
     }
 
-    bool parse_error(std::size_t position, const std::string& lastToken, const Json::exception& error) override {
+    bool parse_error(std::size_t position, const std::string& lastToken,
+                     const nlohmann::detail::exception& error) override {
         mDom.failure = JsonParseFailure{position, lastToken, error.id, error.what()};
         return false;
     }
@@ -48,12 +60,19 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
         std::string key;  // last key read, when `node` is an object
     };
 
-    // Dotted path of the container at level `depth` (1 is the root), built from the levels above it.
+    static std::string Join(const std::string& parent, std::string_view key) {
+        return kStyle == FieldStyle::Dotted ? JoinField(parent, key) : parent + "/" + PointerToken(key);
+    }
+    static std::string Index(const std::string& parent, size_t index) {
+        return kStyle == FieldStyle::Dotted ? IndexField(parent, index) : parent + "/" + std::to_string(index);
+    }
+
+    // Path of the container at level `depth` (1 is the root), built from the levels above it.
     std::string FieldOf(size_t depth) const {
         std::string field;
         for (size_t level = 1; level < depth; ++level) {
             const Frame& parent = mStack[level - 1];
-            field = parent.node->is_array() ? IndexField(field, parent.node->size() - 1) : JoinField(field, parent.key);
+            field = parent.node->is_array() ? Index(field, parent.node->size() - 1) : Join(field, parent.key);
         }
         return field;
     }
@@ -94,7 +113,7 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
         return true;
     }
 
-    JsonDom& mDom;
+    Dom& mDom;
     std::vector<Frame> mStack;
     bool mTooDeep = false;
 };
@@ -166,9 +185,12 @@ std::string IndexField(std::string_view parent, size_t index) {
     return std::string(parent) + "[" + std::to_string(index) + "]";
 }
 
-JsonDom ParseJsonDom(const std::string& text) {
-    JsonDom dom;
-    DomBuilder builder(dom);
+namespace {
+
+template <typename Json, typename Dom, FieldStyle kStyle>
+Dom ParseWith(const std::string& text) {
+    Dom dom;
+    DomBuilder<Json, Dom, kStyle> builder(dom);
     // Every other refusal goes through parse_error; the fallback only keeps "not JSON" from reading as success.
     if (!Json::sax_parse(text, &builder) && !dom.failure) {
         dom.failure = JsonParseFailure{};
@@ -178,6 +200,20 @@ JsonDom ParseJsonDom(const std::string& text) {
         }
     }
     return dom;
+}
+
+}  // namespace
+
+std::string PointerToken(std::string_view key) {
+    std::string token;
+    for (char c : key) token += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    return token;
+}
+
+JsonDom ParseJsonDom(const std::string& text) { return ParseWith<Json, JsonDom, FieldStyle::Dotted>(text); }
+
+JsonDocument ParseJsonDocument(const std::string& text) {
+    return ParseWith<nlohmann::json, JsonDocument, FieldStyle::Pointer>(text);
 }
 
 std::string DescribeParseFailure(std::string_view text, const JsonParseFailure& failure) {

@@ -1,7 +1,9 @@
-// JSON text -> document, for the scene loader. Unlike json::parse it keeps
+// JSON text -> document, for the scene loader and (ParseJsonDocument) the
+// harness's input files (harness/JsonInput.h). Unlike json::parse it keeps
 // where a failure happened (also for number overflow, which json::parse reports
-// without a position) and refuses duplicate keys instead of silently keeping the
-// last one. Internal to core: it exposes nlohmann, which core links privately.
+// without a position) and finds duplicate keys instead of silently keeping the
+// last one. It exposes nlohmann, which core links privately: only core and the
+// harness include it.
 #pragma once
 
 #include <cstddef>
@@ -20,6 +22,9 @@ using Json = nlohmann::ordered_json;
 // (just "seed" under an empty parent), IndexField("stages", 2) is "stages[2]".
 std::string JoinField(std::string_view parent, std::string_view key);
 std::string IndexField(std::string_view parent, size_t index);
+
+// `key` as one token of a JSON pointer (RFC 6901): "~" written "~0", "/" written "~1".
+std::string PointerToken(std::string_view key);
 
 // Deepest nesting of arrays and objects accepted; a scene needs 4 levels.
 inline constexpr size_t kMaxJsonDepth = 64;
@@ -46,6 +51,15 @@ struct JsonDom {
 };
 
 JsonDom ParseJsonDom(const std::string& text);
+
+// The same for nlohmann::json, with duplicate keys as JSON pointers (RFC 6901: "/backends/cpu/status").
+struct JsonDocument {
+    nlohmann::json root;                      // partial when `failure` is set
+    std::optional<JsonParseFailure> failure;  // set when the text is not JSON
+    std::vector<std::string> duplicates;      // JSON pointers of repeated keys, in reading order
+};
+
+JsonDocument ParseJsonDocument(const std::string& text);
 
 // "line L, column C: reason" for a failure of ParseJsonDom(text); an overflowing
 // number is pointed at by its first character.

@@ -32,6 +32,36 @@ inline size_t EditDistance(std::string_view a, std::string_view b) {
     return row[b.size()];
 }
 
+// The known name `name` was most likely meant as, or "" when none is close: the one known name that `name`
+// starts (3 characters or more: "fov" for "fov_deg"), else the nearest within two edits and fewer edits than
+// the shorter name has letters ("cpuu", "CPU"). Names over 64 characters get none (the distance is quadratic).
+template <typename Names>
+std::string_view ClosestName(std::string_view name, const Names& known) {
+    constexpr size_t kMaxSuggestedChars = 64;
+    if (name.size() > kMaxSuggestedChars) return {};
+    if (name.size() >= 3) {
+        std::string_view extended;
+        size_t matches = 0;
+        for (std::string_view candidate : known)
+            if (candidate.size() > name.size() && EditDistance(candidate.substr(0, name.size()), name) == 0) {
+                extended = candidate;
+                ++matches;
+            }
+        if (matches == 1) return extended;
+    }
+    std::string_view best;
+    size_t bestDistance = size_t(-1);
+    for (std::string_view candidate : known) {
+        const size_t d = EditDistance(name, candidate);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = candidate;
+        }
+    }
+    if (best.empty() || bestDistance > 2 || bestDistance >= std::min(name.size(), best.size())) return {};
+    return best;
+}
+
 // One spelling of an enum value.
 template <typename Enum>
 struct NamedValue {

@@ -1,6 +1,9 @@
 #include "core/Npy.h"
 
+#include "core/InputFile.h"
+
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -42,14 +45,15 @@ Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t>
 }
 
 Result<NpyArray> ReadNpy(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    char magic[10];
-    if (!in.read(magic, 10) || std::memcmp(magic, "\x93NUMPY\x01\x00", 8) != 0)
+    // The whole file, checked as every input is (core/InputFile.h): a FIFO or a device is refused, not read.
+    Result<std::string> file = ReadInputFile(path, kArrayInput);
+    if (!file) return std::unexpected(file.error());
+    const std::string& bytes = *file;
+    if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY\x01\x00", 8) != 0)
         return MakeError(path + ": not a version 1.0 .npy file");
-    const size_t length = uint8_t(magic[8]) | (size_t(uint8_t(magic[9])) << 8);
-    std::string header(length, '\0');
-    if (!in.read(header.data(), std::streamsize(length))) return MakeError(path + ": truncated .npy header");
+    const size_t length = uint8_t(bytes[8]) | (size_t(uint8_t(bytes[9])) << 8);
+    if (bytes.size() < 10 + length) return MakeError(path + ": truncated .npy header");
+    const std::string header = bytes.substr(10, length);
 
     NpyArray array;
     if (header.find("'descr': '|u1'") != std::string::npos) array.type = NpyType::U8;
@@ -60,15 +64,23 @@ Result<NpyArray> ReadNpy(const std::string& path) {
     size_t close = header.find(')', open);
     if (open == std::string::npos || close == std::string::npos) return MakeError(path + ": no shape in header");
     std::istringstream dims(header.substr(open + 10, close - open - 10));
+    // The element count, checked against the data the file holds before anything is allocated for it.
     uint64_t count = 1;
+    const uint64_t available = (bytes.size() - 10 - length) / ElementBytes(array.type);
     for (std::string token; std::getline(dims, token, ',');) {
         if (token.find_first_not_of(' ') == std::string::npos) continue;
-        array.shape.push_back(std::stoull(token));
-        count *= array.shape.back();
+        const size_t first = token.find_first_not_of(' ');
+        const size_t last = token.find_last_not_of(' ');
+        uint64_t dim = 0;
+        const auto [end, error] = std::from_chars(token.data() + first, token.data() + last + 1, dim);
+        if (error != std::errc() || end != token.data() + last + 1)
+            return MakeError(path + ": a shape dimension is not a number: '" + token + "'");
+        array.shape.push_back(dim);
+        count = dim != 0 && count > UINT64_MAX / dim ? UINT64_MAX : count * dim;  // saturating; 0 stays 0
     }
+    if (count > available) return MakeError(path + ": truncated .npy data");
     array.data.resize(count * ElementBytes(array.type));
-    if (!in.read(reinterpret_cast<char*>(array.data.data()), std::streamsize(array.data.size())))
-        return MakeError(path + ": truncated .npy data");
+    std::memcpy(array.data.data(), bytes.data() + 10 + length, array.data.size());
     return array;
 }
 

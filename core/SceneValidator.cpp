@@ -7,11 +7,6 @@
 #include "core/NamedValues.h"
 
 namespace cb::scene_io {
-namespace {
-
-constexpr size_t kMaxSuggestedChars = 64;  // longest name given a "did you mean" (the edit distance is quadratic)
-
-}  // namespace
 
 std::string FormatNumber(double value) {
     if (std::isnan(value)) return "nan";
@@ -66,31 +61,8 @@ bool IsPathName(std::string_view name) {
 }
 
 std::string Suggestion(std::string_view name, std::span<const std::string_view> known) {
-    if (name.size() > kMaxSuggestedChars) return "";  // no known name is that long
-    // A name that one known name starts with ("fov" for "fov_deg") is a shortening, not a misspelling.
-    if (name.size() >= 3) {
-        std::string_view extended;
-        size_t matches = 0;
-        for (std::string_view candidate : known) {
-            if (candidate.size() > name.size() && EditDistance(candidate.substr(0, name.size()), name) == 0) {
-                extended = candidate;
-                ++matches;
-            }
-        }
-        if (matches == 1) return " (did you mean " + Quote(extended) + "?)";
-    }
-    std::string_view best;
-    size_t bestDistance = std::numeric_limits<size_t>::max();
-    for (std::string_view candidate : known) {
-        const size_t d = EditDistance(name, candidate);
-        if (d < bestDistance) {
-            bestDistance = d;
-            best = candidate;
-        }
-    }
-    // Close means at most two edits, and fewer edits than the shorter name has letters.
-    if (best.empty() || bestDistance > 2 || bestDistance >= std::min(name.size(), best.size())) return "";
-    return " (did you mean " + Quote(best) + "?)";
+    const std::string_view best = ClosestName(name, known);
+    return best.empty() ? "" : " (did you mean " + Quote(best) + "?)";
 }
 
 // ---- Validator ------------------------------------------------------------------------------------------------

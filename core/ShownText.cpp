@@ -49,6 +49,36 @@ std::string ShownText(std::string_view text, bool escapeQuotes, size_t maxChars)
     return shown;
 }
 
+namespace {
+
+void AppendByte(std::string& out, unsigned char c, bool keepLineBreaks) {
+    constexpr char kDigits[] = "0123456789abcdef";
+    if ((c >= 0x20 && c < 0x7F) || (keepLineBreaks && (c == '\n' || c == '\t'))) {
+        out.push_back(char(c));
+        return;
+    }
+    out += "\\x";
+    out.push_back(kDigits[c >> 4]);
+    out.push_back(kDigits[c & 15]);
+}
+
+}  // namespace
+
+std::string ShownArgument(std::string_view text) {
+    std::string shown;
+    for (size_t i = 0; i < text.size() && i < kMaxShownArgumentBytes; ++i)
+        AppendByte(shown, static_cast<unsigned char>(text[i]), false);
+    if (text.size() > kMaxShownArgumentBytes) shown += "...";
+    return shown;
+}
+
+std::string ShownMessage(std::string_view message) {
+    std::string shown;
+    shown.reserve(message.size());
+    for (char c : message) AppendByte(shown, static_cast<unsigned char>(c), true);
+    return shown;
+}
+
 std::string QuoteShown(std::string_view text) {
     // Built with append rather than operator+: GCC 12 raises a false -Wrestrict
     // on "literal" + std::string (GCC bug 105651).

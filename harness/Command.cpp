@@ -29,8 +29,8 @@ std::optional<int> PositiveInt(const char* text, long max) {
     return int(value);
 }
 
-// A name from the command line as a message shows it (core/ShownText.h): control characters escaped, cut short.
-std::string Shown(std::string_view name) { return ShownText(name); }
+// A name from the command line as a message shows it (core/ShownText.h): printable ASCII, the rest as \xNN, cut short.
+std::string Shown(std::string_view name) { return ShownArgument(name); }
 
 // An option whose value is one of `table`'s names, stored in `field` as its
 // value; otherwise the usage message lists the names: "--x needs a or b".
@@ -125,6 +125,17 @@ std::span<const std::string_view> KnownBackends() {
     return kKnown;
 }
 
+std::optional<std::string> UnknownBackend(std::string_view option, std::string_view name) {
+    const std::span<const std::string_view> known = KnownBackends();
+    if (std::ranges::find(known, name) != known.end()) return std::nullopt;
+    std::string knownList;
+    for (std::string_view k : known) knownList += (knownList.empty() ? "" : ", ") + std::string(k);
+    std::string message = std::string(option) + ": unknown backend '" + Shown(name) + "' (known: " + knownList + ")";
+    if (const std::string_view best = ClosestName(name, known); !best.empty())
+        message += "; did you mean '" + std::string(best) + "'?";
+    return message;
+}
+
 std::optional<std::string> ParseBackendList(std::string_view list, std::vector<std::string>& backends) {
     const std::span<const std::string_view> known = KnownBackends();
     std::string knownList;
@@ -136,20 +147,7 @@ std::optional<std::string> ParseBackendList(std::string_view list, std::vector<s
         const std::string_view name = list.substr(start, comma - start);
         start = comma + 1;
         if (name.empty()) return "--backend: empty backend name in '" + Shown(list) + "'";
-        if (std::ranges::find(known, name) == known.end()) {
-            std::string message = "--backend: unknown backend '" + Shown(name) + "' (known: " + knownList + ")";
-            // Close: at most two edits, and fewer than the known name has letters ("cpuu", "CPU", "gk").
-            std::string_view best;
-            size_t bestDistance = 3;
-            if (name.size() <= 16)
-                for (std::string_view candidate : known)
-                    if (const size_t d = EditDistance(name, candidate); d < bestDistance && d < candidate.size()) {
-                        best = candidate;
-                        bestDistance = d;
-                    }
-            if (!best.empty()) message += "; did you mean '" + std::string(best) + "'?";
-            return message;
-        }
+        if (auto why = UnknownBackend("--backend", name)) return *why;
         if (std::ranges::find(names, name) != names.end() || std::ranges::find(backends, name) != backends.end())
             return "--backend: " + std::string(name) + " named twice";
         names.emplace_back(name);

@@ -96,6 +96,10 @@ OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOpti
 
 // Every backend name the registry knows, built in this build or not, sorted: cpu, gl, vk.
 std::span<const std::string_view> KnownBackends();
+
+// "OPTION: unknown backend 'x' (known: cpu, gl, vk); did you mean 'cpu'?" when `name` is not in KnownBackends(),
+// else nullopt: the one message for a backend named in an option (--backend, perf compare --threshold).
+std::optional<std::string> UnknownBackend(std::string_view option, std::string_view name);
 // Appends the names of one --backend LIST to `backends`. Returns the usage
 // message, and appends nothing, for an empty list or item, a name given twice
 // (in `list` or already in `backends`), or a name not in KnownBackends().

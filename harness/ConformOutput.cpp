@@ -9,7 +9,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/InputFile.h"
+#include "core/NamedValues.h"
 #include "core/SceneNames.h"
+#include "core/ShownText.h"
 #include "core/Shading.h"
 #include "harness/Command.h"
 #include "harness/Conform.h"
@@ -229,13 +232,30 @@ Result<ConformBaseline> ParseConformBaseline(const std::string& file, const std:
         const std::string &stage = fields[first], &backend = fields[first + 1], &status = fields[first + 2];
         if (stage.empty()) return bad("empty stage");
         if (backend.empty()) return bad("empty backend");
+        // The names a conform row can hold: a stage, or "(all)" for a backend that was skipped whole.
+        static const std::vector<std::string_view> kRowStages = [] {
+            std::vector<std::string_view> names = {"(all)"};
+            for (Stage s : kAllStages) names.push_back(StageName(s));
+            return names;
+        }();
+        if (std::ranges::find(kRowStages, stage) == kRowStages.end()) {
+            const std::string_view best = ClosestName(stage, kRowStages);
+            return bad("unknown stage '" + ShownArgument(stage) + "'" +
+                       (best.empty() ? "" : "; did you mean '" + std::string(best) + "'?"));
+        }
+        if (auto why = UnknownBackend("backend", backend)) return bad(*why);
         if (status == "fail" || IsBrokenStatus(status) || status == "expected-fail") {
             if (baseline.Lists(caseName, stage, backend))
                 return bad((withCase ? caseName + "," : "") + stage + "," + backend + " is listed twice");
             baseline.knownFailures.push_back({caseName, stage, backend});
         } else if (status != "pass" && status != "skipped" && status != "flaky" && status != "unexpected-pass") {
-            return bad("unknown status '" + status +
-                       "' (fail, failed, crashed, timed out, out of memory or expected-fail list a known "
+            static constexpr std::string_view kStatuses[] = {"fail",          "failed", "crashed",      "timed out",
+                                                             "out of memory", "expected-fail", "pass", "skipped",
+                                                             "flaky",         "unexpected-pass"};
+            const std::string_view best = ClosestName(status, kStatuses);
+            return bad("unknown status '" + ShownArgument(status) + "'" +
+                       (best.empty() ? "" : " (did you mean '" + std::string(best) + "'?)") +
+                       " (fail, failed, crashed, timed out, out of memory or expected-fail list a known "
                        "failure; pass, skipped, flaky and unexpected-pass are ignored)");
         }
     }
@@ -243,11 +263,9 @@ Result<ConformBaseline> ParseConformBaseline(const std::string& file, const std:
 }
 
 Result<ConformBaseline> LoadConformBaseline(const std::string& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return MakeError(file + ": cannot read: " + std::strerror(errno));
-    std::ostringstream text;
-    text << in.rdbuf();
-    return ParseConformBaseline(file, text.str());
+    Result<std::string> text = ReadInputFile(file, kBaselineInput);
+    if (!text) return std::unexpected(text.error());
+    return ParseConformBaseline(file, *text);
 }
 
 void ApplyBaseline(std::vector<ConformRow>& rows, const ConformBaseline& baseline) {

@@ -1,5 +1,7 @@
 #include "harness/Provenance.h"
 
+#include "core/InputFile.h"
+
 #include <sys/utsname.h>
 
 #include <algorithm>
@@ -63,8 +65,10 @@ void ApplyOverride(json& root, const SceneOverride& o) {
 }  // namespace
 
 json SceneWithOverrides(const std::string& path, std::span<const SceneOverride> overrides) {
-    std::ifstream file(path);
-    json root = json::parse(file, nullptr, /*allow_exceptions=*/false);
+    // Read again as LoadScene read it (core/InputFile.h): the file may have changed since, even into a FIFO.
+    Result<std::string> text = ReadInputFile(path, kSceneInput);
+    if (!text) return nullptr;
+    json root = json::parse(*text, nullptr, /*allow_exceptions=*/false);
     if (root.is_discarded()) return nullptr;
     try {
         for (const SceneOverride& o : overrides) ApplyOverride(root, o);

@@ -8,7 +8,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/InputFile.h"
+#include "core/JsonDom.h"
 #include "core/Npy.h"
+#include "core/ShownText.h"
 #include "harness/SimulationStateDetail.h"
 #include "harness/Transfer.h"
 
@@ -146,10 +149,14 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
     const std::string manifestPath = (fs::path(dir) / std::string(kSimulationStateManifest)).string();
     json m;
     {
-        std::ifstream in(manifestPath, std::ios::binary);
-        if (!in) return MakeError(manifestPath + ": cannot read: " + std::strerror(errno));
-        m = json::parse(in, nullptr, /*allow_exceptions=*/false);
-        if (m.is_discarded() || !m.is_object()) return MakeError(manifestPath + ": not a JSON object (a damaged file?)");
+        Result<std::string> text = ReadInputFile(manifestPath, kDocumentInput);
+        if (!text) return std::unexpected(text.error());
+        scene_io::JsonDocument doc = scene_io::ParseJsonDocument(*text);
+        if (doc.failure || !doc.root.is_object())
+            return MakeError(manifestPath + ": not a JSON object (a damaged file?)");
+        if (!doc.duplicates.empty())
+            return MakeError(manifestPath + ": " + ShownText(doc.duplicates.front(), false, 200) + ": duplicate key");
+        m = std::move(doc.root);
     }
     ManifestReader read(manifestPath);
     SimulationState s;

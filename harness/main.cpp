@@ -6,7 +6,10 @@
 #include <new>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "core/NamedValues.h"
+#include "core/ShownText.h"
 #include "harness/Command.h"
 #include "harness/Isolation.h"
 
@@ -30,7 +33,7 @@ std::string MainHelp() {
 }
 
 int Usage(const std::string& message, std::string_view help) {
-    std::fprintf(stderr, "cloudbench: %s\n\n%.*s", message.c_str(), int(help.size()), help.data());
+    std::fprintf(stderr, "cloudbench: %s\n\n%.*s", cb::ShownMessage(message).c_str(), int(help.size()), help.data());
     return cb::kExitUsage;
 }
 
@@ -42,6 +45,16 @@ const cb::OptionSpec* FindOption(const cb::Command& command, std::string_view ar
     for (const cb::OptionSpec& o : command.extraOptions)
         if (matches(o)) return &o;
     return nullptr;
+}
+
+// "; did you mean '--backend'?" for an option close to one of the command's, else "".
+std::string OptionSuggestion(const cb::Command& command, std::string_view arg) {
+    std::vector<std::string_view> names;
+    if (command.takesScene)
+        for (const cb::OptionSpec& o : cb::SceneCommandOptions()) names.push_back(o.name);
+    for (const cb::OptionSpec& o : command.extraOptions) names.push_back(o.name);
+    const std::string_view best = cb::ClosestName(arg, names);
+    return best.empty() ? "" : "; did you mean '" + std::string(best) + "'?";
 }
 
 }  // namespace
@@ -62,7 +75,7 @@ int main(int argc, char** argv) {
         return cb::kExitOk;
     }
     const cb::Command* command = cb::FindCommand(name);
-    if (!command) return Usage("unknown command '" + std::string(name) + "'", MainHelp());
+    if (!command) return Usage("unknown command '" + cb::ShownArgument(name) + "'", MainHelp());
 
     cb::CommonOptions options;
     options.commandLine.assign(argv, argv + argc);
@@ -80,16 +93,17 @@ int main(int argc, char** argv) {
             const char* value = option->takesValue ? (n + 1 < argc ? argv[++n] : nullptr) : nullptr;
             if (auto message = option->apply(options, value)) return Usage(*message, command->help);
         } else if (arg.starts_with("-")) {
-            return Usage("unknown option '" + std::string(arg) + "'", command->help);
+            return Usage("unknown option '" + cb::ShownArgument(arg) + "'" + OptionSuggestion(*command, arg),
+                         command->help);
         } else if (command->takesArguments) {
             options.arguments.emplace_back(arg);
         } else if (!command->takesScene) {
-            return Usage("unexpected argument '" + std::string(arg) + "'", command->help);
+            return Usage("unexpected argument '" + cb::ShownArgument(arg) + "'", command->help);
         } else if (!sceneGiven) {
             options.scene = std::string(arg);
             sceneGiven = true;
         } else {
-            return Usage("unexpected argument '" + std::string(arg) + "' (one scene at a time)", command->help);
+            return Usage("unexpected argument '" + cb::ShownArgument(arg) + "' (one scene at a time)", command->help);
         }
     }
     // An allocation that fails anywhere outside an isolated backend's process

@@ -103,14 +103,17 @@ TEST(BackendOptions, BackendListRefusesUnknownNamesWithASuggestion) {
     EXPECT_TRUE(backends.empty());
 }
 
+// Test the rule docs/cli.md gives for names from the command line: control and non-ASCII bytes as \xNN (no raw
+// ESC reaches the terminal, and a look-alike "çpu" shows its odd bytes), cut to 40 bytes.
 TEST(BackendOptions, BackendListShowsNamesSafely) {
     std::vector<std::string> backends;
-    EXPECT_EQ(ParseBackendList("c\x1b[2Jpu", backends),
-              "--backend: unknown backend 'c\\u001b[2Jpu' (known: cpu, gl, vk)");  // no raw ESC reaches the terminal
+    EXPECT_EQ(ParseBackendList("c\x1b[2Jpu", backends), "--backend: unknown backend 'c\\x1b[2Jpu' (known: cpu, gl, vk)");
+    EXPECT_EQ(ParseBackendList("\xc3\xa7pu", backends),
+              "--backend: unknown backend '\\xc3\\xa7pu' (known: cpu, gl, vk); did you mean 'cpu'?");  // 2 byte edits
     const std::string huge(1'000'000, 'a');
     const std::optional<std::string> message = ParseBackendList(huge, backends);
     ASSERT_TRUE(message);
-    EXPECT_EQ(*message, "--backend: unknown backend '" + std::string(57, 'a') + "...' (known: cpu, gl, vk)");
+    EXPECT_EQ(*message, "--backend: unknown backend '" + std::string(40, 'a') + "...' (known: cpu, gl, vk)");
 }
 
 // KnownBackends() is the registry's list: every built backend is in it, and

@@ -219,27 +219,6 @@ TEST(HtmlSeedTimings, TablesStagesAndRates) {
         EXPECT_TRUE(tables.count(t)) << t;
 }
 
-// Test that a half-written last line of a history is skipped with a warning naming the file and line.
-TEST(HtmlHistory, HalfWrittenLineSkipped) {
-    const std::string path = (std::filesystem::temp_directory_path() / "cloudbench-html-history.jsonl").string();
-    {
-        std::ofstream out(path);
-        out << R"({"format": "cloudbench-perf/1", "id": "a", "results": {}})" << "\n\n"
-            << R"({"format": "other"})" << "\n"
-            << R"({"format": "cloudbench-perf/1", "id": "b)";
-    }
-    std::vector<std::string> warnings;
-    auto records = ReadHistory(path, warnings);
-    ASSERT_TRUE(records);
-    ASSERT_EQ(records->size(), 1u);
-    EXPECT_EQ((*records)[0]["id"], "a");
-    ASSERT_EQ(warnings.size(), 2u);
-    EXPECT_EQ(warnings[0], path + ":3: skipped: \"format\" is not cloudbench-perf/1");
-    EXPECT_EQ(warnings[1], path + ":4: skipped: not JSON (a half-written record?)");
-    std::filesystem::remove(path);
-    EXPECT_FALSE(ReadHistory(path, warnings));
-}
-
 // Test the verdicts: a failed check is 5, a crashed backend 1 before it, nothing compared 4.
 TEST(HtmlVerdict, ExitCodesAsTheCommandsGive) {
     auto conform = [](std::vector<std::string> statuses) {

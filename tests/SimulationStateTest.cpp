@@ -376,7 +376,7 @@ TEST_F(SimulationStateFiles, ReplacesAStateWholeAndNothingElse) {
 
 TEST_F(SimulationStateFiles, NoManifest) {
     fs::remove(Manifest());
-    EXPECT_EQ(ErrorOfRead(), Manifest() + ": cannot read: No such file or directory");
+    EXPECT_EQ(ErrorOfRead(), Manifest() + ": cannot read the file: No such file or directory");
 }
 
 TEST_F(SimulationStateFiles, NotJson) {

@@ -14,8 +14,22 @@ Each case file holds one input and its expected outcome:
              {"what": "repeat", "before": TEXT, "unit": TEXT, "count": N, "after": TEXT}
   scene_path a path used as is (e.g. /dev/zero); no file is written
   args       a whole command line (after the program), for command-line cases; placeholders {scene} (the case's
-             scene file, or scenes/ci-small.json when the case has none), {out} (a fresh output folder) and
-             {repeat:C:N} (the character C N times)
+             scene file, or scenes/ci-small.json when the case has none), {out} (a fresh output folder),
+             {repeat:C:N} (the character C N times), {FIXTURE} (a pristine fixture, see below) and {NAME} for
+             each of the case's `inputs`
+  inputs     {NAME: spec, ...}: input files for the other commands, written into the case's folder as NAME; a
+             spec is one of
+               {"from": FIXTURE, "patch": {POINTER: value, ...}}  the fixture with JSON pointer (RFC 6901) edits
+                   (null removes the field; "line": N picks the line of a JSON Lines fixture, default the last),
+                   and optionally "replace": [OLD, NEW] on the text, "append": TEXT, and "truncate": N (keep
+                   the first N bytes; negative: drop the last -N), in that order
+               {"text": TEXT}, {"fifo": true}, {"folder": true}, {"link": TARGET} (a symbolic link; placeholders
+               allowed), {"sparse_bytes": N} (a regular file of N zero bytes, sparse)
+  FIXTURES   made once per run by the CLI under test, only those the selected cases use: results (run
+             ci-small, 3 steps, cpu), history (perf record of ci-small), conform (conform ci-small, cpu: exit 4, nothing compared), shard1
+             and shard2 (sweep ci-small --shard 1/2 and 2/2), suite (a perf suite), baseline (a conform
+             baseline), count (a count output: `count` needs the exact build, so this one is written here in the
+             count format)
   -- optional --
   file_name  the written scene's file name (default: the case's stem + ".json")
   commands   for scene cases, the commands run (default ["run", "dump"]), each as
@@ -75,6 +89,143 @@ def apply_patch(scene, patch):
         else:
             node[keys[-1]] = value
     return scene
+
+
+FIXTURE_NAMES = ("results", "history", "conform", "shard1", "shard2", "suite", "baseline", "count")
+
+
+class Fixtures:
+    """Pristine inputs for the other commands, each made on first use by the CLI under test (thread-safe)."""
+
+    def __init__(self, cli, folder):
+        import threading
+        self.cli, self.folder, self.made, self.lock = cli, Path(folder), {}, threading.Lock()
+
+    def run(self, *args, codes=(0,)):
+        proc = subprocess.run([self.cli, *args], stdin=subprocess.DEVNULL, capture_output=True, timeout=600)
+        if proc.returncode not in codes:
+            raise RuntimeError(f"fixture: cloudbench {' '.join(args)} exited {proc.returncode}: "
+                               f"{proc.stderr[-2000:].decode('utf-8', 'replace')}")
+
+    def path(self, name):
+        with self.lock:
+            if name not in self.made:
+                self.made[name] = self.make(name)
+            return self.made[name]
+
+    def make(self, name):
+        f = self.folder
+        quick = ["--backend", "cpu", "--quiet", "--set", "warmup_steps=0"]
+        if name == "results":
+            self.run("run", "ci-small", "--steps", "3", *quick, "--out", str(f / "run"))
+            return f / "run" / "results.json"
+        if name == "history":
+            suite = f / "history-suite.json"
+            suite.write_text(json.dumps({"scenes": [{"scene": "ci-small", "set": ["steps=12", "warmup_steps=2"]}]}))
+            for _ in range(2):
+                self.run("perf", "record", "--suite", str(suite), "--history", str(f / "history.jsonl"),
+                         "--backend", "cpu", "--quiet")
+            return f / "history.jsonl"
+        if name == "conform":
+            # With the CPU alone there is nothing to compare (exit 4), but conform.json is written all the same:
+            # the sanitized CLI is built without GPU backends.
+            self.run("conform", "ci-small", "--steps", "2", *quick, "--out", str(f / "conform"), codes=(0, 4))
+            return f / "conform" / "conform.json"
+        if name in ("shard1", "shard2"):
+            index = name[-1]
+            out = f / name
+            self.run("sweep", "ci-small", "--steps", "2", "--vary", "shade.resolution=1,2", "--repeat", "1",
+                     "--shard", f"{index}/2", *quick, "--out", str(out))
+            return out / "sweep.json"
+        if name == "suite":
+            path = f / "suite.json"
+            path.write_text(json.dumps({"scenes": [{"scene": "ci-small", "set": ["steps=3"]}]}))
+            return path
+        if name == "baseline":
+            path = f / "baseline.csv"
+            path.write_text("stage,backend,status\nshade,vk,fail\n")
+            return path
+        if name == "count":
+            path = f / "count.json"
+            path.write_text(json.dumps({"format": "cloudbench-count/1", "scene": "ci-small", "steps": 3,
+                                        "warmup_steps": 1, "counted_steps": [1, 2],
+                                        "instructions": {"ci-small": {"cpu": {"region": 1000, "ca": 2000}}}}))
+            return path
+        raise ValueError(f"unknown fixture {name}")
+
+
+def json_pointer_set(doc, pointer, value):
+    """Sets (or, for None, removes) the field `pointer` (RFC 6901) of `doc`, creating objects on the way."""
+    parts = [p.replace("~1", "/").replace("~0", "~") for p in pointer.split("/")[1:]]
+    node = doc
+    for part in parts[:-1]:
+        node = node[int(part)] if isinstance(node, list) else node.setdefault(part, {})
+    last = parts[-1]
+    if isinstance(node, list):
+        if value is None:
+            del node[int(last)]
+        else:
+            node[int(last)] = value
+    elif value is None:
+        node.pop(last, None)
+    else:
+        node[last] = value
+
+
+def expand(text, names):
+    for key, value in names.items():
+        text = text.replace("{" + key + "}", str(value))
+    return text
+
+
+def write_inputs(case, folder, fixtures):
+    """Writes the case's `inputs` into `folder`; returns the placeholder values (inputs and fixtures used)."""
+    names = {}
+    used = set(re.findall(r"\{(\w+)\}", json.dumps(case.get("args", [])) + json.dumps(case.get("inputs", {}))))
+    for fixture in FIXTURE_NAMES:
+        if fixture in used or any(spec.get("from") == fixture for spec in case.get("inputs", {}).values()):
+            names[fixture] = fixtures.path(fixture)
+    for name, spec in case.get("inputs", {}).items():
+        path = folder / name
+        if "from" in spec:
+            text = Path(names[spec["from"]]).read_text()
+            if "patch" in spec:
+                lines = text.splitlines(keepends=False)
+                jsonl = spec["from"] == "history"
+                index = (spec.get("line", len(lines)) - 1) if jsonl else None
+                doc = json.loads(lines[index] if jsonl else text)
+                for pointer, value in spec["patch"].items():
+                    json_pointer_set(doc, pointer, value)
+                if jsonl:
+                    lines[index] = json.dumps(doc)
+                    text = "\n".join(lines) + "\n"
+                else:
+                    text = json.dumps(doc, indent=1)
+            if "replace" in spec:
+                old, new = spec["replace"]
+                if old not in text:
+                    raise ValueError(f"{case['name']}: {old!r} is not in fixture {spec['from']}")
+                text = text.replace(old, new)
+            text += spec.get("append", "")
+            data = text.encode("utf-8", "surrogateescape")
+            if "truncate" in spec:
+                data = data[:spec["truncate"]]
+            path.write_bytes(data)
+        elif "text" in spec:
+            path.write_bytes(spec["text"].encode("utf-8", "surrogateescape"))
+        elif spec.get("fifo"):
+            os.mkfifo(path)
+        elif spec.get("folder"):
+            path.mkdir()
+        elif "link" in spec:
+            os.symlink(expand(spec["link"], names), path)
+        elif "sparse_bytes" in spec:
+            with open(path, "wb") as f:
+                f.truncate(spec["sparse_bytes"])
+        else:
+            raise ValueError(f"{case['name']}: input {name} has no known spec")
+        names[name] = path
+    return names
 
 
 def write_scene(case, folder):
@@ -187,7 +338,7 @@ def non_finite_in_outputs(out):
     return bad
 
 
-def run_case(cli, case, skip_rlimit):
+def run_case(cli, case, skip_rlimit, fixtures):
     """(outcome, problems, invocations) for one case; outcome is 'refused', 'finite' or 'failed'."""
     if skip_rlimit and "rlimit_as" in case:
         return "skipped", [], 0
@@ -196,11 +347,16 @@ def run_case(cli, case, skip_rlimit):
     with tempfile.TemporaryDirectory(prefix="badinput-") as tmp:
         tmp = Path(tmp)
         scene = write_scene(case, tmp) or str(SCENES / "ci-small.json")
+        try:
+            names = write_inputs(case, tmp, fixtures)
+        except (RuntimeError, ValueError, OSError) as e:
+            return "failed", [f"cannot make the case's inputs: {e}"], 0
         lines = command_lines(case, scene)
         for n, line in enumerate(lines):
             out = tmp / f"out{n}"
-            argv = [cli] + [re.sub(r"\{repeat:(.):(\d+)\}", lambda m: m[1] * int(m[2]),
-                                   a.replace("{scene}", scene).replace("{out}", str(out))) for a in line]
+            argv = [cli] + [expand(re.sub(r"\{repeat:(.):(\d+)\}", lambda m: m[1] * int(m[2]),
+                                          a.replace("{scene}", scene).replace("{out}", str(out))), names)
+                            for a in line]
             limit = case.get("rlimit_as")
 
             def preexec():
@@ -233,6 +389,8 @@ def run_case(cli, case, skip_rlimit):
                 fail(f"raw control byte {m.group(0)!r} in stderr")
             if "message" in case:
                 pattern = case["message"].replace("{scene}", re.escape(scene))
+                for key, value in names.items():
+                    pattern = pattern.replace("{" + key + "}", re.escape(str(value)))
                 if not re.search(pattern, err.decode("utf-8", "replace"), re.MULTILINE):
                     fail(f"stderr does not match {pattern!r}")
             if proc.returncode == 0:
@@ -288,10 +446,12 @@ def main():
 
     cli = str(Path(args.cli).resolve())
     results = {}
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futures = {pool.submit(run_case, cli, case, args.skip_rlimit): case["name"] for case in cases}
-        for future in concurrent.futures.as_completed(futures):
-            results[futures[future]] = future.result()
+    with tempfile.TemporaryDirectory(prefix="badinput-fixtures-") as fixture_dir:
+        fixtures = Fixtures(cli, fixture_dir)
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+            futures = {pool.submit(run_case, cli, case, args.skip_rlimit, fixtures): case["name"] for case in cases}
+            for future in concurrent.futures.as_completed(futures):
+                results[futures[future]] = future.result()
 
     by_kind = {}
     invocations = 0

@@ -73,9 +73,9 @@ assert os.path.exists(f"{out}/merged/sweep.md")
 
 # A shard set with index 2 missing (2 of 3 given twice would be the other case).
 p = run(["merge", shard_files[0], "--out", f"{out}/bad"], expect=3)
-assert "shard.index" in p.stderr and "missing" in p.stderr, p.stderr
+assert "/shard/index" in p.stderr and "missing" in p.stderr, p.stderr
 p = run(["merge", shard_files[0], shard_files[0], "--out", f"{out}/bad"], expect=3)
-assert "shard.index" in p.stderr, p.stderr
+assert "/shard/index" in p.stderr, p.stderr
 
 # Histories from two machines, one record in both; a half-written last line in one.
 def record(rid, time):

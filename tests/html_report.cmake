@@ -8,15 +8,15 @@ set_tests_properties(Cli.HtmlReport PROPERTIES TIMEOUT 300 SKIP_RETURN_CODE 77 P
 add_test(NAME Cli.ReportMissingFileExits3 COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
          "-DARGS=report;${cli_out}/html-bad/missing.json;-o;${cli_out}/html-bad/r.html" -DEXPECT=3 ${expect_exit})
 set_tests_properties(Cli.ReportMissingFileExits3 PROPERTIES PASS_REGULAR_EXPRESSION
-                     "missing.json: cannot read: No such file or directory")
+                     "missing.json: cannot read the file: No such file or directory")
 add_test(NAME Cli.ReportNotJsonExits3 COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
          "-DARGS=report;${CMAKE_CURRENT_SOURCE_DIR}/check_html_report.py;-o;${cli_out}/html-bad/r.html" -DEXPECT=3
          ${expect_exit})
-set_tests_properties(Cli.ReportNotJsonExits3 PROPERTIES PASS_REGULAR_EXPRESSION "check_html_report.py: not JSON")
+set_tests_properties(Cli.ReportNotJsonExits3 PROPERTIES PASS_REGULAR_EXPRESSION "check_html_report.py: not a results.json, a conform.json, an accuracy.json or a sweep.json: line 1, column 1: malformed JSON")
 add_test(NAME Cli.ReportUnknownFormatExits3 COMMAND ${CMAKE_COMMAND} -DCMD=${cli}
          "-DARGS=report;${CLOUDBENCH_ROOT}/docs/seed-timings.json;-o;${cli_out}/html-bad/r.html" -DEXPECT=3 ${expect_exit})
 set_tests_properties(Cli.ReportUnknownFormatExits3 PROPERTIES PASS_REGULAR_EXPRESSION
-                     "seed-timings.json: not a cloudbench results, conform, accuracy or sweep file")
+                     "seed-timings.json: not a results.json, a conform.json, an accuracy.json or a sweep.json [(].format. is .cloudbench-seed-timings/1.[)]")
 add_test(NAME Cli.ReportNoInputExits2 COMMAND ${CMAKE_COMMAND} -DCMD=${cli} "-DARGS=report" -DEXPECT=2 ${expect_exit})
 add_test(NAME Cli.ReportWritesNothingOnBadInput COMMAND /bin/sh -c "! test -e \"$0\"" ${cli_out}/html-bad/r.html)
 set_tests_properties(Cli.ReportWritesNothingOnBadInput PROPERTIES DEPENDS

@@ -4,14 +4,16 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
+#include "core/ShownText.h"
 #include "harness/Command.h"
+#include "harness/InputFormats.h"
+#include "harness/Measurement.h"
 #include "harness/Session.h"
 #include "harness/Transfer.h"
+#include "harness/VaryAxes.h"
 #include "harness/commands/SweepOutput.h"
 #include "harness/perf/History.h"
 
@@ -51,27 +53,22 @@ struct Input {
 };
 
 // A sweep.json (one JSON object of format cloudbench-sweep/1) or a history
-// (at least one cloudbench-perf/1 record); an error message otherwise.
+// (JSON Lines of cloudbench-perf/1 records); an error message otherwise.
 Result<Input> ReadInput(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return MakeError(path + ": cannot read");
-    std::stringstream text;
-    text << in.rdbuf();
-    Input input;
-    input.path = path;
-    const json whole = json::parse(text.str(), nullptr, false);
-    if (whole.is_object() && whole.value("format", "") == "cloudbench-sweep/1") {
-        input.kind = InputKind::Sweep;
-        input.sweep = whole;
-        return input;
+    static constexpr input::Format kSweep[] = {input::Format::Sweep};
+    auto read = input::ReadDocumentOrHistory(path, kSweep);
+    if (!read) return std::unexpected(read.error());
+    Input in;
+    in.path = path;
+    if (auto* sweep = std::get_if<input::Document>(&*read)) {
+        in.kind = InputKind::Sweep;
+        in.sweep = std::move(sweep->doc);
+        return in;
     }
-    auto records = perf::ReadHistory(path);
-    if (!records) return std::unexpected(records.error());
-    if (records->empty())
-        return MakeError(path +
-                         ": not a sweep.json (format cloudbench-sweep/1) nor a history of cloudbench-perf/1 records");
-    input.records = std::move(*records);
-    return input;
+    input::History& history = std::get<input::History>(*read);
+    input::PrintWarnings(history);
+    in.records = std::move(history.records);
+    return in;
 }
 
 int Fail(const std::string& message, int code) {
@@ -90,10 +87,10 @@ int MergeSweeps(const std::vector<Input>& inputs, const std::string& outDir) {
         for (const Input& input : inputs) {
             const json& doc = input.sweep;
             if (!doc.contains("shard") || !doc["shard"].is_object())
-                return Fail(input.path + ": shard: missing (not the output of sweep --shard I/N)", kExitBadScene);
+                return Fail(input.path + ": /shard: missing (not the output of sweep --shard I/N)", kExitBadScene);
             for (const std::string& field : shared)
                 if (!doc.contains(field) || doc[field] != first.value(field, json()))
-                    return Fail(input.path + ": " + field + ": differs from " + inputs.front().path, kExitBadScene);
+                    return Fail(input.path + ": /" + field + ": differs from " + inputs.front().path, kExitBadScene);
             const json& shard = doc["shard"];
             const int index = shard.at("index").get<int>();
             if (&input == &inputs.front()) {
@@ -101,22 +98,59 @@ int MergeSweeps(const std::vector<Input>& inputs, const std::string& outDir) {
                 points = shard.at("points").get<size_t>();
             }
             if (shard.at("count").get<int>() != count)
-                return Fail(input.path + ": shard.count: differs from " + inputs.front().path, kExitBadScene);
+                return Fail(input.path + ": /shard/count: differs from " + inputs.front().path, kExitBadScene);
             if (shard.at("points").get<size_t>() != points)
-                return Fail(input.path + ": shard.points: differs from " + inputs.front().path, kExitBadScene);
+                return Fail(input.path + ": /shard/points: differs from " + inputs.front().path, kExitBadScene);
             if (index < 1 || index > count)
                 return Fail(
-                    input.path + ": shard.index: " + std::to_string(index) + " is not in 1.." + std::to_string(count),
+                    input.path + ": /shard/index: " + std::to_string(index) + " is not in 1.." + std::to_string(count),
                     kExitBadScene);
             if (auto [it, fresh] = byIndex.emplace(index, &input); !fresh)
-                return Fail(input.path + ": shard.index: " + std::to_string(index) + " also in " + it->second->path,
+                return Fail(input.path + ": /shard/index: " + std::to_string(index) + " also in " + it->second->path,
                             kExitBadScene);
         }
         for (int i = 1; i <= count; ++i)
             if (!byIndex.contains(i))
-                return Fail(inputs.front().path + ": shard.index: shard " + std::to_string(i) + " of " +
+                return Fail(inputs.front().path + ": /shard/index: shard " + std::to_string(i) + " of " +
                                 std::to_string(count) + " is missing",
                             kExitBadScene);
+
+        // Every row's point must be one of its shard's (k % N == I-1, k below the point count) and hold that
+        // point's settings: a wrong index would put a row in another point's place.
+        std::vector<SweepAxis> axes;
+        for (const json& a : first.at("vary"))
+            axes.push_back({a.at("path").get<std::string>(), a.at("values").get<std::vector<std::string>>()});
+        const uint64_t product = VaryPointCount(axes);
+        if (product != points)
+            return Fail(inputs.front().path + ": /shard/points: " + std::to_string(points) + ", but its /vary axes make " +
+                            std::to_string(product) + " points",
+                        kExitBadScene);
+        if (product > kMaxVaryPoints)
+            return Fail(inputs.front().path + ": /vary: " + std::to_string(product) + " points, more than the " +
+                            std::to_string(kMaxVaryPoints) + " a sweep may have",
+                        kExitBadScene);
+        const std::vector<std::vector<SceneOverride>> pointSettings = VaryPoints(axes);
+        for (const auto& [index, input] : byIndex) {
+            const json& rows = input->sweep["shard"]["rows"];
+            for (size_t r = 0; r < rows.size(); ++r) {
+                const std::string field = input->path + ": /shard/rows/" + std::to_string(r);
+                const size_t point = rows[r]["point"].get<size_t>();
+                if (point >= points || int(point % size_t(count)) != index - 1)
+                    return Fail(field + "/point: " + std::to_string(point) + " is not a point of shard " +
+                                    std::to_string(index) + "/" + std::to_string(count) + " (k % " +
+                                    std::to_string(count) + " == " + std::to_string(index - 1) + ", k < " +
+                                    std::to_string(points) + ")",
+                                kExitBadScene);
+                const json& settings = rows[r]["settings"];
+                bool same = settings.size() == pointSettings[point].size();
+                for (size_t k = 0; same && k < settings.size(); ++k)
+                    same = settings[k][0] == pointSettings[point][k].path && settings[k][1] == pointSettings[point][k].value;
+                if (!same)
+                    return Fail(field + "/settings: " + ShownText(settings.dump(), false, 120) + " are not point " + std::to_string(point) +
+                                    "'s settings (" + SettingsLabel(pointSettings[point]) + ")",
+                                kExitBadScene);
+            }
+        }
 
         // Each point is in one shard, so ordering the shards' rows by point
         // (stably: a shard keeps its backend order within a point) gives the
@@ -142,9 +176,6 @@ int MergeSweeps(const std::vector<Input>& inputs, const std::string& outDir) {
         }
         const std::string metric = first.at("metric").get<std::string>();
         MarkPareto(rows, metric);
-        std::vector<SweepAxis> axes;
-        for (const json& a : first.at("vary"))
-            axes.push_back({a.at("path").get<std::string>(), a.at("values").get<std::vector<std::string>>()});
 
         json doc = {{"format", "cloudbench-sweep/1"}, {"references", references}};
         for (const char* field : {"scene", "grid", "step", "metric", "repeats", "reference_start"})

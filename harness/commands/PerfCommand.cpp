@@ -8,6 +8,7 @@
 // PerfHistory.cpp, PerfExport.cpp); what they share is in PerfCommon.h.
 #include <cstdio>
 
+#include "core/ShownText.h"
 #include "harness/commands/PerfCommon.h"
 
 namespace cb::perf_command {
@@ -62,7 +63,7 @@ or an output could not be written, 2 bad command line, 3 a bad input file,
 }  // namespace
 
 int Usage(const std::string& message) {
-    std::fprintf(stderr, "cloudbench: %s\n\n%s", message.c_str(), kHelp);
+    std::fprintf(stderr, "cloudbench: %s\n\n%s", ShownMessage(message).c_str(), kHelp);
     return kExitUsage;
 }
 
@@ -76,7 +77,7 @@ int Perf(const CommonOptions& options) {
     if (sub == "compare") return ComparePerf(args);
     if (sub == "history") return History(args);
     if (sub == "export") return Export(args);
-    return Usage("perf: unknown subcommand '" + sub + "' (record, compare, history, export)");
+    return Usage("perf: unknown subcommand '" + ShownArgument(sub) + "' (record, compare, history, export)");
 }
 
 const CommandRegistration kRegistration({

@@ -10,6 +10,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/NamedValues.h"
+#include "core/ShownText.h"
+#include "harness/InputFormats.h"
 #include "harness/perf/Spawn.h"
 
 namespace cb::perf_command {
@@ -27,7 +30,11 @@ std::optional<std::string> Parse(const std::vector<std::string>& args, const std
         } else if (flagOptions.count(arg)) {
             out.flags.insert(arg);
         } else if (arg.size() > 1 && arg[0] == '-' && !std::isdigit(static_cast<unsigned char>(arg[1]))) {
-            return "unknown option '" + arg + "' for perf " + args[0];
+            std::vector<std::string_view> known(valueOptions.begin(), valueOptions.end());
+            known.insert(known.end(), flagOptions.begin(), flagOptions.end());
+            const std::string_view best = ClosestName(arg, known);
+            return "unknown option '" + ShownArgument(arg) + "' for perf " + args[0] +
+                   (best.empty() ? "" : "; did you mean '" + std::string(best) + "'?");
         } else {
             out.positional.push_back(arg);
         }
@@ -49,7 +56,7 @@ std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& 
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     if (end == text.c_str() || *end != '\0' || !(v >= low && v <= high))
-        return name + ": needs a number in [" + Num("%g", low) + ", " + Num("%g", high) + "], got '" + text + "'";
+        return name + ": needs a number in [" + Num("%g", low) + ", " + Num("%g", high) + "], got '" + ShownArgument(text) + "'";
     value = v;
     return std::nullopt;
 }
@@ -96,11 +103,11 @@ std::optional<int> RunInto(const std::string& binary, const std::string& scene, 
         std::fprintf(stderr, "perf: %s run %s exited %d (see its message above)\n", binary.c_str(), scene.c_str(), *rc);
         return *rc;
     }
-    std::ifstream file(out + "/results.json");
-    const json results = json::parse(file, nullptr, /*allow_exceptions=*/false);
-    if (results.is_discarded()) {
-        std::fprintf(stderr, "perf: %s run %s exited %d and wrote no results.json\n", binary.c_str(), scene.c_str(),
-                     *rc);
+    static constexpr input::Format kResults[] = {input::Format::Results};
+    auto results = input::ReadCloudbenchFile(out + "/results.json", kResults);
+    if (!results) {
+        std::fprintf(stderr, "perf: %s run %s exited %d and wrote no valid results.json: %s\n", binary.c_str(),
+                     scene.c_str(), *rc, results.error().message.c_str());
         failed = true;
         return std::nullopt;
     }
@@ -108,7 +115,7 @@ std::optional<int> RunInto(const std::string& binary, const std::string& scene, 
         std::fprintf(stderr, "perf: %s run %s exited %d\n", binary.c_str(), scene.c_str(), *rc);
         failed = true;
     }
-    if (Status s = perf::AddResults(side, results); !s) {
+    if (Status s = perf::AddResults(side, results->doc); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
     }

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "harness/ReportModel.h"
+#include "core/ShownText.h"
 #include "harness/commands/PerfCommon.h"
 
 namespace cb::perf_command {
@@ -141,7 +142,9 @@ int ComparePerf(const std::vector<std::string>& args) {
             if (equals == std::string::npos)
                 settings.threshold = threshold;
             else if (equals == 0)
-                return Usage("--threshold: empty backend name in '" + value + "'");
+                return Usage("--threshold: empty backend name in '" + ShownArgument(value) + "'");
+            else if (auto why = UnknownBackend("--threshold", value.substr(0, equals)))
+                return Usage(*why);
             else
                 settings.backendThreshold[value.substr(0, equals)] = threshold;
         }
@@ -179,7 +182,7 @@ int ComparePerf(const std::vector<std::string>& args) {
         for (const std::string& s : a.values.at("--set")) extra.insert(extra.end(), {"--set", s});
     const std::string binaries[2] = {a.positional[0], a.positional[1]};
     for (const std::string& b : binaries)
-        if (::access(b.c_str(), X_OK) != 0) return Usage("'" + b + "' is not an executable file");
+        if (::access(b.c_str(), X_OK) != 0) return Usage("'" + ShownArgument(b) + "' is not an executable file");
     const std::vector<std::string> scenes(a.positional.begin() + 2, a.positional.end());
     TemporaryFolder temporary;
     if (temporary.path.empty()) {

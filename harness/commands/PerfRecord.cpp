@@ -4,8 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
+#include "core/ShownText.h"
+#include "harness/InputFormats.h"
 #include "harness/commands/PerfCommon.h"
 #include "harness/perf/CallgrindCount.h"
 #include "harness/perf/History.h"
@@ -22,32 +23,35 @@ struct SuiteEntry {
 // The default suite: the thesis scenes as `run` runs them.
 std::vector<SuiteEntry> DefaultSuite() { return {{"thesis-low", {}}, {"thesis-medium", {}}, {"thesis-high", {}}}; }
 
-// {"scenes": [{"scene": NAME_OR_PATH, "set": ["PATH=VALUE", ...]}, ...]}
+// {"scenes": [{"scene": NAME_OR_PATH, "set": ["PATH=VALUE", ...]}, ...]} (harness/InputFormats.h).
 Result<std::vector<SuiteEntry>> LoadSuite(const std::string& path) {
-    std::ifstream file(path);
-    if (!file) return MakeError(path + ": cannot read");
-    const json doc = json::parse(file, nullptr, /*allow_exceptions=*/false);
-    if (doc.is_discarded() || !doc.is_object()) return MakeError(path + ": not a JSON object");
-    if (!doc.contains("scenes") || !doc["scenes"].is_array() || doc["scenes"].empty())
-        return MakeError(path + ": scenes: must be a non-empty array");
+    static constexpr input::Format kSuite[] = {input::Format::Suite};
+    auto read = input::ReadCloudbenchFile(path, kSuite);
+    if (!read) return std::unexpected(read.error());
     std::vector<SuiteEntry> suite;
-    for (size_t i = 0; i < doc["scenes"].size(); ++i) {
-        const json& e = doc["scenes"][i];
-        const std::string where = path + ": scenes[" + std::to_string(i) + "]";
-        if (!e.is_object() || !e.contains("scene") || !e["scene"].is_string() || e["scene"].get<std::string>().empty())
-            return MakeError(where + ".scene: must be a scene name or path");
-        SuiteEntry entry{e["scene"].get<std::string>(), {}};
-        if (e.contains("set")) {
-            if (!e["set"].is_array()) return MakeError(where + ".set: must be an array of \"PATH=VALUE\"");
-            for (const json& s : e["set"]) {
-                if (!s.is_string() || s.get<std::string>().find('=') == std::string::npos)
-                    return MakeError(where + ".set: must be an array of \"PATH=VALUE\"");
-                entry.set.push_back(s.get<std::string>());
-            }
+    const json& scenes = read->doc["scenes"];
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        const std::string where = path + ": /scenes/" + std::to_string(i);
+        SuiteEntry entry{scenes[i]["scene"].get<std::string>(), {}};
+        if (entry.scene.empty()) return MakeError(where + "/scene: must be a scene name or path, not \"\"");
+        const json set = scenes[i].value("set", json::array());
+        for (size_t k = 0; k < set.size(); ++k) {
+            const std::string s = set[k].get<std::string>();
+            if (s.find('=') == std::string::npos || s.front() == '=')
+                return MakeError(where + "/set/" + std::to_string(k) + ": must be \"PATH=VALUE\", not " + QuoteShown(s));
+            entry.set.push_back(s);
         }
-        suite.push_back(entry);
+        suite.push_back(std::move(entry));
     }
     return suite;
+}
+
+// The instruction counts of a `cloudbench count` output or an instruction file, added to `side`.
+Status AddInstructionsFile(perf::Side& side, const std::string& path) {
+    static constexpr input::Format kCounts[] = {input::Format::Count, input::Format::Instructions};
+    auto read = input::ReadCloudbenchFile(path, kCounts);
+    if (!read) return std::unexpected(read.error());
+    return perf::AddInstructions(side, read->doc);
 }
 
 }  // namespace
@@ -74,11 +78,8 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
     side.label = "record";
     if (a.Has("--instructions")) {
         const std::string path = a.Value("--instructions");
-        std::ifstream file(path);
-        const json doc = json::parse(file, nullptr, /*allow_exceptions=*/false);
         side.label = path;
-        Status s = doc.is_object() ? perf::AddInstructions(side, doc) : Status(MakeError(path + ": not a JSON object"));
-        if (!s) {
+        if (Status s = AddInstructionsFile(side, path); !s) {
             std::fprintf(stderr, "%s\n", s.error().message.c_str());
             return kExitBadScene;
         }
@@ -124,11 +125,10 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
             for (const std::string& set : suite[i].set) argv.insert(argv.end(), {"--set", set});
             if (!a.Has("--quiet")) std::fprintf(stderr, "perf record: counting %s\n", suite[i].scene.c_str());
             auto rc = perf::RunChild(argv, temporary.path + "/runs.log");
-            std::ifstream file(out);
-            const json counts = json::parse(file, nullptr, /*allow_exceptions=*/false);
-            if (!rc || *rc != kExitOk || !counts.is_object() || !perf::AddInstructions(side, counts)) {
-                std::fprintf(stderr, "perf record: counting %s failed (exit %d)\n", suite[i].scene.c_str(),
-                             rc ? *rc : -1);
+            Status added = rc && *rc == kExitOk ? AddInstructionsFile(side, out) : Status();
+            if (!rc || *rc != kExitOk || !added) {
+                std::fprintf(stderr, "perf record: counting %s failed (exit %d)%s\n", suite[i].scene.c_str(),
+                             rc ? *rc : -1, added ? "" : (": " + added.error().message).c_str());
                 notCounted += (notCounted.empty() ? "" : "; ") + suite[i].scene + ": count failed";
                 failed = true;
             }

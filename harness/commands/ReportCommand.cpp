@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "harness/Command.h"
+#include "harness/InputFormats.h"
 #include "harness/Session.h"
 #include "harness/html/HtmlRender.h"
 #include "harness/html/HtmlReport.h"
@@ -47,14 +48,13 @@ int Report(const CommonOptions& options) {
     }
     std::vector<nlohmann::json> history;
     if (!options.history.empty()) {
-        std::vector<std::string> warnings;
-        auto read = html::ReadHistory(options.history, warnings);
-        for (const std::string& warning : warnings) std::fprintf(stderr, "warning: %s\n", warning.c_str());
+        auto read = input::ReadHistory(options.history);
         if (!read) {
             std::fprintf(stderr, "%s\n", read.error().message.c_str());
             return kExitBadScene;
         }
-        history = std::move(*read);
+        input::PrintWarnings(*read);
+        for (input::HistoryRecord& r : read->records) history.push_back(std::move(r.record));
     }
     std::string page;
     try {

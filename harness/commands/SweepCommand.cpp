@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <expected>
 
+#include "core/ShownText.h"
 #include "harness/IsolatedMeasurement.h"
 #include "harness/Measurement.h"
 #include "harness/Transfer.h"
@@ -89,15 +90,17 @@ std::expected<std::vector<Axis>, std::string> ParseVaryAxes(const std::vector<st
     for (const std::string& arg : vary) {
         const size_t eq = arg.find('=');
         if (eq == std::string::npos || eq == 0)
-            return std::unexpected("--vary '" + arg + "': expected PATH=V1,V2,... (a dotted scene path, '=', values)");
+            return std::unexpected("--vary '" + ShownArgument(arg) + "': expected PATH=V1,V2,... (a dotted scene path, '=', values)");
         Axis axis{arg.substr(0, eq), SplitValues(arg.substr(eq + 1))};
         for (const std::string& v : axis.values)
-            if (v.empty()) return std::unexpected("--vary '" + arg + "': empty value in the list");
+            if (v.empty()) return std::unexpected("--vary '" + ShownArgument(arg) + "': empty value in the list");
         for (const Axis& other : axes)
             if (other.path == axis.path)
-                return std::unexpected("--vary '" + arg + "': " + axis.path + " is varied twice");
+                return std::unexpected("--vary '" + ShownArgument(arg) + "': " + ShownArgument(axis.path) + " is varied twice");
         axes.push_back(std::move(axis));
     }
+    // Before the product is made: 10 axes of 10 values would be 10^10 points.
+    if (auto why = VaryTooLarge(axes)) return std::unexpected(*why);
     return axes;
 }
 

@@ -10,10 +10,9 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 
+#include "core/InputFile.h"
 #include "harness/Report.h"
 #include "harness/html/HtmlReport.h"
 
@@ -22,16 +21,11 @@ namespace {
 
 using nlohmann::json;
 
-Result<std::string> ReadBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    std::stringstream bytes;
-    bytes << in.rdbuf();
-    return bytes.str();
-}
+Result<std::string> ReadBytes(const std::string& path) { return ReadInputFile(path, kArrayInput); }
 
 // The first three channels of an image file as linear floats, row 0 at the top.
 Result<std::vector<float>> ReadRgb(const std::string& path, int& width, int& height) {
+    CB_TRY(CheckInputFile(path, kArrayInput));  // OpenImageIO would block on a FIFO
     OIIO::ImageBuf image(path);
     if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
         return MakeError(path + ": cannot read: " + image.geterror());

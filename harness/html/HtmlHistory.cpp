@@ -121,29 +121,4 @@ std::vector<report::Block> HistoryBlocks(const std::vector<json>& history, const
     return blocks;
 }
 
-Result<std::vector<json>> ReadHistory(const std::string& path, std::vector<std::string>& warnings) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    std::vector<json> records;
-    std::string line;
-    for (size_t number = 1; std::getline(in, line); ++number) {
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        json record = json::parse(line, nullptr, false);
-        std::string reason;
-        if (record.is_discarded())
-            reason = "not JSON (a half-written record?)";
-        else if (!record.is_object())
-            reason = "not a JSON object";
-        else if (Str(record, "format") != "cloudbench-perf/1")
-            reason = "\"format\" is not cloudbench-perf/1";
-        if (!reason.empty()) {
-            warnings.push_back(path + ":" + std::to_string(number) + ": skipped: " + reason);
-            continue;
-        }
-        records.push_back(std::move(record));
-    }
-    if (in.bad()) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    return records;
-}
-
 }  // namespace cb::html

@@ -5,9 +5,9 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "core/ShownText.h"
+#include "harness/InputFormats.h"
 #include "harness/html/HtmlReport.h"
 #include "harness/html/ReportJson.h"
 
@@ -15,37 +15,26 @@ namespace cb::html {
 namespace {
 
 Result<ReportInput> ReadOne(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    std::stringstream text;
-    text << in.rdbuf();
-    if (in.bad()) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    ReportInput input{path, InputKind::Results, {}};
-    try {
-        input.doc = json::parse(text.str());
-    } catch (const json::exception& e) {
-        return MakeError(path + ": not JSON: " + e.what());
-    }
-    const std::string format = Str(input.doc, "format");
-    static const std::array<std::pair<std::string_view, InputKind>, 4> kFormats = {{
-        {"cloudbench-results/1", InputKind::Results},
-        {"cloudbench-conform/1", InputKind::Conform},
-        {"cloudbench-accuracy/1", InputKind::Accuracy},
-        {"cloudbench-sweep/1", InputKind::Sweep},
+    static constexpr std::array<std::pair<input::Format, InputKind>, 4> kFormats = {{
+        {input::Format::Results, InputKind::Results},
+        {input::Format::Conform, InputKind::Conform},
+        {input::Format::Accuracy, InputKind::Accuracy},
+        {input::Format::Sweep, InputKind::Sweep},
     }};
-    for (const auto& [name, kind] : kFormats)
-        if (format == name) {
-            input.kind = kind;
-            // The report block is read back into the page: check its shape here, where the file can be named.
-            if (input.doc.contains("report")) try {
-                    (void)report::ReportFromJson(input.doc["report"]);
-                } catch (const json::exception& e) {
-                    return MakeError(path + ": report: " + e.what());
-                }
-            return input;
+    static constexpr std::array<input::Format, 4> kAccepted = {input::Format::Results, input::Format::Conform,
+                                                               input::Format::Accuracy, input::Format::Sweep};
+    auto read = input::ReadCloudbenchFile(path, kAccepted);
+    if (!read) return std::unexpected(read.error());
+    ReportInput in{path, InputKind::Results, std::move(read->doc)};
+    for (const auto& [format, kind] : kFormats)
+        if (format == read->format) in.kind = kind;
+    // The report block is read back into the page: check its shape here, where the file can be named.
+    if (in.doc.contains("report")) try {
+            (void)report::ReportFromJson(in.doc["report"]);
+        } catch (const json::exception& e) {
+            return MakeError(path + ": /report: not a report block: " + ShownText(e.what(), false, 200));
         }
-    return MakeError(path + ": not a cloudbench results, conform, accuracy or sweep file (\"format\" is " +
-                     (format.empty() ? std::string("missing") : "'" + format + "'") + ")");
+    return in;
 }
 
 bool Finished(const std::string& status) { return status == "ok" || status == "unavailable" || status == "unsupported"; }
@@ -72,7 +61,8 @@ Result<std::vector<ReportInput>> ReadReportInput(const std::string& path) {
     std::vector<ReportInput> inputs;
     for (const char* name : {"results.json", "conform.json", "accuracy.json", "sweep.json"}) {
         const std::string file = (std::filesystem::path(path) / name).string();
-        if (!std::filesystem::exists(file, ec)) continue;
+        // A name that is there in any form (a link, a FIFO) is read, so that ReadOne says what is wrong with it.
+        if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) continue;
         auto one = ReadOne(file);
         if (!one) return std::unexpected(one.error());
         inputs.push_back(std::move(*one));

@@ -25,18 +25,11 @@ struct ReportInput {
 
 // Reads one input: a JSON file recognised by its "format"
 // (cloudbench-results/1, cloudbench-conform/1, cloudbench-accuracy/1,
-// cloudbench-sweep/1), or a folder, which stands for the known file names in
-// it (results.json, conform.json, accuracy.json, sweep.json; one at least).
-// Errors name the file: "PATH: cannot read: <reason>", "PATH: not JSON: ...",
-// "PATH: not a cloudbench results, conform, accuracy or sweep file".
+// cloudbench-sweep/1) and checked against its schema (harness/InputFormats.h),
+// or a folder, which stands for the known file names in it (results.json,
+// conform.json, accuracy.json, sweep.json; one at least). Errors name the file
+// and the field.
 Result<std::vector<ReportInput>> ReadReportInput(const std::string& path);
-
-// Reads a history file, JSON Lines, keeping the records whose "format" is
-// cloudbench-perf/1 in file order. A line that is not a JSON object of that
-// format (a half-written last line, say) is skipped and named in `warnings`
-// as "PATH:LINE: skipped: <reason>"; empty lines are ignored. A file that
-// cannot be read is an error naming it.
-Result<std::vector<nlohmann::json>> ReadHistory(const std::string& path, std::vector<std::string>& warnings);
 
 // The verdict one input records, as the exit code its command gave (docs/cli.md):
 // results: 1 when a backend did not finish ("failed", "crashed", ...) or the run is

@@ -1,5 +1,7 @@
 #include "harness/perf/CallgrindCount.h"
 
+#include "core/InputFile.h"
+
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -34,12 +36,8 @@ std::string FindOnPath(const std::string& name) {
     return "";
 }
 
-std::string ReadFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
+// What valgrind and the counting child wrote into the temporary folder: "" when it is not there.
+std::string ReadFile(const std::string& path) { return ReadInputFile(path, kToolOutputInput).value_or(""); }
 
 // The last `lines` lines of `text`.
 std::string Tail(const std::string& text, int lines) {

@@ -6,20 +6,15 @@
 #include <array>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <cstdio>
 
+#include "harness/InputFormats.h"
 #include "harness/perf/History.h"
 
 namespace cb::perf {
 namespace {
 
 using nlohmann::json;
-
-bool IsFile(const std::string& path) {
-    struct stat st {};
-    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
 
 Status AddRecord(Side& side, const json& record) {
     try {
@@ -85,39 +80,40 @@ Status AddInstructions(Side& side, const json& doc) {
 }
 
 Result<Side> LoadSide(const std::string& spec) {
+    // "FILE@SELECTOR" names a record of a history; a file whose own name holds '@' is taken whole.
     std::string path = spec, selector;
-    if (const size_t at = spec.rfind('@'); !IsFile(spec) && at != std::string::npos && at > 0) {
+    bool selected = false;
+    struct stat st {};
+    if (const size_t at = spec.rfind('@'); at != std::string::npos && at > 0 && ::stat(spec.c_str(), &st) != 0) {
         path = spec.substr(0, at);
         selector = spec.substr(at + 1);
+        selected = true;
     }
     Side side;
     side.label = spec;
-    std::ifstream file(path, std::ios::binary);
-    if (!file || !IsFile(path))
-        return MakeError(path + ": cannot read: " + (errno ? std::strerror(errno) : "not a file"));
-    std::stringstream text;
-    text << file.rdbuf();
-    const json doc = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
-    if (!doc.is_discarded() && selector.empty()) {  // one JSON document
-        if (!doc.is_object()) return MakeError(path + ": not a JSON object");
-        const json format = doc.value("format", json());
-        if (format == "cloudbench-results/1") {
-            CB_TRY(AddResults(side, doc));
-        } else if (format == kRecordFormat) {
-            CB_TRY(AddRecord(side, doc));
-        } else if (doc.contains("instructions")) {
-            CB_TRY(AddInstructions(side, doc));
-            side.provenance = doc.value("provenance", json::object());
-            if (side.provenance.is_object()) side.date = side.provenance.value("date", "");
-        } else {
-            return MakeError(path + ": neither a results.json, a history record nor an \"instructions\" file");
+    // A record alone is read as a history of one (input::ReadDocumentOrHistory).
+    static constexpr input::Format kSides[] = {input::Format::Results, input::Format::Count,
+                                               input::Format::Instructions};
+    auto read = input::ReadDocumentOrHistory(path, kSides);
+    if (!read) return std::unexpected(read.error());
+    if (auto* one = std::get_if<input::Document>(&*read)) {
+        if (selected) return MakeError(spec + ": '@' selects a record of a history, and " + path + " is not one");
+        const json& doc = one->doc;
+        switch (one->format) {
+            case input::Format::Results:
+                CB_TRY(AddResults(side, doc));
+                break;
+            default:  // a count output or an instruction file
+                CB_TRY(AddInstructions(side, doc));
+                side.provenance = doc.value("provenance", json::object());
+                side.date = side.provenance.value("date", "");
+                break;
         }
         return side;
     }
-    // A history: JSON Lines.
-    auto records = ReadHistory(path);
-    if (!records) return std::unexpected(records.error());
-    auto record = SelectRecord(*records, path, selector.empty() ? "-1" : selector);
+    auto& history = std::get<input::History>(*read);
+    input::PrintWarnings(history);
+    auto record = SelectRecord(history.records, path, selected ? selector : "-1");
     if (!record) return std::unexpected(record.error());
     side.label = path + "@" + (*record)->record.value("id", "-1");
     CB_TRY(AddRecord(side, (*record)->record));

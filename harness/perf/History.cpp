@@ -10,9 +10,9 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <random>
 
+#include "core/ShownText.h"
 #include "harness/PosixIo.h"
 
 namespace cb::perf {
@@ -26,29 +26,10 @@ std::string DefaultHistoryPath() {
 }
 
 Result<std::vector<HistoryRecord>> ReadHistory(const std::string& path) {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    std::vector<HistoryRecord> records;
-    size_t lineNumber = 0;
-    for (std::string line; std::getline(file, line);) {
-        ++lineNumber;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        nlohmann::json record = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
-        std::string why;
-        if (record.is_discarded())
-            why = "not JSON (a write cut short?)";
-        else if (!record.is_object() || record.value("format", nlohmann::json()) != kRecordFormat)
-            why = std::string("not a ") + kRecordFormat + " record";
-        else if (!record.contains("results") || !record["results"].is_object())
-            why = "no \"results\" object";
-        if (!why.empty()) {
-            std::fprintf(stderr, "%s:%zu: skipped: %s\n", path.c_str(), lineNumber, why.c_str());
-            continue;
-        }
-        records.push_back({lineNumber, std::move(record)});
-    }
-    if (file.bad()) return MakeError(path + ": cannot read: " + std::strerror(errno));
-    return records;
+    Result<input::History> history = input::ReadHistory(path);
+    if (!history) return std::unexpected(history.error());
+    input::PrintWarnings(*history);
+    return std::move(history->records);
 }
 
 Status AppendRecord(const std::string& path, const nlohmann::json& record) {
@@ -82,7 +63,8 @@ Status AppendRecord(const std::string& path, const nlohmann::json& record) {
 
 Result<const HistoryRecord*> SelectRecord(const std::vector<HistoryRecord>& records, const std::string& path,
                                           const std::string& selector) {
-    const std::string name = path + "@" + selector;
+    const std::string name = path + "@" + ShownText(selector);
+    if (selector.empty()) return MakeError(name + ": no record named after '@' (give an id, a unique prefix of one, or -N)");
     if (records.empty()) return MakeError(name + ": the history holds no record");
     if (selector.size() > 1 && selector[0] == '-' && selector.find_first_not_of("0123456789", 1) == std::string::npos) {
         const size_t back = std::strtoul(selector.c_str() + 1, nullptr, 10);

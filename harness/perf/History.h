@@ -7,24 +7,20 @@
 #include <vector>
 
 #include "core/Error.h"
+#include "harness/InputFormats.h"
 
 namespace cb::perf {
 
 inline constexpr const char* kRecordFormat = "cloudbench-perf/1";
 
-struct HistoryRecord {
-    size_t line = 0;  // 1-based line in the file
-    nlohmann::json record;
-};
+using input::HistoryRecord;
 
 // $CLOUDBENCH_HISTORY, else $XDG_DATA_HOME/cloudbench/history.jsonl, else
 // $HOME/.local/share/cloudbench/history.jsonl.
 std::string DefaultHistoryPath();
 
-// Every record of the history at `path`, in file order. A line that is not a
-// JSON object of format cloudbench-perf/1 (a write cut short, a corrupted
-// line) is skipped with a warning on stderr naming the file and the line.
-// Error: "PATH: cannot read: <strerror>".
+// Every record of the history at `path`, in file order (input::ReadHistory),
+// its warnings (lines cut short, skipped) printed to stderr.
 Result<std::vector<HistoryRecord>> ReadHistory(const std::string& path);
 
 // Appends `record` as one line: the file (and its folder) created when
