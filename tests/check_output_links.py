@@ -22,6 +22,8 @@ appear in the victim's folder, and the link must still be there. GROUP is one of
   named     files the user names: report -o FILE and its temporary name,
             perf compare --json FILE, perf export --gbench OUT,
             perf history --json FILE
+  count     count --out FILE and its temporary name (CLOUDBENCH must be a build
+            that counts: without -march=native, valgrind installed)
   followed  what is followed: --out DIR given as a link, a link among DIR's
             leading folders, and a link among the folders of report -o FILE;
             the outputs land in the folder the link points to
@@ -247,6 +249,13 @@ def group_named():
                  lambda f: ["perf", "history", history, "--json", os.path.join(f, "changes.json")])
 
 
+def group_count():
+    count = lambda f: ["count", "ci-small", "--steps", "2", "--set", "warmup_steps=1", "--quiet",  # noqa: E731
+                       "--out", os.path.join(f, "count.json")]
+    refused_case("count --out", "count.json", count)
+    refused_case("count --out temporary", ".count.partial.json", count)
+
+
 def group_followed():
     # --out DIR given as a link: followed (the user named it); the outputs and the lock are in its target.
     real = fresh("cases/followed-real")
@@ -273,7 +282,7 @@ def group_followed():
 def main():
     global CLI, WORK
     groups = {"run": group_run, "dump": group_dump, "commands": group_commands, "sweep": group_sweep,
-              "named": group_named, "followed": group_followed}
+              "named": group_named, "count": group_count, "followed": group_followed}
     if len(sys.argv) != 4 or sys.argv[3] not in groups:
         sys.exit(__doc__)
     CLI, WORK = os.path.abspath(sys.argv[1]), os.path.join(os.path.abspath(sys.argv[2]), sys.argv[3])

@@ -3,7 +3,7 @@
 small tmpfs mounted in a private mount namespace (`unshare -rm`, or `unshare -m`
 as root); exits 77 (skipped) where neither may mount.
 
-usage: check_output_mounts.py CLOUDBENCH DIR full|readonly|writers-full|writers-readonly
+usage: check_output_mounts.py CLOUDBENCH DIR full|readonly|writers-full|writers-readonly|count
 
 full: (1) a run that fits into a 256 KiB tmpfs, with tiny frames; the disk is
   then filled, leaving 32 KiB; a run with the scene's real frames must exit 1
@@ -23,9 +23,10 @@ writers-full, writers-readonly: the writers of the other commands, into a full
   naming the file or folder, and leave no temporary file. writers-full also
   fills the disk so that sweep.json fits but sweep.png does not: sweep exits
   1 with "DIR/sweep.png: cannot write: No space left on device", no Python
-  traceback, sweep.json and sweep.md written and no sweep.png. (count --out
-  writes through the same writer, Session::WriteText, but counts only on a
-  build without -march=native under valgrind: not run here.)
+  traceback, sweep.json and sweep.md written and no sweep.png.
+count: CLOUDBENCH is a build that counts (without -march=native, valgrind
+  installed; tests/exact.cmake): count --out FILE on a full and on a read-only
+  tmpfs exits 1 with "FILE: cannot write: <reason>".
 """
 import os
 import re
@@ -274,8 +275,29 @@ def sweep_png_full(cli, work):
     print("sweep.png: %s; sweep.json and sweep.md written" % expected)
 
 
+def count(cli, work):
+    for kind, reason in (("full", "No space left on device"), ("readonly", "Read-only file system")):
+        mount = os.path.join(work, "count-" + kind)
+        mount_tmpfs(mount, "64k")
+        if kind == "full":
+            fill(mount, 0)
+        else:
+            result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
+            if result.returncode != 0:
+                print("skipped: cannot remount read-only: " + result.stderr.strip())
+                sys.exit(SKIP)
+        path = os.path.join(mount, "count.json")
+        result = subprocess.run([cli, "count", "ci-small", "--steps", "2", "--set", "warmup_steps=1", "--quiet",
+                                 "--out", path], capture_output=True, text=True, timeout=300)
+        expected = "%s: cannot write: %s" % (path, reason)
+        if result.returncode != 1 or expected not in result.stderr.splitlines():
+            fail("count on a %s disk: exit %d, stderr %r; expected exit 1 and %r"
+                 % (kind, result.returncode, result.stderr, expected))
+        print("count --out on a %s disk: %s" % (kind, expected))
+
+
 def main():
-    modes = ("full", "readonly", "writers-full", "writers-readonly")
+    modes = ("full", "readonly", "writers-full", "writers-readonly", "count")
     if len(sys.argv) != 4 or sys.argv[3] not in modes:
         sys.exit(__doc__)
     if not os.environ.get(INSIDE):
@@ -284,6 +306,8 @@ def main():
     os.makedirs(work, exist_ok=True)
     if sys.argv[3].startswith("writers-"):
         writers(cli, work, sys.argv[3][len("writers-"):])
+    elif sys.argv[3] == "count":
+        count(cli, work)
     else:
         {"full": full, "readonly": readonly}[sys.argv[3]](cli, work)
     print("ok")
