@@ -16,7 +16,8 @@ appear in the victim's folder, and the link must still be there. GROUP is one of
   dump      a step folder that is a link, a .npy and a frame in a step folder,
             the temporary name of a .npy, and a previous dump's journalled
             step_0000/q.npy whose step_0000 is now a link
-  commands  conform.json, conform.csv, accuracy.json, accuracy.md
+  commands  conform.json, conform.csv, conform's lock, a conform --vary case
+            folder, accuracy.json, accuracy.md
   sweep     sweep.json, sweep.md, sweep.png, a shard's sweep.json and sweep.png,
             merge's sweep.json, sweep.png and history.jsonl
   named     files the user names: report -o FILE and its temporary name,
@@ -183,6 +184,9 @@ def group_commands():
     refused_case("conform lock", ".cloudbench.lock", conform)
     refused_case("accuracy.json", "accuracy.json", accuracy)
     refused_case("accuracy.md", "accuracy.md", accuracy)
+    # conform --vary: a folder per case for its difference images.
+    refused_case("conform case folder", "smooth.radius=0", lambda f: conform(f)[:2] + ["--vary", "smooth.radius=0,2"]
+                 + conform(f)[2:], folder_link=True)
 
 
 def sweep_command(folder, *extra):
