@@ -2,6 +2,9 @@
 
 #include "core/InputFile.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -16,10 +19,11 @@ size_t ElementBytes(NpyType type) { return type == NpyType::U8 ? 1 : 4; }
 
 }  // namespace
 
-Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t> shape, std::span<const std::byte> data) {
+Status WriteNpy(int fd, const std::string& name, NpyType type, std::span<const uint64_t> shape,
+                std::span<const std::byte> data) {
     uint64_t count = 1;
     for (uint64_t d : shape) count *= d;
-    if (count * ElementBytes(type) != data.size()) return MakeError(path + ": npy data size does not match its shape");
+    if (count * ElementBytes(type) != data.size()) return MakeError(name + ": npy data size does not match its shape");
 
     std::ostringstream dict;
     dict << "{'descr': '" << Descr(type) << "', 'fortran_order': False, 'shape': (";
@@ -31,17 +35,27 @@ Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t>
     header.append((64 - total % 64) % 64, ' ');
     header.push_back('\n');
 
-    std::ofstream out(path, std::ios::binary);
-    if (!out) return MakeError(path + ": cannot write: " + std::strerror(errno));
-    const char magic[8] = {'\x93', 'N', 'U', 'M', 'P', 'Y', 1, 0};
-    out.write(magic, 8);
     const uint16_t length = static_cast<uint16_t>(header.size());
-    const char lengthBytes[2] = {char(length & 0xff), char(length >> 8)};
-    out.write(lengthBytes, 2);
-    out.write(header.data(), std::streamsize(header.size()));
-    out.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size()));
-    if (!out) return MakeError(path + ": write failed: " + std::strerror(errno));
+    const char preamble[10] = {'\x93', 'N', 'U', 'M', 'P', 'Y', 1, 0, char(length & 0xff), char(length >> 8)};
+    const std::string_view parts[] = {{preamble, sizeof preamble},
+                                      header,
+                                      {reinterpret_cast<const char*>(data.data()), data.size()}};
+    for (std::string_view part : parts)
+        for (size_t done = 0; done < part.size();) {
+            const ssize_t n = ::write(fd, part.data() + done, part.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) return MakeError(name + ": cannot write: " + std::strerror(n < 0 ? errno : EIO));
+            done += size_t(n);
+        }
     return {};
+}
+
+Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t> shape, std::span<const std::byte> data) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) return MakeError(path + ": cannot write: " + std::strerror(errno));
+    Status written = WriteNpy(fd, path, type, shape, data);
+    if (::close(fd) != 0 && written) return MakeError(path + ": cannot write: " + std::strerror(errno));
+    return written;
 }
 
 Result<NpyArray> ReadNpy(const std::string& path) {

@@ -13,6 +13,11 @@ namespace cb {
 
 enum class NpyType : uint8_t { U8, F32 };
 
+// Writes the array through `fd` (open for writing, at its start); `name` is
+// the file's name in messages: "NAME: cannot write: <strerror>".
+Status WriteNpy(int fd, const std::string& name, NpyType type, std::span<const uint64_t> shape,
+                std::span<const std::byte> data);
+// Creates or truncates `path` (never through a symbolic link at `path`: O_NOFOLLOW) and writes the array.
 Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t> shape, std::span<const std::byte> data);
 
 struct NpyArray {

@@ -1,16 +1,20 @@
 #include "harness/OutputFolder.h"
 #include "harness/PosixIo.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
 namespace cb {
@@ -18,10 +22,12 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kLockName = ".cloudbench.lock";
+constexpr int kFolderFlags = O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC;
 
 struct ClaimedFolder {
     fs::path root;  // absolute and lexically normal
     std::string dir;  // as the command was given it, for messages
+    int rootFd = -1;  // the folder itself, opened once by name; every name in it is opened from here
     int lockFd = -1;  // held open (and locked) until the process exits
     int journalFd = -1;  // O_APPEND: whole lines from the parent and forked children never interleave
     std::string journalPath;
@@ -57,10 +63,49 @@ ClaimedFolder* FindClaim(const fs::path& root) {
     return nullptr;
 }
 
-ClaimedFolder* FindClaimHolding(const fs::path& path) {
+// The claimed folder that holds `path` (the deepest, should claims nest), or is `path` when `orRoot`.
+ClaimedFolder* FindClaimHolding(const fs::path& path, bool orRoot = false) {
+    ClaimedFolder* found = nullptr;
     for (ClaimedFolder& claim : gClaimed)
-        if (!InsideRelative(claim.root, path).empty()) return &claim;
-    return nullptr;
+        if ((!InsideRelative(claim.root, path).empty() || (orRoot && claim.root == path)) &&
+            (!found || claim.root.native().size() > found->root.native().size()))
+            found = &claim;
+    return found;
+}
+
+Error Cannot(const std::string& shown, int error) { return Error{shown + ": cannot write: " + std::strerror(error)}; }
+
+// Whether `name` in the folder `dirFd` is a symbolic link (the name itself, not what it points to).
+bool IsLinkAt(int dirFd, const std::string& name) {
+    struct stat info {};
+    return fstatat(dirFd, name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && S_ISLNK(info.st_mode);
+}
+
+// Opens the folders of `relative` (plain names: no "." or "..") below `from`, one name at a time, never
+// following a link; creates each missing one first when `create`. `absent` is set when, without `create`,
+// a folder on the way does not exist or is not a folder (then nothing below it exists either).
+Result<OpenFolder> WalkDown(OpenFolder from, const fs::path& relative, bool create, bool& absent) {
+    absent = false;
+    OpenFolder current = std::move(from);
+    for (const fs::path& part : relative) {
+        const std::string name = part.string();
+        if (name.empty() || name == ".") continue;
+        const std::string shown = current.ShownChild(name);
+        int fd = openat(current.Fd(), name.c_str(), kFolderFlags);
+        if (fd < 0 && errno == ENOENT && create) {
+            if (mkdirat(current.Fd(), name.c_str(), 0777) != 0 && errno != EEXIST)
+                return std::unexpected(Cannot(shown, errno));
+            fd = openat(current.Fd(), name.c_str(), kFolderFlags);
+        }
+        if (fd < 0) {
+            const int error = errno;
+            if (IsLinkAt(current.Fd(), name)) return std::unexpected(LinkRefused(shown));
+            absent = !create && (error == ENOENT || error == ENOTDIR);
+            return std::unexpected(Cannot(shown, error));
+        }
+        current = OpenFolder(fd, shown);
+    }
+    return current;
 }
 
 Result<std::string> ReadWhole(int fd, const std::string& name) {
@@ -100,17 +145,35 @@ std::vector<JournalEntry> ParseJournal(const std::string& text) {
     return entries;
 }
 
-// Removes `path` (a file or a link, never a folder); a missing file is not an error.
-Status RemoveIfPresent(const std::string& path) {
-    if (unlink(path.c_str()) == 0 || errno == ENOENT) return {};
-    return MakeError(path + ": cannot remove the previous run's file: " + std::strerror(errno));
+// Removes the file the journal entry `relative` names below `root`, walking down without following links. A
+// folder on the way that is gone (or is a file) leaves nothing to remove; a folder at the name itself is not the
+// file the journal recorded: it is left in place with a warning (the journal lists only files), so a folder put
+// there later never blocks every later run.
+Status RemoveJournalled(const OpenFolder& root, const std::string& relative) {
+    const fs::path path(relative);
+    bool absent = false;
+    auto folder = WalkDown(OpenFolder(fcntl(root.Fd(), F_DUPFD_CLOEXEC, 0), root.Shown()), path.parent_path(),
+                           /*create=*/false, absent);
+    if (!folder && absent) return {};
+    if (!folder) return std::unexpected(folder.error());
+    const std::string name = path.filename().string();
+    Status removed = RemoveFileAt(*folder, name, "the previous run's file");
+    struct stat info {};
+    if (!removed && fstatat(folder->Fd(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && S_ISDIR(info.st_mode)) {
+        std::fprintf(stderr,
+                     "warning: %s: a folder where the previous run wrote a file; left in place (the journal lists "
+                     "only files)\n",
+                     folder->ShownChild(name).c_str());
+        return {};
+    }
+    return removed;
 }
 
 // Removes what the previous journal lists: the placed JSON outputs first (they
 // name the other files, so a removal cut short never leaves one naming a file
 // already gone), then the other placed files, then every temporary name, then
 // the folders that removal left empty.
-Status RemovePreviousOutputs(const std::string& dir, const std::vector<JournalEntry>& entries) {
+Status RemovePreviousOutputs(const OpenFolder& root, const std::vector<JournalEntry>& entries) {
     std::vector<std::string> placed, temporaries;
     std::set<std::string> seenPlaced, seenTemporary;
     for (const JournalEntry& e : entries) {
@@ -119,15 +182,23 @@ Status RemovePreviousOutputs(const std::string& dir, const std::vector<JournalEn
     }
     std::stable_partition(placed.begin(), placed.end(),
                           [](const std::string& r) { return fs::path(r).extension() == ".json"; });
-    for (const std::string& relative : placed) CB_TRY(RemoveIfPresent(dir + "/" + relative));
+    for (const std::string& relative : placed) CB_TRY(RemoveJournalled(root, relative));
     std::set<std::string, std::greater<>> folders;  // deepest first
     for (const std::string& relative : temporaries) {
-        CB_TRY(RemoveIfPresent(TemporaryNameOf(dir + "/" + relative)));
+        CB_TRY(RemoveJournalled(root, TemporaryNameOf(relative)));
         for (fs::path parent = fs::path(relative).parent_path(); parent.has_relative_path();
              parent = parent.parent_path())
             folders.insert(parent.generic_string());
     }
-    for (const std::string& folder : folders) rmdir((dir + "/" + folder).c_str());  // only when empty
+    // Only folders left empty go (AT_REMOVEDIR removes no other); one that is now a link is never followed.
+    for (const std::string& folder : folders) {
+        bool absent = false;
+        const fs::path path(folder);
+        auto parent = WalkDown(OpenFolder(fcntl(root.Fd(), F_DUPFD_CLOEXEC, 0), root.Shown()), path.parent_path(),
+                               /*create=*/false, absent);
+        if (parent && !IsLinkAt(parent->Fd(), path.filename().string()))
+            unlinkat(parent->Fd(), path.filename().c_str(), AT_REMOVEDIR);
+    }
     return {};
 }
 
@@ -145,7 +216,134 @@ std::string DescribeHolder(int lockFd) {
     return " (pid " + pid + ", " + command + ")";
 }
 
+// Opens (creating) the regular file `name` in `folder` for reading and writing, never through a link:
+// the lock and the journal, the two files cloudbench writes in place.
+Result<int> OpenInPlace(const OpenFolder& folder, const std::string& name, int flags) {
+    const std::string shown = folder.ShownChild(name);
+    const int fd = openat(folder.Fd(), name.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC | flags,
+                          0644);
+    if (fd < 0) {
+        const int error = errno;
+        if (error == ELOOP || IsLinkAt(folder.Fd(), name)) return std::unexpected(LinkRefused(shown));
+        return std::unexpected(Cannot(folder.Shown(), error));
+    }
+    struct stat info {};
+    if (fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+        close(fd);
+        return MakeError(shown + ": not a regular file; cloudbench keeps its " +
+                         (name == kLockName ? "lock" : "journal") + " there (remove it)");
+    }
+    return fd;
+}
+
 }  // namespace
+
+OpenFolder::~OpenFolder() {
+    if (mFd >= 0) close(mFd);
+}
+
+OpenFolder& OpenFolder::operator=(OpenFolder&& other) noexcept {
+    if (this != &other) {
+        if (mFd >= 0) close(mFd);
+        mFd = other.mFd;
+        mShown = std::move(other.mShown);
+        other.mFd = -1;
+    }
+    return *this;
+}
+
+std::string OpenFolder::ShownChild(std::string_view name) const {
+    if (mShown.empty() || mShown == ".") return std::string(name);
+    return mShown + (mShown.back() == '/' ? "" : "/") + std::string(name);
+}
+
+Error LinkRefused(const std::string& shown) {
+    return Error{shown + ": is a symbolic link; cloudbench does not write through links (remove it)"};
+}
+
+Result<OpenFolder> OpenFolderForWriting(const std::string& dir, bool create) {
+    const fs::path target = Normal(dir);
+    std::optional<OpenFolder> root;
+    fs::path relative;
+    {
+        std::lock_guard guard(gMutex);
+        if (ClaimedFolder* claim = FindClaimHolding(target, /*orRoot=*/true)) {
+            const int fd = fcntl(claim->rootFd, F_DUPFD_CLOEXEC, 0);
+            if (fd < 0) return std::unexpected(Cannot(claim->dir, errno));
+            root.emplace(fd, claim->dir);
+            relative = InsideRelative(claim->root, target);
+        }
+    }
+    bool absent = false;
+    if (root) return WalkDown(std::move(*root), relative, create, absent);
+    // A folder the user named (or the folder of a file the user named): its path is followed as given.
+    const std::string shown = dir.empty() ? "." : dir;
+    if (create) {
+        std::error_code ec;
+        fs::create_directories(shown, ec);
+        if (ec) return std::unexpected(Cannot(shown, ec.value()));
+    }
+    const int fd = open(shown.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return std::unexpected(Cannot(shown, errno));
+    return OpenFolder(fd, shown);
+}
+
+Status RefuseLinkAt(const OpenFolder& folder, const std::string& name) {
+    if (IsLinkAt(folder.Fd(), name)) return std::unexpected(LinkRefused(folder.ShownChild(name)));
+    return {};
+}
+
+Status RemoveFileAt(const OpenFolder& folder, const std::string& name, std::string_view what) {
+    const std::string shown = folder.ShownChild(name);
+    auto cannot = [&](const std::string& why) {
+        return MakeError(shown + ": cannot remove " + std::string(what) + ": " + why);
+    };
+    struct stat info {};
+    if (fstatat(folder.Fd(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) != 0)
+        return errno == ENOENT ? Status{} : cannot(std::strerror(errno));
+    if (S_ISLNK(info.st_mode)) return std::unexpected(LinkRefused(shown));
+    if (S_ISDIR(info.st_mode)) return cannot("it is a folder");
+    // A name swapped for a link since the check is removed as a name: unlinkat never follows it.
+    if (unlinkat(folder.Fd(), name.c_str(), 0) != 0 && errno != ENOENT) return cannot(std::strerror(errno));
+    return {};
+}
+
+Status RemoveTreeAt(const OpenFolder& folder, const std::string& name) {
+    const std::string shown = folder.ShownChild(name);
+    auto cannot = [&](int error) { return MakeError(shown + ": cannot remove: " + std::strerror(error)); };
+    struct stat info {};
+    if (fstatat(folder.Fd(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) != 0)
+        return errno == ENOENT ? Status{} : cannot(errno);
+    if (S_ISLNK(info.st_mode)) return std::unexpected(LinkRefused(shown));
+    if (!S_ISDIR(info.st_mode)) {
+        if (unlinkat(folder.Fd(), name.c_str(), 0) != 0 && errno != ENOENT) return cannot(errno);
+        return {};
+    }
+    const int fd = openat(folder.Fd(), name.c_str(), kFolderFlags);
+    if (fd < 0) return IsLinkAt(folder.Fd(), name) ? std::unexpected(LinkRefused(shown)) : cannot(errno);
+    OpenFolder inside(fd, shown);
+    const int listFd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+    DIR* list = listFd >= 0 ? fdopendir(listFd) : nullptr;
+    if (!list) {
+        if (listFd >= 0) close(listFd);
+        return cannot(errno);
+    }
+    std::vector<std::string> names;
+    while (const dirent* entry = readdir(list))
+        if (std::strcmp(entry->d_name, ".") != 0 && std::strcmp(entry->d_name, "..") != 0)
+            names.emplace_back(entry->d_name);
+    closedir(list);
+    for (const std::string& child : names) {
+        // A link inside is removed as a name (unlinkat), never followed.
+        if (IsLinkAt(inside.Fd(), child)) {
+            if (unlinkat(inside.Fd(), child.c_str(), 0) != 0 && errno != ENOENT) return cannot(errno);
+            continue;
+        }
+        CB_TRY(RemoveTreeAt(inside, child));
+    }
+    if (unlinkat(folder.Fd(), name.c_str(), AT_REMOVEDIR) != 0 && errno != ENOENT) return cannot(errno);
+    return {};
+}
 
 std::string TemporaryNameOf(const std::string& path) {
     const fs::path target(path);
@@ -159,38 +357,46 @@ Status ClaimOutputFolder(const std::string& dir, std::string_view command) {
     if (FindClaim(root)) return {};
     auto cannot = [&](int error) { return MakeError(dir + ": cannot write: " + std::strerror(error)); };
 
-    const std::string lockPath = dir + "/" + kLockName;
-    const int lockFd = open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (lockFd < 0) return cannot(errno);
-    while (flock(lockFd, LOCK_EX | LOCK_NB) != 0) {
+    // The folder itself is opened by the name the user gave, following links in it: the user named it.
+    // Every name below it is then opened from this descriptor, without following links.
+    const int rootFd = open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (rootFd < 0) return cannot(errno);
+    const OpenFolder folder(fcntl(rootFd, F_DUPFD_CLOEXEC, 0), dir);
+    auto lockFd = OpenInPlace(folder, kLockName, 0);
+    if (!lockFd) {
+        close(rootFd);
+        return std::unexpected(lockFd.error());
+    }
+    while (flock(*lockFd, LOCK_EX | LOCK_NB) != 0) {
         if (errno == EINTR) continue;
         const int error = errno;
-        const std::string holder = error == EWOULDBLOCK ? DescribeHolder(lockFd) : "";
-        close(lockFd);
+        const std::string holder = error == EWOULDBLOCK ? DescribeHolder(*lockFd) : "";
+        close(*lockFd);
+        close(rootFd);
         if (error == EWOULDBLOCK) return MakeError(dir + ": in use by another cloudbench command" + holder);
         return MakeError(dir + ": cannot lock " + kLockName + ": " + std::strerror(error));
     }
     // Who holds it, for the message of a command that finds it locked; informative only, so a
     // failure here (a full disk) is not an error.
     const std::string holder = std::to_string(getpid()) + " " + std::string(command) + "\n";
-    if (ftruncate(lockFd, 0) == 0) (void)!pwrite(lockFd, holder.data(), holder.size(), 0);
+    if (ftruncate(*lockFd, 0) == 0) (void)!pwrite(*lockFd, holder.data(), holder.size(), 0);
 
-    ClaimedFolder claim{root, dir, lockFd, -1, dir + "/.cloudbench-" + std::string(command) + ".files"};
-    claim.journalFd = open(claim.journalPath.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-    if (claim.journalFd < 0) {
-        const int error = errno;
-        close(lockFd);
-        return cannot(error);
-    }
+    const std::string journalName = ".cloudbench-" + std::string(command) + ".files";
+    ClaimedFolder claim{root, dir, rootFd, *lockFd, -1, folder.ShownChild(journalName)};
     auto fail = [&](Error error) -> Status {
-        close(claim.journalFd);
-        close(lockFd);
+        if (claim.journalFd >= 0) close(claim.journalFd);
+        close(claim.lockFd);
+        close(claim.rootFd);
         return std::unexpected(std::move(error));
     };
+    auto journalFd = OpenInPlace(folder, journalName, O_APPEND);
+    if (!journalFd) return fail(journalFd.error());
+    claim.journalFd = *journalFd;
     auto previous = ReadWhole(claim.journalFd, claim.journalPath);
     if (!previous) return fail(previous.error());
     // The journal is emptied only once every file it lists is gone: a claim cut short by a kill is redone.
-    if (Status removed = RemovePreviousOutputs(dir, ParseJournal(*previous)); !removed) return fail(removed.error());
+    if (Status removed = RemovePreviousOutputs(folder, ParseJournal(*previous)); !removed)
+        return fail(removed.error());
     if (ftruncate(claim.journalFd, 0) != 0) return fail(cannot(errno).error());
     gClaimed.push_back(std::move(claim));
     return {};

@@ -13,6 +13,7 @@
 #include "core/MemoryPlan.h"
 #include "core/Npy.h"
 #include "harness/OutputFolder.h"
+#include "harness/PosixIo.h"
 
 namespace cb {
 namespace fs = std::filesystem;
@@ -30,9 +31,8 @@ std::string_view BackendStatusName(BackendStatus status) {
 }
 
 Status MakeFolder(const std::string& dir) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) return MakeError(dir + ": cannot create the output folder: " + ec.message());
+    auto folder = OpenFolderForWriting(dir, /*create=*/true);
+    if (!folder) return std::unexpected(folder.error());
     return {};
 }
 
@@ -64,19 +64,19 @@ Result<Scene> Session::LoadVariant(std::span<const SceneOverride> extra) const {
 }
 
 Status CheckWritableFolder(const std::string& dir) {
+    auto folder = OpenFolderForWriting(dir, /*create=*/true);
+    if (!folder) return std::unexpected(folder.error());
     auto cannot = [&](int error) { return MakeError(dir + ": cannot write: " + std::strerror(error)); };
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) return cannot(ec.value());
     // A probe file proves that files can be created, written and removed here.
-    const std::string probe = dir + "/.cloudbench-probe-" + std::to_string(getpid());
-    const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const std::string probe = ".cloudbench-probe-" + std::to_string(getpid());
+    CB_TRY(RemoveFileAt(*folder, probe, "a stale probe file"));
+    const int fd = openat(folder->Fd(), probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0) return cannot(errno);
     const char byte = 0;
     const bool wrote = write(fd, &byte, 1) == 1;
     int error = wrote ? 0 : errno;
     if (close(fd) != 0 && error == 0) error = errno;
-    if (unlink(probe.c_str()) != 0 && error == 0) error = errno;
+    if (unlinkat(folder->Fd(), probe.c_str(), 0) != 0 && error == 0) error = errno;
     if (error != 0) return cannot(error);
     return {};
 }
@@ -157,55 +157,73 @@ std::string ReplaceAll(std::string text, const std::string& from, const std::str
 // Checks a finished temporary file before it is renamed into place: it must be
 // a regular file whose data reach the disk (fsync), and a .npy must read back
 // whole, which catches a write lost in a stream's final flush. Errors name `path`.
-Status CheckFinished(const std::string& temp, const std::string& path) {
+Status CheckFinished(const Session::TemporaryFile& temp, const std::string& path) {
     auto cannot = [&](const std::string& why) { return MakeError(path + ": cannot write: " + why); };
-    const int fd = open(temp.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return cannot(std::strerror(errno));
     struct stat info {};
-    int error = fstat(fd, &info) != 0 ? errno : 0;
-    const bool regular = error == 0 && S_ISREG(info.st_mode);
-    if (regular && fsync(fd) != 0) error = errno;
-    close(fd);
-    if (error != 0) return cannot(std::strerror(error));
-    if (!regular) return cannot("the temporary file is not a regular file");
+    if (fstat(temp.fd, &info) != 0) return cannot(std::strerror(errno));
+    if (!S_ISREG(info.st_mode)) return cannot("the temporary file is not a regular file");
+    if (fsync(temp.fd) != 0) return cannot(std::strerror(errno));
     if (fs::path(path).extension() == ".npy")
-        if (auto back = ReadNpy(temp); !back)
-            return cannot("it does not read back whole (" + ReplaceAll(back.error().message, temp, path) + ")");
+        if (auto back = ReadNpy(temp.path); !back)
+            return cannot("it does not read back whole (" + ReplaceAll(back.error().message, temp.path, path) + ")");
     return {};
 }
 
-// Whether the file system holding `folder` has no block left for an unprivileged writer.
-bool FileSystemFull(const fs::path& folder) {
+// Whether the file system holding the folder `fd` has no block left for an unprivileged writer.
+bool FileSystemFull(int fd) {
     struct statvfs info {};
-    return statvfs((folder.empty() ? fs::path(".") : folder).c_str(), &info) == 0 && info.f_bavail == 0;
+    return fstatvfs(fd, &info) == 0 && info.f_bavail == 0;
 }
 
 }  // namespace
 
-Status Session::WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write) {
+Status Session::WriteAtomically(const std::string& path, const std::function<Status(const TemporaryFile&)>& write) {
     const fs::path target(path);
+    const std::string name = target.filename().string();
+    if (name.empty() || name == "." || name == "..") return MakeError(path + ": cannot write: not a file name");
     // Same folder (so the rename cannot cross file systems), same extension (image writers go by it).
-    const std::string temp = TemporaryNameOf(path);
+    const std::string tempName = TemporaryNameOf(name);
     CB_TRY(RecordOutput(path, OutputEvent::Writing));  // the output folder's journal (harness/OutputFolder.h)
+    auto folder = OpenFolderForWriting(target.parent_path().string(), /*create=*/false);
+    if (!folder) return std::unexpected(folder.error());
+    CB_TRY(RefuseLinkAt(*folder, name));
+    // A temporary file left by a killed write is removed (a link there is refused), then the new one is
+    // created exclusively: O_EXCL fails on any name already there, a link included, so nothing is opened
+    // through a link planted after the removal.
+    CB_TRY(RemoveFileAt(*folder, tempName, "a stale temporary file"));
+    TemporaryFile temp;
+    temp.fd = openat(folder->Fd(), tempName.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (temp.fd < 0) {
+        const int error = errno;
+        if (Status link = RefuseLinkAt(*folder, tempName); !link) return link;
+        return MakeError(path + ": cannot write: " + std::strerror(error));
+    }
+    temp.path = "/proc/self/fd/" + std::to_string(temp.fd);
     errno = 0;
     Status written = write(temp);
     const int writeErrno = errno;  // what the failed system call said, when the writer does not say it
     if (written) written = CheckFinished(temp, path);
-    std::error_code ec;
+    // The temporary name must still be the file created above: what took its place since (a link) is never
+    // renamed into place.
+    struct stat mine {}, named {};
+    if (written && (fstat(temp.fd, &mine) != 0 ||
+                    fstatat(folder->Fd(), tempName.c_str(), &named, AT_SYMLINK_NOFOLLOW) != 0 ||
+                    mine.st_ino != named.st_ino || mine.st_dev != named.st_dev))
+        written = MakeError(path + ": cannot write: its temporary file " + folder->ShownChild(tempName) +
+                            " was replaced while it was written");
+    if (close(temp.fd) != 0 && written) written = MakeError(path + ": cannot write: " + std::strerror(errno));
     if (written) written = RecordOutput(path, OutputEvent::Placing);
-    if (written) {
-        fs::rename(temp, target, ec);
-        if (ec) {
-            (void)RecordOutput(path, OutputEvent::NotPlaced);
-            written = MakeError(path + ": cannot move the finished file into place: " + ec.message());
-        }
+    if (written && renameat(folder->Fd(), tempName.c_str(), folder->Fd(), name.c_str()) != 0) {
+        const int error = errno;
+        (void)RecordOutput(path, OutputEvent::NotPlaced);
+        written = MakeError(path + ": cannot move the finished file into place: " + std::strerror(error));
     }
     if (!written) {
-        fs::remove(temp, ec);  // the old file, if any, stays as it was
-        std::string message = ReplaceAll(written.error().message, temp, path);
+        unlinkat(folder->Fd(), tempName.c_str(), 0);  // the old file, if any, stays as it was
+        std::string message = ReplaceAll(written.error().message, temp.path, path);
         // A library writer (OIIO) may fail without saying why, and leave a stale errno from
         // an unrelated call: a full file system is checked first, and named as such.
-        const int reason = FileSystemFull(target.parent_path()) ? ENOSPC : writeErrno;
+        const int reason = FileSystemFull(folder->Fd()) ? ENOSPC : writeErrno;
         if (reason != 0 && message.find(std::strerror(reason)) == std::string::npos)
             message += std::string(": ") + std::strerror(reason);
         return MakeError(message);
@@ -214,21 +232,8 @@ Status Session::WriteAtomically(const std::string& path, const std::function<Sta
 }
 
 Status Session::WriteText(const std::string& path, const std::string& text) {
-    return WriteAtomically(path, [&](const std::string& temp) -> Status {
-        auto cannot = [&](int error) { return MakeError(path + ": cannot write: " + std::strerror(error)); };
-        const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-        if (fd < 0) return cannot(errno);
-        for (size_t done = 0; done < text.size();) {
-            const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-            if (n < 0 && errno == EINTR) continue;
-            if (n <= 0) {
-                const int error = n < 0 ? errno : EIO;
-                close(fd);
-                return cannot(error);
-            }
-            done += size_t(n);
-        }
-        if (close(fd) != 0) return cannot(errno);
+    return WriteAtomically(path, [&](const TemporaryFile& temp) -> Status {
+        if (!WriteAll(temp.fd, text)) return MakeError(path + ": cannot write: " + std::strerror(errno));
         return {};
     });
 }
@@ -244,7 +249,8 @@ Status Session::WriteNpy(const std::string& path, Backend& backend, const Buffer
     const Extent3 e = buffer.Extent();
     const uint64_t shape[3] = {e.nz, e.ny, e.nx};
     const NpyType type = buffer.Format() == BufferFormat::F32 ? NpyType::F32 : NpyType::U8;
-    return WriteAtomically(path, [&](const std::string& temp) { return cb::WriteNpy(temp, type, shape, data); });
+    return WriteAtomically(path,
+                           [&](const TemporaryFile& temp) { return cb::WriteNpy(temp.fd, path, type, shape, data); });
 }
 
 nlohmann::json Session::Provenance() const {

@@ -67,13 +67,26 @@ class Session {
     std::vector<OpenedBackend> OpenBackends(const std::vector<std::string>& names, const Scene* scene = nullptr,
                                             bool report = true);
 
-    // Writes `path` through `write`, which is given a temporary name in the
-    // same folder with the same extension (".<stem>.partial<ext>"). The
-    // finished file is checked (a regular file, fsync'ed; a .npy reads back
-    // whole) and renamed to `path`. On any failure the temporary file is
-    // removed, `path` keeps its old contents, and the error names `path` (never
-    // the temporary name) and the system's reason (strerror of errno).
-    static Status WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write);
+    // The temporary file a writer fills. `fd` is open for reading and writing at
+    // offset 0 (owned by WriteAtomically); `path` is "/proc/self/fd/N" of that
+    // descriptor, for a library that opens by name (OpenImageIO, a child
+    // process): opening it opens this same file, so no link planted under the
+    // temporary name can redirect the library's write (docs/results.md#output-folders).
+    struct TemporaryFile {
+        int fd = -1;
+        std::string path;
+    };
+    // Writes `path` through `write`, which is given the temporary file
+    // ".<stem>.partial<ext>" in the same folder, created exclusively
+    // (O_CREAT | O_EXCL | O_NOFOLLOW) in the folder's descriptor after a stale
+    // one is removed (OpenFolderForWriting, harness/OutputFolder.h: inside an
+    // output folder no link is followed). The finished file is checked (a
+    // regular file, fsync'ed; a .npy reads back whole) and renamed to `path`
+    // (renameat in the same folder). A symbolic link at `path` or at its
+    // temporary name is refused. On any failure the temporary file is removed,
+    // `path` keeps its old contents, and the error names `path` (never the
+    // temporary name) and the system's reason (strerror of errno).
+    static Status WriteAtomically(const std::string& path, const std::function<Status(const TemporaryFile&)>& write);
     // Errors read "PATH: cannot write: <strerror(errno)>".
     static Status WriteText(const std::string& path, const std::string& text);
     // Writes `doc` with a "provenance" block added.
@@ -99,10 +112,13 @@ class Session {
     std::vector<BackendProvenance> mBackends;
 };
 
-// Creates `dir` and its parents; the error names the folder and the reason.
+// Creates `dir` and its parents (inside a claimed output folder one name at a
+// time, refusing a link: OpenFolderForWriting); the error reads
+// "DIR: cannot write: <strerror(errno)>" or names the link.
 Status MakeFolder(const std::string& dir);
-// Creates `dir` and its parents, then creates, writes and removes a probe file
-// in it; the error reads "DIR: cannot write: <strerror(errno)>".
+// Creates `dir` and its parents, then creates (exclusively, never through a
+// link), writes and removes a probe file in it; the error reads
+// "DIR: cannot write: <strerror(errno)>".
 Status CheckWritableFolder(const std::string& dir);
 
 // Reads a buffer back in canonical form; adds the time it took to `timesMs` when given.

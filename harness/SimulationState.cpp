@@ -2,16 +2,19 @@
 
 #include <fcntl.h>
 #include <stdio.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "core/Npy.h"
+#include "harness/OutputFolder.h"
+#include "harness/PosixIo.h"
 #include "harness/SimulationStateDetail.h"
 #include "harness/Transfer.h"
 
@@ -24,14 +27,20 @@ using namespace simulation_state_detail;
 
 namespace {
 
-Status FsyncPath(const std::string& path, bool directory) {
-    const int fd = open(path.c_str(), (directory ? O_RDONLY | O_DIRECTORY : O_RDONLY) | O_CLOEXEC);
-    if (fd < 0) return MakeError(path + ": cannot write: " + std::strerror(errno));
-    const int rc = fsync(fd);
-    const int error = errno;
-    close(fd);
-    if (rc != 0) return MakeError(path + ": cannot write: " + std::strerror(error));
+Status FsyncFd(int fd, const std::string& shown) {
+    if (fsync(fd) != 0) return MakeError(shown + ": cannot write: " + std::strerror(errno));
     return {};
+}
+
+// Creates the file `name` in `folder` (exclusively, never through a link) and writes it through `write`.
+Status WriteNewFile(const OpenFolder& folder, const std::string& name, const std::function<Status(int)>& write) {
+    const std::string shown = folder.ShownChild(name);
+    const int fd = openat(folder.Fd(), name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) return MakeError(shown + ": cannot write: " + std::strerror(errno));
+    Status written = write(fd);
+    if (written) written = FsyncFd(fd, shown);
+    if (close(fd) != 0 && written) written = MakeError(shown + ": cannot write: " + std::strerror(errno));
+    return written;
 }
 
 json RasterJson(const std::vector<RasterEllipsoid>& list) {
@@ -206,56 +215,71 @@ Status WriteSimulationState(const SimulationState& state, const std::string& dir
     const fs::path target = fs::path(dir).lexically_normal();
     const std::string name = target.filename().string();
     if (name.empty() || name == "." || name == "..") return MakeError(dir + ": not a folder name to save a state as");
-    fs::path parent = target.parent_path();
-    if (parent.empty()) parent = ".";
-    std::error_code ec;
-    fs::create_directories(parent, ec);
-    if (ec) return MakeError(parent.string() + ": cannot create: " + ec.message());
+    // The folder that holds DIR is the user's (followed as named); DIR itself is replaced, so it is never
+    // followed: a link at DIR, at its temporary name or inside them is refused or removed as a name
+    // (harness/OutputFolder.h).
+    auto parent = OpenFolderForWriting(target.parent_path().string(), /*create=*/true);
+    if (!parent) return std::unexpected(parent.error());
+    CB_TRY(RefuseLinkAt(*parent, name));
+    struct stat info {};
+    const bool exists = fstatat(parent->Fd(), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0;
     // Never replace something that is not a saved state.
-    if (fs::exists(target, ec) &&
-        (!fs::is_directory(target, ec) || !fs::exists(target / std::string(kSimulationStateManifest), ec)))
-        return MakeError(dir + ": exists and is not a saved state (no " + std::string(kSimulationStateManifest) +
-                         "); not replaced");
-    const fs::path temp = parent / ("." + name + ".partial-" + std::to_string(getpid()));
-    fs::remove_all(temp, ec);
-    if (!fs::create_directory(temp, ec) || ec)
-        return MakeError(dir + ": cannot write: cannot create " + temp.string() + ": " + ec.message());
+    if (exists) {
+        struct stat manifest {};
+        const int fd = S_ISDIR(info.st_mode) ? openat(parent->Fd(), name.c_str(), O_RDONLY | O_DIRECTORY |
+                                                                                        O_NOFOLLOW | O_CLOEXEC)
+                                             : -1;
+        const bool saved = fd >= 0 && fstatat(fd, std::string(kSimulationStateManifest).c_str(), &manifest,
+                                              AT_SYMLINK_NOFOLLOW) == 0;
+        if (fd >= 0) close(fd);
+        if (!saved)
+            return MakeError(dir + ": exists and is not a saved state (no " + std::string(kSimulationStateManifest) +
+                             "); not replaced");
+    }
+    const std::string tempName = "." + name + ".partial-" + std::to_string(getpid());
+    CB_TRY(RemoveTreeAt(*parent, tempName));
+    const std::string tempShown = parent->ShownChild(tempName);
+    if (mkdirat(parent->Fd(), tempName.c_str(), 0777) != 0)
+        return MakeError(dir + ": cannot write: cannot create " + tempShown + ": " + std::strerror(errno));
     auto written = [&]() -> Status {
+        const int tempFd = openat(parent->Fd(), tempName.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+        if (tempFd < 0) return MakeError(dir + ": cannot write: " + tempShown + ": " + std::strerror(errno));
+        const OpenFolder temp(tempFd, tempShown);
         for (const SavedBuffer& b : state.buffers) {
-            const std::string path = (temp / FileOf(b.resource, b.role, b.camera)).string();
+            const std::string file = FileOf(b.resource, b.role, b.camera);
             const std::vector<uint64_t> shape = ShapeOf(b.extent);
             const NpyType type = b.format == BufferFormat::F32 ? NpyType::F32 : NpyType::U8;
-            CB_TRY(WriteNpy(path, type, shape, b.data));
-            CB_TRY(FsyncPath(path, false));
+            CB_TRY(WriteNewFile(temp, file,
+                                [&](int fd) { return WriteNpy(fd, temp.ShownChild(file), type, shape, b.data); }));
         }
         // The manifest last: a folder with a whole manifest has every buffer it lists.
-        const std::string manifest = (temp / std::string(kSimulationStateManifest)).string();
-        {
-            std::ofstream out(manifest, std::ios::binary);
-            out << ManifestOf(state).dump(1) << "\n";
-            if (!out.flush()) return MakeError(manifest + ": cannot write: " + std::strerror(errno));
-        }
-        CB_TRY(FsyncPath(manifest, false));
-        CB_TRY(FsyncPath(temp.string(), true));
-        if (fs::exists(target, ec)) {
-            // One atomic swap; the previous state then sits in `temp` and is removed.
-            if (renameat2(AT_FDCWD, temp.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0) {
+        const std::string manifest(kSimulationStateManifest);
+        CB_TRY(WriteNewFile(temp, manifest, [&](int fd) -> Status {
+            if (!WriteAll(fd, ManifestOf(state).dump(1) + "\n"))
+                return MakeError(temp.ShownChild(manifest) + ": cannot write: " + std::strerror(errno));
+            return {};
+        }));
+        CB_TRY(FsyncFd(temp.Fd(), tempShown));
+        if (exists) {
+            // One atomic swap; the previous state then sits in the temporary name and is removed.
+            if (renameat2(parent->Fd(), tempName.c_str(), parent->Fd(), name.c_str(), RENAME_EXCHANGE) != 0) {
                 if (errno != EINVAL && errno != ENOSYS)
                     return MakeError(dir + ": cannot replace the previous state: " + std::strerror(errno));
                 // A file system without RENAME_EXCHANGE: two renames (the old state survives as .old until the end).
-                const fs::path old = parent / ("." + name + ".old-" + std::to_string(getpid()));
-                fs::rename(target, old, ec);
-                if (!ec) fs::rename(temp, target, ec);
-                if (ec) return MakeError(dir + ": cannot replace the previous state: " + ec.message());
-                fs::remove_all(old, ec);
-                return FsyncPath(parent.string(), true);
+                const std::string old = "." + name + ".old-" + std::to_string(getpid());
+                CB_TRY(RemoveTreeAt(*parent, old));
+                if (renameat(parent->Fd(), name.c_str(), parent->Fd(), old.c_str()) != 0 ||
+                    renameat(parent->Fd(), tempName.c_str(), parent->Fd(), name.c_str()) != 0)
+                    return MakeError(dir + ": cannot replace the previous state: " + std::strerror(errno));
+                (void)RemoveTreeAt(*parent, old);
+                return FsyncFd(parent->Fd(), parent->Shown());
             }
-        } else if (std::rename(temp.c_str(), target.c_str()) != 0) {
+        } else if (renameat(parent->Fd(), tempName.c_str(), parent->Fd(), name.c_str()) != 0) {
             return MakeError(dir + ": cannot write: " + std::strerror(errno));
         }
-        return FsyncPath(parent.string(), true);
+        return FsyncFd(parent->Fd(), parent->Shown());
     }();
-    fs::remove_all(temp, ec);  // on success: the previous state, if any; on failure: the partial one
+    (void)RemoveTreeAt(*parent, tempName);  // on success: the previous state, if any; on failure: the partial one
     return written;
 }
 

@@ -3,7 +3,7 @@
 small tmpfs mounted in a private mount namespace (`unshare -rm`, or `unshare -m`
 as root); exits 77 (skipped) where neither may mount.
 
-usage: check_output_mounts.py CLOUDBENCH DIR full|readonly
+usage: check_output_mounts.py CLOUDBENCH DIR full|readonly|writers-full|writers-readonly|count
 
 full: (1) a run that fits into a 256 KiB tmpfs, with tiny frames; the disk is
   then filled, leaving 32 KiB; a run with the scene's real frames must exit 1
@@ -16,8 +16,20 @@ full: (1) a run that fits into a 256 KiB tmpfs, with tiny frames; the disk is
 readonly: a folder holding a results.json, then remounted read-only: a run into
   it, and into a new folder under it, exits 1 at once with
   "DIR: cannot write: Read-only file system"; the results.json is kept.
+writers-full, writers-readonly: the writers of the other commands, into a full
+  (nothing left) or a read-only tmpfs: perf compare --json, perf export --gbench,
+  perf history --json, report -o, merge (shards and histories) each exit 1 with
+  "PATH: cannot write: No space left on device" (or "Read-only file system")
+  naming the file or folder, and leave no temporary file. writers-full also
+  fills the disk so that sweep.json fits but sweep.png does not: sweep exits
+  1 with "DIR/sweep.png: cannot write: No space left on device", no Python
+  traceback, sweep.json and sweep.md written and no sweep.png.
+count: CLOUDBENCH is a build that counts (without -march=native, valgrind
+  installed; tests/exact.cmake): count --out FILE on a full and on a read-only
+  tmpfs exits 1 with "FILE: cannot write: <reason>".
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -157,14 +169,147 @@ def readonly(cli, work):
         fail("results.json changed on a read-only file system")
 
 
+def writer_inputs(cli, work, kind):
+    """What the writers read, made outside the tmpfs: a results.json, two sweep shards, a history."""
+    inputs = os.path.join(work, "inputs-" + kind)
+    shutil.rmtree(inputs, ignore_errors=True)
+    fast = ["--backend", "cpu", "--steps", "2", "--set", "warmup_steps=0", "--threads", "2", "--quiet"]
+    made = {"results": os.path.join(inputs, "run", "results.json"), "history": os.path.join(inputs, "history.jsonl"),
+            "shards": [os.path.join(inputs, "shard-%d" % i, "sweep.json") for i in (1, 2)]}
+    commands = [["run", "ci-small"] + fast + ["--out", os.path.dirname(made["results"])]]
+    commands += [["sweep", "ci-small", "--vary", "shade.resolution=1,2", "--shard", "%d/2" % i] + fast +
+                 ["--out", os.path.dirname(made["shards"][i - 1])] for i in (1, 2)]
+    os.makedirs(inputs)
+    suite = os.path.join(inputs, "suite.json")
+    with open(suite, "w") as f:
+        f.write('{"scenes": [{"scene": "ci-small", "set": ["steps=2", "warmup_steps=0"]}]}\n')
+    commands.append(["perf", "record", "--suite", suite, "--history", made["history"], "--backend", "cpu", "--quiet"])
+    for command in commands:
+        result = subprocess.run([cli] + command, capture_output=True, text=True, timeout=120)
+        if result.returncode != 0:
+            fail("%s exited %d: %s" % (" ".join(command), result.returncode, result.stderr))
+    return made
+
+
+def writers(cli, work, kind):
+    made = writer_inputs(cli, work, kind)
+    mount = os.path.join(work, "writers-" + kind)
+    mount_tmpfs(mount, "256k")
+    folder = os.path.join(mount, "out")
+    os.makedirs(folder)
+    reason = "No space left on device" if kind == "full" else "Read-only file system"
+    failed = []
+    if kind == "full":
+        fill(mount, 0)
+    else:
+        result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
+        if result.returncode != 0:
+            print("skipped: cannot remount read-only: " + result.stderr.strip())
+            sys.exit(SKIP)
+    cases = [
+        ("perf compare --json", os.path.join(folder, "compare.json"),
+         ["perf", "compare", made["results"], made["results"], "--json", os.path.join(folder, "compare.json")]),
+        ("perf export --gbench", os.path.join(folder, "gbench.json"),
+         ["perf", "export", "--gbench", os.path.join(folder, "gbench.json"), made["results"]]),
+        ("perf history --json", os.path.join(folder, "changes.json"),
+         ["perf", "history", made["history"], "--json", os.path.join(folder, "changes.json")]),
+        ("report -o", os.path.join(folder, "report.html"),
+         ["report", made["results"], "-o", os.path.join(folder, "report.html")]),
+        ("merge of shards", os.path.join(folder, "merged"),
+         ["merge"] + made["shards"] + ["--out", os.path.join(folder, "merged")]),
+        ("merge of histories", os.path.join(folder, "histories"),
+         ["merge", made["history"], "--out", os.path.join(folder, "histories")]),
+    ]
+    for name, path, command in cases:
+        result = subprocess.run([cli] + command, capture_output=True, text=True, timeout=120)
+        # The file, or for merge its folder or a file in it; "merge: " may come first.
+        named = re.compile(r"^(merge: )?%s(/[^/:]+)?: cannot write: %s$" % (re.escape(path), re.escape(reason)))
+        lines = [line for line in result.stderr.splitlines() if named.match(line)]
+        if result.returncode != 1 or not lines:
+            failed.append("%s: exit %d, stderr %r; expected exit 1 and a line '%s: cannot write: %s'"
+                          % (name, result.returncode, result.stderr, path, reason))
+            print("FAIL: " + failed[-1])
+        else:
+            print("%s: %s" % (name, lines[0]))
+    if output_checks.temporary_files(mount):
+        failed.append("temporary files left: %s" % output_checks.temporary_files(mount))
+    if kind == "full":
+        sweep_png_full(cli, work)
+    if failed:
+        fail("%d writer(s) did not say why" % len(failed))
+
+
+def sweep_png_full(cli, work):
+    """A disk with room for sweep.json and sweep.md but not sweep.png."""
+    plots = subprocess.run(["/usr/bin/python3", "-c", "import matplotlib"], capture_output=True).returncode == 0
+    if not plots:
+        print("no python3 with matplotlib: sweep promises no plot; sweep.png not checked")
+        return
+    mount = os.path.join(work, "sweep-full")
+    mount_tmpfs(mount, "256k")
+    folder = os.path.join(mount, "out")
+    # The lock, the journal and the probe take a page each; sweep.json (7 KiB for two points) two pages;
+    # sweep.md one. sweep.png (40 KiB) then finds no room.
+    fill(mount, 8 * 4096)
+    command = [cli, "sweep", "ci-small", "--vary", "shade.resolution=1,2", "--backend", "cpu", "--steps", "2",
+               "--set", "warmup_steps=0", "--threads", "2", "--quiet", "--out", folder]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    print("sweep with no room for sweep.png: exit %d\n%s" % (result.returncode, result.stderr.strip()))
+    expected = "%s/sweep.png: cannot write: No space left on device" % folder
+    problems = []
+    if result.returncode != 1:
+        problems.append("exit %d, expected 1" % result.returncode)
+    if expected not in result.stderr.splitlines():
+        problems.append("no line %r" % expected)
+    if "Traceback" in result.stderr:
+        problems.append("a Python traceback reached the user")
+    for name in ("sweep.json", "sweep.md"):
+        if not os.path.isfile(os.path.join(folder, name)):
+            problems.append("no %s" % name)
+    if os.path.exists(os.path.join(folder, "sweep.png")):
+        problems.append("a sweep.png was left")
+    if output_checks.temporary_files(folder):
+        problems.append("temporary files left: %s" % output_checks.temporary_files(folder))
+    if problems:
+        fail("; ".join(problems))
+    print("sweep.png: %s; sweep.json and sweep.md written" % expected)
+
+
+def count(cli, work):
+    for kind, reason in (("full", "No space left on device"), ("readonly", "Read-only file system")):
+        mount = os.path.join(work, "count-" + kind)
+        mount_tmpfs(mount, "64k")
+        if kind == "full":
+            fill(mount, 0)
+        else:
+            result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
+            if result.returncode != 0:
+                print("skipped: cannot remount read-only: " + result.stderr.strip())
+                sys.exit(SKIP)
+        path = os.path.join(mount, "count.json")
+        result = subprocess.run([cli, "count", "ci-small", "--steps", "2", "--set", "warmup_steps=1", "--quiet",
+                                 "--out", path], capture_output=True, text=True, timeout=300)
+        expected = "%s: cannot write: %s" % (path, reason)
+        if result.returncode != 1 or expected not in result.stderr.splitlines():
+            fail("count on a %s disk: exit %d, stderr %r; expected exit 1 and %r"
+                 % (kind, result.returncode, result.stderr, expected))
+        print("count --out on a %s disk: %s" % (kind, expected))
+
+
 def main():
-    if len(sys.argv) != 4 or sys.argv[3] not in ("full", "readonly"):
+    modes = ("full", "readonly", "writers-full", "writers-readonly", "count")
+    if len(sys.argv) != 4 or sys.argv[3] not in modes:
         sys.exit(__doc__)
     if not os.environ.get(INSIDE):
         reexec_in_namespace()
     cli, work = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(work, exist_ok=True)
-    {"full": full, "readonly": readonly}[sys.argv[3]](cli, work)
+    if sys.argv[3].startswith("writers-"):
+        writers(cli, work, sys.argv[3][len("writers-"):])
+    elif sys.argv[3] == "count":
+        count(cli, work)
+    else:
+        {"full": full, "readonly": readonly}[sys.argv[3]](cli, work)
     print("ok")
 
 

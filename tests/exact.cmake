@@ -91,3 +91,13 @@ print("record counts match count for", len(counted), "stages")' "$2" "$3"]=]
          ${exact_cli} ${CMAKE_CURRENT_BINARY_DIR}/exact-suite.json ${cli_out}/exact-history.jsonl ${cli_out}/count-a.json)
 set_tests_properties(Exact.PerfRecordCountsInstructions PROPERTIES FIXTURES_REQUIRED "exact_build;exact_counts"
                      DEPENDS Exact.CountCiSmallA TIMEOUT 300 PASS_REGULAR_EXPRESSION "record counts match count")
+
+# count --out FILE writes through the writer every command shares (Session::WriteText): a link at FILE or at its
+# temporary name is refused, and a full or read-only disk is named in the message (docs/results.md#output-folders).
+add_test(NAME Exact.CountOutputLinkRefused
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_output_links.py ${exact_cli} ${cli_out}/links count)
+add_test(NAME Exact.CountOutputDiskSaysWhy COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_output_mounts.py
+                                                  ${exact_cli} ${cli_out}/mounts count)
+set_tests_properties(Exact.CountOutputLinkRefused Exact.CountOutputDiskSaysWhy PROPERTIES FIXTURES_REQUIRED exact_build
+                     TIMEOUT 300 FAIL_REGULAR_EXPRESSION "FAIL: ")
+set_tests_properties(Exact.CountOutputDiskSaysWhy PROPERTIES SKIP_RETURN_CODE 77)

@@ -2,21 +2,29 @@
 """Plots a `cloudbench sweep` result: error against time, one series per backend,
 one panel per stage (shade, shadow; the two renderers render_march and
 render_splat share one "images" panel, one series per renderer x backend), the
-Pareto front marked. Usage: plot_sweep.py sweep.json sweep.png"""
+Pareto front marked.
+
+Usage: plot_sweep.py SWEEP_JSON OUT_PNG [NAME]
+NAME is how messages name OUT_PNG (cloudbench passes /proc/self/fd/3, the
+temporary file it opened, and the file's real name). On any failure the script
+prints one line on standard error, "plot_sweep.py: REASON" (a write that fails:
+"plot_sweep.py: NAME: cannot write: <strerror>"), never a traceback, and exits 1."""
 import json
 import sys
 
-import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+class Failure(Exception):
+    """A reason to stop, printed as the one line of the failure."""
 
 
-def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: plot_sweep.py SWEEP_JSON OUT_PNG")
-    with open(sys.argv[1]) as f:
-        doc = json.load(f)
+def plot(doc, source):
+    """The figure of the sweep `doc` (read from `source`), with matplotlib's Agg backend."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as e:
+        raise Failure("matplotlib cannot be imported: %s" % e)
     metric = doc["metric"]
     rows = [r for r in doc["rows"] if r["status"] == "ok"]
     renderers = ("render_march", "render_splat")
@@ -27,7 +35,7 @@ def main():
             else r["backend"]
     stages = [s for s in ("shade", "shadow", "images") if any(r["panel"] == s for r in rows)]
     if not stages:
-        sys.exit("plot_sweep.py: no measured rows in " + sys.argv[1])
+        raise Failure("no measured rows in " + source)
     fig, axes = plt.subplots(1, len(stages), figsize=(6.5 * len(stages), 5), squeeze=False)
     varied = [v["path"] for v in doc["vary"]]
     # One colour per backend in every panel.
@@ -61,8 +69,39 @@ def main():
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(sys.argv[2], dpi=110)
+    return fig
+
+
+def main():
+    if len(sys.argv) not in (3, 4):
+        print("usage: plot_sweep.py SWEEP_JSON OUT_PNG [NAME]", file=sys.stderr)
+        return 2
+    source, out = sys.argv[1], sys.argv[2]
+    shown = sys.argv[3] if len(sys.argv) == 4 else out
+    try:
+        try:
+            with open(source) as f:
+                doc = json.load(f)
+        except OSError as e:
+            raise Failure("%s: cannot read: %s" % (source, e.strerror or e))
+        except ValueError as e:
+            raise Failure("%s: not JSON: %s" % (source, e))
+        try:
+            fig = plot(doc, source)
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
+            raise Failure("%s: not a sweep.json this script reads (%s: %s)" % (source, type(e).__name__, e))
+        try:
+            fig.savefig(out, format="png", dpi=110)
+        except OSError as e:
+            raise Failure("%s: cannot write: %s" % (shown, e.strerror or e))
+    except Failure as e:
+        print("plot_sweep.py: %s" % e, file=sys.stderr)
+        return 1
+    except Exception as e:  # anything else still ends in one line, not a traceback
+        print("plot_sweep.py: %s: %s" % (type(e).__name__, e), file=sys.stderr)
+        return 1
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

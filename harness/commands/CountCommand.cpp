@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "harness/Session.h"
 #include "harness/Simulation.h"
@@ -72,9 +71,11 @@ int CountChild(const CommonOptions& options) {
             return kExitFailed;
         }
     }
-    std::ofstream out(options.outDir);
-    out << nlohmann::json{{"device", backend.Device()}}.dump() << "\n";
-    return out.good() ? kExitOk : kExitFailed;
+    if (Status s = Session::WriteText(options.outDir, nlohmann::json{{"device", backend.Device()}}.dump() + "\n"); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return kExitFailed;
+    }
+    return kExitOk;
 }
 
 int Count(const CommonOptions& options) {

@@ -52,8 +52,8 @@ Status WriteReferenceDump(const Simulation& sim, const std::string& dir, int thr
     if (!tracer) return std::unexpected(tracer.error());
     const ref::ReferenceParams p = MakeReferenceParams(scene, ref::RayStart::VoxelExit);
     auto write = [&](const std::string& path, const uint64_t(&shape)[3], const std::vector<float>& values) {
-        return Session::WriteAtomically(path, [&](const std::string& temp) {
-            return WriteNpy(temp, NpyType::F32, shape, std::as_bytes(std::span(values)));
+        return Session::WriteAtomically(path, [&](const Session::TemporaryFile& temp) {
+            return WriteNpy(temp.fd, path, NpyType::F32, shape, std::as_bytes(std::span(values)));
         });
     };
     if (wantT) CB_TRY(write(dir + "/T_ref.npy", {e.nz, e.ny, e.nx}, (*tracer)->Transmittance(p)));
@@ -61,7 +61,8 @@ Status WriteReferenceDump(const Simulation& sim, const std::string& dir, int thr
     return {};
 }
 
-// Writes every output of the simulation's current step into DIR/step_tttt/.
+// Writes every output of the simulation's current step into DIR/step_tttt/ (created, or opened, from the
+// output folder's descriptor without following a link: MakeFolder).
 Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOptions& options) {
     char folder[32];
     std::snprintf(folder, sizeof folder, "/step_%04u", s.CurrentStep());

@@ -238,9 +238,10 @@ int Merge(const CommonOptions& options) {
     for (const Input& input : inputs)
         if (input.kind != inputs.front().kind)
             return Fail("sweep files and histories mixed: " + inputs.front().path + " and " + input.path, kExitUsage);
-    std::error_code error;
-    std::filesystem::create_directories(options.outDir, error);
-    if (error) return Fail(options.outDir + ": cannot create: " + error.message(), kExitFailed);
+    // DIR is created and probed (a full or read-only disk is named before anything is written); links in
+    // its path are followed, since the user named it, and none at the names written in it (Session::WriteText).
+    if (Status writable = CheckWritableFolder(options.outDir); !writable)
+        return Fail(writable.error().message, kExitFailed);
     return inputs.front().kind == InputKind::Sweep ? MergeSweeps(inputs, options.outDir)
                                                    : MergeHistories(inputs, options.outDir);
 }

@@ -13,6 +13,7 @@
 #include "core/NamedValues.h"
 #include "core/ShownText.h"
 #include "harness/InputFormats.h"
+#include "harness/Session.h"
 #include "harness/perf/Spawn.h"
 
 namespace cb::perf_command {
@@ -62,21 +63,11 @@ std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& 
 }
 
 bool WriteJsonFile(const std::string& path, const json& doc) {
-    const std::string temporary = path + ".partial";
-    {
-        std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-        file << doc.dump(1) << "\n";
-        file.flush();
-        if (!file) {
-            std::fprintf(stderr, "%s: cannot write\n", path.c_str());
-            std::remove(temporary.c_str());
-            return false;
-        }
+    if (Status s = Session::WriteText(path, doc.dump(1) + "\n"); !s) {
+        std::fprintf(stderr, "%s\n", s.error().message.c_str());
+        return false;
     }
-    std::error_code ec;
-    fs::rename(temporary, path, ec);
-    if (ec) std::fprintf(stderr, "%s: cannot write: %s\n", path.c_str(), ec.message().c_str());
-    return !ec;
+    return true;
 }
 
 TemporaryFolder::TemporaryFolder() {

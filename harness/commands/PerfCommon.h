@@ -51,7 +51,9 @@ std::string Num(const char* format, double v);
 std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& name, double low, double high,
                                         double& value);
 
-// Writes `doc` to `path` whole: a temporary file in the same folder, renamed.
+// Writes `doc` to `path` whole (Session::WriteText: a temporary file in the same
+// folder, renamed; never through a link); on failure prints
+// "PATH: cannot write: <strerror>" and returns false.
 bool WriteJsonFile(const std::string& path, const json& doc);
 
 // A temporary folder for runs' outputs, removed when this goes out of scope.
