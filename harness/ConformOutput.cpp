@@ -232,9 +232,10 @@ Result<ConformBaseline> ParseConformBaseline(const std::string& file, const std:
         const std::string &stage = fields[first], &backend = fields[first + 1], &status = fields[first + 2];
         if (stage.empty()) return bad("empty stage");
         if (backend.empty()) return bad("empty backend");
-        // The names a conform row can hold: a stage, or "(all)" for a backend that was skipped whole.
+        // The names a conform row can hold: a stage, the density stage's cover, or "(all)" for a backend that was
+        // skipped whole.
         static const std::vector<std::string_view> kRowStages = [] {
-            std::vector<std::string_view> names = {"(all)"};
+            std::vector<std::string_view> names = {"(all)", kCoverRowStage};
             for (Stage s : kAllStages) names.push_back(StageName(s));
             return names;
         }();

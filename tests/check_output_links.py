@@ -251,6 +251,10 @@ def group_named():
                  lambda f: ["perf", "export", "--gbench", os.path.join(f, "gbench.json"), results])
     refused_case("perf history --json", "changes.json",
                  lambda f: ["perf", "history", history, "--json", os.path.join(f, "changes.json")])
+    suite = os.path.join(WORK, "inputs", "suite.json")
+    refused_case("perf record --history", "history.jsonl",
+                 lambda f: ["perf", "record", "--suite", suite, "--history", os.path.join(f, "history.jsonl"),
+                            "--backend", "cpu", "--quiet"])
 
 
 def group_count():

@@ -13,6 +13,7 @@
 #include <random>
 
 #include "core/ShownText.h"
+#include "harness/OutputFolder.h"
 #include "harness/PosixIo.h"
 
 namespace cb::perf {
@@ -37,14 +38,17 @@ Status AppendRecord(const std::string& path, const nlohmann::json& record) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    // Like every file the user names (docs/results.md, "Output folders"): its folder is followed, a link at its own
+    // name is refused, never appended through.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0 && errno == ELOOP) return std::unexpected(LinkRefused(path));
     if (fd < 0) return fail();
     std::string line = record.dump() + "\n";
     // A previous line cut short has no newline: end it, so this record stays readable.
     struct stat st {};
     if (::fstat(fd, &st) == 0 && st.st_size > 0) {
         char last = '\n';
-        const int reader = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        const int reader = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
         if (reader >= 0) {
             if (::pread(reader, &last, 1, st.st_size - 1) != 1) last = '\n';
             ::close(reader);
