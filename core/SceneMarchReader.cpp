@@ -120,12 +120,15 @@ void ReadLightning(const Json& root, Validator& check, LightningSettings& lightn
             std::max({lightning.color[0], lightning.color[1], lightning.color[2]}) * lightning.intensity;
         const double atGuard = brightest / (lightning.radius * lightning.radius);
         if (brightest > kMaxSingle)
-            check.Fail("lightning.intensity", "color * intensity (the light's radiance at 1 m) must be at most 1e+30 in "
-                                              "each channel, got " + FormatNumber(brightest));
+            check.Fail("lightning.intensity",
+                       "color * intensity (the light's radiance at 1 m) must be at most 1e+30 in "
+                       "each channel, got " +
+                           FormatNumber(brightest));
         else if (atGuard > kMaxSingle)
-            check.Fail("lightning.radius", "color * intensity / radius^2 (the light's radiance at its guard radius, the "
-                                           "most it reaches) must be at most 1e+30 in each channel, got " +
-                                               FormatNumber(atGuard));
+            check.Fail("lightning.radius",
+                       "color * intensity / radius^2 (the light's radiance at its guard radius, the "
+                       "most it reaches) must be at most 1e+30 in each channel, got " +
+                           FormatNumber(atGuard));
     }
     if (const Json* flash = check.Section(*section, "lightning", "flash", kFlashKeys)) {
         if (const Json* v = Validator::Find(*flash, "start")) {

@@ -347,7 +347,8 @@ void CheckLightningPosition(const Scene& scene, Validator& check) {
         if (!(std::fabs(edges) <= kMaxVoxelEdges))
             check.Fail(IndexField("lightning.position", c),
                        "(position - grid.origin) / grid.voxel_size (the light's distance from the grid in voxel "
-                       "edges) must be in [-1e+18, 1e+18], got " + FormatNumber(edges));
+                       "edges) must be in [-1e+18, 1e+18], got " +
+                           FormatNumber(edges));
     }
 }
 

@@ -123,7 +123,8 @@ bool CheckAzimuth(double degrees, const std::string& field, std::string_view whe
     if (std::fabs(degrees) <= kMaxAzimuthDeg) return true;
     check.Fail(field, "the azimuth must be in [-" + FormatNumber(kMaxAzimuthDeg) + ", " + FormatNumber(kMaxAzimuthDeg) +
                           "] degrees (beyond, double precision no longer fixes the sun's direction to float's "
-                          "precision), got " + FormatNumber(degrees) + std::string(where));
+                          "precision), got " +
+                          FormatNumber(degrees) + std::string(where));
     return false;
 }
 
@@ -260,12 +261,12 @@ void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
     // The peak bounds every P^ the stages form (core/Shading.h kMaxPhasePeak); only g moves it (Mie's is ~7400).
     const float peak = PhasePeak(phase);
     if (!(peak <= kMaxPhasePeak))
-        check.Fail("phase.g", "the phase function's peak P^max (P^ at cos theta = " +
-                                  std::string(phase.g < 0 ? "-1" : "1") +
-                                  ", in single precision as the stages evaluate it) must be at most " +
-                                  FormatNumber(kMaxPhasePeak) + " (2^18), got " + FormatNumber(peak) + " (" +
-                                  std::string(PhaseKindName(phase.kind)) + ", g = " +
-                                  (gValue ? Describe(*gValue) : FormatNumber(phase.g)) + ")");
+        check.Fail("phase.g",
+                   "the phase function's peak P^max (P^ at cos theta = " + std::string(phase.g < 0 ? "-1" : "1") +
+                       ", in single precision as the stages evaluate it) must be at most " +
+                       FormatNumber(kMaxPhasePeak) + " (2^18), got " + FormatNumber(peak) + " (" +
+                       std::string(PhaseKindName(phase.kind)) +
+                       ", g = " + (gValue ? Describe(*gValue) : FormatNumber(phase.g)) + ")");
 }
 
 void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {

@@ -214,7 +214,7 @@ inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
 // interpolation lies between two values), 1 for none. Near |g| = 1 the float
 // value is far from the exact (1 + g)/(1 - g)^2: the denominator 1 + g^2 - 2g
 // is a difference of numbers near 2, a multiple of 2^-23, and 0 (peak inf)
-// for |g| >= 1 - 2^-12 or so.
+// for most |g| within 3e-4 of 1 (the first at 0.999701).
 inline float PhasePeak(const PhaseParams& phase) {
     if (phase.kind == PhaseKind::Mie) {
         float peak = 0;

@@ -152,8 +152,13 @@ TEST(ExtremeInputs, RenderSplatWithTinyFovIsFinite) {
 TEST(ExtremeInputs, ShadePlanTapsWithinOneCellForAnySun) {
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
     const Extent3 e{16, 12, 8};
-    for (const Vec3& sun : std::vector<Vec3>{{nan, nan, 0.5f}, {nan, nan, nan}, {inf, 0, 0}, {-inf, inf, 1},
-                                             {0, 0, 0}, {1e-45f, -1e-45f, 0}, {0.3f, -0.8f, nan}}) {
+    for (const Vec3& sun : std::vector<Vec3>{{nan, nan, 0.5f},
+                                             {nan, nan, nan},
+                                             {inf, 0, 0},
+                                             {-inf, inf, 1},
+                                             {0, 0, 0},
+                                             {1e-45f, -1e-45f, 0},
+                                             {0.3f, -0.8f, nan}}) {
         for (SampleFilter filter : {SampleFilter::Bilinear, SampleFilter::Nearest}) {
             ShadeParams p;
             p.sun = sun;

@@ -384,7 +384,8 @@ TEST(SceneTest, SeveralErrorsTogether) {
 TEST(SceneTest, NoiseFrequencyMessageHasTheRealPower) {
     auto coverage = [](int octaves) {
         return ErrorOf(R"({"grid": {"size": [8, 8, 8]}, "stages": ["noise"],
-                           "noise": {"coverage": {"frequency": [1, 1], "octaves": )" + std::to_string(octaves) + "}}}");
+                           "noise": {"coverage": {"frequency": [1, 1], "octaves": )" +
+                       std::to_string(octaves) + "}}}");
     };
     const std::string reason = "times lacunarity^(octaves - 1) must be at most 4096 lattice cells, got ";
     EXPECT_TRUE(HasLine(coverage(14), "test.json: noise.coverage.frequency[0]: " + reason + "1 x 8192"));  // 2^13
@@ -395,7 +396,8 @@ TEST(SceneTest, NoiseFrequencyMessageHasTheRealPower) {
                                     "noise": {"frequency": [1, 2, 3], "lacunarity": 8, "octaves": 16}})"),
                         "test.json: noise.frequency[0]: " + reason + "1 x 35184372088832"));
     // 4096 x 2^0 is at the bound and accepted.
-    Parsed(R"({"grid": {"size": [8, 8, 8]}, "stages": ["noise"], "noise": {"coverage": {"frequency": [4096, 1], "octaves": 1}}})");
+    Parsed(R"({"grid": {"size": [8, 8, 8]}, "stages": ["noise"],
+               "noise": {"coverage": {"frequency": [4096, 1], "octaves": 1}}})");
 }
 
 }  // namespace

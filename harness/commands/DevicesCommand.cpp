@@ -46,9 +46,10 @@ void PrintGLContexts() {
         if (c.available) {
             std::printf("  %-7s %s: OpenGL %s\n", name.c_str(), c.renderer.c_str(), c.version.c_str());
             // Every buffer is a 2-D texture array, one layer per slice: an image's rows are its layers.
-            std::printf("  %-7s texture limits: %d x %d, %d layers (render.height and grid nz at most %d on it, "
-                        "render.width, grid nx and ny at most %d)\n",
-                        "", c.maxTextureSize, c.maxTextureSize, c.maxArrayLayers, c.maxArrayLayers, c.maxTextureSize);
+            std::printf(
+                "  %-7s texture limits: %d x %d, %d layers (render.height and grid nz at most %d on it, "
+                "render.width, grid nx and ny at most %d)\n",
+                "", c.maxTextureSize, c.maxTextureSize, c.maxArrayLayers, c.maxArrayLayers, c.maxTextureSize);
         } else
             std::printf("  %-7s unavailable: %s\n", name.c_str(), c.reason.c_str());
     }
