@@ -1,5 +1,6 @@
 // Readers of the ray marcher's sections: `march` (SPEC 10) and `lightning`
 // (seed 002 eq. 21). Fields, units and defaults: docs/scenes.md.
+#include <algorithm>
 #include <array>
 #include <string_view>
 
@@ -108,6 +109,26 @@ void ReadLightning(const Json& root, Validator& check, LightningSettings& lightn
     if (const Json* v = find("radius")) {
         // r0^2 must stay a normal float: 1e-15 m squared is still far above FLT_MIN.
         if (auto d = check.Number(*v, "lightning.radius", Range{.lo = 1e-15, .hi = 1e15})) lightning.radius = *d;
+    }
+    // The light's radiance in float: colour * intensity (radiance * m^2, as the kernel holds it), and
+    // colour * intensity / r0^2, the most it reaches (at the guard radius: the falloff is 1 / max(D^2, r0^2)), each
+    // at most the sun's bound 1e30. The light then adds at most 1e30 * 2^19.5 per sample (every P^ is at most
+    // 2^19.5, core/Shading.h kMaxPhasePeak), as the sun does; the sum over a ray stays finite (the derivation is
+    // ReadSun's). Colour 1e30 times intensity 1e30 was inf in float and made pixels inf on every backend.
+    if (lightning.enabled) {
+        const double brightest =
+            std::max({lightning.color[0], lightning.color[1], lightning.color[2]}) * lightning.intensity;
+        const double atGuard = brightest / (lightning.radius * lightning.radius);
+        if (brightest > kMaxSingle)
+            check.Fail("lightning.intensity",
+                       "color * intensity (the light's radiance at 1 m) must be at most 1e+30 in "
+                       "each channel, got " +
+                           FormatNumber(brightest));
+        else if (atGuard > kMaxSingle)
+            check.Fail("lightning.radius",
+                       "color * intensity / radius^2 (the light's radiance at its guard radius, the "
+                       "most it reaches) must be at most 1e+30 in each channel, got " +
+                           FormatNumber(atGuard));
     }
     if (const Json* flash = check.Section(*section, "lightning", "flash", kFlashKeys)) {
         if (const Json* v = Validator::Find(*flash, "start")) {

@@ -51,11 +51,15 @@ void ReadFbm(const Json& section, std::string_view parent, Validator& check, Fbm
 // frequency is bounded, and simplex tiles only on periods that are multiples of 3.
 void CheckFrequencies(const FbmSettings& fbm, const uint32_t* frequency, size_t axes, std::string_view field,
                       Validator& check) {
-    int64_t multiplier = 1;
-    for (uint32_t o = 1; o < fbm.octaves && multiplier <= kMaxLatticeFrequency; ++o) multiplier *= fbm.lacunarity;
+    // The real lacunarity^(octaves - 1) (it was capped at the first power past the bound, so the message said
+    // "1 x 8192" for any octaves from 14 on), at most 8^15 = 2^45, exact in 64 bits; its product with the
+    // frequency is compared in double, exact up to 2^53 and only rounded far past the bound.
+    uint64_t multiplier = 1;
+    for (uint32_t o = 1; o < fbm.octaves; ++o) multiplier *= fbm.lacunarity;
     for (size_t a = 0; a < axes; ++a) {
         const std::string name = axes > 1 ? IndexField(field, a) : std::string(field);
-        if (int64_t(frequency[a]) * multiplier > kMaxLatticeFrequency) {
+        const double product = double(frequency[a]) * double(multiplier);
+        if (product > double(kMaxLatticeFrequency)) {
             check.Fail(name, "times lacunarity^(octaves - 1) must be at most " + std::to_string(kMaxLatticeFrequency) +
                                  " lattice cells, got " + std::to_string(frequency[a]) + " x " +
                                  std::to_string(multiplier));

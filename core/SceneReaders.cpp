@@ -3,6 +3,7 @@
 #include "core/SceneReaders.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string_view>
@@ -333,15 +334,40 @@ void CheckOpticalDepths(const Scene& scene, Validator& check) {
                                   "depth per unit of D) must be at most 1e+30, got " + FormatNumber(perD));
 }
 
-// A sun moving at a constant speed must stay within [-90, 90] degrees of elevation over the run's steps.
+// The lightning's position in voxel edges, (position - origin) / h, as the kernel takes it (in float, core/March.h):
+// at most 1e18 from the grid's corner on each axis. A sample p lies in the box (edges of at most 2^32 voxels), so
+// |x_l - p|^2 <= 3 (1e18 + 2^32)^2 = 3e36 stays below float's 3.4e38; past about 1e19 it overflows to inf, and the
+// light march toward the light then steps inf * 0 = NaN.
+void CheckLightningPosition(const Scene& scene, Validator& check) {
+    constexpr double kMaxVoxelEdges = 1e18;
+    const LightningSettings& l = scene.lightning;
+    if (!l.enabled) return;
+    for (size_t c = 0; c < 3; ++c) {
+        const double edges = (l.position[c] - scene.grid.origin[c]) / scene.grid.voxelSize;
+        if (!(std::fabs(edges) <= kMaxVoxelEdges))
+            check.Fail(IndexField("lightning.position", c),
+                       "(position - grid.origin) / grid.voxel_size (the light's distance from the grid in voxel "
+                       "edges) must be in [-1e+18, 1e+18], got " +
+                           FormatNumber(edges));
+    }
+}
+
+// A sun moving at a constant speed must stay within [-90, 90] degrees of elevation over the run's steps, and its
+// azimuth within CheckAzimuth's bound (both are linear in the step: the last step is the farthest from step 0's).
 void CheckSunSpeed(const Scene& scene, Validator& check) {
     const SunSettings& sun = scene.sun;
-    if (!sun.path.empty() || sun.elevationSpeedDeg == 0) return;
+    if (!sun.path.empty()) return;
     const uint32_t last = scene.steps - 1;
-    const double el = sun.ElevationAt(last);
-    if (el < -90 || el > 90)
-        check.Fail("sun.speed.elevation_deg", "the elevation reaches " + FormatNumber(el) + " degrees at the last step (" +
-                                                  std::to_string(last) + "), outside [-90, 90]");
+    if (sun.elevationSpeedDeg != 0) {
+        const double el = sun.ElevationAt(last);
+        if (el < -90 || el > 90)
+            check.Fail("sun.speed.elevation_deg", "the elevation reaches " + FormatNumber(el) +
+                                                      " degrees at the last step (" + std::to_string(last) +
+                                                      "), outside [-90, 90]");
+    }
+    if (sun.azimuthSpeedDeg != 0)
+        CheckAzimuth(sun.AzimuthAt(last), "sun.speed.azimuth_deg", " at the last step (" + std::to_string(last) + ")",
+                     check);
 }
 
 }  // namespace
@@ -415,6 +441,7 @@ void ReadScene(const Json& root, const std::string& label, Validator& check, Sce
 
     if (stepsOk) CheckSunSpeed(scene, check);
     CheckOpticalDepths(scene, check);
+    CheckLightningPosition(scene, check);
 
     // Size checks, before anything grid-sized exists.
     if (!sizeOk) return;

@@ -34,6 +34,9 @@ void ReadDensity(const Json& root, Validator& check, DensitySettings& density);
 // Lighting and rendering sections (core/SceneRenderReaders.cpp).
 
 void ReadSun(const Json& root, Validator& check, SunSettings& sun);
+// True when the sun may take azimuth `degrees` (at most 1e9 in magnitude); otherwise fails `field` with the bound
+// and the value, `where` appended (e.g. " at the last step (29)").
+bool CheckAzimuth(double degrees, const std::string& field, std::string_view where, Validator& check);
 void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting);
 void ReadPhase(const Json& root, Validator& check, PhaseParams& phase);
 void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);

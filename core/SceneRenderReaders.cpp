@@ -28,6 +28,7 @@ constexpr std::string_view kGroundKeys[] = {"albedo"};
 constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
 
 constexpr int64_t kShadeResolutions[] = {1, 2, 4};
+
 constexpr int64_t kMaxImageEdge = 16384;
 constexpr int64_t kMaxFramesPerStep = 1024;
 
@@ -99,7 +100,33 @@ std::optional<CameraSettings> ReadCamera(const Json& value, const std::string& f
     return camera;
 }
 
+// An azimuth in degrees: finite, and within kMaxAzimuthDeg (CheckAzimuth).
+std::optional<double> ReadAzimuth(const Json& value, const std::string& field, Validator& check) {
+    std::optional<double> d = check.Number(value, field, kFinite);
+    if (d && !CheckAzimuth(*d, field, "", check)) return std::nullopt;
+    return d;
+}
+
 }  // namespace
+
+// The largest |azimuth| the sun may reach, in degrees. The code evaluates the
+// angle in double (a path's interpolation lo + (hi - lo) w, or the speed's
+// az + speed t; then times pi/180, core/Scene.h DirectionAt) and rounds cos and
+// sin to float. Those roundings cost at most 3 ulps of the angle in radians,
+// 3 * 2^-52 * 1e9 * pi/180 = 1.2e-8 rad here, below half an ulp of float at 1,
+// 2^-25 = 3.0e-8: the float direction is the angle's. Past about 2.6e9 degrees
+// it is not, and at 1e308 a path's hi - lo overflows to inf and the direction
+// becomes NaN.
+constexpr double kMaxAzimuthDeg = 1e9;
+
+bool CheckAzimuth(double degrees, const std::string& field, std::string_view where, Validator& check) {
+    if (std::fabs(degrees) <= kMaxAzimuthDeg) return true;
+    check.Fail(field, "the azimuth must be in [-" + FormatNumber(kMaxAzimuthDeg) + ", " + FormatNumber(kMaxAzimuthDeg) +
+                          "] degrees (beyond, double precision no longer fixes the sun's direction to float's "
+                          "precision), got " +
+                          FormatNumber(degrees) + std::string(where));
+    return false;
+}
 
 void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
     const Json* section = check.Section(root, "", "sun", kSunKeys);
@@ -108,7 +135,7 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
         if (auto d = check.Number(*v, "sun.elevation_deg", Range{.lo = -90, .hi = 90})) sun.elevationDeg = *d;
     }
     if (const Json* v = Validator::Find(*section, "azimuth_deg")) {
-        if (auto d = check.Number(*v, "sun.azimuth_deg", kFinite)) sun.azimuthDeg = *d;
+        if (auto d = ReadAzimuth(*v, "sun.azimuth_deg", check)) sun.azimuthDeg = *d;
     }
     if (const Json* v = Validator::Find(*section, "color")) {
         if (auto a = check.Numbers<3>(*v, "sun.color", kSingleNonNegative)) sun.color = *a;
@@ -151,7 +178,7 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
                 else
                     check.Fail(JoinField(field, "elevation_deg"), "required field is missing");
                 if (const Json* v = Validator::Find(k, "azimuth_deg"))
-                    az = check.Number(*v, JoinField(field, "azimuth_deg"), kFinite);
+                    az = ReadAzimuth(*v, JoinField(field, "azimuth_deg"), check);
                 else
                     check.Fail(JoinField(field, "azimuth_deg"), "required field is missing");
                 if (!step || !el || !az) {
@@ -187,7 +214,17 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
             }
         }
     }
-    // The radiance color * intensity is what the renderers use, in single precision.
+    // The radiance color * intensity is what the renderers use, in single precision. With it, the lightning's
+    // (ReadLightning), ambient and background each at most 1e30 and every P^ at most 2^19.5 (ReadPhase), every
+    // output stays finite (float's largest is 3.4e38):
+    //   a sample's light  sun T P^ powder + ambient + lightning T P^ / max(D^2, r0^2)
+    //                     <= 1e30 * 2^19.5 + 1e30 + 1e30 * 2^19.5 < 1.5e36 (T, powder <= 1);
+    //   a march pixel     L + T_view background, L = sum of T_n (1 - tau_n) * light_n: the float weights sum to at
+    //                     most 2 (each step's weight is at most twice the drop of the float T_view, which starts at
+    //                     1), and each float add of a positive x to a sum rounds it up by at most 2x, so
+    //                     L <= 6 * 1.5e36 and the pixel <= 9e36 + 1e30;
+    //   a splat pixel     a blend C (1 - a) + c a of the background (or the ground) and colours <= 7.5e35 + 1e30;
+    //   the ground        albedo (sun max(s_z, 0) G + ambient) <= 2e30.
     const double brightest = std::max({sun.color[0], sun.color[1], sun.color[2]}) * sun.intensity;
     if (brightest > kMaxSingle)
         check.Fail("sun.intensity", "color * intensity (the sun's radiance) must be at most 1e+30 in each channel, got " +
@@ -211,7 +248,8 @@ void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
     if (const Json* v = Validator::Find(*section, "function")) {
         if (auto kind = check.Choice(*v, "phase.function", kPhaseKindNames)) phase.kind = *kind;
     }
-    if (const Json* v = Validator::Find(*section, "g")) {
+    const Json* gValue = Validator::Find(*section, "g");
+    if (const Json* v = gValue) {
         if (auto d = check.Number(*v, "phase.g", Range{.lo = -1, .loOpen = true, .hi = 1, .hiOpen = true})) {
             // g is kept as a float: a value within 2^-25 of +-1 would become +-1 there.
             if (std::fabs(float(*d)) >= 1.0f)
@@ -220,6 +258,15 @@ void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
                 phase.g = float(*d);
         }
     }
+    // The peak bounds every P^ the stages form (core/Shading.h kMaxPhasePeak); only g moves it (Mie's is ~7400).
+    const float peak = PhasePeak(phase);
+    if (!(peak <= kMaxPhasePeak))
+        check.Fail("phase.g",
+                   "the phase function's peak P^max (P^ at cos theta = " + std::string(phase.g < 0 ? "-1" : "1") +
+                       ", in single precision as the stages evaluate it) must be at most " +
+                       FormatNumber(kMaxPhasePeak) + " (2^18), got " + FormatNumber(peak) + " (" +
+                       std::string(PhaseKindName(phase.kind)) +
+                       ", g = " + (gValue ? Describe(*gValue) : FormatNumber(phase.g)) + ")");
 }
 
 void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {

@@ -207,6 +207,40 @@ inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
     return 1.0f;
 }
 
+// The largest P^ over cos theta in [-1, 1] as PhaseValue evaluates it in float:
+// at cos = 1 for g >= 0 and at -1 for g < 0 (Henyey-Greenstein, Cornette-
+// Shanks: every rounding in PhaseValue is monotone in cos, and g -> -g,
+// cos -> -cos gives the same floats), the table's largest value for Mie (the
+// interpolation lies between two values), 1 for none. Near |g| = 1 the float
+// value is far from the exact (1 + g)/(1 - g)^2: the denominator 1 + g^2 - 2g
+// is a difference of numbers near 2, a multiple of 2^-23, and 0 (peak inf)
+// for most |g| within 3e-4 of 1 (the first at 0.999701).
+inline float PhasePeak(const PhaseParams& phase) {
+    if (phase.kind == PhaseKind::Mie) {
+        float peak = 0;
+        for (uint32_t i = 0; i < kMieCloudTable.count; ++i) peak = std::max(peak, kMieCloudTable.values[i]);
+        return peak;
+    }
+    const float forward = PhaseValue(phase, 1.0f), backward = PhaseValue(phase, -1.0f);
+    // NaN (never for |g| < 1, but a bound must not pass it) reads as infinite.
+    if (std::isnan(forward) || std::isnan(backward)) return std::numeric_limits<float>::infinity();
+    return std::max(forward, backward);
+}
+
+// The largest phase peak (PhasePeak) a scene may have: 2^18. The renderers
+// evaluate P^ at cos theta = s . d of unit vectors in float, which may round
+// past 1 (by 2 ulps of 1 in float on the CPU; the twins' GLSL division and
+// square root add a few more): bounds are made for |cos| up to 1 + 2^-19, 16
+// ulps. For Henyey-Greenstein and Cornette-Shanks the peak is about 2/d with
+// d = (1 - |g|)^2 the denominator at |cos| = 1, so a peak <= 2^18 keeps
+// d >= 2^-17, and cos = 1 + 2^-19 lowers d by 2|g| 2^-19 <= 2^-18, at most
+// half: no denominator reaches 0 (inf) or goes negative (NaN, from the square
+// root), and every P^ a renderer evaluates is at most 2^1.5 times the peak,
+// 2^19.5 < 7.5e5 (checked for every float g in [0.9, 1) whose peak passes:
+// FiniteBounds.PhasePeakBoundKeepsEveryCosineFinite). Shade's forward
+// scattering gain alpha_s P^(0) gamma / (4 pi) is then at most 2^18 too.
+inline constexpr float kMaxPhasePeak = 262144.0f;
+
 // ---- Per-slice attenuation (SPEC 6) --------------------------------------------
 
 enum class AttenuationKind : uint8_t { Beer, Thesis };
@@ -300,7 +334,11 @@ inline ShearWarp MakeShearWarp(const Vec3& s, SampleFilter filter) {
     g.v = g.w == 2 ? 1 : 2;
     g.absSw = std::fabs(s[g.w]);
     g.sunAbove = s[g.w] > 0;
-    const float du = s[g.u] / g.absSw, dv = s[g.v] / g.absSw;  // |du|, |dv| <= 1
+    // |du|, |dv| <= 1 since w is the largest component (a float quotient of |a| <= |b| is at most 1). Clamped all
+    // the same, NaN to 1 (fmin returns the number), so that the taps are -1, 0 or 1 for any s: the CPU sizes its
+    // scratch by them, and a NaN direction once gave int(floor(NaN)) = INT_MIN and rows for 2^31 cells.
+    const float du = std::fmax(-1.0f, std::fmin(s[g.u] / g.absSw, 1.0f));
+    const float dv = std::fmax(-1.0f, std::fmin(s[g.v] / g.absSw, 1.0f));
     if (filter == SampleFilter::Nearest) {
         g.u0 = int(std::floor(du + 0.5f));
         g.v0 = int(std::floor(dv + 0.5f));

@@ -291,9 +291,8 @@ Result<std::unique_ptr<Buffer>> BackendGL::CreateBuffer(BufferFormat format, Ext
     const Functions& f = mContext->F();
     const TexelFormat t = FormatOf(format);
     const GLsizei width = GLsizei(format == BufferFormat::Bits ? (extent.nx + 31) / 32 : extent.nx);
-    GLint maxSize = 0, maxLayers = 0;
-    f.GetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
-    f.GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+    const GLint maxSize = mContext->Integer(GL_MAX_TEXTURE_SIZE),
+                maxLayers = mContext->Integer(GL_MAX_ARRAY_TEXTURE_LAYERS);
     if (width > maxSize || extent.ny > uint32_t(maxSize) || extent.nz > uint32_t(maxLayers))
         return MakeError("gl: a buffer of extent (" + std::to_string(extent.nx) + ", " + std::to_string(extent.ny) +
                          ", " + std::to_string(extent.nz) + ") needs a " + std::to_string(width) + " x " +

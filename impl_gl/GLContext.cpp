@@ -172,6 +172,12 @@ std::string GLContext::String(GLenum name) const {
     return text ? text : "?";
 }
 
+GLint GLContext::Integer(GLenum name) const {
+    GLint value = 0;
+    F().GetIntegerv(name, &value);
+    return value;
+}
+
 Status GLContext::Check(const char* what) const {
     const GLenum e = F().GetError();
     if (e == GL_NO_ERROR) return {};

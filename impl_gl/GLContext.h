@@ -38,6 +38,8 @@ class GLContext {
     bool SoftwareRasterizer() const;
     // glGetString(name) as the driver spells it; "?" when it returns null.
     std::string String(GLenum name) const;
+    // glGetIntegerv(name): one of this context's limits (GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS, ...).
+    GLint Integer(GLenum name) const;
     // "doing X: GL_INVALID_OPERATION" for a pending GL error; ok otherwise.
     Status Check(const char* what) const;
     // The linked program of pass `name`: shaders/<name>.frag with

@@ -77,6 +77,8 @@ Result<std::vector<GLContextInfo>> ListGLContexts() {
             info.available = true;
             info.renderer = (*context)->String(GL_RENDERER);
             info.version = (*context)->String(GL_VERSION);
+            info.maxTextureSize = (*context)->Integer(GL_MAX_TEXTURE_SIZE);
+            info.maxArrayLayers = (*context)->Integer(GL_MAX_ARRAY_TEXTURE_LAYERS);
         } else {
             info.reason = context.error().message;
         }

@@ -50,6 +50,10 @@ struct GLContextInfo {
     bool available = false;
     std::string renderer;  // GL_RENDERER, when available
     std::string version;   // GL_VERSION, when available
+    // The texture limits every buffer meets (a 2-D texture array: nx or its 32-bit words by ny, nz layers; an image
+    // of W x H pixels has H layers), when available.
+    int32_t maxTextureSize = 0;  // GL_MAX_TEXTURE_SIZE
+    int32_t maxArrayLayers = 0;  // GL_MAX_ARRAY_TEXTURE_LAYERS
     std::string reason;    // why it cannot be created, when not
 };
 

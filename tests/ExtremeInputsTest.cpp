@@ -2,12 +2,16 @@
 // an extreme focal length in the splat renderer. Each case crashed, wrapped an
 // integer or produced NaN before the fix; none relies on a sanitizer to fail.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <string>
 
 #include "core/Camera.h"
 #include "core/Ellipsoids.h"
+#include "core/ShadePlan.h"
 #include "core/Splat.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/RegionReference.h"
@@ -139,6 +143,70 @@ TEST(ExtremeInputs, RenderSplatWithTinyFovIsFinite) {
     for (size_t n = 0; n < rgb.size(); ++n) ASSERT_EQ(rgb[n], p.background[n % 3]) << "value " << n;
     EXPECT_LE(stats.splats, e.Count());
     EXPECT_EQ(stats.fragments, 0u);
+}
+
+// Test that the shade plan's taps into the previous slice are -1, 0 or 1 for any sun vector, NaN and inf
+// components included, and are floor(s_u / |s_w|) (bilinear) for valid ones. A sun path from -1e308 to 1e308
+// degrees (issue 28, now refused at load) gave s = (NaN, NaN, 0.5): int(floor(NaN)) was INT_MIN, and the CPU's
+// shade sized a scratch of 2^31 rows by it (std::bad_alloc at step 2).
+TEST(ExtremeInputs, ShadePlanTapsWithinOneCellForAnySun) {
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const Extent3 e{16, 12, 8};
+    for (const Vec3& sun : std::vector<Vec3>{{nan, nan, 0.5f},
+                                             {nan, nan, nan},
+                                             {inf, 0, 0},
+                                             {-inf, inf, 1},
+                                             {0, 0, 0},
+                                             {1e-45f, -1e-45f, 0},
+                                             {0.3f, -0.8f, nan}}) {
+        for (SampleFilter filter : {SampleFilter::Bilinear, SampleFilter::Nearest}) {
+            ShadeParams p;
+            p.sun = sun;
+            p.filter = filter;
+            const ShearWarp g = MakeShadePlan(p, e).geometry;
+            EXPECT_TRUE(g.u0 >= -1 && g.u0 <= 1 && g.v0 >= -1 && g.v0 <= 1)
+                << "sun (" << sun[0] << ", " << sun[1] << ", " << sun[2] << "): taps " << g.u0 << ", " << g.v0;
+        }
+    }
+    // Valid directions keep their taps: the largest component is w, so |s_u / s_w| <= 1 and nothing is clamped.
+    for (int el = -85; el <= 85; el += 17)
+        for (int az = 0; az < 360; az += 13) {
+            ShadeParams p;
+            p.sun = SunDirection(el * 3.14159265358979 / 180, az * 3.14159265358979 / 180);
+            const ShearWarp g = MakeShadePlan(p, e).geometry;
+            EXPECT_EQ(g.u0, int(std::floor(p.sun[g.u] / std::fabs(p.sun[g.w])))) << el << " " << az;
+            EXPECT_EQ(g.v0, int(std::floor(p.sun[g.v] / std::fabs(p.sun[g.w])))) << el << " " << az;
+        }
+}
+
+// Test that the CPU shade with a NaN sun allocates within the grid's scale: under a soft RLIMIT_AS of its address
+// space now plus 256 MiB (restored after) it returns; before, it threw std::bad_alloc for rows of 2^31 cells.
+TEST(ExtremeInputs, CpuShadeWithNanSunStaysWithinTheGrid) {
+    cpu::BackendCpu backend(1);
+    const Extent3 e{32, 32, 8};
+    auto q = test::MakeFilled(backend, BufferFormat::F32, e, std::vector<float>(e.Count(), 0.5f));
+    auto T = test::MakeBuffer(backend, BufferFormat::F32, e);
+    ShadeParams p;
+    p.sun = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(), 0.5f};
+    std::ifstream status("/proc/self/status");
+    uint64_t vmKb = 0;
+    for (std::string line; std::getline(status, line);)
+        if (line.starts_with("VmSize:")) vmKb = std::stoull(line.substr(7));
+    rlimit old{};
+    ASSERT_TRUE(vmKb > 0 && getrlimit(RLIMIT_AS, &old) == 0);
+    rlimit tight = old;
+    tight.rlim_cur = std::min<rlim_t>(old.rlim_cur, vmKb * 1024 + (rlim_t(256) << 20));
+    ASSERT_EQ(setrlimit(RLIMIT_AS, &tight), 0);
+    bool threw = false;
+    Status s;
+    try {
+        s = backend.Shade(p, *q, *T);
+    } catch (const std::bad_alloc&) {
+        threw = true;
+    }
+    ASSERT_EQ(setrlimit(RLIMIT_AS, &old), 0);
+    EXPECT_FALSE(threw) << "shade ran out of memory";
+    EXPECT_TRUE(s.has_value()) << s.error().message;
 }
 
 }  // namespace

@@ -95,6 +95,40 @@ TEST(GLContextsInOneProcess, EachBackendKeepsItsOwnContext) {
     EXPECT_EQ(back, laterBytes);
 }
 
+// Test that the texture limits `cloudbench devices` prints for each context (the registry's GLContextInfo, read
+// from the context) are the ones gl's buffers meet: a buffer of exactly that many layers (an image's rows) or
+// columns is made, one more is refused naming the limit. render.height's documented 16384 is more than llvmpipe's
+// 2048 layers (docs/scenes.md).
+TEST(GLLimits, DevicesLimitsAreWhatCreateBufferEnforces) {
+    auto contexts = ListGLContexts();
+    if (!contexts) GTEST_SKIP() << "unsupported here: " << contexts.error().message;
+    size_t tried = 0;
+    for (const GLContextInfo& info : *contexts) {
+        if (!info.available) continue;
+        SCOPED_TRACE(std::string(ContextKindName(info.kind)));
+        BackendOptions options;
+        options.glContext = info.kind;
+        auto backend = CreateBackend("gl", options);
+        ASSERT_TRUE(backend.has_value()) << backend.error().message;
+        const uint32_t layers = uint32_t(info.maxArrayLayers), size = uint32_t(info.maxTextureSize);
+        ASSERT_GT(layers, 0u);
+        ASSERT_GT(size, 0u);
+        EXPECT_TRUE((*backend)->CreateBuffer(BufferFormat::F32, {1, 1, layers}).has_value());
+        auto tall = (*backend)->CreateBuffer(BufferFormat::F32, {1, 1, layers + 1});
+        ASSERT_FALSE(tall.has_value());
+        EXPECT_NE(tall.error().message.find("with " + std::to_string(layers) + " layers"), std::string::npos)
+            << tall.error().message;
+        EXPECT_TRUE((*backend)->CreateBuffer(BufferFormat::F32, {size, 1, 1}).has_value());
+        auto wide = (*backend)->CreateBuffer(BufferFormat::F32, {size + 1, 1, 1});
+        ASSERT_FALSE(wide.has_value());
+        EXPECT_NE(wide.error().message.find("allows " + std::to_string(size) + " x " + std::to_string(size)),
+                  std::string::npos)
+            << wide.error().message;
+        ++tried;
+    }
+    if (tried == 0) GTEST_SKIP() << "no OpenGL context here";
+}
+
 }  // namespace
 }  // namespace cb::gl
 #endif

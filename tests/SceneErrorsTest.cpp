@@ -14,6 +14,7 @@ namespace {
 using test::ErrorOf;
 using test::HasLine;
 using test::HasLineStartingWith;
+using test::Parsed;
 using test::SplitLines;
 
 // ---- Refused scenes ------------------------------------------------------------------------------------------
@@ -376,6 +377,27 @@ TEST(SceneTest, SeveralErrorsTogether) {
     EXPECT_TRUE(HasLine(message, "test.json: ca.p_ext: must be in [0, 1], got -0.5"));
     EXPECT_TRUE(HasLine(message, "test.json: smooth.radius: must be in [0, 2], got 3"));
     EXPECT_EQ(SplitLines(message).size(), 4u) << message;
+}
+
+// Test that a lattice frequency past its bound is reported with the real lacunarity^(octaves - 1): the power was
+// capped at the first past 4096, so the coverage map said "1 x 8192" for 14, 15 and 16 octaves alike.
+TEST(SceneTest, NoiseFrequencyMessageHasTheRealPower) {
+    auto coverage = [](int octaves) {
+        return ErrorOf(R"({"grid": {"size": [8, 8, 8]}, "stages": ["noise"],
+                           "noise": {"coverage": {"frequency": [1, 1], "octaves": )" +
+                       std::to_string(octaves) + "}}}");
+    };
+    const std::string reason = "times lacunarity^(octaves - 1) must be at most 4096 lattice cells, got ";
+    EXPECT_TRUE(HasLine(coverage(14), "test.json: noise.coverage.frequency[0]: " + reason + "1 x 8192"));  // 2^13
+    EXPECT_TRUE(HasLine(coverage(15), "test.json: noise.coverage.frequency[0]: " + reason + "1 x 16384"));
+    EXPECT_TRUE(HasLine(coverage(16), "test.json: noise.coverage.frequency[0]: " + reason + "1 x 32768"));
+    // 8^15 = 2^45 = 35184372088832, far past the old cap of 8^5 = 32768.
+    EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 8, 8]}, "stages": ["noise"],
+                                    "noise": {"frequency": [1, 2, 3], "lacunarity": 8, "octaves": 16}})"),
+                        "test.json: noise.frequency[0]: " + reason + "1 x 35184372088832"));
+    // 4096 x 2^0 is at the bound and accepted.
+    Parsed(R"({"grid": {"size": [8, 8, 8]}, "stages": ["noise"],
+               "noise": {"coverage": {"frequency": [4096, 1], "octaves": 1}}})");
 }
 
 }  // namespace

@@ -27,6 +27,9 @@ struct Snapshot {
     bool Has(Resource r) const { return !current[size_t(r)].empty(); }
 };
 
+// A buffer's canonical data as float (bytes widened).
+std::vector<float> DownloadAsFloat(Backend& backend, const Buffer& buffer);
+
 // Checks one array: finite, within the resource's documented range, 0/1 where
 // it is a flag, and for T (docs/pipeline.md "No subnormals") 0 or at least 1e-30.
 void CheckArray(Resource r, const Scene& s, const std::vector<float>& values, const std::string& what);

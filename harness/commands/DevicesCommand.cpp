@@ -13,7 +13,9 @@ constexpr const char* kHelp = R"(usage: cloudbench devices
 
 Lists the backends of this build, the Vulkan devices with the index and name
 that --vk-device takes, and the OpenGL contexts that --gl-context takes, each
-tried here: its GL_RENDERER and GL_VERSION, or why it cannot be created.
+tried here: its GL_RENDERER and GL_VERSION and its texture limits
+(GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS: the largest render.width and
+render.height, and grid edges, gl can run), or why it cannot be created.
 Exits 4 when the Vulkan backend is built but finds no device.
 )";
 
@@ -41,9 +43,14 @@ void PrintGLContexts() {
     std::printf("OpenGL contexts (--gl-context NAME):\n");
     for (const GLContextInfo& c : *contexts) {
         const std::string name(gl::ContextKindName(c.kind));
-        if (c.available)
+        if (c.available) {
             std::printf("  %-7s %s: OpenGL %s\n", name.c_str(), c.renderer.c_str(), c.version.c_str());
-        else
+            // Every buffer is a 2-D texture array, one layer per slice: an image's rows are its layers.
+            std::printf(
+                "  %-7s texture limits: %d x %d, %d layers (render.height and grid nz at most %d on it, "
+                "render.width, grid nx and ny at most %d)\n",
+                "", c.maxTextureSize, c.maxTextureSize, c.maxArrayLayers, c.maxArrayLayers, c.maxTextureSize);
+        } else
             std::printf("  %-7s unavailable: %s\n", name.c_str(), c.reason.c_str());
     }
 }
