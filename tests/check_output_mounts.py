@@ -191,6 +191,17 @@ def writer_inputs(cli, work, kind):
     return made
 
 
+def make_unwritable(mount, kind):
+    """Fills the tmpfs at `mount` ("full") or remounts it read-only ("readonly"; skipped, 77, when it cannot)."""
+    if kind == "full":
+        fill(mount, 0)
+        return
+    result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
+    if result.returncode != 0:
+        print("skipped: cannot remount read-only: " + result.stderr.strip())
+        sys.exit(SKIP)
+
+
 def writers(cli, work, kind):
     made = writer_inputs(cli, work, kind)
     mount = os.path.join(work, "writers-" + kind)
@@ -199,13 +210,7 @@ def writers(cli, work, kind):
     os.makedirs(folder)
     reason = "No space left on device" if kind == "full" else "Read-only file system"
     failed = []
-    if kind == "full":
-        fill(mount, 0)
-    else:
-        result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
-        if result.returncode != 0:
-            print("skipped: cannot remount read-only: " + result.stderr.strip())
-            sys.exit(SKIP)
+    make_unwritable(mount, kind)
     cases = [
         ("perf compare --json", os.path.join(folder, "compare.json"),
          ["perf", "compare", made["results"], made["results"], "--json", os.path.join(folder, "compare.json")]),
@@ -279,13 +284,7 @@ def count(cli, work):
     for kind, reason in (("full", "No space left on device"), ("readonly", "Read-only file system")):
         mount = os.path.join(work, "count-" + kind)
         mount_tmpfs(mount, "64k")
-        if kind == "full":
-            fill(mount, 0)
-        else:
-            result = subprocess.run(["mount", "-o", "remount,ro", mount], capture_output=True, text=True)
-            if result.returncode != 0:
-                print("skipped: cannot remount read-only: " + result.stderr.strip())
-                sys.exit(SKIP)
+        make_unwritable(mount, kind)
         path = os.path.join(mount, "count.json")
         result = subprocess.run([cli, "count", "ci-small", "--steps", "2", "--set", "warmup_steps=1", "--quiet",
                                  "--out", path], capture_output=True, text=True, timeout=300)
