@@ -218,7 +218,9 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
         }
         case CompareRule::Kind::Image: {
             const uint32_t width = e.ny, height = e.nz;  // images are (3, width, height)
-            const ImageComparison cmp = CompareImages(*r, *g, width, height, rule);
+            auto compared = CompareImages(*r, *g, width, height, rule);
+            if (!compared) return std::unexpected(compared.error());
+            const ImageComparison& cmp = *compared;
             ConformRow& row = tally.Row(stageName, name, rule.Text(d.symbol), rule.limit);
             if (!(cmp.maxError <= row.worst)) {
                 row.worst = cmp.maxError;

@@ -79,13 +79,14 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run);
 report::Section TimingSection(const Scene& scene, const BackendRun& run);
 
 // Writes D as a grey top view (x right, y up, white = densest column), 8-bit
-// PNG through OpenImageIO. `columnSum` is canonical D, nx*ny floats.
+// PNG through the image module. `columnSum` is canonical D, nx*ny floats.
 Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny,
                     uint32_t nz);
 
 // An image comparison by a CompareRule of kind Image (default: SPEC 8's, per
 // channel |d| <= 2/255 on at least 99.9 % of pixels and <= 8/255 everywhere),
-// with PSNR and mean absolute error, from OpenImageIO's ImageBufAlgo::compare.
+// with PSNR and mean absolute error, from OpenImageIO's ImageBufAlgo::compare
+// (through the image module: an error only when the module cannot be loaded).
 struct ImageComparison {
     CompareRule rule;
     double maxError = 0, meanError = 0, psnr = 0;
@@ -94,8 +95,9 @@ struct ImageComparison {
     int worstX = 0, worstY = 0;
     bool Passes() const { return maxError <= rule.limit && double(pixelsOverTolerance) <= rule.share * double(pixels); }
 };
-ImageComparison CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate, uint32_t width,
-                              uint32_t height, const CompareRule& rule = Describe(Stage::RenderSplat).rule(Scene{}));
+Result<ImageComparison> CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate,
+                                      uint32_t width, uint32_t height,
+                                      const CompareRule& rule = Describe(Stage::RenderSplat).rule(Scene{}));
 // Writes |reference - candidate| as an EXR (for a failed comparison).
 Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
                             const std::vector<float>& candidate, uint32_t width, uint32_t height);
@@ -107,7 +109,7 @@ std::string FrameFileStem(Stage renderer, const std::string& camera, const std::
 
 // Writes a linear RGB float image (3 floats a pixel, row 0 at the top) as
 // `stem`.exr (float, linear) and, with png = true, `stem`.png (8-bit sRGB),
-// through OpenImageIO. Returns the paths written.
+// through the image module. Returns the paths written.
 // The PNG of an HDR frame (the ray marcher's): each channel becomes
 // ReinhardToneMap(C, exposure) (core/March.h), or min(exposure C, 1) without
 // the tone map, before the sRGB encoding. The EXR stays linear.

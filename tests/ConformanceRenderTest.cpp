@@ -195,7 +195,7 @@ TEST_P(Conformance, RenderSplat) {
         EXPECT_EQ(stats[1].splats, stats[0].splats) << "camera " << c;
         EXPECT_EQ(stats[1].voxelsVisited, stats[0].voxelsVisited) << "camera " << c;
         EXPECT_EQ(stats[1].fragments, stats[0].fragments) << "camera " << c;
-        const ImageComparison cmp = CompareImages(images[0], images[1], W, H);
+        const ImageComparison cmp = CompareImages(images[0], images[1], W, H).value();
         if (!cmp.Passes()) {
             const std::string path =
                 ::testing::TempDir() + "/render_diff_" + mBackend->Name() + "_" + std::to_string(c) + ".exr";

@@ -280,7 +280,7 @@ TEST_P(GroundRender, MatchesCpu) {
     ASSERT_EQ(got.size(), ref.size());
     const Stage stage = Which() == Renderer::Splat ? Stage::RenderSplat : Stage::RenderMarch;
     const CompareRule rule = Describe(stage).rule(Scene{});
-    const ImageComparison cmp = CompareImages(ref, got, W, H, rule);
+    const ImageComparison cmp = CompareImages(ref, got, W, H, rule).value();
     EXPECT_TRUE(cmp.Passes()) << "max error " << cmp.maxError << " at (" << cmp.worstX << ", " << cmp.worstY << "), "
                               << cmp.pixelsOverTolerance << " of " << cmp.pixels << " pixels over tolerance";
     // The frame holds ground in shadow, lit ground and sky.

@@ -213,7 +213,7 @@ TEST_P(MarchConformance, OptionMatrix) {
             EXPECT_NEAR(double(got.stats.samples), double(ref.stats.samples), 2 + 1e-3 * double(ref.stats.samples));
             EXPECT_NEAR(double(got.stats.lightSamples), double(ref.stats.lightSamples),
                         2 + 1e-3 * double(ref.stats.lightSamples));
-            const ImageComparison cmp = CompareImages(ref.rgb, got.rgb, W, H, rule);
+            const ImageComparison cmp = CompareImages(ref.rgb, got.rgb, W, H, rule).value();
             if (!cmp.Passes()) {
                 const std::string path = ::testing::TempDir() + "/march_diff_" + mBackend->Name() + ".exr";
                 (void)WriteDifferenceImage(path, ref.rgb, got.rgb, W, H);

@@ -201,7 +201,7 @@ TEST_P(Rotation, RenderSplatSameImage) {
         const std::vector<float> plain = render(e, qp, qc, T, cam, sun);
         const std::vector<float> turned =
             render(er, RotRotate(e, qp), RotRotate(e, qc), RotRotate(e, T), RotCamera(e, cam), RotVec(sun));
-        const ImageComparison c = CompareImages(plain, turned, W, H);
+        const ImageComparison c = CompareImages(plain, turned, W, H).value();
         EXPECT_TRUE(c.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << ": max "
                                 << c.maxError << " at (" << c.worstX << ", " << c.worstY << "), "
                                 << c.pixelsOverTolerance << " pixels over";
@@ -211,7 +211,7 @@ TEST_P(Rotation, RenderSplatSameImage) {
         // changes with the turn moves many by more than 1e-4.
         CompareRule same = c.rule;
         same.tolerance = 1e-4;
-        const ImageComparison tight = CompareImages(plain, turned, W, H, same);
+        const ImageComparison tight = CompareImages(plain, turned, W, H, same).value();
         EXPECT_TRUE(tight.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << ": "
                                     << tight.pixelsOverTolerance << " pixels over 1e-4";
         size_t lit = 0;  // pixels other than the background
@@ -274,7 +274,7 @@ TEST_P(Rotation, RenderMarchSameImage) {
                 const std::vector<float> plain = render(e, qp, qc, T, cam, sun, light, jitter);
                 const std::vector<float> turned = render(er, RotRotate(e, qp), RotRotate(e, qc), RotRotate(e, T),
                                                          RotCamera(e, cam), RotVec(sun), light, jitter);
-                const ImageComparison c = CompareImages(plain, turned, W, H, rule);
+                const ImageComparison c = CompareImages(plain, turned, W, H, rule).value();
                 EXPECT_TRUE(c.Passes()) << "eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2] << " light "
                                         << int(light) << " jitter " << jitter << ": max " << c.maxError << " at ("
                                         << c.worstX << ", " << c.worstY << "), " << c.pixelsOverTolerance

@@ -239,19 +239,19 @@ TEST(ImageRule, ThresholdsAndCounts) {
     const uint32_t W = 100, H = 100;
     const std::vector<float> a(3 * W * H, 0.5f);
     std::vector<float> b = a;
-    EXPECT_TRUE(CompareImages(a, b, W, H).Passes());
+    EXPECT_TRUE(CompareImages(a, b, W, H).value().Passes());
     b[3 * (10 + W * 20) + 1] += 9.0f / 255.0f;
-    ImageComparison c = CompareImages(a, b, W, H);
+    ImageComparison c = CompareImages(a, b, W, H).value();
     EXPECT_FALSE(c.Passes());
     EXPECT_EQ(c.worstX, 10);
     EXPECT_EQ(c.worstY, 20);
     b = a;
     for (uint32_t n = 0; n < 5; ++n) b[3 * n] += 2.5f / 255.0f;  // 5 of 10000 pixels
-    c = CompareImages(a, b, W, H);
+    c = CompareImages(a, b, W, H).value();
     EXPECT_EQ(c.pixelsOverTolerance, 5u);
     EXPECT_TRUE(c.Passes());
     for (uint32_t n = 5; n < 20; ++n) b[3 * n] += 2.5f / 255.0f;  // 20 of 10000
-    EXPECT_FALSE(CompareImages(a, b, W, H).Passes());
+    EXPECT_FALSE(CompareImages(a, b, W, H).value().Passes());
 }
 
 }  // namespace

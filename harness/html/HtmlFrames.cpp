@@ -1,11 +1,6 @@
 // The frames section of `cloudbench report` (FrameBlocks in HtmlReport.h):
-// images read and compared through OpenImageIO, differences encoded as PNG
-// in memory.
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
-
+// images read and compared through the image module (OpenImageIO),
+// differences encoded as PNG in memory.
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -15,6 +10,7 @@
 #include "core/InputFile.h"
 #include "harness/Report.h"
 #include "harness/html/HtmlReport.h"
+#include "harness/images/ImageModule.h"
 
 namespace cb::html {
 namespace {
@@ -24,36 +20,12 @@ using nlohmann::json;
 Result<std::string> ReadBytes(const std::string& path) { return ReadInputFile(path, kArrayInput); }
 
 // The first three channels of an image file as linear floats, row 0 at the top.
-Result<std::vector<float>> ReadRgb(const std::string& path, int& width, int& height) {
+Result<images::FloatImage> ReadRgb(const images::Module& module, const std::string& path) {
     CB_TRY(CheckInputFile(path, kArrayInput));  // OpenImageIO would block on a FIFO
-    OIIO::ImageBuf image(path);
-    if (!image.read(0, 0, true, OIIO::TypeDesc::FLOAT))
-        return MakeError(path + ": cannot read: " + image.geterror());
-    const OIIO::ImageSpec& spec = image.spec();
-    if (spec.nchannels < 3) return MakeError(path + ": has " + std::to_string(spec.nchannels) + " channels, not RGB");
-    width = spec.width;
-    height = spec.height;
-    std::vector<float> rgb(size_t(width) * size_t(height) * 3);
-    OIIO::ROI roi = image.roi();
-    roi.chbegin = 0;
-    roi.chend = 3;
-    if (!image.get_pixels(roi, OIIO::TypeDesc::FLOAT, rgb.data()))
-        return MakeError(path + ": cannot read: " + image.geterror());
-    return rgb;
-}
-
-// `image` (floats in [0, 1] after clamping) as an 8-bit PNG file in memory.
-Result<std::string> EncodePng(const OIIO::ImageBuf& image) {
-    std::vector<unsigned char> file;
-    OIIO::Filesystem::IOVecOutput proxy(file);
-    auto out = OIIO::ImageOutput::create("difference.png", &proxy);
-    if (!out) return MakeError("difference.png: no PNG writer: " + OIIO::geterror());
-    OIIO::ImageSpec spec(image.spec().width, image.spec().height, image.spec().nchannels, OIIO::TypeDesc::UINT8);
-    std::vector<unsigned char> pixels(spec.image_bytes());
-    if (!image.get_pixels(image.roi(), OIIO::TypeDesc::UINT8, pixels.data()) || !out->open("difference.png", spec) ||
-        !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
-        return MakeError("difference.png: cannot encode: " + out->geterror());
-    return std::string(file.begin(), file.end());
+    images::FloatImage image;
+    const std::string why = module.read(path, 3, image);
+    if (!why.empty()) return MakeError(path + ": cannot read: " + why);
+    return image;
 }
 
 struct Difference {
@@ -64,25 +36,26 @@ struct Difference {
 
 // |candidate - reference| scaled so that the image rule's limit is white.
 Result<Difference> DifferenceOf(const std::string& referencePath, const std::string& candidatePath) {
-    int w0 = 0, h0 = 0, w1 = 0, h1 = 0;
-    auto reference = ReadRgb(referencePath, w0, h0);
+    auto module = images::Load();
+    if (!module) return MakeError(candidatePath + ": cannot compare: " + module.error().message);
+    auto reference = ReadRgb(**module, referencePath);
     if (!reference) return std::unexpected(reference.error());
-    auto candidate = ReadRgb(candidatePath, w1, h1);
+    auto candidate = ReadRgb(**module, candidatePath);
     if (!candidate) return std::unexpected(candidate.error());
+    const int w0 = reference->width, h0 = reference->height, w1 = candidate->width, h1 = candidate->height;
     if (w0 != w1 || h0 != h1)
         return MakeError(candidatePath + ": " + std::to_string(w1) + "x" + std::to_string(h1) + ", but " +
                          referencePath + " is " + std::to_string(w0) + "x" + std::to_string(h0));
     Difference d;
-    d.comparison = CompareImages(*reference, *candidate, uint32_t(w0), uint32_t(h0));
+    auto comparison = CompareImages(reference->pixels, candidate->pixels, uint32_t(w0), uint32_t(h0));
+    if (!comparison) return std::unexpected(comparison.error());
+    d.comparison = *comparison;
     d.gain = d.comparison.rule.limit > 0 && std::isfinite(d.comparison.rule.limit) ? 1 / d.comparison.rule.limit : 1;
-    const OIIO::ImageSpec spec(w0, h0, 3, OIIO::TypeDesc::FLOAT);
-    const OIIO::ImageBuf a(spec, reference->data()), b(spec, candidate->data());  // wrap, do not copy
-    OIIO::ImageBuf scaled = OIIO::ImageBufAlgo::clamp(
-        OIIO::ImageBufAlgo::mul(OIIO::ImageBufAlgo::absdiff(a, b), float(d.gain)), 0.0f, 1.0f);
-    if (scaled.has_error()) return MakeError(candidatePath + ": difference: " + scaled.geterror());
-    auto png = EncodePng(scaled);
-    if (!png) return std::unexpected(png.error());
-    d.png = std::move(*png);
+    images::FloatImage scaled;
+    std::string why = (*module)->difference(reference->View(), candidate->View(), float(d.gain), /*clamp=*/true, scaled);
+    if (!why.empty()) return MakeError(candidatePath + ": difference: " + why);
+    why = (*module)->encodePng(scaled.View(), d.png);
+    if (!why.empty()) return MakeError("difference.png: " + why);
     return d;
 }
 
