@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The array-for-array fingerprint of every backend's dumps, for refactors that
-# must change no result (issue 10): sha256 of each .npy, and of each frame's
-# EXR with its capture date blanked (the only field that differs between runs).
+# must change no result: sha256 of each .npy, and of each frame's EXR with its
+# capture date blanked (the only field that differs between runs). The scenes
+# cover both renderers: the splat path with wind and the ground shadow, the ray
+# march over noise, and lightning.
 # usage: tools/dump_manifest.sh BUILD_DIR OUT_FILE
 set -euo pipefail
 bin="$1/cloudbench"; out="$2"
@@ -10,6 +12,11 @@ for be in cpu vk gl; do
   "$bin" dump ci-small --backend "$be" --steps 6 --set 'ca.wind_shift=[[1,0]]' --out "$work/ci-$be" --quiet >/dev/null
 done
 "$bin" dump thesis-low --backend cpu --steps 4 --out "$work/low-cpu" --quiet >/dev/null
+for be in cpu vk gl; do
+  for scene in ci-small-wind ground-shadow noise-layer lightning; do
+    "$bin" dump "$scene" --backend "$be" --steps 2 --out "$work/$scene-$be" --quiet >/dev/null
+  done
+done
 ( cd "$work"
   for f in $(find . -name '*.npy' | sort); do echo "$(sha256sum < "$f" | cut -c1-64)  $f"; done
   for f in $(find . -name '*.exr' | sort); do
