@@ -78,8 +78,8 @@ Result<ImageComparison> CompareImages(const std::vector<float>& reference, const
     if (!module) return MakeError("cannot compare images: " + module.error().message);
     // failthresh: the limit; warnthresh: the tolerance. A pixel counts once, as a failure or a warning.
     const float limit = std::isinf(rule.limit) ? std::numeric_limits<float>::max() : float(rule.limit);
-    const images::Comparison result = (*module)->compare(Rgb(reference, width, height),
-                                                         Rgb(candidate, width, height), limit, float(rule.tolerance));
+    const images::Comparison result =
+        (*module)->compare(Rgb(reference, width, height), Rgb(candidate, width, height), limit, float(rule.tolerance));
     ImageComparison c;
     c.rule = rule;
     c.maxError = result.maxError;
@@ -97,8 +97,8 @@ Status WriteDifferenceImage(const std::string& path, const std::vector<float>& r
     auto module = images::Load();
     if (!module) return MakeError(path + ": cannot write: " + module.error().message);
     images::FloatImage difference;
-    const std::string why = (*module)->difference(Rgb(reference, width, height), Rgb(candidate, width, height),
-                                                  1.0f, /*clamp=*/false, difference);
+    const std::string why = (*module)->difference(Rgb(reference, width, height), Rgb(candidate, width, height), 1.0f,
+                                                  /*clamp=*/false, difference);
     if (!why.empty()) return MakeError(path + ": cannot write: " + why);
     return WriteImage(path, difference.View(), /*eightBit=*/false);
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Issue 16 item 7: the measurements to make on a real GPU, in one call of a few minutes.
-# Here:       cmake --workflow --preset release && ../shared/tools/gpu-bundle.sh
+# Here:       cmake --workflow --preset release, then pack the release build (cloudbench, cloudbench_tests,
+#             libcloudbench_images.so, the libraries they need, scenes/) into .gpu/ with an env.sh
 # GPU host:   . .gpu/env.sh && tools/gpu_issue16.sh "$OUT"      (carry .gpu; $OUT comes back)
 # Writes to DIR (default /tmp/gpu16): devices.txt, conform-*.txt, run-*.txt with their results.json,
 # gtest-*.txt, and summary.txt, the lines to copy beside issue 16's table in docs/performance.md
@@ -11,7 +12,7 @@ mkdir -p "$out"
 cli=${CLOUDBENCH_CLI:-.gpu/cloudbench}
 tests=${CLOUDBENCH_TESTS:-.gpu/cloudbench_tests}
 scenes=${CLOUDBENCH_SCENES:-.gpu/scenes}
-[ -x "$cli" ] || { echo "gpu_issue16: no $cli; run ../shared/tools/gpu-bundle.sh first" >&2; exit 1; }
+[ -x "$cli" ] || { echo "gpu_issue16: no $cli; pack the release build into .gpu first" >&2; exit 1; }
 step() {  # step NAME SECONDS COMMAND...: runs it, keeps its output and exit status
     local name=$1 limit=$2; shift 2
     echo "== $name: $*" | tee -a "$out/summary.txt"

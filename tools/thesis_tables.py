@@ -40,7 +40,7 @@ from check_bad_inputs import exr_floats  # noqa: E402  (the pixels, not the head
 SETTINGS = [("none", ["render.culling=false", "render.skipping=false"]),
             ("vfd", ["render.culling=true", "render.skipping=false"]),
             ("vfd_ess", ["render.culling=true", "render.skipping=true"])]
-# Seed 000 Tables 8.2 (none), 8.3 (VFD), 8.4 (VFD/ESS), fps, NVIDIA GeForce 8700M GT (shared/seeds/TABLES.md).
+# Fizimayer's thesis, Tables 8.2 (none), 8.3 (VFD), 8.4 (VFD/ESS), fps, NVIDIA GeForce 8700M GT.
 THESIS = {"thesis-low": (33, 95, 118), "thesis-medium": (25, 51, 55), "thesis-high": (11, 21, 33)}
 THESIS_GPU = "NVIDIA GeForce 8700M GT"
 

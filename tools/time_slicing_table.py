@@ -31,7 +31,7 @@ from statistics import median
 ROOT = Path(__file__).resolve().parent.parent
 SLICES = [0, 1, 4, 32]
 RENDER_ONLY_FRAMES = 8  # frames per step of the unsliced run: frame 0 carries the step, 1..7 render only
-# Seed 000 section 8.1.2 (shared/seeds/TABLES.md): one slice of 32 per frame; 128 frames (32 region + 32 simulation +
+# Fizimayer's thesis, section 8.1.2: one slice of 32 per frame; 128 frames (32 region + 32 simulation +
 # 32 smoothing + 32 density) per step, an update every 2.13 s at 60 fps; the simulation "did not affect framerate".
 THESIS = {"frames": 128, "period_s": 2.13, "gpu": "NVIDIA GeForce 8700M GT"}
 

@@ -52,7 +52,8 @@ Result<Difference> DifferenceOf(const std::string& referencePath, const std::str
     d.comparison = *comparison;
     d.gain = d.comparison.rule.limit > 0 && std::isfinite(d.comparison.rule.limit) ? 1 / d.comparison.rule.limit : 1;
     images::FloatImage scaled;
-    std::string why = (*module)->difference(reference->View(), candidate->View(), float(d.gain), /*clamp=*/true, scaled);
+    std::string why =
+        (*module)->difference(reference->View(), candidate->View(), float(d.gain), /*clamp=*/true, scaled);
     if (!why.empty()) return MakeError(candidatePath + ": difference: " + why);
     why = (*module)->encodePng(scaled.View(), d.png);
     if (!why.empty()) return MakeError("difference.png: " + why);

@@ -160,10 +160,11 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
             out.sections.push_back(
                 {"Frames: " + Str(Obj(input.doc, "scene"), "name") + " (" + input.path + ")", FrameBlocks(input)});
 
-    out.sections.push_back({"The seeds' figures",
-                            {report::Paragraph{"From docs/seed-timings.json (the seeds' TABLES.md), with the hardware "
-                                               "each was measured on."},
-                             SeedSources(), SeedTable()}});
+    out.sections.push_back(
+        {"The source documents' figures",
+         {report::Paragraph{"From docs/seed-timings.json (copied from the source documents' tables), with the "
+                            "hardware each was measured on."},
+          SeedSources(), SeedTable()}});
 
     Section provenance{"Provenance", {}};
     for (const ReportInput& input : inputs) {
