@@ -165,7 +165,7 @@ struct ShadowParams {
     Vec3 sun{0, 0, 1};
     ShadowForm form = ShadowForm::Beer;
     float sigma = 0.02f, voxelSize = 50, kappa = 0.25f;
-    float coverage = 1, densityFactor = 1;  // wang form (seed 002 eq. 19)
+    float coverage = 1, densityFactor = 1;  // wang form (Wang, Ji and Zhang, eq. 19)
     uint32_t nz = 1;  // grid height in voxels (the volume's mid-height is nz/2)
 };
 

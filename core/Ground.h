@@ -1,7 +1,7 @@
 // The ground plane in the frame (issue 15 item 4; docs/pipeline.md, "The
 // ground in the frame"): the plane z = origin_z (SPEC 7) under the clouds, a
 // Lambertian surface of the scene's albedo lit by the sun through the ground
-// shadow G (seed 002 eq. 19) and by the ambient light. Both renderers take it
+// shadow G (Wang, Ji and Zhang, eq. 19) and by the ambient light. Both renderers take it
 // as the pixel's background: where the pixel's ray meets the plane between the
 // near and far planes, background = albedo (sunRadiance max(s_z, 0) G(p) +
 // ambient); elsewhere the flat background. The clouds are composited over it

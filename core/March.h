@@ -118,7 +118,7 @@ inline float TrilinearSample(const float* v, const Extent3& e, float outside, co
 
 // ---- Kernel constants ------------------------------------------------------------
 
-// The point light (seed 002 eq. 21) as the kernel sees it.
+// The point light (Wang, Ji and Zhang, eq. 21) as the kernel sees it.
 struct MarchPointLight {
     bool on = false;
     Vec3 position{};        // voxel units

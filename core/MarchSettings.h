@@ -1,5 +1,5 @@
 // Scene settings of the ray marcher (SPEC 10, section `march`) and of the
-// lightning point light (seed 002 section 6.3, section `lightning`). Read by
+// lightning point light (Wang, Ji and Zhang, section 6.3, section `lightning`). Read by
 // core/SceneMarchReader.cpp; fields, units and defaults in docs/scenes.md.
 #pragma once
 
@@ -31,7 +31,7 @@ struct MarchSettings {
     bool toneMap = true;         // PNG only; false: clamp(exposure C)
 };
 
-// A point light (seed 002 eq. 21) that flashes over a window of steps.
+// A point light (Wang, Ji and Zhang, eq. 21) that flashes over a window of steps.
 struct LightningSettings {
     bool enabled = false;
     std::array<double, 3> position{0, 0, 0};   // world, metres

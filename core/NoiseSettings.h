@@ -54,7 +54,7 @@ struct NoiseDetail {
     bool operator==(const NoiseDetail&) const = default;
 };
 
-// Wang's coverage and density modulation (seed 002 eq. 15-16), in place of the
+// Wang's coverage and density modulation (Wang, Ji and Zhang, eq. 15-16), in place of the
 // threshold: q = D max(v - (m + 1 - C), 0), with a 2-D weather map
 // m(x, y) = max(0, 2 f - 1), f a Perlin fBm over x and y in [0, 1], tiled: half
 // the sky has m = 0 (only the coverage thins it), the rest is thinned up to m = 1.

@@ -87,7 +87,7 @@ struct SunKeyframe {
 };
 
 // The sun (SPEC 0): direction from elevation and azimuth, and its radiance.
-// It may move (seed 000 section 1.3.2): along keyframes, or at a constant
+// It may move (Fizimayer's thesis, section 1.3.2): along keyframes, or at a constant
 // angular speed. Either way it is evaluated once per step (ElevationAt,
 // AzimuthAt); the frames between two steps see step t's sun (docs/pipeline.md,
 // "The real-time loop").
@@ -138,7 +138,7 @@ struct ShadeSettings {
     SampleFilter filter = SampleFilter::Bilinear;
     int resolution = 1;  // 1, 2 or 4
     StorageFormat storage = StorageFormat::Fp32;
-    bool scattering = false;   // multiple forward scattering (seed 002 eq. 5-7)
+    bool scattering = false;   // multiple forward scattering (Wang, Ji and Zhang, eq. 5-7)
     double albedo = 0.9;       // alpha_s
     double solidAngle = 0.05;  // gamma, steradians
 };
@@ -147,8 +147,8 @@ struct ShadeSettings {
 struct ShadowSettings {
     ShadowForm form = ShadowForm::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D); wang: eq. 19
     double kappa = 0.25;                 // thesis form: shadow per unit of D
-    double coverage = 1;                 // wang form: coverage C (seed 002 eq. 15, 19)
-    double densityFactor = 1;            // wang form: density factor D_w (seed 002 eq. 16, 19)
+    double coverage = 1;                 // wang form: coverage C (Wang, Ji and Zhang, eq. 15, 19)
+    double densityFactor = 1;            // wang form: density factor D_w (Wang, Ji and Zhang, eq. 16, 19)
 };
 
 // What every renderer shares (section `render`): the image, the cameras,
@@ -156,10 +156,10 @@ struct ShadowSettings {
 struct RenderSettings {
     uint32_t width = 320, height = 240;
     double alpha = 0.5;                   // interpolation between the previous and the current step
-    // Frames rendered per render step (seed 000 section 6.3). 1: one frame
+    // Frames rendered per render step (Fizimayer's thesis, section 6.3). 1: one frame
     // at `alpha`; F > 1: frames f = 0..F-1 at alpha = (f + 1) / F.
     uint32_t framesPerStep = 1;
-    // Time-slicing (SPEC 13, seed 000 sections 7.1 and 8.1.2): 0 computes a
+    // Time-slicing (SPEC 13, Fizimayer's thesis, sections 7.1 and 8.1.2): 0 computes a
     // step all at once; s > 0 spreads the next step's stages over this step's
     // frames, s slices of one stage per frame (docs/pipeline.md). A step then
     // draws max(framesPerStep, the frames its shares take) frames.

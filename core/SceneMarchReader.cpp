@@ -1,5 +1,5 @@
 // Readers of the ray marcher's sections: `march` (SPEC 10) and `lightning`
-// (seed 002 eq. 21). Fields, units and defaults: docs/scenes.md.
+// (Wang, Ji and Zhang, eq. 21). Fields, units and defaults: docs/scenes.md.
 #include <algorithm>
 #include <array>
 #include <string_view>

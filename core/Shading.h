@@ -245,7 +245,7 @@ inline constexpr float kMaxPhasePeak = 262144.0f;
 
 enum class AttenuationKind : uint8_t { Beer, Thesis };
 // Forms of the ground shadow (SPEC 7): beer, the thesis's inverted density map,
-// and Wang's coverage-modulated shadow factor (seed 002 eq. 19).
+// and Wang's coverage-modulated shadow factor (Wang, Ji and Zhang, eq. 19).
 enum class ShadowForm : uint8_t { Beer, Thesis, Wang };
 enum class SampleFilter : uint8_t { Bilinear, Nearest };
 
@@ -285,7 +285,7 @@ inline float GroundShadow(bool beer, float opticalDepthPerD, float kappa, float 
     return beer ? ExpNonPositive(-opticalDepthPerD * d) : 1.0f - std::clamp(kappa * d, 0.0f, 1.0f);
 }
 
-// Wang's ground shadow (seed 002 eq. 19), S = 1 - D_w max(T_S - (T_2D + 1 - C), 0),
+// Wang's ground shadow (Wang, Ji and Zhang, eq. 19), S = 1 - D_w max(T_S - (T_2D + 1 - C), 0),
 // on our data (docs/pipeline.md "Wang's shadow form"): the shadow texture T_S
 // is the opacity of the column along the sun, 1 - exp(-opticalDepthPerD d);
 // the modulation texture T_2D is 0 (the automaton already varies the cloud);

@@ -348,7 +348,7 @@ ResourcePlan PlanResources(const Scene& scene) {
         for (Resource r : d.readsPrevious(scene))
             if (plan.used[size_t(r)]) plan.previous[size_t(r)] = true;
     }
-    // Time-slicing's third buffer set (seed 000 section 7.1): the next step's
+    // Time-slicing's third buffer set (Fizimayer's thesis, section 7.1): the next step's
     // value of everything but the images and the double-buffered state.
     if (scene.render.slicesPerFrame > 0)
         for (Resource r : kAllResources)

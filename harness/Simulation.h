@@ -18,7 +18,7 @@
 // Output steps: every step when dumping or when the scene does not render;
 // otherwise the render steps (render.every_steps).
 //
-// Time-slicing (render.slices_per_frame = s > 0; SPEC 13, seed 000 section
+// Time-slicing (render.slices_per_frame = s > 0; SPEC 13, Fizimayer's thesis, section
 // 7.1): step t computes its stages once (step 0 all at once, later steps
 // during the frames of the step before), then draws its frames, and while
 // they are drawn computes step t+1 into a third buffer set (BufferRole::

@@ -1,4 +1,4 @@
-// The host-side ellipsoid list (SPEC section 2, seed 000 section 4.3.3.5).
+// The host-side ellipsoid list (SPEC section 2, Fizimayer's thesis, section 4.3.3.5).
 #include <gtest/gtest.h>
 
 #include "core/Ellipsoids.h"

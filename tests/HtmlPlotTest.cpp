@@ -1,5 +1,5 @@
 // The pieces of `cloudbench report` (harness/html/): the SVG plot generators,
-// the HTML renderer, the report model read back from JSON, the seeds' figures,
+// the HTML renderer, the report model read back from JSON, the source documents' figures,
 // the history reader and the verdicts. Expected numbers are worked out by hand
 // (NumPy's linear quantiles, Tukey's fences, RFC 4648's vectors), not taken
 // from the code's output.
@@ -194,7 +194,7 @@ TEST(HtmlRender, ReportJsonRoundTrip) {
     EXPECT_THROW(report::ReportFromJson(nlohmann::json{{"title", 1}}), nlohmann::json::exception);
 }
 
-// Test the seeds' figures: every cited table is there, every stage is one of ours, and each time agrees with
+// Test the source documents' figures: every cited table is there, every stage is one of ours, and each time agrees with
 // the rate the document printed (1000 / fps, or 1000 / updates per second).
 TEST(HtmlSeedTimings, TablesStagesAndRates) {
     const nlohmann::json& seeds = SeedTimings();

@@ -80,7 +80,7 @@ TEST(ScenesShipped, Sizes) {
     EXPECT_LE(small->grid.size.Count(), 100000u);
 }
 
-// Test that the thesis scenes reach the thesis's cover bands (seed 000 section
+// Test that the thesis scenes reach the thesis's cover bands (Fizimayer's thesis, section
 // 8.1: low 15-20 %, medium about 40 %, high over 70 %), as the median cover of
 // the steps after warm-up, with the scenes' own seeds and step counts.
 TEST(ScenesShipped, ThesisCoverInBands) {

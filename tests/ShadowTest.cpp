@@ -86,7 +86,7 @@ TEST(Shadow, OddHeightAndMinusYHandWorked) {
     EXPECT_NEAR(G[4 + 10 * 6], 1.0f, 1e-6);
 }
 
-// Test Wang's form (seed 002 eq. 19, S = 1 - D_w max(T_S - (T_2D + 1 - C), 0))
+// Test Wang's form (Wang, Ji and Zhang, eq. 19, S = 1 - D_w max(T_S - (T_2D + 1 - C), 0))
 // by hand, with T_S the column's opacity 1 - exp(-sigma h D / s_z) and T_2D = 0
 // (docs/pipeline.md). D = 2, sigma h = 0.5: overhead tau = 1, opacity
 // 1 - e^-1 = 0.632121; C = 0.8, D_w = 0.5: S = 1 - 0.5 (0.632121 - 0.2) = 0.783940.

@@ -11,7 +11,7 @@ in Debian's headless chromium from file:// and checks that
 - the page holds the plots and tables the inputs call for, counted here from the
   input files: one box plot per results.json, one history plot per scene x stage of
   the history plus one for instruction counts, one Pareto plot per swept stage; the
-  verdict, conformance matrix, timing and seeds' tables plus each input's own
+  verdict, conformance matrix, timing and source documents' tables plus each input's own
   tables; the frames, their differences and top views as data: images; exactly the
   two planted change points.
 
@@ -160,7 +160,7 @@ def expected_counts(results, conform, sweep, history_path):
     plots["history"] = len(pairs) + len(instruction_scenes)
     own_tables = sum(1 for doc in (results, conform, sweep) for section in doc["report"]["sections"]
                      for block in section["blocks"] if "table" in block)
-    tables = 1 + 1 + 1 + 1 + own_tables  # verdict, conformance matrix, timing, seeds' figures
+    tables = 1 + 1 + 1 + 1 + own_tables  # verdict, conformance matrix, timing, source documents' figures
     frames = [f for f in results["files"] if f.startswith("frame-") and f.endswith(".png")]
     views = {}
     for f in frames:

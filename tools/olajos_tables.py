@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Olajos's Tables 3.1-3.4 (seed 001 section 3.2) as ratios on this machine.
+"""Olajos's Tables 3.1-3.4 (Olajos's thesis, section 3.2) as ratios on this machine.
 
 Runs scenes/noise-track.json (8 cameras along a test track, 1280x720) on the CPU
 backend once per setting, the settings interleaved (A B C ... A B C ...), ROUNDS
@@ -64,7 +64,7 @@ SETTINGS = [
 ]
 FRAMES = 2  # frames per camera per run: a static scene renders the same march every step
 
-# Olajos's GTX 680 averages (seed 001 Tables 3.1-3.4, ms).
+# Olajos's GTX 680 averages (Olajos's thesis, Tables 3.1-3.4, ms).
 OLAJOS = {
     "skip": (23.728955, 56.155690),  # on, off
     "adaptive": (21.761936, 23.728955),  # on, off

@@ -9,7 +9,7 @@ backend, interleaved (round r: scene, setting, backend innermost), and prints a
 Markdown table per backend: the frame rate of render_splat per camera (1000 /
 the run's median frame ms) as median [min max] over the rounds, our ratios
 VFD/none and VFD+ESS/none, and the thesis's frame rates and ratios beside them
-(seed 000, Tables 8.2-8.4, measured on an NVIDIA GeForce 8700M GT). It also
+(Fizimayer's thesis, Tables 8.2-8.4, measured on an NVIDIA GeForce 8700M GT). It also
 checks that every camera's last image (the EXR) is bit for bit the same under
 the three settings per backend and round (culling and skipping change no pixel,
 SPEC 8) and exits 1 if not.
@@ -102,7 +102,7 @@ def main():
     print(f"{a.rounds} interleaved rounds, {a.size}, {a.warmup} warm-up steps then one render step of {a.frames} "
           f"frames per camera; render_splat fps = 1000 / the run's median frame ms, median [min max] over rounds; "
           f"1-minute load {min(loads):.1f}..{max(loads):.1f}; {time.time() - t0:.0f} s in all. "
-          f"Thesis: seed 000 Tables 8.2-8.4, {THESIS_GPU}, one figure per scene.\n")
+          f"Thesis: Fizimayer's thesis, Tables 8.2-8.4, {THESIS_GPU}, one figure per scene.\n")
     table = {}
     for b in backends:
         dev = runs[b][scenes[0]]["none"][0]["device"]
@@ -131,7 +131,7 @@ def main():
         print("MISMATCH", m)
     if a.json:
         Path(a.json).write_text(json.dumps({
-            "what": "seed 000 Tables 8.2-8.4 on every backend (tools/thesis_tables.py)",
+            "what": "Fizimayer's thesis, Tables 8.2-8.4 on every backend (tools/thesis_tables.py)",
             "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "size": a.size, "rounds": a.rounds,
             "warmup_steps": a.warmup, "frames_per_step": a.frames, "loads": loads,
             "thesis": {"gpu": THESIS_GPU, "fps_none_vfd_vfd_ess": THESIS},

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Seed 000 section 8.1.2 ("computation over multiple frames") on every backend (issue 15 item 1).
+"""Fizimayer's thesis, section 8.1.2 ("computation over multiple frames") on every backend (issue 15 item 1).
 
 Runs thesis-medium (256x256x32, the automaton, shade and shadow, render_splat with its two cameras) with
 render.slices_per_frame = 0 (the whole step in one frame), 1, 4 and 32, rendering every step after the warm-up,
@@ -101,7 +101,7 @@ def main():
                     print(f"{b} slices {s}: failed ({e.returncode}); skipped", file=sys.stderr)
                 print(f"round {rnd} slices {s} {b} done", file=sys.stderr)
     bad = False
-    print(f"# Seed 000 section 8.1.2 on every backend: thesis-medium, {a.size}, {a.steps} timed steps x "
+    print(f"# Fizimayer's thesis, section 8.1.2 on every backend: thesis-medium, {a.size}, {a.steps} timed steps x "
           f"{a.rounds} rounds\n")
     for b in backends:
         if not runs[b][0]:

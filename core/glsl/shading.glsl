@@ -83,7 +83,7 @@ float GroundShadow(uint beer, float opticalDepthPerD, float kappa, float d) {
     return beer != 0u ? ExpNonPositive(depth) : thesis;
 }
 
-// Wang's ground shadow, seed 002 eq. 19 (core/Shading.h WangShadow): T_S is the
+// Wang's ground shadow, Wang, Ji and Zhang, eq. 19 (core/Shading.h WangShadow): T_S is the
 // column's opacity along the sun, T_2D = 0, C = coverage, D_w = densityFactor.
 float WangShadow(float opticalDepthPerD, float coverage, float densityFactor, float d) {
     precise float depth = -opticalDepthPerD * d;

@@ -18,13 +18,15 @@ SVG, images embedded) from any of results.json, conform.json, accuracy.json
 and sweep.json (recognised by their "format"; a folder stands for those of
 them it holds) and a perf history (JSON Lines of cloudbench-perf/1 records):
 the provenance and the verdict with its exit code, the stage x backend
-conformance matrix, per-stage timing tables beside the seeds' figures, box
-plots of the per-step times, history plots, the accuracy Pareto plots, the
-rendered frames with their difference images, and each input's own tables.
+conformance matrix, per-stage timing tables beside the source documents'
+figures, box plots of the per-step times, history plots, the accuracy Pareto
+plots, the rendered frames with their difference images, and each input's own
+tables.
 
   -o, --output FILE   the page to write (default report.html)
-  --history FILE      a perf history; lines that are not records are skipped
-                      with a warning
+  --history FILE      a perf history; lines that are not JSON are skipped
+                      with a warning, a record that breaks the format is
+                      an error
 
 Exits 0 when the page is written (whatever the verdict it shows), 1 when it
 cannot be written, 2 for a bad command line (no input), 3 for an input that

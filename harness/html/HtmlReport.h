@@ -1,6 +1,6 @@
 // What `cloudbench report` shows, built as a report model (harness/ReportModel.h)
 // from the JSON outputs of run, conform, accuracy and sweep (docs/results.md),
-// a perf history (JSON Lines of cloudbench-perf/1 records) and the seeds'
+// a perf history (JSON Lines of cloudbench-perf/1 records) and the source documents'
 // timing figures (docs/seed-timings.json), then rendered by
 // harness/html/HtmlRender.h. docs/cli.md describes the page.
 #pragma once
@@ -44,7 +44,7 @@ Verdict VerdictOf(const ReportInput& input);
 // Of several: 0 when every one is 0, else the first non-zero code in the order 1, 5, 4.
 int CombinedExitCode(const std::vector<Verdict>& verdicts);
 
-// The seeds' figures compiled in from docs/seed-timings.json.
+// The source documents' figures compiled in from docs/seed-timings.json.
 const nlohmann::json& SeedTimings();
 
 // The frames of a results.json (the PNGs its "files" list, beside it) and,
@@ -56,7 +56,7 @@ const nlohmann::json& SeedTimings();
 std::vector<report::Block> FrameBlocks(const ReportInput& results);
 
 // The whole page's model: provenance and verdict, the conformance matrix,
-// timing tables with the seeds' figures, timing distributions, history plots
+// timing tables with the source documents' figures, timing distributions, history plots
 // (change points marked where a record lists them in "change_points"), the
 // accuracy Pareto plots, the frames, then each input's own report block.
 report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::vector<nlohmann::json>& history,

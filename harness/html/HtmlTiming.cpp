@@ -1,6 +1,6 @@
 // The timing parts of `cloudbench report` (harness/html/ReportSections.h): a
-// results.json's stage times beside the seeds' figures, their box plots, and
-// the seeds' own table.
+// results.json's stage times beside the source documents' figures, their box plots, and
+// the source documents' own table.
 #include <algorithm>
 
 #include "cloudbench_seed_timings.h"
@@ -47,7 +47,7 @@ std::string SeedText(const json& figure) {
            ", " + Str(figure, "table") + ", " + Str(source, "hardware") + ")";
 }
 
-// The seeds' figures for a stage of a run of `scene`: those for every scene, and those for this one.
+// The source documents' figures for a stage of a run of `scene`: those for every scene, and those for this one.
 std::vector<std::string> SeedFiguresFor(const std::string& stage, const std::string& scene) {
     std::vector<std::string> out;
     for (const json& f : Arr(SeedTimings(), "figures")) {
@@ -66,7 +66,7 @@ Table TimingTable(const json& doc) {
         columns.push_back(Column(b + " median").Real("%.3f").Unit("ms"));
         columns.push_back(Column(b + " q1-q3").Unit("ms"));
     }
-    columns.push_back(Column("seeds' figures"));
+    columns.push_back(Column("source documents' figures"));
     Table table(columns);
     for (const std::string& stage : ResultStages(doc)) {
         std::vector<Cell> row = {stage};

@@ -1,6 +1,6 @@
 // The parts of `cloudbench report`'s page that BuildReport (HtmlReport.cpp)
 // assembles, one file each (internal to harness/html): timing tables, the
-// seeds' figures and timing distributions (HtmlTiming.cpp), history plots
+// source documents' figures and timing distributions (HtmlTiming.cpp), history plots
 // (HtmlHistory.cpp) and the accuracy Pareto plots (HtmlPareto.cpp).
 #pragma once
 
@@ -13,7 +13,7 @@
 
 namespace cb::html {
 
-// A results.json's stage times per backend (median, q1-q3) beside the seeds' figures for each stage.
+// A results.json's stage times per backend (median, q1-q3) beside the source documents' figures for each stage.
 report::Table TimingTable(const nlohmann::json& doc);
 // Every figure of docs/seed-timings.json, and the document and setup of each seed.
 report::Table SeedTable();

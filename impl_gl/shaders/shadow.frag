@@ -4,7 +4,7 @@ layout(binding = 0) uniform sampler2DArray d;
 uniform ivec2 size;
 uniform ivec2 base;      // floor of the offset
 uniform vec2 fraction;   // its fraction
-uniform int form;        // ShadowForm: 0 beer exp(-k D), 1 thesis 1 - clamp(kappa D), 2 wang (seed 002 eq. 19)
+uniform int form;        // ShadowForm: 0 beer exp(-k D), 1 thesis 1 - clamp(kappa D), 2 wang (Wang, Ji and Zhang, eq. 19)
 uniform float opticalDepthPerD;
 uniform float kappa;
 uniform float coverage, densityFactor;  // wang

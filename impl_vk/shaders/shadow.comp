@@ -11,7 +11,7 @@ layout(push_constant) uniform Params {
     uint nx, ny;
     int bx, by;        // floor of the offset
     float fx, fy;      // its fraction
-    uint form;         // ShadowForm: 0 beer exp(-k D), 1 thesis 1 - clamp(kappa D), 2 wang (seed 002 eq. 19)
+    uint form;         // ShadowForm: 0 beer exp(-k D), 1 thesis 1 - clamp(kappa D), 2 wang (Wang, Ji and Zhang, eq. 19)
     float opticalDepthPerD, kappa;
     uint noSun;        // 1: G = 1
     float coverage, densityFactor;  // wang
