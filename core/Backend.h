@@ -4,7 +4,7 @@
 //
 // Data lives in backend-owned Buffers whose internal layout is the backend's
 // business (the CPU packs bit fields 64 voxels to a word). Upload and Download
-// convert to and from the canonical layout of SPEC.md section 0, so the harness
+// convert to and from the canonical layout of SPEC 0 (docs/contract.md), so the harness
 // can feed any stage another backend's output (stage-isolated conformance) and
 // time transfers apart from stages. Every stage call returns when its outputs
 // are complete. No exceptions cross this interface: failures come back as Status.

@@ -1,4 +1,4 @@
-// Grid sizes and voxel indexing (SPEC.md section 0).
+// Grid sizes and voxel indexing (SPEC 0 (docs/contract.md)).
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-// The algorithm of the simulation stages (SPEC.md sections 2-5), in one place.
+// The algorithm of the simulation stages (docs/contract.md sections 2-5), in one place.
 // Backends keep only their schedule (threading, packing, tiling); the numbers
 // they compute come from here (C++) or from the GLSL twins under core/glsl/.
 #pragma once

@@ -1,4 +1,4 @@
-// The algorithm of the lighting stages (SPEC.md sections 6-9): sun direction,
+// The algorithm of the lighting stages (docs/contract.md sections 6-9): sun direction,
 // principal axis, per-slice attenuation, phase functions, storage rounding,
 // and the splat kernel. Backends keep only their schedule.
 #pragma once

@@ -1,4 +1,4 @@
-// The one list of pipeline stages (SPEC.md sections 2-10a). Each name is also
+// The one list of pipeline stages (docs/contract.md sections 2-10a). Each name is also
 // the timing label, the dump name and the report row, so a stage is spelled the
 // same everywhere: scene files, results.json, tables and test names.
 //
@@ -54,7 +54,7 @@ constexpr std::string_view StageName(Stage stage) {
     return "?";
 }
 
-// The section of SPEC.md that is the stage's contract ("2" ... "10a").
+// The section of docs/contract.md that is the stage's contract ("2" ... "10a").
 constexpr std::string_view StageSpecSection(Stage stage) {
     switch (stage) {
 #define CB_STAGE_SPEC(name, text, spec, splat) \

@@ -1,5 +1,5 @@
 // cloudbench: cross-backend validation and benchmark harness for the cloud
-// pipeline of SPEC.md. The registry loop: finds the command named by argv[1]
+// pipeline of docs/contract.md. The registry loop: finds the command named by argv[1]
 // (harness/commands/), parses its options, prints help, runs it. docs/cli.md
 // describes the commands.
 #include <cstdio>

@@ -1,5 +1,5 @@
 // The items' own properties for SPEC 12's suite (tests/Spec12Checks.h), each
-// hand-derived from SPEC.md and docs/pipeline.md.
+// hand-derived from docs/contract.md and docs/pipeline.md.
 #include "tests/Spec12Checks.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // The items' own properties for SPEC 12's suite (tests/Spec12ExtremesTest.cpp),
-// each hand-derived from SPEC.md and docs/pipeline.md, and the scene values
+// each hand-derived from docs/contract.md and docs/pipeline.md, and the scene values
 // the items are built from. Defined in tests/Spec12Checks.cpp.
 #pragma once
 

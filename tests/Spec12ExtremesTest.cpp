@@ -5,7 +5,7 @@
 // descriptors, so a new stage's outputs are checked too) is downloaded in
 // canonical form and checked: no NaN or Inf, within the resource's documented
 // range, 0/1 for bit fields and occupancy, T never subnormal; then the item's
-// own property, hand-derived from SPEC.md and docs/pipeline.md.
+// own property, hand-derived from docs/contract.md and docs/pipeline.md.
 //
 // The generic checks are in tests/Spec12Outputs.cpp, the items' own
 // properties in tests/Spec12Checks.cpp, the soak in tests/Spec12SoakTest.cpp.

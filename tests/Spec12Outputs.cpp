@@ -1,5 +1,5 @@
 // SPEC 12's generic checks (tests/Spec12Outputs.h): every output array of a
-// step, downloaded and checked against the range SPEC.md documents for it.
+// step, downloaded and checked against the range docs/contract.md documents for it.
 #include "tests/Spec12Outputs.h"
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 """Checks a `cloudbench dump` with NumPy, independently of the C++ code.
 
 For every step folder it checks shapes and dtypes, then recomputes from the
-dumped inputs, with NumPy written from SPEC.md alone:
+dumped inputs, with NumPy written from docs/contract.md alone:
   - q from cld (binomial smoothing, zero outside the grid), bit for bit;
   - D as the column sums of q, tiles and bands from q;
   - the automaton step t -> t+1 from (hum, act, cld, region) at step t,

@@ -3,7 +3,7 @@
 
 For every step folder: T_ref.npy is float32 (nz, ny, nx) and shadow_ref.npy
 float32 (1, ny, nx), both in [0, 1]; then, from the dumped q alone, a plain 3-D
-voxel walk (Amanatides-Woo) written here from SPEC.md recomputes the optical
+voxel walk (Amanatides-Woo) written here from docs/contract.md recomputes the optical
 depth toward the sun for a random sample of voxels (counted from where the ray
 leaves the voxel, docs/accuracy.md) and of ground cells, and compares
 exp(-sigma h tau) within 1e-5.
