@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "registry/Registry.h"
 #if CLOUDBENCH_HAVE_VK
@@ -13,15 +15,38 @@
 
 namespace cb::test {
 
-// The backend named `name` with the Khronos validation layer on ("gl_rgba8":
-// gl with the automaton in the thesis's RGBA8 layout); an Error says why it
-// cannot start here (the caller skips).
-inline Result<std::unique_ptr<Backend>> MakeTestBackend(const std::string& name) {
+// The backends a backend-parametrised suite runs on: every backend this build
+// has. The one list of the tests; a suite names it instead of spelling backends.
+inline std::vector<std::string> TestBackends() { return BuiltBackends(); }
+
+// TestBackends(), and gl once more as "gl_rgba8" (the automaton in the
+// thesis's RGBA8 layout), for the suites that run the automaton.
+inline std::vector<std::string> TestBackendsAndCaLayouts() {
+    std::vector<std::string> names = TestBackends();
+    if (std::find(names.begin(), names.end(), "gl") != names.end()) names.push_back("gl_rgba8");
+    return names;
+}
+
+// What a test backend named `name` is made of: the registry's name and the
+// options, with the Khronos validation layer on (the tests expect no message).
+struct TestBackendSetup {
+    std::string backend;
     BackendOptions options;
-    options.vkValidation = true;  // the tests expect no message
-    const bool rgba8 = name == "gl_rgba8";
-    if (rgba8) options.glCaLayout = gl::CaLayout::Rgba8;
-    return CreateBackend(rgba8 ? "gl" : name, options);
+};
+inline TestBackendSetup SetupOf(const std::string& name) {
+    TestBackendSetup setup{name, {}};
+    setup.options.vkValidation = true;
+    if (name == "gl_rgba8") {
+        setup.backend = "gl";
+        setup.options.glCaLayout = gl::CaLayout::Rgba8;
+    }
+    return setup;
+}
+
+// The backend named `name` (SetupOf); an Error says why it cannot start here (the caller skips).
+inline Result<std::unique_ptr<Backend>> MakeTestBackend(const std::string& name) {
+    const TestBackendSetup setup = SetupOf(name);
+    return CreateBackend(setup.backend, setup.options);
 }
 
 // Expects that a Vulkan backend's validation layer reported nothing; any other backend passes.

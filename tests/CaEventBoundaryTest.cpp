@@ -279,7 +279,7 @@ TEST_P(CaEventBoundaryBackend, ActivationAtThreshold) { RunStepCases(EbEvent::Ac
 TEST_P(CaEventBoundaryBackend, InitialHumidityAtThreshold) { RunInitCases(kStreamHumidity); }
 TEST_P(CaEventBoundaryBackend, InitialActivationAtThreshold) { RunInitCases(kStreamActivation); }
 
-INSTANTIATE_TEST_SUITE_P(Backends, CaEventBoundaryBackend, ::testing::Values("cpu", "vk", "gl", "gl_rgba8"),
+INSTANTIATE_TEST_SUITE_P(Backends, CaEventBoundaryBackend, ::testing::ValuesIn(cb::test::TestBackendsAndCaLayouts()),
                          [](const auto& info) { return std::string(info.param); });
 
 }  // namespace

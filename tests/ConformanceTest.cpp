@@ -6,6 +6,7 @@
 // splat renderer and the whole pipeline, and shares this instantiation.
 #include <gtest/gtest.h>
 
+#include "tests/BackendTestUtil.h"
 #include "tests/ConformanceFixture.h"
 
 namespace cb::conformance {
@@ -217,9 +218,12 @@ TEST_P(Conformance, DensityLargeTilesAndManyBands) {
 }
 
 std::vector<BackendVariant> AllBackends() {
-    BackendOptions rgba8;
-    rgba8.glCaLayout = gl::CaLayout::Rgba8;
-    return {{"cpu", {}}, {"vk", {}}, {"gl", {}}, {"gl", rgba8}};
+    std::vector<BackendVariant> variants;
+    for (const std::string& name : test::TestBackendsAndCaLayouts()) {
+        const test::TestBackendSetup setup = test::SetupOf(name);
+        variants.push_back({setup.backend, setup.options});
+    }
+    return variants;
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "harness/Report.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/BackendVk.h"
@@ -294,7 +295,7 @@ TEST_P(GroundRender, MatchesCpu) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Ground, GroundRender,
-                         ::testing::Combine(::testing::Values("cpu", "gl", "vk"),
+                         ::testing::Combine(::testing::ValuesIn(cb::test::TestBackends()),
                                             ::testing::Values(Renderer::Splat, Renderer::March)),
                          [](const ::testing::TestParamInfo<GroundParam>& info) {
                              return std::string(std::get<1>(info.param) == Renderer::Splat ? "Splat" : "March") + "_" +

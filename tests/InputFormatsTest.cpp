@@ -64,7 +64,7 @@ TEST_F(InputFileTest, DevicesFoldersAndMissingFiles) {
 
 // Test that a file over its kind's size is refused with both numbers, and one at the size is read whole.
 TEST_F(InputFileTest, SizeLimit) {
-    constexpr InputKind kTiny{"a tiny file", 8};
+    constexpr InputKind kTiny{"a tiny file", 8, 1};
     const std::string at = Write("eight", "12345678"), over = Write("nine", "123456789");
     ASSERT_TRUE(ReadInputFile(at, kTiny));
     EXPECT_EQ(*ReadInputFile(at, kTiny), "12345678");

@@ -18,6 +18,7 @@
 #include "harness/Report.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/BackendVk.h"
@@ -234,7 +235,7 @@ TEST_P(MarchConformance, OptionMatrix) {
 }
 
 INSTANTIATE_TEST_SUITE_P(RenderMarch, MarchConformance,
-                         ::testing::Combine(::testing::Values("cpu", "vk", "gl"),
+                         ::testing::Combine(::testing::ValuesIn(cb::test::TestBackends()),
                                             ::testing::Values(MarchGrid{"Small32x32x16", {32, 32, 16}},
                                                               MarchGrid{"Odd31x29x13", {31, 29, 13}},
                                                               MarchGrid{"Thin1x1x9", {1, 1, 9}})),

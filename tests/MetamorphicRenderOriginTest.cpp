@@ -69,7 +69,7 @@ TEST_P(MetamorphicOrigin, MovingTheOriginChangesNothing) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, MetamorphicOrigin, ::testing::Values("cpu", "vk", "gl"),
+INSTANTIATE_TEST_SUITE_P(Backends, MetamorphicOrigin, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace

@@ -298,7 +298,7 @@ TEST(MetamorphicRender, CulledBoxesHoldNoVisibleSplat) {
     EXPECT_GT(nearMisses, 100u);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, MetamorphicRenderBackend, ::testing::Values("cpu", "vk", "gl"),
+INSTANTIATE_TEST_SUITE_P(Backends, MetamorphicRenderBackend, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace

@@ -379,9 +379,9 @@ TEST_P(Rotation, EllipsoidListUpdateTurnsWithTheGrid) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Rotation, ::testing::Values("cpu", "vk", "gl"),
+INSTANTIATE_TEST_SUITE_P(Backends, Rotation, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return std::string(info.param); });
-INSTANTIATE_TEST_SUITE_P(Backends, RotationCa, ::testing::Values("cpu", "vk", "gl", "gl_rgba8"),
+INSTANTIATE_TEST_SUITE_P(Backends, RotationCa, ::testing::ValuesIn(cb::test::TestBackendsAndCaLayouts()),
                          [](const auto& info) { return std::string(info.param); });
 
 }  // namespace

@@ -168,7 +168,9 @@ void ExpectSameSteps(const std::vector<SavedRunView>& expected, const std::vecto
         }
         EXPECT_EQ(b.cover, a.cover);
         EXPECT_EQ(b.frames, a.frames);
-        if (same == SameAs::Bits || t > split) EXPECT_EQ(b.frameStats, a.frameStats) << "splats, voxels visited, fragments";
+        if (same == SameAs::Bits || t > split) {
+            EXPECT_EQ(b.frameStats, a.frameStats) << "splats, voxels visited, fragments";
+        }
         for (Stage stage : kAllStages)
             EXPECT_EQ(b.skipped[size_t(stage)], a.skipped[size_t(stage)]) << StageName(stage) << " skipped";
     }
@@ -257,7 +259,7 @@ TEST_P(SimulationStateSplit, SplitRunOfAStillField) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, SimulationStateSplit, ::testing::ValuesIn(BuiltBackends()),
+INSTANTIATE_TEST_SUITE_P(Backends, SimulationStateSplit, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return info.param; });
 
 // Saved on one backend, resumed on another: the state is backend-neutral (canonical bytes, host state in JSON).
@@ -286,8 +288,8 @@ TEST_P(SimulationStateAcross, ResumedOnAnotherBackend) {
 
 std::vector<std::pair<std::string, std::string>> BackendPairs() {
     std::vector<std::pair<std::string, std::string>> pairs;
-    for (const std::string& a : BuiltBackends())
-        for (const std::string& b : BuiltBackends())
+    for (const std::string& a : cb::test::TestBackends())
+        for (const std::string& b : cb::test::TestBackends())
             if (a != b && (a == "cpu" || b == "cpu")) pairs.push_back({a, b});
     return pairs;
 }

@@ -203,9 +203,9 @@ TEST_P(SparseOddSizeCa, GrowthFromOneActBit) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, SparseOddSize, ::testing::Values("cpu", "vk", "gl"),
+INSTANTIATE_TEST_SUITE_P(Backends, SparseOddSize, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return std::string(info.param); });
-INSTANTIATE_TEST_SUITE_P(Backends, SparseOddSizeCa, ::testing::Values("cpu", "vk", "gl", "gl_rgba8"),
+INSTANTIATE_TEST_SUITE_P(Backends, SparseOddSizeCa, ::testing::ValuesIn(cb::test::TestBackendsAndCaLayouts()),
                          [](const auto& info) { return std::string(info.param); });
 
 }  // namespace

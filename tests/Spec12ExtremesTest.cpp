@@ -23,6 +23,7 @@
 #include "core/Scene.h"
 #include "core/StageDescriptors.h"
 #include "harness/Simulation.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/Spec12Checks.h"
 #include "tests/Spec12Outputs.h"
 
@@ -249,7 +250,7 @@ TEST_P(Spec12Extremes, EveryItemEveryOutputFiniteAndInRange) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Spec12Extremes, ::testing::Values("cpu", "gl", "vk"),
+INSTANTIATE_TEST_SUITE_P(Backends, Spec12Extremes, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace cb::spec12_test

@@ -18,6 +18,7 @@
 #include "core/Shading.h"
 #include "core/StageDescriptors.h"
 #include "harness/Simulation.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/SceneTestUtil.h"
 #include "tests/Spec12Checks.h"
 #include "tests/Spec12Outputs.h"
@@ -219,7 +220,7 @@ TEST_P(FiniteBounds, EveryExtremeAtItsBoundFinite) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, FiniteBounds, ::testing::Values("cpu", "gl", "vk"),
+INSTANTIATE_TEST_SUITE_P(Backends, FiniteBounds, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 // Test the phase peak's bound against what it promises (core/Shading.h kMaxPhasePeak): for every float g in

@@ -14,6 +14,7 @@
 #include "core/Random.h"
 #include "core/Scene.h"
 #include "harness/Simulation.h"
+#include "tests/BackendTestUtil.h"
 #include "tests/Spec12Outputs.h"
 #include "tests/TestUtil.h"
 
@@ -131,7 +132,7 @@ TEST_P(Spec12Soak, TenThousandStepsCoverInBandMemoryFlat) {
                 sumCover / kSoakSteps / columns, sumLower / kSoakSteps / columns, sumUpper / kSoakSteps / columns);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Spec12Soak, ::testing::Values("cpu", "gl", "vk"),
+INSTANTIATE_TEST_SUITE_P(Backends, Spec12Soak, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace cb::spec12_test

@@ -124,7 +124,7 @@ TEST_P(TimeSliceLoop, EveryStepEqualsTheUnslicedLoop) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceLoop, ::testing::ValuesIn(BuiltBackends()),
+INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceLoop, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return info.param; });
 
 // A CPU backend that keeps the alpha of every splat call.

@@ -334,7 +334,7 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceStages, ::testing::ValuesIn(BuiltBackends()),
+INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceStages, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return info.param; });
 INSTANTIATE_TEST_SUITE_P(GlRgba8, TimeSliceStages, ::testing::Values(std::string("gl_rgba8")),
                          [](const auto& info) { return info.param; });
