@@ -3,8 +3,10 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "harness/Isolation.h"
 #include "harness/StageParams.h"
@@ -72,8 +74,78 @@ Buffer* PreviousOrCurrent(const StageBuffers& io, Resource r) {
     return io.Previous(r) ? io.Previous(r) : io.Current(r);
 }
 
-Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
-                         StageCallRecord& record) {
+// One adapter per stage: makes the stage's parameters from the scene, picks
+// its buffers and makes the backend call. kStageCalls expands CB_STAGES, so a
+// stage without its adapter does not compile.
+using StageAdapter = Status (*)(Backend& backend, const Scene& sc, const StageHostInputs& host,
+                                const StageBuffers& io, StageCallRecord& record);
+
+// Runs `call` timed as stage `stage`'s one call of this step.
+template <typename Fn>
+Status TimedStage(Stage stage, Backend& backend, const StageHostInputs& host, StageCallRecord& record, Fn&& call) {
+    const std::string backendName = backend.Name();  // the label holds a view of it
+    const StageCountLabel label{StageName(stage), backendName, host.step, ""};
+    return Timed(backend, record, label, host.markBatch, std::nullopt, call);
+}
+
+Status CallRegion(Backend& backend, const Scene&, const StageHostInputs& host, const StageBuffers& io,
+                  StageCallRecord& record) {
+    return TimedStage(Stage::Region, backend, host, record,
+                      [&] { return backend.Region(host.raster, *io.Current(Resource::Region), host.slices); });
+}
+
+Status CallCa(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+              StageCallRecord& record) {
+    CaStepParams params = MakeCaStepParams(sc, host.step);
+    std::vector<int32_t> shiftX, shiftY;
+    if (sc.ca.HasWind())
+        for (const SliceShift& s : sc.ca.windShift) shiftX.push_back(s.sx), shiftY.push_back(s.sy);
+    params.shiftX = shiftX;
+    params.shiftY = shiftY;
+    params.slices = host.slices;
+    const ConstCaFields in{io.Current(Resource::Hum), io.Current(Resource::Act), io.Current(Resource::Cld)};
+    const CaFields out{io.Next(Resource::Hum), io.Next(Resource::Act), io.Next(Resource::Cld)};
+    return TimedStage(Stage::Ca, backend, host, record,
+                      [&] { return backend.CaStep(params, in, *io.Current(Resource::Region), out); });
+}
+
+Status CallSmooth(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                  StageCallRecord& record) {
+    return TimedStage(Stage::Smooth, backend, host, record, [&] {
+        return backend.Smooth(sc.smooth.radius, *io.Current(Resource::Cld), *io.Current(Resource::Q), host.slices);
+    });
+}
+
+Status CallDensity(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                   StageCallRecord& record) {
+    DensityOutputs out{io.Current(Resource::ColumnSum), io.Current(Resource::Tiles), io.Current(Resource::Bands), 0};
+    DensityParams params = MakeDensityParams(sc);
+    params.slices = host.slices;
+    CB_TRY(TimedStage(Stage::Density, backend, host, record, [&] {
+        return backend.Density(params, *io.Current(Resource::Q), io.Current(Resource::Cld), out);
+    }));
+    record.coveredColumns = out.coveredColumns;
+    return {};
+}
+
+Status CallShade(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                 StageCallRecord& record) {
+    ShadeParams p = MakeShadeParams(sc, host.step);
+    p.slices = host.slices;
+    return TimedStage(Stage::Shade, backend, host, record,
+                      [&] { return backend.Shade(p, *io.Current(Resource::Q), *io.Current(Resource::T)); });
+}
+
+Status CallShadow(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                  StageCallRecord& record) {
+    const ShadowParams p = MakeShadowParams(sc, host.step);
+    return TimedStage(Stage::Shadow, backend, host, record, [&] {
+        return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow));
+    });
+}
+
+Status CallRenderSplat(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                       StageCallRecord& record) {
     return RenderEachCamera(
         Stage::RenderSplat, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
             SplatParams p = MakeSplatParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
@@ -90,8 +162,8 @@ Status RenderSplatFrames(Backend& backend, const Scene& sc, const StageHostInput
         });
 }
 
-Status RenderMarchFrames(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
-                         StageCallRecord& record) {
+Status CallRenderMarch(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                       StageCallRecord& record) {
     return RenderEachCamera(
         Stage::RenderMarch, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
             const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
@@ -103,61 +175,24 @@ Status RenderMarchFrames(Backend& backend, const Scene& sc, const StageHostInput
         });
 }
 
+Status CallNoise(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                 StageCallRecord& record) {
+    const NoiseParams p = MakeNoiseParams(sc, host.step);
+    return TimedStage(Stage::Noise, backend, host, record,
+                      [&] { return backend.Noise(p, *io.Current(Resource::Q)); });
+}
+
+// Indexed by Stage, in CB_STAGES order.
+constexpr StageAdapter kStageCalls[] = {
+#define CB_STAGE_CALL(name, text, spec, splat) &Call##name,
+    CB_STAGES(CB_STAGE_CALL)
+#undef CB_STAGE_CALL
+};
+static_assert(std::size(kStageCalls) == kStageCount, "one adapter per stage");
+
 Status Call(Stage stage, Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
             StageCallRecord& record) {
-    const std::string backendName = backend.Name();
-    const StageCountLabel label{StageName(stage), backendName, host.step, ""};
-    auto timed = [&](auto&& call) { return Timed(backend, record, label, host.markBatch, std::nullopt, call); };
-    switch (stage) {
-        case Stage::Region:
-            return timed([&] { return backend.Region(host.raster, *io.Current(Resource::Region), host.slices); });
-        case Stage::Ca: {
-            CaStepParams params = MakeCaStepParams(sc, host.step);
-            std::vector<int32_t> shiftX, shiftY;
-            if (sc.ca.HasWind())
-                for (const SliceShift& s : sc.ca.windShift) shiftX.push_back(s.sx), shiftY.push_back(s.sy);
-            params.shiftX = shiftX;
-            params.shiftY = shiftY;
-            params.slices = host.slices;
-            const ConstCaFields in{io.Current(Resource::Hum), io.Current(Resource::Act), io.Current(Resource::Cld)};
-            const CaFields out{io.Next(Resource::Hum), io.Next(Resource::Act), io.Next(Resource::Cld)};
-            return timed([&] { return backend.CaStep(params, in, *io.Current(Resource::Region), out); });
-        }
-        case Stage::Smooth:
-            return timed([&] {
-                return backend.Smooth(sc.smooth.radius, *io.Current(Resource::Cld), *io.Current(Resource::Q),
-                                      host.slices);
-            });
-        case Stage::Density: {
-            DensityOutputs out{io.Current(Resource::ColumnSum), io.Current(Resource::Tiles),
-                               io.Current(Resource::Bands), 0};
-            DensityParams params = MakeDensityParams(sc);
-            params.slices = host.slices;
-            CB_TRY(timed(
-                [&] { return backend.Density(params, *io.Current(Resource::Q), io.Current(Resource::Cld), out); }));
-            record.coveredColumns = out.coveredColumns;
-            return {};
-        }
-        case Stage::Shade: {
-            ShadeParams p = MakeShadeParams(sc, host.step);
-            p.slices = host.slices;
-            return timed([&] { return backend.Shade(p, *io.Current(Resource::Q), *io.Current(Resource::T)); });
-        }
-        case Stage::Shadow: {
-            const ShadowParams p = MakeShadowParams(sc, host.step);
-            return timed(
-                [&] { return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow)); });
-        }
-        case Stage::RenderSplat:
-            return RenderSplatFrames(backend, sc, host, io, record);
-        case Stage::Noise: {
-            const NoiseParams p = MakeNoiseParams(sc, host.step);
-            return timed([&] { return backend.Noise(p, *io.Current(Resource::Q)); });
-        }
-        case Stage::RenderMarch:
-            return RenderMarchFrames(backend, sc, host, io, record);
-    }
-    return MakeError("the harness cannot call stage '" + std::string(StageName(stage)) + "' yet");
+    return kStageCalls[size_t(stage)](backend, sc, host, io, record);
 }
 
 // The test-only slowdown switch, CLOUDBENCH_TEST_SLOWDOWN=<stage>:<factor>
