@@ -4,7 +4,7 @@
 #             libcloudbench_images.so, the libraries they need, scenes/) into .gpu/ with an env.sh
 # GPU host:   . .gpu/env.sh && tools/gpu_issue16.sh "$OUT"      (carry .gpu; $OUT comes back)
 # Writes to DIR (default /tmp/gpu16): devices.txt, conform-*.txt, run-*.txt with their results.json,
-# gtest-*.txt, and summary.txt, the lines to copy beside issue 16's table in docs/performance.md
+# gtest-*.txt, and summary.txt, the lines for a new dated report under reports/perf/
 # ("H200, after issue 16"). Every command has its own time limit, so one that hangs costs only itself.
 set -uo pipefail
 out=${1:-/tmp/gpu16}
