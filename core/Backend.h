@@ -144,6 +144,16 @@ struct NoiseParams {
     Extent3 grid;                             // must equal q's extent
 };
 
+// The shaded grid's coarsening f (SPEC 6: shade.resolution), the one list the
+// scene reader and every backend check against.
+inline constexpr int64_t kShadeResolutions[] = {1, 2, 4};
+inline constexpr const char* kShadeResolutionsText = "1, 2 or 4";
+inline bool IsShadeResolution(int64_t f) {
+    for (const int64_t allowed : kShadeResolutions)
+        if (f == allowed) return true;
+    return false;
+}
+
 // Inputs of the shade stage (SPEC 6) besides q.
 struct ShadeParams {
     Vec3 sun{0, 0, 1};  // unit vector toward the sun
@@ -152,7 +162,7 @@ struct ShadeParams {
     float voxelSize = 50;  // h, metres
     float thesisAr = 0.9f;
     SampleFilter filter = SampleFilter::Bilinear;
-    int resolution = 1;  // 1, 2 or 4
+    int resolution = 1;  // one of kShadeResolutions
     StorageFormat storage = StorageFormat::Fp32;
     bool scattering = false;
     float albedo = 0.9f, solidAngle = 0.05f;

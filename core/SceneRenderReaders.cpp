@@ -6,6 +6,7 @@
 #include <string_view>
 #include <utility>
 
+#include "core/Backend.h"
 #include "core/SceneNames.h"
 #include "core/SceneReaders.h"
 
@@ -26,8 +27,6 @@ constexpr std::string_view kRenderKeys[] = {"width",    "height",      "q_min", 
                                             "every_steps", "frames_per_step", "slices_per_frame", "cameras", "ground"};
 constexpr std::string_view kGroundKeys[] = {"albedo"};
 constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
-
-constexpr int64_t kShadeResolutions[] = {1, 2, 4};
 
 constexpr int64_t kMaxImageEdge = 16384;
 constexpr int64_t kMaxFramesPerStep = 1024;
@@ -286,7 +285,7 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
         if (auto filter = check.Choice(*v, "shade.filter", kSampleFilterNames)) shade.filter = *filter;
     }
     if (const Json* v = find("resolution")) {
-        if (auto n = check.IntegerChoice(*v, "shade.resolution", kShadeResolutions, "1, 2 or 4"))
+        if (auto n = check.IntegerChoice(*v, "shade.resolution", kShadeResolutions, kShadeResolutionsText))
             shade.resolution = int(*n);
     }
     if (const Json* v = find("storage")) {

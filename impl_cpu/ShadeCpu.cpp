@@ -469,7 +469,7 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
 
 Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
     const int f = params.resolution;
-    if (f != 1 && f != 2 && f != 4) return MakeError("cpu: shade resolution must be 1, 2 or 4");
+    if (!IsShadeResolution(f)) return MakeError(std::string("cpu: shade resolution must be ") + kShadeResolutionsText);
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* T = static_cast<BufferCpu&>(TBuffer).F32();
     const Extent3 e = qBuffer.Extent();

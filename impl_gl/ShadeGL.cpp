@@ -15,7 +15,7 @@ namespace cb::gl {
 // preceding share), and the share ending at nw writes T.
 Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const int res = params.resolution;
-    if (res != 1 && res != 2 && res != 4) return MakeError("gl: shade resolution must be 1, 2 or 4");
+    if (!IsShadeResolution(res)) return MakeError(std::string("gl: shade resolution must be ") + kShadeResolutionsText);
     const Functions& f = mContext->F();
     auto slice = mContext->Program("shade_slice");
     if (!slice) return std::unexpected(slice.error());

@@ -43,7 +43,7 @@ uint32_t ShadeBlockSteps(int u0, int v0) {
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const int f = params.resolution;
-    if (f != 1 && f != 2 && f != 4) return MakeError("vk: shade resolution must be 1, 2 or 4");
+    if (!IsShadeResolution(f)) return MakeError(std::string("vk: shade resolution must be ") + kShadeResolutionsText);
     const Extent3 e = q.Extent();
     const ShadePlan plan = MakeShadePlan(params, e);
     const uint32_t* n = plan.cells;
