@@ -153,6 +153,11 @@ inline bool IsShadeResolution(int64_t f) {
         if (f == allowed) return true;
     return false;
 }
+// What a shade stage answers for a resolution outside kShadeResolutions: "BACKEND: shade resolution must be ...".
+inline Status CheckShadeResolution(std::string_view backend, int64_t f) {
+    if (IsShadeResolution(f)) return {};
+    return MakeError(std::string(backend) + ": shade resolution must be " + kShadeResolutionsText);
+}
 
 // Inputs of the shade stage (SPEC 6) besides q.
 struct ShadeParams {

@@ -1,4 +1,4 @@
-// Cameras and the shared back-to-front splat order (SPEC 8 (docs/contract.md)).
+// Cameras and the shared back-to-front splat order (SPEC 8, docs/contract.md).
 // Everything here runs on the host, once per frame, and is handed to every
 // backend, so all backends project and sort the same way.
 #pragma once

@@ -1,4 +1,4 @@
-// The host-side ellipsoid list (SPEC 2 (docs/contract.md); Fizimayer's thesis, section 4.3.3.5).
+// The host-side ellipsoid list (SPEC 2, docs/contract.md; Fizimayer's thesis, section 4.3.3.5).
 // It is updated once per step on the host, identically for every backend; the
 // backends only rasterise its RasterEllipsoid form.
 #pragma once

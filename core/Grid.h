@@ -1,4 +1,4 @@
-// Grid sizes and voxel indexing (SPEC 0 (docs/contract.md)).
+// Grid sizes and voxel indexing (SPEC 0, docs/contract.md).
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-// The algorithm: random numbers (SPEC 1 (docs/contract.md)). Every implementation draws
+// The algorithm: random numbers (SPEC 1, docs/contract.md). Every implementation draws
 // the same numbers from this stateless hash; the GLSL twin is core/glsl/random.glsl
 // (added with the GPU backends) and must stay identical.
 #pragma once

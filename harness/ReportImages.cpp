@@ -41,9 +41,16 @@ namespace {
 // path works for every format and for the read-back. The format is named from
 // `path`'s extension, since the /proc name has none. Errors read
 // "PATH: cannot write: <reason>"; Session::WriteAtomically adds the errno.
-Status WriteImage(const std::string& path, images::ImageView image, bool eightBit) {
+// The image module, or "PATH: cannot write: <why it cannot be loaded>".
+Result<const images::Module*> ModuleToWrite(const std::string& path) {
     auto module = images::Load();
     if (!module) return MakeError(path + ": cannot write: " + module.error().message);
+    return module;
+}
+
+Status WriteImage(const std::string& path, images::ImageView image, bool eightBit) {
+    auto module = ModuleToWrite(path);
+    if (!module) return std::unexpected(module.error());
     const std::string extension = std::filesystem::path(path).extension().string();
     const std::string format = extension.empty() ? "" : extension.substr(1);  // "png", "exr"
     return Session::WriteAtomically(path, [&](const Session::TemporaryFile& temp) -> Status {
@@ -94,8 +101,8 @@ Result<ImageComparison> CompareImages(const std::vector<float>& reference, const
 
 Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
                             const std::vector<float>& candidate, uint32_t width, uint32_t height) {
-    auto module = images::Load();
-    if (!module) return MakeError(path + ": cannot write: " + module.error().message);
+    auto module = ModuleToWrite(path);
+    if (!module) return std::unexpected(module.error());
     images::FloatImage difference;
     const std::string why = (*module)->difference(Rgb(reference, width, height), Rgb(candidate, width, height), 1.0f,
                                                   /*clamp=*/false, difference);
@@ -111,8 +118,8 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
     written.push_back(exr);
     if (png) {
         const std::string path = stem + ".png";
-        auto module = images::Load();
-        if (!module) return MakeError(path + ": cannot write: " + module.error().message);
+        auto module = ModuleToWrite(path);
+        if (!module) return std::unexpected(module.error());
         std::vector<float> mapped;
         if (toneMap) {
             mapped.resize(rgb.size());

@@ -276,8 +276,8 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     record.step = mStep;
     record.timing = mTiming;
     const bool outputStep = IsOutputStep(mStep);
-    // Everything up to the observer: the stages, then the frames between steps t-1 and t (Fizimayer's thesis, section 6.3),
-    // one per alpha of render.frames_per_step.
+    // Everything up to the observer: the stages, then the frames between steps t-1 and t (Fizimayer's thesis,
+    // section 6.3), one per alpha of render.frames_per_step.
     auto beforeObserver = [&]() -> Status {
         CB_TRY(RunStepStages(record, outputStep));
         bool renders = false;

@@ -469,7 +469,7 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
 
 Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
     const int f = params.resolution;
-    if (!IsShadeResolution(f)) return MakeError(std::string("cpu: shade resolution must be ") + kShadeResolutionsText);
+    CB_TRY(CheckShadeResolution("cpu", f));
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* T = static_cast<BufferCpu&>(TBuffer).F32();
     const Extent3 e = qBuffer.Extent();

@@ -15,7 +15,7 @@ namespace cb::gl {
 // preceding share), and the share ending at nw writes T.
 Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const int res = params.resolution;
-    if (!IsShadeResolution(res)) return MakeError(std::string("gl: shade resolution must be ") + kShadeResolutionsText);
+    CB_TRY(CheckShadeResolution("gl", res));
     const Functions& f = mContext->F();
     auto slice = mContext->Program("shade_slice");
     if (!slice) return std::unexpected(slice.error());

@@ -43,7 +43,7 @@ uint32_t ShadeBlockSteps(int u0, int v0) {
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const int f = params.resolution;
-    if (!IsShadeResolution(f)) return MakeError(std::string("vk: shade resolution must be ") + kShadeResolutionsText);
+    CB_TRY(CheckShadeResolution("vk", f));
     const Extent3 e = q.Extent();
     const ShadePlan plan = MakeShadePlan(params, e);
     const uint32_t* n = plan.cells;

@@ -134,24 +134,25 @@ std::map<std::string, Reflected> Reflect(const std::string& shader, const std::s
     return members;
 }
 
-// An expression that reads the block's first member, so that the block is live.
-std::string FirstLane(const Block& block) {
+// A compute shader holding `declaration` (a struct of `block`'s GLSL name) as
+// member `m` of a block laid out as `layout` ("std430": a storage buffer,
+// "std140": a uniform block), which reads m's first member so that the block
+// is live.
+std::string BlockShader(const std::string& declaration, const Block& block, const std::string& layout) {
     const Member& first = block.members.front();
-    return first.name + (first.glType == kGlVec4 || first.glType == kGlUvec4 ? ".x" : "");
+    const std::string lane = first.name + (first.glType == kGlVec4 || first.glType == kGlUvec4 ? ".x" : "");
+    const std::string qualifier = layout == "std430" ? "layout(std430, binding = 0) readonly buffer Block"
+                                                     : "layout(std140, binding = 0) uniform Block";
+    return "#version 450\nlayout(local_size_x = 1) in;\n" + declaration + "\n" + qualifier + " { " + block.glslName +
+           " m; };\nlayout(std430, binding = 1) writeonly buffer Out { uint o; };\n" + "void main() { o = uint(m." +
+           lane + "); }\n";
 }
 
 void ExpectSameLayout(const Block& block, const std::string& layout) {
     const std::string declaration = GlslStruct(block);
     ASSERT_FALSE(declaration.empty()) << "no `struct " << block.glslName << " { ... };` in core/glsl/" << block.file;
-    const std::string qualifier = layout == "std430" ? "layout(std430, binding = 0) readonly buffer Block"
-                                                     : "layout(std140, binding = 0) uniform Block";
-    const std::string shader = "#version 450\nlayout(local_size_x = 1) in;\n" + declaration + "\n" + qualifier + " { " +
-                               block.glslName + " m; };\n" +
-                               "layout(std430, binding = 1) writeonly buffer Out { uint o; };\n"
-                               "void main() { o = uint(m." +
-                               FirstLane(block) + "); }\n";
     std::string log;
-    const auto reflected = Reflect(shader, "m", log);
+    const auto reflected = Reflect(BlockShader(declaration, block, layout), "m", log);
     ASSERT_EQ(reflected.size(), block.members.size())
         << block.glslName << " (" << layout << "): GLSL has " << reflected.size() << " members, the C++ table "
         << block.members.size() << "; glslangValidator said:\n"
@@ -180,7 +181,7 @@ TEST(GpuBlockLayout, EveryMemberAtTheSameOffsetInCppAndGlsl) {
 // Test that the check can fail: a GLSL twin with two members swapped is caught.
 TEST(GpuBlockLayout, SwappedMembersAreCaught) {
     if (std::string(CLOUDBENCH_GLSLANG_VALIDATOR).empty()) GTEST_SKIP() << "no glslangValidator in this build";
-    Block march = Blocks().front();
+    const Block march = Blocks().front();
     std::string log;
     std::string declaration = GlslStruct(march);
     ASSERT_FALSE(declaration.empty());
@@ -189,11 +190,7 @@ TEST(GpuBlockLayout, SwappedMembersAreCaught) {
     ASSERT_NE(right, std::string::npos);
     declaration.replace(right, 11, "vec4 forward;");
     declaration.replace(forward, 13, "vec4 right;");
-    const std::string shader = "#version 450\nlayout(local_size_x = 1) in;\n" + declaration +
-                               "\nlayout(std430, binding = 0) readonly buffer Block { MarchGpu m; };\n"
-                               "layout(std430, binding = 1) writeonly buffer Out { uint o; };\n"
-                               "void main() { o = uint(m.eye.x); }\n";
-    const auto reflected = Reflect(shader, "m", log);
+    const auto reflected = Reflect(BlockShader(declaration, march, "std430"), "m", log);
     ASSERT_EQ(reflected.count("forward"), 1u) << log;
     EXPECT_NE(reflected.at("forward").offset, offsetof(MarchGpu, forward));
     EXPECT_EQ(reflected.at("forward").offset, offsetof(MarchGpu, right));

@@ -220,6 +220,31 @@ TEST_P(FiniteBounds, EveryExtremeAtItsBoundFinite) {
     }
 }
 
+// Test that a shade call with a resolution outside kShadeResolutions is refused by the backend itself (the
+// interface is also called by tests and tools, not only from a validated scene), with the backend's name, and
+// that every resolution in the list is taken.
+TEST_P(FiniteBounds, ShadeRefusesAResolutionOutsideTheList) {
+    std::string whyNot;
+    Backend* backend = BackendFor(GetParam(), whyNot);
+    if (!backend) GTEST_SKIP() << "unsupported here: " << whyNot;
+    const Extent3 e{8, 8, 4};
+    auto q = test::MakeFilled(*backend, BufferFormat::F32, e, std::vector<float>(e.Count(), 0.5f));
+    auto T = test::MakeBuffer(*backend, BufferFormat::F32, e);
+    for (const int f : {0, 3, 8, -1}) {
+        ShadeParams p;
+        p.resolution = f;
+        const Status status = backend->Shade(p, *q, *T);
+        ASSERT_FALSE(status) << "resolution " << f;
+        EXPECT_EQ(status.error().message, backend->Name() + ": shade resolution must be 1, 2 or 4");
+    }
+    for (const int64_t f : kShadeResolutions) {
+        ShadeParams p;
+        p.resolution = int(f);
+        const Status status = backend->Shade(p, *q, *T);
+        EXPECT_TRUE(status) << "resolution " << f << ": " << status.error().message;
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, FiniteBounds, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 

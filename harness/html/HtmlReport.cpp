@@ -141,7 +141,8 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
             "Median and quartiles of each stage's wall time per call over the steps after warm-up (" +
             Str(Obj(input.doc, "scene"), "steps", "?") + " steps, " +
             Str(Obj(input.doc, "scene"), "warmup_steps", "?") + " warm-up). Backends: " + backends +
-            ". The source documents' figures were measured on other hardware and scenes (the thesis's 256x32x256 volume; "
+            ". The source documents' figures were measured on other hardware and scenes (the thesis's 256x32x256 "
+            "volume; "
             "Olajos's are whole ray-marched frames): a sense of scale, not a comparison of methods."});
         timing.blocks.emplace_back(TimingTable(input.doc));
         timing.blocks.emplace_back(TimingBoxes(input));
