@@ -1,6 +1,6 @@
 # Build step for one OpenGL shader (run with cmake -P):
 #   SOURCE     impl_gl/shaders/<name>.frag (no #version line)
-#   INCLUDES   ;-list of core/glsl files to prepend
+#   INCLUDES   ;-list of core/math files to prepend
 #   OUTPUT     the .inc file to write: the full source as a C++ raw string
 #   VALIDATOR  glslangValidator, which must accept the full source
 get_filename_component(name ${SOURCE} NAME)

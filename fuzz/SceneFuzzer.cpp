@@ -12,22 +12,24 @@
 // is only done for small grids and ellipsoid counts, so that one input stays well under the -timeout.
 // Contract: no crash, no sanitizer report, no leak, and the invariants below hold; a broken invariant traps.
 #include <cmath>
-#include <cstdio>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/MemoryPlan.h"
-#include "core/Scene.h"
-#include "core/ShadePlan.h"
-#include "core/Splat.h"
-#include "core/StageDescriptors.h"
-#include "harness/StageParams.h"
+#include "core/math/Camera.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/MemoryPlan.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/pipeline/ShadePlan.h"
+#include "core/pipeline/SplatFrame.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "core/scene/Scene.h"
+#include "harness/run/StageParams.h"
 
 namespace {
 

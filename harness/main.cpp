@@ -8,10 +8,10 @@
 #include <string_view>
 #include <vector>
 
-#include "core/NamedValues.h"
-#include "core/ShownText.h"
-#include "harness/Command.h"
-#include "harness/Isolation.h"
+#include "core/base/NamedValues.h"
+#include "core/base/ShownText.h"
+#include "harness/platform/Command.h"
+#include "harness/platform/Isolation.h"
 
 namespace {
 

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <thread>
 
-#include "core/ProcessMemory.h"
-#include "core/Scene.h"
+#include "core/base/ProcessMemory.h"
+#include "core/scene/Scene.h"
 #include "impl_cpu/CaKernels.h"
 
 namespace cb::cpu {

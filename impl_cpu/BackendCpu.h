@@ -2,20 +2,20 @@
 // volumes, parallelised with TBB inside a task arena of a chosen size.
 #pragma once
 
+#include <tbb/task_arena.h>
+
 #include <memory>
 #include <vector>
 
-#include <tbb/task_arena.h>
-
-#include "core/Backend.h"
-#include "core/MemoryPlan.h"
-#include "core/Noise.h"
-#include "core/Splat.h"
+#include "core/math/Noise.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/Backend.h"
+#include "core/pipeline/MemoryPlan.h"
 #include "impl_cpu/BitField.h"
 
 namespace cb::cpu {
 
-// Buffer storage on the CPU, in the host layout (core/MemoryPlan.h). U8 volumes
+// Buffer storage on the CPU, in the host layout (core/pipeline/MemoryPlan.h). U8 volumes
 // carry kPadding spare zero bytes at the end so that kernels may read a full
 // 64-voxel word past a row's end.
 class BufferCpu final : public Buffer {
@@ -76,7 +76,7 @@ class BackendCpu : public Backend {
     // shade's coarse grids; per-call rows and the renderer's
     // splat lists (which depend on the clouds) are not counted.
     uint64_t ScratchBytes(const Scene& scene) const override;
-    // What this process may still allocate: available memory, cgroup and RLIMIT_AS (core/ProcessMemory.h).
+    // What this process may still allocate: available memory, cgroup and RLIMIT_AS (core/base/ProcessMemory.h).
     std::optional<uint64_t> AvailableBytes() const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)

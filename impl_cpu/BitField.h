@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/Grid.h"
+#include "core/math/Grid.h"
 
 namespace cb::cpu {
 

@@ -3,7 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "core/Automaton.h"
+#include "core/math/Automaton.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/CaKernels.h"
 

@@ -2,8 +2,8 @@
 
 #include <immintrin.h>
 
-#include "core/Random.h"
-#include "core/Rules.h"
+#include "core/math/Random.h"
+#include "core/math/Rules.h"
 
 namespace cb::cpu {
 
@@ -53,7 +53,7 @@ CB_VECTOR_TARGET uint64_t EventBitsAvx512(uint32_t key, uint32_t v0, const uint8
         __m512i rnd = _mm512_srli_epi32(LowBias32x16(_mm512_xor_si512(v, keyV)), 8);
         __m512i region = _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(r + 16 * chunk)));
         if (invert) region = _mm512_sub_epi32(c255, region);
-        // rand24 < (R*q + 127)/255  <=>  255*(rand24 + 1) <= R*q + 127  (core/Rules.h)
+        // rand24 < (R*q + 127)/255  <=>  255*(rand24 + 1) <= R*q + 127  (core/math/Rules.h)
         __m512i lhs = _mm512_mullo_epi32(_mm512_add_epi32(rnd, one), c255);
         __m512i rhs = _mm512_add_epi32(_mm512_mullo_epi32(region, qV), c127);
         __mmask16 fires = _mm512_cmple_epu32_mask(lhs, rhs);

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "core/Automaton.h"
+#include "core/math/Automaton.h"
 
 namespace cb::cpu {
 
@@ -24,7 +24,7 @@ bool HasVectorKernels();
 const char* CaKernelName();
 
 // SPEC 3 steps 1-3 for the 64 voxels v0 .. v0+63 of one word: the bit-parallel
-// form of core/Automaton.h (CaGrowth on the word, then CaVoxelEvents for every
+// form of core/math/Automaton.h (CaGrowth on the word, then CaVoxelEvents for every
 // bit at once), tested against the per-voxel twin. f: the growth neighbourhood;
 // r: the 64 region bytes (padded); valid: the bits inside the grid.
 inline CaBits<uint64_t> CaStepWord(CaBits<uint64_t> s, uint64_t f, const uint8_t* r, uint64_t valid, uint32_t v0,

@@ -1,5 +1,5 @@
 // Stage `noise` on the CPU (SPEC 10a): q formed from noise, by the formulas of
-// core/Noise.h.
+// core/math/Noise.h.
 //
 // Schedule: the per-scene state (permutation tables, the detail volume) is
 // made once and kept in the backend; each call computes the step's offsets on

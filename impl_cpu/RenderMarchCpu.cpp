@@ -2,17 +2,17 @@
 // once into one padded volume of (q, T) pairs (a border voxel of q = 0, T = 1
 // stands for "outside the grid", so the trilinear taps need no bounds checks),
 // the brick skip structure is built from it, and then every pixel runs the
-// shared kernel MarchRay (core/March.h), TBB over 8 x 8 pixel tiles.
-#include <algorithm>
-#include <atomic>
-#include <cmath>
-
+// shared kernel MarchRay (core/math/March.h), TBB over 8 x 8 pixel tiles.
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/blocked_range3d.h>
 #include <tbb/parallel_for.h>
 
-#include "core/March.h"
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "core/math/March.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
@@ -64,7 +64,7 @@ struct MarchCachedDensity {
 template <class Light>
 void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks, float* image,
                  MarchStats& stats, const float* G, const Extent3& grid, Light&& makeLight) {
-    // The ground (core/Ground.h): with G, each pixel's background where its ray meets the plane.
+    // The ground (core/math/Ground.h): with G, each pixel's background where its ray meets the plane.
     const GroundLight groundLight = MakeGroundLight(params);
     const Vec3 eyeVoxel = GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize);
     const CameraFrame& cam = params.camera;

@@ -29,7 +29,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "core/Splat.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/SplatFrame.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
@@ -122,7 +123,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const float* qCur = static_cast<const BufferCpu&>(*in.qCur).F32();
     const float* T = static_cast<const BufferCpu&>(*in.T).F32();
     float* image = static_cast<BufferCpu&>(imageBuffer).F32();
-    // The ground (core/Ground.h): each pixel's background where its ray meets the plane.
+    // The ground (core/math/Ground.h): each pixel's background where its ray meets the plane.
     CB_TRY(CheckGroundInput(p.ground, in.G, e, "cpu: render_splat"));
     const float* G = p.ground.on ? static_cast<const BufferCpu&>(*in.G).F32() : nullptr;
     const GroundLight groundLight = MakeGroundLight(p);

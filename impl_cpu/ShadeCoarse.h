@@ -3,7 +3,7 @@
 #pragma once
 #include <tbb/task_arena.h>
 
-#include "core/Grid.h"
+#include "core/math/Grid.h"
 
 namespace cb {
 struct ShadePlan;

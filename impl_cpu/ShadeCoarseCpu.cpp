@@ -1,15 +1,14 @@
 // Shade at resolution f > 1 on the CPU (SPEC 6): the coarse grid of q that
 // the sweep runs on, and T read back from the coarse grid trilinearly.
-#include "impl_cpu/ShadeCoarse.h"
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include "core/ShadePlan.h"
-#include "core/Shading.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/ShadePlan.h"
+#include "impl_cpu/ShadeCoarse.h"
 
 namespace cb::cpu {
 namespace {

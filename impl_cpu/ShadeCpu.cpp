@@ -8,6 +8,8 @@
 // q = 0. The row kernel runs on whole vectors. At resolution f > 1 the same
 // loop runs on the mean of each f^3 block and the result is read back
 // trilinearly (ShadeCoarseCpu.cpp). The ground's shadow is in ShadowCpu.cpp.
+#include <tbb/parallel_for_each.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -15,9 +17,7 @@
 #include <string>
 #include <utility>
 
-#include <tbb/parallel_for_each.h>
-
-#include "core/ShadePlan.h"
+#include "core/pipeline/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/ShadeCoarse.h"
 #include "impl_cpu/ShadeSchedule.h"

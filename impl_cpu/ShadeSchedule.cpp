@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/Grid.h"
-#include "core/ShadePlan.h"
+#include "core/math/Grid.h"
+#include "core/pipeline/ShadePlan.h"
 
 namespace cb::cpu {
 

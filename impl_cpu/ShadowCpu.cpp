@@ -3,7 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "core/Shading.h"
+#include "core/math/Shading.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {

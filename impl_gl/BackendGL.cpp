@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/NoiseGpu.h"
-#include "core/Scene.h"
-#include "core/Shading.h"
-#include "impl_gl/BackendGLInternal.h"
+#include "core/math/NoiseGpu.h"
+#include "core/math/Shading.h"
+#include "core/scene/Scene.h"
 
 namespace cb::gl {
 namespace {

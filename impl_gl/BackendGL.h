@@ -8,8 +8,8 @@
 //
 // Files: the host side of each stage is in its own <Stage>GL.cpp (RegionGL.cpp,
 // CaGL.cpp, ...); BackendGL.cpp holds the context, buffers, transfers and the
-// helpers the stages share (scratch slots, BindTargets, DrawLayers), with the
-// rest of what they share in BackendGLInternal.h.
+// helpers the stages share (scratch slots, BindTargets, DrawLayers). Tex and
+// the member templates are defined below the class.
 #pragma once
 
 #include <array>
@@ -21,8 +21,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Noise.h"
+#include "core/math/Noise.h"
+#include "core/pipeline/Backend.h"
 #include "impl_gl/GLContext.h"
 
 namespace cb::gl {
@@ -53,7 +53,7 @@ class BackendGL final : public Backend {
     bool Supports(Stage stage) const override;
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
 
-    // Pipelined timing (core/Backend.h). In a batch a stage call records its
+    // Pipelined timing (core/pipeline/Backend.h). In a batch a stage call records its
     // passes between two GL_TIMESTAMP queries (from a pool) and returns without
     // waiting; EndBatch waits once (glFinish) and reads the queries. Density's
     // cover and render_splat's stats are deferred: each call writes them to a
@@ -137,17 +137,17 @@ class BackendGL final : public Backend {
         EllipsoidList,    // Region: the ellipsoids, read by the vertex shader
         CoverCounter,     // Density: the atomic counter of covered columns
         SplatOrder,       // RenderSplat: the flattened shared order
-        SplatFrame,       // RenderSplat: the shared frame block (core/Splat.h)
+        SplatFrame,       // RenderSplat: the shared frame block (core/math/Splat.h)
         SplatCounters,    // RenderSplat: the shader's counters (splats drawn)
         ImageCopy,        // RenderSplat: the pixel buffer the image passes through
-        NoiseData,        // Noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
-        MarchBlock,       // RenderMarch: the MarchGpu uniform block (core/MarchGpu.h)
+        NoiseData,        // Noise: the scene's data block (core/math/NoiseGpu.h), kept while mNoiseForm's scene stays
+        MarchBlock,       // RenderMarch: the MarchGpu uniform block (core/pipeline/MarchGpu.h)
         MarchVolumeCopy,  // RenderMarch: the padded volume as a storage buffer of (q_alpha, T) pairs
         MarchBricksCopy,  // RenderMarch, skipping: the brick flags as a storage buffer
         MarchPhaseTable,  // RenderMarch, phase mie: kMieCloudTable's values, uploaded once (mMieUploaded)
         MarchCounters,    // RenderMarch: the shader's MarchStats counters
         MarchImageCopy,   // RenderMarch: the pixel buffer the image passes through
-        GroundBlock,      // RenderSplat, RenderMarch with the ground: the GroundGpu uniform block (core/Ground.h)
+        GroundBlock,      // RenderSplat, RenderMarch with the ground: the GroundGpu uniform block (core/math/Ground.h)
         Count
     };
     // An array indexed by one slot enum and nothing else.
@@ -227,7 +227,7 @@ class BackendGL final : public Backend {
     // Draws the full-screen triangle of `program` (in use, its other uniforms
     // set) once per layer k < layers: uniform "layer" = k, the render targets
     // layer k of each of `textures`, and perLayer(k) for whatever else changes
-    // with k. The template is defined in BackendGLInternal.h.
+    // with k. The template is defined below the class.
     // DrawLayerRange: the same for the layers begin <= k < end only (a share, SliceRange).
     template <typename PerLayer>
     Status DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures,
@@ -266,7 +266,7 @@ class BackendGL final : public Backend {
             uint32_t interval;
         };
         std::vector<Pair> pairs;
-        // A deferred host result (core/Backend.h): a buffer of counters this
+        // A deferred host result (core/pipeline/Backend.h): a buffer of counters this
         // call alone wrote, and for render_splat its fragment query.
         struct Deferred {
             uint32_t mark = 0;
@@ -320,5 +320,29 @@ class BackendGL final : public Backend {
     };
     Rgba8ShareState mShareState;
 };
+
+// For the stages' host files (<Stage>GL.cpp) and the façade.
+
+// The texture behind a buffer; every buffer this backend sees is one it created.
+inline const BufferGL& Tex(const Buffer& b) { return static_cast<const BufferGL&>(b); }
+
+template <typename PerLayer>
+Status BackendGL::DrawLayerRange(GLuint program, uint32_t begin, uint32_t end, std::initializer_list<GLuint> textures,
+                                 PerLayer&& perLayer) {
+    if (IsLayered(program)) return MakeError("gl: a layered pass cannot set uniforms per layer");
+    const Functions& f = mContext->F();
+    const GLint layerUniform = f.GetUniformLocation(program, "layer");
+    std::array<std::pair<GLuint, int>, 4> targets;
+    if (textures.size() > targets.size()) return MakeError("gl: a pass has more than 4 render targets");
+    for (uint32_t k = begin; k < end; ++k) {
+        size_t n = 0;
+        for (GLuint texture : textures) targets[n++] = {texture, int(k)};
+        CB_TRY(BindTargets(std::span(targets.data(), n)));
+        f.Uniform1i(layerUniform, GLint(k));
+        perLayer(k);
+        Draw(GL_TRIANGLES, 0, 3);
+    }
+    return {};
+}
 
 }  // namespace cb::gl

@@ -2,7 +2,7 @@
 #include <array>
 #include <utility>
 
-#include "impl_gl/BackendGLInternal.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

@@ -1,14 +1,14 @@
 // An OpenGL 4.5 core context without a window: OSMesa (llvmpipe, the default)
 // or EGL (surfaceless or device platform, for real GPUs). Programs come from
 // the shader sources embedded at build time (impl_gl/shaders), each with the
-// shared GLSL includes of core/glsl prepended.
+// shared GLSL includes of core/math prepended.
 #pragma once
 
 #include <map>
 #include <memory>
 #include <string>
 
-#include "core/Error.h"
+#include "core/base/Error.h"
 #include "impl_gl/GLFunctions.h"
 #include "impl_gl/GLOptions.h"
 

@@ -6,7 +6,7 @@
 
 #include <array>
 
-#include "core/NamedValues.h"
+#include "core/base/NamedValues.h"
 
 namespace cb::gl {
 

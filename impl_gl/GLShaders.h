@@ -1,5 +1,5 @@
 // GLSL sources of impl_gl/shaders, each with "#version 450 core" and the
-// shared includes of core/glsl prepended, embedded at build time after
+// shared includes of core/math prepended, embedded at build time after
 // glslangValidator checked them (a syntax error fails the build).
 #pragma once
 

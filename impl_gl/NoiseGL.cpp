@@ -1,10 +1,10 @@
 // Stage `noise` (SPEC 10a) on OpenGL: noise.frag, one full-screen pass per
-// slice into the R32F layers of q. The scene's data block (core/NoiseGpu.h:
+// slice into the R32F layers of q. The scene's data block (core/math/NoiseGpu.h:
 // permutation tables, HD per slice, towers, the detail volume) is made and
 // uploaded once per scene into the NoiseData storage buffer, kept while the
 // settings and the grid stay the same; each call sets only the step's offsets.
-#include "core/NoiseGpu.h"
-#include "impl_gl/BackendGLInternal.h"
+#include "core/math/NoiseGpu.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

@@ -5,8 +5,8 @@
 //   2. march_bricks (skipping only): the bricks' empty flags, one pass per
 //      brick layer into R32UI layers, copied likewise; counts the empty ones.
 //   3. render_march: the full-screen triangle over the image, one fragment per
-//      pixel, MarchPixel of core/glsl/march.glsl with the MarchGpu block
-//      (core/MarchGpu.h) as a std140 uniform block, in a program specialised
+//      pixel, MarchPixel of core/math/march.glsl with the MarchGpu block
+//      (core/pipeline/MarchGpu.h) as a std140 uniform block, in a program specialised
 //      for the call's option bits and phase kind (linked on first use of each
 //      combination, then cached), and the Mie table (uploaded
 //      once, only for phase mie) as a storage buffer; the counters of
@@ -16,9 +16,9 @@
 #include <algorithm>
 #include <string>
 
-#include "core/MarchGpu.h"
-#include "core/Shading.h"
-#include "impl_gl/BackendGLInternal.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/MarchGpu.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

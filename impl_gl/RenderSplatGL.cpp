@@ -1,7 +1,8 @@
 #include <vector>
 
-#include "core/Splat.h"
-#include "impl_gl/BackendGLInternal.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/SplatFrame.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

@@ -1,8 +1,8 @@
 #include <array>
 #include <utility>
 
-#include "core/ShadePlan.h"
-#include "impl_gl/BackendGLInternal.h"
+#include "core/pipeline/ShadePlan.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

@@ -1,4 +1,4 @@
-#include "impl_gl/BackendGLInternal.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

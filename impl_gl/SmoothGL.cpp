@@ -1,6 +1,6 @@
 #include <algorithm>
 
-#include "impl_gl/BackendGLInternal.h"
+#include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 

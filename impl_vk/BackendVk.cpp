@@ -1,5 +1,5 @@
 // The Vulkan backend's façade: the context, buffers and their transfers, and
-// the helpers every stage shares (Record in StageVk.h, Scratch). The host side
+// the helpers every stage shares (Record and Dev in BackendVk.h, Scratch). The host side
 // of each stage is in its own file: RegionVk.cpp, CaVk.cpp, SmoothVk.cpp,
 // DensityVk.cpp, ShadeVk.cpp, ShadowVk.cpp, RenderSplatVk.cpp.
 #include "impl_vk/BackendVk.h"
@@ -7,10 +7,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/MarchGpu.h"
-#include "core/NoiseGpu.h"
-#include "core/Scene.h"
-#include "impl_vk/StageVk.h"
+#include "core/math/NoiseGpu.h"
+#include "core/pipeline/MarchGpu.h"
+#include "core/scene/Scene.h"
 
 namespace cb::vk {
 namespace {
@@ -89,7 +88,7 @@ uint64_t BackendVk::ScratchBytes(const Scene& scene) const {
     // shade below full resolution: q and T on the coarse grid, ceil(n / f) cells per axis (ShadeVk.cpp).
     if (const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1)); scene.stages.Has(Stage::Shade) && f > 1)
         bytes += 2 * Extent3{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)}.Count() * 4;
-    // noise: the data block (core/NoiseGpu.h): header, two tables, HD per slice, towers, detail volume.
+    // noise: the data block (core/math/NoiseGpu.h): header, two tables, HD per slice, towers, detail volume.
     if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);
     // render_march: the constants, the padded volume (T only with light "shade"), a word per brick with
     // skipping, the Mie table with phase Mie, the counters (RenderMarchVk.cpp).

@@ -7,10 +7,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Noise.h"
+#include "core/math/Noise.h"
+#include "core/pipeline/Backend.h"
 #include "impl_vk/VulkanContext.h"
 
 namespace cb::vk {
@@ -33,45 +34,45 @@ class BufferVk final : public Buffer {
 // and SmoothSumXY, which carry a sweep from one share to the next, SPEC 13) and
 // grows to the largest size asked of it.
 enum class VkScratch {
-    EllipsoidList,      // region: the ellipsoids, 32 bytes each
-    RegionTileStarts,   // region: first RegionTileEntries index per 16x16 tile of a slice, and one past the end
-    RegionTileEntries,  // region: ellipsoid indices, tile by tile
-    CaRulesHum,         // ca: the rules' hum before advection (only with wind)
-    CaRulesAct,         // ca: the rules' act before advection (only with wind)
-    CaRulesCld,         // ca: the rules' cld before advection (only with wind)
-    CaWindShifts,       // ca: (shiftX, shiftY) per slice (only with wind)
-    SmoothSumX,         // smooth: the bit field summed along x
-    SmoothSumXY,        // smooth: those sums summed along y; kept between the shares of a sweep
-    CoverCounter,       // density: covered columns, one uint
-    ShadeCoarseQ,       // shade: q on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
-    ShadeCoarseT,       // shade: T on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
-    SplatFrame,         // render_splat: grid, camera and light (the shaders' Frame)
-    SplatRankParts,     // render_splat: per position of each axis order, its coordinate and index shares
-    SplatBoxes,         // render_splat: visibility of each tile x band box, one byte each
-    SplatCandidates,    // render_splat: a bit per rank, 1 where it makes a splat
-    SplatChunkSplats,   // render_splat: splats per chunk of ranks
-    SplatChunkPairs,    // render_splat: (screen tile, splat) pairs per chunk of ranks
-    SplatChunkOffsets,  // render_splat: SplatChunkSplats scanned, and the total
+    EllipsoidList,          // region: the ellipsoids, 32 bytes each
+    RegionTileStarts,       // region: first RegionTileEntries index per 16x16 tile of a slice, and one past the end
+    RegionTileEntries,      // region: ellipsoid indices, tile by tile
+    CaRulesHum,             // ca: the rules' hum before advection (only with wind)
+    CaRulesAct,             // ca: the rules' act before advection (only with wind)
+    CaRulesCld,             // ca: the rules' cld before advection (only with wind)
+    CaWindShifts,           // ca: (shiftX, shiftY) per slice (only with wind)
+    SmoothSumX,             // smooth: the bit field summed along x
+    SmoothSumXY,            // smooth: those sums summed along y; kept between the shares of a sweep
+    CoverCounter,           // density: covered columns, one uint
+    ShadeCoarseQ,           // shade: q on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
+    ShadeCoarseT,           // shade: T on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
+    SplatFrame,             // render_splat: grid, camera and light (the shaders' Frame)
+    SplatRankParts,         // render_splat: per position of each axis order, its coordinate and index shares
+    SplatBoxes,             // render_splat: visibility of each tile x band box, one byte each
+    SplatCandidates,        // render_splat: a bit per rank, 1 where it makes a splat
+    SplatChunkSplats,       // render_splat: splats per chunk of ranks
+    SplatChunkPairs,        // render_splat: (screen tile, splat) pairs per chunk of ranks
+    SplatChunkOffsets,      // render_splat: SplatChunkSplats scanned, and the total
     SplatChunkPairOffsets,  // render_splat: SplatChunkPairs scanned, and the total
-    SplatTotals,        // render_splat: the splats, the pairs, and 64 slots of voxels visited and fragments, read by the host
-    Splats,             // render_splat: the splats in the shared order, 48 bytes each
-    SplatTiles,         // render_splat: screen tiles per splat
-    SplatPairOffsets,   // render_splat: SplatTiles scanned, and the total
-    SplatKeys,          // render_splat: the pairs' screen tiles (radix sort ping)
-    SplatValues,        // render_splat: the pairs' splat indices (radix sort ping)
-    SplatKeysSwap,      // render_splat: the pairs' screen tiles (radix sort pong)
-    SplatValuesSwap,    // render_splat: the pairs' splat indices (radix sort pong)
-    SplatSortCounts,    // render_splat: pairs per radix digit x sort block
-    SplatSortOffsets,   // render_splat: SplatSortCounts scanned, and the total
-    SplatTileBases,     // render_splat: the first sorted pair of each screen tile, and the pairs
-    SplatScanSums,      // render_splat: the block sums of its scans (scan.comp)
-    NoiseData,          // noise: the scene's data block (core/NoiseGpu.h), kept while mNoiseForm's scene stays
-    MarchFrame,         // render_march: the constants (core/MarchGpu.h), 256 bytes
-    MarchVolume,        // render_march: the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha
-    MarchBricks,        // render_march: one word per brick, 1 iff empty (only with skipping)
-    MarchMieTable,      // render_march: kMieCloudTable's values, uploaded once (only with phase Mie)
-    MarchStats,         // render_march: the MarchStats counters, 64-bit as two words each
-    GroundFrame,        // render_splat, render_march with the ground: the GroundGpu block (core/Ground.h)
+    SplatTotals,  // render_splat: the splats, the pairs, and 64 slots of voxels visited and fragments, read by the host
+    Splats,       // render_splat: the splats in the shared order, 48 bytes each
+    SplatTiles,   // render_splat: screen tiles per splat
+    SplatPairOffsets,  // render_splat: SplatTiles scanned, and the total
+    SplatKeys,         // render_splat: the pairs' screen tiles (radix sort ping)
+    SplatValues,       // render_splat: the pairs' splat indices (radix sort ping)
+    SplatKeysSwap,     // render_splat: the pairs' screen tiles (radix sort pong)
+    SplatValuesSwap,   // render_splat: the pairs' splat indices (radix sort pong)
+    SplatSortCounts,   // render_splat: pairs per radix digit x sort block
+    SplatSortOffsets,  // render_splat: SplatSortCounts scanned, and the total
+    SplatTileBases,    // render_splat: the first sorted pair of each screen tile, and the pairs
+    SplatScanSums,     // render_splat: the block sums of its scans (scan.comp)
+    NoiseData,         // noise: the scene's data block (core/math/NoiseGpu.h), kept while mNoiseForm's scene stays
+    MarchFrame,        // render_march: the constants (core/pipeline/MarchGpu.h), 256 bytes
+    MarchVolume,       // render_march: the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha
+    MarchBricks,       // render_march: one word per brick, 1 iff empty (only with skipping)
+    MarchMieTable,     // render_march: kMieCloudTable's values, uploaded once (only with phase Mie)
+    MarchStats,        // render_march: the MarchStats counters, 64-bit as two words each
+    GroundFrame,       // render_splat, render_march with the ground: the GroundGpu block (core/math/Ground.h)
     Count
 };
 
@@ -107,7 +108,7 @@ class BackendVk final : public Backend {
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
-    // Pipelined timing (core/Backend.h): the context records the batch into one
+    // Pipelined timing (core/pipeline/Backend.h): the context records the batch into one
     // command buffer (VulkanContext::BeginBatch); a Download inside it, and
     // render_splat's counts (which size its next passes), submit and wait once
     // each. Density's cover is deferred: read after the batch's wait.
@@ -141,7 +142,7 @@ class BackendVk final : public Backend {
 
   private:
     explicit BackendVk(std::unique_ptr<VulkanContext> context) : mContext(std::move(context)) {}
-    // Records with `fn`, submits, waits and keeps the device time (defined in StageVk.h).
+    // Records with `fn`, submits, waits and keeps the device time (defined below the class).
     template <typename Fn>
     Status Record(const char* what, Fn&& fn);
     // The slot's buffer, grown to at least `size` bytes; its contents are undefined.
@@ -176,5 +177,19 @@ class BackendVk final : public Backend {
     };
     std::optional<SmoothSweep> mSmoothSweep;
 };
+
+// For the stages' host files (<Stage>Vk.cpp) and the façade.
+
+// The device buffer behind a Buffer; only buffers made by BackendVk::CreateBuffer.
+inline const DeviceBuffer& Dev(const Buffer& b) { return static_cast<const BufferVk&>(b).Device(); }
+
+// Records with `fn`, submits, waits; the submit's device time becomes LastDeviceMs().
+template <typename Fn>
+Status BackendVk::Record(const char* what, Fn&& fn) {
+    auto ms = mContext->Run(what, std::forward<Fn>(fn));
+    if (!ms) return std::unexpected(ms.error());
+    mLastDeviceMs = *ms;
+    return {};
+}
 
 }  // namespace cb::vk

@@ -4,7 +4,7 @@
 #include <iterator>
 #include <vector>
 
-#include "impl_vk/StageVk.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 namespace {

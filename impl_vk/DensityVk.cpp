@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string>
 
-#include "impl_vk/StageVk.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 
@@ -46,7 +46,7 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
         r.Barrier();
         r.DispatchGroups(**pass, buffers, &push, sizeof push, tilesX, row1 - row0, 1);
     }));
-    if (mContext->InBatch()) {  // the cover after the batch's wait (core/Backend.h, deferred host results)
+    if (mContext->InBatch()) {  // the cover after the batch's wait (core/pipeline/Backend.h, deferred host results)
         const uint32_t mark = mContext->Interval();
         return mContext->DownloadLater(**counter, 4, [this, mark](std::span<const std::byte> bytes) {
             uint32_t covered = 0;

@@ -1,10 +1,10 @@
 // Stage `noise` (SPEC 10a) on Vulkan: noise.comp, one invocation per voxel.
-// The scene's data block (core/NoiseGpu.h: permutation tables, HD per slice,
+// The scene's data block (core/math/NoiseGpu.h: permutation tables, HD per slice,
 // towers, the detail volume) is made and uploaded once per scene and kept in
 // the NoiseData slot while the settings and the grid stay the same; each call
 // pushes only the step's offsets.
-#include "core/NoiseGpu.h"
-#include "impl_vk/StageVk.h"
+#include "core/math/NoiseGpu.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 

@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include "core/Grid.h"
-#include "core/Rules.h"
+#include "core/math/Grid.h"
+#include "core/math/Rules.h"
 
 namespace cb::vk {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "impl_vk/BackendVk.h"
 #include "impl_vk/RegionTileLists.h"
-#include "impl_vk/StageVk.h"
 
 namespace cb::vk {
 

@@ -6,15 +6,15 @@
 //      over the brick grown by one voxel (step 2), and the count of empty ones;
 //   3. render_march.comp (light "shade") or render_march_q.comp ("march"), both
 //      shaders/render_march.glsl: one invocation per pixel in 8 x 8 workgroups,
-//      MarchPixel of core/glsl/march.glsl, and the MarchStats counters.
-// The constants are core/MarchGpu.h's block in a storage buffer (256 bytes: more
+//      MarchPixel of core/math/march.glsl, and the MarchStats counters.
+// The constants are core/pipeline/MarchGpu.h's block in a storage buffer (256 bytes: more
 // than the 128 bytes of push constants every device guarantees). The Mie table
 // (kMieCloudTable) is uploaded once, on the first call whose phase is Mie.
 #include <algorithm>
 #include <array>
 
-#include "core/MarchGpu.h"
-#include "impl_vk/StageVk.h"
+#include "core/pipeline/MarchGpu.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 namespace {

@@ -6,9 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "core/Splat.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/SplatFrame.h"
+#include "impl_vk/BackendVk.h"
 #include "impl_vk/PairSortVk.h"
-#include "impl_vk/StageVk.h"
 
 namespace cb::vk {
 namespace {
@@ -51,7 +52,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(CheckGroundInput(p.ground, in.G, e, "vk: render_splat"));
 
     // Which tile x band boxes can hold a splat: the frustum (host geometry,
-    // shared with the CPU, core/Backend.h SplatBoxVisibility) and, when
+    // shared with the CPU, core/pipeline/Backend.h SplatBoxVisibility) and, when
     // skipping, the two steps' band occupancy, ORed on the device
     // (splat_boxes.comp), so nothing is read back for it.
     SplatParams frustumOnly = p;

@@ -11,8 +11,8 @@
 // two byte for byte).
 #include <algorithm>
 
-#include "core/ShadePlan.h"
-#include "impl_vk/StageVk.h"
+#include "core/pipeline/ShadePlan.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 namespace {

@@ -1,5 +1,5 @@
 // Stage `shadow` (SPEC 7) on Vulkan: shadow.comp, one invocation per column.
-#include "impl_vk/StageVk.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 

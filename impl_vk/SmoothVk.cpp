@@ -6,7 +6,7 @@
 // over the rest only; any other share sums its whole halo.
 #include <algorithm>
 
-#include "impl_vk/StageVk.h"
+#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 

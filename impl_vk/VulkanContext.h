@@ -1,7 +1,7 @@
 // The Vulkan objects a backend needs: instance, one device and its compute
 // queue, memory, compute pipelines from the build's SPIR-V, and submission with
 // timestamp queries: synchronous per call, or recorded into one command buffer
-// per batch (BeginBatch .. EndBatch, core/Backend.h "Pipelined timing"). Every
+// per batch (BeginBatch .. EndBatch, core/pipeline/Backend.h "Pipelined timing"). Every
 // Vulkan call is checked and its failure says what was being done (CheckVk).
 #pragma once
 
@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/Error.h"
+#include "core/base/Error.h"
 
 namespace cb::vk {
 
@@ -92,12 +92,12 @@ class VulkanContext {
     // In a batch: records a copy of the first `bytes` of `buffer` into the
     // batch's host-visible arena and gives them to `done` after the batch's
     // next wait (EndBatch's, or an earlier one), without a wait of its own
-    // (deferred host results, core/Backend.h). Outside a batch: a Download,
+    // (deferred host results, core/pipeline/Backend.h). Outside a batch: a Download,
     // then `done`.
     using ReadDone = std::function<void(std::span<const std::byte>)>;
     Status DownloadLater(const DeviceBuffer& buffer, VkDeviceSize bytes, ReadDone done);
 
-    // ---- Batches (core/Backend.h, "Pipelined timing") ----
+    // ---- Batches (core/pipeline/Backend.h, "Pipelined timing") ----
     // BeginBatch starts interval 0; MarkBatch the next one. Between BeginBatch
     // and EndBatch, Run records (each call bracketed by a timestamp pair of the
     // current interval and followed by a barrier that orders it before every

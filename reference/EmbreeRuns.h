@@ -11,7 +11,7 @@
 #include <mutex>
 #include <string>
 
-#include "core/Error.h"
+#include "core/base/Error.h"
 
 namespace cb::ref {
 

@@ -8,7 +8,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/March.h"
+#include "core/math/March.h"
 #include "reference/Trilinear.h"
 
 namespace cb::ref {

@@ -1,5 +1,5 @@
 // The exact reference render of the ray marcher (SPEC 11, issue 13 item 5):
-// render_march's own per-ray kernel MarchRay (core/March.h) with a light
+// render_march's own per-ray kernel MarchRay (core/math/March.h) with a light
 // functor that returns the EXACT transmittance toward the sun and toward the
 // point light at each sample (TrilinearDepthTracer: the same trilinear field
 // of q_alpha the marcher samples), a fine fixed step, epsilon = 0 (no early
@@ -12,8 +12,8 @@
 #include <span>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Error.h"
+#include "core/base/Error.h"
+#include "core/pipeline/Backend.h"
 #include "reference/Reference.h"
 
 namespace cb::ref {

@@ -17,9 +17,9 @@
 #include <span>
 #include <vector>
 
-#include "core/Error.h"
-#include "core/Grid.h"
-#include "core/Shading.h"
+#include "core/base/Error.h"
+#include "core/math/Grid.h"
+#include "core/math/Shading.h"
 
 namespace cb::ref {
 

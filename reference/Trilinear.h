@@ -24,8 +24,8 @@
 #include <span>
 #include <vector>
 
-#include "core/Error.h"
-#include "core/Grid.h"
+#include "core/base/Error.h"
+#include "core/math/Grid.h"
 #include "reference/Reference.h"
 
 namespace cb::ref {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Error.h"
+#include "core/base/Error.h"
+#include "core/pipeline/Backend.h"
 #include "impl_gl/GLOptions.h"
 
 namespace cb {

@@ -1,4 +1,4 @@
-// The accuracy measurement (harness/Accuracy.h): error statistics, the
+// The accuracy measurement (harness/accuracy/Accuracy.h): error statistics, the
 // reference's ray start against what shade computes, and the jump of T where
 // the principal axis switches against its a-priori bound.
 #include <gtest/gtest.h>
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/Random.h"
-#include "harness/Accuracy.h"
+#include "core/math/Random.h"
+#include "harness/accuracy/Accuracy.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "harness/Command.h"
+#include "harness/platform/Command.h"
 #include "impl_gl/GLOptions.h"
 #include "registry/Registry.h"
 

@@ -2,7 +2,7 @@
 // tests/CaReference.h, on random states of odd sizes over many steps.
 #include <gtest/gtest.h>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/CaKernels.h"
 #include "tests/CaReference.h"

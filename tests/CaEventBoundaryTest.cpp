@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "impl_cpu/CaKernels.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/CaReference.h"

@@ -1,13 +1,13 @@
 // A plain one-byte-per-voxel automaton written from SPEC section 3 alone, as
 // the slow path the bit-field backends are checked against. It shares nothing
-// with the backends but the hash of core/Random.h (tested on its own).
+// with the backends but the hash of core/math/Random.h (tested on its own).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
-#include "core/Grid.h"
-#include "core/Random.h"
+#include "core/math/Grid.h"
+#include "core/math/Random.h"
 
 namespace cb::test {
 

@@ -5,7 +5,7 @@
 #include <set>
 #include <tuple>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "harness/perf/CallgrindDump.h"
-#include "harness/perf/CallgrindRequests.h"
+#include "harness/platform/CallgrindRequests.h"
 
 namespace cb {
 namespace {

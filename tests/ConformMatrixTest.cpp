@@ -6,9 +6,10 @@
 
 #include <algorithm>
 
-#include "core/SceneNames.h"
-#include "harness/Conform.h"
-#include "harness/ConformMatrix.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/SceneNames.h"
+#include "harness/conform/Conform.h"
+#include "harness/conform/ConformMatrix.h"
 
 namespace cb {
 namespace {

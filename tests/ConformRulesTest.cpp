@@ -5,7 +5,8 @@
 
 #include <type_traits>
 
-#include "harness/Conform.h"
+#include "core/pipeline/SceneLoad.h"
+#include "harness/conform/Conform.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb {

@@ -13,11 +13,11 @@
 #include <sstream>
 #include <tuple>
 
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
-#include "core/Scene.h"
-#include "harness/Report.h"
-#include "harness/Simulation.h"
+#include "core/math/Random.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/scene/Scene.h"
+#include "harness/report/Report.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/TestUtil.h"

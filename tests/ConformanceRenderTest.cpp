@@ -3,6 +3,7 @@
 // backend and size: ConformanceFixture.h, ConformanceTest.cpp).
 #include <gtest/gtest.h>
 
+#include "core/pipeline/SceneLoad.h"
 #include "tests/ConformanceFixture.h"
 
 namespace cb::conformance {
@@ -91,7 +92,7 @@ TEST_P(Conformance, Shadow) {
 
 // Test the splat renderer from four cameras (outside, inside, straight down,
 // partly out of view) with culling and skipping on, the last two cameras over
-// the ground lit through a G (core/Ground.h): per channel |d| <= 2/255
+// the ground lit through a G (core/math/Ground.h): per channel |d| <= 2/255
 // on 99.9 % of pixels and <= 8/255 everywhere (SPEC 8). A failure writes the
 // difference image and names the worst pixel.
 TEST_P(Conformance, RenderSplat) {

@@ -1,7 +1,7 @@
 // The density map (SPEC section 5): column sums, tile and band occupancy, cover.
 #include <gtest/gtest.h>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

@@ -1,7 +1,7 @@
 // The host-side ellipsoid list (SPEC section 2, Fizimayer's thesis, section 4.3.3.5).
 #include <gtest/gtest.h>
 
-#include "core/Ellipsoids.h"
+#include "core/pipeline/Ellipsoids.h"
 
 namespace cb {
 namespace {

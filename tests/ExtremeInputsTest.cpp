@@ -9,10 +9,10 @@
 #include <limits>
 #include <string>
 
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/ShadePlan.h"
-#include "core/Splat.h"
+#include "core/math/Camera.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/RegionReference.h"
 #include "tests/TestUtil.h"

@@ -1,5 +1,5 @@
 // The cases of the GLSL twin tests (GlslTwinTest.cpp): every function of
-// core/glsl but MakeSplat, grouped by its GLSL file, with random inputs,
+// core/math but MakeSplat, grouped by its GLSL file, with random inputs,
 // hand-picked edges and the C++ twin.
 #include <algorithm>
 #include <cmath>
@@ -8,12 +8,12 @@
 #include <vector>
 
 #include "GlslTwinHarness.h"
-#include "core/Automaton.h"
-#include "core/Noise.h"
-#include "core/Random.h"
-#include "core/Rules.h"
-#include "core/Shading.h"
-#include "core/Splat.h"
+#include "core/math/Automaton.h"
+#include "core/math/Noise.h"
+#include "core/math/Random.h"
+#include "core/math/Rules.h"
+#include "core/math/Shading.h"
+#include "core/math/Splat.h"
 
 namespace cb::test {
 

@@ -1,5 +1,5 @@
 // The harness of the GLSL twin tests (GlslTwinTest.cpp): a case is one
-// function of core/glsl, run by tests/twin/twin.comp on a Vulkan device and
+// function of core/math, run by tests/twin/twin.comp on a Vulkan device and
 // compared with its C++ twin; the cases are in GlslTwinCases.cpp.
 #pragma once
 
@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "core/MarchGpu.h"
-#include "core/Random.h"
-#include "core/Splat.h"
+#include "core/math/Random.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/MarchGpu.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/VulkanContext.h"
 #endif
@@ -64,7 +64,7 @@ inline std::vector<float> AndNeighbours(float x) {
     return {std::nextafter(x, -INFINITY), x, std::nextafter(x, INFINITY)};
 }
 
-// Every function of core/glsl but MakeSplat, PowderTerm and those that read a MarchGpu block
+// Every function of core/math but MakeSplat, PowderTerm and those that read a MarchGpu block
 // (GlslTwinTest.cpp has them), with its random inputs, edges and C++ twin.
 std::vector<TwinCase> Cases();
 // The march.glsl part of Cases() (GlslTwinMarchCases.cpp).

@@ -1,13 +1,13 @@
-// The twin cases of core/glsl/march.glsl that need no MarchGpu block (the rest
+// The twin cases of core/math/march.glsl that need no MarchGpu block (the rest
 // run in GlslTwinTest.cpp): ArcCos, the Mie lookup, the ray and step formulas.
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "GlslTwinHarness.h"
-#include "core/Ground.h"
-#include "core/March.h"
-#include "core/Shading.h"
+#include "core/math/Ground.h"
+#include "core/math/March.h"
+#include "core/math/Shading.h"
 
 namespace cb::test {
 

@@ -1,4 +1,4 @@
-// Every function of core/glsl against its C++ twin in core/ (issue 10, item 7):
+// Every function of core/math against its C++ twin in core/ (issue 10, item 7):
 // tests/twin/twin.comp runs the GLSL on a Vulkan device, on random inputs and
 // hand-picked edges (ties, zeros, boundaries), and each output is compared with
 // the C++ bit for bit.
@@ -25,8 +25,8 @@
 // The harness is in GlslTwinHarness.h/.cpp, the cases in GlslTwinCases.cpp.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -37,14 +37,14 @@
 #include <vector>
 
 #include "GlslTwinHarness.h"
-#include "core/Automaton.h"
-#include "core/Camera.h"
-#include "core/March.h"
-#include "core/MarchGpu.h"
-#include "core/Random.h"
-#include "core/Rules.h"
-#include "core/Shading.h"
-#include "core/Splat.h"
+#include "core/math/Automaton.h"
+#include "core/math/Camera.h"
+#include "core/math/March.h"
+#include "core/math/Random.h"
+#include "core/math/Rules.h"
+#include "core/math/Shading.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/MarchGpu.h"
 #include "impl_cpu/CaKernels.h"
 
 namespace cb {
@@ -116,7 +116,7 @@ void MakeSplatCpp(const SplatFrame& F, const Words& in, Words& out) {
 
 using test::GlslTwin;
 
-// Test that every GLSL function of core/glsl equals its C++ twin on 4096
+// Test that every GLSL function of core/math equals its C++ twin on 4096
 // random inputs and the hand-picked edges (bit-exact on lavapipe).
 TEST_F(GlslTwin, EveryFunctionEqualsItsCppTwin) {
     for (const TwinCase& c : Cases()) {

@@ -1,5 +1,5 @@
 // Test that every GPU parameter block declared twice, in C++ (core/) and in
-// GLSL (core/glsl/), has the same members at the same offsets with the same
+// GLSL (core/math/), has the same members at the same offsets with the same
 // types, member by member, as glslang lays the GLSL out (std430, and std140
 // where the C++ header promises both). The GLSL struct is taken from its file
 // as it is, put into a buffer block of a small compute shader, and
@@ -21,9 +21,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/Ground.h"
-#include "core/MarchGpu.h"
-#include "core/Splat.h"
+#include "core/math/Ground.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/MarchGpu.h"
 
 namespace cb::gpu_block_layout {
 namespace {
@@ -51,7 +51,7 @@ struct Member {
 
 struct Block {
     std::string glslName;  // the struct's name in GLSL (and in C++)
-    std::string file;      // under core/glsl/
+    std::string file;      // under core/math/
     size_t bytes;          // sizeof the C++ struct
     bool std140;           // the header promises std140 as well as std430
     std::vector<Member> members;
@@ -97,7 +97,7 @@ std::vector<Block> Blocks() {
     };
 }
 
-// The declaration `struct NAME { ... };` as it stands in core/glsl/FILE.
+// The declaration `struct NAME { ... };` as it stands in core/math/FILE.
 std::string GlslStruct(const Block& block) {
     std::ifstream in(std::filesystem::path(CLOUDBENCH_SOURCE_DIR) / "core" / "glsl" / block.file);
     std::stringstream text;
@@ -150,7 +150,7 @@ std::string BlockShader(const std::string& declaration, const Block& block, cons
 
 void ExpectSameLayout(const Block& block, const std::string& layout) {
     const std::string declaration = GlslStruct(block);
-    ASSERT_FALSE(declaration.empty()) << "no `struct " << block.glslName << " { ... };` in core/glsl/" << block.file;
+    ASSERT_FALSE(declaration.empty()) << "no `struct " << block.glslName << " { ... };` in core/math/" << block.file;
     std::string log;
     const auto reflected = Reflect(BlockShader(declaration, block, layout), "m", log);
     ASSERT_EQ(reflected.size(), block.members.size())

@@ -1,5 +1,5 @@
 // The ground plane in the frame (issue 15 item 4; docs/pipeline.md, "The ground
-// in the frame"): core/Ground.h's formulas against values worked out by hand,
+// in the frame"): core/math/Ground.h's formulas against values worked out by hand,
 // both renderers on every backend against closed forms (an empty volume over a
 // ground of known G), the flat background where no ray meets the ground, and
 // the backends against the CPU by SPEC 8's and SPEC 10's image rules.
@@ -10,9 +10,9 @@
 #include <tuple>
 #include <vector>
 
-#include "core/Ground.h"
-#include "core/Random.h"
-#include "harness/Report.h"
+#include "core/math/Ground.h"
+#include "core/math/Random.h"
+#include "harness/report/Report.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/BackendTestUtil.h"
@@ -24,7 +24,7 @@
 namespace cb {
 namespace {
 
-// ---- core/Ground.h alone ------------------------------------------------------
+// ---- core/math/Ground.h alone ------------------------------------------------------
 
 // Test that a ray meets z = 0 where the line does, and only pointing down within [tNear, tFar].
 TEST(GroundFormula, HitPoint) {

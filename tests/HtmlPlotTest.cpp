@@ -1,4 +1,4 @@
-// The pieces of `cloudbench report` (harness/html/): the SVG plot generators,
+// The pieces of `cloudbench report` (harness/report/html/): the SVG plot generators,
 // the HTML renderer, the report model read back from JSON, the source documents' figures,
 // the history reader and the verdicts. Expected numbers are worked out by hand
 // (NumPy's linear quantiles, Tukey's fences, RFC 4648's vectors), not taken
@@ -13,11 +13,12 @@
 #include <regex>
 #include <set>
 
-#include "core/Stage.h"
-#include "harness/ReportModel.h"
-#include "harness/html/HtmlRender.h"
-#include "harness/html/HtmlReport.h"
-#include "harness/html/SvgPlot.h"
+#include "core/scene/Stage.h"
+#include "harness/report/ReportModel.h"
+#include "harness/report/html/HtmlRender.h"
+#include "harness/report/html/HtmlReport.h"
+#include "harness/report/html/ReportSections.h"
+#include "harness/report/html/SvgPlot.h"
 
 namespace cb::html {
 namespace {

@@ -1,11 +1,11 @@
-// Image error statistics (harness/ImageAccuracy.h): per-pixel max over the
+// Image error statistics (harness/accuracy/ImageAccuracy.h): per-pixel max over the
 // channels, and PSNR against closed forms worked out by hand here.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "harness/ImageAccuracy.h"
+#include "harness/accuracy/ImageAccuracy.h"
 
 namespace cb {
 namespace {

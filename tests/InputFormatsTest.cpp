@@ -1,19 +1,18 @@
-// The one reader of input files (core/InputFile.h) and the schemas of the JSON
-// files cloudbench reads back (harness/JsonInput.h, harness/InputFormats.h).
+// The one reader of input files (core/base/InputFile.h) and the schemas of the JSON
+// files cloudbench reads back (harness/platform/JsonInput.h, harness/report/InputFormats.h).
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 
-#include "core/InputFile.h"
-#include "core/Npy.h"
-#include "harness/InputFormats.h"
-#include "harness/JsonInput.h"
+#include "core/base/InputFile.h"
+#include "core/base/Npy.h"
+#include "harness/platform/JsonInput.h"
+#include "harness/report/InputFormats.h"
 
 namespace cb {
 namespace {

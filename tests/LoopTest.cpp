@@ -9,9 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "core/Scene.h"
-#include "harness/Report.h"
-#include "harness/Simulation.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/report/Report.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

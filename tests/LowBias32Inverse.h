@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 
 namespace cb::test {
 

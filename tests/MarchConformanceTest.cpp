@@ -14,8 +14,8 @@
 #include <tuple>
 #include <vector>
 
-#include "core/Random.h"
-#include "harness/Report.h"
+#include "core/math/Random.h"
+#include "harness/report/Report.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/BackendTestUtil.h"
@@ -56,7 +56,8 @@ std::vector<MarchVariant> MarchVariants(const Extent3& e) {
         {"skipping off", [](MarchParams& p) { p.skipping = false; }},
         {"jitter", [](MarchParams& p) { p.jitter = true; }},
         {"jitter, skipping off", [](MarchParams& p) { p.jitter = true, p.skipping = false; }},
-        {"adaptive step", [](MarchParams& p) { p.setup.adaptive = true, p.setup.kappa = 0.05f, p.setup.adaptiveStart = 8; }},
+        {"adaptive step",
+         [](MarchParams& p) { p.setup.adaptive = true, p.setup.kappa = 0.05f, p.setup.adaptiveStart = 8; }},
         {"adaptive, jitter, skipping off",
          [](MarchParams& p) {
              p.setup.adaptive = true, p.setup.kappa = 0.08f, p.setup.adaptiveStart = 4;
@@ -68,7 +69,10 @@ std::vector<MarchVariant> MarchVariants(const Extent3& e) {
          [](MarchParams& p) { p.light = MarchLightSource::March, p.lightSteps = 4, p.setup.powder = true; }},
         {"shade light, powder c 3.5", [](MarchParams& p) { p.setup.powder = true, p.setup.powderC = 3.5f; }},
         {"phase none", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::None; }},
-        {"phase Cornette-Shanks g 0.75", [](MarchParams& p) { p.setup.phase = {PhaseKind::CornetteShanks, 0.75f}; }},
+        {"phase Cornette-Shanks g 0.75",
+         [](MarchParams& p) {
+             p.setup.phase = {PhaseKind::CornetteShanks, 0.75f};
+         }},
         {"phase Mie", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::Mie; }},
         {"point light, shade light", point},
         {"point light, light march, Mie, jitter, adaptive",
@@ -80,8 +84,11 @@ std::vector<MarchVariant> MarchVariants(const Extent3& e) {
              p.setup.adaptive = true, p.setup.kappa = 0.05f, p.setup.adaptiveStart = 6;
          }},
         {"epsilon 0, dense", [](MarchParams& p) { p.setup.epsilon = 0, p.setup.sigmaH = 0.6f; }},
-        // The ground plane lit through G (core/Ground.h) as the background, per pixel.
-        {"ground", [](MarchParams& p) { p.ground = {true, {0.35f, 0.3f, 0.25f}}; }},
+        // The ground plane lit through G (core/math/Ground.h) as the background, per pixel.
+        {"ground",
+         [](MarchParams& p) {
+             p.ground = {true, {0.35f, 0.3f, 0.25f}};
+         }},
         {"ground, light march, jitter",
          [](MarchParams& p) {
              p.ground = {true, {0.6f, 0.5f, 0.4f}};

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "core/March.h"
+#include "core/math/March.h"
 #include "impl_cpu/BackendCpu.h"
 #include "reference/MarchReference.h"
 #include "tests/TestUtil.h"

@@ -1,4 +1,4 @@
-// The ray marcher (SPEC 10): the shared kernel (core/March.h) against closed
+// The ray marcher (SPEC 10): the shared kernel (core/math/March.h) against closed
 // forms, and the CPU backend's render_march on small grids. Expected values
 // come from analytic integrals or independent double-precision quadrature,
 // never from the code under test.
@@ -14,8 +14,8 @@
 #include <limits>
 #include <vector>
 
-#include "core/March.h"
-#include "core/Random.h"
+#include "core/math/March.h"
+#include "core/math/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/MarchTestUtil.h"
 #include "tests/TestUtil.h"

@@ -5,9 +5,9 @@
 
 #include <array>
 
-#include "core/Backend.h"
-#include "core/Camera.h"
-#include "core/Shading.h"
+#include "core/math/Camera.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/Backend.h"
 
 namespace cb::test {
 

@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "SceneTestUtil.h"
-#include "core/MemoryPlan.h"
-#include "core/Scene.h"
-#include "core/StageDescriptors.h"
-#include "harness/Simulation.h"
+#include "core/pipeline/MemoryPlan.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 

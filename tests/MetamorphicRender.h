@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Camera.h"
-#include "core/Random.h"
-#include "core/Splat.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/Backend.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 #if CLOUDBENCH_HAVE_GL

@@ -11,9 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "core/Camera.h"
-#include "core/Random.h"
-#include "core/Splat.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/SplatFrame.h"
 #include "tests/MetamorphicRender.h"
 #include "tests/TestUtil.h"
 

@@ -18,9 +18,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/Grid.h"
-#include "core/Shading.h"
-#include "core/StageDescriptors.h"
+#include "core/math/Grid.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/StageDescriptors.h"
 #include "tests/BackendTestUtil.h"
 
 namespace cb {

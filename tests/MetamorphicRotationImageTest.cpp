@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
-#include "core/StageDescriptors.h"
-#include "harness/Report.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "harness/report/Report.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/MetamorphicRotation.h"
 #include "tests/TestUtil.h"

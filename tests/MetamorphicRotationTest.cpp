@@ -4,7 +4,7 @@
 // with it) must give turned outputs: bit for bit for the integer stages, within
 // SPEC's tolerance for the float ones, and the same image from a camera turned
 // about the grid. Unlike a differential test, this sees a bug that every
-// backend shares (core/, core/glsl) and one that swaps or mirrors an axis.
+// backend shares (core/, core/math) and one that swaps or mirrors an axis.
 //
 // The automaton is equivariant only where nothing is random: its draws are
 // keyed by the voxel index v = i + nx (j + ny k), which the rotation changes
@@ -23,11 +23,11 @@
 #include <string>
 #include <vector>
 
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
-#include "core/StageDescriptors.h"
-#include "harness/Report.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "harness/report/Report.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/MetamorphicRotation.h"
 #include "tests/TestUtil.h"

@@ -1,4 +1,4 @@
-// Lorenz-Mie scattering (core/Mie.h) and the project's Mie phase table (SPEC 9;
+// Lorenz-Mie scattering (core/math/Mie.h) and the project's Mie phase table (SPEC 9;
 // docs/pipeline.md, "Mie phase table").
 //
 // Sources of the expected values:
@@ -27,9 +27,9 @@
 #include <numbers>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Mie.h"
-#include "core/Shading.h"
+#include "core/math/Mie.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/Backend.h"
 #include "registry/Registry.h"
 
 namespace cb {
@@ -322,7 +322,7 @@ std::vector<double> ExactMieCloudPhase(const std::vector<double>& degrees, uint3
     return mie::AverageOverDistribution(d, mu, 2).phase;
 }
 
-// Test that the built table is what core/Mie.cpp computes (at the nodes, up to float rounding and the
+// Test that the built table is what core/math/Mie.cpp computes (at the nodes, up to float rounding and the
 // recorded renormalisation).
 TEST(MieTable, EqualsRecomputationAtNodes) {
     std::vector<double> degrees;

@@ -1,5 +1,5 @@
 // Stage `noise` (SPEC 10a): the noises, fBm, the forming and the CPU stage
-// (core/Noise.h, impl_cpu/NoiseCpu.cpp). Expected values come from closed
+// (core/math/Noise.h, impl_cpu/NoiseCpu.cpp). Expected values come from closed
 // forms, hand arithmetic, brute force or an independent loop in the test.
 #include <gtest/gtest.h>
 
@@ -8,9 +8,10 @@
 #include <numeric>
 #include <string>
 
-#include "core/Noise.h"
-#include "core/Scene.h"
-#include "harness/Simulation.h"
+#include "core/math/Noise.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

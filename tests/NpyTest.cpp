@@ -6,7 +6,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "core/Npy.h"
+#include "core/base/Npy.h"
 
 namespace cb {
 namespace {

@@ -1,10 +1,9 @@
-// The output folder's claim (harness/OutputFolder.h): the journal of written
+// The output folder's claim (harness/platform/OutputFolder.h): the journal of written
 // files, what the next claim removes, and what it never touches; and that no
 // name cloudbench creates, replaces, locks or removes is followed when it is a
 // symbolic link.
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -12,9 +11,9 @@
 #include <fstream>
 #include <iterator>
 
-#include "core/Npy.h"
-#include "harness/OutputFolder.h"
-#include "harness/Session.h"
+#include "core/base/Npy.h"
+#include "harness/platform/OutputFolder.h"
+#include "harness/run/Session.h"
 
 namespace cb {
 namespace {

@@ -11,7 +11,7 @@
 #include <span>
 #include <vector>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/PairSortVk.h"

@@ -1,4 +1,4 @@
-// Pipelined timing on gl (core/Backend.h, "Pipelined timing"; issue 16): a
+// Pipelined timing on gl (core/pipeline/Backend.h, "Pipelined timing"; issue 16): a
 // step's stage calls recorded in one batch give the same bytes as the same
 // calls one by one; the batch waits for the device once, plus once for each
 // host value or read back inside it; EndBatch gives one device time per
@@ -16,10 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/Scene.h"
-#include "harness/StageParams.h"
+#include "core/math/Camera.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/StageParams.h"
 #include "registry/Registry.h"
 #if CLOUDBENCH_HAVE_GL
 #include "impl_gl/BackendGL.h"

@@ -17,10 +17,11 @@
 #include <span>
 #include <utility>
 
-#include "core/Scene.h"
-#include "harness/Report.h"
-#include "harness/Simulation.h"
-#include "harness/Transfer.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/report/Report.h"
+#include "harness/run/RunTransfer.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 
@@ -48,7 +49,7 @@ class BatchLoggingCpu : public cpu::BackendCpu {
     // EndBatch returns this many extra times (after the intervals'), or, with leading, one time in front.
     int extraTimes = 0;
     bool leading = false;
-    // In a batch, density's cover and render_splat's stats are deferred (core/Backend.h): the call leaves
+    // In a batch, density's cover and render_splat's stats are deferred (core/pipeline/Backend.h): the call leaves
     // the caller's values and TakeDeferredResults gives them, by mark, after EndBatch.
     bool deferResults = false;
 
@@ -169,7 +170,7 @@ std::vector<std::string> Names(std::span<const BatchLoggingCpu::Call> calls) {
     return names;
 }
 
-// What an unsliced step must call, in order (harness/Simulation.h): the stages that ran that neither render nor
+// What an unsliced step must call, in order (harness/run/Simulation.h): the stages that ran that neither render nor
 // advance the state, in schedule order; each frame's renderers, one call per camera; then the state's advance.
 std::vector<std::string> ExpectedOrder(const Simulation& sim, const StepRecord& r) {
     std::vector<std::string> order;

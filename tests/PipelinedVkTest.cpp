@@ -1,4 +1,4 @@
-// Pipelined timing on Vulkan (core/Backend.h "Pipelined timing", issue 16): a
+// Pipelined timing on Vulkan (core/pipeline/Backend.h "Pipelined timing", issue 16): a
 // step's stage calls recorded in one batch give the bytes of the same calls
 // made one by one; the batch submits once and waits once, plus one of each per
 // Download (render_splat's read-backs; density's cover is read after the batch's
@@ -18,11 +18,12 @@
 #include <string>
 #include <vector>
 
-#include "core/Camera.h"
-#include "core/Random.h"
-#include "core/Scene.h"
-#include "core/Splat.h"
-#include "harness/Simulation.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 

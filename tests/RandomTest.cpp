@@ -3,8 +3,8 @@
 
 #include <set>
 
-#include "core/Random.h"
-#include "core/Rules.h"
+#include "core/math/Random.h"
+#include "core/math/Rules.h"
 
 namespace cb {
 namespace {

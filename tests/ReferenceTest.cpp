@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/Random.h"
-#include "core/Shading.h"
+#include "core/math/Random.h"
+#include "core/math/Shading.h"
 #include "reference/Reference.h"
 
 namespace cb {

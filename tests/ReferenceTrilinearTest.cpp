@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "reference/Trilinear.h"
 
 namespace cb {

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/Rules.h"
-#include "core/Grid.h"
+#include "core/math/Grid.h"
+#include "core/math/Rules.h"
 
 namespace cb::test {
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
+#include "core/math/Random.h"
+#include "core/pipeline/Ellipsoids.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/RegionReference.h"
 #include "tests/TestUtil.h"

@@ -15,10 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "core/March.h"
-#include "core/Scene.h"
-#include "core/Shading.h"
-#include "harness/StageParams.h"
+#include "core/math/March.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/MarchTestUtil.h"

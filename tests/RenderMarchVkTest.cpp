@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "core/March.h"
-#include "core/Scene.h"
+#include "core/math/March.h"
+#include "core/scene/Scene.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/MarchTestUtil.h"

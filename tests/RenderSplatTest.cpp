@@ -1,11 +1,11 @@
-// The splat renderer (SPEC 8) and the shared camera and order (core/Camera.h).
+// The splat renderer (SPEC 8) and the shared camera and order (core/math/Camera.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/Camera.h"
-#include "core/Random.h"
-#include "harness/Report.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "harness/report/Report.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

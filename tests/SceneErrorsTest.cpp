@@ -6,7 +6,7 @@
 #include <string>
 
 #include "SceneTestUtil.h"
-#include "core/Scene.h"
+#include "core/scene/Scene.h"
 
 namespace cb {
 namespace {

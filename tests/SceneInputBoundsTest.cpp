@@ -12,9 +12,10 @@
 #include <string>
 
 #include "SceneTestUtil.h"
-#include "core/Grid.h"
-#include "core/ProcessMemory.h"
-#include "core/Scene.h"
+#include "core/base/ProcessMemory.h"
+#include "core/math/Grid.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
 
 namespace cb {
 namespace {

@@ -5,7 +5,8 @@
 #include <string>
 
 #include "SceneTestUtil.h"
-#include "core/Scene.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
 
 namespace cb {
 namespace {

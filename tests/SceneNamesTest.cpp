@@ -1,4 +1,4 @@
-// The published names of the scene's choices (core/SceneNames.h): every enum
+// The published names of the scene's choices (core/scene/SceneNames.h): every enum
 // value has exactly one name, the names read back to their values, the scene
 // loader accepts each of them, and they are exactly those docs/scenes.md lists.
 #include <gtest/gtest.h>
@@ -12,8 +12,9 @@
 #include <string_view>
 #include <vector>
 
-#include "core/Scene.h"
-#include "core/SceneNames.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "core/scene/SceneNames.h"
 
 namespace cb {
 namespace {

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "SceneTestUtil.h"
-#include "core/Scene.h"
+#include "core/scene/Scene.h"
 
 namespace cb {
 namespace {

@@ -1,7 +1,5 @@
 // Scene loading: defaults, every field, and scene files. The refusals are in
 // SceneErrorsTest.cpp, the --set overrides in SceneOverridesTest.cpp.
-#include "core/Scene.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,6 +10,8 @@
 #include <string>
 
 #include "SceneTestUtil.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
 
 namespace cb {
 namespace {

@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/Scene.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
 
 namespace cb::test {
 

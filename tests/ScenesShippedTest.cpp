@@ -7,11 +7,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/Ellipsoids.h"
-#include "core/Noise.h"
-#include "core/Scene.h"
-#include "harness/Report.h"
-#include "harness/Simulation.h"
+#include "core/math/Noise.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/report/Report.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb {

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "core/Random.h"
-#include "core/ShadePlan.h"
+#include "core/math/Random.h"
+#include "core/pipeline/ShadePlan.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 

@@ -8,8 +8,8 @@
 #include <numbers>
 #include <utility>
 
-#include "core/ShadePlan.h"
-#include "core/Shading.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/ShadeSchedule.h"
 #include "tests/ShadeTestUtil.h"

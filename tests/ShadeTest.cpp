@@ -8,7 +8,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/Shading.h"
+#include "core/math/Shading.h"
 #include "tests/ShadeTestUtil.h"
 #include "tests/TestUtil.h"
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "core/Shading.h"
+#include "core/math/Shading.h"
 
 namespace cb {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "core/Shading.h"
+#include "core/math/Shading.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

@@ -10,13 +10,14 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
-#include "core/Rules.h"
-#include "core/Shading.h"
-#include "core/Splat.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/math/Rules.h"
+#include "core/math/Shading.h"
+#include "core/math/Splat.h"
+#include "core/pipeline/Backend.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/SplatFrame.h"
 #include "tests/LowBias32Inverse.h"
 
 namespace cb {

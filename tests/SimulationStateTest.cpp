@@ -18,10 +18,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "core/Npy.h"
-#include "core/Scene.h"
-#include "harness/Simulation.h"
-#include "harness/SimulationState.h"
+#include "core/base/Npy.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
+#include "harness/run/SimulationState.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/BackendTestUtil.h"

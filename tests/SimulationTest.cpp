@@ -3,8 +3,9 @@
 
 #include <cmath>
 
-#include "core/Scene.h"
-#include "harness/Simulation.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

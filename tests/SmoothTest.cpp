@@ -1,7 +1,7 @@
 // Smoothing (SPEC section 4) against hand-worked kernels and a direct 3-D sum.
 #include <gtest/gtest.h>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
 

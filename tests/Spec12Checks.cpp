@@ -12,9 +12,9 @@
 #include <optional>
 #include <sstream>
 
-#include "core/Shading.h"
-#include "harness/Accuracy.h"
-#include "harness/StageParams.h"
+#include "core/math/Shading.h"
+#include "harness/accuracy/Accuracy.h"
+#include "harness/run/StageParams.h"
 #include "tests/TestUtil.h"
 
 namespace cb::spec12_test {

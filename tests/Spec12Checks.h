@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/Scene.h"
-#include "harness/Simulation.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "tests/Spec12Outputs.h"
 
 namespace cb::spec12_test {

@@ -19,10 +19,11 @@
 #include <tuple>
 #include <vector>
 
-#include "core/Random.h"
-#include "core/Scene.h"
-#include "core/StageDescriptors.h"
-#include "harness/Simulation.h"
+#include "core/math/Random.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/Spec12Checks.h"
 #include "tests/Spec12Outputs.h"

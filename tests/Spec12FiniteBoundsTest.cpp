@@ -14,10 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "core/SceneNames.h"
-#include "core/Shading.h"
-#include "core/StageDescriptors.h"
-#include "harness/Simulation.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "core/scene/SceneNames.h"
+#include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/SceneTestUtil.h"
 #include "tests/Spec12Checks.h"
@@ -248,7 +249,7 @@ TEST_P(FiniteBounds, ShadeRefusesAResolutionOutsideTheList) {
 INSTANTIATE_TEST_SUITE_P(Backends, FiniteBounds, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
-// Test the phase peak's bound against what it promises (core/Shading.h kMaxPhasePeak): for every float g in
+// Test the phase peak's bound against what it promises (core/math/Shading.h kMaxPhasePeak): for every float g in
 // [0.9, 1) whose peak passes, and its negative, P^ at |cos theta| up to 1 + 2^-19 (16 ulps past 1, the
 // renderers' rounding with margin) is finite and at most 2^1.5 times the peak. With the bound 16 times larger
 // (2^22) it fails from g = 0.997243 on (denominators within the rounding of cos).

@@ -10,7 +10,7 @@
 #include <map>
 #include <memory>
 
-#include "core/Shading.h"
+#include "core/math/Shading.h"
 #include "registry/Registry.h"
 #include "tests/TestUtil.h"
 

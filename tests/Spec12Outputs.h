@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "core/Scene.h"
-#include "core/StageDescriptors.h"
-#include "harness/Simulation.h"
+#include "core/pipeline/StageDescriptors.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 
 namespace cb::spec12_test {
 

@@ -11,9 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "core/Random.h"
-#include "core/Scene.h"
-#include "harness/Simulation.h"
+#include "core/math/Random.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/Spec12Outputs.h"
 #include "tests/TestUtil.h"

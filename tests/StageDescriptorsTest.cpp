@@ -1,9 +1,9 @@
-// The stage list, the descriptors and the scheduler (core/Stage.h,
-// core/StageDescriptors.h). Every backend shares them, so a differential test
+// The stage list, the descriptors and the scheduler (core/scene/Stage.h,
+// core/pipeline/StageDescriptors.h). Every backend shares them, so a differential test
 // cannot see a mistake here: each is checked against hand-worked cases.
 #include <gtest/gtest.h>
 
-#include "core/StageDescriptors.h"
+#include "core/pipeline/StageDescriptors.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb {

@@ -9,9 +9,9 @@
 #include <memory>
 #include <vector>
 
-#include "core/Backend.h"
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
+#include "core/math/Random.h"
+#include "core/pipeline/Backend.h"
+#include "core/pipeline/Ellipsoids.h"
 
 namespace cb::test {
 

@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "core/Random.h"
+#include "core/math/Random.h"
 #include "registry/Registry.h"
 #include "tests/TestUtil.h"
 

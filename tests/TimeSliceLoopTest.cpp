@@ -11,10 +11,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "core/Scene.h"
-#include "core/ShadePlan.h"
-#include "harness/Simulation.h"
-#include "harness/StageParams.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/pipeline/ShadePlan.h"
+#include "core/scene/Scene.h"
+#include "harness/run/Simulation.h"
+#include "harness/run/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/BackendTestUtil.h"

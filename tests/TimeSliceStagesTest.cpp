@@ -1,4 +1,4 @@
-// Time-slicing at the stage level (SPEC 13, core/Backend.h SliceRange): a
+// Time-slicing at the stage level (SPEC 13, core/pipeline/Backend.h SliceRange): a
 // stage run as a sequence of shares, ascending and each once, must leave
 // exactly the outputs of the whole call, byte for byte, on every backend.
 // Each output starts filled with a pattern no stage writes, so a share that
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
-#include "core/ShadePlan.h"
+#include "core/math/Random.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/ShadePlan.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/TestUtil.h"
 
@@ -324,8 +324,8 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
             share.slices = s;
             return mBackend->Shade(share, *field, *T);
         };
-        // A backend may keep the sweep in scratch and write T when it ends (gl does; core/Backend.h): inside the
-        // shares run, final values or the pattern; outside, the pattern only.
+        // A backend may keep the sweep in scratch and write T when it ends (gl does; core/pipeline/Backend.h): inside
+        // the shares run, final values or the pattern; outside, the pattern only.
         ExpectOnly("shade", {T.get()}, shade, {{0, 3}, {3, 5}}, {0, 5}, sweepSlice, /*writtenMayWait=*/true);
         // At resolution 2, T is written by the last share alone.
         p.resolution = 2;

@@ -2,7 +2,7 @@
 """conform's deqp-runner features (issue 17, item 4): the cover count compared,
 conform.csv, --baseline and --flake-reruns, on ci-small against one backend.
 A mismatch is planted with the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH
-switch (harness/Conform.h): <backend>:<row stage>[:<attempts it fails on>].
+switch (harness/conform/Conform.h): <backend>:<row stage>[:<attempts it fails on>].
 
 With --matrix (cases "matrix" and "matrix-baseline"), every case of the built-in
 set must appear, worked out by hand from scenes/ci-small.json (tests/ConformMatrixTest.cpp

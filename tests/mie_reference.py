@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Independent Lorenz-Mie values for tests/MieTest.cpp.
 
-Not the Bohren-Huffman recurrences of core/Mie.cpp: a_n and b_n from their
+Not the Bohren-Huffman recurrences of core/math/Mie.cpp: a_n and b_n from their
 defining formulas (Bohren & Huffman 1983, eq. 4.53) with scipy's spherical
 Bessel functions j_n, y_n of real and complex argument, and the angular
 functions from numpy's Legendre polynomials (pi_n = P_n'(mu),

@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <numbers>
 
-#include "core/SceneNames.h"
-#include "harness/ImageAccuracy.h"
-#include "harness/IsolatedMeasurement.h"
-#include "harness/Measurement.h"
-#include "harness/StageParams.h"
-#include "harness/Transfer.h"
+#include "core/scene/SceneNames.h"
+#include "harness/accuracy/AccuracyTransfer.h"
+#include "harness/accuracy/ImageAccuracy.h"
+#include "harness/accuracy/IsolatedMeasurement.h"
+#include "harness/accuracy/Measurement.h"
+#include "harness/report/ReportTransfer.h"
+#include "harness/run/RunTransfer.h"
+#include "harness/run/StageParams.h"
 
 namespace cb {
 namespace {
@@ -63,7 +65,7 @@ std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage
         for (const char* v : values)
             if (current != v) out.push_back({{path, v}});
     };
-    // A choice's names come from the scene's own table (core/SceneNames.h), in its order.
+    // A choice's names come from the scene's own table (core/scene/SceneNames.h), in its order.
     auto addNames = [&](const char* path, const auto& names, auto current) {
         for (const auto& [name, value] : names)
             if (value != current) out.push_back({{path, std::string(name)}});
@@ -268,7 +270,7 @@ int Accuracy(const CommonOptions& options) {
         "voxel's exit point toward the sun)\n",
         scene.name.c_str(), scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps - 1);
     // Each backend measures every setting, the ray start and the switches in a
-    // process of its own (harness/IsolatedMeasurement.h); the parent merges.
+    // process of its own (harness/accuracy/IsolatedMeasurement.h); the parent merges.
     std::vector<PlannedSetting> plan;
     for (Stage stage : {Stage::Shade, Stage::Shadow}) {
         if (!scene.stages.Has(stage)) continue;

@@ -1,19 +1,20 @@
 // `cloudbench conform`: stage-isolated conformance of every backend against
-// the CPU on a scene (harness/Conform.h); writes conform.json and conform.csv,
+// the CPU on a scene (harness/conform/Conform.h); writes conform.json and conform.csv,
 // exits 5 on a failure; --baseline and --flake-reruns as deqp-runner's, and
-// --matrix / --vary to compare over cases of options (harness/ConformMatrix.h, docs/cli.md).
+// --matrix / --vary to compare over cases of options (harness/conform/ConformMatrix.h, docs/cli.md).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
 
-#include "core/StageDescriptors.h"
-#include "harness/Conform.h"
-#include "harness/ConformMatrix.h"
-#include "harness/Isolation.h"
-#include "harness/Session.h"
-#include "harness/Transfer.h"
+#include "core/pipeline/StageDescriptors.h"
 #include "harness/commands/SweepOutput.h"
+#include "harness/conform/Conform.h"
+#include "harness/conform/ConformMatrix.h"
+#include "harness/conform/ConformTransfer.h"
+#include "harness/platform/Isolation.h"
+#include "harness/run/RunTransfer.h"
+#include "harness/run/Session.h"
 
 namespace cb {
 namespace {
@@ -22,7 +23,7 @@ constexpr const char* kHelpIntro = R"(usage: cloudbench conform [SCENE] [options
 
 Runs SCENE on the CPU and, at every step, feeds each other backend's stages
 the CPU's inputs of that step (stage-isolated conformance), and compares their
-outputs by SPEC's rule for the stage (core/StageDescriptors.cpp):
+outputs by SPEC's rule for the stage (core/pipeline/StageDescriptors.cpp):
 )";
 constexpr const char* kHelpOptions = R"(Prints stage x backend with the result, the rule and the worst error with where
 it is, writes DIR/conform.json and DIR/conform.csv, and exits 5 if any check

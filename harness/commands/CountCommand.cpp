@@ -3,15 +3,15 @@
 // them, summed over the steps after warm-up and step by step, as
 // cloudbench-count/1 JSON. The command runs itself again under valgrind; in
 // that child role (RUNNING_ON_VALGRIND) it only steps the scene, and the stage
-// brackets of harness/StageCall.cpp write one dump per call.
+// brackets of harness/run/StageCall.cpp write one dump per call.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
-#include "harness/Session.h"
-#include "harness/Simulation.h"
 #include "harness/perf/CallgrindCount.h"
-#include "harness/perf/CallgrindRequests.h"
+#include "harness/platform/CallgrindRequests.h"
+#include "harness/run/Session.h"
+#include "harness/run/Simulation.h"
 
 namespace cb {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "harness/Command.h"
+#include "harness/platform/Command.h"
 #include "registry/Registry.h"
 
 namespace cb {

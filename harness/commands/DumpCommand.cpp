@@ -2,11 +2,11 @@
 // (docs/results.md#dumps), and with --reference the exact references.
 #include <cstdio>
 
-#include "core/Npy.h"
-#include "harness/Accuracy.h"
-#include "harness/Report.h"
-#include "harness/Session.h"
-#include "harness/Simulation.h"
+#include "core/base/Npy.h"
+#include "harness/accuracy/Accuracy.h"
+#include "harness/report/Report.h"
+#include "harness/run/Session.h"
+#include "harness/run/Simulation.h"
 
 namespace cb {
 namespace {

@@ -7,15 +7,15 @@
 #include <map>
 #include <set>
 
-#include "core/ShownText.h"
-#include "harness/Command.h"
-#include "harness/InputFormats.h"
-#include "harness/Measurement.h"
-#include "harness/Session.h"
-#include "harness/Transfer.h"
-#include "harness/VaryAxes.h"
+#include "core/base/ShownText.h"
+#include "harness/accuracy/AccuracyTransfer.h"
+#include "harness/accuracy/Measurement.h"
 #include "harness/commands/SweepOutput.h"
 #include "harness/perf/History.h"
+#include "harness/platform/Command.h"
+#include "harness/report/InputFormats.h"
+#include "harness/run/Session.h"
+#include "harness/run/VaryAxes.h"
 
 namespace cb {
 namespace {

@@ -8,7 +8,7 @@
 // PerfHistory.cpp, PerfExport.cpp); what they share is in PerfCommon.h.
 #include <cstdio>
 
-#include "core/ShownText.h"
+#include "core/base/ShownText.h"
 #include "harness/commands/PerfCommon.h"
 
 namespace cb::perf_command {

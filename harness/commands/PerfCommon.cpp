@@ -10,11 +10,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/NamedValues.h"
-#include "core/ShownText.h"
-#include "harness/InputFormats.h"
-#include "harness/Session.h"
+#include "core/base/NamedValues.h"
+#include "core/base/ShownText.h"
 #include "harness/perf/Spawn.h"
+#include "harness/report/InputFormats.h"
+#include "harness/run/Session.h"
 
 namespace cb::perf_command {
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "harness/Command.h"
 #include "harness/perf/Compare.h"
+#include "harness/platform/Command.h"
 
 namespace cb::perf_command {
 

@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <tuple>
 
-#include "harness/ReportModel.h"
-#include "core/ShownText.h"
+#include "core/base/ShownText.h"
 #include "harness/commands/PerfCommon.h"
+#include "harness/report/ReportModel.h"
 
 namespace cb::perf_command {
 namespace {

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/ShownText.h"
-#include "harness/InputFormats.h"
+#include "core/base/ShownText.h"
 #include "harness/commands/PerfCommon.h"
 #include "harness/perf/CallgrindCount.h"
 #include "harness/perf/History.h"
 #include "harness/perf/Spawn.h"
+#include "harness/report/InputFormats.h"
 
 namespace cb::perf_command {
 namespace {
@@ -23,7 +23,7 @@ struct SuiteEntry {
 // The default suite: the thesis scenes as `run` runs them.
 std::vector<SuiteEntry> DefaultSuite() { return {{"thesis-low", {}}, {"thesis-medium", {}}, {"thesis-high", {}}}; }
 
-// {"scenes": [{"scene": NAME_OR_PATH, "set": ["PATH=VALUE", ...]}, ...]} (harness/InputFormats.h).
+// {"scenes": [{"scene": NAME_OR_PATH, "set": ["PATH=VALUE", ...]}, ...]} (harness/report/InputFormats.h).
 Result<std::vector<SuiteEntry>> LoadSuite(const std::string& path) {
     static constexpr input::Format kSuite[] = {input::Format::Suite};
     auto read = input::ReadCloudbenchFile(path, kSuite);

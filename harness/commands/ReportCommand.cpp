@@ -1,12 +1,12 @@
 // `cloudbench report`: one self-contained HTML page from the JSON outputs of
-// run, conform, accuracy and sweep and a perf history (harness/html/).
+// run, conform, accuracy and sweep and a perf history (harness/report/html/).
 #include <cstdio>
 
-#include "harness/Command.h"
-#include "harness/InputFormats.h"
-#include "harness/Session.h"
-#include "harness/html/HtmlRender.h"
-#include "harness/html/HtmlReport.h"
+#include "harness/platform/Command.h"
+#include "harness/report/InputFormats.h"
+#include "harness/report/html/HtmlRender.h"
+#include "harness/report/html/HtmlReport.h"
+#include "harness/run/Session.h"
 
 namespace cb {
 namespace {

@@ -3,13 +3,13 @@
 #include <cstdio>
 #include <map>
 
-#include "harness/Isolation.h"
-#include "harness/OutputFolder.h"
-#include "harness/Report.h"
-#include "harness/Session.h"
-#include "harness/Simulation.h"
-#include "harness/SimulationState.h"
-#include "harness/Transfer.h"
+#include "harness/platform/Isolation.h"
+#include "harness/platform/OutputFolder.h"
+#include "harness/report/Report.h"
+#include "harness/run/RunTransfer.h"
+#include "harness/run/Session.h"
+#include "harness/run/Simulation.h"
+#include "harness/run/SimulationState.h"
 
 namespace cb {
 namespace {

@@ -7,11 +7,12 @@
 #include <cstdlib>
 #include <expected>
 
-#include "core/ShownText.h"
-#include "harness/IsolatedMeasurement.h"
-#include "harness/Measurement.h"
-#include "harness/Transfer.h"
+#include "core/base/ShownText.h"
+#include "harness/accuracy/AccuracyTransfer.h"
+#include "harness/accuracy/IsolatedMeasurement.h"
+#include "harness/accuracy/Measurement.h"
 #include "harness/commands/SweepOutput.h"
+#include "harness/run/RunTransfer.h"
 
 namespace cb {
 namespace {
@@ -165,7 +166,7 @@ int Sweep(const CommonOptions& options) {
     std::vector<size_t> planPoint;
     for (size_t k = 0; k < points->size(); ++k)
         if (!sharded || int(k % size_t(options.shardCount)) == options.shardIndex - 1) planPoint.push_back(k);
-    // Each backend measures every point in a process of its own (harness/IsolatedMeasurement.h).
+    // Each backend measures every point in a process of its own (harness/accuracy/IsolatedMeasurement.h).
     std::vector<PlannedSetting> plan;
     for (size_t k : planPoint) plan.push_back({(*points)[k], stages});
     auto parts = MeasureEachBackend(**session, names, plan, {}, [&](size_t n) {

@@ -13,8 +13,8 @@
 #include <cstring>
 #include <string_view>
 
-#include "harness/Command.h"
-#include "harness/Session.h"
+#include "harness/platform/Command.h"
+#include "harness/run/Session.h"
 
 extern char** environ;
 

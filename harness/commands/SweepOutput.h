@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "core/Error.h"
-#include "harness/Measurement.h"
-#include "harness/VaryAxes.h"
+#include "core/base/Error.h"
+#include "harness/accuracy/Measurement.h"
+#include "harness/run/VaryAxes.h"
 
 namespace cb {
 

@@ -1,7 +1,5 @@
 #include "harness/perf/CallgrindCount.h"
 
-#include "core/InputFile.h"
-
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,7 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "harness/perf/CallgrindRequests.h"
+#include "core/base/InputFile.h"
+#include "harness/platform/CallgrindRequests.h"
 
 extern char** environ;
 

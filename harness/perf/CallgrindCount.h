@@ -1,7 +1,7 @@
 // Exact mode (docs/performance.md): counts the instructions of each stage call
 // by running this binary again under callgrind, in a child process that steps
 // the scene on one backend at one thread (`cloudbench count` in its child
-// role), and reading the dumps that the stage brackets of harness/StageCall.cpp
+// role), and reading the dumps that the stage brackets of harness/run/StageCall.cpp
 // write. `cloudbench count` is its command line; `perf record` may call it too.
 #pragma once
 
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/Scene.h"
+#include "core/scene/Scene.h"
 #include "harness/perf/CallgrindDump.h"
 
 namespace cb {
@@ -21,7 +21,7 @@ namespace cb {
 std::optional<std::string> WhyCannotCount(const std::string& buildFlags);
 
 // valgrind's options: callgrind counting Ir only, uninstrumented until the
-// first stage call (harness/perf/CallgrindRequests.h), all dumps in one file,
+// first stage call (harness/platform/CallgrindRequests.h), all dumps in one file,
 // no per-line or per-instruction detail (the counts are per part).
 std::vector<std::string> CallgrindOptions(const std::string& outFile, const std::string& logFile);
 

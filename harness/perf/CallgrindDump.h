@@ -1,7 +1,7 @@
 // Reads callgrind's output files (the "callgrind format" of the valgrind
 // manual) for `cloudbench count`: each dump part's trigger and its total
 // instruction count (event Ir), and the stage calls named by the client
-// requests of harness/perf/CallgrindRequests.h.
+// requests of harness/platform/CallgrindRequests.h.
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/Error.h"
+#include "core/base/Error.h"
 
 namespace cb {
 

@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 
-#include "harness/InputFormats.h"
 #include "harness/perf/History.h"
+#include "harness/report/InputFormats.h"
 
 namespace cb::perf {
 namespace {

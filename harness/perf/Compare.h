@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/Error.h"
+#include "core/base/Error.h"
 #include "harness/perf/Stats.h"
 
 namespace cb::perf {

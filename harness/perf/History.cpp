@@ -12,9 +12,9 @@
 #include <filesystem>
 #include <random>
 
-#include "core/ShownText.h"
-#include "harness/OutputFolder.h"
-#include "harness/PosixIo.h"
+#include "core/base/ShownText.h"
+#include "harness/platform/OutputFolder.h"
+#include "harness/platform/PosixIo.h"
 
 namespace cb::perf {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "core/Error.h"
-#include "harness/InputFormats.h"
+#include "core/base/Error.h"
+#include "harness/report/InputFormats.h"
 
 namespace cb::perf {
 

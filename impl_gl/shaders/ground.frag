@@ -1,4 +1,4 @@
-// The ground pass of stage `render_splat` (core/glsl/ground.glsl): the full-screen
+// The ground pass of stage `render_splat` (core/math/ground.glsl): the full-screen
 // triangle writes each pixel's background, the lit ground where the pixel's ray
 // meets it, before the splats blend over it. The fragment at gl_FragCoord
 // (x + 0.5, y + 0.5) is the image's pixel (x, y), as in render_march.frag.

@@ -1,6 +1,6 @@
 // Stage `noise` (SPEC 10a): one fragment per voxel of slice `layer`, q =
-// NoiseForm::Q by core/glsl/noise.glsl (prepended), reading the scene's data
-// block (core/NoiseGpu.h) from a storage buffer and the step's offsets.
+// NoiseForm::Q by core/math/noise.glsl (prepended), reading the scene's data
+// block (core/math/NoiseGpu.h) from a storage buffer and the step's offsets.
 layout(std430, binding = 0) readonly buffer Data { uint data[]; };
 uniform int layer;
 uniform float offsets[8];

@@ -2,7 +2,7 @@
 // full-screen pass. The fragment at gl_FragCoord (x + 0.5, y + 0.5) is the
 // image's pixel (x, y): the target's row y = 0 is the first row read back, so
 // the canonical layout's row 0 (the top) needs no flip. MarchPixel of
-// core/glsl/march.glsl (prepended) marches the ray; the volume, the bricks and
+// core/math/march.glsl (prepended) marches the ray; the volume, the bricks and
 // the Mie table are storage buffers read by index (never a filtering sampler).
 layout(std140, binding = 0) uniform MarchBlock { MarchGpu march; };
 layout(std430, binding = 0) readonly buffer MarchVolume { vec2 marchQT[]; };

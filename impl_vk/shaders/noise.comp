@@ -1,6 +1,6 @@
 #version 450
 // Stage `noise` (SPEC 10a), one invocation per voxel: q = NoiseForm::Q by
-// core/glsl/noise.glsl, reading the scene's data block (core/NoiseGpu.h) and
+// core/math/noise.glsl, reading the scene's data block (core/math/NoiseGpu.h) and
 // the step's offsets.
 #extension GL_GOOGLE_include_directive : require
 #include "random.glsl"

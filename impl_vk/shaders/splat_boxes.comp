@@ -1,5 +1,5 @@
 #version 450
-// render_splat's box visibility on the device (SPEC 8, core/Backend.h
+// render_splat's box visibility on the device (SPEC 8, core/pipeline/Backend.h
 // SplatBoxVisibility): boxes holds the frustum's visible boxes (host geometry,
 // uploaded in order with the recorded calls); a box stays visible only if
 // either step's band occupancy has it. The buffers are bytes of 0 or 1, read

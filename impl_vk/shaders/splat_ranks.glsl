@@ -1,6 +1,6 @@
 // Shared by the splat passes that walk ranks (SPEC 8): the bindings, and the
 // splat of the voxel of a given rank in the shared back-to-front order
-// (core/glsl/splat.glsl MakeSplat). A rank is (o, m, i): its positions in the
+// (core/math/splat.glsl MakeSplat). A rank is (o, m, i): its positions in the
 // outer, middle and inner axis orders, r = (o nMid + m) nIn + i.
 #ifndef CLOUDBENCH_SPLAT_RANKS_GLSL
 #define CLOUDBENCH_SPLAT_RANKS_GLSL

@@ -9,14 +9,15 @@
 #include <numbers>
 #include <numeric>
 
-#include "core/Camera.h"
-#include "core/Ellipsoids.h"
-#include "core/Random.h"
-#include "core/Scene.h"
-#include "core/SceneNames.h"
-#include "core/Shading.h"
-#include "harness/StageParams.h"
-#include "core/ShadePlan.h"
+#include "core/math/Camera.h"
+#include "core/math/Random.h"
+#include "core/math/Shading.h"
+#include "core/pipeline/Ellipsoids.h"
+#include "core/pipeline/SceneLoad.h"
+#include "core/pipeline/ShadePlan.h"
+#include "core/scene/Scene.h"
+#include "core/scene/SceneNames.h"
+#include "harness/run/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/ShadeSchedule.h"
 

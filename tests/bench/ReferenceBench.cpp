@@ -5,8 +5,9 @@
 
 #include <map>
 
-#include "core/Random.h"
-#include "harness/Accuracy.h"
+#include "core/math/Random.h"
+#include "core/pipeline/SceneLoad.h"
+#include "harness/accuracy/Accuracy.h"
 #include "reference/Trilinear.h"
 
 namespace cb {

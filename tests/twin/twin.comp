@@ -1,5 +1,5 @@
 #version 450
-// The GLSL twins of core/glsl, one function per `fn` (tests/GlslTwinTest.cpp
+// The GLSL twins of core/math, one function per `fn` (tests/GlslTwinTest.cpp
 // lists them): element n reads 16 words at in[16 n] and writes 16 at out[16 n];
 // floats travel as their bits.
 #extension GL_GOOGLE_include_directive : require

@@ -1,0 +1,372 @@
+// The ray-march renderer's algorithm (SPEC 10): ray generation, the box and
+// near/far clip, the step schedule, trilinear sampling, the light march, the
+// point light, the tone map, and ONE per-ray kernel, MarchRay, shared by the
+// CPU backend and the exact reference render (which passes its own light
+// functor). Decisions where SPEC is silent: docs/pipeline.md, "Ray-march
+// renderer" and "Lightning".
+//
+// Everything inside a ray works in VOXEL units: a point p has world position
+// origin + h p, voxel (i, j, k) fills [i, i+1] x [j, j+1] x [k, k+1], and the
+// distance t along a ray is in voxel edges (metres = h t). The per-sample code
+// is scalar float without the standard library's containers, so the GLSL ports
+// (issue 14) can twin it line by line.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "core/math/Camera.h"
+#include "core/math/Grid.h"
+#include "core/math/Random.h"
+#include "core/math/Shading.h"
+
+namespace cb {
+
+// ---- Small vector helpers (GLSL has them built in) ------------------------------
+
+inline Vec3 MarchAdd(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+inline Vec3 MarchScale(const Vec3& a, float s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+inline Vec3 MarchAlong(const Vec3& o, const Vec3& d, float t) {
+    return {o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t};
+}
+inline float MarchDot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// ---- Rays ------------------------------------------------------------------------
+
+// A ray in voxel units: origin o (the eye), unit direction d, and the part
+// [tMin, tMax] that lies inside the volume's box and between the near and far
+// planes. Empty when tMin >= tMax.
+struct MarchRayGeometry {
+    Vec3 origin{}, dir{};
+    float tMin = 0, tMax = 0;
+    bool Empty() const { return !(tMin < tMax); }
+};
+
+// Direction of the ray through the centre of pixel (x, y), row 0 at the top
+// (SPEC 8's projection inverted), and cos of its angle to the view axis.
+struct PixelDirection {
+    Vec3 dir;
+    float cosForward;
+};
+inline PixelDirection PixelRayDirection(const CameraFrame& c, uint32_t x, uint32_t y) {
+    const float u = (float(x) + 0.5f - 0.5f * float(c.width)) / c.focalPx;
+    const float v = (0.5f * float(c.height) - (float(y) + 0.5f)) / c.focalPx;
+    Vec3 d;
+    for (int i = 0; i < 3; ++i) d[i] = c.forward[i] + u * c.right[i] + v * c.upVector[i];
+    const float inv = 1.0f / std::sqrt(MarchDot(d, d));  // |d| >= 1: forward, right, up are orthonormal
+    return {MarchScale(d, inv), inv};
+}
+
+// Clips [tMin, tMax] of the ray o + t d to the box [0, size] (slab method). A
+// direction component of (nearly) zero keeps the interval when o lies inside
+// that slab and empties it otherwise, so no 0 * inf is ever formed.
+inline void ClipRayToBox(const Vec3& o, const Vec3& d, const Vec3& size, float& tMin, float& tMax) {
+    for (int a = 0; a < 3; ++a) {
+        if (std::fabs(d[a]) < 1e-20f) {
+            if (o[a] < 0.0f || o[a] > size[a]) tMax = tMin = 0.0f;
+            continue;
+        }
+        const float inv = 1.0f / d[a];
+        float t0 = (0.0f - o[a]) * inv, t1 = (size[a] - o[a]) * inv;
+        if (t0 > t1) std::swap(t0, t1);
+        tMin = std::max(tMin, t0);
+        tMax = std::min(tMax, t1);
+    }
+}
+
+// The camera ray of pixel (x, y) in voxel units, clipped to the box [0, n] and
+// to the near and far planes (view depth in [near, far], metres).
+inline MarchRayGeometry MakePixelRay(const CameraFrame& c, const Vec3& originWorld, float voxelSize, const Vec3& size,
+                                     uint32_t x, uint32_t y) {
+    const PixelDirection p = PixelRayDirection(c, x, y);
+    MarchRayGeometry r;
+    for (int i = 0; i < 3; ++i) r.origin[i] = (c.eye[i] - originWorld[i]) / voxelSize;
+    r.dir = p.dir;
+    // depth = t h cosForward.
+    const float perDepth = 1.0f / (voxelSize * p.cosForward);
+    r.tMin = c.nearPlane * perDepth;
+    r.tMax = c.farPlane * perDepth;
+    ClipRayToBox(r.origin, r.dir, size, r.tMin, r.tMax);
+    return r;
+}
+
+// ---- Sampling --------------------------------------------------------------------
+
+// Trilinear sample of a canonical volume between voxel centres at voxel-unit
+// point p; taps outside the grid read `outside` (q: 0, T: 1). The definition
+// the faster samplers (a padded volume on the CPU, textures on GPUs) match.
+inline float TrilinearSample(const float* v, const Extent3& e, float outside, const Vec3& p) {
+    const float cx = p[0] - 0.5f, cy = p[1] - 0.5f, cz = p[2] - 0.5f;
+    const float fx = std::floor(cx), fy = std::floor(cy), fz = std::floor(cz);
+    const float wx = cx - fx, wy = cy - fy, wz = cz - fz;
+    // Far outside: every tap is outside (also keeps the int conversion defined).
+    const float lim = float(std::max({e.nx, e.ny, e.nz})) + 2.0f;
+    if (!(std::fabs(fx) < lim && std::fabs(fy) < lim && std::fabs(fz) < lim)) return outside;
+    const int64_t i0 = int64_t(fx), j0 = int64_t(fy), k0 = int64_t(fz);
+    auto tap = [&](int64_t i, int64_t j, int64_t k) {
+        if (i < 0 || j < 0 || k < 0 || i >= int64_t(e.nx) || j >= int64_t(e.ny) || k >= int64_t(e.nz)) return outside;
+        return v[size_t(i) + size_t(e.nx) * (size_t(j) + size_t(e.ny) * size_t(k))];
+    };
+    const float c00 = Lerp(tap(i0, j0, k0), tap(i0 + 1, j0, k0), wx);
+    const float c10 = Lerp(tap(i0, j0 + 1, k0), tap(i0 + 1, j0 + 1, k0), wx);
+    const float c01 = Lerp(tap(i0, j0, k0 + 1), tap(i0 + 1, j0, k0 + 1), wx);
+    const float c11 = Lerp(tap(i0, j0 + 1, k0 + 1), tap(i0 + 1, j0 + 1, k0 + 1), wx);
+    return Lerp(Lerp(c00, c10, wy), Lerp(c01, c11, wy), wz);
+}
+
+// ---- Kernel constants ------------------------------------------------------------
+
+// The point light (Wang, Ji and Zhang, eq. 21) as the kernel sees it.
+struct MarchPointLight {
+    bool on = false;
+    Vec3 position{};         // voxel units
+    Vec3 radiance{};         // colour * intensity (radiance * m^2)
+    float minDistance2 = 1;  // r0^2 in metres^2: the 1/D^2 law is capped at 1/r0^2
+};
+
+struct MarchSetup {
+    Vec3 size{1, 1, 1};   // the box [0, size], voxel units (nx, ny, nz)
+    float voxelSize = 1;  // h, metres
+    float step = 0.5f;    // Delta_0, voxel edges
+    bool adaptive = false;
+    float kappa = 0, adaptiveStart = 0;  // Delta(t) = Delta_0 + kappa max(0, t - t_a), t from the eye
+    float sigmaH = 1;                    // sigma h: optical depth per voxel edge at q = 1 (finite)
+    float epsilon = 0.01f;
+    Vec3 sun{0, 0, 1};  // unit, toward the sun
+    Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
+    PhaseParams phase;
+    bool powder = false;
+    float powderC = 2;
+    MarchPointLight point;
+};
+
+// sigma h, capped so that sigma h q l stays free of inf * 0 (as in MakeSliceAttenuation).
+inline float MarchOpticalDepthPerVoxel(float sigma, float voxelSize) {
+    return sigma > 0 ? std::min(sigma * voxelSize, std::numeric_limits<float>::max()) : 0.0f;
+}
+
+// Segment transmittance tau = exp(-sigma h q l), l in voxel edges.
+inline float SegmentTransmittance(float sigmaH, float q, float length) {
+    return ExpNonPositive(-(sigmaH * q) * length);
+}
+
+// Step length at distance t from the eye: fixed, or Olajos's adaptive step.
+inline float MarchStepAt(const MarchSetup& s, float t) {
+    return s.adaptive ? s.step + s.kappa * std::max(0.0f, t - s.adaptiveStart) : s.step;
+}
+
+// Jitter xi of pixel v at `frame` (the step): rand24(seed, frame, 3, v) / 2^24.
+inline float MarchJitter(uint32_t seed, uint32_t frame, uint32_t pixel) {
+    return float(Rand24(seed, frame, kStreamOther, pixel)) * (1.0f / 16777216.0f);
+}
+
+// Powder (Olajos eq. in section 2.5) with d the optical depth toward the sun,
+// -ln T_light: 1 - exp(-c d) = 1 - T_light^c.
+inline float PowderTerm(float c, float lightT) { return 1.0f - std::pow(std::max(lightT, 0.0f), c); }
+
+// Reinhard tone map of one linear channel with an exposure: x / (1 + x), x = exposure C.
+inline float ReinhardToneMap(float c, float exposure) {
+    const float x = std::max(c * exposure, 0.0f);
+    return std::isinf(x) ? 1.0f : x / (1.0f + x);
+}
+
+// The point light's radiance factor at distance^2 d2 (metres^2): 1 / max(d2, r0^2).
+inline float PointLightFalloff(float distance2, float minDistance2) { return 1.0f / std::max(distance2, minDistance2); }
+
+// ---- Brick skip structure (SPEC 10) ----------------------------------------------
+
+// Bricks of `brick`^3 voxels; empty[b] = 1 iff q_alpha = 0 over the brick grown
+// by one voxel, so every trilinear sample inside an empty brick reads q = 0
+// exactly. Index bx + bricksX (by + bricksY bz).
+struct MarchBricks {
+    const uint8_t* empty = nullptr;
+    uint32_t brick = 8;
+    uint32_t count[3] = {0, 0, 0};
+};
+
+// 1/d per component for RayExitFromBox: FLT_MAX where d is (nearly) zero, so
+// that axis never bounds the exit (o lies inside that slab of the brick).
+inline Vec3 InverseDirection(const Vec3& d) {
+    Vec3 inv;
+    for (int a = 0; a < 3; ++a) inv[a] = std::fabs(d[a]) < 1e-20f ? std::numeric_limits<float>::max() : 1.0f / d[a];
+    return inv;
+}
+
+// Distance along o + t d at which the ray leaves the box [lo, hi] (at least t);
+// invD = InverseDirection(d).
+inline float RayExitFromBox(const Vec3& o, const Vec3& invD, const Vec3& lo, const Vec3& hi, float t) {
+    float exit = std::numeric_limits<float>::max();
+    for (int a = 0; a < 3; ++a) exit = std::min(exit, ((invD[a] >= 0.0f ? hi[a] : lo[a]) - o[a]) * invD[a]);
+    return std::max(exit, t);
+}
+
+// ---- Light functor for the light march (Olajos) -----------------------------------
+
+// What a light functor returns at a sample: transmittance toward the sun and
+// toward the point light (1 where the light is off).
+struct MarchLightSample {
+    float sun = 1, point = 1;
+};
+
+// T along the segment from p toward unit direction u over length `length`
+// (voxel edges): n equal segments, midpoint samples of the density functor q.
+template <class Density>
+float MarchTransmittance(const Vec3& p, const Vec3& u, float length, uint32_t n, float sigmaH, Density&& q) {
+    if (!(length > 0.0f) || n == 0) return 1.0f;
+    const float dl = length / float(n);
+    float depth = 0;
+    for (uint32_t j = 0; j < n; ++j) depth += q(MarchAlong(p, u, (float(j) + 0.5f) * dl));
+    return ExpNonPositive(-(sigmaH * depth) * dl);
+}
+
+// T toward the sun: n_l segments from p to the box exit along s.
+template <class Density>
+float SunLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& q) {
+    float t0 = 0, t1 = std::numeric_limits<float>::max();
+    ClipRayToBox(p, s.sun, s.size, t0, t1);
+    return t1 > t0 ? MarchTransmittance(p, s.sun, t1, n, s.sigmaH, q) : 1.0f;
+}
+
+// T toward the point light: n_l segments from p toward it, ending at the light
+// or at the box exit, whichever comes first.
+template <class Density>
+float PointLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& q) {
+    const Vec3 toLight{s.point.position[0] - p[0], s.point.position[1] - p[1], s.point.position[2] - p[2]};
+    const float dist = std::sqrt(MarchDot(toLight, toLight));
+    if (!(dist > 0.0f)) return 1.0f;
+    const Vec3 u = MarchScale(toLight, 1.0f / dist);
+    float t0 = 0, t1 = dist;
+    ClipRayToBox(p, u, s.size, t0, t1);
+    return t1 > t0 ? MarchTransmittance(p, u, t1, n, s.sigmaH, q) : 1.0f;
+}
+
+// ---- The per-ray kernel ----------------------------------------------------------
+
+struct MarchRayResult {
+    Vec3 color{};                // C = L + T_view background (linear HDR)
+    Vec3 light{};                // L alone (a per-pixel background, the ground, composites as L + T_view background)
+    float transmittance = 1;     // T_view at the end
+    uint32_t samples = 0;        // density samples taken
+    uint32_t lightCalls = 0;     // light functor calls (samples with q > 0)
+    uint32_t bricksSkipped = 0;  // empty bricks jumped over
+};
+
+// Marches one ray (SPEC 10). Segment n is [t_n, t_{n+1}] clipped to tMax,
+// t_0 = tMin, t_{n+1} = t_n + Delta(t_n) (fixed: t_n = tMin + n Delta); its
+// sample sits at t_n + xi l_n, l_n its clipped length. q(p) returns q_alpha at
+// voxel-unit point p; light(p) returns a MarchLightSample. Samples inside empty
+// bricks (bricks may be null) are skipped without moving any other sample.
+template <class Density, class Light>
+MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float xi, const MarchBricks* bricks,
+                        Density&& q, Light&& light) {
+    MarchRayResult r;
+    float L0 = 0, L1 = 0, L2 = 0, T = 1;
+    if (!ray.Empty()) {
+        // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
+        const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+        const float B = bricks ? float(bricks->brick) : 1.0f, invB = 1.0f / B;
+        const Vec3 invDir = InverseDirection(ray.dir);
+        float tn = ray.tMin;
+        uint32_t n = 0;
+        while (tn < ray.tMax) {
+            const float delta = MarchStepAt(s, tn);
+            float tNext = s.adaptive ? tn + delta : ray.tMin + float(n + 1) * delta;
+            // Never stalls: a step below the float spacing at tn still moves on.
+            if (!(tNext > tn)) tNext = std::nextafter(tn, std::numeric_limits<float>::max());
+            const float len = std::min(tNext, ray.tMax) - tn;
+            const float ts = tn + xi * len;
+            const Vec3 p = MarchAlong(ray.origin, ray.dir, ts);
+            if (bricks) {
+                // p * (1/B) may round across a brick face; the bricks' one-voxel margin covers that.
+                const int bx = int(std::floor(p[0] * invB)), by = int(std::floor(p[1] * invB)),
+                          bz = int(std::floor(p[2] * invB));
+                const bool inside = bx >= 0 && by >= 0 && bz >= 0 && uint32_t(bx) < bricks->count[0] &&
+                                    uint32_t(by) < bricks->count[1] && uint32_t(bz) < bricks->count[2];
+                if (inside &&
+                    bricks->empty[uint32_t(bx) + bricks->count[0] * (uint32_t(by) + bricks->count[1] * uint32_t(bz))]) {
+                    // Jump to the first sample at or past the brick's exit; the samples in between read q = 0.
+                    const Vec3 lo{float(bx) * B, float(by) * B, float(bz) * B};
+                    const Vec3 hi{lo[0] + B, lo[1] + B, lo[2] + B};
+                    float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
+                    ++r.bricksSkipped;
+                    // Walk on through the empty bricks that follow (probing a hundredth of a voxel past each
+                    // exit face: the points in between lie within the next brick's one-voxel margin).
+                    while (tExit < ray.tMax) {
+                        const float tProbe = tExit + 0.01f;
+                        const Vec3 pe = MarchAlong(ray.origin, ray.dir, tProbe);
+                        const int ex = int(std::floor(pe[0] * invB)), ey = int(std::floor(pe[1] * invB)),
+                                  ez = int(std::floor(pe[2] * invB));
+                        if (!(ex >= 0 && ey >= 0 && ez >= 0 && uint32_t(ex) < bricks->count[0] &&
+                              uint32_t(ey) < bricks->count[1] && uint32_t(ez) < bricks->count[2]) ||
+                            !bricks->empty[uint32_t(ex) +
+                                           bricks->count[0] * (uint32_t(ey) + bricks->count[1] * uint32_t(ez))])
+                            break;
+                        const Vec3 elo{float(ex) * B, float(ey) * B, float(ez) * B};
+                        const Vec3 ehi{elo[0] + B, elo[1] + B, elo[2] + B};
+                        tExit = RayExitFromBox(ray.origin, invDir, elo, ehi, tProbe);
+                        ++r.bricksSkipped;
+                    }
+                    if (s.adaptive) {
+                        // Iterate the cheap recurrence; the positions are those of the unskipped march.
+                        float t = tNext;
+                        while (t < ray.tMax) {
+                            float tAfter = t + MarchStepAt(s, t);
+                            if (!(tAfter > t)) tAfter = std::nextafter(t, std::numeric_limits<float>::max());
+                            const float sample = t + xi * (std::min(tAfter, ray.tMax) - t);
+                            if (sample >= tExit) break;
+                            t = tAfter;
+                        }
+                        tn = t;
+                    } else {
+                        // First m > n with tMin + (m + xi) Delta >= tExit, rounded down (never past it).
+                        const float m = std::floor((tExit - ray.tMin) / delta - xi);
+                        n = std::max(n + 1, uint32_t(std::clamp(m, 0.0f, 16777216.0f)));
+                        tn = ray.tMin + float(n) * delta;
+                    }
+                    continue;
+                }
+            }
+            ++r.samples;
+            const float qa = q(p);
+            if (qa > 0.0f) {
+                ++r.lightCalls;
+                const float tau = SegmentTransmittance(s.sigmaH, qa, len);
+                const MarchLightSample l = light(p);
+                float sunGain = l.sun * sunPhase;
+                if (s.powder) sunGain *= PowderTerm(s.powderC, l.sun);
+                float in0 = s.sunRadiance[0] * sunGain + s.ambient[0];
+                float in1 = s.sunRadiance[1] * sunGain + s.ambient[1];
+                float in2 = s.sunRadiance[2] * sunGain + s.ambient[2];
+                if (s.point.on) {
+                    const Vec3 toLight{s.point.position[0] - p[0], s.point.position[1] - p[1],
+                                       s.point.position[2] - p[2]};
+                    const float d2v = MarchDot(toLight, toLight);
+                    const float d2 = d2v * s.voxelSize * s.voxelSize;
+                    // cos theta = u . d with u the unit vector from p toward the light: 1 when the
+                    // light shines straight at the eye through p, as s . d for the sun.
+                    const float cosL = d2v > 0.0f ? MarchDot(toLight, ray.dir) / std::sqrt(d2v) : 1.0f;
+                    const float g = l.point * PointLightFalloff(d2, s.point.minDistance2) * PhaseValue(s.phase, cosL);
+                    in0 += s.point.radiance[0] * g;
+                    in1 += s.point.radiance[1] * g;
+                    in2 += s.point.radiance[2] * g;
+                }
+                const float w = T * (1.0f - tau);
+                L0 += w * in0;
+                L1 += w * in1;
+                L2 += w * in2;
+                T *= tau;
+                if (T < s.epsilon || T == 0.0f) break;
+            }
+            ++n;
+            tn = tNext;
+        }
+    }
+    r.transmittance = T;
+    r.light = {L0, L1, L2};
+    r.color = {L0 + T * s.background[0], L1 + T * s.background[1], L2 + T * s.background[2]};
+    return r;
+}
+
+}  // namespace cb

@@ -1,0 +1,364 @@
+// GLSL twin of core/math/March.h (SPEC 10): the ray of a pixel, the box clip, the
+// step schedule, the padded trilinear sampler, the light march, the point
+// light, the Mie table lookup and the per-ray kernel MarchRay. Must stay in
+// step with the C++; the same operations in the same order, `precise` where
+// the CPU (built with -ffp-contract=off) rounds each product.
+//
+// Include after random.glsl and shading.glsl. The including shader declares
+// the block that holds a MarchGpu (core/pipeline/MarchGpu.h) and DEFINES:
+//   vec2  MarchFetchQT(uint paddedIndex);  // (q_alpha, T) of the padded volume:
+//         (nx+2) x (ny+2) x (nz+2), voxel (i, j, k) at padded (i+1, j+1, k+1),
+//         index i + px (j + py k); the border reads (0, 1)
+//   bool  MarchBrickEmpty(uint brick);     // bx + Bx (by + By bz); skipping only
+//   float MarchPhaseTableValue(uint i);    // kMieCloudTable.values[i]; Mie only
+#ifndef CLOUDBENCH_MARCH_GLSL
+#define CLOUDBENCH_MARCH_GLSL
+
+// core/pipeline/MarchGpu.h, row for row.
+struct MarchGpu {
+    vec4 eye;            // xyz voxel units; w focalPx
+    vec4 forward;        // w near (metres)
+    vec4 right;          // w far (metres)
+    vec4 up;             // w voxel size h (metres)
+    vec4 size;           // xyz box; w sigma h
+    vec4 stepping;       // step, kappa, adaptive start, epsilon
+    vec4 sun;            // xyz toward the sun; w phase g
+    vec4 sunRadiance;    // rgb; w powder c
+    vec4 ambient;        // rgb; w Mie index per radian
+    vec4 background;     // rgb
+    vec4 pointPosition;  // xyz voxel units; w r0^2 (metres^2)
+    vec4 pointRadiance;  // rgb
+    uvec4 image;         // width, height, seed, frame
+    uvec4 flags;         // flag bits, phase kind, light steps n_l, brick edge B
+    uvec4 strides;       // px, px * py, Mie table count
+    uvec4 bricks;        // bricks along x, y, z
+};
+
+const uint kMarchAdaptive = 1u;
+const uint kMarchJitter = 2u;
+const uint kMarchPowder = 4u;
+const uint kMarchPointLight = 8u;
+const uint kMarchSkipping = 16u;
+const uint kMarchLightMarch = 32u;
+const uint kMarchGround = 64u;  // the background is the ground (core/math/ground.glsl), per pixel
+const uint kMarchPhaseMie = 3u;  // PhaseKind::Mie
+const uint kMarchStreamOther = 3u;
+const float kMarchFloatMax = 3.402823466e+38;
+
+vec2 MarchFetchQT(uint paddedIndex);
+bool MarchBrickEmpty(uint brick);
+float MarchPhaseTableValue(uint i);
+
+// ---- Rays ----
+
+struct MarchRayGeometry {
+    vec3 origin, dir;
+    float tMin, tMax;
+};
+
+// The next float above x (std::nextafter(x, FLT_MAX)) for finite x.
+float MarchNextUp(float x) {
+    if (x == 0.0) return uintBitsToFloat(1u);
+    const uint bits = floatBitsToUint(x);
+    return uintBitsToFloat(x > 0.0 ? bits + 1u : bits - 1u);
+}
+
+vec3 MarchAlong(vec3 o, vec3 d, float t) {
+    precise vec3 p = vec3(o.x + d.x * t, o.y + d.y * t, o.z + d.z * t);
+    return p;
+}
+
+float MarchDot(vec3 a, vec3 b) {
+    precise float r = a.x * b.x + a.y * b.y + a.z * b.z;
+    return r;
+}
+
+// Slab clip of o + t d to the box [0, size] (core/math/March.h ClipRayToBox).
+void ClipRayToBox(vec3 o, vec3 d, vec3 size, inout float tMin, inout float tMax) {
+    for (int a = 0; a < 3; ++a) {
+        if (abs(d[a]) < 1e-20) {
+            if (o[a] < 0.0 || o[a] > size[a]) {
+                tMax = 0.0;
+                tMin = 0.0;
+            }
+            continue;
+        }
+        precise float inv = 1.0 / d[a];
+        precise float t0 = (0.0 - o[a]) * inv;
+        precise float t1 = (size[a] - o[a]) * inv;
+        if (t0 > t1) {
+            const float swap = t0;
+            t0 = t1;
+            t1 = swap;
+        }
+        tMin = max(tMin, t0);
+        tMax = min(tMax, t1);
+    }
+}
+
+// The camera ray of pixel (x, y), row 0 at the top (core/math/March.h MakePixelRay).
+MarchRayGeometry MakePixelRay(MarchGpu m, uint x, uint y) {
+    const float focal = m.eye.w;
+    precise float u = (float(x) + 0.5 - 0.5 * float(m.image.x)) / focal;
+    precise float v = (0.5 * float(m.image.y) - (float(y) + 0.5)) / focal;
+    precise vec3 d;
+    for (int i = 0; i < 3; ++i) d[i] = m.forward[i] + u * m.right[i] + v * m.up[i];
+    precise float inv = 1.0 / sqrt(MarchDot(d, d));
+    MarchRayGeometry r;
+    r.origin = m.eye.xyz;
+    r.dir = vec3(d.x * inv, d.y * inv, d.z * inv);
+    precise float perDepth = 1.0 / (m.up.w * inv);
+    r.tMin = m.forward.w * perDepth;
+    r.tMax = m.right.w * perDepth;
+    ClipRayToBox(r.origin, r.dir, m.size.xyz, r.tMin, r.tMax);
+    return r;
+}
+
+// ---- Sampling: the padded (q, T) volume (impl_cpu/RenderMarchCpu.cpp MarchPaddedVolume) ----
+
+struct MarchTaps {
+    uint base;
+    vec3 w;
+};
+
+MarchTaps MarchTapsAt(MarchGpu m, vec3 p) {
+    precise float cx = clamp(p.x, 0.0, m.size.x) + 0.5;
+    precise float cy = clamp(p.y, 0.0, m.size.y) + 0.5;
+    precise float cz = clamp(p.z, 0.0, m.size.z) + 0.5;
+    const uint i = uint(cx), j = uint(cy), k = uint(cz);
+    MarchTaps t;
+    t.base = i + m.strides.x * j + m.strides.y * k;
+    precise vec3 w = vec3(cx - float(i), cy - float(j), cz - float(k));
+    t.w = w;
+    return t;
+}
+
+// Lerp per component, unfused (core/math/Shading.h Lerp).
+vec2 MarchLerp2(vec2 a, vec2 b, float t) { return vec2(Lerp(a.x, b.x, t), Lerp(a.y, b.y, t)); }
+
+// (q_alpha, T) trilinear at the taps.
+vec2 MarchBlend(MarchGpu m, MarchTaps t) {
+    const uint px = m.strides.x, pxy = m.strides.y;
+    const uint a = t.base, b = t.base + pxy;
+    const vec2 c00 = MarchLerp2(MarchFetchQT(a), MarchFetchQT(a + 1u), t.w.x);
+    const vec2 c10 = MarchLerp2(MarchFetchQT(a + px), MarchFetchQT(a + px + 1u), t.w.x);
+    const vec2 c01 = MarchLerp2(MarchFetchQT(b), MarchFetchQT(b + 1u), t.w.x);
+    const vec2 c11 = MarchLerp2(MarchFetchQT(b + px), MarchFetchQT(b + px + 1u), t.w.x);
+    return MarchLerp2(MarchLerp2(c00, c10, t.w.y), MarchLerp2(c01, c11, t.w.y), t.w.z);
+}
+
+float MarchSampleQ(MarchGpu m, vec3 p) { return MarchBlend(m, MarchTapsAt(m, p)).x; }
+
+// ---- Kernel formulas (core/math/March.h) ----
+
+float SegmentTransmittance(float sigmaH, float q, float len) {
+    precise float x = -(sigmaH * q) * len;
+    return ExpNonPositive(x);
+}
+
+float MarchStepAt(MarchGpu m, float t) {
+    precise float adaptive = m.stepping.x + m.stepping.y * max(0.0, t - m.stepping.z);
+    return (m.flags.x & kMarchAdaptive) != 0u ? adaptive : m.stepping.x;
+}
+
+float MarchJitter(uint seed, uint frame, uint pixel) {
+    return float(Rand24FromKey(StreamKey(seed, frame, kMarchStreamOther), pixel)) * (1.0 / 16777216.0);
+}
+
+float PowderTerm(float c, float lightT) { return 1.0 - pow(max(lightT, 0.0), c); }
+
+float PointLightFalloff(float distance2, float minDistance2) { return 1.0 / max(distance2, minDistance2); }
+
+// The Mie table linearly interpolated in theta (core/math/Shading.h SamplePhaseTable),
+// read by hand: hardware filtering's few fractional weight bits would break conformance.
+float SampleMiePhase(float indexPerRadian, uint count, float cosTheta) {
+    const float theta = ArcCos(clamp(cosTheta, -1.0, 1.0));
+    precise float x = clamp(theta * indexPerRadian, 0.0, float(count - 1u));
+    const uint i = min(uint(x), count - 2u);
+    return Lerp(MarchPhaseTableValue(i), MarchPhaseTableValue(i + 1u), x - float(i));
+}
+
+// P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
+float MarchPhase(MarchGpu m, float cosTheta) {
+    if (m.flags.y == kMarchPhaseMie) return SampleMiePhase(m.ambient.w, m.strides.z, cosTheta);
+    return PhaseValue(m.flags.y, m.sun.w, cosTheta);
+}
+
+// 1/d per component; FLT_MAX where d is (nearly) zero.
+vec3 InverseDirection(vec3 d) {
+    vec3 inv;
+    for (int a = 0; a < 3; ++a) inv[a] = abs(d[a]) < 1e-20 ? kMarchFloatMax : 1.0 / d[a];
+    return inv;
+}
+
+float RayExitFromBox(vec3 o, vec3 invD, vec3 lo, vec3 hi, float t) {
+    float exit = kMarchFloatMax;
+    for (int a = 0; a < 3; ++a) {
+        precise float e = ((invD[a] >= 0.0 ? hi[a] : lo[a]) - o[a]) * invD[a];
+        exit = min(exit, e);
+    }
+    return max(exit, t);
+}
+
+// T along the segment from p toward unit u over `len`: n midpoint samples.
+float MarchTransmittance(MarchGpu m, vec3 p, vec3 u, float len, uint n) {
+    if (!(len > 0.0) || n == 0u) return 1.0;
+    precise float dl = len / float(n);
+    precise float depth = 0.0;
+    for (uint j = 0u; j < n; ++j) {
+        precise float t = (float(j) + 0.5) * dl;
+        depth += MarchSampleQ(m, MarchAlong(p, u, t));
+    }
+    precise float x = -(m.size.w * depth) * dl;
+    return ExpNonPositive(x);
+}
+
+float SunLightMarch(MarchGpu m, vec3 p) {
+    float t0 = 0.0, t1 = kMarchFloatMax;
+    ClipRayToBox(p, m.sun.xyz, m.size.xyz, t0, t1);
+    return t1 > t0 ? MarchTransmittance(m, p, m.sun.xyz, t1, m.flags.z) : 1.0;
+}
+
+float PointLightMarch(MarchGpu m, vec3 p) {
+    precise vec3 toLight = vec3(m.pointPosition.x - p.x, m.pointPosition.y - p.y, m.pointPosition.z - p.z);
+    const float dist = sqrt(MarchDot(toLight, toLight));
+    if (!(dist > 0.0)) return 1.0;
+    precise float inv = 1.0 / dist;
+    const vec3 u = vec3(toLight.x * inv, toLight.y * inv, toLight.z * inv);
+    float t0 = 0.0, t1 = dist;
+    ClipRayToBox(p, u, m.size.xyz, t0, t1);
+    return t1 > t0 ? MarchTransmittance(m, p, u, t1, m.flags.z) : 1.0;
+}
+
+bool MarchBrickInside(MarchGpu m, ivec3 b) {
+    return b.x >= 0 && b.y >= 0 && b.z >= 0 && uint(b.x) < m.bricks.x && uint(b.y) < m.bricks.y &&
+           uint(b.z) < m.bricks.z;
+}
+
+uint MarchBrickIndex(MarchGpu m, ivec3 b) { return uint(b.x) + m.bricks.x * (uint(b.y) + m.bricks.y * uint(b.z)); }
+
+ivec3 MarchBrickOf(vec3 p, float invB) {
+    precise vec3 s = vec3(p.x * invB, p.y * invB, p.z * invB);
+    return ivec3(floor(s));
+}
+
+// ---- The per-ray kernel (core/math/March.h MarchRay) ----
+
+struct MarchRayResult {
+    vec3 color;
+    vec3 light;  // L alone (core/math/March.h MarchRayResult::light)
+    float transmittance;
+    uint samples, lightCalls, bricksSkipped;
+};
+
+MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
+    MarchRayResult r;
+    r.samples = 0u;
+    r.lightCalls = 0u;
+    r.bricksSkipped = 0u;
+    precise float L0 = 0.0, L1 = 0.0, L2 = 0.0, T = 1.0;
+    const bool adaptive = (m.flags.x & kMarchAdaptive) != 0u;
+    const bool skipping = (m.flags.x & kMarchSkipping) != 0u;
+    const bool lightMarch = (m.flags.x & kMarchLightMarch) != 0u;
+    const bool pointOn = (m.flags.x & kMarchPointLight) != 0u;
+    const bool powder = (m.flags.x & kMarchPowder) != 0u;
+    if (ray.tMin < ray.tMax) {
+        const float sunPhase = MarchPhase(m, MarchDot(m.sun.xyz, ray.dir));
+        const float B = skipping ? float(m.flags.w) : 1.0;
+        precise float invB = 1.0 / B;
+        const vec3 invDir = InverseDirection(ray.dir);
+        float tn = ray.tMin;
+        uint n = 0u;
+        while (tn < ray.tMax) {
+            const float delta = MarchStepAt(m, tn);
+            precise float tFixed = ray.tMin + float(n + 1u) * delta;
+            precise float tAdaptive = tn + delta;
+            float tNext = adaptive ? tAdaptive : tFixed;
+            if (!(tNext > tn)) tNext = MarchNextUp(tn);
+            precise float len = min(tNext, ray.tMax) - tn;
+            precise float ts = tn + xi * len;
+            const vec3 p = MarchAlong(ray.origin, ray.dir, ts);
+            if (skipping) {
+                const ivec3 b = MarchBrickOf(p, invB);
+                if (MarchBrickInside(m, b) && MarchBrickEmpty(MarchBrickIndex(m, b))) {
+                    const vec3 lo = vec3(b) * B;
+                    float tExit = RayExitFromBox(ray.origin, invDir, lo, lo + vec3(B), ts);
+                    ++r.bricksSkipped;
+                    while (tExit < ray.tMax) {
+                        precise float tProbe = tExit + 0.01;
+                        const ivec3 e = MarchBrickOf(MarchAlong(ray.origin, ray.dir, tProbe), invB);
+                        if (!MarchBrickInside(m, e) || !MarchBrickEmpty(MarchBrickIndex(m, e))) break;
+                        const vec3 elo = vec3(e) * B;
+                        tExit = RayExitFromBox(ray.origin, invDir, elo, elo + vec3(B), tProbe);
+                        ++r.bricksSkipped;
+                    }
+                    if (adaptive) {
+                        float t = tNext;
+                        while (t < ray.tMax) {
+                            precise float tAfter = t + MarchStepAt(m, t);
+                            if (!(tAfter > t)) tAfter = MarchNextUp(t);
+                            precise float sampleT = t + xi * (min(tAfter, ray.tMax) - t);
+                            if (sampleT >= tExit) break;
+                            t = tAfter;
+                        }
+                        tn = t;
+                    } else {
+                        precise float mm = floor((tExit - ray.tMin) / delta - xi);
+                        n = max(n + 1u, uint(clamp(mm, 0.0, 16777216.0)));
+                        precise float tAt = ray.tMin + float(n) * delta;
+                        tn = tAt;
+                    }
+                    continue;
+                }
+            }
+            ++r.samples;
+            const MarchTaps taps = MarchTapsAt(m, p);
+            const vec2 qt = MarchBlend(m, taps);
+            const float qa = qt.x;
+            if (qa > 0.0) {
+                ++r.lightCalls;
+                const float tau = SegmentTransmittance(m.size.w, qa, len);
+                const float lightSun = lightMarch ? SunLightMarch(m, p) : qt.y;
+                precise float sunGain = lightSun * sunPhase;
+                if (powder) sunGain *= PowderTerm(m.sunRadiance.w, lightSun);
+                precise float in0 = m.sunRadiance.x * sunGain + m.ambient.x;
+                precise float in1 = m.sunRadiance.y * sunGain + m.ambient.y;
+                precise float in2 = m.sunRadiance.z * sunGain + m.ambient.z;
+                if (pointOn) {
+                    const float lightPoint = PointLightMarch(m, p);
+                    precise vec3 toLight =
+                        vec3(m.pointPosition.x - p.x, m.pointPosition.y - p.y, m.pointPosition.z - p.z);
+                    const float d2v = MarchDot(toLight, toLight);
+                    precise float d2 = d2v * m.up.w * m.up.w;
+                    precise float cosL = d2v > 0.0 ? MarchDot(toLight, ray.dir) / sqrt(d2v) : 1.0;
+                    precise float g = lightPoint * PointLightFalloff(d2, m.pointPosition.w) * MarchPhase(m, cosL);
+                    in0 += m.pointRadiance.x * g;
+                    in1 += m.pointRadiance.y * g;
+                    in2 += m.pointRadiance.z * g;
+                }
+                precise float w = T * (1.0 - tau);
+                L0 += w * in0;
+                L1 += w * in1;
+                L2 += w * in2;
+                T *= tau;
+                if (T < m.stepping.w || T == 0.0) break;
+            }
+            ++n;
+            tn = tNext;
+        }
+    }
+    r.transmittance = T;
+    r.light = vec3(L0, L1, L2);
+    precise vec3 c = vec3(L0 + T * m.background.x, L1 + T * m.background.y, L2 + T * m.background.z);
+    r.color = c;
+    return r;
+}
+
+// The whole pixel: its ray, its jitter and the march.
+MarchRayResult MarchPixel(MarchGpu m, uint x, uint y) {
+    const MarchRayGeometry ray = MakePixelRay(m, x, y);
+    const float xi = (m.flags.x & kMarchJitter) != 0u ? MarchJitter(m.image.z, m.image.w, x + m.image.x * y) : 0.5;
+    return MarchRay(m, ray, xi);
+}
+
+#endif

@@ -1,0 +1,88 @@
+// GLSL twin of core/math/Splat.h (SPEC 8): the frame block, the splat of a voxel,
+// a pixel's alpha. Needs shading.glsl before it. Must stay in step with the C++.
+#ifndef CLOUDBENCH_SPLAT_GLSL
+#define CLOUDBENCH_SPLAT_GLSL
+
+// std430, field for field core/math/Splat.h SplatFrame (which says what each lane holds).
+struct SplatFrame {
+    uvec4 grid;
+    uvec4 axes;
+    uvec4 orderBase;
+    uvec4 boxes;
+    uvec4 image;
+    vec4 eye;
+    vec4 forward;
+    vec4 right;
+    vec4 up;
+    vec4 sun;
+    vec4 sunRadiance;
+    vec4 ambient;
+    vec4 background;
+    vec4 origin;
+    vec4 misc;
+};
+
+// std430, field for field core/math/Splat.h Splat.
+struct Splat {
+    float px, py, size, alphaScale;
+    float r, g, b, pad;
+    int x0, x1, y0, y1;
+};
+
+float SplatQ(float qPrev, float qCur, float alpha) {
+    precise float qa = qPrev + alpha * (qCur - qPrev);
+    return qa;
+}
+
+// std::isfinite.
+bool SplatFinite(float v) { return !isnan(v) && !isinf(v); }
+
+// The splat of voxel idx with q_alpha qa and transmittance t; false when it makes none
+// (also when px, py or size is not finite). Covered pixels are clamped before int().
+bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
+    s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
+    if (!(qa > F.ambient.w)) return false;
+    const float h = F.origin.w;
+    precise vec3 centre = vec3(F.origin.x + (float(idx.x) + 0.5) * h, F.origin.y + (float(idx.y) + 0.5) * h,
+                               F.origin.z + (float(idx.z) + 0.5) * h);
+    precise float dx = centre.x - F.eye.x, dy = centre.y - F.eye.y, dz = centre.z - F.eye.z;
+    precise float x = dx * F.right.x + dy * F.right.y + dz * F.right.z;
+    precise float y = dx * F.up.x + dy * F.up.y + dz * F.up.z;
+    precise float depth = dx * F.forward.x + dy * F.forward.y + dz * F.forward.z;
+    if (!(depth > F.eye.w)) return false;
+    const float focal = F.forward.w;
+    precise float px = 0.5 * float(F.image.x) + x * focal / depth;
+    precise float py = 0.5 * float(F.image.y) - y * focal / depth;
+    precise float size = clamp(F.misc.x * focal / depth, 1.0, 255.0);
+    if (!SplatFinite(px) || !SplatFinite(py) || !SplatFinite(size)) return false;
+    precise float len = sqrt(dx * dx + dy * dy + dz * dz);
+    precise float cosTheta = (F.sun.x * dx + F.sun.y * dy + F.sun.z * dz) / len;
+    precise float light = t * PhaseValue(uint(F.sunRadiance.w), F.sun.w, cosTheta);
+    s.px = px;
+    s.py = py;
+    s.size = size;
+    s.alphaScale = qa * F.background.w;
+    s.r = F.sunRadiance.x * light + F.ambient.x;
+    s.g = F.sunRadiance.y * light + F.ambient.y;
+    s.b = F.sunRadiance.z * light + F.ambient.z;
+    precise float halfSize = 0.5 * size;
+    const float imageW = float(F.image.x), imageH = float(F.image.y);
+    s.x0 = int(min(max(0.0, ceil(px - halfSize - 0.5)), imageW));
+    s.x1 = int(max(min(imageW - 1.0, ceil(px + halfSize - 0.5) - 1.0), -1.0));
+    s.y0 = int(min(max(0.0, ceil(py - halfSize - 0.5)), imageH));
+    s.y1 = int(max(min(imageH - 1.0, ceil(py + halfSize - 0.5) - 1.0), -1.0));
+    return true;
+}
+
+// (pixelCentre - centre) / size + 0.5, with pixelCentre = x + 0.5.
+float SplatCoord(float pixelCentre, float centre, float size) {
+    precise float a = (pixelCentre - centre) / size + 0.5;
+    return a;
+}
+
+float SplatAlpha(float alphaScale, float a, float b) {
+    precise float alpha = clamp(alphaScale * SplatKernel(a, b), 0.0, 1.0);
+    return alpha;
+}
+
+#endif

@@ -1,0 +1,168 @@
+// One descriptor per stage: what it reads and writes, when it runs, and how two
+// implementations of it are compared. The simulation, `conform`, `dump`, the
+// memory plan and the conformance tests walk these instead of naming stages,
+// so a new stage is a CB_STAGES line, a descriptor and its backends' code.
+//
+// Data flows through resources, never from stage to stage: "density needs q",
+// whoever writes q (smooth, or a noise producer).
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/pipeline/Backend.h"
+#include "core/scene/Scene.h"
+#include "core/scene/Stage.h"
+
+namespace cb {
+
+// X(Enum, "name", format, "dump file stem"): the buffers that pass between
+// stages (SPEC 0). Images have no dump array; they are written as frames.
+#define CB_RESOURCES(X)                                                             \
+    X(Region, "region", U8, "region") /* R: region weights, grid */                 \
+    X(Hum, "hum", Bits, "hum")        /* automaton fields, grid */                  \
+    X(Act, "act", Bits, "act")                                                      \
+    X(Cld, "cld", Bits, "cld")                                                      \
+    X(Q, "q", F32, "q")                   /* density in [0, 1], grid */             \
+    X(ColumnSum, "D", F32, "density")     /* column sums, (nx, ny, 1) */            \
+    X(Tiles, "tiles", U8, "tiles")        /* tile occupancy, (tx, ty, 1) */         \
+    X(Bands, "bands", U8, "bands")        /* tile x band occupancy, (tx, ty, bz) */ \
+    X(T, "T", F32, "T")                   /* transmittance toward the sun, grid */  \
+    X(Shadow, "G", F32, "shadow")         /* ground shadow, (nx, ny, 1) */          \
+    X(SplatImage, "image_splat", F32, "") /* (3, width, height) per camera */       \
+    X(MarchImage, "image_march", F32, "")
+
+enum class Resource : uint8_t {
+#define CB_RESOURCE_ENUM(name, text, format, file) name,
+    CB_RESOURCES(CB_RESOURCE_ENUM)
+#undef CB_RESOURCE_ENUM
+};
+
+inline constexpr std::array kAllResources = {
+#define CB_RESOURCE_VALUE(name, text, format, file) Resource::name,
+    CB_RESOURCES(CB_RESOURCE_VALUE)
+#undef CB_RESOURCE_VALUE
+};
+inline constexpr size_t kResourceCount = kAllResources.size();
+
+std::string_view ResourceName(Resource resource);
+// The stem of the resource's array in a dump (`dump`: DIR/step_tttt/<stem>.npy);
+// "" for images, which are written as frames.
+std::string_view ResourceDumpStem(Resource resource);
+BufferFormat ResourceFormat(Resource resource);
+// The extent of one buffer of the resource in this scene.
+Extent3 ResourceExtent(Resource resource, const Scene& scene);
+// Images: one buffer per camera; every other resource: one.
+bool IsPerCamera(Resource resource);
+
+// How two implementations of a stage are compared, as data (SPEC's rule for
+// the stage). Integer and boolean outputs are bit-exact; floats within a
+// tolerance; images by SPEC 8's (or SPEC 10's) pixel-share rule.
+struct CompareRule {
+    enum class Kind : uint8_t {
+        BitExact,   // every element equal
+        Absolute,   // |d| <= tolerance everywhere
+        Quantised,  // |d| <= tolerance everywhere, and at most `share` of elements differ at all
+        Image,      // per channel |d| <= tolerance on at least 1 - share of pixels, <= limit everywhere
+        Codes,      // |code difference| <= tolerance everywhere, on the stored codes of `storage` (StorageCode)
+    };
+    Kind kind = Kind::BitExact;
+    double tolerance = 0;
+    double share = 0;
+    double limit = 0;
+    StorageFormat storage = StorageFormat::Fp32;  // Codes: the format whose codes are compared
+
+    // As the tables print it, e.g. "bit-exact", "|dT| <= 1e-05"; `symbol` names the compared quantity.
+    std::string Text(std::string_view symbol) const;
+    // The tolerance alone, as Text writes it ("2/255" for an image rule's 8-bit steps, "%g" otherwise).
+    std::string ToleranceText() const;
+};
+
+struct StageDescriptor {
+    Stage stage;
+    std::string_view section;     // the scene section of its settings ("" for none)
+    std::vector<Resource> reads;  // this step's values (a stage that advances the state reads its own)
+    // Read when some enabled stage writes them, and not needed otherwise
+    // (density's cover comes from cld with an automaton, from q without).
+    std::vector<Resource> optionalReads;
+    // Inputs whose previous step's value it also reads in this scene
+    // (interpolating renderers); nullptr for none.
+    std::vector<Resource> (*readsPrevious)(const Scene& scene) = nullptr;
+    std::vector<Resource> writes;
+    // Writes step t+1's values of its outputs from step t's (the automaton):
+    // it runs after every stage that reads them, and its outputs are double-buffered.
+    bool advancesState = false;
+    // Runs on output steps only (render steps, or every step when dumping).
+    bool outputStepsOnly = false;
+    // Skipped when none of its inputs changed since it last ran.
+    bool skipsUnchangedInputs = false;
+    // Reads the sun's direction at the step (a host input): with
+    // skipsUnchangedInputs, a change of direction counts as a changed input.
+    bool readsSun = false;
+    // True when its outputs depend on the step itself in this scene (a time
+    // coordinate): it then runs every step despite skipsUnchangedInputs.
+    // nullptr: never (a stage with no inputs and no time runs once).
+    bool (*dependsOnStep)(const Scene& scene) = nullptr;
+    // Time-slicing (SPEC 13): how many shares its work at `step` splits into
+    // (core/pipeline/Backend.h SliceRange); nullptr: it runs whole, as one share.
+    uint32_t (*shareCount)(const Scene& scene, uint32_t step) = nullptr;
+    // A renderer: writes one image per camera.
+    bool renderer = false;
+    std::string_view symbol;  // the compared quantity in rule texts ("R", "T", ...)
+    // The comparison for this scene (shade's tolerance depends on its storage format).
+    CompareRule (*rule)(const Scene& scene) = nullptr;
+    std::string_view ruleNote;  // how the rule depends on the scene, for the help ("" if it does not)
+};
+
+const StageDescriptor& Describe(Stage stage);
+
+// The enabled stages in the order a step runs them: every producer before
+// the stages that read its outputs, and stages that advance the state after
+// every other stage (they end the step).
+std::vector<Stage> ScheduleStages(const StageSet& enabled);
+
+// The stage among `enabled` that writes `resource`, if any.
+std::optional<Stage> ProducerOf(Resource resource, const StageSet& enabled);
+
+// An enabled stage's input that no enabled stage writes, and the stages that could.
+struct MissingInput {
+    Stage stage;
+    Resource resource;
+    std::vector<Stage> producers;
+};
+std::vector<MissingInput> MissingInputs(const StageSet& enabled);
+
+// The resources a scene's enabled stages write, and which of them are also
+// kept for the previous step (read by an interpolating renderer).
+struct ResourcePlan {
+    std::array<bool, kResourceCount> used{};
+    std::array<bool, kResourceCount> previous{};
+    std::array<bool, kResourceCount> doubleBuffered{};  // written by a stage that advances the state
+    std::array<bool, kResourceCount> pending{};         // time-slicing: the next step's value, computed over frames
+};
+ResourcePlan PlanResources(const Scene& scene);
+
+// Which copy of a resource a buffer holds: this step's, the next step's (a
+// state-advancing writer's output), the previous step's (an interpolating
+// renderer's input), or the next step's value being computed over the frames
+// of this one (time-slicing's third set, render.slices_per_frame > 0).
+enum class BufferRole : uint8_t { Current, Next, Previous, Pending };
+std::string_view BufferRoleName(BufferRole role);  // "current", "next", "previous", "pending"
+
+struct PlannedBuffer {
+    Resource resource;
+    BufferRole role = BufferRole::Current;
+    uint32_t camera = 0;  // per-camera resources: the camera's index; 0 otherwise
+    BufferFormat format = BufferFormat::F32;
+    Extent3 extent;
+    bool operator==(const PlannedBuffer&) const = default;
+};
+
+// Every buffer a simulation of `scene` allocates, in allocation order: per
+// resource its current buffers (one per camera for images), then its next, then its
+// previous, then its pending. Simulation::Allocate allocates exactly these; the memory plan prices them.
+std::vector<PlannedBuffer> PlanBuffers(const Scene& scene);
+
+}  // namespace cb

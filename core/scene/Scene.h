@@ -1,0 +1,234 @@
+// A scene: what to simulate and which stages to run. Loaded from JSON by
+// LoadScene() (core/pipeline/SceneLoad.h), which validates every field before any work is done. The fields,
+// their units and defaults are documented in docs/scenes.md.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/base/Error.h"
+#include "core/math/Camera.h"
+#include "core/math/Grid.h"
+#include "core/math/NoiseSettings.h"
+#include "core/math/Shading.h"
+#include "core/scene/MarchSettings.h"
+#include "core/scene/Stage.h"
+
+namespace cb {
+
+struct GridSettings {
+    Extent3 size{64, 16, 64};
+    double voxelSize = 50.0;                // metres per voxel edge (h)
+    std::array<double, 3> origin{0, 0, 0};  // world position of voxel corner (0,0,0), metres
+};
+
+// Per-slice integer wind shift for Dobashi advection, in voxels per step.
+struct SliceShift {
+    int32_t sx = 0, sy = 0;
+};
+
+struct CaSettings {
+    uint32_t seed = 1;
+    double hum0 = 0.35;   // initial humidity probability
+    double act0 = 0.001;  // initial activation probability
+    double pExt = 0.1;
+    double pHum = 0.1;
+    double pAct = 0.001;
+    // Empty: no advection. Otherwise exactly nz entries (a one-entry list in
+    // the file is expanded to every slice).
+    std::vector<SliceShift> windShift;
+
+    bool HasWind() const {
+        for (const SliceShift& s : windShift)
+            if (s.sx != 0 || s.sy != 0) return true;
+        return false;
+    }
+};
+
+// Horizontal wind that moves the ellipsoids, in voxels per step: one vector, or
+// a grid of vectors spread over the region bounds and looked up bilinearly.
+struct EllipsoidWind {
+    std::array<double, 2> vector{0, 0};
+    uint32_t gridNx = 0, gridNy = 0;          // 0: use `vector`
+    std::vector<std::array<double, 2>> grid;  // gridNx*gridNy, x fastest
+};
+
+struct EllipsoidSettings {
+    uint64_t seed = 1;
+    uint32_t targetCount = 40;
+    uint32_t densityAdaption = 2;                 // most added or removed per step
+    std::array<double, 3> sizeMean{16, 16, 8};    // semi-axes in voxels
+    std::array<double, 3> sizeVariance{4, 4, 2};  // uniform +- around the mean
+    double lifetimeMean = 400;                    // steps
+    double lifetimeVariance = 100;
+    uint32_t shrinkSteps = 40;
+    double margin = 16;                            // voxels added around the grid (region bounds)
+    std::array<double, 2> heightRange{0.25, 0.5};  // centre height, fraction of nz
+    EllipsoidWind wind;
+    double jitter = 0.05;  // uniform +- per axis per step, voxels
+};
+
+struct SmoothSettings {
+    int radius = 1;  // 0, 1 or 2
+};
+
+struct DensitySettings {
+    uint32_t tile = 32;  // tile edge in columns
+    uint32_t band = 4;   // slices per height band
+};
+
+// One keyframe of a sun path: the sun's angles at a step.
+struct SunKeyframe {
+    uint32_t step = 0;
+    double elevationDeg = 0, azimuthDeg = 0;
+    bool operator==(const SunKeyframe&) const = default;
+};
+
+// The sun (SPEC 0): direction from elevation and azimuth, and its radiance.
+// It may move (Fizimayer's thesis, section 1.3.2): along keyframes, or at a constant
+// angular speed. Either way it is evaluated once per step (ElevationAt,
+// AzimuthAt); the frames between two steps see step t's sun (docs/pipeline.md,
+// "The real-time loop").
+struct SunSettings {
+    double elevationDeg = 40;                     // above the horizon, degrees (step 0's, with a path)
+    double azimuthDeg = 30;                       // from +x toward +y, degrees (step 0's, with a path)
+    std::array<double, 3> color{1.0, 0.96, 0.9};  // linear RGB
+    double intensity = 1.0;                       // multiplies color
+    // Keyframes in increasing step order; empty: no path. Between two
+    // keyframes both angles are interpolated linearly in the step; before the
+    // first and after the last the sun holds that keyframe's angles.
+    std::vector<SunKeyframe> path;
+    // Degrees per step added to elevationDeg and azimuthDeg (no path).
+    double elevationSpeedDeg = 0, azimuthSpeedDeg = 0;
+
+    double ElevationAt(uint32_t step) const;
+    double AzimuthAt(uint32_t step) const;
+    // Unit vector toward the sun at `step`.
+    Vec3 DirectionAt(uint32_t step) const {
+        constexpr double kDeg = 3.14159265358979323846 / 180.0;
+        return SunDirection(ElevationAt(step) * kDeg, AzimuthAt(step) * kDeg);
+    }
+    // Unit vector toward the sun at step 0 (the fixed sun's direction).
+    Vec3 Direction() const { return DirectionAt(0); }
+    // True when the direction may differ between steps (a path of two or more
+    // keyframes, or a non-zero speed).
+    bool Moves() const { return path.size() > 1 || elevationSpeedDeg != 0 || azimuthSpeedDeg != 0; }
+    // color * intensity.
+    Vec3 Radiance() const {
+        return {float(color[0] * intensity), float(color[1] * intensity), float(color[2] * intensity)};
+    }
+};
+
+struct LightingSettings {
+    std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
+    std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
+
+    // In single precision, as the renderers use them.
+    Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }
+    Vec3 Background() const { return {float(background[0]), float(background[1]), float(background[2])}; }
+};
+
+// Stage `shade` (SPEC 6).
+// The shaded grid's coarsening f (SPEC 6: shade.resolution), the one list the
+// scene reader and every backend check against.
+inline constexpr int64_t kShadeResolutions[] = {1, 2, 4};
+inline constexpr const char* kShadeResolutionsText = "1, 2 or 4";
+inline bool IsShadeResolution(int64_t f) {
+    for (const int64_t allowed : kShadeResolutions)
+        if (f == allowed) return true;
+    return false;
+}
+struct ShadeSettings {
+    AttenuationKind attenuation = AttenuationKind::Beer;
+    double sigma = 0.02;    // extinction coefficient at q = 1, 1/m (beer, and tau for scattering)
+    double thesisAr = 0.9;  // a_r of the thesis's linear form
+    SampleFilter filter = SampleFilter::Bilinear;
+    int resolution = 1;  // one of kShadeResolutions
+    StorageFormat storage = StorageFormat::Fp32;
+    bool scattering = false;   // multiple forward scattering (Wang, Ji and Zhang, eq. 5-7)
+    double albedo = 0.9;       // alpha_s
+    double solidAngle = 0.05;  // gamma, steradians
+};
+
+// Stage `shadow` (SPEC 7).
+struct ShadowSettings {
+    ShadowForm form = ShadowForm::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D); wang: eq. 19
+    double kappa = 0.25;                 // thesis form: shadow per unit of D
+    double coverage = 1;                 // wang form: coverage C (Wang, Ji and Zhang, eq. 15, 19)
+    double densityFactor = 1;            // wang form: density factor D_w (Wang, Ji and Zhang, eq. 16, 19)
+};
+
+// What every renderer shares (section `render`): the image, the cameras,
+// when to render and where between two steps.
+struct RenderSettings {
+    uint32_t width = 320, height = 240;
+    double alpha = 0.5;  // interpolation between the previous and the current step
+    // Frames rendered per render step (Fizimayer's thesis, section 6.3). 1: one frame
+    // at `alpha`; F > 1: frames f = 0..F-1 at alpha = (f + 1) / F.
+    uint32_t framesPerStep = 1;
+    // Time-slicing (SPEC 13, Fizimayer's thesis, sections 7.1 and 8.1.2): 0 computes a
+    // step all at once; s > 0 spreads the next step's stages over this step's
+    // frames, s slices of one stage per frame (docs/pipeline.md). A step then
+    // draws max(framesPerStep, the frames its shares take) frames.
+    uint32_t slicesPerFrame = 0;
+    uint32_t everySteps = 0;              // render every N steps after warm-up (and the last); 0 = last step only
+    std::vector<CameraSettings> cameras;  // at least one when a renderer runs
+    // The ground plane z = origin_z under the clouds, lit through G (render.ground;
+    // docs/pipeline.md, "The ground in the frame"). Needs the stage `shadow`.
+    struct Ground {
+        bool on = false;                              // absent from the scene: off
+        std::array<double, 3> albedo{0.3, 0.3, 0.3};  // linear RGB reflectance, each in [0, 1]
+    } ground;
+
+    // The interpolation weight of frame `frame` (0-based) of a render step of
+    // `frames` frames (0: framesPerStep). One frame without time-slicing draws
+    // at the fixed `alpha`; otherwise frames run alpha = (frame + 1) / frames.
+    float FrameAlpha(uint32_t frame, uint32_t frames = 0) const {
+        if (frames == 0) frames = framesPerStep;
+        if (frames <= 1 && slicesPerFrame == 0) return float(alpha);
+        return float(double(frame + 1) / double(frames > 0 ? frames : 1));
+    }
+};
+
+// Stage `render_splat` (SPEC 8): the splat renderer's own settings. In scene
+// files they sit in the `render` section beside the shared ones (docs/scenes.md).
+struct SplatSettings {
+    double qMin = 0.3;        // a voxel makes a splat iff q_alpha > q_min
+    double splatScale = 1.5;  // splat diameter d = splatScale * voxel size
+    double opacity = 0.6;
+    bool culling = true;   // view-frustum culling of tile-band boxes
+    bool skipping = true;  // empty-space skipping from the density map
+};
+
+struct Scene {
+    std::string name;
+    std::string path;  // file it was read from ("" for built-in)
+    GridSettings grid;
+    uint32_t steps = 20;
+    uint32_t warmupSteps = 0;  // leading steps left out of timing and cover statistics
+    StageSet stages;
+    CaSettings ca;
+    EllipsoidSettings ellipsoids;
+    SmoothSettings smooth;
+    DensitySettings density;
+    SunSettings sun;
+    LightingSettings lighting;
+    PhaseParams phase;  // used by shade (scattering) and render_splat
+    ShadeSettings shade;
+    ShadowSettings shadow;
+    RenderSettings render;
+    SplatSettings splat;
+    MarchSettings march;          // stage render_march (section `march`)
+    LightningSettings lightning;  // the point light of render_march (section `lightning`)
+    NoiseSettings noise;          // stage `noise` (SPEC 10a)
+};
+
+// One --set PATH=VALUE override, applied to the JSON before validation.
+struct SceneOverride {
+    std::string path;   // dotted, e.g. "ca.seed" or "grid.size"
+    std::string value;  // JSON text; a bare word is taken as a string
+};
+
+}  // namespace cb

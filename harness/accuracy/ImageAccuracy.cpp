@@ -1,0 +1,272 @@
+#include "harness/accuracy/ImageAccuracy.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "core/scene/SceneNames.h"
+#include "harness/platform/Isolation.h"
+#include "harness/run/StageParams.h"
+
+namespace cb {
+using nlohmann::json;
+
+ImageErrorStats ImageErrors(std::span<const float> approx, std::span<const float> reference) {
+    ImageErrorStats out;
+    const size_t n = std::min(approx.size(), reference.size()) / 3;
+    std::vector<float> perPixel(n), zero(n, 0.0f);
+    double sq = 0;
+    for (size_t p = 0; p < n; ++p) {
+        float e = 0;
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(approx[3 * p + c]) - double(reference[3 * p + c]);
+            e = std::max(e, float(std::fabs(d)));
+            sq += d * d;
+            out.peak = std::max(out.peak, double(reference[3 * p + c]));
+        }
+        perPixel[p] = e;
+    }
+    out.pixel = AbsoluteErrors(perPixel, zero);
+    out.mse = n ? sq / double(3 * n) : 0.0;
+    if (out.mse > 0 && out.peak > 0) out.psnr = 10 * std::log10(out.peak * out.peak / out.mse);
+    return out;
+}
+
+namespace {
+
+RenderAccuracy RenderNotMeasured(std::string status, std::string detail) {
+    RenderAccuracy a;
+    a.status = std::move(status);
+    a.detail = std::move(detail);
+    return a;
+}
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+json ImageRowJson(Stage renderer, const std::string& backend, const std::vector<SceneOverride>& setting,
+                  const std::string& referencePhase, const RenderAccuracy& a) {
+    json settings = json::object();
+    for (const SceneOverride& o : setting) settings[o.path] = o.value;
+    json j = {{"renderer", StageName(renderer)},
+              {"backend", backend},
+              {"settings", settings},
+              {"label", SettingsLabel(setting)},
+              {"reference_phase", referencePhase},
+              {"status", a.status}};
+    if (!a.detail.empty()) j["detail"] = a.detail;
+    if (a.status == "ok") {
+        j["time"] = TimeJson(a.timeMs);
+        j["prep_ms"] = a.prepMs;
+        j["error"] = {{"count", a.error.pixel.count},
+                      {"max", a.error.pixel.max},
+                      {"mean", a.error.pixel.mean},
+                      {"p99", a.error.pixel.p99},
+                      {"worst_index", a.error.pixel.worst},
+                      {"mse", a.error.mse},
+                      {"peak", a.error.peak},
+                      {"psnr_db", a.error.psnr ? json(*a.error.psnr) : json(nullptr)}};
+    }
+    return j;
+}
+
+Status MeasureImageRows(ImageReferences& refs, const Session& session, const std::vector<SceneOverride>& setting,
+                        std::span<const OpenedBackend> backends, std::span<const Stage> renderers, json& rows) {
+    auto loaded = refs.Load(setting);
+    if (!loaded) {
+        // A setting the scene refuses (e.g. a light source that needs a stage the scene lacks).
+        for (Stage r : renderers)
+            for (const OpenedBackend& slot : backends)
+                rows.push_back(
+                    ImageRowJson(r, slot.name, setting, "", RenderNotMeasured("invalid", loaded.error().message)));
+        return {};
+    }
+    for (Stage r : renderers)
+        for (const OpenedBackend& slot : backends) {
+            // A backend without the renderer has one "unsupported" row, at the scene's settings.
+            if (slot.backend && !slot.backend->Supports(r) && !setting.empty()) continue;
+            RenderAccuracy a = slot.backend ? MeasureRender(*slot.backend, r, loaded->scene, *loaded->in,
+                                                            loaded->reference->result.image, session.Options().repeats)
+                                            : RenderNotMeasured("unavailable", slot.reason);
+            if (a.status != "ok" && !session.Options().quiet)
+                std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(r)).c_str(),
+                             SettingsLabel(setting).c_str(), a.status.c_str(), a.detail.c_str());
+            rows.push_back(ImageRowJson(r, slot.name, setting, loaded->reference->phase, a));
+        }
+    return {};
+}
+
+}  // namespace
+
+RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
+                             std::span<const float> reference, int repeats) {
+    if (renderer != Stage::RenderMarch && renderer != Stage::RenderSplat)
+        return RenderNotMeasured("failed", "not a renderer");
+    if (!backend.Supports(renderer))
+        return RenderNotMeasured("unsupported",
+                                 backend.Name() + " does not implement " + std::string(StageName(renderer)) + " yet");
+    if (scene.render.cameras.empty()) return RenderNotMeasured("failed", "the scene has no camera");
+    const CameraSettings& camera = scene.render.cameras[0];
+    auto fail = [](const std::string& what, const Error& e) { return RenderNotMeasured("failed", what + e.message); };
+    auto q = backend.CreateBuffer(BufferFormat::F32, in.grid);
+    if (!q) return fail("", q.error());
+    if (Status s = backend.Upload(**q, std::as_bytes(std::span(in.q))); !s) return fail("", s.error());
+    auto image = backend.CreateBuffer(BufferFormat::F32, {3, scene.render.width, scene.render.height});
+    if (!image) return fail("", image.error());
+    RenderAccuracy a;
+    // T from shade on this backend, untimed in the render's time.
+    std::unique_ptr<Buffer> T;
+    const bool needsT = renderer == Stage::RenderSplat || scene.march.light == MarchLightSource::Shade;
+    if (needsT) {
+        if (!backend.Supports(Stage::Shade))
+            return RenderNotMeasured("unsupported", backend.Name() + " does not implement shade, which feeds T");
+        auto t = backend.CreateBuffer(BufferFormat::F32, in.grid);
+        if (!t) return fail("", t.error());
+        T = std::move(*t);
+        const auto start = std::chrono::steady_clock::now();
+        if (Status s = backend.Shade(MakeShadeParams(scene), **q, *T); !s) return fail("shade: ", s.error());
+        a.prepMs += MillisecondsSince(start);
+    }
+    MarkPhase(StageName(renderer), in.step);
+    InjectTestFault(backend.Name(), StageName(renderer));
+    Result<Summary> time;
+    if (renderer == Stage::RenderMarch) {
+        const MarchParams p = MakeMarchParams(scene, camera, in.step);
+        const MarchInputs inputs{q->get(), q->get(), T.get()};
+        time = TimeRepeated(repeats, [&] { return backend.RenderMarch(p, inputs, **image, nullptr); });
+    } else {
+        SplatParams p = MakeSplatParams(scene, camera);
+        const SplatOrder order = MakeSplatOrder(p.camera, scene.grid.size, scene.grid.origin, scene.grid.voxelSize);
+        p.order = &order;
+        // The density stage's occupancy (read when skipping), untimed in the render's time.
+        const DensityParams dp = MakeDensityParams(scene);
+        const Extent3 e = in.grid;
+        auto D = backend.CreateBuffer(BufferFormat::F32, {e.nx, e.ny, 1});
+        auto tiles = backend.CreateBuffer(BufferFormat::U8, {CeilDiv(e.nx, dp.tile), CeilDiv(e.ny, dp.tile), 1});
+        auto bands = backend.CreateBuffer(BufferFormat::U8,
+                                          {CeilDiv(e.nx, dp.tile), CeilDiv(e.ny, dp.tile), CeilDiv(e.nz, dp.band)});
+        if (!D || !tiles || !bands) return RenderNotMeasured("failed", "cannot create the density buffers");
+        if (backend.Supports(Stage::Density)) {
+            DensityOutputs outs{D->get(), tiles->get(), bands->get(), 0};
+            const auto start = std::chrono::steady_clock::now();
+            if (Status s = backend.Density(dp, **q, nullptr, outs); !s) return fail("density: ", s.error());
+            a.prepMs += MillisecondsSince(start);
+        } else {
+            p.skipping = false;
+        }
+        const SplatInputs inputs{q->get(), q->get(), T.get(), tiles->get(), tiles->get(), bands->get(), bands->get()};
+        time = TimeRepeated(repeats, [&] { return backend.RenderSplat(p, inputs, **image, nullptr); });
+    }
+    if (!time) return fail(std::string(StageName(renderer)) + ": ", time.error());
+    a.timeMs = *time;
+    std::vector<float> out(size_t(3) * scene.render.width * scene.render.height);
+    if (Status s = backend.Download(**image, std::as_writable_bytes(std::span(out))); !s) return fail("", s.error());
+    a.error = ImageErrors(out, reference);
+    return a;
+}
+
+std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& sc) {
+    std::vector<std::vector<SceneOverride>> out;
+    for (double f : {0.5, 2.0, 4.0}) out.push_back({{"march.step", Fmt("%.9g", sc.march.step * f)}});
+    if (!sc.march.adaptive) out.push_back({{"march.adaptive.enabled", "true"}});
+    if (sc.march.light == MarchLightSource::Shade) {
+        for (int n : {2, 4, 8, 16}) out.push_back({{"march.light", "march"}, {"march.light_steps", std::to_string(n)}});
+        if (sc.shade.resolution != 2) out.push_back({{"shade.resolution", "2"}});
+    } else {
+        for (uint32_t n : {2u, 4u, 8u, 16u})
+            if (n != sc.march.lightSteps) out.push_back({{"march.light_steps", std::to_string(n)}});
+        if (sc.stages.Has(Stage::Shade)) out.push_back({{"march.light", "shade"}});
+    }
+    out.push_back({{"march.jitter", sc.march.jitter ? "false" : "true"}});
+    out.push_back({{"march.skipping.enabled", sc.march.skipping ? "false" : "true"}});
+    if (sc.march.epsilon != 0) out.push_back({{"march.epsilon", "0"}});
+    // Every phase function against the Mie reference, the scene's own included
+    // (its row is the cost of approximating Mie); for a Mie scene that row is the scene's.
+    for (const auto& [name, kind] : kPhaseKindNames)
+        if (kind != PhaseKind::Mie || sc.phase.kind != PhaseKind::Mie)
+            out.push_back({{"phase.function", std::string(name)}});
+    return out;
+}
+
+Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<SceneOverride>& setting, Stage renderer,
+                                        Backend& backend) {
+    auto loaded = eval.Images().Load(setting);
+    if (!loaded) return std::unexpected(loaded.error());
+    const RenderAccuracy a = MeasureRender(backend, renderer, loaded->scene, *loaded->in,
+                                           loaded->reference->result.image, eval.Options().repeats);
+    StageAccuracy out;
+    out.status = a.status;
+    out.detail = a.detail;
+    out.timeMs = a.timeMs;
+    out.all = a.error.pixel;
+    out.psnrDb = a.error.psnr;
+    return out;
+}
+
+Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<const OpenedBackend> backends) {
+    const Scene& scene = session.GetScene();
+    ImageReferences& refs = eval.Images();
+    json rows = json::array();
+    if (scene.stages.Has(Stage::RenderMarch)) {
+        const Stage march[] = {Stage::RenderMarch};
+        CB_TRY(MeasureImageRows(refs, session, {}, backends, march, rows));
+        for (const auto& v : MarchImageVariants(scene))
+            CB_TRY(MeasureImageRows(refs, session, v, backends, march, rows));
+    }
+    if (scene.stages.Has(Stage::RenderSplat)) {
+        const Stage splat[] = {Stage::RenderSplat};
+        CB_TRY(MeasureImageRows(refs, session, {}, backends, splat, rows));
+    }
+    return json{{"rows", rows}, {"references", refs.Records()}};
+}
+
+report::Table ImageRowsTable(const json& rows) {
+    using report::Column;
+    report::Table table({Column("renderer"), Column("setting"), Column("backend"), Column("time ms (q1-q3)").Unit("ms"),
+                         Column("T etc. ms").Real("%.3f").Unit("ms"), Column("max").Real("%.3g"),
+                         Column("mean").Real("%.3g"), Column("p99").Real("%.3g"), Column("PSNR dB").Real("%.2f"),
+                         Column("reference phase")});
+    for (const json& r : rows) {
+        std::vector<report::Cell> cells = {r["renderer"].get<std::string>(), r["label"].get<std::string>(),
+                                           r["backend"].get<std::string>()};
+        if (r["status"] != "ok") {
+            cells.push_back(r["status"].get<std::string>() + ": " + r.value("detail", std::string()));
+            table.rows.push_back(std::move(cells));
+            continue;
+        }
+        const json& t = r["time"];
+        cells.push_back(Fmt("%.3f", t["median_ms"].get<double>()) + " (" + Fmt("%.3f", t["q1_ms"].get<double>()) + "-" +
+                        Fmt("%.3f", t["q3_ms"].get<double>()) + ")");
+        cells.push_back(r["prep_ms"].get<double>());
+        const json& e = r["error"];
+        cells.push_back(e["max"].get<double>());
+        cells.push_back(e["mean"].get<double>());
+        cells.push_back(e["p99"].get<double>());
+        if (e["psnr_db"].is_null())
+            cells.push_back("inf");
+        else
+            cells.push_back(e["psnr_db"].get<double>());
+        cells.push_back(r["reference_phase"].get<std::string>());
+        table.rows.push_back(std::move(cells));
+    }
+    return table;
+}
+
+report::Table ImageReferenceTable(const json& references) {
+    using report::Column;
+    report::Table table({Column("reference inputs"), Column("phase"), Column("step voxel").Real("%.4g"),
+                         Column("image"), Column("samples").Integer(), Column("light rays").Integer(),
+                         Column("s").Real("%.3f").Unit("s"), Column("M light rays/s").Real("%.3f")});
+    for (const json& r : references)
+        table.rows.push_back(
+            {r["inputs"].get<std::string>(), r["phase"].get<std::string>(), r["step_voxels"].get<double>(),
+             std::to_string(r["width"].get<uint32_t>()) + "x" + std::to_string(r["height"].get<uint32_t>()),
+             int64_t(r["samples"].get<uint64_t>()), int64_t(r["light_rays"].get<uint64_t>()),
+             r["seconds"].get<double>(), r["rays_per_s"].get<double>() / 1e6});
+    return table;
+}
+
+}  // namespace cb

@@ -1,0 +1,224 @@
+#include "harness/platform/Command.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <map>
+
+#include "core/base/NamedValues.h"
+#include "core/base/ShownText.h"
+
+namespace cb {
+namespace {
+
+std::map<std::string_view, Command>& Registry() {
+    static std::map<std::string_view, Command> registry;
+    return registry;
+}
+
+// A positive integer in [1, max], or nullopt.
+std::optional<int> PositiveInt(const char* text, long max) {
+    if (!text) return std::nullopt;
+    char* end = nullptr;
+    const long value = std::strtol(text, &end, 10);
+    if (*end != '\0' || value < 1 || value > max) return std::nullopt;
+    return int(value);
+}
+
+// A name from the command line as a message shows it (core/base/ShownText.h): printable ASCII, the rest as \xNN, cut
+// short.
+std::string Shown(std::string_view name) { return ShownArgument(name); }
+
+// An option whose value is one of `table`'s names, stored in `field` as its
+// value; otherwise the usage message lists the names: "--x needs a or b".
+template <typename Enum, size_t N>
+OptionSpec Choice(std::string_view name, Enum CommonOptions::*field, const std::array<NamedValue<Enum>, N>& table) {
+    const std::string message = std::string(name) + " needs " + ChoiceOf(table);
+    return {name, "", true, [=, &table](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                const std::optional<Enum> value = v ? ValueNamed(table, v) : std::nullopt;
+                if (!value) return message;
+                o.*field = *value;
+                return std::nullopt;
+            }};
+}
+
+// The table's names as a choice, the first marked as the default: "a (default) or b".
+template <typename Enum, size_t N>
+std::string DefaultFirst(const std::array<NamedValue<Enum>, N>& table) {
+    std::string out;
+    for (size_t i = 0; i < N; ++i) {
+        if (i > 0) out += i + 1 == N ? " or " : ", ";
+        out += table[i].name;
+        if (i == 0) out += " (default)";
+    }
+    return out;
+}
+
+// Function-local statics: commands in other files read them during static initialisation.
+std::vector<OptionSpec> MakeSceneCommandOptions() {
+    return {
+        {"--backend", "--backends", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             if (!v) return "--backend needs a list, e.g. --backend cpu";
+             return ParseBackendList(v, o.backends);
+         }},
+        {"--steps", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             if (!v) return "--steps needs a number";
+             o.overrides.push_back({"steps", v});
+             return std::nullopt;
+         }},
+        TextOption("--out", &CommonOptions::outDir, "--out needs a folder"),
+        {"--set", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             const char* eq = v ? std::strchr(v, '=') : nullptr;
+             if (!eq || eq == v) return "--set needs PATH=VALUE, e.g. --set ca.seed=42";
+             o.overrides.push_back({std::string(v, eq), std::string(eq + 1)});
+             return std::nullopt;
+         }},
+        {"--threads", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             const std::optional<int> threads = PositiveInt(v, 1024);
+             if (!threads) return "--threads needs a number from 1";
+             o.cpuThreads = *threads;
+             return std::nullopt;
+         }},
+        Choice("--gl-context", &CommonOptions::glContext, gl::kContextKindNames),
+        Choice("--gl-ca-layout", &CommonOptions::glCaLayout, gl::kCaLayoutNames),
+        TextOption("--vk-device", &CommonOptions::vkDevice, "--vk-device needs an index or a name"),
+        FlagOption("--quiet", &CommonOptions::quiet),
+    };
+}
+
+}  // namespace
+
+OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field) {
+    return {name, "", false, [=](CommonOptions& o, const char*) -> std::optional<std::string> {
+                o.*field = true;
+                return std::nullopt;
+            }};
+}
+
+OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing) {
+    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                if (!v) return missing;
+                if (!*v) return std::string(name) + ": must not be empty";
+                o.*field = v;
+                return std::nullopt;
+            }};
+}
+
+OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOptions::*field, std::string missing) {
+    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                if (!v) return missing;
+                (o.*field).push_back(v);
+                return std::nullopt;
+            }};
+}
+
+std::span<const std::string_view> KnownBackends() {
+    // The names registry/Registry.cpp's CreateBackend knows (BackendOptionsTest checks them against it).
+    static constexpr std::array<std::string_view, 3> kKnown = {"cpu", "gl", "vk"};
+    return kKnown;
+}
+
+std::optional<std::string> UnknownBackend(std::string_view option, std::string_view name) {
+    const std::span<const std::string_view> known = KnownBackends();
+    if (std::ranges::find(known, name) != known.end()) return std::nullopt;
+    std::string knownList;
+    for (std::string_view k : known) knownList += (knownList.empty() ? "" : ", ") + std::string(k);
+    std::string message = std::string(option) + ": unknown backend '" + Shown(name) + "' (known: " + knownList + ")";
+    if (const std::string_view best = ClosestName(name, known); !best.empty())
+        message += "; did you mean '" + std::string(best) + "'?";
+    return message;
+}
+
+std::optional<std::string> ParseBackendList(std::string_view list, std::vector<std::string>& backends) {
+    const std::span<const std::string_view> known = KnownBackends();
+    std::string knownList;
+    for (std::string_view name : known) knownList += (knownList.empty() ? "" : ", ") + std::string(name);
+    if (list.empty()) return "--backend: empty list (known: " + knownList + ")";
+    std::vector<std::string> names;
+    for (size_t start = 0; start <= list.size();) {
+        const size_t comma = std::min(list.find(',', start), list.size());
+        const std::string_view name = list.substr(start, comma - start);
+        start = comma + 1;
+        if (name.empty()) return "--backend: empty backend name in '" + Shown(list) + "'";
+        if (auto why = UnknownBackend("--backend", name)) return *why;
+        if (std::ranges::find(names, name) != names.end() || std::ranges::find(backends, name) != backends.end())
+            return "--backend: " + std::string(name) + " named twice";
+        names.emplace_back(name);
+    }
+    backends.insert(backends.end(), names.begin(), names.end());
+    return std::nullopt;
+}
+
+BackendOptions CommonOptions::Backend() const {
+    BackendOptions b;
+    b.cpuThreads = cpuThreads;
+    b.vkDevice = vkDevice;
+    b.glContext = glContext;
+    b.glCaLayout = glCaLayout;
+    return b;
+}
+
+std::span<const OptionSpec> SceneCommandOptions() {
+    static const std::vector<OptionSpec> options = MakeSceneCommandOptions();
+    return options;
+}
+
+std::string GlOptionsHelp() {
+    return "  --gl-context CTX   OpenGL context: " + DefaultFirst(gl::kContextKindNames) +
+           "\n  --gl-ca-layout L   OpenGL automaton layout: " + DefaultFirst(gl::kCaLayoutNames) + "\n";
+}
+
+OptionSpec RepeatOption() {
+    return {"--repeat", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                const std::optional<int> repeats = PositiveInt(v, 10000);
+                if (!repeats) return "--repeat needs a number from 1";
+                o.repeats = *repeats;
+                return std::nullopt;
+            }};
+}
+
+OptionSpec ReferenceStepOption() {
+    return {"--reference-step", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+                char* end = nullptr;
+                const double step = std::strtod(v, &end);
+                if (end == v || *end != '\0' || !(step >= 1.0 / 1024 && step <= 1))
+                    return "--reference-step needs a number of voxel edges in [1/1024, 1]";
+                o.referenceStep = step;
+                return std::nullopt;
+            }};
+}
+
+CommandRegistration::CommandRegistration(Command command) {
+    const std::string_view name = command.name;
+    Registry().emplace(name, std::move(command));
+}
+
+std::vector<const Command*> RegisteredCommands() {
+    std::vector<const Command*> out;
+    for (const auto& [name, command] : Registry()) out.push_back(&command);
+    std::ranges::stable_sort(out, {}, &Command::helpOrder);
+    return out;
+}
+
+const Command* FindCommand(std::string_view name) {
+    auto it = Registry().find(name);
+    return it == Registry().end() ? nullptr : &it->second;
+}
+
+std::string ResolveScenePath(const std::string& nameOrPath) {
+    const std::string& name = nameOrPath.empty() ? std::string(kDefaultScene) : nameOrPath;
+    if (name.find('/') != std::string::npos || name.ends_with(".json")) return name;
+    const char* env = std::getenv("CLOUDBENCH_SCENES");
+    const std::filesystem::path dir = env ? std::filesystem::path(env) : std::filesystem::path(CLOUDBENCH_SCENES_DIR);
+    return (dir / (name + ".json")).string();
+}
+
+}  // namespace cb

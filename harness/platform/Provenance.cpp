@@ -1,0 +1,107 @@
+#include "harness/platform/Provenance.h"
+
+#include <sys/utsname.h>
+
+#include <algorithm>
+#include <ctime>
+#include <fstream>
+#include <thread>
+
+#include "cloudbench_build_info.h"
+#include "core/base/InputFile.h"
+
+namespace cb {
+namespace {
+
+using nlohmann::json;
+
+std::string CpuModel() {
+    std::ifstream cpuinfo("/proc/cpuinfo");
+    for (std::string line; std::getline(cpuinfo, line);) {
+        if (!line.starts_with("model name")) continue;
+        const size_t colon = line.find(':');
+        if (colon != std::string::npos && colon + 2 <= line.size()) return line.substr(colon + 2);
+    }
+    return "unknown";
+}
+
+std::string OperatingSystem() {
+    utsname u{};
+    if (uname(&u) != 0) return "unknown";
+    return std::string(u.sysname) + " " + u.release + " " + u.version + " " + u.machine;
+}
+
+std::string UtcNow() {
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    gmtime_r(&now, &utc);
+    char text[32];
+    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+    return text;
+}
+
+// The value as the loader reads it: JSON text, or a bare word as a string.
+json OverrideValue(const std::string& text) {
+    json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
+    return value.is_discarded() ? json(text) : value;
+}
+
+// Sets the field at the override's dotted path (a number indexes an array).
+void ApplyOverride(json& root, const SceneOverride& o) {
+    json* node = &root;
+    for (size_t start = 0; start <= o.path.size();) {
+        const size_t dot = std::min(o.path.find('.', start), o.path.size());
+        const std::string key = o.path.substr(start, dot - start);
+        if (node->is_array() && !key.empty() && key.find_first_not_of("0123456789") == std::string::npos)
+            node = &node->at(std::stoul(key));
+        else
+            node = &(*node)[key];
+        start = dot + 1;
+    }
+    *node = OverrideValue(o.value);
+}
+
+}  // namespace
+
+json SceneWithOverrides(const std::string& path, std::span<const SceneOverride> overrides) {
+    // Read again as LoadScene read it (core/base/InputFile.h): the file may have changed since, even into a FIFO.
+    Result<std::string> text = ReadInputFile(path, kSceneInput);
+    if (!text) return nullptr;
+    json root = json::parse(*text, nullptr, /*allow_exceptions=*/false);
+    if (root.is_discarded()) return nullptr;
+    try {
+        for (const SceneOverride& o : overrides) ApplyOverride(root, o);
+    } catch (const std::exception&) {
+        return nullptr;  // LoadScene reports what is wrong with the override
+    }
+    return root;
+}
+
+json MakeProvenance(std::span<const std::string> commandLine, const SceneProvenance& scene,
+                    std::span<const BackendProvenance> backends) {
+    const std::string dirty = CLOUDBENCH_GIT_DIRTY;
+    json doc = {
+        {"git",
+         {{"commit", CLOUDBENCH_GIT_COMMIT}, {"dirty", dirty == "unknown" ? json(dirty) : json(dirty == "true")}}},
+        {"build",
+         {{"type", CLOUDBENCH_BUILD_TYPE}, {"flags", CLOUDBENCH_CXX_FLAGS}, {"compiler", CLOUDBENCH_COMPILER}}},
+        {"machine", {{"cpu", CpuModel()}, {"threads", std::thread::hardware_concurrency()}, {"os", OperatingSystem()}}},
+        {"date", UtcNow()},
+        {"backends", json::array()},
+        {"command_line", commandLine},
+    };
+    for (const BackendProvenance& b : backends) {
+        json entry = {{"name", b.name}, {"status", b.status}, {"device", b.device}};
+        if (!b.reason.empty()) entry["reason"] = b.reason;
+        doc["backends"].push_back(entry);
+    }
+    json overrides = json::array();
+    for (const SceneOverride& o : scene.overrides) overrides.push_back({{"path", o.path}, {"value", o.value}});
+    doc["scene"] = {{"path", scene.path},
+                    {"name", scene.scene ? scene.scene->name : ""},
+                    {"overrides", overrides},
+                    {"resolved", SceneWithOverrides(scene.path, scene.overrides)}};
+    return doc;
+}
+
+}  // namespace cb

@@ -1,0 +1,181 @@
+// `run`'s report section of one backend (TimingSection, harness/report/Report.h): the
+// per-stage timing table with each camera's frames, the loop, each timing
+// mode's step, the stage runs and the cloud cover.
+#include <cstdio>
+
+#include "harness/report/Report.h"
+
+namespace cb {
+namespace {
+
+// The timing table's columns: stage, median, q1, q3, min, max (ms), then two
+// notes without a title: the device median and a camera's frame summary.
+std::vector<report::Column> TimingColumns() {
+    using report::Column;
+    std::vector<Column> columns = {Column("stage").Width(18).Separator("  ")};
+    for (const char* title : {"median ms", "q1", "q3", "min", "max"})
+        columns.push_back(Column(title).Real("%.3f").Unit("ms").Width(10).AlignRight());
+    columns.push_back(Column("device median").Real("%.3f").Unit("ms").Separator("   ").Prefix("device ").NoTextTitle());
+    columns.push_back(Column("frames").Separator("  ").NoTextTitle());
+    return columns;
+}
+
+std::vector<report::Cell> TimingRow(const std::string& name, const std::vector<double>& samples,
+                                    const std::vector<double>& device, std::string note = "") {
+    const Summary s = Summarize(samples);
+    std::vector<report::Cell> row = {name, s.median, s.q1, s.q3, s.min, s.max};
+    row.push_back(device.empty() ? report::Cell() : report::Cell(Summarize(device).median));
+    row.push_back(note.empty() ? report::Cell() : report::Cell(std::move(note)));
+    return row;
+}
+
+}  // namespace
+
+report::Section TimingSection(const Scene& scene, const BackendRun& run) {
+    report::Section section;
+    char line[256];
+    if (run.steps.size() > scene.warmupSteps)
+        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, statistics over steps %u..%zu", run.name.c_str(),
+                      run.device.c_str(), run.steps.size(), scene.warmupSteps, run.steps.size() - 1);
+    else
+        std::snprintf(line, sizeof line, "backend %s (%s): %zu steps, none after the %u warm-up steps",
+                      run.name.c_str(), run.device.c_str(), run.steps.size(), scene.warmupSteps);
+    section.title = line;
+    // Wall time; "device" follows where the backend measures GPU time.
+    report::Table table(TimingColumns(), report::TextLayout::Columns);
+    for (Stage stage : kAllStages) {
+        if (!scene.stages.Has(stage)) continue;
+        table.rows.push_back(TimingRow(std::string(StageName(stage)), StageSamples(scene, run, stage),
+                                       StageSamples(scene, run, stage, true)));
+    }
+    // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's count of `what`.
+    auto frameRows = [&](Stage renderer, const std::string& label, const char* what, auto count) {
+        if (!scene.stages.Has(renderer)) return;
+        for (const CameraSettings& camera : scene.render.cameras) {
+            std::vector<double> ms;
+            uint64_t last = 0;
+            ForEachFrame(run, renderer, camera.name, [&](const StepRecord&, const FrameRecord& f) {
+                ms.push_back(f.ms);
+                last = count(f);
+            });
+            const Summary s = Summarize(ms);
+            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu %s", s.count,
+                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(last), what);
+            table.rows.push_back(TimingRow(("  " + label + " " + camera.name).substr(0, 18), ms, {}, line));
+        }
+    };
+    frameRows(Stage::RenderSplat, "frame", "splats", [](const FrameRecord& f) { return uint64_t(f.stats.splats); });
+    frameRows(Stage::RenderMarch, "march", "samples", [](const FrameRecord& f) { return uint64_t(f.march.samples); });
+    if (scene.stages.Has(Stage::Region)) {
+        std::vector<double> host;
+        for (const StepRecord& r : run.steps)
+            if (r.step >= scene.warmupSteps) host.push_back(r.ellipsoidUpdateMs);
+        table.rows.push_back(TimingRow("(host) ellipsoids", host, {}));
+    }
+    if (!run.downloadMs.empty()) table.rows.push_back(TimingRow("(transfer) download", run.downloadMs, {}));
+    section.blocks.push_back(std::move(table));
+    // The whole loop (simulation + frames) and how often each stage ran.
+    const LoopFigures loop = MeasureLoop(scene, run);
+    if (loop.steps > 0) {
+        const Summary st = Summarize(loop.stepMs);
+        if (const auto fps = loop.Fps())
+            std::snprintf(
+                line, sizeof line,
+                "  loop: %llu frames (%.4g per render step) in %u steps, %.1f ms: %.1f fps; step median %.3f ms, "
+                "max %.3f ms",
+                static_cast<unsigned long long>(loop.frames), double(loop.frames) / loop.renderSteps, loop.steps,
+                loop.wallMs, *fps, st.median, st.max);
+        else
+            std::snprintf(line, sizeof line,
+                          "  loop: no frames in %u steps, %.1f ms: %.1f steps/s; step median %.3f ms", loop.steps,
+                          loop.wallMs, loop.wallMs > 0 ? loop.steps * 1000.0 / loop.wallMs : 0.0, st.median);
+        section.blocks.push_back(report::Paragraph{line});
+        if (!loop.frameMs.empty()) {
+            // The thesis's figure of a loop: the frame the viewer waits longest for, beside the typical one.
+            const Summary fr = Summarize(loop.frameMs);
+            std::snprintf(
+                line, sizeof line,
+                "  frames: median %.3f ms [q1 %.3f, q3 %.3f], slowest %.3f ms (step %u frame %u%s%s)%s", fr.median,
+                fr.q1, fr.q3, fr.max, loop.slowestStep, loop.slowestFrame, loop.slowestWork.empty() ? "" : ": ",
+                loop.slowestWork.c_str(),
+                scene.render.slicesPerFrame > 0
+                    ? (", time-sliced at " + std::to_string(scene.render.slicesPerFrame) + " slices per frame").c_str()
+                    : "");
+            section.blocks.push_back(report::Paragraph{line});
+        }
+    }
+    // Each timing mode's step (median [q1, q3]) and what it asked of the device (medians over its steps).
+    std::string modes;
+    for (TimingMode mode : {TimingMode::Pipelined, TimingMode::Synchronized}) {
+        const std::vector<const StepRecord*> steps = StepsIn(scene, run, mode);
+        if (steps.empty()) continue;
+        std::vector<double> ms, submissions, waits;
+        for (const StepRecord* r : steps) {
+            ms.push_back(r->stepMs);
+            submissions.push_back(double(r->submissions));
+            waits.push_back(double(r->hostWaits));
+        }
+        const Summary st = Summarize(ms);
+        const double sub = Summarize(submissions).median, wait = Summarize(waits).median;
+        std::snprintf(line, sizeof line, "%s: step %.3f ms [%.3f, %.3f] (%.4g submission%s, %.4g wait%s)",
+                      std::string(TimingModeName(mode)).c_str(), st.median, st.q1, st.q3, sub, sub == 1 ? "" : "s",
+                      wait, wait == 1 ? "" : "s");
+        modes += (modes.empty() ? "  " : "; ") + std::string(line);
+    }
+    if (!modes.empty()) section.blocks.push_back(report::Paragraph{modes});
+    if (!StepsIn(scene, run, TimingMode::Pipelined).empty()) {
+        // Pipelined, a stage's call time is the host's recording; its time is the device's.
+        bool anyDevice = false;
+        for (Stage stage : kAllStages)
+            anyDevice |=
+                scene.stages.Has(stage) && !StageSamples(scene, run, stage, true, TimingMode::Pipelined).empty();
+        std::string stages = anyDevice ? "  pipelined per stage, median device ms (host recording ms):"
+                                       : "  pipelined per stage, no device clock; median host recording ms:";
+        const char* sep = " ";
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            const std::vector<double> host = StageSamples(scene, run, stage, false, TimingMode::Pipelined);
+            if (host.empty()) continue;
+            const std::vector<double> device = StageSamples(scene, run, stage, true, TimingMode::Pipelined);
+            const std::string name(StageName(stage));
+            if (!anyDevice)
+                std::snprintf(line, sizeof line, "%s %.3f", name.c_str(), Summarize(host).median);
+            else if (device.empty())
+                std::snprintf(line, sizeof line, "%s - (%.3f)", name.c_str(), Summarize(host).median);
+            else
+                std::snprintf(line, sizeof line, "%s %.3f (%.3f)", name.c_str(), Summarize(device).median,
+                              Summarize(host).median);
+            stages += sep + std::string(line);
+            sep = ", ";
+        }
+        section.blocks.push_back(report::Paragraph{stages});
+    }
+    if (!run.steps.empty()) {
+        std::string runs = "  stage runs (" + std::to_string(run.steps.size()) + " steps):";
+        const char* sep = " ";
+        for (Stage stage : kAllStages) {
+            if (!scene.stages.Has(stage)) continue;
+            const StageRunCount c = CountStageRuns(run, stage);
+            runs += sep + std::string(StageName(stage)) + " " + std::to_string(c.ran);
+            if (c.skippedUnchanged) runs += " (" + std::to_string(c.skippedUnchanged) + " skipped, unchanged)";
+            if (Describe(stage).renderer) runs += " (" + std::to_string(c.frames) + " frames)";
+            sep = ", ";
+        }
+        section.blocks.push_back(report::Paragraph{runs});
+    }
+    if (scene.stages.Has(Stage::Density) && !run.steps.empty()) {
+        std::vector<double> after;
+        for (const StepRecord& r : run.steps)
+            if (r.step >= scene.warmupSteps && r.coveredColumns)
+                after.push_back(CoverFraction(scene, *r.coveredColumns));
+        const Summary s = Summarize(after);
+        const StepRecord& last = run.steps.back();
+        std::snprintf(line, sizeof line, "  cloud cover: last step %.1f %%, median %.1f %% (min %.1f, max %.1f)",
+                      last.coveredColumns ? 100.0 * CoverFraction(scene, *last.coveredColumns) : 0.0, 100 * s.median,
+                      100 * s.min, 100 * s.max);
+        section.blocks.push_back(report::Paragraph{line});
+    }
+    return section;
+}
+
+}  // namespace cb

@@ -1,0 +1,113 @@
+// libcloudbench_images.so: the operations of harness/report/images/ImageModule.h
+// through OpenImageIO. Nothing else in cloudbench includes OpenImageIO.
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include "harness/report/images/ImageModule.h"
+
+namespace cb::images {
+namespace {
+
+OIIO::ImageSpec FloatSpec(const ImageView& image) {
+    OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
+    if (image.colorSpace && *image.colorSpace) spec.attribute("oiio:ColorSpace", image.colorSpace);
+    return spec;
+}
+
+// Wraps the view's pixels, without copying; OpenImageIO only reads them here.
+OIIO::ImageBuf Wrap(const ImageView& image) {
+    return OIIO::ImageBuf(FloatSpec(image), const_cast<float*>(image.pixels));
+}
+
+FloatImage Copy(const OIIO::ImageBuf& buffer) {
+    const OIIO::ImageSpec& spec = buffer.spec();
+    FloatImage out{spec.width, spec.height, spec.nchannels, {}, spec.get_string_attribute("oiio:ColorSpace")};
+    out.pixels.resize(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+    buffer.get_pixels(buffer.roi(), OIIO::TypeDesc::FLOAT, out.pixels.data());
+    return out;
+}
+
+// OIIO's PNG writer can report success on a full disk, so the file is read
+// back whole. ImageInput, not ImageBuf: the shared image cache could answer
+// with an earlier file of the same name.
+std::string Write(const std::string& path, const std::string& format, ImageView image, bool eightBit) {
+    OIIO::ImageBuf buffer = Wrap(image);
+    if (eightBit) buffer.set_write_format(OIIO::TypeDesc::UINT8);
+    if (!buffer.write(path, OIIO::TypeUnknown, format)) return buffer.geterror();
+    auto in = OIIO::ImageInput::create(format);
+    OIIO::ImageSpec got;
+    std::vector<float> pixels(size_t(image.width) * size_t(image.height) * size_t(image.channels));
+    const bool whole = in && in->open(path, got) && got.width == image.width && got.height == image.height &&
+                       got.nchannels == image.channels &&
+                       in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::FLOAT, pixels.data());
+    if (whole) return "";
+    return "it does not read back whole (" + (in ? in->geterror() : OIIO::geterror()) + ")";
+}
+
+std::string Read(const std::string& path, int channels, FloatImage& image) {
+    OIIO::ImageBuf buffer(path);
+    if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT)) return buffer.geterror();
+    const OIIO::ImageSpec& spec = buffer.spec();
+    if (spec.nchannels < channels) return "has " + std::to_string(spec.nchannels) + " channels, not RGB";
+    image = FloatImage{spec.width, spec.height, channels, {}, spec.get_string_attribute("oiio:ColorSpace")};
+    image.pixels.resize(size_t(spec.width) * size_t(spec.height) * size_t(channels));
+    OIIO::ROI roi = buffer.roi();
+    roi.chbegin = 0;
+    roi.chend = channels;
+    if (!buffer.get_pixels(roi, OIIO::TypeDesc::FLOAT, image.pixels.data())) return buffer.geterror();
+    return "";
+}
+
+Comparison Compare(ImageView a, ImageView b, float limit, float tolerance) {
+    const auto result = OIIO::ImageBufAlgo::compare(Wrap(a), Wrap(b), limit, tolerance);
+    Comparison c;
+    c.maxError = result.maxerror;
+    c.meanError = result.meanerror;
+    c.psnr = result.PSNR;
+    c.pixelsOverTolerance = size_t(result.nfail + result.nwarn);
+    c.worstX = result.maxx;
+    c.worstY = result.maxy;
+    return c;
+}
+
+std::string Difference(ImageView a, ImageView b, float gain, bool clamp, FloatImage& out) {
+    OIIO::ImageBuf d = OIIO::ImageBufAlgo::absdiff(Wrap(a), Wrap(b));
+    if (gain != 1) d = OIIO::ImageBufAlgo::mul(d, gain);
+    if (clamp) d = OIIO::ImageBufAlgo::clamp(d, 0.0f, 1.0f);
+    if (d.has_error()) return d.geterror();
+    out = Copy(d);
+    return "";
+}
+
+std::string LinearToSrgb(ImageView linear, FloatImage& srgb) {
+    OIIO::ImageBuf converted;
+    if (!OIIO::ImageBufAlgo::colorconvert(converted, Wrap(linear), "linear", "sRGB")) return converted.geterror();
+    srgb = Copy(converted);
+    return "";
+}
+
+std::string EncodePng(ImageView image, std::string& bytes) {
+    std::vector<unsigned char> file;
+    OIIO::Filesystem::IOVecOutput proxy(file);
+    auto out = OIIO::ImageOutput::create("image.png", &proxy);
+    if (!out) return "no PNG writer: " + OIIO::geterror();
+    const OIIO::ImageBuf buffer = Wrap(image);
+    OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::UINT8);
+    std::vector<unsigned char> pixels(spec.image_bytes());
+    if (!buffer.get_pixels(buffer.roi(), OIIO::TypeDesc::UINT8, pixels.data()) || !out->open("image.png", spec) ||
+        !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
+        return "cannot encode: " + out->geterror();
+    bytes.assign(file.begin(), file.end());
+    return "";
+}
+
+const Module kModule{kModuleVersion, Write, Read, Compare, Difference, LinearToSrgb, EncodePng};
+
+}  // namespace
+}  // namespace cb::images
+
+extern "C" __attribute__((visibility("default"))) const cb::images::Module* cloudbench_image_module() {
+    return &cb::images::kModule;
+}

@@ -1,0 +1,103 @@
+#include "harness/run/RunTransfer.h"
+
+#include <utility>
+
+#include "harness/platform/TransferJson.h"
+
+namespace cb::transfer {
+
+json ToJson(const StepRecord& r) {
+    json stageMs = json::array(), hostMs = json::array(), deviceMs = json::array(), frames = json::array(),
+         skipped = json::array();
+    for (size_t s = 0; s < kStageCount; ++s) {
+        stageMs.push_back(Optional(r.stageMs[s]));
+        hostMs.push_back(Optional(r.hostMs[s]));
+        deviceMs.push_back(Optional(r.deviceMs[s]));
+        skipped.push_back(r.skippedUnchanged[s]);
+    }
+    for (const FrameRecord& f : r.frames)
+        frames.push_back({{"renderer", StageName(f.renderer)},
+                          {"camera", f.camera},
+                          {"frame", f.frame},
+                          {"alpha", D(f.alpha)},
+                          {"ms", D(f.ms)},
+                          {"pipelined", f.pipelined},
+                          {"device_ms", Optional(f.deviceMs)},
+                          {"splats", f.stats.splats},
+                          {"voxels_visited", f.stats.voxelsVisited},
+                          {"fragments", f.stats.fragments},
+                          {"march",
+                           {{"rays", f.march.rays},
+                            {"samples", f.march.samples},
+                            {"light_samples", f.march.lightSamples},
+                            {"bricks_skipped", f.march.bricksSkipped},
+                            {"empty_bricks", f.march.emptyBricks},
+                            {"bricks", f.march.bricks}}}});
+    json frameMs = json::array();
+    for (double ms : r.frameMs) frameMs.push_back(D(ms));
+    return {{"step", r.step},
+            {"timing", TimingModeName(r.timing)},
+            {"stage_ms", stageMs},
+            {"host_ms", hostMs},
+            {"submissions", r.submissions},
+            {"host_waits", r.hostWaits},
+            {"batches", r.batches},
+            {"device_ms", deviceMs},
+            {"ellipsoid_update_ms", D(r.ellipsoidUpdateMs)},
+            {"covered_columns", Optional(r.coveredColumns)},
+            {"skipped_unchanged", skipped},
+            {"frames_rendered", r.framesRendered},
+            {"step_ms", D(r.stepMs)},
+            {"frame_ms", frameMs},
+            {"frame_work", r.frameWork},
+            {"frames", frames}};
+}
+
+StepRecord StepFromJson(const json& j) {
+    StepRecord r;
+    r.step = j.at("step").get<uint32_t>();
+    for (size_t s = 0; s < kStageCount; ++s) {
+        r.stageMs[s] = OptionalFrom<double>(j.at("stage_ms").at(s));
+        r.deviceMs[s] = OptionalFrom<double>(j.at("device_ms").at(s));
+        r.hostMs[s] = OptionalFrom<double>(j.at("host_ms").at(s));
+    }
+    r.timing = j.at("timing").get<std::string>() == "pipelined" ? TimingMode::Pipelined : TimingMode::Synchronized;
+    r.submissions = j.at("submissions").get<uint64_t>();
+    r.hostWaits = j.at("host_waits").get<uint64_t>();
+    r.batches = j.at("batches").get<uint32_t>();
+    r.ellipsoidUpdateMs = FromD(j.at("ellipsoid_update_ms"));
+    r.coveredColumns = OptionalFrom<uint32_t>(j.at("covered_columns"));
+    for (size_t s = 0; s < kStageCount; ++s) r.skippedUnchanged[s] = j.at("skipped_unchanged").at(s).get<bool>();
+    r.framesRendered = j.at("frames_rendered").get<uint32_t>();
+    r.stepMs = FromD(j.at("step_ms"));
+    for (const json& ms : j.at("frame_ms")) r.frameMs.push_back(FromD(ms));
+    r.frameWork = j.at("frame_work").get<std::vector<std::string>>();
+    for (const json& f : j.at("frames")) {
+        FrameRecord frame;
+        frame.renderer = ParseStage(f.at("renderer").get<std::string>()).value_or(Stage::RenderSplat);
+        frame.camera = f.at("camera").get<std::string>();
+        frame.frame = f.at("frame").get<uint32_t>();
+        frame.alpha = float(FromD(f.at("alpha")));
+        frame.ms = FromD(f.at("ms"));
+        frame.pipelined = f.at("pipelined").get<bool>();
+        frame.deviceMs = OptionalFrom<double>(f.at("device_ms"));
+        frame.stats = {f.at("splats").get<uint64_t>(), f.at("voxels_visited").get<uint64_t>(),
+                       f.at("fragments").get<uint64_t>()};
+        if (const auto m = f.find("march"); m != f.end())
+            frame.march = {m->at("rays").get<uint64_t>(),          m->at("samples").get<uint64_t>(),
+                           m->at("light_samples").get<uint64_t>(), m->at("bricks_skipped").get<uint64_t>(),
+                           m->at("empty_bricks").get<uint64_t>(),  m->at("bricks").get<uint64_t>()};
+        r.frames.push_back(std::move(frame));
+    }
+    return r;
+}
+
+json ToJson(const BackendProvenance& b) {
+    return {{"name", b.name}, {"status", b.status}, {"device", b.device}, {"reason", b.reason}};
+}
+BackendProvenance ProvenanceFromJson(const json& j) {
+    return {j.at("name").get<std::string>(), j.at("status").get<std::string>(), j.at("device").get<std::string>(),
+            j.at("reason").get<std::string>()};
+}
+
+}  // namespace cb::transfer
