@@ -7,6 +7,7 @@
 // sizeof alone would miss two swapped members of one type, or a member moved
 // across a padding lane.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -99,7 +100,7 @@ std::vector<Block> Blocks() {
 
 // The declaration `struct NAME { ... };` as it stands in core/math/FILE.
 std::string GlslStruct(const Block& block) {
-    std::ifstream in(std::filesystem::path(CLOUDBENCH_SOURCE_DIR) / "core" / "glsl" / block.file);
+    std::ifstream in(std::filesystem::path(CLOUDBENCH_SOURCE_DIR) / "core" / "math" / block.file);
     std::stringstream text;
     text << in.rdbuf();
     const std::string source = text.str();
@@ -115,7 +116,10 @@ struct Reflected {
 
 // glslangValidator's reflection of `instance`'s members (instance.member: offset N, type T, ...).
 std::map<std::string, Reflected> Reflect(const std::string& shader, const std::string& instance, std::string& log) {
-    const auto path = std::filesystem::path(::testing::TempDir()) / "gpu_block_layout.comp";
+    // A name of this process and call: ctest runs this suite's tests in parallel processes.
+    static int calls = 0;
+    const auto path = std::filesystem::path(::testing::TempDir()) /
+                      ("gpu_block_layout_" + std::to_string(getpid()) + "_" + std::to_string(calls++) + ".comp");
     std::ofstream(path) << shader;
     const std::string command =
         std::string(CLOUDBENCH_GLSLANG_VALIDATOR) + " -l -q --reflect-all-block-variables " + path.string() + " 2>&1";
@@ -131,6 +135,7 @@ std::map<std::string, Reflected> Reflect(const std::string& shader, const std::s
             members[m[1].str()] = {std::stoul(m[2].str()), int(std::stoul(m[3].str(), nullptr, 16))};
     }
     pclose(pipe);
+    std::filesystem::remove(path);
     return members;
 }
 

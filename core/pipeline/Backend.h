@@ -256,6 +256,50 @@ struct MarchStats {
     uint64_t emptyBricks = 0, bricks = 0;  // of the skip structure (0 without skipping)
 };
 
+// A renderer's counters as lists: each counter's member, its JSON name and
+// where it is shown. The lists drive the read-back from an isolated child and
+// a saved state (harness/run/RunTransfer.cpp), results.json and its schema
+// (harness/report/ResultsJson.cpp, harness/report/InputFormats.cpp) and the
+// text report (harness/report/TimingSection.cpp), so a new counter is its
+// member and one line here; the static_asserts fail when a member is missing.
+enum class CounterShown {
+    ReadBack,          // travels with the record only (a child's result, a saved state)
+    Results,           // also per frame in results.json
+    ResultsAndReport,  // also the count the text report gives after a camera's frames (one per renderer)
+};
+template <typename Stats>
+struct Counter {
+    std::string_view name;  // the JSON key
+    uint64_t Stats::*member;
+    CounterShown shown;
+};
+inline constexpr Counter<SplatStats> kSplatCounters[] = {
+    {"splats", &SplatStats::splats, CounterShown::ResultsAndReport},
+    {"voxels_visited", &SplatStats::voxelsVisited, CounterShown::Results},
+    {"fragments", &SplatStats::fragments, CounterShown::ReadBack},
+};
+inline constexpr Counter<MarchStats> kMarchCounters[] = {
+    {"rays", &MarchStats::rays, CounterShown::ReadBack},
+    {"samples", &MarchStats::samples, CounterShown::ResultsAndReport},
+    {"light_samples", &MarchStats::lightSamples, CounterShown::Results},
+    {"bricks_skipped", &MarchStats::bricksSkipped, CounterShown::Results},
+    {"empty_bricks", &MarchStats::emptyBricks, CounterShown::ReadBack},
+    {"bricks", &MarchStats::bricks, CounterShown::ReadBack},
+};
+// The one counter of `list` that the text report gives.
+template <typename Stats, size_t N>
+constexpr const Counter<Stats>& ReportedCounter(const Counter<Stats> (&list)[N]) {
+    size_t found = N;
+    for (size_t i = 0; i < N; ++i)
+        if (list[i].shown == CounterShown::ResultsAndReport) found = found == N ? i : N + 1;
+    if (found >= N) throw "a renderer's counters name exactly one ResultsAndReport";  // fails the constant evaluation
+    return list[found];
+}
+static_assert(ReportedCounter(kSplatCounters).name == "splats");
+static_assert(ReportedCounter(kMarchCounters).name == "samples");
+static_assert(sizeof(SplatStats) == std::size(kSplatCounters) * sizeof(uint64_t), "a SplatStats member is unlisted");
+static_assert(sizeof(MarchStats) == std::size(kMarchCounters) * sizeof(uint64_t), "a MarchStats member is unlisted");
+
 // The backends' entry points, X(stage, Method, (parameters)): one or more per
 // stage (the automaton has two). Contracts:
 // Region, CaStep, Smooth, Density and Shade compute the share `slices` (SliceRange).

@@ -40,8 +40,6 @@ using scene_io::Validator;
 // Stages depend on resources, not on each other (core/pipeline/StageDescriptors.h): one line per stage and set
 // of stages that could write what it lacks. Checked only on a clean list, so one typo does not cascade.
 void CheckStageInputs(const StageSet& stages, Validator& check) {
-    // Stages depend on resources, not on each other (core/pipeline/StageDescriptors.h);
-    // one line per stage and set of stages that could write what it lacks.
     const std::vector<MissingInput> missing = MissingInputs(stages);
     for (size_t n = 0; n < missing.size();) {
         std::string resources, producers;

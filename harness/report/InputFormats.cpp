@@ -99,12 +99,14 @@ Node ReportBlock() {
     return Object({{"title", Text(), true}, {"sections", ArrayOf(section), true}});
 }
 
-Node FrameCamera(std::initializer_list<const char*> counters) {
+template <typename Stats, size_t N>
+Node FrameCamera(const Counter<Stats> (&counters)[N]) {
     std::vector<Field> fields = SummaryFields(true);
     fields.push_back({"steps", ArrayOf(Step()), true});
     fields.push_back({"alphas", ArrayOf(Fraction()), true});
     fields.push_back({"fps_median", Number(0, 1e12), true});
-    for (const char* counter : counters) fields.push_back({counter, ArrayOf(Count()), true});
+    for (const Counter<Stats>& c : counters)
+        if (c.shown != CounterShown::ReadBack) fields.push_back({std::string(c.name), ArrayOf(Count()), true});
     return Object(std::move(fields));
 }
 
@@ -153,8 +155,8 @@ Node ResultsBackend() {
         {"transfers", MapOf(KeyRule::Any, Summary())},
         {"stage_runs", MapOf(KeyRule::Stage, stageRuns)},
         {"loop", loop},
-        {"frames", MapOf(KeyRule::PathName, FrameCamera({"splats", "voxels_visited"}))},
-        {"march_frames", MapOf(KeyRule::PathName, FrameCamera({"samples", "light_samples", "bricks_skipped"}))},
+        {"frames", MapOf(KeyRule::PathName, FrameCamera(kSplatCounters))},
+        {"march_frames", MapOf(KeyRule::PathName, FrameCamera(kMarchCounters))},
         {"cover", ArrayOf(Fraction())},
         {"cover_summary", Object({{"mean", Fraction(), true},
                                   {"median", Fraction(), true},

@@ -1,13 +1,29 @@
 // results.json (harness/report/Report.h ResultsJson and TimingJson; the format is in
 // docs/results.md): per backend, each stage's timing summary and how often it
 // ran, the loop, the frames, the cover, and the timing of each mode.
-#include <initializer_list>
+#include <functional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "harness/report/Report.h"
 
 namespace cb {
 namespace {
+
+// A counter of a frame as results.json lists it: its name and its value in a frame.
+using FrameCounter = std::pair<std::string, std::function<uint64_t(const FrameRecord&)>>;
+
+// The counters of `list` that results.json shows, read from the frame's statistics `stats`.
+template <typename Stats, size_t N>
+std::vector<FrameCounter> ResultsCounters(const Counter<Stats> (&list)[N], Stats FrameRecord::*stats) {
+    std::vector<FrameCounter> out;
+    for (const Counter<Stats>& c : list)
+        if (c.shown != CounterShown::ReadBack)
+            out.push_back(
+                {std::string(c.name), [stats, member = c.member](const FrameRecord& f) { return (f.*stats).*member; }});
+    return out;
+}
 
 nlohmann::json SummaryJson(const std::vector<double>& samples) {
     Summary s = Summarize(samples);
@@ -134,10 +150,9 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         b["host"] = {{"ellipsoid_update", SummaryJson(hostSamples)}};
         b["transfers"] = {{"download", SummaryJson(run.downloadMs)}};
         // Per camera of a renderer: every frame's time (not a pipelined frame's: its call
-        // time is host time), step and alpha, the renderer's counters (`counters`: a
-        // field name and a value of a frame each), and their summary.
-        using FrameCounter = std::pair<const char*, uint64_t (*)(const FrameRecord&)>;
-        auto framesJson = [&](Stage renderer, std::initializer_list<FrameCounter> counters) {
+        // time is host time), step and alpha, the renderer's counters shown in results.json
+        // (`counters`: a field name and a value of a frame each), and their summary.
+        auto framesJson = [&](Stage renderer, const std::vector<FrameCounter>& counters) {
             nlohmann::json cameras = nlohmann::json::object();
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> ms;
@@ -159,14 +174,9 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             return cameras;
         };
         if (scene.stages.Has(Stage::RenderSplat))
-            b["frames"] = framesJson(Stage::RenderSplat,
-                                     {{"splats", [](const FrameRecord& f) { return f.stats.splats; }},
-                                      {"voxels_visited", [](const FrameRecord& f) { return f.stats.voxelsVisited; }}});
+            b["frames"] = framesJson(Stage::RenderSplat, ResultsCounters(kSplatCounters, &FrameRecord::stats));
         if (scene.stages.Has(Stage::RenderMarch))
-            b["march_frames"] = framesJson(
-                Stage::RenderMarch, {{"samples", [](const FrameRecord& f) { return f.march.samples; }},
-                                     {"light_samples", [](const FrameRecord& f) { return f.march.lightSamples; }},
-                                     {"bricks_skipped", [](const FrameRecord& f) { return f.march.bricksSkipped; }}});
+            b["march_frames"] = framesJson(Stage::RenderMarch, ResultsCounters(kMarchCounters, &FrameRecord::march));
         if (scene.stages.Has(Stage::Density)) {
             nlohmann::json cover = nlohmann::json::array();
             std::vector<double> after;

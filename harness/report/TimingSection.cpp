@@ -49,7 +49,7 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
                                        StageSamples(scene, run, stage, true)));
     }
     // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's count of `what`.
-    auto frameRows = [&](Stage renderer, const std::string& label, const char* what, auto count) {
+    auto frameRows = [&](Stage renderer, const std::string& label, std::string_view what, auto count) {
         if (!scene.stages.Has(renderer)) return;
         for (const CameraSettings& camera : scene.render.cameras) {
             std::vector<double> ms;
@@ -59,13 +59,18 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
                 last = count(f);
             });
             const Summary s = Summarize(ms);
-            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu %s", s.count,
-                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(last), what);
+            std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu %.*s", s.count,
+                          s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(last),
+                          int(what.size()), what.data());
             table.rows.push_back(TimingRow(("  " + label + " " + camera.name).substr(0, 18), ms, {}, line));
         }
     };
-    frameRows(Stage::RenderSplat, "frame", "splats", [](const FrameRecord& f) { return uint64_t(f.stats.splats); });
-    frameRows(Stage::RenderMarch, "march", "samples", [](const FrameRecord& f) { return uint64_t(f.march.samples); });
+    const auto& splatCount = ReportedCounter(kSplatCounters);
+    const auto& marchCount = ReportedCounter(kMarchCounters);
+    frameRows(Stage::RenderSplat, "frame", splatCount.name,
+              [&](const FrameRecord& f) { return f.stats.*splatCount.member; });
+    frameRows(Stage::RenderMarch, "march", marchCount.name,
+              [&](const FrameRecord& f) { return f.march.*marchCount.member; });
     if (scene.stages.Has(Stage::Region)) {
         std::vector<double> host;
         for (const StepRecord& r : run.steps)

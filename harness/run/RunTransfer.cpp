@@ -5,6 +5,20 @@
 #include "harness/platform/TransferJson.h"
 
 namespace cb::transfer {
+namespace {
+
+template <typename Stats, size_t N>
+json CountersJson(const Stats& stats, const Counter<Stats> (&counters)[N]) {
+    json out = json::object();
+    for (const Counter<Stats>& c : counters) out[std::string(c.name)] = stats.*c.member;
+    return out;
+}
+template <typename Stats, size_t N>
+void CountersFromJson(const json& j, const Counter<Stats> (&counters)[N], Stats& stats) {
+    for (const Counter<Stats>& c : counters) stats.*c.member = j.at(std::string(c.name)).get<uint64_t>();
+}
+
+}  // namespace
 
 json ToJson(const StepRecord& r) {
     json stageMs = json::array(), hostMs = json::array(), deviceMs = json::array(), frames = json::array(),
@@ -15,7 +29,7 @@ json ToJson(const StepRecord& r) {
         deviceMs.push_back(Optional(r.deviceMs[s]));
         skipped.push_back(r.skippedUnchanged[s]);
     }
-    for (const FrameRecord& f : r.frames)
+    for (const FrameRecord& f : r.frames) {
         frames.push_back({{"renderer", StageName(f.renderer)},
                           {"camera", f.camera},
                           {"frame", f.frame},
@@ -23,16 +37,9 @@ json ToJson(const StepRecord& r) {
                           {"ms", D(f.ms)},
                           {"pipelined", f.pipelined},
                           {"device_ms", Optional(f.deviceMs)},
-                          {"splats", f.stats.splats},
-                          {"voxels_visited", f.stats.voxelsVisited},
-                          {"fragments", f.stats.fragments},
-                          {"march",
-                           {{"rays", f.march.rays},
-                            {"samples", f.march.samples},
-                            {"light_samples", f.march.lightSamples},
-                            {"bricks_skipped", f.march.bricksSkipped},
-                            {"empty_bricks", f.march.emptyBricks},
-                            {"bricks", f.march.bricks}}}});
+                          {"march", CountersJson(f.march, kMarchCounters)}});
+        frames.back().update(CountersJson(f.stats, kSplatCounters));
+    }
     json frameMs = json::array();
     for (double ms : r.frameMs) frameMs.push_back(D(ms));
     return {{"step", r.step},
@@ -81,12 +88,8 @@ StepRecord StepFromJson(const json& j) {
         frame.ms = FromD(f.at("ms"));
         frame.pipelined = f.at("pipelined").get<bool>();
         frame.deviceMs = OptionalFrom<double>(f.at("device_ms"));
-        frame.stats = {f.at("splats").get<uint64_t>(), f.at("voxels_visited").get<uint64_t>(),
-                       f.at("fragments").get<uint64_t>()};
-        if (const auto m = f.find("march"); m != f.end())
-            frame.march = {m->at("rays").get<uint64_t>(),          m->at("samples").get<uint64_t>(),
-                           m->at("light_samples").get<uint64_t>(), m->at("bricks_skipped").get<uint64_t>(),
-                           m->at("empty_bricks").get<uint64_t>(),  m->at("bricks").get<uint64_t>()};
+        CountersFromJson(f, kSplatCounters, frame.stats);
+        if (const auto m = f.find("march"); m != f.end()) CountersFromJson(*m, kMarchCounters, frame.march);
         r.frames.push_back(std::move(frame));
     }
     return r;
