@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 namespace {
@@ -23,9 +24,7 @@ Status BackendVk::CaInitialize(const CaInitParams& params, CaFields out) {
     auto pipeline = mContext->GetPipeline("ca_init", 3);
     if (!pipeline) return std::unexpected(pipeline.error());
     const uint32_t words = (e.nx + 31) / 32;
-    struct {
-        uint32_t nx, ny, nz, words, seed, qHum0, qAct0;
-    } push{e.nx, e.ny, e.nz, words, params.seed, params.qHum0, params.qAct0};
+    CaInitPush push{e.nx, e.ny, e.nz, words, params.seed, params.qHum0, params.qAct0};
     const DeviceBuffer* buffers[] = {&Dev(*out.hum), &Dev(*out.act), &Dev(*out.cld)};
     return Record("ca initial state", [&](VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, words * e.ny * e.nz);
@@ -48,9 +47,8 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     bool wind = false;
     for (size_t k = 0; k < params.shiftX.size(); ++k) wind |= params.shiftX[k] != 0 || params.shiftY[k] != 0;
 
-    struct {
-        uint32_t nx, ny, nz, words, seed, step, qExt, qHum, qAct, first, end;
-    } push{e.nx, e.ny, e.nz, words, params.seed, params.step, params.qExt, params.qHum, params.qAct, first, end};
+    CaStepPush push{e.nx,        e.ny,        e.nz,        words, params.seed, params.step,
+                    params.qExt, params.qHum, params.qAct, first, end};
     const DeviceBuffer* targets[3] = {&Dev(*out.hum), &Dev(*out.act), &Dev(*out.cld)};
     Pipeline* advect = nullptr;
     DeviceBuffer* shifts = nullptr;
@@ -81,9 +79,7 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         r.DispatchRange(**rules, buffers, &push, sizeof push, first, end);
         if (advect) {
             r.Barrier();
-            struct {
-                uint32_t nx, ny, words, first, end;
-            } advectPush{e.nx, e.ny, words, first, end};
+            AdvectPush advectPush{e.nx, e.ny, words, first, end};
             const DeviceBuffer* advectBuffers[] = {targets[0],     targets[1],     targets[2], &Dev(*out.hum),
                                                    &Dev(*out.act), &Dev(*out.cld), shifts};
             r.DispatchRange(*advect, advectBuffers, &advectPush, sizeof advectPush, first, end);

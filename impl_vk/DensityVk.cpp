@@ -8,6 +8,7 @@
 #include <string>
 
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 
@@ -34,10 +35,8 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     if (!pass) return std::unexpected(pass.error());
     auto counter = Scratch(VkScratch::CoverCounter, 4);
     if (!counter) return std::unexpected(counter.error());
-    struct {
-        uint32_t nx, ny, nz, words, fromCld, tile, band, tilesX, tilesY, bandCount, ty0;
-    } push{e.nx,        e.ny,   e.nz,   (e.nx + 31) / 32, cld ? 1u : 0u, params.tile,
-           params.band, tilesX, tilesY, bandCount,        row0};
+    DensityPush push{e.nx,        e.ny,   e.nz,   (e.nx + 31) / 32, cld ? 1u : 0u, params.tile,
+                     params.band, tilesX, tilesY, bandCount,        row0};
     // Without cld the cover counts columns with D > 0; q stands in at the unused binding.
     const DeviceBuffer* buffers[] = {&Dev(q),  &Dev(cld ? *cld : q), &Dev(*out.columnSum),
                                      *counter, &Dev(*out.tiles),     &Dev(*out.bands)};

@@ -5,6 +5,7 @@
 // pushes only the step's offsets.
 #include "core/math/NoiseGpu.h"
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 
@@ -23,10 +24,10 @@ Status BackendVk::Noise(const NoiseParams& params, Buffer& q) {
         CB_TRY(mContext->Upload(**data, std::as_bytes(std::span(words))));
         mNoiseForm = std::move(form);
     }
-    const std::array<float, 8> push = noise::GpuOffsets(mNoiseForm->Offsets(params.step));
+    const NoisePush push{noise::GpuOffsets(mNoiseForm->Offsets(params.step))};
     const DeviceBuffer* buffers[] = {&mScratch[size_t(VkScratch::NoiseData)], &Dev(q)};
     return Record("noise", [&](VulkanContext::Recorder& r) {
-        r.Dispatch(**pipeline, buffers, push.data(), sizeof push, uint32_t(params.grid.Count()));
+        r.Dispatch(**pipeline, buffers, &push, sizeof push, uint32_t(params.grid.Count()));
     });
 }
 

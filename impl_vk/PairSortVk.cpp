@@ -3,13 +3,13 @@
 
 #include <algorithm>
 
+#include "impl_vk/PushBlocks.h"
+
 namespace cb::vk {
 
 void RecordScan(VulkanContext::Recorder& r, Pipeline& scan, const DeviceBuffer& in, const DeviceBuffer& out,
                 const DeviceBuffer& sums, uint32_t n) {
-    struct {
-        uint32_t n, mode;
-    } push{n, 0};
+    ScanPush push{n, 0};
     const DeviceBuffer* buffers[] = {&in, &out, &sums};
     const uint32_t blocks = ScanSumsEntries(n);
     r.Dispatch(scan, buffers, &push, sizeof push, blocks);
@@ -34,9 +34,7 @@ PairSortPlan PlanPairSort(uint32_t pairs, uint32_t largestKey) {
 void RecordPairSort(VulkanContext::Recorder& r, Pipeline& sort, Pipeline& scan, const PairSortPlan& plan,
                     const DeviceBuffer* const keys[2], const DeviceBuffer* const values[2], const DeviceBuffer& counts,
                     const DeviceBuffer& offsets, const DeviceBuffer& sums) {
-    struct {
-        uint32_t n, shift, block, blocks, mode;
-    } push{plan.pairs, 0, plan.block, plan.blocks, 0};
+    RadixSortPush push{plan.pairs, 0, plan.block, plan.blocks, 0};
     for (uint32_t digit = 0; digit < plan.digits; ++digit) {
         const uint32_t from = digit % 2, to = 1 - from;
         const DeviceBuffer* countPass[] = {keys[from], values[from], &counts, keys[to], values[to]};

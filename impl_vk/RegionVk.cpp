@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 #include "impl_vk/RegionTileLists.h"
 
 namespace cb::vk {
@@ -30,9 +31,7 @@ Status BackendVk::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     auto pipeline =
         mContext->GetPipeline("region", 4, slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
     if (!pipeline) return std::unexpected(pipeline.error());
-    struct {
-        uint32_t nx, ny, k0, first, end, tilesX, tilesY;
-    } push{e.nx, e.ny, k0, e.nx * e.ny * k0, e.nx * e.ny * k1, lists.tilesX, lists.tilesY};
+    RegionPush push{e.nx, e.ny, k0, e.nx * e.ny * k0, e.nx * e.ny * k1, lists.tilesX, lists.tilesY};
     const DeviceBuffer* buffers[] = {*list, &Dev(region), *starts, *entries};
     return Record("region", [&](VulkanContext::Recorder& r) {
         r.DispatchRange(**pipeline, buffers, &push, sizeof push, push.first, push.end);

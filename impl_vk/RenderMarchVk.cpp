@@ -15,6 +15,7 @@
 
 #include "core/pipeline/MarchGpu.h"
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 namespace {
@@ -91,13 +92,9 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         groundG = &Dev(*in.G);
     }
 
-    const struct {
-        uint32_t nx, ny, nz, hasT;
-        float alpha;
-    } volumePush{e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha};
-    const struct {
-        uint32_t px, py, pz, brick, bx, by, bz, qStride;
-    } brickPush{px, py, pz, B, frame.bricks[0], frame.bricks[1], frame.bricks[2], shadeLight ? 2u : 1u};
+    const MarchVolumePush volumePush{e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha};
+    const MarchBricksPush brickPush{
+        px, py, pz, B, frame.bricks[0], frame.bricks[1], frame.bricks[2], shadeLight ? 2u : 1u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),
                                            *volume};
     const DeviceBuffer* brickBuffers[] = {*volume, bricks, *statsBuffer};

@@ -10,6 +10,7 @@
 #include "core/pipeline/SplatFrame.h"
 #include "impl_vk/BackendVk.h"
 #include "impl_vk/PairSortVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 namespace {
@@ -137,18 +138,16 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     };
     // 1. Splats and (screen tile, splat) pairs per chunk of ranks, their offsets,
     //    and both totals, which size everything after: the one host wait.
-    struct {
-        uint32_t chunks, tileSize;
-    } chunkPush{chunks, kTileSize};
+    SplatChunksPush chunkPush{chunks, kTileSize};
     const DeviceBuffer* countBuffers[] = {common[0],           common[1],          common[2],          common[3],
                                           common[4],           common[5],          scratch.chunkSplats, scratch.chunkPairs,
                                           scratch.candidates, scratch.totals};
-    const uint32_t boxWords = CeilDiv(uint32_t(boxes.size()), 4);
+    const SplatBoxesPush boxPush{CeilDiv(uint32_t(boxes.size()), 4)};
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
     CB_TRY(run("render_splat: counting splats", [&](VulkanContext::Recorder& r) {
         if (p.skipping) {
-            r.Dispatch(*pipes[kBoxes], boxBuffers, &boxWords, sizeof boxWords, boxWords);
+            r.Dispatch(*pipes[kBoxes], boxBuffers, &boxPush, sizeof boxPush, boxPush.words);
             r.Barrier();
         }
         r.Fill(*scratch.totals, 0);
@@ -195,21 +194,14 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
                                           common[3],            common[4],      common[5],
                                           scratch.chunkOffsets, scratch.splats, scratch.splatTiles,
                                           scratch.candidates};
-    struct {
-        uint32_t splatCount, tilesX, tileSize;
-    } pairPush{splatCount, tilesX, kTileSize};
+    SplatPairsPush pairPush{splatCount, tilesX, kTileSize};
     const DeviceBuffer* pairBuffers[] = {scratch.splats, scratch.pairOffsets, scratch.keys[0], scratch.values[0]};
     // One invocation per splat, in rows of kRowGroups workgroups (splat_tiles.glsl LinearInvocation).
     constexpr uint32_t kRowGroups = 32768;
     const uint32_t splatGroups = std::max(1u, CeilDiv(splatCount, 64u));
-    struct {
-        uint32_t pairs, tiles;
-    } rangePush{pairCount, screenTiles};
-    struct {
-        uint32_t width, height, tilesX, tileSize;
-        float background[4];
-        uint32_t ground;
-    } composite{W, H, tilesX, kTileSize, {p.background[0], p.background[1], p.background[2], 0}, p.ground.on ? 1u : 0u};
+    SplatRangesPush rangePush{pairCount, screenTiles};
+    SplatCompositePush composite{
+        W, H, tilesX, kTileSize, {p.background[0], p.background[1], p.background[2], 0}, p.ground.on ? 1u : 0u};
     // The ground's block and G; without the ground, a buffer that exists (a binding needs one), unread.
     const DeviceBuffer* groundBlock = scratch.frame;
     const DeviceBuffer* groundG = scratch.frame;

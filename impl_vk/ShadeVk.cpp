@@ -13,6 +13,7 @@
 
 #include "core/pipeline/ShadePlan.h"
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 namespace {
@@ -83,57 +84,41 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const ShearWarp& g = plan.geometry;
     const SliceAttenuation& a = plan.attenuation;
     const uint32_t stride[3] = {1, n[0], n[0] * n[1]};
-    struct {
-        uint32_t nu, nv, strideU, strideV, sliceBase, prevBase;
-        int32_t u0, v0;
-        float fu, fv;
-        uint32_t first, beer;
-        float depthPerQ, thesisAr, scatterGain;
-        uint32_t storage;
-    } push{n[g.u],
-           n[g.v],
-           stride[g.u],
-           stride[g.v],
-           0,
-           0,
-           g.u0,
-           g.v0,
-           g.fu,
-           g.fv,
-           0,
-           a.kind == AttenuationKind::Beer ? 1u : 0u,
-           a.opticalDepthPerQ,
-           a.thesisAr,
-           a.scatterGain,
-           uint32_t(params.storage)};
-    struct {
-        uint32_t nu, nv, strideU, strideV, strideW, nw, sunAbove, begin, end;
-        int32_t u0, v0;
-        float fu, fv;
-        uint32_t beer;
-        float depthPerQ, thesisAr, scatterGain;
-        uint32_t storage;
-    } block{n[g.u],
-            n[g.v],
-            stride[g.u],
-            stride[g.v],
-            stride[g.w],
-            nw,
-            g.sunAbove ? 1u : 0u,
-            0,
-            0,
-            g.u0,
-            g.v0,
-            g.fu,
-            g.fv,
-            push.beer,
-            a.opticalDepthPerQ,
-            a.thesisAr,
-            a.scatterGain,
-            uint32_t(params.storage)};
-    struct {
-        uint32_t nx, ny, nz, cx, cy, cz, f;
-    } resample{e.nx, e.ny, e.nz, n[0], n[1], n[2], uint32_t(f)};
+    ShadeSlicePush push{n[g.u],
+                        n[g.v],
+                        stride[g.u],
+                        stride[g.v],
+                        0,
+                        0,
+                        g.u0,
+                        g.v0,
+                        g.fu,
+                        g.fv,
+                        0,
+                        a.kind == AttenuationKind::Beer ? 1u : 0u,
+                        a.opticalDepthPerQ,
+                        a.thesisAr,
+                        a.scatterGain,
+                        uint32_t(params.storage)};
+    ShadeBlockPush block{n[g.u],
+                         n[g.v],
+                         stride[g.u],
+                         stride[g.v],
+                         stride[g.w],
+                         nw,
+                         g.sunAbove ? 1u : 0u,
+                         0,
+                         0,
+                         g.u0,
+                         g.v0,
+                         g.fu,
+                         g.fv,
+                         push.beer,
+                         a.opticalDepthPerQ,
+                         a.thesisAr,
+                         a.scatterGain,
+                         uint32_t(params.storage)};
+    ShadeResamplePush resample{e.nx, e.ny, e.nz, n[0], n[1], n[2], uint32_t(f)};
     const DeviceBuffer* sliceBuffers[] = {shadeQ, shadeT};
     const DeviceBuffer* downBuffers[] = {&Dev(q), shadeQ};
     const DeviceBuffer* upBuffers[] = {shadeT, &Dev(T)};

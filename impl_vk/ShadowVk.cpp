@@ -1,5 +1,6 @@
 // Stage `shadow` (SPEC 7) on Vulkan: shadow.comp, one invocation per column.
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 
@@ -8,26 +9,18 @@ Status BackendVk::Shadow(const ShadowParams& params, const Buffer& columnSum, Bu
     auto pipeline = mContext->GetPipeline("shadow", 2);
     if (!pipeline) return std::unexpected(pipeline.error());
     const ShadowLookup l = MakeShadowLookup(params.sun, e.nx, e.ny, params.nz, params.sigma, params.voxelSize);
-    struct {
-        uint32_t nx, ny;
-        int32_t bx, by;
-        float fx, fy;
-        uint32_t form;  // ShadowForm
-        float opticalDepthPerD, kappa;
-        uint32_t noSun;
-        float coverage, densityFactor;
-    } push{e.nx,
-           e.ny,
-           l.baseX,
-           l.baseY,
-           l.fx,
-           l.fy,
-           uint32_t(params.form),
-           l.opticalDepthPerD,
-           params.kappa,
-           l.noSun ? 1u : 0u,
-           params.coverage,
-           params.densityFactor};
+    ShadowPush push{e.nx,
+                    e.ny,
+                    l.baseX,
+                    l.baseY,
+                    l.fx,
+                    l.fy,
+                    uint32_t(params.form),
+                    l.opticalDepthPerD,
+                    params.kappa,
+                    l.noSun ? 1u : 0u,
+                    params.coverage,
+                    params.densityFactor};
     const DeviceBuffer* buffers[] = {&Dev(columnSum), &Dev(G)};
     return Record("shadow", [&](VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, e.nx * e.ny);

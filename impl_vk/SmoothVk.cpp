@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
 
@@ -31,12 +32,7 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     if (!sumX) return std::unexpected(sumX.error());
     auto sumXY = Scratch(VkScratch::SmoothSumXY, e.Count() * 4);
     if (!sumXY) return std::unexpected(sumXY.error());
-    struct {
-        uint32_t nx, ny, nz, words;
-        int32_t radius;
-        float invW;
-        uint32_t pass, first, end;  // voxels
-    } push{e.nx, e.ny, e.nz, (e.nx + 31) / 32, radius, 1.0f / float(SmoothNormaliser(radius)), 0, 0, 0};
+    SmoothPush push{e.nx, e.ny, e.nz, (e.nx + 31) / 32, radius, 1.0f / float(SmoothNormaliser(radius)), 0, 0, 0};
     const DeviceBuffer* buffers[] = {&Dev(cld), *sumX, *sumXY, &Dev(q)};
     CB_TRY(Record("smooth", [&](VulkanContext::Recorder& rec) {
         for (push.pass = 0; push.pass < 3; ++push.pass) {

@@ -15,8 +15,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -25,6 +27,7 @@
 #include "core/math/Ground.h"
 #include "core/math/Splat.h"
 #include "core/pipeline/MarchGpu.h"
+#include "impl_vk/PushBlocks.h"
 
 namespace cb::gpu_block_layout {
 namespace {
@@ -199,6 +202,148 @@ TEST(GpuBlockLayout, SwappedMembersAreCaught) {
     ASSERT_EQ(reflected.count("forward"), 1u) << log;
     EXPECT_NE(reflected.at("forward").offset, offsetof(MarchGpu, forward));
     EXPECT_EQ(reflected.at("forward").offset, offsetof(MarchGpu, right));
+}
+
+// ---- The Vulkan push-constant blocks (impl_vk/PushBlocks.h) against the shaders' `Params` ----
+
+constexpr int kGlUint = 0x1405;
+using vk::PushFloat8;  // the member types CB_VK_PUSH_BLOCKS names unqualified
+using vk::PushVec4;
+
+template <typename T>
+constexpr int PushGlType() {
+    if constexpr (std::is_same_v<T, uint32_t>) return kGlUint;
+    if constexpr (std::is_same_v<T, PushFloat8>) return kGlFloat;  // float[8]: reflected as float, size 8
+    return GlTypeOf<T>();
+}
+template <typename T>
+constexpr size_t PushCount() {
+    return std::is_same_v<T, PushFloat8> ? 8 : 1;
+}
+
+struct PushMember {
+    std::string name;
+    size_t offset;
+    int glType;
+    size_t count;  // array elements (1 for a scalar or vector)
+};
+struct PushBlock {
+    size_t bytes;  // sizeof the C++ struct
+    std::vector<PushMember> members;
+};
+
+#define CB_TEST_PUSH_MEMBER(type, name) \
+    PushMember{#name, offsetof(PushStruct, name), PushGlType<type>(), PushCount<type>()},
+#define CB_TEST_PUSH_BLOCK(Name, MEMBERS)                                      \
+    {#Name, [] {                                                               \
+         using PushStruct = vk::Name;                                          \
+         return PushBlock{sizeof(PushStruct), {MEMBERS(CB_TEST_PUSH_MEMBER)}}; \
+     }()},
+#define CB_TEST_PUSH_SHADER(Name, shader) {#Name, shader},
+
+const std::map<std::string, PushBlock>& PushBlocks() {
+    static const std::map<std::string, PushBlock> blocks = {CB_VK_PUSH_BLOCKS(CB_TEST_PUSH_BLOCK)};
+    return blocks;
+}
+// (block, shader file stem) for every shader with a push-constant block.
+const std::vector<std::pair<std::string, std::string>>& PushShaders() {
+    static const std::vector<std::pair<std::string, std::string>> shaders = {CB_VK_PUSH_SHADERS(CB_TEST_PUSH_SHADER)};
+    return shaders;
+}
+
+struct ReflectedPush {
+    std::map<std::string, PushMember> members;
+    size_t bytes = 0;  // the block's size
+    std::string log;
+};
+
+// glslangValidator's reflection of impl_vk/shaders/<stem>.comp's `Params` block, from the file itself.
+ReflectedPush ReflectPush(const std::string& stem) {
+    const std::filesystem::path root(CLOUDBENCH_SOURCE_DIR);
+    const std::string command = std::string(CLOUDBENCH_GLSLANG_VALIDATOR) +
+                                " --target-env vulkan1.2 -l -q --reflect-all-block-variables -I" +
+                                (root / "core" / "math").string() + " -I" + (root / "impl_vk" / "shaders").string() +
+                                " " + (root / "impl_vk" / "shaders" / (stem + ".comp")).string() + " 2>&1";
+    ReflectedPush out;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return out;
+    const std::regex member("^Params\\.([A-Za-z0-9_]+): offset (\\d+), type ([0-9a-f]+), size (\\d+),");
+    const std::regex block("^Params: offset -1, type ffffffff, size (\\d+),");
+    char line[512];
+    while (std::fgets(line, sizeof line, pipe)) {
+        out.log += line;
+        std::cmatch m;
+        if (std::regex_search(line, m, member))
+            out.members[m[1].str()] = {m[1].str(), std::stoul(m[2].str()), int(std::stoul(m[3].str(), nullptr, 16)),
+                                       std::stoul(m[4].str())};
+        else if (std::regex_search(line, m, block))
+            out.bytes = std::stoul(m[1].str());
+    }
+    pclose(pipe);
+    return out;
+}
+
+// Every way `block` (the C++ side) differs from `reflected` (the shader's), one line each; none when they agree.
+std::vector<std::string> PushDifferences(const std::string& name, const PushBlock& block,
+                                         const ReflectedPush& reflected) {
+    std::vector<std::string> out;
+    if (reflected.members.size() != block.members.size())
+        out.push_back(name + ": the shader's Params has " + std::to_string(reflected.members.size()) +
+                      " members, the C++ block " + std::to_string(block.members.size()));
+    for (const PushMember& m : block.members) {
+        const auto it = reflected.members.find(m.name);
+        if (it == reflected.members.end()) {
+            out.push_back(name + "." + m.name + " is not in the shader's Params");
+            continue;
+        }
+        const PushMember& g = it->second;
+        if (g.offset != m.offset)
+            out.push_back(name + "." + m.name + ": offset " + std::to_string(g.offset) + " in GLSL, " +
+                          std::to_string(m.offset) + " in C++");
+        if (g.glType != m.glType || g.count != m.count)
+            out.push_back(name + "." + m.name + ": GL type " + std::to_string(g.glType) + " x " +
+                          std::to_string(g.count) + " in GLSL, " + std::to_string(m.glType) + " x " +
+                          std::to_string(m.count) + " from C++");
+    }
+    if (reflected.bytes != block.bytes)
+        out.push_back(name + ": " + std::to_string(reflected.bytes) + " bytes in GLSL, sizeof " +
+                      std::to_string(block.bytes) + " in C++");
+    return out;
+}
+
+TEST(GpuBlockLayout, EveryVulkanPushBlockMemberAtItsShadersOffset) {
+    if (std::string(CLOUDBENCH_GLSLANG_VALIDATOR).empty()) GTEST_SKIP() << "no glslangValidator in this build";
+    std::set<std::string> pushed;
+    for (const auto& [name, stem] : PushShaders()) {
+        pushed.insert(stem);
+        const ReflectedPush reflected = ReflectPush(stem);
+        ASSERT_FALSE(reflected.members.empty()) << stem << ".comp: no Params block reflected\n" << reflected.log;
+        for (const std::string& difference : PushDifferences(name, PushBlocks().at(name), reflected))
+            ADD_FAILURE() << stem << ".comp: " << difference;
+    }
+    // Every shader that declares a push-constant block is in the list.
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::filesystem::path(CLOUDBENCH_SOURCE_DIR) / "impl_vk" / "shaders")) {
+        if (entry.path().extension() != ".comp") continue;
+        std::ifstream in(entry.path());
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        if (text.find("layout(push_constant)") != std::string::npos) {
+            EXPECT_EQ(pushed.count(entry.path().stem().string()), 1u)
+                << entry.path().filename() << " has a push-constant block that CB_VK_PUSH_SHADERS does not list";
+        }
+    }
+}
+
+// Test that the check can fail: ShadowPush with fx and fy swapped on the C++ side differs in both offsets.
+TEST(GpuBlockLayout, ASwappedPushMemberIsCaught) {
+    if (std::string(CLOUDBENCH_GLSLANG_VALIDATOR).empty()) GTEST_SKIP() << "no glslangValidator in this build";
+    PushBlock shadow = PushBlocks().at("ShadowPush");
+    auto fx = std::find_if(shadow.members.begin(), shadow.members.end(), [](auto& m) { return m.name == "fx"; });
+    auto fy = std::find_if(shadow.members.begin(), shadow.members.end(), [](auto& m) { return m.name == "fy"; });
+    ASSERT_NE(fx, shadow.members.end());
+    ASSERT_NE(fy, shadow.members.end());
+    std::swap(fx->offset, fy->offset);
+    EXPECT_EQ(PushDifferences("ShadowPush", shadow, ReflectPush("shadow")).size(), 2u);
 }
 
 }  // namespace
