@@ -261,7 +261,7 @@ struct ReflectedPush {
 ReflectedPush ReflectPush(const std::string& stem) {
     const std::filesystem::path root(CLOUDBENCH_SOURCE_DIR);
     const std::string command = std::string(CLOUDBENCH_GLSLANG_VALIDATOR) +
-                                " --target-env vulkan1.2 -l -q --reflect-all-block-variables -I" +
+                                " --target-env vulkan1.2 -l -q --reflect-all-block-variables -o /dev/null -I" +
                                 (root / "core" / "math").string() + " -I" + (root / "impl_vk" / "shaders").string() +
                                 " " + (root / "impl_vk" / "shaders" / (stem + ".comp")).string() + " 2>&1";
     ReflectedPush out;
