@@ -23,13 +23,17 @@
 #include "core/math/Camera.h"
 #include "core/math/Splat.h"
 #include "core/pipeline/Ellipsoids.h"
-#include "core/pipeline/MemoryPlan.h"
-#include "core/pipeline/SceneLoad.h"
 #include "core/pipeline/ShadePlan.h"
 #include "core/pipeline/SplatFrame.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/MemoryPlan.h"
+#include "core/plan/SceneLoad.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
-#include "harness/run/StageParams.h"
+#include "core/stages/ca/Ca.h"
+#include "core/stages/density/Density.h"
+#include "core/stages/render_splat/RenderSplat.h"
+#include "core/stages/shade/Shade.h"
+#include "core/stages/shadow/Shadow.h"
 
 namespace {
 

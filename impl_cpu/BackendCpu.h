@@ -10,12 +10,11 @@
 #include "core/math/Noise.h"
 #include "core/math/Splat.h"
 #include "core/pipeline/Backend.h"
-#include "core/pipeline/MemoryPlan.h"
 #include "impl_cpu/BitField.h"
 
 namespace cb::cpu {
 
-// Buffer storage on the CPU, in the host layout (core/pipeline/MemoryPlan.h). U8 volumes
+// Buffer storage on the CPU, in the host layout (HostBufferBytes, core/pipeline/Backend.h). U8 volumes
 // carry kPadding spare zero bytes at the end so that kernels may read a full
 // 64-voxel word past a row's end.
 class BufferCpu final : public Buffer {

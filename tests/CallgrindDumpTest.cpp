@@ -3,8 +3,8 @@
 // Specification"), and the stage brackets' names read back.
 #include <gtest/gtest.h>
 
+#include "core/base/CallgrindRequests.h"
 #include "harness/perf/CallgrindDump.h"
-#include "harness/platform/CallgrindRequests.h"
 
 namespace cb {
 namespace {

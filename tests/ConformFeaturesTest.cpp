@@ -2,7 +2,7 @@
 // bit-exactly, --baseline, --flake-reruns' merge, the exit code and conform.csv.
 #include <gtest/gtest.h>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "harness/conform/Conform.h"
 #include "impl_cpu/BackendCpu.h"
 

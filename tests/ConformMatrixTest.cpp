@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/SceneNames.h"
 #include "harness/conform/Conform.h"
 #include "harness/conform/ConformMatrix.h"

@@ -5,7 +5,7 @@
 
 #include <type_traits>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "harness/conform/Conform.h"
 #include "impl_cpu/BackendCpu.h"
 

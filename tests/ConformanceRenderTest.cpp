@@ -3,7 +3,7 @@
 // backend and size: ConformanceFixture.h, ConformanceTest.cpp).
 #include <gtest/gtest.h>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "tests/ConformanceFixture.h"
 
 namespace cb::conformance {

@@ -143,7 +143,7 @@ std::vector<std::pair<std::string, NoiseSettings>> NoiseVariants(const Extent3& 
     return v;
 }
 
-// Test the noise stage: |dq| <= 1e-5 against the CPU (SPEC 10a, core/pipeline/StageDescriptors.cpp), steps 0 and 5.
+// Test the noise stage: |dq| <= 1e-5 against the CPU (SPEC 10a, core/stages/noise/Noise.cpp), steps 0 and 5.
 TEST_P(Conformance, Noise) {
     if (auto why = SkipReason(Stage::Noise)) GTEST_SKIP() << *why;
     const Extent3 e = Size();

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "SceneTestUtil.h"
-#include "core/pipeline/MemoryPlan.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/MemoryPlan.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"

@@ -20,7 +20,7 @@
 
 #include "core/math/Grid.h"
 #include "core/math/Shading.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "tests/BackendTestUtil.h"
 
 namespace cb {

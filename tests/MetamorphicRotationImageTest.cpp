@@ -16,7 +16,7 @@
 #include "core/math/Camera.h"
 #include "core/math/Random.h"
 #include "core/pipeline/Ellipsoids.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "harness/report/Report.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/MetamorphicRotation.h"

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/math/Noise.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"

@@ -18,9 +18,13 @@
 
 #include "core/math/Camera.h"
 #include "core/pipeline/Ellipsoids.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
-#include "harness/run/StageParams.h"
+#include "core/stages/ca/Ca.h"
+#include "core/stages/density/Density.h"
+#include "core/stages/render_splat/RenderSplat.h"
+#include "core/stages/shade/Shade.h"
+#include "core/stages/shadow/Shadow.h"
 #include "registry/Registry.h"
 #if CLOUDBENCH_HAVE_GL
 #include "impl_gl/BackendGL.h"

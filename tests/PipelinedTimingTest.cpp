@@ -17,7 +17,7 @@
 #include <span>
 #include <utility>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/report/Report.h"
 #include "harness/run/RunTransfer.h"

@@ -21,7 +21,7 @@
 #include "core/math/Camera.h"
 #include "core/math/Random.h"
 #include "core/math/Splat.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"

@@ -17,9 +17,11 @@
 
 #include "core/math/March.h"
 #include "core/math/Shading.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
-#include "harness/run/StageParams.h"
+#include "core/stages/noise/Noise.h"
+#include "core/stages/render_march/RenderMarch.h"
+#include "core/stages/shade/Shade.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/MarchTestUtil.h"

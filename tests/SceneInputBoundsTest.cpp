@@ -14,7 +14,7 @@
 #include "SceneTestUtil.h"
 #include "core/base/ProcessMemory.h"
 #include "core/math/Grid.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 
 namespace cb {

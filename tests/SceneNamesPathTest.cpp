@@ -5,7 +5,7 @@
 #include <string>
 
 #include "SceneTestUtil.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 
 namespace cb {

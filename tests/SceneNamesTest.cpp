@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "core/scene/SceneNames.h"
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 
 namespace cb::test {

@@ -9,7 +9,7 @@
 
 #include "core/math/Noise.h"
 #include "core/pipeline/Ellipsoids.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/report/Report.h"
 #include "harness/run/Simulation.h"

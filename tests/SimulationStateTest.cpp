@@ -19,7 +19,7 @@
 #include <set>
 
 #include "core/base/Npy.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 #include "harness/run/SimulationState.h"

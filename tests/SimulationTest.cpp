@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"

@@ -13,8 +13,8 @@
 #include <sstream>
 
 #include "core/math/Shading.h"
+#include "core/stages/shade/Shade.h"
 #include "harness/accuracy/Accuracy.h"
-#include "harness/run/StageParams.h"
 #include "tests/TestUtil.h"
 
 namespace cb::spec12_test {

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "core/math/Shading.h"
-#include "core/pipeline/SceneLoad.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/SceneLoad.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/SceneNames.h"
 #include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 

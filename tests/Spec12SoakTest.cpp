@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/math/Random.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 #include "tests/BackendTestUtil.h"

@@ -1,9 +1,9 @@
 // The stage list, the descriptors and the scheduler (core/scene/Stage.h,
-// core/pipeline/StageDescriptors.h). Every backend shares them, so a differential test
+// core/plan/StageGraph.h). Every backend shares them, so a differential test
 // cannot see a mistake here: each is checked against hand-worked cases.
 #include <gtest/gtest.h>
 
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb {

@@ -11,11 +11,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "core/pipeline/SceneLoad.h"
 #include "core/pipeline/ShadePlan.h"
+#include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
+#include "core/stages/shade/Shade.h"
 #include "harness/run/Simulation.h"
-#include "harness/run/StageParams.h"
 #include "impl_cpu/BackendCpu.h"
 #include "registry/Registry.h"
 #include "tests/BackendTestUtil.h"

@@ -1,5 +1,5 @@
 // Settings of stage `noise` (SPEC 10a): the scene section `noise`, read by
-// core/scene/SceneNoiseReader.cpp and documented in docs/scenes.md ("noise"). The
+// core/stages/noise/Noise.cpp and documented in docs/scenes.md ("noise"). The
 // formulas that use them are in core/math/Noise.h.
 #pragma once
 

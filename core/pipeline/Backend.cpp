@@ -1,5 +1,7 @@
 #include "core/pipeline/Backend.h"
 
+#include "core/base/ProcessMemory.h"
+
 namespace cb {
 
 size_t CanonicalElementBytes(BufferFormat format) { return format == BufferFormat::F32 ? 4 : 1; }
@@ -66,6 +68,23 @@ Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Exten
     if (G->Format() != BufferFormat::F32 || G->Extent() != Extent3{grid.nx, grid.ny, 1})
         return MakeError(std::string(where) + ": G must be F32 of extent (nx, ny, 1) of the grid");
     return {};
+}
+
+uint64_t HostBufferBytes(BufferFormat format, const Extent3& e) {
+    switch (format) {
+        case BufferFormat::Bits:
+            return SaturatingMul(SaturatingMul(uint64_t(CeilDiv(e.nx, 64)) * e.ny, e.nz), 8);
+        case BufferFormat::U8:
+            return SaturatingAdd(CanonicalBufferBytes(format, e), kHostU8Padding);
+        case BufferFormat::F32:
+            return CanonicalBufferBytes(format, e);
+    }
+    return CanonicalBufferBytes(format, e);
+}
+
+GroundParams MakeGroundParams(const Scene& sc) {
+    const auto& a = sc.render.ground.albedo;
+    return {sc.render.ground.on, {float(a[0]), float(a[1]), float(a[2])}};
 }
 
 }  // namespace cb

@@ -5,7 +5,8 @@
 //
 // Everything the CPU computes once per call (the eye in voxel units, sigma h,
 // the point light in voxel units) is computed here by the same code
-// (core/math/March.h, harness/run/StageParams), so the GPU starts from the CPU's floats.
+// (core/math/March.h, MakeMarchParams in core/stages/render_march/), so the GPU
+// starts from the CPU's floats.
 #pragma once
 
 #include <array>

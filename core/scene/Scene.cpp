@@ -1,5 +1,5 @@
 // The scene's own computations: the sun at a step of the run. Loading is in
-// core/pipeline/SceneLoad.cpp.
+// core/plan/SceneLoad.cpp.
 #include "core/scene/Scene.h"
 
 #include <cstdint>

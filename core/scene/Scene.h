@@ -1,5 +1,5 @@
 // A scene: what to simulate and which stages to run. Loaded from JSON by
-// LoadScene() (core/pipeline/SceneLoad.h), which validates every field before any work is done. The fields,
+// LoadScene() (core/plan/SceneLoad.h), which validates every field before any work is done. The fields,
 // their units and defaults are documented in docs/scenes.md.
 #pragma once
 
@@ -13,8 +13,16 @@
 #include "core/math/Grid.h"
 #include "core/math/NoiseSettings.h"
 #include "core/math/Shading.h"
-#include "core/scene/MarchSettings.h"
 #include "core/scene/Stage.h"
+#include "core/stages/ca/CaTypes.h"
+#include "core/stages/density/DensityTypes.h"
+#include "core/stages/noise/NoiseTypes.h"
+#include "core/stages/region/RegionTypes.h"
+#include "core/stages/render_march/RenderMarchTypes.h"
+#include "core/stages/render_splat/RenderSplatTypes.h"
+#include "core/stages/shade/ShadeTypes.h"
+#include "core/stages/shadow/ShadowTypes.h"
+#include "core/stages/smooth/SmoothTypes.h"
 
 namespace cb {
 
@@ -22,61 +30,6 @@ struct GridSettings {
     Extent3 size{64, 16, 64};
     double voxelSize = 50.0;                // metres per voxel edge (h)
     std::array<double, 3> origin{0, 0, 0};  // world position of voxel corner (0,0,0), metres
-};
-
-// Per-slice integer wind shift for Dobashi advection, in voxels per step.
-struct SliceShift {
-    int32_t sx = 0, sy = 0;
-};
-
-struct CaSettings {
-    uint32_t seed = 1;
-    double hum0 = 0.35;   // initial humidity probability
-    double act0 = 0.001;  // initial activation probability
-    double pExt = 0.1;
-    double pHum = 0.1;
-    double pAct = 0.001;
-    // Empty: no advection. Otherwise exactly nz entries (a one-entry list in
-    // the file is expanded to every slice).
-    std::vector<SliceShift> windShift;
-
-    bool HasWind() const {
-        for (const SliceShift& s : windShift)
-            if (s.sx != 0 || s.sy != 0) return true;
-        return false;
-    }
-};
-
-// Horizontal wind that moves the ellipsoids, in voxels per step: one vector, or
-// a grid of vectors spread over the region bounds and looked up bilinearly.
-struct EllipsoidWind {
-    std::array<double, 2> vector{0, 0};
-    uint32_t gridNx = 0, gridNy = 0;          // 0: use `vector`
-    std::vector<std::array<double, 2>> grid;  // gridNx*gridNy, x fastest
-};
-
-struct EllipsoidSettings {
-    uint64_t seed = 1;
-    uint32_t targetCount = 40;
-    uint32_t densityAdaption = 2;                 // most added or removed per step
-    std::array<double, 3> sizeMean{16, 16, 8};    // semi-axes in voxels
-    std::array<double, 3> sizeVariance{4, 4, 2};  // uniform +- around the mean
-    double lifetimeMean = 400;                    // steps
-    double lifetimeVariance = 100;
-    uint32_t shrinkSteps = 40;
-    double margin = 16;                            // voxels added around the grid (region bounds)
-    std::array<double, 2> heightRange{0.25, 0.5};  // centre height, fraction of nz
-    EllipsoidWind wind;
-    double jitter = 0.05;  // uniform +- per axis per step, voxels
-};
-
-struct SmoothSettings {
-    int radius = 1;  // 0, 1 or 2
-};
-
-struct DensitySettings {
-    uint32_t tile = 32;  // tile edge in columns
-    uint32_t band = 4;   // slices per height band
 };
 
 // One keyframe of a sun path: the sun's angles at a step.
@@ -131,34 +84,6 @@ struct LightingSettings {
 };
 
 // Stage `shade` (SPEC 6).
-// The shaded grid's coarsening f (SPEC 6: shade.resolution), the one list the
-// scene reader and every backend check against.
-inline constexpr int64_t kShadeResolutions[] = {1, 2, 4};
-inline constexpr const char* kShadeResolutionsText = "1, 2 or 4";
-inline bool IsShadeResolution(int64_t f) {
-    for (const int64_t allowed : kShadeResolutions)
-        if (f == allowed) return true;
-    return false;
-}
-struct ShadeSettings {
-    AttenuationKind attenuation = AttenuationKind::Beer;
-    double sigma = 0.02;    // extinction coefficient at q = 1, 1/m (beer, and tau for scattering)
-    double thesisAr = 0.9;  // a_r of the thesis's linear form
-    SampleFilter filter = SampleFilter::Bilinear;
-    int resolution = 1;  // one of kShadeResolutions
-    StorageFormat storage = StorageFormat::Fp32;
-    bool scattering = false;   // multiple forward scattering (Wang, Ji and Zhang, eq. 5-7)
-    double albedo = 0.9;       // alpha_s
-    double solidAngle = 0.05;  // gamma, steradians
-};
-
-// Stage `shadow` (SPEC 7).
-struct ShadowSettings {
-    ShadowForm form = ShadowForm::Beer;  // beer: exp(-sigma h D / s_z); thesis: 1 - clamp(kappa D); wang: eq. 19
-    double kappa = 0.25;                 // thesis form: shadow per unit of D
-    double coverage = 1;                 // wang form: coverage C (Wang, Ji and Zhang, eq. 15, 19)
-    double densityFactor = 1;            // wang form: density factor D_w (Wang, Ji and Zhang, eq. 16, 19)
-};
 
 // What every renderer shares (section `render`): the image, the cameras,
 // when to render and where between two steps.
@@ -190,16 +115,6 @@ struct RenderSettings {
         if (frames <= 1 && slicesPerFrame == 0) return float(alpha);
         return float(double(frame + 1) / double(frames > 0 ? frames : 1));
     }
-};
-
-// Stage `render_splat` (SPEC 8): the splat renderer's own settings. In scene
-// files they sit in the `render` section beside the shared ones (docs/scenes.md).
-struct SplatSettings {
-    double qMin = 0.3;        // a voxel makes a splat iff q_alpha > q_min
-    double splatScale = 1.5;  // splat diameter d = splatScale * voxel size
-    double opacity = 0.6;
-    bool culling = true;   // view-frustum culling of tile-band boxes
-    bool skipping = true;  // empty-space skipping from the density map
 };
 
 struct Scene {

@@ -1,5 +1,5 @@
-// Readers of the lighting and rendering sections (sun, lighting, phase, shade,
-// shadow, render with its cameras).
+// Readers of the lighting and rendering sections every stage shares (sun,
+// lighting, phase, render with its cameras).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -17,10 +17,6 @@ constexpr std::string_view kSunKeyframeKeys[] = {"step", "elevation_deg", "azimu
 constexpr std::string_view kSunSpeedKeys[] = {"elevation_deg", "azimuth_deg"};
 constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
 constexpr std::string_view kPhaseKeys[] = {"function", "g"};
-constexpr std::string_view kShadeKeys[] = {"attenuation", "sigma",   "thesis_ar", "filter",
-                                           "resolution",  "storage", "scattering"};
-constexpr std::string_view kScatteringKeys[] = {"enabled", "albedo", "solid_angle"};
-constexpr std::string_view kShadowKeys[] = {"form", "kappa", "coverage", "density_factor"};
 constexpr std::string_view kRenderKeys[] = {
     "width",    "height",      "q_min",           "splat_scale",      "opacity", "alpha", "culling",
     "skipping", "every_steps", "frames_per_step", "slices_per_frame", "cameras", "ground"};
@@ -270,83 +266,6 @@ void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
                        FormatNumber(kMaxPhasePeak) + " (2^18), got " + FormatNumber(peak) + " (" +
                        std::string(PhaseKindName(phase.kind)) +
                        ", g = " + (gValue ? Describe(*gValue) : FormatNumber(phase.g)) + ")");
-}
-
-void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
-    const Json* section = check.Section(root, "", "shade", kShadeKeys);
-    if (!section) return;
-    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
-    if (const Json* v = find("attenuation")) {
-        if (auto kind = check.Choice(*v, "shade.attenuation", kAttenuationKindNames)) shade.attenuation = *kind;
-    }
-    if (const Json* v = find("sigma")) {
-        if (auto d = check.Number(*v, "shade.sigma", kSingleNonNegative)) shade.sigma = *d;
-    }
-    if (const Json* v = find("thesis_ar")) {
-        if (auto d = check.Number(*v, "shade.thesis_ar", kProbability)) shade.thesisAr = *d;
-    }
-    if (const Json* v = find("filter")) {
-        if (auto filter = check.Choice(*v, "shade.filter", kSampleFilterNames)) shade.filter = *filter;
-    }
-    if (const Json* v = find("resolution")) {
-        if (auto n = check.IntegerChoice(*v, "shade.resolution", kShadeResolutions, kShadeResolutionsText))
-            shade.resolution = int(*n);
-    }
-    if (const Json* v = find("storage")) {
-        if (auto format = check.Choice(*v, "shade.storage", kStorageFormatNames)) shade.storage = *format;
-    }
-    const Json* scattering = check.Section(*section, "shade", "scattering", kScatteringKeys);
-    if (!scattering) return;
-    if (const Json* v = Validator::Find(*scattering, "enabled")) {
-        if (auto b = check.Boolean(*v, "shade.scattering.enabled")) shade.scattering = *b;
-    }
-    if (const Json* v = Validator::Find(*scattering, "albedo")) {
-        if (auto d = check.Number(*v, "shade.scattering.albedo", kProbability)) shade.albedo = *d;
-    }
-    if (const Json* v = Validator::Find(*scattering, "solid_angle")) {
-        const Range solidAngle{.lo = 0, .loOpen = true, .hi = 4 * std::numbers::pi};
-        if (auto d = check.Number(*v, "shade.scattering.solid_angle", solidAngle)) shade.solidAngle = *d;
-    }
-}
-
-void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
-    const Json* section = check.Section(root, "", "shadow", kShadowKeys);
-    if (!section) return;
-    if (const Json* v = Validator::Find(*section, "form")) {
-        if (auto kind = check.Choice(*v, "shadow.form", kShadowFormNames)) shadow.form = *kind;
-    }
-    if (const Json* v = Validator::Find(*section, "kappa")) {
-        if (auto d = check.Number(*v, "shadow.kappa", kSingleNonNegative)) shadow.kappa = *d;
-    }
-    if (const Json* v = Validator::Find(*section, "coverage")) {
-        if (auto d = check.Number(*v, "shadow.coverage", kProbability)) shadow.coverage = *d;
-    }
-    if (const Json* v = Validator::Find(*section, "density_factor")) {
-        if (auto d = check.Number(*v, "shadow.density_factor", kProbability)) shadow.densityFactor = *d;
-    }
-}
-
-// The splat renderer's fields of the `render` section (its keys are checked by ReadRender).
-void ReadSplat(const Json& root, Validator& check, SplatSettings& splat) {
-    const Json* section = Validator::Find(root, "render");
-    if (!section || !section->is_object()) return;
-    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
-    auto field = [](std::string_view key) { return JoinField("render", key); };
-    if (const Json* v = find("q_min")) {
-        if (auto d = check.Number(*v, field("q_min"), kNonNegative)) splat.qMin = *d;
-    }
-    if (const Json* v = find("splat_scale")) {
-        if (auto d = check.Number(*v, field("splat_scale"), kPositive)) splat.splatScale = *d;
-    }
-    if (const Json* v = find("opacity")) {
-        if (auto d = check.Number(*v, field("opacity"), kProbability)) splat.opacity = *d;
-    }
-    if (const Json* v = find("culling")) {
-        if (auto b = check.Boolean(*v, field("culling"))) splat.culling = *b;
-    }
-    if (const Json* v = find("skipping")) {
-        if (auto b = check.Boolean(*v, field("skipping"))) splat.skipping = *b;
-    }
 }
 
 bool ReadRender(const Json& root, Validator& check, RenderSettings& render) {

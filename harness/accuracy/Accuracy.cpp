@@ -5,9 +5,10 @@
 #include <cmath>
 #include <limits>
 
+#include "core/stages/shade/Shade.h"
+#include "core/stages/shadow/Shadow.h"
 #include "harness/platform/Isolation.h"
 #include "harness/run/Simulation.h"
-#include "harness/run/StageParams.h"
 #include "registry/Registry.h"
 
 namespace cb {

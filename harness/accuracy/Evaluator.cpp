@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "core/scene/SceneNames.h"
-#include "harness/run/StageParams.h"
+#include "core/stages/render_march/RenderMarch.h"
 
 namespace cb {
 using nlohmann::json;

@@ -7,8 +7,11 @@
 #include <map>
 
 #include "core/scene/SceneNames.h"
+#include "core/stages/density/Density.h"
+#include "core/stages/render_march/RenderMarch.h"
+#include "core/stages/render_splat/RenderSplat.h"
+#include "core/stages/shade/Shade.h"
 #include "harness/platform/Isolation.h"
-#include "harness/run/StageParams.h"
 
 namespace cb {
 using nlohmann::json;

@@ -6,13 +6,13 @@
 #include <numbers>
 
 #include "core/scene/SceneNames.h"
+#include "core/stages/shade/Shade.h"
 #include "harness/accuracy/AccuracyTransfer.h"
 #include "harness/accuracy/ImageAccuracy.h"
 #include "harness/accuracy/IsolatedMeasurement.h"
 #include "harness/accuracy/Measurement.h"
 #include "harness/report/ReportTransfer.h"
 #include "harness/run/RunTransfer.h"
-#include "harness/run/StageParams.h"
 
 namespace cb {
 namespace {

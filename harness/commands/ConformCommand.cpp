@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <optional>
 
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "harness/commands/SweepOutput.h"
 #include "harness/conform/Conform.h"
 #include "harness/conform/ConformMatrix.h"
@@ -23,7 +23,7 @@ constexpr const char* kHelpIntro = R"(usage: cloudbench conform [SCENE] [options
 
 Runs SCENE on the CPU and, at every step, feeds each other backend's stages
 the CPU's inputs of that step (stage-isolated conformance), and compares their
-outputs by SPEC's rule for the stage (core/pipeline/StageDescriptors.cpp):
+outputs by SPEC's rule for the stage (each stage's descriptor, core/stages/<stage>/):
 )";
 constexpr const char* kHelpOptions = R"(Prints stage x backend with the result, the rule and the worst error with where
 it is, writes DIR/conform.json and DIR/conform.csv, and exits 5 if any check

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/base/CallgrindRequests.h"
 #include "harness/perf/CallgrindCount.h"
-#include "harness/platform/CallgrindRequests.h"
 #include "harness/run/Session.h"
 #include "harness/run/Simulation.h"
 

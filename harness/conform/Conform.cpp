@@ -12,7 +12,7 @@
 #include <map>
 #include <sstream>
 
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "harness/platform/Command.h"
 #include "harness/report/Report.h"
 #include "harness/run/Simulation.h"

@@ -14,8 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/base/CallgrindRequests.h"
 #include "core/base/InputFile.h"
-#include "harness/platform/CallgrindRequests.h"
 
 extern char** environ;
 

@@ -21,7 +21,7 @@ namespace cb {
 std::optional<std::string> WhyCannotCount(const std::string& buildFlags);
 
 // valgrind's options: callgrind counting Ir only, uninstrumented until the
-// first stage call (harness/platform/CallgrindRequests.h), all dumps in one file,
+// first stage call (core/base/CallgrindRequests.h), all dumps in one file,
 // no per-line or per-instruction detail (the counts are per part).
 std::vector<std::string> CallgrindOptions(const std::string& outFile, const std::string& logFile);
 

@@ -1,7 +1,7 @@
 // Reads callgrind's output files (the "callgrind format" of the valgrind
 // manual) for `cloudbench count`: each dump part's trigger and its total
 // instruction count (event Ir), and the stage calls named by the client
-// requests of harness/platform/CallgrindRequests.h.
+// requests of core/base/CallgrindRequests.h.
 #pragma once
 
 #include <cstdint>

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/pipeline/Backend.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 #include "harness/report/ReportModel.h"
 #include "harness/run/Simulation.h"

@@ -11,8 +11,8 @@
 #include <filesystem>
 
 #include "core/base/Npy.h"
-#include "core/pipeline/MemoryPlan.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/MemoryPlan.h"
+#include "core/plan/SceneLoad.h"
 #include "harness/platform/OutputFolder.h"
 #include "harness/platform/PosixIo.h"
 

@@ -5,8 +5,8 @@
 #include <chrono>
 #include <cstdio>
 
-#include "core/pipeline/MemoryPlan.h"
-#include "harness/run/StageParams.h"
+#include "core/plan/MemoryPlan.h"
+#include "core/stages/ca/Ca.h"
 
 namespace cb {
 

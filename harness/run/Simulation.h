@@ -1,5 +1,5 @@
 // Runs a scene's enabled stages on one backend, one step at a time, scheduled
-// by the resources they read and write (core/pipeline/StageDescriptors.h): only the
+// by the resources they read and write (core/plan/StageGraph.h): only the
 // buffers the enabled stages write are allocated (SPEC 14), every producer
 // runs before its readers, and a stage that advances the state (the
 // automaton) runs after every reader of that state.
@@ -41,7 +41,7 @@
 
 #include "core/pipeline/Backend.h"
 #include "core/pipeline/Ellipsoids.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 #include "harness/run/StageCall.h"
 

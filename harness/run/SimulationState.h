@@ -27,7 +27,7 @@
 
 #include "core/base/Error.h"
 #include "core/pipeline/Ellipsoids.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 #include "harness/run/Simulation.h"
 

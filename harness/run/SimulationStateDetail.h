@@ -13,7 +13,7 @@
 
 #include "core/math/Grid.h"
 #include "core/pipeline/Backend.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 
 namespace cb::simulation_state_detail {
 

@@ -6,7 +6,7 @@
 #include <map>
 
 #include "core/math/Random.h"
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 #include "harness/accuracy/Accuracy.h"
 #include "reference/Trilinear.h"
 

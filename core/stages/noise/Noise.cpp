@@ -1,4 +1,5 @@
-// Reader of the `noise` section (stage `noise`, SPEC 10a; docs/scenes.md, "noise").
+#include "core/stages/noise/Noise.h"
+
 #include <string>
 #include <string_view>
 
@@ -205,3 +206,42 @@ void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise) {
 }
 
 }  // namespace cb::scene_io
+
+namespace cb {
+namespace {
+
+// SPEC 10a.
+CompareRule NoiseRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}; }
+
+// Noise reads nothing: static noise is made once, drifting noise every step (SPEC 14).
+bool NoiseAnimated(const Scene& scene) { return scene.noise.Animated(); }
+
+}  // namespace
+
+NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.noise, sc.grid.size}; }
+
+// Made on first use: commands describe stages in their help text during static
+// initialisation. Fields left out take their defaults.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const StageDescriptor& DescribeNoise() {
+    static const StageDescriptor descriptor{
+        .stage = Stage::Noise,
+        .section = "noise",
+        .writes = {Resource::Q},
+        .skipsUnchangedInputs = true,
+        .dependsOnStep = NoiseAnimated,
+        .symbol = "q",
+        .rule = NoiseRule,
+    };
+    return descriptor;
+}
+#pragma GCC diagnostic pop
+
+Status CallNoise(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                 StageCallRecord& record) {
+    const NoiseParams p = MakeNoiseParams(sc, host.step);
+    return TimedStage(Stage::Noise, backend, host, record, [&] { return backend.Noise(p, *io.Current(Resource::Q)); });
+}
+
+}  // namespace cb

@@ -1,7 +1,8 @@
-// Readers of the ray marcher's sections: `march` (SPEC 10) and `lightning`
-// (Wang, Ji and Zhang, eq. 21). Fields, units and defaults: docs/scenes.md.
+#include "core/stages/render_march/RenderMarch.h"
+
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <string_view>
 
 #include "core/base/NamedValues.h"
@@ -142,3 +143,94 @@ void ReadLightning(const Json& root, Validator& check, LightningSettings& lightn
 }
 
 }  // namespace cb::scene_io
+
+namespace cb {
+namespace {
+
+// SPEC 10: 1e-4 per linear channel on 99.9 % of pixels.
+CompareRule MarchImageRule(const Scene&) {
+    return {CompareRule::Kind::Image, 1e-4, 0.001, std::numeric_limits<double>::infinity()};
+}
+
+// The ray marcher interpolates q between the last two steps, like the splat renderer.
+std::vector<Resource> MarchPrevious(const Scene&) { return {Resource::Q}; }
+
+}  // namespace
+
+MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame,
+                            uint32_t frames) {
+    MarchParams p;
+    p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
+    const float h = float(sc.grid.voxelSize);
+    p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
+    MarchSetup& s = p.setup;
+    s.size = {float(sc.grid.size.nx), float(sc.grid.size.ny), float(sc.grid.size.nz)};
+    s.voxelSize = h;
+    s.step = float(sc.march.step);
+    s.adaptive = sc.march.adaptive;
+    s.kappa = float(sc.march.kappa);
+    s.adaptiveStart = float(sc.march.adaptiveStart);
+    s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
+    s.epsilon = float(sc.march.epsilon);
+    s.sun = sc.sun.DirectionAt(step);
+    s.sunRadiance = sc.sun.Radiance();
+    s.ambient = sc.lighting.Ambient();
+    s.background = sc.lighting.Background();
+    s.phase = sc.phase;
+    s.powder = sc.march.powder;
+    s.powderC = float(sc.march.powderC);
+    const LightningSettings& l = sc.lightning;
+    s.point.on = l.OnAt(step);
+    for (int c = 0; c < 3; ++c) {
+        s.point.position[c] = float((l.position[c] - sc.grid.origin[c]) / sc.grid.voxelSize);
+        s.point.radiance[c] = float(l.color[c] * l.intensity);
+    }
+    s.point.minDistance2 = float(l.radius * l.radius);
+    p.alpha = sc.render.FrameAlpha(frame, frames);
+    p.light = sc.march.light;
+    p.lightSteps = sc.march.lightSteps;
+    p.jitter = sc.march.jitter;
+    p.seed = sc.ca.seed;
+    p.frame = step;
+    p.skipping = sc.march.skipping;
+    p.brick = sc.march.brick;
+    p.ground = MakeGroundParams(sc);
+    return p;
+}
+
+// Made on first use: commands describe stages in their help text during static
+// initialisation. Fields left out take their defaults.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const StageDescriptor& DescribeRenderMarch() {
+    static const StageDescriptor descriptor{
+        .stage = Stage::RenderMarch,
+        .section = "render",
+        .reads = {Resource::Q},
+        // march.light "shade" (the default) needs T, render.ground G: checked when the scene is loaded.
+        .optionalReads = {Resource::T, Resource::Shadow},
+        .readsPrevious = MarchPrevious,
+        .writes = {Resource::MarchImage},
+        .outputStepsOnly = true,
+        .renderer = true,
+        .symbol = "image",
+        .rule = MarchImageRule,
+    };
+    return descriptor;
+}
+#pragma GCC diagnostic pop
+
+Status CallRenderMarch(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                       StageCallRecord& record) {
+    return RenderEachCamera(
+        Stage::RenderMarch, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            // T only where shade runs (the light source "shade").
+            MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
+            return timed(
+                [&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march); });
+        });
+}
+
+}  // namespace cb

@@ -1,5 +1,5 @@
 // Loading a scene file: parsed, overridden, every section read and checked,
-// then checked across sections and against memory (core/pipeline/SceneLoad.cpp).
+// then checked across sections and against memory (core/plan/SceneLoad.cpp).
 #pragma once
 
 #include <string>

@@ -1,12 +1,12 @@
 // Loading a scene: the JSON text, the overrides, every section read and
 // checked on its own (core/scene/SceneReaders.h), then, in this one place, the
 // checks that need more than one section or the pipeline: the stage graph's
-// inputs (core/pipeline/StageDescriptors.h), what the renderers and the ground
+// inputs (core/plan/StageGraph.h), what the renderers and the ground
 // need, the optical depths, the lightning's and the sun's range over the run,
 // the voxel count, and the memory the enabled stages need against what this
-// process may use (core/pipeline/MemoryPlan.h). Every check reports into one
+// process may use (core/plan/MemoryPlan.h). Every check reports into one
 // list of "label: field: reason" lines, so a user sees all problems at once.
-#include "core/pipeline/SceneLoad.h"
+#include "core/plan/SceneLoad.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,8 +18,9 @@
 #include "core/base/InputFile.h"
 #include "core/base/JsonDom.h"
 #include "core/base/ProcessMemory.h"
-#include "core/pipeline/MemoryPlan.h"
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/MemoryPlan.h"
+#include "core/plan/SceneSections.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/SceneReaders.h"
 #include "core/scene/SceneValidator.h"
 
@@ -37,7 +38,7 @@ using scene_io::kU32Max;
 using scene_io::Quote;
 using scene_io::Validator;
 
-// Stages depend on resources, not on each other (core/pipeline/StageDescriptors.h): one line per stage and set
+// Stages depend on resources, not on each other (core/plan/StageGraph.h): one line per stage and set
 // of stages that could write what it lacks. Checked only on a clean list, so one typo does not cascade.
 void CheckStageInputs(const StageSet& stages, Validator& check) {
     const std::vector<MissingInput> missing = MissingInputs(stages);

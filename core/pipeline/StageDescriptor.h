@@ -1,13 +1,12 @@
-// One descriptor per stage: what it reads and writes, when it runs, and how two
-// implementations of it are compared. The simulation, `conform`, `dump`, the
-// memory plan and the conformance tests walk these instead of naming stages,
-// so a new stage is a CB_STAGES line, a descriptor and its backends' code.
+// What a stage's descriptor says: what it reads and writes (resources), when
+// it runs, and how two implementations of it are compared (CompareRule). Each
+// stage's module (core/stages/<stage>/) holds its descriptor; the table of all
+// of them, the schedule and the buffer plan are core/plan/StageGraph.h.
 //
 // Data flows through resources, never from stage to stage: "density needs q",
 // whoever writes q (smooth, or a noise producer).
 #pragma once
 
-#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -116,53 +115,9 @@ struct StageDescriptor {
     std::string_view ruleNote;  // how the rule depends on the scene, for the help ("" if it does not)
 };
 
-const StageDescriptor& Describe(Stage stage);
-
-// The enabled stages in the order a step runs them: every producer before
-// the stages that read its outputs, and stages that advance the state after
-// every other stage (they end the step).
-std::vector<Stage> ScheduleStages(const StageSet& enabled);
-
-// The stage among `enabled` that writes `resource`, if any.
-std::optional<Stage> ProducerOf(Resource resource, const StageSet& enabled);
-
-// An enabled stage's input that no enabled stage writes, and the stages that could.
-struct MissingInput {
-    Stage stage;
-    Resource resource;
-    std::vector<Stage> producers;
-};
-std::vector<MissingInput> MissingInputs(const StageSet& enabled);
-
-// The resources a scene's enabled stages write, and which of them are also
-// kept for the previous step (read by an interpolating renderer).
-struct ResourcePlan {
-    std::array<bool, kResourceCount> used{};
-    std::array<bool, kResourceCount> previous{};
-    std::array<bool, kResourceCount> doubleBuffered{};  // written by a stage that advances the state
-    std::array<bool, kResourceCount> pending{};         // time-slicing: the next step's value, computed over frames
-};
-ResourcePlan PlanResources(const Scene& scene);
-
-// Which copy of a resource a buffer holds: this step's, the next step's (a
-// state-advancing writer's output), the previous step's (an interpolating
-// renderer's input), or the next step's value being computed over the frames
-// of this one (time-slicing's third set, render.slices_per_frame > 0).
-enum class BufferRole : uint8_t { Current, Next, Previous, Pending };
-std::string_view BufferRoleName(BufferRole role);  // "current", "next", "previous", "pending"
-
-struct PlannedBuffer {
-    Resource resource;
-    BufferRole role = BufferRole::Current;
-    uint32_t camera = 0;  // per-camera resources: the camera's index; 0 otherwise
-    BufferFormat format = BufferFormat::F32;
-    Extent3 extent;
-    bool operator==(const PlannedBuffer&) const = default;
-};
-
-// Every buffer a simulation of `scene` allocates, in allocation order: per
-// resource its current buffers (one per camera for images), then its next, then its
-// previous, then its pending. Simulation::Allocate allocates exactly these; the memory plan prices them.
-std::vector<PlannedBuffer> PlanBuffers(const Scene& scene);
+// Helpers the stages' descriptors share.
+CompareRule BitExactRule(const Scene& scene);
+// The share count of a stage whose shares are the slices k (time-slicing; SliceRange): nz.
+uint32_t SharesOfSlicesK(const Scene& scene, uint32_t step);
 
 }  // namespace cb

@@ -1,23 +1,11 @@
-#include "core/pipeline/MemoryPlan.h"
+#include "core/plan/MemoryPlan.h"
 
 #include <algorithm>
 
-#include "core/pipeline/StageDescriptors.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 
 namespace cb {
-
-uint64_t HostBufferBytes(BufferFormat format, const Extent3& e) {
-    switch (format) {
-        case BufferFormat::Bits:
-            return SaturatingMul(SaturatingMul(uint64_t(CeilDiv(e.nx, 64)) * e.ny, e.nz), 8);
-        case BufferFormat::U8:
-            return SaturatingAdd(CanonicalBufferBytes(format, e), kHostU8Padding);
-        case BufferFormat::F32:
-            return CanonicalBufferBytes(format, e);
-    }
-    return CanonicalBufferBytes(format, e);
-}
 
 uint64_t HostStagingBytes(const Scene& scene) {
     uint64_t largest = 0;

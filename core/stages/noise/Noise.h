@@ -1,0 +1,27 @@
+// Stage `noise` (SPEC 10a, docs/contract.md): a producer of q formed from noise (Olajos, Santos and
+// Dehling), instead of the automaton and smoothing.
+// Its home: the types (NoiseTypes.h), the reader of its section, its parameters from a scene, its descriptor and its
+// call adapter.
+#pragma once
+
+#include <cstdint>
+
+#include "core/pipeline/StageAdapter.h"
+#include "core/pipeline/StageDescriptor.h"
+#include "core/scene/SectionReader.h"
+#include "core/stages/noise/NoiseTypes.h"
+
+namespace cb {
+
+namespace scene_io {
+void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise);
+}  // namespace scene_io
+
+// Points into scene.noise: the scene must outlive the parameters.
+NoiseParams MakeNoiseParams(const Scene& scene, uint32_t step);
+
+const StageDescriptor& DescribeNoise();
+Status CallNoise(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io,
+                 StageCallRecord& record);
+
+}  // namespace cb

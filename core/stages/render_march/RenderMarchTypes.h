@@ -1,0 +1,101 @@
+// Stage `render_march`'s types (SPEC 10, docs/contract.md): the ray marcher's settings (section `march`), the
+// lightning point light's (Wang, Ji and Zhang, section 6.3; section `lightning`), its parameters,
+// inputs and counters. Fields, units and defaults in docs/scenes.md.
+// The scene (core/scene/Scene.h) and the backend interface (core/pipeline/Backend.h) include
+// this header; the stage's reader, parameters, descriptor and call are beside it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <iterator>
+
+#include "core/base/Counter.h"
+#include "core/math/Camera.h"
+#include "core/math/Ground.h"
+#include "core/math/March.h"
+
+namespace cb {
+
+class Buffer;  // core/pipeline/Backend.h
+
+// Where the light toward the sun at a sample comes from (SPEC 10).
+enum class MarchLightSource : uint8_t {
+    Shade,  // trilinear T of the shade stage at the sample (taps outside read 1)
+    March,  // a secondary march of n_l steps toward the sun (Olajos's light march)
+};
+
+struct MarchSettings {
+    double step = 0.5;  // Delta_0, voxel edges
+    bool adaptive = false;
+    double kappa = 0.05;        // Delta(t) = Delta_0 + kappa max(0, t - t_a)
+    double adaptiveStart = 64;  // t_a, voxel edges from the eye
+    bool jitter = false;        // xi from rand24(seed, step, 3, pixel) instead of 0.5
+    MarchLightSource light = MarchLightSource::Shade;
+    uint32_t lightSteps = 8;  // n_l
+    bool powder = false;
+    double powderC = 2.0;   // powder = 1 - exp(-c tau_light) = 1 - T_light^c
+    double epsilon = 0.01;  // stop when T_view < epsilon
+    bool skipping = true;   // brick skip structure
+    uint32_t brick = 8;     // brick edge in voxels
+    double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
+    bool toneMap = true;    // PNG only; false: clamp(exposure C)
+};
+
+// A point light (Wang, Ji and Zhang, eq. 21) that flashes over a window of steps.
+struct LightningSettings {
+    bool enabled = false;
+    std::array<double, 3> position{0, 0, 0};  // world, metres
+    std::array<double, 3> color{0.8, 0.85, 1.0};
+    double intensity = 1e6;                   // radiance * metres^2
+    double radius = 50;                       // r0, metres: the 1/D^2 law is capped at 1/r0^2
+    uint32_t flashStart = 0, flashSteps = 1;  // on for steps [start, start + steps)
+
+    bool OnAt(uint32_t step) const {
+        return enabled && step >= flashStart && uint64_t(step) < uint64_t(flashStart) + flashSteps;
+    }
+};
+
+// Inputs of the ray marcher (SPEC 10) besides its buffers: the kernel's
+// constants (core/math/March.h, voxel units) and how the backend feeds it.
+struct MarchParams {
+    CameraFrame camera;
+    MarchSetup setup;
+    std::array<float, 3> origin{0, 0, 0};  // world position of voxel corner (0, 0, 0)
+    float alpha = 0.5f;                    // q_alpha = (1 - alpha) q_prev + alpha q_cur
+    MarchLightSource light = MarchLightSource::Shade;
+    uint32_t lightSteps = 8;  // n_l of the light march (sun with `march`, and the point light)
+    bool jitter = false;
+    uint32_t seed = 1, frame = 0;  // xi = rand24(seed, frame, 3, x + W y) / 2^24 with jitter
+    bool skipping = true;
+    uint32_t brick = 8;
+    GroundParams ground;  // the ground plane under the clouds (core/math/Ground.h); on: MarchInputs::G
+};
+
+struct MarchInputs {
+    const Buffer* qPrev = nullptr;  // F32 volume
+    const Buffer* qCur = nullptr;   // F32 volume
+    const Buffer* T = nullptr;      // F32 volume; required with MarchLightSource::Shade, else unread
+    const Buffer* G = nullptr;      // F32 (nx, ny, 1): the ground shadow; read only with params.ground.on
+};
+
+struct MarchStats {
+    uint64_t rays = 0;                     // rays that met the box between the near and far planes
+    uint64_t samples = 0;                  // density samples
+    uint64_t lightSamples = 0;             // light functor calls (samples with q_alpha > 0)
+    uint64_t bricksSkipped = 0;            // empty bricks jumped over, summed over rays
+    uint64_t emptyBricks = 0, bricks = 0;  // of the skip structure (0 without skipping)
+};
+
+// The ray marcher's counters (core/base/Counter.h).
+inline constexpr Counter<MarchStats> kMarchCounters[] = {
+    {"rays", &MarchStats::rays, CounterShown::ReadBack},
+    {"samples", &MarchStats::samples, CounterShown::ResultsAndReport},
+    {"light_samples", &MarchStats::lightSamples, CounterShown::Results},
+    {"bricks_skipped", &MarchStats::bricksSkipped, CounterShown::Results},
+    {"empty_bricks", &MarchStats::emptyBricks, CounterShown::ReadBack},
+    {"bricks", &MarchStats::bricks, CounterShown::ReadBack},
+};
+static_assert(ReportedCounter(kMarchCounters).name == "samples");
+static_assert(sizeof(MarchStats) == std::size(kMarchCounters) * sizeof(uint64_t), "a MarchStats member is unlisted");
+
+}  // namespace cb

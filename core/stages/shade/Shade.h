@@ -1,0 +1,27 @@
+// Stage `shade` (SPEC 6, docs/contract.md): the transmittance T toward the sun by inverse shear-warp
+// (Fizimayer's thesis, chapter 5).
+// Its home: the types (ShadeTypes.h), the reader of its section, its parameters from a scene, its descriptor and its
+// call adapter.
+#pragma once
+
+#include <cstdint>
+
+#include "core/pipeline/StageAdapter.h"
+#include "core/pipeline/StageDescriptor.h"
+#include "core/scene/SectionReader.h"
+#include "core/stages/shade/ShadeTypes.h"
+
+namespace cb {
+
+namespace scene_io {
+void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
+}  // namespace scene_io
+
+// The sun is the scene's at `step` (SunSettings::DirectionAt; step 0 is the fixed sun's).
+ShadeParams MakeShadeParams(const Scene& scene, uint32_t step = 0);
+
+const StageDescriptor& DescribeShade();
+Status CallShade(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io,
+                 StageCallRecord& record);
+
+}  // namespace cb

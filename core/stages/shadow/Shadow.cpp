@@ -1,0 +1,80 @@
+#include "core/stages/shadow/Shadow.h"
+
+#include "core/scene/SceneNames.h"
+#include "core/scene/SceneReaders.h"
+
+namespace cb::scene_io {
+namespace {
+
+constexpr std::string_view kShadowKeys[] = {"form", "kappa", "coverage", "density_factor"};
+
+}  // namespace
+
+void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
+    const Json* section = check.Section(root, "", "shadow", kShadowKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "form")) {
+        if (auto kind = check.Choice(*v, "shadow.form", kShadowFormNames)) shadow.form = *kind;
+    }
+    if (const Json* v = Validator::Find(*section, "kappa")) {
+        if (auto d = check.Number(*v, "shadow.kappa", kSingleNonNegative)) shadow.kappa = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "coverage")) {
+        if (auto d = check.Number(*v, "shadow.coverage", kProbability)) shadow.coverage = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "density_factor")) {
+        if (auto d = check.Number(*v, "shadow.density_factor", kProbability)) shadow.densityFactor = *d;
+    }
+}
+
+}  // namespace cb::scene_io
+
+namespace cb {
+namespace {
+
+CompareRule ShadowRule(const Scene&) { return {CompareRule::Kind::Absolute, 1e-5}; }
+
+}  // namespace
+
+ShadowParams MakeShadowParams(const Scene& sc, uint32_t step) {
+    ShadowParams p;
+    p.sun = sc.sun.DirectionAt(step);
+    p.form = sc.shadow.form;
+    p.sigma = float(sc.shade.sigma);
+    p.voxelSize = float(sc.grid.voxelSize);
+    p.kappa = float(sc.shadow.kappa);
+    p.coverage = float(sc.shadow.coverage);
+    p.densityFactor = float(sc.shadow.densityFactor);
+    p.nz = sc.grid.size.nz;
+    return p;
+}
+
+// Made on first use: commands describe stages in their help text during static
+// initialisation. Fields left out take their defaults.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const StageDescriptor& DescribeShadow() {
+    static const StageDescriptor descriptor{
+        .stage = Stage::Shadow,
+        .section = "shadow",
+        .reads = {Resource::ColumnSum},
+        .writes = {Resource::Shadow},
+        .outputStepsOnly = true,
+        .skipsUnchangedInputs = true,
+        .readsSun = true,
+        .symbol = "G",
+        .rule = ShadowRule,
+    };
+    return descriptor;
+}
+#pragma GCC diagnostic pop
+
+Status CallShadow(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                  StageCallRecord& record) {
+    const ShadowParams p = MakeShadowParams(sc, host.step);
+    return TimedStage(Stage::Shadow, backend, host, record, [&] {
+        return backend.Shadow(p, *io.Current(Resource::ColumnSum), *io.Current(Resource::Shadow));
+    });
+}
+
+}  // namespace cb

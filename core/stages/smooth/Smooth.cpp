@@ -1,0 +1,49 @@
+#include "core/stages/smooth/Smooth.h"
+
+#include "core/scene/SceneReaders.h"
+
+namespace cb::scene_io {
+namespace {
+
+constexpr std::string_view kSmoothKeys[] = {"radius"};
+
+}  // namespace
+
+void ReadSmooth(const Json& root, Validator& check, SmoothSettings& smooth) {
+    const Json* section = check.Section(root, "", "smooth", kSmoothKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "radius")) {
+        if (auto n = check.Integer(*v, "smooth.radius", 0, 2)) smooth.radius = int(*n);
+    }
+}
+
+}  // namespace cb::scene_io
+
+namespace cb {
+
+// Made on first use: commands describe stages in their help text during static
+// initialisation. Fields left out take their defaults.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const StageDescriptor& DescribeSmooth() {
+    static const StageDescriptor descriptor{
+        .stage = Stage::Smooth,
+        .section = "smooth",
+        .reads = {Resource::Cld},
+        .writes = {Resource::Q},
+        .shareCount = SharesOfSlicesK,
+        .symbol = "q",
+        .rule = BitExactRule,
+    };
+    return descriptor;
+}
+#pragma GCC diagnostic pop
+
+Status CallSmooth(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                  StageCallRecord& record) {
+    return TimedStage(Stage::Smooth, backend, host, record, [&] {
+        return backend.Smooth(sc.smooth.radius, *io.Current(Resource::Cld), *io.Current(Resource::Q), host.slices);
+    });
+}
+
+}  // namespace cb
