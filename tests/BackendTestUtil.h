@@ -19,6 +19,13 @@ namespace cb::test {
 // has. The one list of the tests; a suite names it instead of spelling backends.
 inline std::vector<std::string> TestBackends() { return BuiltBackends(); }
 
+// TestBackends() but the CPU, for the suites that test a GPU backend against the CPU's.
+inline std::vector<std::string> GpuTestBackends() {
+    std::vector<std::string> names = TestBackends();
+    std::erase(names, std::string("cpu"));
+    return names;
+}
+
 // TestBackends(), and gl once more as "gl_rgba8" (the automaton in the
 // thesis's RGBA8 layout), for the suites that run the automaton.
 inline std::vector<std::string> TestBackendsAndCaLayouts() {

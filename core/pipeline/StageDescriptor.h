@@ -7,6 +7,7 @@
 // whoever writes q (smooth, or a noise producer).
 #pragma once
 
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -79,6 +80,26 @@ struct CompareRule {
     std::string ToleranceText() const;
 };
 
+// A setting of a stage's section that takes one of a few values (shade.resolution: 1, 2 or 4): its
+// scene path, its values as a scene file writes them, in the order conform's matrix and accuracy's
+// options walk them, and the scene's value written the same way. The stage's reader reads the setting
+// under `path` against the same values.
+struct ChoiceSetting {
+    std::string_view path;
+    std::vector<std::string> (*values)();
+    std::string (*current)(const Scene& scene);
+};
+
+// The names of a NamedValue table (core/base/NamedValues.h), in its order, as a choice's values.
+template <const auto& kTable>
+std::vector<std::string> TableNames() {
+    std::vector<std::string> names;
+    for (const auto& entry : kTable) names.emplace_back(entry.name);
+    return names;
+}
+inline std::vector<std::string> BooleanValues() { return {"false", "true"}; }
+inline std::string BooleanText(bool value) { return value ? "true" : "false"; }
+
 struct StageDescriptor {
     Stage stage;
     std::string_view section;     // the scene section of its settings ("" for none)
@@ -113,6 +134,7 @@ struct StageDescriptor {
     // The comparison for this scene (shade's tolerance depends on its storage format).
     CompareRule (*rule)(const Scene& scene) = nullptr;
     std::string_view ruleNote;  // how the rule depends on the scene, for the help ("" if it does not)
+    std::span<const ChoiceSetting> choices;  // its settings with a few values each
 };
 
 // Helpers the stages' descriptors share.

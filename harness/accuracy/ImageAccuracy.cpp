@@ -177,7 +177,7 @@ std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& sc) {
     if (!sc.march.adaptive) out.push_back({{"march.adaptive.enabled", "true"}});
     if (sc.march.light == MarchLightSource::Shade) {
         for (int n : {2, 4, 8, 16}) out.push_back({{"march.light", "march"}, {"march.light_steps", std::to_string(n)}});
-        if (sc.shade.resolution != 2) out.push_back({{"shade.resolution", "2"}});
+        if (sc.shade.resolution != 2) out.push_back({{std::string(ShadeResolutionSetting().path), "2"}});
     } else {
         for (uint32_t n : {2u, 4u, 8u, 16u})
             if (n != sc.march.lightSteps) out.push_back({{"march.light_steps", std::to_string(n)}});

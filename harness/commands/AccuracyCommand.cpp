@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "core/plan/StageGraph.h"
 #include "core/scene/SceneNames.h"
 #include "core/stages/shade/Shade.h"
 #include "harness/accuracy/AccuracyTransfer.h"
@@ -58,27 +59,13 @@ Options:
 )";
 const std::string kHelp = kHelpText + IsolationOptionsHelp();
 
-// Values of each shade and shadow option that differ from the scene's.
+// Every value of the stage's choice settings (its descriptor's) that differs from the scene's.
 std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage stage) {
     std::vector<std::vector<SceneOverride>> out;
-    auto add = [&](const char* path, std::initializer_list<const char*> values, const std::string& current) {
-        for (const char* v : values)
-            if (current != v) out.push_back({{path, v}});
-    };
-    // A choice's names come from the scene's own table (core/scene/SceneNames.h), in its order.
-    auto addNames = [&](const char* path, const auto& names, auto current) {
-        for (const auto& [name, value] : names)
-            if (value != current) out.push_back({{path, std::string(name)}});
-    };
-    if (stage == Stage::Shade) {
-        const ShadeSettings& s = scene.shade;
-        addNames("shade.attenuation", kAttenuationKindNames, s.attenuation);
-        addNames("shade.filter", kSampleFilterNames, s.filter);
-        add("shade.resolution", {"1", "2", "4"}, std::to_string(s.resolution));
-        addNames("shade.storage", kStorageFormatNames, s.storage);
-        add("shade.scattering.enabled", {"false", "true"}, s.scattering ? "true" : "false");
-    } else {
-        addNames("shadow.form", kShadowFormNames, scene.shadow.form);
+    for (const ChoiceSetting& choice : Describe(stage).choices) {
+        const std::string current = choice.current(scene);
+        for (std::string& value : choice.values())
+            if (value != current) out.push_back({{std::string(choice.path), std::move(value)}});
     }
     return out;
 }

@@ -3,12 +3,12 @@
 #include <algorithm>
 
 #include "core/math/Shading.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/SceneNames.h"
+#include "core/stages/shade/Shade.h"
 
 namespace cb {
 namespace {
-
-std::string BoolText(bool b) { return b ? "true" : "false"; }
 
 // One candidate case of the built-in set: its overrides, before those equal to the scene's are dropped.
 struct Candidate {
@@ -28,16 +28,10 @@ std::string StagesWithout(const Scene& scene, Stage drop) {
 }  // namespace
 
 std::optional<std::string> ConformSceneValue(const Scene& scene, const std::string& path) {
-    if (path == "smooth.radius") return std::to_string(scene.smooth.radius);
-    if (path == "shade.attenuation") return std::string(AttenuationKindName(scene.shade.attenuation));
-    if (path == "shade.filter") return std::string(SampleFilterName(scene.shade.filter));
-    if (path == "shade.resolution") return std::to_string(scene.shade.resolution);
-    if (path == "shade.storage") return std::string(StorageFormatName(scene.shade.storage));
-    if (path == "shade.scattering.enabled") return BoolText(scene.shade.scattering);
+    for (Stage stage : kAllStages)
+        for (const ChoiceSetting& choice : Describe(stage).choices)
+            if (choice.path == path) return choice.current(scene);
     if (path == "phase.function") return std::string(PhaseKindName(scene.phase.kind));
-    if (path == "shadow.form") return std::string(ShadowFormName(scene.shadow.form));
-    if (path == "render.culling") return BoolText(scene.splat.culling);
-    if (path == "render.skipping") return BoolText(scene.splat.skipping);
     return std::nullopt;
 }
 
@@ -53,30 +47,12 @@ std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sce
     const StageSet& stages = scene.stages;
     const bool shade = stages.Has(Stage::Shade), splat = stages.Has(Stage::RenderSplat);
     std::vector<Candidate> candidates;
-    auto each = [&](bool when, const std::string& path, std::initializer_list<std::string_view> values) {
-        if (!when) return;
-        for (std::string_view v : values) candidates.push_back({{{path, std::string(v)}}, {}, {}});
-    };
-    auto names = [](const auto& table) {
-        std::vector<std::string_view> out;
-        for (const auto& entry : table) out.push_back(entry.name);
-        return out;
-    };
-    auto eachNamed = [&](bool when, const std::string& path, const std::vector<std::string_view>& values) {
-        if (!when) return;
-        for (std::string_view v : values) candidates.push_back({{{path, std::string(v)}}, {}, {}});
-    };
-    each(stages.Has(Stage::Smooth), "smooth.radius", {"0", "1", "2"});
-    eachNamed(shade, "shade.attenuation", names(kAttenuationKindNames));
-    eachNamed(shade, "shade.filter", names(kSampleFilterNames));
-    each(shade, "shade.resolution", {"1", "2", "4"});
-    eachNamed(shade, "shade.storage", names(kStorageFormatNames));
-    each(shade, "shade.scattering.enabled", {"false", "true"});
     // The phase function: with scattering on when the scene shades, so that shade compares it too.
-    if (shade || splat)
+    auto eachPhase = [&] {
+        if (!shade && !splat) return;
         for (const auto& [name, kind] : kPhaseKindNames) {
             Candidate c{{{"phase.function", std::string(name)}}, {}, {}};
-            if (shade) c.overrides.push_back({"shade.scattering.enabled", "true"});
+            if (shade) c.overrides.push_back({std::string(ShadeScatteringSetting().path), "true"});
             if (kind == PhaseKind::Mie) {
                 // render_splat on gl and vk refuses a Mie scene (docs/scenes.md, issue 14): compared without it,
                 // and only where shade (P(0) of the table) still sees it.
@@ -85,9 +61,15 @@ std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sce
             }
             candidates.push_back(std::move(c));
         }
-    eachNamed(stages.Has(Stage::Shadow), "shadow.form", names(kShadowFormNames));
-    each(splat, "render.culling", {"true", "false"});
-    each(splat, "render.skipping", {"true", "false"});
+    };
+    // Every value of each enabled stage's choice settings (its descriptor's), the phase function after shade's.
+    for (Stage stage : kAllStages) {
+        if (stages.Has(stage))
+            for (const ChoiceSetting& choice : Describe(stage).choices)
+                for (std::string& value : choice.values())
+                    candidates.push_back({{{std::string(choice.path), std::move(value)}}, {}, {}});
+        if (stage == Stage::Shade) eachPhase();
+    }
     // The sun on each principal axis other than the scene's (a fixed sun; shade marches along that axis).
     if (shade && !scene.sun.Moves()) {
         const int axis = PrincipalAxis(scene.sun.Direction());

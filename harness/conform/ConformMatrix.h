@@ -31,12 +31,12 @@ std::string ConformCaseName(const std::vector<SceneOverride>& overrides, std::op
 
 // The built-in option set (--matrix): the case "scene", then, one option at a
 // time from the scene's own settings, every value of every option below that
-// the scene does not already use, for the stages the scene runs:
-//   smooth.radius 0 1 2; shade.attenuation; shade.filter; shade.resolution 1 2 4;
-//   shade.storage; shade.scattering.enabled; phase.function (with scattering on
+// the scene does not already use, for the stages the scene runs: each stage's
+// choice settings in CB_STAGES order (its descriptor's `choices`: smooth.radius;
+// shade.attenuation, filter, resolution, storage, scattering.enabled; shadow.form;
+// render.culling, render.skipping), with, after shade's, phase.function (with scattering on
 //   when the scene shades, so that shade and render_splat both see it; "mie"
-//   without render_splat, which gl and vk refuse for it); shadow.form;
-//   render.culling; render.skipping; the sun on each principal axis (a fixed
+//   without render_splat, which gl and vk refuse for it); the sun on each principal axis (a fixed
 //   sun only); ca.wind_shift (on when the scene has none, off otherwise); and,
 //   when `glCompared`, gl's other automaton layout (a case for gl only).
 // A case whose overrides all equal the scene's values is dropped (the case

@@ -2,6 +2,18 @@
 
 #include "core/scene/SceneReaders.h"
 
+namespace cb {
+namespace {
+
+constexpr ChoiceSetting kSplatCulling{"render.culling", BooleanValues,
+                                      [](const Scene& s) { return BooleanText(s.splat.culling); }};
+constexpr ChoiceSetting kSplatSkipping{"render.skipping", BooleanValues,
+                                       [](const Scene& s) { return BooleanText(s.splat.skipping); }};
+constexpr ChoiceSetting kSplatChoices[] = {kSplatCulling, kSplatSkipping};
+
+}  // namespace
+}  // namespace cb
+
 namespace cb::scene_io {
 
 // The splat renderer's fields of the `render` section (its keys are checked by ReadRender).
@@ -20,10 +32,10 @@ void ReadSplat(const Json& root, Validator& check, SplatSettings& splat) {
         if (auto d = check.Number(*v, field("opacity"), kProbability)) splat.opacity = *d;
     }
     if (const Json* v = find("culling")) {
-        if (auto b = check.Boolean(*v, field("culling"))) splat.culling = *b;
+        if (auto b = check.Boolean(*v, kSplatCulling.path)) splat.culling = *b;
     }
     if (const Json* v = find("skipping")) {
-        if (auto b = check.Boolean(*v, field("skipping"))) splat.skipping = *b;
+        if (auto b = check.Boolean(*v, kSplatSkipping.path)) splat.skipping = *b;
     }
 }
 
@@ -83,6 +95,7 @@ const StageDescriptor& DescribeRenderSplat() {
         .renderer = true,
         .symbol = "image",
         .rule = SplatImageRule,
+        .choices = kSplatChoices,
     };
     return descriptor;
 }

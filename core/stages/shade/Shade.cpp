@@ -6,6 +6,33 @@
 #include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
 
+namespace cb {
+namespace {
+
+std::vector<std::string> ShadeResolutionValues() {
+    std::vector<std::string> values;
+    for (const int64_t f : kShadeResolutions) values.push_back(std::to_string(f));
+    return values;
+}
+
+// shade's settings with a few values each, in the order conform's matrix and accuracy walk them.
+constexpr ChoiceSetting kShadeAttenuation{"shade.attenuation", TableNames<kAttenuationKindNames>, [](const Scene& s) {
+                                              return std::string(AttenuationKindName(s.shade.attenuation));
+                                          }};
+constexpr ChoiceSetting kShadeFilter{"shade.filter", TableNames<kSampleFilterNames>,
+                                     [](const Scene& s) { return std::string(SampleFilterName(s.shade.filter)); }};
+constexpr ChoiceSetting kShadeResolution{"shade.resolution", ShadeResolutionValues,
+                                         [](const Scene& s) { return std::to_string(s.shade.resolution); }};
+constexpr ChoiceSetting kShadeStorage{"shade.storage", TableNames<kStorageFormatNames>,
+                                      [](const Scene& s) { return std::string(StorageFormatName(s.shade.storage)); }};
+constexpr ChoiceSetting kShadeScattering{"shade.scattering.enabled", BooleanValues,
+                                         [](const Scene& s) { return BooleanText(s.shade.scattering); }};
+constexpr ChoiceSetting kShadeChoices[] = {kShadeAttenuation, kShadeFilter, kShadeResolution, kShadeStorage,
+                                           kShadeScattering};
+
+}  // namespace
+}  // namespace cb
+
 namespace cb::scene_io {
 namespace {
 
@@ -20,7 +47,7 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
     if (!section) return;
     auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
     if (const Json* v = find("attenuation")) {
-        if (auto kind = check.Choice(*v, "shade.attenuation", kAttenuationKindNames)) shade.attenuation = *kind;
+        if (auto kind = check.Choice(*v, kShadeAttenuation.path, kAttenuationKindNames)) shade.attenuation = *kind;
     }
     if (const Json* v = find("sigma")) {
         if (auto d = check.Number(*v, "shade.sigma", kSingleNonNegative)) shade.sigma = *d;
@@ -29,19 +56,19 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
         if (auto d = check.Number(*v, "shade.thesis_ar", kProbability)) shade.thesisAr = *d;
     }
     if (const Json* v = find("filter")) {
-        if (auto filter = check.Choice(*v, "shade.filter", kSampleFilterNames)) shade.filter = *filter;
+        if (auto filter = check.Choice(*v, kShadeFilter.path, kSampleFilterNames)) shade.filter = *filter;
     }
     if (const Json* v = find("resolution")) {
-        if (auto n = check.IntegerChoice(*v, "shade.resolution", kShadeResolutions, kShadeResolutionsText))
+        if (auto n = check.IntegerChoice(*v, kShadeResolution.path, kShadeResolutions, kShadeResolutionsText))
             shade.resolution = int(*n);
     }
     if (const Json* v = find("storage")) {
-        if (auto format = check.Choice(*v, "shade.storage", kStorageFormatNames)) shade.storage = *format;
+        if (auto format = check.Choice(*v, kShadeStorage.path, kStorageFormatNames)) shade.storage = *format;
     }
     const Json* scattering = check.Section(*section, "shade", "scattering", kScatteringKeys);
     if (!scattering) return;
     if (const Json* v = Validator::Find(*scattering, "enabled")) {
-        if (auto b = check.Boolean(*v, "shade.scattering.enabled")) shade.scattering = *b;
+        if (auto b = check.Boolean(*v, kShadeScattering.path)) shade.scattering = *b;
     }
     if (const Json* v = Validator::Find(*scattering, "albedo")) {
         if (auto d = check.Number(*v, "shade.scattering.albedo", kProbability)) shade.albedo = *d;
@@ -75,6 +102,9 @@ uint32_t SweepSlices(const Scene& scene, uint32_t step) {
 }
 
 }  // namespace
+
+const ChoiceSetting& ShadeResolutionSetting() { return kShadeResolution; }
+const ChoiceSetting& ShadeScatteringSetting() { return kShadeScattering; }
 
 ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
     ShadeParams p;
@@ -110,6 +140,7 @@ const StageDescriptor& DescribeShade() {
         .symbol = "T",
         .rule = ShadeRule,
         .ruleNote = "one storage quantum with fp16 or unorm8 storage",
+        .choices = kShadeChoices,
     };
     return descriptor;
 }

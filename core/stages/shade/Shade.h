@@ -20,6 +20,10 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
 // The sun is the scene's at `step` (SunSettings::DirectionAt; step 0 is the fixed sun's).
 ShadeParams MakeShadeParams(const Scene& scene, uint32_t step = 0);
 
+// Two of its choice settings (its descriptor's `choices`), for the commands that set them.
+const ChoiceSetting& ShadeResolutionSetting();
+const ChoiceSetting& ShadeScatteringSetting();
+
 const StageDescriptor& DescribeShade();
 Status CallShade(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io,
                  StageCallRecord& record);

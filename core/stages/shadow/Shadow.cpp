@@ -3,6 +3,16 @@
 #include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
 
+namespace cb {
+namespace {
+
+constexpr ChoiceSetting kShadowForm{"shadow.form", TableNames<kShadowFormNames>,
+                                    [](const Scene& s) { return std::string(ShadowFormName(s.shadow.form)); }};
+constexpr ChoiceSetting kShadowChoices[] = {kShadowForm};
+
+}  // namespace
+}  // namespace cb
+
 namespace cb::scene_io {
 namespace {
 
@@ -14,7 +24,7 @@ void ReadShadow(const Json& root, Validator& check, ShadowSettings& shadow) {
     const Json* section = check.Section(root, "", "shadow", kShadowKeys);
     if (!section) return;
     if (const Json* v = Validator::Find(*section, "form")) {
-        if (auto kind = check.Choice(*v, "shadow.form", kShadowFormNames)) shadow.form = *kind;
+        if (auto kind = check.Choice(*v, kShadowForm.path, kShadowFormNames)) shadow.form = *kind;
     }
     if (const Json* v = Validator::Find(*section, "kappa")) {
         if (auto d = check.Number(*v, "shadow.kappa", kSingleNonNegative)) shadow.kappa = *d;
@@ -64,6 +74,7 @@ const StageDescriptor& DescribeShadow() {
         .readsSun = true,
         .symbol = "G",
         .rule = ShadowRule,
+        .choices = kShadowChoices,
     };
     return descriptor;
 }

@@ -2,6 +2,21 @@
 
 #include "core/scene/SceneReaders.h"
 
+namespace cb {
+namespace {
+
+std::vector<std::string> SmoothRadiusValues() {
+    std::vector<std::string> values;
+    for (int r = 0; r <= kMaxSmoothRadius; ++r) values.push_back(std::to_string(r));
+    return values;
+}
+constexpr ChoiceSetting kSmoothRadius{"smooth.radius", SmoothRadiusValues,
+                                      [](const Scene& s) { return std::to_string(s.smooth.radius); }};
+constexpr ChoiceSetting kSmoothChoices[] = {kSmoothRadius};
+
+}  // namespace
+}  // namespace cb
+
 namespace cb::scene_io {
 namespace {
 
@@ -13,7 +28,7 @@ void ReadSmooth(const Json& root, Validator& check, SmoothSettings& smooth) {
     const Json* section = check.Section(root, "", "smooth", kSmoothKeys);
     if (!section) return;
     if (const Json* v = Validator::Find(*section, "radius")) {
-        if (auto n = check.Integer(*v, "smooth.radius", 0, 2)) smooth.radius = int(*n);
+        if (auto n = check.Integer(*v, kSmoothRadius.path, 0, kMaxSmoothRadius)) smooth.radius = int(*n);
     }
 }
 
@@ -34,6 +49,7 @@ const StageDescriptor& DescribeSmooth() {
         .shareCount = SharesOfSlicesK,
         .symbol = "q",
         .rule = BitExactRule,
+        .choices = kSmoothChoices,
     };
     return descriptor;
 }

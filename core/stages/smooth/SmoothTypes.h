@@ -5,8 +5,10 @@
 
 namespace cb {
 
+inline constexpr int kMaxSmoothRadius = 2;
+
 struct SmoothSettings {
-    int radius = 1;  // 0, 1 or 2
+    int radius = 1;  // 0 .. kMaxSmoothRadius
 };
 
 }  // namespace cb
