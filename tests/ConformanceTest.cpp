@@ -6,6 +6,7 @@
 // splat renderer and the whole pipeline, and shares this instantiation.
 #include <gtest/gtest.h>
 
+#include "core/plan/StageGraph.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/ConformanceFixture.h"
 
@@ -164,8 +165,8 @@ TEST_P(Conformance, Noise) {
                 const float d = std::fabs(a[n] - b[n]);
                 if (!(d <= worstError)) worstError = d, worst = n;
             }
-            EXPECT_LE(worstError, 1e-5f) << "at " << Where(e, worst) << ": cpu " << a[worst] << ", " << mBackend->Name()
-                                         << " " << b[worst];
+            EXPECT_LE(worstError, Describe(Stage::Noise).rule(Scene{}).tolerance)
+                << "at " << Where(e, worst) << ": cpu " << a[worst] << ", " << mBackend->Name() << " " << b[worst];
             if (e.nx > 1) {
                 EXPECT_GT(sum, 0.0f) << "the variant forms no cloud: a weak test";
             }

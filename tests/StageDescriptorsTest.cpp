@@ -135,6 +135,7 @@ TEST(StageRules, SpecRulesAndTexts) {
     EXPECT_EQ(text(Stage::Shadow), "|dG| <= 1e-05");
     EXPECT_EQ(text(Stage::RenderSplat), "2/255 on 99.9 %, 8/255 max");
     EXPECT_EQ(text(Stage::RenderMarch), "0.0001 on 99.9 %");
+    EXPECT_EQ(text(Stage::Noise), "|dq| <= 1e-05");
     scene.shade.storage = StorageFormat::Unorm8;  // one storage quantum, on the stored codes (SPEC 6)
     const CompareRule codes = Describe(Stage::Shade).rule(scene);
     EXPECT_EQ(codes.kind, CompareRule::Kind::Codes);
