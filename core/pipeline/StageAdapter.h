@@ -88,8 +88,8 @@ using StageAdapter = Status (*)(Backend& backend, const Scene& scene, const Stag
 // interval, owned by `frame` (an index in record.frames, or the stage), and
 // takes no device time: LastDeviceMs() means nothing in a batch.
 template <typename Fn>
-inline Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& label, bool markBatch,
-                    std::optional<size_t> frame, Fn&& call) {
+Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& label, bool markBatch,
+             std::optional<size_t> frame, Fn&& call) {
     const CallgrindStageBracket counted(label);
     if (markBatch) {
         backend.MarkBatch();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include "core/pipeline/StageAdapter.h"
 #include "core/pipeline/StageDescriptor.h"
