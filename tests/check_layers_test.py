@@ -46,6 +46,16 @@ results = [
     expect("a header and its .cpp are one module", {**clean, "core/math/Grid.h": "#pragma once\n"}, 0, "0 breaks"),
     expect("a file over 600 lines", {**clean, "core/math/Long.cpp": "//\n" * 601}, 1,
            "core/math/Long.cpp: 601 lines, more than 600"),
+    expect("a stage's types header stands below the scene, its module above the pipeline",
+           {**clean, "core/stages/shade/ShadeTypes.h": '#include "core/math/Grid.h"\n',
+            "core/scene/Scene.h": '#include "core/stages/shade/ShadeTypes.h"\n',
+            "core/pipeline/Backend.h": '#include "core/scene/Scene.h"\n',
+            "core/stages/shade/Shade.h": '#include "core/pipeline/Backend.h"\n'}, 0, "0 breaks"),
+    expect("a stage's types header includes its module",
+           {**clean, "core/stages/shade/ShadeTypes.h": '#include "core/stages/shade/Shade.h"\n',
+            "core/stages/shade/Shade.h": "#pragma once\n"}, 1,
+           "core/stages/shade/ShadeTypes.h: includes core/stages/shade/Shade.h, "
+           "but core/stages/*/types may not include core/stages/*"),
     expect("a wing not in the table", {**clean, "core/extra/New.h": "#pragma once\n"}, 1,
            "core/extra/New.h: the wing core/extra is not in tools/check_layers.py's WINGS"),
 ]

@@ -18,6 +18,9 @@ namespace {
 
 // Each stage's module names its descriptor Describe<Stage> and its adapter
 // Call<Stage>; these tables expand CB_STAGES, so a stage without them does not compile.
+// Describe<Stage> returns a function-local static, made on first use: commands
+// describe stages in their help text during static initialisation. The fields
+// it leaves out take their defaults (each module silences GCC's warning about that).
 using DescribeFn = const StageDescriptor& (*)();
 constexpr DescribeFn kDescriptors[] = {
 #define CB_STAGE_DESCRIBE(name, text, spec, splat) &Describe##name,

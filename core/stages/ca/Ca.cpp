@@ -65,8 +65,6 @@ CaStepParams MakeCaStepParams(const Scene& sc, uint32_t step) {
     return p;
 }
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeCa() {

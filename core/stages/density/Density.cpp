@@ -51,8 +51,6 @@ DensityParams MakeDensityParams(const Scene& sc) {
     return p;
 }
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeDensity() {

@@ -220,8 +220,6 @@ bool NoiseAnimated(const Scene& scene) { return scene.noise.Animated(); }
 
 NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.noise, sc.grid.size}; }
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeNoise() {

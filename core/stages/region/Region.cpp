@@ -147,8 +147,6 @@ CompareRule RegionRule(const Scene&) { return {CompareRule::Kind::Quantised, 1, 
 
 }  // namespace
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRegion() {

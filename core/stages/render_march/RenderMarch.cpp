@@ -198,8 +198,6 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderMarch() {

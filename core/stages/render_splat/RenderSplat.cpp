@@ -79,8 +79,6 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderSplat() {

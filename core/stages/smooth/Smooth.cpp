@@ -36,8 +36,6 @@ void ReadSmooth(const Json& root, Validator& check, SmoothSettings& smooth) {
 
 namespace cb {
 
-// Made on first use: commands describe stages in their help text during static
-// initialisation. Fields left out take their defaults.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeSmooth() {
