@@ -7,10 +7,15 @@
 #include <memory>
 #include <vector>
 
-#include "core/math/Noise.h"
-#include "core/math/Splat.h"
 #include "core/pipeline/Backend.h"
+#include "core/pipeline/StageObjects.h"
 #include "impl_cpu/BitField.h"
+#include "impl_cpu/CaCpuState.h"
+#include "impl_cpu/NoiseCpuState.h"
+#include "impl_cpu/RenderMarchCpuState.h"
+#include "impl_cpu/RenderSplatCpuState.h"
+#include "impl_cpu/ShadeCpuState.h"
+#include "impl_cpu/SmoothCpuState.h"
 
 namespace cb::cpu {
 
@@ -36,25 +41,6 @@ class BufferCpu final : public Buffer {
     std::vector<float> mF32;
 };
 
-// One voxel of the ray marcher's formed volume: q_alpha and T side by side,
-// so a trilinear sample of both touches one set of cache lines.
-struct MarchQT {
-    float q, t;
-};
-
-// What smooth keeps between the shares of one sweep (SmoothCpu.cpp): the ring
-// of slices filtered in x and y, valid for a share that starts at `next` on the
-// same cld field and radius.
-struct SmoothShareState {
-    const BitField* cld = nullptr;  // not owned; nullptr: nothing to resume
-    int radius = 0;
-    Extent3 extent;
-    uint32_t next = 0;      // the first output slice of the share that may resume
-    uint32_t filtered = 0;  // slices below this one have been filtered into the ring
-    std::vector<uint8_t> ring;  // 2 radius + 1 slices of numerators (1 or 2 bytes each)
-    std::vector<uint8_t> xs;    // one slice of x sums
-};
-
 // Not final: tests derive test-only stages from it (a producer of q other than smooth).
 class BackendCpu : public Backend {
   public:
@@ -63,7 +49,7 @@ class BackendCpu : public Backend {
 
     std::string Name() const override { return "cpu"; }
     std::string Device() const override;
-    bool Supports(Stage stage) const override;
+    bool Supports(Stage stage) const override { return StagesCpu::Implements(stage); }
 
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
@@ -71,10 +57,8 @@ class BackendCpu : public Backend {
 
     // The host layout (HostBufferBytes).
     uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
-    // The automaton's advection fields with wind, each thread's smoothing ring,
-    // shade's coarse grids; per-call rows and the renderer's
-    // splat lists (which depend on the clouds) are not counted.
-    uint64_t ScratchBytes(const Scene& scene) const override;
+    // The sum of the stage objects' (each says what it counts in its <Stage>CpuState.h).
+    uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
     // What this process may still allocate: available memory, cgroup and RLIMIT_AS (core/base/ProcessMemory.h).
     std::optional<uint64_t> AvailableBytes() const override;
 
@@ -85,19 +69,14 @@ class BackendCpu : public Backend {
     int Threads() const { return mArena.max_concurrency(); }
 
   private:
+    // The stage objects (core/pipeline/StageObjects.h): what each stage keeps
+    // between calls so that steady-state steps do not allocate, in its <Stage>CpuState.h.
+    using StagesCpu =
+        StageObjects<NothingKept<Stage::Region>, CaCpuState, SmoothCpuState, NothingKept<Stage::Density>, ShadeCpuState,
+                     NothingKept<Stage::Shadow>, RenderSplatCpuState, NoiseCpuState, RenderMarchCpuState>;
+
     tbb::task_arena mArena;
-    // Scratch kept between calls so that steady-state steps do not allocate.
-    std::vector<BitField> mAdvectScratch;
-    SmoothShareState mSmoothShare;                    // smooth in shares (time-slicing)
-    std::vector<float> mShadeCoarseQ, mShadeCoarseT;  // shade at resolution f > 1
-    std::vector<MarchQT> mMarchVolume;                // render_march: padded (q_alpha, T)
-    std::vector<uint8_t> mMarchBricks;                // render_march: empty bricks
-    std::vector<std::vector<Splat>> mSplatSlices;     // render_splat: each outer slice's splats
-    // Noise: what does not change per step (permutations, the detail volume),
-    // made on the first call and again only when the settings or grid change;
-    // and the weather map of one call (coverage only).
-    std::unique_ptr<noise::NoiseForm> mNoiseForm;
-    std::vector<float> mNoiseMap;
+    StagesCpu mStages;
 };
 
 }  // namespace cb::cpu

@@ -5,6 +5,7 @@
 
 #include "core/math/Automaton.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/CaCpuState.h"
 #include "impl_cpu/CaKernels.h"
 
 namespace cb::cpu {
@@ -43,6 +44,11 @@ void AdvectField(const BitField& src, BitField& dst, std::span<const int32_t> sh
 }
 
 }  // namespace
+
+uint64_t CaCpuState::ScratchBytes(const Scene& scene) const {
+    if (!scene.ca.HasWind()) return 0;
+    return SaturatingMul(HostBufferBytes(BufferFormat::Bits, scene.grid.size), 3);
+}
 
 Status BackendCpu::CaInitialize(const CaInitParams& params, CaFields out) {
     auto& hum = static_cast<BufferCpu&>(*out.hum).Bits();
@@ -96,8 +102,9 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
     BitField* dst[3] = {&static_cast<BufferCpu&>(*out.hum).Bits(), &static_cast<BufferCpu&>(*out.act).Bits(),
                         &static_cast<BufferCpu&>(*out.cld).Bits()};
     if (wind) {
-        if (mAdvectScratch.size() != 3 || !(mAdvectScratch[0].Extent() == e)) mAdvectScratch.assign(3, BitField(e));
-        for (int f = 0; f < 3; ++f) dst[f] = &mAdvectScratch[f];
+        std::vector<BitField>& advect = mStages.Get<CaCpuState>().advect;
+        if (advect.size() != 3 || !(advect[0].Extent() == e)) advect.assign(3, BitField(e));
+        for (int f = 0; f < 3; ++f) dst[f] = &advect[f];
     }
 
     const CaEvents events = MakeCaEvents(params.seed, params.step, params.qExt, params.qHum, params.qAct);

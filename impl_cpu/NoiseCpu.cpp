@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/NoiseCpuState.h"
 
 namespace cb::cpu {
 namespace {
@@ -64,13 +65,22 @@ void PerlinFbmRow(const noise::NoiseForm& form, const noise::StepOffsets& offset
 
 }  // namespace
 
+uint64_t NoiseCpuState::ScratchBytes(const Scene& scene) const {
+    const NoiseSettings& n = scene.noise;
+    uint64_t bytes = 0;
+    if (n.detail.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(n.detail.size) * n.detail.size * n.detail.size);
+    if (n.coverage.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(scene.grid.size.nx) * scene.grid.size.ny);
+    return bytes;
+}
+
 Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
     if (!params.settings) return MakeError("cpu: noise without settings");
     if (q.Format() != BufferFormat::F32 || !(q.Extent() == params.grid))
         return MakeError("cpu: noise: q must be an F32 volume of the grid's size");
-    if (!mNoiseForm || !(mNoiseForm->Settings() == *params.settings) || !(mNoiseForm->Grid() == params.grid))
-        mNoiseForm = std::make_unique<noise::NoiseForm>(*params.settings, params.grid);
-    const noise::NoiseForm& form = *mNoiseForm;
+    NoiseCpuState& state = mStages.Get<NoiseCpuState>();
+    if (!state.form || !(state.form->Settings() == *params.settings) || !(state.form->Grid() == params.grid))
+        state.form = std::make_unique<noise::NoiseForm>(*params.settings, params.grid);
+    const noise::NoiseForm& form = *state.form;
     const noise::StepOffsets offsets = form.Offsets(params.step);
     const Extent3 e = params.grid;
     const bool coverage = params.settings->coverage.enabled;
@@ -78,10 +88,10 @@ Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
 
     mArena.execute([&] {
         if (coverage) {
-            mNoiseMap.resize(size_t(e.nx) * e.ny);
+            state.map.resize(size_t(e.nx) * e.ny);
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny), [&](const tbb::blocked_range<uint32_t>& rows) {
                 for (uint32_t j = rows.begin(); j != rows.end(); ++j)
-                    for (uint32_t i = 0; i < e.nx; ++i) mNoiseMap[i + size_t(e.nx) * j] = form.Map(offsets, i, j);
+                    for (uint32_t i = 0; i < e.nx; ++i) state.map[i + size_t(e.nx) * j] = form.Map(offsets, i, j);
             });
         }
         const noise::Lattice lattice = form.BaseLattice();
@@ -94,7 +104,7 @@ Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
             for (uint32_t row = rows.begin(); row != rows.end(); ++row) {
                 const uint32_t j = row % e.ny, k = row / e.ny;
                 float* o = out + size_t(e.nx) * row;
-                const float* map = coverage ? mNoiseMap.data() + size_t(e.nx) * j : nullptr;
+                const float* map = coverage ? state.map.data() + size_t(e.nx) * j : nullptr;
                 if (perlinRows) PerlinFbmRow(form, offsets, j, k, sums.data());
                 for (uint32_t i = 0; i < e.nx; ++i) {
                     float base;

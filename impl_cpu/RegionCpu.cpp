@@ -1,10 +1,10 @@
 // Stage `region` on the CPU (SPEC 2): each ellipsoid is evaluated only over the
 // voxels of each row that its surface can reach, and max-blended into R.
-#include <algorithm>
-#include <cmath>
-
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "impl_cpu/BackendCpu.h"
 

@@ -14,6 +14,7 @@
 
 #include "core/math/March.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/RenderMarchCpuState.h"
 
 namespace cb::cpu {
 namespace {
@@ -110,7 +111,16 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
 
 }  // namespace
 
+uint64_t RenderMarchCpuState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint64_t padded = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
+    const uint32_t b = std::max(scene.march.brick, 1u);
+    const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
+    return SaturatingAdd(SaturatingMul(padded, sizeof(MarchQT)), bricks);
+}
+
 Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
+    RenderMarchCpuState& state = mStages.Get<RenderMarchCpuState>();
     if (!in.qPrev || !in.qCur) return MakeError("cpu: render_march needs q");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e) return MakeError("cpu: render_march: q_prev and q_cur differ in size");
@@ -134,12 +144,12 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
 
     mArena.execute([&] {
         // 1. q_alpha and T into the padded volume; the border reads q = 0, T = 1.
-        mMarchVolume.assign(px * py * pz, MarchQT{0.0f, 1.0f});
+        state.volume.assign(px * py * pz, MarchQT{0.0f, 1.0f});
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.nz), [&](const tbb::blocked_range<uint32_t>& r) {
             for (uint32_t k = r.begin(); k < r.end(); ++k)
                 for (uint32_t j = 0; j < e.ny; ++j) {
                     const size_t src = size_t(e.nx) * (j + size_t(e.ny) * k);
-                    MarchQT* dst = mMarchVolume.data() + 1 + px * (j + 1) + px * py * (k + 1);
+                    MarchQT* dst = state.volume.data() + 1 + px * (j + 1) + px * py * (k + 1);
                     for (uint32_t i = 0; i < e.nx; ++i)
                         dst[i] = {Lerp(qPrev[src + i], qCur[src + i], alpha), T ? T[src + i] : 1.0f};
                 }
@@ -147,7 +157,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
         // 2. Bricks: empty iff q_alpha = 0 over the brick grown by one voxel (padded indices b B .. (b+1) B + 1).
         MarchBricks bricks;
         if (params.skipping) {
-            mMarchBricks.assign(size_t(bx) * by * bz, 0);
+            state.bricks.assign(size_t(bx) * by * bz, 0);
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, bz), [&](const tbb::blocked_range<uint32_t>& r) {
                 for (uint32_t c = r.begin(); c < r.end(); ++c)
                     for (uint32_t b = 0; b < by; ++b)
@@ -159,23 +169,23 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
                             for (size_t k = size_t(c) * B; k <= k1 && empty; ++k)
                                 for (size_t j = size_t(b) * B; j <= j1 && empty; ++j)
                                     for (size_t i = size_t(a) * B; i <= i1; ++i)
-                                        if (mMarchVolume[i + px * (j + py * k)].q != 0.0f) {
+                                        if (state.volume[i + px * (j + py * k)].q != 0.0f) {
                                             empty = false;
                                             break;
                                         }
-                            mMarchBricks[a + size_t(bx) * (b + size_t(by) * c)] = empty ? 1 : 0;
+                            state.bricks[a + size_t(bx) * (b + size_t(by) * c)] = empty ? 1 : 0;
                         }
             });
-            bricks.empty = mMarchBricks.data();
+            bricks.empty = state.bricks.data();
             bricks.brick = B;
             bricks.count[0] = bx;
             bricks.count[1] = by;
             bricks.count[2] = bz;
-            local.bricks = mMarchBricks.size();
-            local.emptyBricks = uint64_t(std::count(mMarchBricks.begin(), mMarchBricks.end(), uint8_t(1)));
+            local.bricks = state.bricks.size();
+            local.emptyBricks = uint64_t(std::count(state.bricks.begin(), state.bricks.end(), uint8_t(1)));
         }
         // 3. The rays.
-        const MarchPaddedVolume volume{mMarchVolume.data(), px, px * py, params.setup.size};
+        const MarchPaddedVolume volume{state.volume.data(), px, px * py, params.setup.size};
         const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
         const MarchSetup& s = params.setup;
         const uint32_t nl = params.lightSteps;

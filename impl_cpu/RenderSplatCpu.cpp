@@ -22,6 +22,8 @@
 #include <cstring>
 #include <vector>
 
+#include "impl_cpu/RenderSplatCpuState.h"
+
 #if defined(__AVX512F__)
 #include <immintrin.h>
 #endif
@@ -112,6 +114,7 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
 }  // namespace
 
 Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& imageBuffer, SplatStats* stats) {
+    std::vector<std::vector<Splat>>& slicesKept = mStages.Get<RenderSplatCpuState>().slices;
     if (!p.order || !in.qPrev || !in.qCur || !in.T) return MakeError("cpu: render_splat needs q (both steps), T and an order");
     if (p.skipping && (!in.tilesPrev || !in.tilesCur || !in.bandsPrev || !in.bandsCur))
         return MakeError("cpu: render_splat with skipping needs both steps' occupancy");
@@ -169,7 +172,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
         rank[a].resize(order.indices[a].size());
         for (uint32_t r = 0; r < rank[a].size(); ++r) rank[a][order.indices[a][r]] = r;
     }
-    if (mSplatSlices.size() < outerIdx.size()) mSplatSlices.resize(outerIdx.size());
+    if (slicesKept.size() < outerIdx.size()) slicesKept.resize(outerIdx.size());
     std::vector<uint64_t> visitedPerSlice(outerIdx.size(), 0);
     const SplatFrame frame = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
     const float qMin = frame.ambient[3], alpha = p.alpha;
@@ -221,7 +224,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) {
             for (size_t n = range.begin(); n != range.end(); ++n) {
-                std::vector<Splat>& out = mSplatSlices[n];
+                std::vector<Splat>& out = slicesKept[n];
                 out.clear();
                 uint64_t visited = 0;
                 uint32_t idx[3];
@@ -272,7 +275,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     // over runs of consecutive slices (each run counts, then writes from its
     // own offsets, which follow the earlier runs'), so every band's list is in
     // slice order; the fragments are counted on the way.
-    const std::span<const std::vector<Splat>> slices(mSplatSlices.data(), outerIdx.size());
+    const std::span<const std::vector<Splat>> slices(slicesKept.data(), outerIdx.size());
     const uint32_t bands = CeilDiv(H, kSplatCpuRowsPerBand);
     const size_t runs = std::clamp<size_t>(slices.size(), 1, 64), perRun = (slices.size() + runs - 1) / runs;
     std::vector<uint32_t> runCount(runs * bands, 0);  // runCount[run * bands + band]

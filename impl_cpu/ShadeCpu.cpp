@@ -20,6 +20,7 @@
 #include "core/pipeline/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/ShadeCoarse.h"
+#include "impl_cpu/ShadeCpuState.h"
 #include "impl_cpu/ShadeSchedule.h"
 
 namespace cb::cpu {
@@ -467,6 +468,14 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
 
 }  // namespace
 
+uint64_t ShadeCpuState::ScratchBytes(const Scene& scene) const {
+    const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
+    if (f == 1) return 0;
+    const Extent3 e = scene.grid.size;
+    const uint64_t cells[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+    return SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4);
+}
+
 Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
     const int f = params.resolution;
     CB_TRY(CheckShadeResolution("cpu", f));
@@ -476,7 +485,7 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
     const ShadePlan plan = MakeShadePlan(params, e);
     // The share: the sweep's slices m in [m0, m1), of the shaded (at f > 1 the
     // coarse) grid. At f > 1 the share with m = 0 also forms the coarse q, the
-    // coarse grids stay in mShadeCoarseQ/T until the last share, and the share
+    // coarse grids stay in ShadeCpuState's coarseQ and coarseT until the last share, and the share
     // ending at nw writes all of T from them.
     const uint32_t m0 = params.slices.Begin(plan.nw), m1 = params.slices.End(plan.nw);
     if (m0 >= m1) return {};
@@ -487,18 +496,19 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
 
     const uint32_t* c = plan.cells;
     const size_t coarseSlice = size_t(c[0]) * c[1];
-    if (m0 > 0 && (mShadeCoarseQ.size() != coarseSlice * c[2] || mShadeCoarseT.size() != coarseSlice * c[2]))
+    ShadeCpuState& state = mStages.Get<ShadeCpuState>();
+    if (m0 > 0 && (state.coarseQ.size() != coarseSlice * c[2] || state.coarseT.size() != coarseSlice * c[2]))
         return MakeError("cpu: shade share [" + std::to_string(m0) + ", " + std::to_string(m1) +
                          ") without the share that starts the sweep");
     if (m0 == 0) {
-        mShadeCoarseQ.assign(coarseSlice * c[2], 0.0f);
-        mShadeCoarseT.assign(coarseSlice * c[2], 1.0f);
-        DownsampleShadeQ(plan, f, q, e, mShadeCoarseQ.data(), mArena);
+        state.coarseQ.assign(coarseSlice * c[2], 0.0f);
+        state.coarseT.assign(coarseSlice * c[2], 1.0f);
+        DownsampleShadeQ(plan, f, q, e, state.coarseQ.data(), mArena);
     }
-    ShadeGrid(plan, params.storage, mShadeCoarseQ.data(), mShadeCoarseT.data(), mArena, m0, m1);
+    ShadeGrid(plan, params.storage, state.coarseQ.data(), state.coarseT.data(), mArena, m0, m1);
     if (m1 < plan.nw) return {};
 
-    UpsampleShadeT(plan, f, mShadeCoarseT.data(), e, T, mArena);
+    UpsampleShadeT(plan, f, state.coarseT.data(), e, T, mArena);
     return {};
 }
 

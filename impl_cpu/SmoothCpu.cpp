@@ -6,15 +6,16 @@
 // them in x and then y into a small ring of slices that stays in L2, and sums
 // that ring in z straight into the float output. Every inner loop runs over a
 // whole row of bytes or integers, which the compiler vectorises.
-#include <algorithm>
-#include <array>
-#include <cstring>
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 
+#include <algorithm>
+#include <array>
+#include <cstring>
+
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/SmoothCpuState.h"
 
 namespace cb::cpu {
 namespace {
@@ -183,6 +184,21 @@ void SmoothShare(const BitField& cld, float* q, uint32_t k0, uint32_t k1, Smooth
 
 }  // namespace
 
+uint64_t SmoothCpuState::ScratchBytes(const Scene& scene) const {
+    const int r = scene.smooth.radius;
+    if (r <= 0) return 0;
+    const Extent3 e = scene.grid.size;
+    const uint64_t slice = uint64_t(e.nx) * e.ny;
+    const uint64_t runs = std::min<uint64_t>(e.nz, uint64_t(threads));
+    const uint64_t numeratorBytes = r == 1 ? 1 : 2;  // at r = 1 a byte, at r = 2 two
+    const uint64_t perRun = SaturatingAdd(SaturatingMul(slice, (2 * r + 1) * numeratorBytes + 1),
+                                          uint64_t(e.nx) + 2 * r + 8 + 4 * uint64_t(e.nx));
+    uint64_t bytes = SaturatingMul(runs, perRun);
+    if (scene.render.slicesPerFrame > 0)
+        bytes = SaturatingAdd(bytes, SaturatingMul(slice, (2 * r + 1) * numeratorBytes + 1));
+    return bytes;
+}
+
 Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, SliceRange slices) {
     if (radius < 0 || radius > 2) return MakeError("cpu: smooth radius must be 0, 1 or 2");
     const BitField& cld = static_cast<const BufferCpu&>(cldBuffer).Bits();
@@ -208,8 +224,10 @@ Status BackendCpu::Smooth(int radius, const Buffer& cldBuffer, Buffer& qBuffer, 
     }
 
     if (!slices.IsWhole(e.nz)) {
-        if (radius == 1) SmoothShare<1>(cld, q, k0, k1, mSmoothShare, mArena);
-        else SmoothShare<2>(cld, q, k0, k1, mSmoothShare, mArena);
+        if (radius == 1)
+            SmoothShare<1>(cld, q, k0, k1, mStages.Get<SmoothCpuState>().share, mArena);
+        else
+            SmoothShare<2>(cld, q, k0, k1, mStages.Get<SmoothCpuState>().share, mArena);
         return {};
     }
 

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/math/NoiseGpu.h"
-#include "core/math/Shading.h"
 #include "core/scene/Scene.h"
 
 namespace cb::gl {
@@ -37,10 +35,7 @@ Result<std::unique_ptr<BackendGL>> BackendGL::Create(ContextKind context, CaLayo
 BackendGL::~BackendGL() {
     const Functions& f = mContext->F();
     if (!mAllQueries.empty()) f.DeleteQueries(GLsizei(mAllQueries.size()), mAllQueries.data());
-    for (ScratchTexture& t : mScratch)
-        if (t.texture) f.DeleteTextures(1, &t.texture);
-    for (auto& [buffer, bytes] : mBuffers)
-        if (buffer) f.DeleteBuffers(1, &buffer);
+    // The stage objects delete their textures and buffers after this, while the context is current.
 }
 
 // ---- Synchronisation, counted (Submissions) ----
@@ -179,47 +174,45 @@ void BackendGL::MultiDraw(GLenum mode, const GLint* firsts, const GLsizei* count
     ++mDraws;
 }
 
-void BackendGL::KeepImageCopy(const Buffer& image, GlScratchBuffer slot, size_t bytes) {
-    mImageCopy = {Tex(image).Texture(), slot, bytes, mWriteEpoch};
+void BackendGL::KeepImageCopy(const Buffer& image, const BufferSlot& copy, size_t bytes) {
+    mImageCopy = {Tex(image).Texture(), copy.name.Get(), bytes, mWriteEpoch};
 }
 
-std::string BackendGL::Device() const { return mContext->Renderer() + (mRgba8 ? ", automaton in RGBA8" : ""); }
-
-bool BackendGL::Supports(Stage stage) const {
-    return IsSplatPipelineStage(stage) || stage == Stage::Noise || stage == Stage::RenderMarch;
+std::string BackendGL::Device() const {
+    return mContext->Renderer() + (mStages.Get<CaGLState>().rgba8 ? ", automaton in RGBA8" : "");
 }
 
-GLuint BackendGL::Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
-    const Functions& f = mContext->F();
-    ScratchTexture& t = mScratch[slot];
-    if (t.texture && t.target == target && t.format == format && t.width == width && t.height == height &&
+GLuint BackendGL::Scratch(TextureSlot& t, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth) {
+    if (t.name.Get() && t.target == target && t.format == format && t.width == width && t.height == height &&
         t.depth == depth)
-        return t.texture;
-    if (t.texture) f.DeleteTextures(1, &t.texture);
-    t = {0, target, format, width, height, depth};
-    f.CreateTextures(target, 1, &t.texture);
+        return t.name.Get();
+    const Functions& f = mContext->F();
+    GLuint texture = 0;
+    f.CreateTextures(target, 1, &texture);
+    t.name.Reset(&f, texture);
+    t.target = target, t.format = format, t.width = width, t.height = height, t.depth = depth;
     if (target == GL_TEXTURE_2D)
-        f.TextureStorage2D(t.texture, 1, format, width, height);
+        f.TextureStorage2D(texture, 1, format, width, height);
     else
-        f.TextureStorage3D(t.texture, 1, format, width, height, depth);
-    f.TextureParameteri(t.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    f.TextureParameteri(t.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    return t.texture;
+        f.TextureStorage3D(texture, 1, format, width, height, depth);
+    f.TextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    f.TextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return texture;
 }
 
-GLuint BackendGL::ScratchBuffer(GlScratchBuffer slot, size_t bytes) {
-    const Functions& f = mContext->F();
-    auto& [buffer, size] = mBuffers[slot];
+GLuint BackendGL::ScratchBuffer(BufferSlot& slot, size_t bytes) {
     bytes = std::max<size_t>(bytes, 16);
-    if (buffer && size >= bytes) return buffer;
-    if (buffer) f.DeleteBuffers(1, &buffer);
+    if (slot.name.Get() && slot.bytes >= bytes) return slot.name.Get();
+    const Functions& f = mContext->F();
+    GLuint buffer = 0;
     f.CreateBuffers(1, &buffer);
+    slot.name.Reset(&f, buffer);
     f.NamedBufferData(buffer, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_DRAW);
-    size = bytes;
+    slot.bytes = bytes;
     return buffer;
 }
 
-GLuint BackendGL::CounterBuffer(GlScratchBuffer slot, size_t bytes) {
+GLuint BackendGL::CounterBuffer(BufferSlot& slot, size_t bytes) {
     if (!mBatch.active) return ScratchBuffer(slot, bytes);
     const Functions& f = mContext->F();
     GLuint buffer = 0;
@@ -314,44 +307,6 @@ uint64_t BackendGL::BufferBytes(BufferFormat format, const Extent3& extent) cons
     return CanonicalBufferBytes(format, extent);
 }
 
-uint64_t BackendGL::ScratchBytes(const Scene& scene) const {
-    const Extent3 e = scene.grid.size;
-    const uint64_t voxels = e.Count();
-    uint64_t bytes = 0;
-    if (scene.stages.Has(Stage::Region)) bytes += voxels;  // RegionUnorm: R8
-    if (scene.stages.Has(Stage::Ca)) {
-        if (scene.ca.HasWind()) bytes += 3 * BufferBytes(BufferFormat::Bits, e);  // CaHum, CaAct, CaCld
-        if (mRgba8) bytes += 2 * voxels * 4;                                      // Rgba8StateA, Rgba8StateB
-    }
-    if (scene.stages.Has(Stage::Smooth)) bytes += 2 * voxels * 2;          // SmoothX, SmoothXY: R16UI
-    if (scene.stages.Has(Stage::Density)) bytes += uint64_t(e.nx) * e.ny;  // CoverFlags: R8UI
-    if (scene.stages.Has(Stage::Shade)) {
-        // ShadeCoarseQ below full resolution and ShadeVolume: R32F on the shaded grid, ceil(n / f) cells per
-        // axis; ShadePing and ShadePong: R32F slices of nu x nv cells, counted for the two longest axes.
-        const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
-        uint64_t cells[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
-        const uint64_t grid = cells[0] * cells[1] * cells[2] * 4;
-        std::sort(cells, cells + 3);
-        bytes += (f > 1 ? 2 : 1) * grid + 2 * cells[1] * cells[2] * 4;
-    }
-    if (scene.stages.Has(Stage::RenderSplat))
-        bytes += uint64_t(scene.render.width) * scene.render.height * 16;              // SplatTarget: RGBA32F
-    if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);  // NoiseData
-    if (scene.stages.Has(Stage::RenderMarch)) {
-        // MarchVolume (RG32F) and its storage-buffer copy; with skipping MarchBricks (R32UI) and its copy;
-        // MarchTarget (RGBA32F) and the RGB32F image copy; with phase mie the table.
-        const uint64_t padded = uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2);
-        bytes += 2 * padded * 8;
-        if (scene.march.skipping) {
-            const uint32_t b = std::max(scene.march.brick, 1u);
-            bytes += 2 * uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b) * 4;
-        }
-        bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
-        if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
-    }
-    return bytes;
-}
-
 Status BackendGL::Upload(Buffer& buffer, std::span<const std::byte> canonical) {
     if (canonical.size() != buffer.CanonicalBytes()) return MakeError("gl: upload size does not match the buffer");
     const Functions& f = mContext->F();
@@ -381,7 +336,7 @@ Status BackendGL::Download(const Buffer& buffer, std::span<std::byte> canonical)
     // A renderer's image still in its pixel buffer: only the copy out of it.
     const ImageCopy& kept = mImageCopy;
     if (kept.texture == b.Texture() && kept.epoch == mWriteEpoch && kept.bytes == canonical.size()) {
-        WaitingRead(ReadKind::Buffer, mBuffers[kept.slot].first, 0, 0, 0, canonical.size(), canonical.data());
+        WaitingRead(ReadKind::Buffer, kept.buffer, 0, 0, 0, canonical.size(), canonical.data());
         return mContext->Check("downloading an image from its pixel buffer");
     }
     if (b.Format() != BufferFormat::Bits) {

@@ -6,10 +6,11 @@
 // a channel per bit), converted to and from the packed fields it shares with
 // the other stages (docs/pipeline.md).
 //
-// Files: the host side of each stage is in its own <Stage>GL.cpp (RegionGL.cpp,
+// Files: each stage has its object in <Stage>GLState.h (what it keeps between calls
+// and its scratch bytes) and its entry in <Stage>GL.cpp (RegionGL.cpp,
 // CaGL.cpp, ...); BackendGL.cpp holds the context, buffers, transfers and the
-// helpers the stages share (scratch slots, BindTargets, DrawLayers). Tex and
-// the member templates are defined below the class.
+// helpers the stages share (Scratch, BindTargets, DrawLayers). Tex and the
+// member templates are defined below the class.
 #pragma once
 
 #include <array>
@@ -21,9 +22,18 @@
 #include <utility>
 #include <vector>
 
-#include "core/math/Noise.h"
 #include "core/pipeline/Backend.h"
+#include "core/pipeline/StageObjects.h"
+#include "impl_gl/CaGLState.h"
+#include "impl_gl/DensityGLState.h"
 #include "impl_gl/GLContext.h"
+#include "impl_gl/NoiseGLState.h"
+#include "impl_gl/RegionGLState.h"
+#include "impl_gl/RenderMarchGLState.h"
+#include "impl_gl/RenderSplatGLState.h"
+#include "impl_gl/ScratchGL.h"
+#include "impl_gl/ShadeGLState.h"
+#include "impl_gl/SmoothGLState.h"
 
 namespace cb::gl {
 
@@ -50,7 +60,7 @@ class BackendGL final : public Backend {
 
     std::string Name() const override { return "gl"; }
     std::string Device() const override;
-    bool Supports(Stage stage) const override;
+    bool Supports(Stage stage) const override { return StagesGL::Implements(stage); }
     std::optional<double> LastDeviceMs() const override { return mLastDeviceMs; }
 
     // Pipelined timing (core/pipeline/Backend.h). In a batch a stage call records its
@@ -96,79 +106,26 @@ class BackendGL final : public Backend {
 
     // Texture bytes: bit fields as R32UI, ceil(nx/32) texels per row; bytes R8UI; floats R32F.
     uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
-    // The scratch textures whose size the scene fixes (GlScratch): region's R8
-    // layers, the automaton's rule outputs with wind (and its RGBA8 state),
-    // smooth's R16UI sums, density's cover flags, shade's volumes and slices
-    // (counted for the two longest axes), the splat target; the ray marcher's
-    // padded volume, bricks and image, each with the storage or pixel buffer it
-    // is copied into, and the Mie table. Other buffer objects (lists, counters,
-    // blocks) are not counted. GL does not report available memory.
-    uint64_t ScratchBytes(const Scene& scene) const override;
+    // The sum of the stage objects' textures whose size the scene fixes (each
+    // says which in its <Stage>GLState.h) and the ray marcher's storage and pixel
+    // copies; other buffer objects (lists, counters, blocks) are not counted.
+    // GL does not report available memory.
+    uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:
-    // The scratch textures, each used by one stage only (named first), kept
-    // between calls and remade when its target, format or size changes.
-    enum class GlScratch {
-        RegionUnorm,   // Region: the R8 UNORM layers the ellipsoids MAX-blend into
-        CaHum,         // CaStep, with wind: the rules' humidity, before advection
-        CaAct,         // CaStep, with wind: the rules' activation, before advection
-        CaCld,         // CaStep, with wind: the rules' clouds, before advection
-        Rgba8StateA,   // CaStep, RGBA8 layout: the state between steps (see mStateOf)
-        Rgba8StateB,   // CaStep, RGBA8 layout: the rules' output
-        SmoothX,       // Smooth: the R16UI sums along x
-        SmoothXY,      // Smooth: the R16UI sums along x and y
-        CoverFlags,    // Density: the R8UI flags of the covered columns
-        ShadeCoarseQ,  // Shade, resolution > 1: the down-sampled q
-        ShadeVolume,   // Shade: the w-major volume of slices
-        ShadePing,     // Shade: the slice loop's previous slice
-        ShadePong,     // Shade: the slice loop's current slice
-        SplatTarget,   // RenderSplat: the RGBA32F image
-        MarchVolume,   // RenderMarch: the padded (q_alpha, T) volume, RG32F layers
-        MarchBricks,   // RenderMarch, skipping: the R32UI empty flags of the bricks
-        MarchTarget,   // RenderMarch: the RGBA32F image
-        Count
-    };
-    // The scratch buffer objects, each used by one stage only, grown as needed.
-    enum class GlScratchBuffer {
-        EllipsoidList,    // Region: the ellipsoids, read by the vertex shader
-        CoverCounter,     // Density: the atomic counter of covered columns
-        SplatOrder,       // RenderSplat: the flattened shared order
-        SplatFrame,       // RenderSplat: the shared frame block (core/math/Splat.h)
-        SplatCounters,    // RenderSplat: the shader's counters (splats drawn)
-        ImageCopy,        // RenderSplat: the pixel buffer the image passes through
-        NoiseData,        // Noise: the scene's data block (core/math/NoiseGpu.h), kept while mNoiseForm's scene stays
-        MarchBlock,       // RenderMarch: the MarchGpu uniform block (core/pipeline/MarchGpu.h)
-        MarchVolumeCopy,  // RenderMarch: the padded volume as a storage buffer of (q_alpha, T) pairs
-        MarchBricksCopy,  // RenderMarch, skipping: the brick flags as a storage buffer
-        MarchPhaseTable,  // RenderMarch, phase mie: kMieCloudTable's values, uploaded once (mMieUploaded)
-        MarchCounters,    // RenderMarch: the shader's MarchStats counters
-        MarchImageCopy,   // RenderMarch: the pixel buffer the image passes through
-        GroundBlock,      // RenderSplat, RenderMarch with the ground: the GroundGpu uniform block (core/math/Ground.h)
-        Count
-    };
-    // An array indexed by one slot enum and nothing else.
-    template <typename Slot, typename T>
-    class SlotArray {
-      public:
-        T& operator[](Slot slot) { return mItems[size_t(slot)]; }
-        auto begin() { return mItems.begin(); }
-        auto end() { return mItems.end(); }
-
-      private:
-        std::array<T, size_t(Slot::Count)> mItems{};
-    };
-    struct ScratchTexture {
-        GLuint texture = 0;
-        GLenum target = 0, format = 0;
-        GLsizei width = 0, height = 0, depth = 0;
-    };
+    // The stage objects (core/pipeline/StageObjects.h): each stage's textures,
+    // buffer objects and what it keeps between calls, in its <Stage>GLState.h.
+    using StagesGL = StageObjects<RegionGLState, CaGLState, SmoothGLState, DensityGLState, ShadeGLState,
+                                  NothingKept<Stage::Shadow>, RenderSplatGLState, NoiseGLState, RenderMarchGLState>;
 
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8)
-        : mContext(std::move(context)), mRgba8(rgba8), mSoftwareRasterizer(mContext->SoftwareRasterizer()) {}
+        : mContext(std::move(context)), mSoftwareRasterizer(mContext->SoftwareRasterizer()) {
+        mStages.Get<CaGLState>().rgba8 = rgba8;
+    }
 
     // A stage call's device time: a GL_TIMESTAMP query at construction and one
     // at Stop(). Outside a batch Stop() waits (Finish) and sets mLastDeviceMs;
@@ -204,19 +161,21 @@ class BackendGL final : public Backend {
     // Draw calls, counted in mDraws.
     void Draw(GLenum mode, GLint first, GLsizei count, GLsizei instances = 1);
     void MultiDraw(GLenum mode, const GLint* firsts, const GLsizei* counts, GLsizei draws);
-    // A renderer's image whose canonical bytes its pixel buffer `slot` still
+    // A renderer's image whose canonical bytes its pixel buffer `copy` still
     // holds: Download of it reads the buffer instead of the texture while
     // nothing has been written since (mWriteEpoch).
-    void KeepImageCopy(const Buffer& image, GlScratchBuffer slot, size_t bytes);
-    GLuint Scratch(GlScratch slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
-    GLuint ScratchBuffer(GlScratchBuffer slot, size_t bytes);
+    void KeepImageCopy(const Buffer& image, const BufferSlot& copy, size_t bytes);
+    // The slot's texture, remade when its target, format or size differ.
+    GLuint Scratch(TextureSlot& slot, GLenum target, GLenum format, GLsizei width, GLsizei height, GLsizei depth = 1);
+    // The slot's buffer object, grown to at least `bytes` (16 at least); its contents are undefined.
+    GLuint ScratchBuffer(BufferSlot& slot, size_t bytes);
     // In a batch, a zeroed buffer of `bytes` for one call's counters, read and
     // deleted at EndBatch (deferred results); outside one, ScratchBuffer(slot).
-    GLuint CounterBuffer(GlScratchBuffer slot, size_t bytes);
+    GLuint CounterBuffer(BufferSlot& slot, size_t bytes);
     // Copies a renderer's W x H RGB(A) float target into `image` ((3, W, H) F32)
-    // on the device, through the pixel buffer in `slot`: the target's rows, top
+    // on the device, through the pixel buffer in `copy`: the target's rows, top
     // first, in RGB floats are exactly the canonical layout.
-    void CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScratchBuffer slot, Buffer& image);
+    void CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, BufferSlot& copy, Buffer& image);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the
     // context's framebuffer as colour attachments 0, 1, ... and makes them the
     // draw buffers; the other attachments are detached.
@@ -247,7 +206,7 @@ class BackendGL final : public Backend {
     Status CaStepRgba8Share(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out);
 
     std::unique_ptr<GLContext> mContext;
-    bool mRgba8 = false;
+    StagesGL mStages;  // after mContext: their names are deleted while it is current
     std::optional<double> mLastDeviceMs;
     SubmissionCounts mCounts;
     bool mLayered = true, mLayeredFailed = false;
@@ -282,43 +241,14 @@ class BackendGL final : public Backend {
     // Advanced by every call that may write a buffer (CreateBuffer, Upload, each stage call).
     uint64_t mWriteEpoch = 0;
     struct ImageCopy {
-        GLuint texture = 0;
-        GlScratchBuffer slot{};
+        GLuint texture = 0, buffer = 0;
         size_t bytes = 0;
         uint64_t epoch = ~uint64_t(0);
     };
     ImageCopy mImageCopy;
-    SlotArray<GlScratch, ScratchTexture> mScratch;
-    SlotArray<GlScratchBuffer, std::pair<GLuint, size_t>> mBuffers;  // buffer, bytes
-    // Noise: the scene whose data block is in the NoiseData buffer (NoiseGL.cpp).
-    std::unique_ptr<noise::NoiseForm> mNoiseForm;
-    // RenderMarch: whether the MarchPhaseTable buffer holds kMieCloudTable (RenderMarchGL.cpp).
-    bool mMieUploaded = false;
-    // Which packed fields the thesis-layout state in Rgba8StateA holds: the last
-    // step's outputs, valid until a bit field is written some other way.
-    std::array<GLuint, 3> mStateOf{};
-    uint64_t mBitsWrites = 0, mStateWrites = ~uint64_t(0);
-    // Smooth: the slices [begin, end) whose xy sums SmoothXY holds, of which cld
-    // at which radius, valid while no bit field is written (mBitsWrites).
-    struct SmoothSums {
-        GLuint cld = 0;
-        int radius = -1;
-        Extent3 extent;
-        uint64_t bitsWrites = ~uint64_t(0);
-        uint32_t begin = 0, end = 0;
-    };
-    SmoothSums mSmoothSums;
-    // CaStep in shares, RGBA8 layout: Rgba8StateA holds `inputs` for slices
-    // [packedBegin, packedEnd) and Rgba8StateB this step's rule results for
-    // [0, rulesEnd), valid while no bit field is written but by the shares.
-    struct Rgba8ShareState {
-        std::array<GLuint, 3> inputs{}, outputs{};
-        Extent3 extent;
-        uint64_t bitsWrites = ~uint64_t(0);
-        bool wind = false;
-        uint32_t packedBegin = 0, packedEnd = 0, rulesEnd = 0;
-    };
-    Rgba8ShareState mShareState;
+    // Counts the writes of bit fields (Upload, the automaton), so that what a
+    // stage keeps from one call to the next is known to be current.
+    uint64_t mBitsWrites = 0;
 };
 
 // For the stages' host files (<Stage>GL.cpp) and the façade.

@@ -3,8 +3,17 @@
 #include <utility>
 
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/CaGLState.h"
 
 namespace cb::gl {
+
+uint64_t CaGLState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    uint64_t bytes = 0;
+    if (scene.ca.HasWind()) bytes += 3 * Extent3{CeilDiv(e.nx, 32), e.ny, e.nz}.Count() * 4;  // R32UI words
+    if (rgba8) bytes += 2 * e.Count() * 4;
+    return bytes;
+}
 
 Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
     const Functions& f = mContext->F();
@@ -26,7 +35,8 @@ Status BackendGL::CaInitialize(const CaInitParams& params, CaFields out) {
 }
 
 Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
-    if (mRgba8)
+    CaGLState& ca = mStages.Get<CaGLState>();
+    if (ca.rgba8)
         return params.slices.IsWhole(in.hum->Extent().nz) ? CaStepRgba8(params, in, region, out)
                                                           : CaStepRgba8Share(params, in, region, out);
     const Functions& f = mContext->F();
@@ -45,9 +55,9 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     // With wind the rules write scratch fields that the advection pass shifts into `out`.
     GLuint next[3] = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
     if (wind) {
-        next[0] = Scratch(GlScratch::CaHum, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
-        next[1] = Scratch(GlScratch::CaAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
-        next[2] = Scratch(GlScratch::CaCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[0] = Scratch(ca.rulesHum, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[1] = Scratch(ca.rulesAct, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
+        next[2] = Scratch(ca.rulesCld, GL_TEXTURE_2D_ARRAY, GL_R32UI, words, GLsizei(e.ny), GLsizei(e.nz));
     }
     Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
@@ -80,11 +90,12 @@ Status BackendGL::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
     return mContext->Check("ca");
 }
 
-// The thesis's layout: the step runs on RGBA8UI voxels (Rgba8StateA -> Rgba8StateB,
-// and back to Rgba8StateA through the advection pass when there is wind), then the
+// The thesis's layout: the step runs on RGBA8UI voxels (stateA -> stateB,
+// and back to stateA through the advection pass when there is wind), then the
 // packed fields the other stages read are written from it. The packing of
-// `in` is skipped when Rgba8StateA already holds it (the previous step's result).
+// `in` is skipped when stateA already holds it (the previous step's result).
 Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    CaGLState& ca = mStages.Get<CaGLState>();
     const Functions& f = mContext->F();
     auto pack = mContext->Program("ca_pack_rgba8");
     if (!pack) return std::unexpected(pack.error());
@@ -96,12 +107,12 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     if (!unpack) return std::unexpected(unpack.error());
     const Extent3 e = in.hum->Extent();
     const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
-    const GLuint stateA = Scratch(GlScratch::Rgba8StateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
-    const GLuint stateB = Scratch(GlScratch::Rgba8StateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateA = Scratch(ca.stateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateB = Scratch(ca.stateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
     const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
-    const bool packed = mStateOf == inputs && mStateWrites == mBitsWrites;
+    const bool packed = ca.stateOf == inputs && ca.stateWrites == mBitsWrites;
     const bool wind = !params.shiftX.empty();
-    mShareState = {};  // this call rewrites Rgba8StateA
+    ca.share = {};  // this call rewrites stateA
     Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     f.Viewport(0, 0, nx, ny);
@@ -136,23 +147,24 @@ Status BackendGL::CaStepRgba8(const CaStepParams& params, ConstCaFields in, cons
     f.Uniform3i(f.GetUniformLocation(*unpack, "size"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
     CB_TRY(DrawLayers(*unpack, e.nz, {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()}));
     ++mBitsWrites;
-    // Without wind the result is in Rgba8StateB: swap the slots so Rgba8StateA holds it.
-    if (result == stateB) std::swap(mScratch[GlScratch::Rgba8StateA], mScratch[GlScratch::Rgba8StateB]);
-    mStateOf = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
-    mStateWrites = mBitsWrites;
+    // Without wind the result is in stateB: swap the slots so stateA holds it.
+    if (result == stateB) ca.stateA.Swap(ca.stateB);
+    ca.stateOf = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
+    ca.stateWrites = mBitsWrites;
     timer.Stop();
     return mContext->Check("ca (RGBA8 layout)");
 }
 
 // A share [k0, k1) of a step in the thesis's layout. The rules read act at
-// k - 2 .. k + 1, so the share needs `in` in Rgba8StateA for slices
-// [k0 - 2, k1 + 1); it packs only those a preceding share (mShareState) or the
-// previous step (mStateOf) did not leave there. Rgba8StateA is not written: the
-// rules go to Rgba8StateB and are unpacked from there, with wind through a
+// k - 2 .. k + 1, so the share needs `in` in stateA for slices
+// [k0 - 2, k1 + 1); it packs only those a preceding share (ca.share) or the
+// previous step (ca.stateOf) did not leave there. stateA is not written: the
+// rules go to stateB and are unpacked from there, with wind through a
 // shifted unpacking that folds in the advection. Without wind, the share that
-// ends a complete ascending sequence leaves the step's state in Rgba8StateA as
+// ends a complete ascending sequence leaves the step's state in stateA as
 // the whole call does; with wind the next step packs its input again.
 Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in, const Buffer& region, CaFields out) {
+    CaGLState& ca = mStages.Get<CaGLState>();
     const Functions& f = mContext->F();
     const bool wind = !params.shiftX.empty();
     auto pack = mContext->Program("ca_pack_rgba8");
@@ -169,20 +181,20 @@ Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in,
         return {};
     }
     const GLsizei nx = GLsizei(e.nx), ny = GLsizei(e.ny), nz = GLsizei(e.nz);
-    const GLuint stateA = Scratch(GlScratch::Rgba8StateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
-    const GLuint stateB = Scratch(GlScratch::Rgba8StateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateA = Scratch(ca.stateA, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
+    const GLuint stateB = Scratch(ca.stateB, GL_TEXTURE_2D_ARRAY, GL_RGBA8UI, nx, ny, nz);
     const std::array<GLuint, 3> inputs = {Tex(*in.hum).Texture(), Tex(*in.act).Texture(), Tex(*in.cld).Texture()};
     const std::array<GLuint, 3> outputs = {Tex(*out.hum).Texture(), Tex(*out.act).Texture(), Tex(*out.cld).Texture()};
-    // What Rgba8StateA holds of `in`, and what Rgba8StateB holds of this step's rules.
-    Rgba8ShareState& held = mShareState;
+    // What stateA holds of `in`, and what stateB holds of this step's rules.
+    CaGLState::ShareState& held = ca.share;
     const bool continues = held.inputs == inputs && held.outputs == outputs && held.extent == e &&
                            held.bitsWrites == mBitsWrites && held.wind == wind;
     if (!continues) {
         // The previous step's whole state, or nothing.
-        const bool whole = mStateOf == inputs && mStateWrites == mBitsWrites;
+        const bool whole = ca.stateOf == inputs && ca.stateWrites == mBitsWrites;
         held = {inputs, outputs, e, mBitsWrites, wind, 0, whole ? e.nz : 0, 0};
     }
-    mStateOf = {};  // Rgba8StateB is about to change; Rgba8StateA's claim lives on in `held`
+    ca.stateOf = {};  // stateB is about to change; stateA's claim lives on in `held`
     const uint32_t lo = k0 >= 2 ? k0 - 2 : 0, hi = std::min(e.nz, k1 + 1);
     uint32_t pack0 = lo;
     if (held.packedBegin <= lo && held.packedEnd >= lo) {
@@ -210,7 +222,7 @@ Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in,
     f.Uniform1ui(f.GetUniformLocation(*rules, "qHum"), params.qHum);
     f.Uniform1ui(f.GetUniformLocation(*rules, "qAct"), params.qAct);
     CB_TRY(DrawLayerRange(*rules, k0, k1, {stateB}));
-    // Rgba8StateB's rule results: a run from slice 0 grown by ascending shares.
+    // stateB's rule results: a run from slice 0 grown by ascending shares.
     held.rulesEnd = held.rulesEnd == k0 ? k1 : 0;
     f.BindTextureUnit(0, stateB);
     f.Viewport(0, 0, GLsizei(CeilDiv(e.nx, 32)), ny);
@@ -223,10 +235,10 @@ Status BackendGL::CaStepRgba8Share(const CaStepParams& params, ConstCaFields in,
     ++mBitsWrites;
     held.bitsWrites = mBitsWrites;
     if (!wind && held.rulesEnd == e.nz) {
-        // The step is complete in Rgba8StateB: it becomes the state the next step starts from.
-        std::swap(mScratch[GlScratch::Rgba8StateA], mScratch[GlScratch::Rgba8StateB]);
-        mStateOf = outputs;
-        mStateWrites = mBitsWrites;
+        // The step is complete in stateB: it becomes the state the next step starts from.
+        ca.stateA.Swap(ca.stateB);
+        ca.stateOf = outputs;
+        ca.stateWrites = mBitsWrites;
         held = {};
     }
     timer.Stop();

@@ -1,8 +1,13 @@
 #include <algorithm>
 
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/DensityGLState.h"
 
 namespace cb::gl {
+
+uint64_t DensityGLState::ScratchBytes(const Scene& scene) const {
+    return uint64_t(scene.grid.size.nx) * scene.grid.size.ny;
+}
 
 Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Buffer* cld, DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("gl: density tile and band must be positive");
@@ -54,11 +59,12 @@ Status BackendGL::Density(const DensityParams& params, const Buffer& q, const Bu
     f.Disable(GL_BLEND);
 
     // Cover: an atomic counter over the columns; the column flags land in a scratch R8UI layer.
-    const GLuint counter = CounterBuffer(GlScratchBuffer::CoverCounter, sizeof(GLuint));
+    const GLuint counter = CounterBuffer(mStages.Get<DensityGLState>().coverCounter, sizeof(GLuint));
     const GLuint initial = 0;
     f.NamedBufferSubData(counter, 0, sizeof initial, &initial);
     f.BindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter);
-    const GLuint flags = Scratch(GlScratch::CoverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx), GLsizei(e.ny), 1);
+    const GLuint flags = Scratch(mStages.Get<DensityGLState>().coverFlags, GL_TEXTURE_2D_ARRAY, GL_R8UI, GLsizei(e.nx),
+                                 GLsizei(e.ny), 1);
     CB_TRY(BindTargets({{flags, 0}}));
     f.UseProgram(*cover);  // in the rows' viewport: only their columns count
     // Without cld the cover counts columns with D > 0 and leaves the cld unit unbound.

@@ -1,6 +1,9 @@
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/RegionGLState.h"
 
 namespace cb::gl {
+
+uint64_t RegionGLState::ScratchBytes(const Scene& scene) const { return scene.grid.size.Count(); }
 
 // region: per slice, one instanced quad per ellipsoid into an R8 UNORM layer
 // with MAX blending (integer targets cannot blend), then one copy into the
@@ -21,10 +24,10 @@ Status BackendGL::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& re
     const Extent3 e = region.Extent();
     static_assert(sizeof(RasterEllipsoid) == 8 * sizeof(float));
     Timing timer(*this);
-    const GLuint list = ScratchBuffer(GlScratchBuffer::EllipsoidList, ellipsoids.size_bytes());
+    const GLuint list = ScratchBuffer(mStages.Get<RegionGLState>().ellipsoids, ellipsoids.size_bytes());
     if (!ellipsoids.empty()) f.NamedBufferSubData(list, 0, GLsizeiptr(ellipsoids.size_bytes()), ellipsoids.data());
-    const GLuint unorm =
-        Scratch(GlScratch::RegionUnorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx), GLsizei(e.ny), GLsizei(e.nz));
+    const GLuint unorm = Scratch(mStages.Get<RegionGLState>().unorm, GL_TEXTURE_2D_ARRAY, GL_R8, GLsizei(e.nx),
+                                 GLsizei(e.ny), GLsizei(e.nz));
     const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
     if (k0 >= k1) {
         mLastDeviceMs = 0.0;

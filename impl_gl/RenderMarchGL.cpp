@@ -1,6 +1,6 @@
 // Stage `render_march` (SPEC 10) on OpenGL, the thesis's way: fragment passes.
 //   1. march_volume: the padded (q_alpha, T) volume, one pass per padded layer
-//      into the RG32F layers of MarchVolume (border (0, 1); T only with light
+//      into the RG32F layers of `volume` (border (0, 1); T only with light
 //      "shade", else 1), copied on the device into a storage buffer.
 //   2. march_bricks (skipping only): the bricks' empty flags, one pass per
 //      brick layer into R32UI layers, copied likewise; counts the empty ones.
@@ -19,10 +19,25 @@
 #include "core/math/Shading.h"
 #include "core/pipeline/MarchGpu.h"
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/RenderMarchGLState.h"
 
 namespace cb::gl {
 
+uint64_t RenderMarchGLState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint64_t padded = uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2);
+    uint64_t bytes = 2 * padded * 8;
+    if (scene.march.skipping) {
+        const uint32_t b = std::max(scene.march.brick, 1u);
+        bytes += 2 * uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b) * 4;
+    }
+    bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
+    if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    return bytes;
+}
+
 Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
+    RenderMarchGLState& state = mStages.Get<RenderMarchGLState>();
     if (!in.qPrev || !in.qCur) return MakeError("gl: render_march needs q");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e) return MakeError("gl: render_march: q_prev and q_cur differ in size");
@@ -59,13 +74,13 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
-    const GLuint counters = ScratchBuffer(GlScratchBuffer::MarchCounters, 9 * 4);
+    const GLuint counters = ScratchBuffer(state.counters, 9 * 4);
     const uint32_t zero[9] = {};
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, counters);
 
     // 1. The padded (q_alpha, T) volume.
-    const GLuint volume = Scratch(GlScratch::MarchVolume, GL_TEXTURE_2D_ARRAY, GL_RG32F, px, py, pz);
+    const GLuint volume = Scratch(state.volume, GL_TEXTURE_2D_ARRAY, GL_RG32F, px, py, pz);
     f.UseProgram(*volumeProgram);
     f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());
@@ -75,7 +90,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.Uniform1i(f.GetUniformLocation(*volumeProgram, "hasT"), shadeLight ? 1 : 0);
     f.Viewport(0, 0, px, py);
     CB_TRY(DrawLayers(*volumeProgram, uint32_t(pz), {volume}));
-    const GLuint volumeCopy = ScratchBuffer(GlScratchBuffer::MarchVolumeCopy, volumeBytes);
+    const GLuint volumeCopy = ScratchBuffer(state.volumeCopy, volumeBytes);
     f.BindBuffer(GL_PIXEL_PACK_BUFFER, volumeCopy);
     f.PixelStorei(GL_PACK_ALIGNMENT, 1);
     f.GetTextureImage(volume, 0, GL_RG, GL_FLOAT, GLsizei(volumeBytes), nullptr);
@@ -86,14 +101,14 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     if (params.skipping) {
         const GLsizei bx = GLsizei(brickCounts[0]), by = GLsizei(brickCounts[1]), bz = GLsizei(brickCounts[2]);
         const size_t brickBytes = size_t(bx) * size_t(by) * size_t(bz) * 4;
-        const GLuint bricks = Scratch(GlScratch::MarchBricks, GL_TEXTURE_2D_ARRAY, GL_R32UI, bx, by, bz);
+        const GLuint bricks = Scratch(state.bricks, GL_TEXTURE_2D_ARRAY, GL_R32UI, bx, by, bz);
         f.UseProgram(*bricksProgram);
         f.BindTextureUnit(0, volume);
         f.Uniform1i(f.GetUniformLocation(*bricksProgram, "brick"), GLint(B));
         f.Uniform3i(f.GetUniformLocation(*bricksProgram, "padded"), px, py, pz);
         f.Viewport(0, 0, bx, by);
         CB_TRY(DrawLayers(*bricksProgram, uint32_t(bz), {bricks}));
-        bricksCopy = ScratchBuffer(GlScratchBuffer::MarchBricksCopy, brickBytes);
+        bricksCopy = ScratchBuffer(state.bricksCopy, brickBytes);
         f.BindBuffer(GL_PIXEL_PACK_BUFFER, bricksCopy);
         f.GetTextureImage(bricks, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(brickBytes), nullptr);
         f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
@@ -104,15 +119,15 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     GLuint phaseTable = volumeCopy;  // bound to the unused binding unless the phase is Mie
     if (params.setup.phase.kind == PhaseKind::Mie) {
         const size_t tableBytes = size_t(kMieCloudTable.count) * 4;
-        phaseTable = ScratchBuffer(GlScratchBuffer::MarchPhaseTable, tableBytes);
-        if (!mMieUploaded) {
+        phaseTable = ScratchBuffer(state.phaseTable, tableBytes);
+        if (!state.mieUploaded) {
             f.NamedBufferSubData(phaseTable, 0, GLsizeiptr(tableBytes), kMieCloudTable.values);
-            mMieUploaded = true;
+            state.mieUploaded = true;
         }
     }
-    const GLuint blockBuffer = ScratchBuffer(GlScratchBuffer::MarchBlock, sizeof block);
+    const GLuint blockBuffer = ScratchBuffer(state.block, sizeof block);
     f.NamedBufferSubData(blockBuffer, 0, sizeof block, &block);
-    const GLuint target = Scratch(GlScratch::MarchTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    const GLuint target = Scratch(state.target, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
     CB_TRY(BindTargets({{target, -1}}));
     f.UseProgram(*marchProgram);
     f.BindBufferBase(GL_UNIFORM_BUFFER, 0, blockBuffer);
@@ -124,7 +139,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     if (params.ground.on) {
         const GroundGpu ground = MakeGroundGpu(params.camera, params.origin, params.setup.voxelSize,
                                                MakeGroundLight(params), e.nx, e.ny);
-        groundBuffer = ScratchBuffer(GlScratchBuffer::GroundBlock, sizeof ground);
+        groundBuffer = ScratchBuffer(state.ground, sizeof ground);
         f.NamedBufferSubData(groundBuffer, 0, sizeof ground, &ground);
     }
     f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
@@ -132,7 +147,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.Viewport(0, 0, GLsizei(W), GLsizei(H));
     Draw(GL_TRIANGLES, 0, 3);
 
-    CopyTargetToImage(target, W, H, GlScratchBuffer::MarchImageCopy, image);
+    CopyTargetToImage(target, W, H, state.imageCopy, image);
     timer.Stop();
     if (stats) {
         f.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -3,14 +3,20 @@
 #include "core/math/Splat.h"
 #include "core/pipeline/SplatFrame.h"
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/RenderSplatGLState.h"
 
 namespace cb::gl {
+
+uint64_t RenderSplatGLState::ScratchBytes(const Scene& scene) const {
+    return uint64_t(scene.render.width) * scene.render.height * 16;
+}
 
 // render_splat: GL_POINTS in the shared order, one vertex per voxel; culling
 // and skipping become a multi-draw over the runs of ranks whose tile x band
 // box is visible. The RGBA32F target is drawn with row 0 at the top, so one
 // read into a pixel buffer and one upload from it give the canonical (3, W, H) image.
 Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
+    RenderSplatGLState& state = mStages.Get<RenderSplatGLState>();
     // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
     if (p.phase.kind == PhaseKind::Mie)
         return MakeError("gl does not implement phase 'mie' in render_splat yet (issue 14)");
@@ -89,23 +95,23 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
 
     Timing timer(*this);
-    const GLuint orderBuffer = ScratchBuffer(GlScratchBuffer::SplatOrder, flat.indices.size() * 4);
+    const GLuint orderBuffer = ScratchBuffer(state.order, flat.indices.size() * 4);
     f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
     // The shared frame; this backend's lane: the largest point size.
     SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
     frame.misc[2] = pointRange[1];
-    const GLuint frameBuffer = ScratchBuffer(GlScratchBuffer::SplatFrame, sizeof frame);
+    const GLuint frameBuffer = ScratchBuffer(state.frame, sizeof frame);
     f.NamedBufferSubData(frameBuffer, 0, sizeof frame, &frame);
-    const GLuint counters = CounterBuffer(GlScratchBuffer::SplatCounters, 16);
+    const GLuint counters = CounterBuffer(state.counters, 16);
     const uint32_t zero[4] = {};
     f.NamedBufferSubData(counters, 0, sizeof zero, zero);
-    const GLuint target = Scratch(GlScratch::SplatTarget, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    const GLuint target = Scratch(state.target, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
     CB_TRY(BindTargets({{target, -1}}));
     f.BindVertexArray(mContext->EmptyVao());
     if (p.ground.on) {
         // The ground pass (ground.frag): each pixel's background, which the splats then blend over.
         const GroundGpu block = MakeGroundGpu(p.camera, p.origin, p.voxelSize, MakeGroundLight(p), e.nx, e.ny);
-        const GLuint groundBuffer = ScratchBuffer(GlScratchBuffer::GroundBlock, sizeof block);
+        const GLuint groundBuffer = ScratchBuffer(state.ground, sizeof block);
         f.NamedBufferSubData(groundBuffer, 0, sizeof block, &block);
         f.UseProgram(*groundProgram);
         f.BindBufferBase(GL_UNIFORM_BUFFER, 1, groundBuffer);
@@ -144,7 +150,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.Disable(GL_PROGRAM_POINT_SIZE);
     f.BindTextureUnit(4, 0);
     f.BindTextureUnit(5, 0);
-    CopyTargetToImage(target, W, H, GlScratchBuffer::ImageCopy, image);
+    CopyTargetToImage(target, W, H, state.imageCopy, image);
     timer.Stop();
     if (mBatch.active) {  // read after EndBatch's wait (TakeDeferredResults); the buffer is this call's own
         if (stats)
@@ -165,10 +171,10 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     return mContext->Check("render_splat");
 }
 
-void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScratchBuffer slot, Buffer& image) {
+void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, BufferSlot& copySlot, Buffer& image) {
     const Functions& f = mContext->F();
     const size_t imageBytes = size_t(W) * H * 3 * sizeof(float);
-    const GLuint copy = ScratchBuffer(slot, imageBytes);
+    const GLuint copy = ScratchBuffer(copySlot, imageBytes);
     f.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
     f.BindBuffer(GL_PIXEL_PACK_BUFFER, copy);
     f.PixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -179,7 +185,7 @@ void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, GlScrat
     f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
     f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
     // The pixel buffer keeps the canonical image: a Download reads it without a texture read back (issue 16).
-    KeepImageCopy(image, slot, imageBytes);
+    KeepImageCopy(image, copySlot, imageBytes);
 }
 
 }  // namespace cb::gl

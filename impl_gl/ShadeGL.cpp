@@ -1,10 +1,21 @@
+#include <algorithm>
 #include <array>
 #include <utility>
 
 #include "core/pipeline/ShadePlan.h"
 #include "impl_gl/BackendGL.h"
+#include "impl_gl/ShadeGLState.h"
 
 namespace cb::gl {
+
+uint64_t ShadeGLState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
+    uint64_t cells[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+    const uint64_t grid = cells[0] * cells[1] * cells[2] * 4;
+    std::sort(cells, cells + 3);
+    return (f > 1 ? 2 : 1) * grid + 2 * cells[1] * cells[2] * 4;
+}
 
 // shade: optional down-sampling pass, then the slice loop from the sun's side
 // (ping-pong between two 2-D textures, each slice also written to layer w of a
@@ -14,6 +25,7 @@ namespace cb::gl {
 // slice before m0 is in the ping-pong texture of m0's parity, left by the
 // preceding share), and the share ending at nw writes T.
 Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    ShadeGLState& state = mStages.Get<ShadeGLState>();
     const int res = params.resolution;
     CB_TRY(CheckShadeResolution("gl", res));
     const Functions& f = mContext->F();
@@ -37,7 +49,7 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     Timing timer(*this);
     f.BindVertexArray(mContext->EmptyVao());
     GLuint shadedQ = Tex(q).Texture();
-    if (res > 1) shadedQ = Scratch(GlScratch::ShadeCoarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
+    if (res > 1) shadedQ = Scratch(state.coarseQ, GL_TEXTURE_2D_ARRAY, GL_R32F, n[0], n[1], n[2]);
     if (res > 1 && m0 == 0) {
         f.UseProgram(*down);
         f.BindTextureUnit(0, Tex(q).Texture());
@@ -46,9 +58,9 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
         f.Viewport(0, 0, n[0], n[1]);
         CB_TRY(DrawLayers(*down, uint32_t(n[2]), {shadedQ}));
     }
-    const GLuint volume = Scratch(GlScratch::ShadeVolume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
-    GLuint ping = Scratch(GlScratch::ShadePing, GL_TEXTURE_2D, GL_R32F, nu, nv);
-    GLuint pong = Scratch(GlScratch::ShadePong, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    const GLuint volume = Scratch(state.volume, GL_TEXTURE_2D_ARRAY, GL_R32F, nu, nv, nw);
+    GLuint ping = Scratch(state.ping, GL_TEXTURE_2D, GL_R32F, nu, nv);
+    GLuint pong = Scratch(state.pong, GL_TEXTURE_2D, GL_R32F, nu, nv);
     auto unit = [](int axis) {
         GLint v[3] = {0, 0, 0};
         v[axis] = 1;

@@ -1,15 +1,11 @@
 // The Vulkan backend's façade: the context, buffers and their transfers, and
-// the helpers every stage shares (Record and Dev in BackendVk.h, Scratch). The host side
-// of each stage is in its own file: RegionVk.cpp, CaVk.cpp, SmoothVk.cpp,
-// DensityVk.cpp, ShadeVk.cpp, ShadowVk.cpp, RenderSplatVk.cpp.
+// the helpers every stage shares (Record and Dev in BackendVk.h, Scratch). Each
+// stage has its object in <Stage>VkState.h (what it keeps between calls and its
+// scratch bytes) and its entry in <Stage>Vk.cpp: RegionVk.cpp, CaVk.cpp, ...
 #include "impl_vk/BackendVk.h"
 
 #include <algorithm>
 #include <vector>
-
-#include "core/math/NoiseGpu.h"
-#include "core/pipeline/MarchGpu.h"
-#include "core/scene/Scene.h"
 
 namespace cb::vk {
 namespace {
@@ -35,31 +31,27 @@ Result<std::unique_ptr<BackendVk>> BackendVk::Create(const std::string& device, 
     return std::unique_ptr<BackendVk>(new BackendVk(std::move(*context)));
 }
 
-BackendVk::~BackendVk() {
-    for (DeviceBuffer& b : mScratch) mContext->DestroyBuffer(b);
-}
+// The stage objects destroy their buffers after this, before the context.
+BackendVk::~BackendVk() = default;
 
-bool BackendVk::Supports(Stage stage) const {
-    return IsSplatPipelineStage(stage) || stage == Stage::Noise || stage == Stage::RenderMarch;
-}
-
-Result<DeviceBuffer*> BackendVk::Scratch(VkScratch slot, VkDeviceSize size) {
-    DeviceBuffer& b = mScratch.at(size_t(slot));
+Result<DeviceBuffer*> BackendVk::Scratch(BufferSlot& slot, VkDeviceSize size) {
+    DeviceBuffer& b = slot.buffer;
     if (b.size < size) {
-        mScratchHeld.at(size_t(slot)).reset();
+        slot.held.reset();
         mContext->DestroyBuffer(b);
         auto created = mContext->CreateBuffer(size);
         if (!created) return std::unexpected(created.error());
         b = *created;
+        slot.context = mContext.get();
     }
     return &b;
 }
 
-Result<DeviceBuffer*> BackendVk::ScratchHolding(VkScratch slot, std::span<const std::byte> bytes,
+Result<DeviceBuffer*> BackendVk::ScratchHolding(BufferSlot& slot, std::span<const std::byte> bytes,
                                                 VkDeviceSize minSize) {
     auto b = Scratch(slot, std::max<VkDeviceSize>(minSize, bytes.size()));
     if (!b) return b;
-    auto& held = mScratchHeld.at(size_t(slot));
+    auto& held = slot.held;
     if (held && std::equal(held->begin(), held->end(), bytes.begin(), bytes.end())) return b;
     held.reset();
     if (!bytes.empty()) CB_TRY(mContext->Upload(**b, bytes));
@@ -76,31 +68,6 @@ Result<std::unique_ptr<Buffer>> BackendVk::CreateBuffer(BufferFormat format, Ext
 
 uint64_t BackendVk::BufferBytes(BufferFormat format, const Extent3& extent) const {
     return VulkanContext::StorageBufferBytes(DeviceBytes(format, extent));
-}
-
-uint64_t BackendVk::ScratchBytes(const Scene& scene) const {
-    const Extent3 e = scene.grid.size;
-    uint64_t bytes = 0;
-    // ca with wind: the rules' three outputs before advection (CaVk.cpp).
-    if (scene.stages.Has(Stage::Ca) && scene.ca.HasWind()) bytes += 3 * BufferBytes(BufferFormat::Bits, e);
-    // smooth: the sums along x and along x and y, a uint per voxel each (SmoothVk.cpp).
-    if (scene.stages.Has(Stage::Smooth)) bytes += 2 * e.Count() * 4;
-    // shade below full resolution: q and T on the coarse grid, ceil(n / f) cells per axis (ShadeVk.cpp).
-    if (const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1)); scene.stages.Has(Stage::Shade) && f > 1)
-        bytes += 2 * Extent3{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)}.Count() * 4;
-    // noise: the data block (core/math/NoiseGpu.h): header, two tables, HD per slice, towers, detail volume.
-    if (scene.stages.Has(Stage::Noise)) bytes += noise::GpuDataBytes(scene.noise, e);
-    // render_march: the constants, the padded volume (T only with light "shade"), a word per brick with
-    // skipping, the Mie table with phase Mie, the counters (RenderMarchVk.cpp).
-    if (scene.stages.Has(Stage::RenderMarch)) {
-        bytes += sizeof(MarchGpu) + MarchVolumeBytes(e, scene.march.light == MarchLightSource::Shade) + 10 * 4;
-        if (scene.march.skipping) {
-            const auto b = MarchBrickCounts(e, scene.march.brick);
-            bytes += uint64_t(b[0]) * b[1] * b[2] * 4;
-        }
-        if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
-    }
-    return bytes;
 }
 
 Status BackendVk::Upload(Buffer& buffer, std::span<const std::byte> canonical) {

@@ -10,8 +10,17 @@
 #include <utility>
 #include <vector>
 
-#include "core/math/Noise.h"
 #include "core/pipeline/Backend.h"
+#include "core/pipeline/StageObjects.h"
+#include "impl_vk/CaVkState.h"
+#include "impl_vk/DensityVkState.h"
+#include "impl_vk/NoiseVkState.h"
+#include "impl_vk/RegionVkState.h"
+#include "impl_vk/RenderMarchVkState.h"
+#include "impl_vk/RenderSplatVkState.h"
+#include "impl_vk/ScratchVk.h"
+#include "impl_vk/ShadeVkState.h"
+#include "impl_vk/SmoothVkState.h"
 #include "impl_vk/VulkanContext.h"
 
 namespace cb::vk {
@@ -29,56 +38,6 @@ class BufferVk final : public Buffer {
     DeviceBuffer mBuffer;
 };
 
-// The backend's reusable device buffers (BackendVk::Scratch). Each slot belongs
-// to one stage, keeps its contents only within a call (except ShadeCoarseQ/T
-// and SmoothSumXY, which carry a sweep from one share to the next, SPEC 13) and
-// grows to the largest size asked of it.
-enum class VkScratch {
-    EllipsoidList,          // region: the ellipsoids, 32 bytes each
-    RegionTileStarts,       // region: first RegionTileEntries index per 16x16 tile of a slice, and one past the end
-    RegionTileEntries,      // region: ellipsoid indices, tile by tile
-    CaRulesHum,             // ca: the rules' hum before advection (only with wind)
-    CaRulesAct,             // ca: the rules' act before advection (only with wind)
-    CaRulesCld,             // ca: the rules' cld before advection (only with wind)
-    CaWindShifts,           // ca: (shiftX, shiftY) per slice (only with wind)
-    SmoothSumX,             // smooth: the bit field summed along x
-    SmoothSumXY,            // smooth: those sums summed along y; kept between the shares of a sweep
-    CoverCounter,           // density: covered columns, one uint
-    ShadeCoarseQ,           // shade: q on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
-    ShadeCoarseT,           // shade: T on the coarse grid (resolution 2 or 4); kept between the shares of a sweep
-    SplatFrame,             // render_splat: grid, camera and light (the shaders' Frame)
-    SplatRankParts,         // render_splat: per position of each axis order, its coordinate and index shares
-    SplatBoxes,             // render_splat: visibility of each tile x band box, one byte each
-    SplatCandidates,        // render_splat: a bit per rank, 1 where it makes a splat
-    SplatChunkSplats,       // render_splat: splats per chunk of ranks
-    SplatChunkPairs,        // render_splat: (screen tile, splat) pairs per chunk of ranks
-    SplatChunkOffsets,      // render_splat: SplatChunkSplats scanned, and the total
-    SplatChunkPairOffsets,  // render_splat: SplatChunkPairs scanned, and the total
-    SplatTotals,  // render_splat: the splats, the pairs, and 64 slots of voxels visited and fragments, read by the host
-    Splats,       // render_splat: the splats in the shared order, 48 bytes each
-    SplatTiles,   // render_splat: screen tiles per splat
-    SplatPairOffsets,  // render_splat: SplatTiles scanned, and the total
-    SplatKeys,         // render_splat: the pairs' screen tiles (radix sort ping)
-    SplatValues,       // render_splat: the pairs' splat indices (radix sort ping)
-    SplatKeysSwap,     // render_splat: the pairs' screen tiles (radix sort pong)
-    SplatValuesSwap,   // render_splat: the pairs' splat indices (radix sort pong)
-    SplatSortCounts,   // render_splat: pairs per radix digit x sort block
-    SplatSortOffsets,  // render_splat: SplatSortCounts scanned, and the total
-    SplatTileBases,    // render_splat: the first sorted pair of each screen tile, and the pairs
-    SplatScanSums,     // render_splat: the block sums of its scans (scan.comp)
-    NoiseData,         // noise: the scene's data block (core/math/NoiseGpu.h), kept while mNoiseForm's scene stays
-    MarchFrame,        // render_march: the constants (core/pipeline/MarchGpu.h), 256 bytes
-    MarchVolume,       // render_march: the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha
-    MarchBricks,       // render_march: one word per brick, 1 iff empty (only with skipping)
-    MarchMieTable,     // render_march: kMieCloudTable's values, uploaded once (only with phase Mie)
-    MarchStats,        // render_march: the MarchStats counters, 64-bit as two words each
-    GroundFrame,       // render_splat, render_march with the ground: the GroundGpu block (core/math/Ground.h)
-    Count
-};
-
-// Bytes of render_march's padded volume on a grid of extent e: (q, T) pairs, or q alone.
-uint64_t MarchVolumeBytes(const Extent3& e, bool withT);
-
 class BackendVk final : public Backend {
   public:
     // device: index, name substring or "" (first device); validation: Khronos layer on.
@@ -88,7 +47,7 @@ class BackendVk final : public Backend {
 
     std::string Name() const override { return "vk"; }
     std::string Device() const override { return mContext->DeviceName(); }
-    bool Supports(Stage stage) const override;
+    bool Supports(Stage stage) const override { return StagesVk::Implements(stage); }
 
     Result<std::unique_ptr<Buffer>> CreateBuffer(BufferFormat format, Extent3 extent) override;
     Status Upload(Buffer& buffer, std::span<const std::byte> canonical) override;
@@ -97,10 +56,8 @@ class BackendVk final : public Backend {
     // Bit fields as rows of ceil(nx/32) 32-bit words, bytes as bytes, floats as
     // floats, each buffer padded to a multiple of 4 bytes.
     uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
-    // The automaton's rule outputs with wind, smooth's two sum volumes, shade's
-    // coarse q and T below full resolution, noise's data block; the region's and the renderer's
-    // lists (which depend on the ellipsoids and the clouds) are not counted.
-    uint64_t ScratchBytes(const Scene& scene) const override;
+    // The sum of the stage objects' (each says what it counts in its <Stage>VkState.h).
+    uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
     // The largest device-local heap.
     std::optional<uint64_t> AvailableBytes() const override { return mContext->LargestDeviceLocalHeap(); }
 
@@ -141,41 +98,29 @@ class BackendVk final : public Backend {
     uint32_t ValidationMessages() const { return mContext->ValidationMessages(); }
 
   private:
+    // The stage objects (core/pipeline/StageObjects.h): each stage's device
+    // buffers and what it keeps between calls, in its <Stage>VkState.h.
+    using StagesVk = StageObjects<RegionVkState, CaVkState, SmoothVkState, DensityVkState, ShadeVkState,
+                                  NothingKept<Stage::Shadow>, RenderSplatVkState, NoiseVkState, RenderMarchVkState>;
+
     explicit BackendVk(std::unique_ptr<VulkanContext> context) : mContext(std::move(context)) {}
     // Records with `fn`, submits, waits and keeps the device time (defined below the class).
     template <typename Fn>
     Status Record(const char* what, Fn&& fn);
     // The slot's buffer, grown to at least `size` bytes; its contents are undefined.
-    Result<DeviceBuffer*> Scratch(VkScratch slot, VkDeviceSize size);
+    Result<DeviceBuffer*> Scratch(BufferSlot& slot, VkDeviceSize size);
     // The slot's buffer (at least `minSize` bytes) holding `bytes` from offset 0,
     // uploaded only when they differ from what this last uploaded there; for
     // slots the host writes and no shader does (the shares of a stage upload
     // the same list once).
-    Result<DeviceBuffer*> ScratchHolding(VkScratch slot, std::span<const std::byte> bytes, VkDeviceSize minSize);
+    Result<DeviceBuffer*> ScratchHolding(BufferSlot& slot, std::span<const std::byte> bytes, VkDeviceSize minSize);
 
     std::unique_ptr<VulkanContext> mContext;
+    StagesVk mStages;  // after mContext: their buffers are destroyed before it
     std::optional<double> mLastDeviceMs;
     ShadeSweep mShadeSweep = ShadeSweep::Auto;
     uint32_t mSplatChunkRanks = 0;
     std::vector<DeferredHostResult> mDeferredResults;  // this batch's, so far (TakeDeferredResults)
-    // Indexed by VkScratch. A fixed array, so pointers to one slot stay valid
-    // while others grow.
-    std::array<DeviceBuffer, size_t(VkScratch::Count)> mScratch{};
-    // What ScratchHolding last uploaded into each slot; reset when the slot grows.
-    std::array<std::optional<std::vector<std::byte>>, size_t(VkScratch::Count)> mScratchHeld{};
-    // noise: the scene whose data block is in the NoiseData slot (NoiseVk.cpp).
-    std::unique_ptr<noise::NoiseForm> mNoiseForm;
-    // render_march: kMieCloudTable is in the MarchMieTable slot (RenderMarchVk.cpp).
-    bool mMieUploaded = false;
-    // smooth: the share sequence whose x-y sums are in the SmoothSumXY slot: the
-    // slices [0, summedTo) of `cld` at `radius`, its next share starting at `next`
-    // (SmoothVk.cpp). Reset by every smooth call that does not continue it.
-    struct SmoothSweep {
-        const Buffer* cld = nullptr;
-        int radius = 0;
-        uint32_t next = 0, summedTo = 0;
-    };
-    std::optional<SmoothSweep> mSmoothSweep;
 };
 
 // For the stages' host files (<Stage>Vk.cpp) and the façade.

@@ -5,19 +5,15 @@
 #include <vector>
 
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/CaVkState.h"
 #include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
-namespace {
-
-// The scratch slot that holds field `field` (0 hum, 1 act, 2 cld, as in CaFields) of the rules' output.
-VkScratch CaRulesOutputSlot(size_t field) {
-    constexpr VkScratch kSlots[] = {VkScratch::CaRulesHum, VkScratch::CaRulesAct, VkScratch::CaRulesCld};
-    assert(field < std::size(kSlots));
-    return kSlots[field];
+uint64_t CaVkState::ScratchBytes(const Scene& scene) const {
+    if (!scene.ca.HasWind()) return 0;
+    const Extent3 e = scene.grid.size;
+    return 3 * VulkanContext::StorageBufferBytes(VkDeviceSize(CeilDiv(e.nx, 32)) * e.ny * e.nz * 4);
 }
-
-}  // namespace
 
 Status BackendVk::CaInitialize(const CaInitParams& params, CaFields out) {
     const Extent3 e = out.hum->Extent();
@@ -56,7 +52,7 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
         // The rules write into scratch; advection moves the result into `out`.
         // Advection shifts within a slice, so a share needs only its own slices.
         for (size_t f = 0; f < 3; ++f) {
-            auto s = Scratch(CaRulesOutputSlot(f), VkDeviceSize(words) * e.ny * e.nz * 4);
+            auto s = Scratch(mStages.Get<CaVkState>().rules[f], VkDeviceSize(words) * e.ny * e.nz * 4);
             if (!s) return std::unexpected(s.error());
             targets[f] = *s;
         }
@@ -65,7 +61,7 @@ Status BackendVk::CaStep(const CaStepParams& params, ConstCaFields in, const Buf
             packed.push_back(params.shiftX[k]);
             packed.push_back(params.shiftY[k]);
         }
-        auto s = ScratchHolding(VkScratch::CaWindShifts, std::as_bytes(std::span(packed)), 8);
+        auto s = ScratchHolding(mStages.Get<CaVkState>().windShifts, std::as_bytes(std::span(packed)), 8);
         if (!s) return std::unexpected(s.error());
         shifts = *s;
         auto p = mContext->GetPipeline("advect", 7,

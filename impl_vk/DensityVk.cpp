@@ -8,6 +8,7 @@
 #include <string>
 
 #include "impl_vk/BackendVk.h"
+#include "impl_vk/DensityVkState.h"
 #include "impl_vk/PushBlocks.h"
 
 namespace cb::vk {
@@ -33,7 +34,7 @@ Status BackendVk::Density(const DensityParams& params, const Buffer& q, const Bu
     // The share's rows come from the push constant ty0, so the plain pipeline serves shares too.
     auto pass = mContext->GetPipeline("density", 6);
     if (!pass) return std::unexpected(pass.error());
-    auto counter = Scratch(VkScratch::CoverCounter, 4);
+    auto counter = Scratch(mStages.Get<DensityVkState>().coverCounter, 4);
     if (!counter) return std::unexpected(counter.error());
     DensityPush push{e.nx,        e.ny,   e.nz,   (e.nx + 31) / 32, cld ? 1u : 0u, params.tile,
                      params.band, tilesX, tilesY, bandCount,        row0};

@@ -16,6 +16,7 @@
 #include "core/pipeline/MarchGpu.h"
 #include "impl_vk/BackendVk.h"
 #include "impl_vk/PushBlocks.h"
+#include "impl_vk/RenderMarchVkState.h"
 
 namespace cb::vk {
 namespace {
@@ -30,7 +31,20 @@ uint64_t MarchVolumeBytes(const Extent3& e, bool withT) {
     return uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull) * (withT ? 8u : 4u);
 }
 
+uint64_t RenderMarchVkState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    uint64_t bytes =
+        sizeof(MarchGpu) + MarchVolumeBytes(e, scene.march.light == MarchLightSource::Shade) + kMarchStatWords * 4;
+    if (scene.march.skipping) {
+        const auto b = MarchBrickCounts(e, scene.march.brick);
+        bytes += uint64_t(b[0]) * b[1] * b[2] * 4;
+    }
+    if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    return bytes;
+}
+
 Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
+    RenderMarchVkState& state = mStages.Get<RenderMarchVkState>();
     if (!in.qPrev || !in.qCur) return MakeError("vk: render_march needs q");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e) return MakeError("vk: render_march: q_prev and q_cur differ in size");
@@ -55,28 +69,28 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         if (!pipe) return std::unexpected(pipe.error());
         pipes[n] = *pipe;
     }
-    auto frameBuffer = Scratch(VkScratch::MarchFrame, sizeof frame);
+    auto frameBuffer = Scratch(state.frame, sizeof frame);
     if (!frameBuffer) return std::unexpected(frameBuffer.error());
-    auto volume = Scratch(VkScratch::MarchVolume, MarchVolumeBytes(e, shadeLight));
+    auto volume = Scratch(state.volume, MarchVolumeBytes(e, shadeLight));
     if (!volume) return std::unexpected(volume.error());
-    auto statsBuffer = Scratch(VkScratch::MarchStats, kMarchStatWords * 4);
+    auto statsBuffer = Scratch(state.stats, kMarchStatWords * 4);
     if (!statsBuffer) return std::unexpected(statsBuffer.error());
     // Unread bindings get a buffer that exists (the frame): a binding needs one.
     const DeviceBuffer* bricks = *frameBuffer;
     if (params.skipping) {
-        auto b = Scratch(VkScratch::MarchBricks, VkDeviceSize(brickCount) * 4);
+        auto b = Scratch(state.bricks, VkDeviceSize(brickCount) * 4);
         if (!b) return std::unexpected(b.error());
         bricks = *b;
     }
     const DeviceBuffer* table = *frameBuffer;
     if (mie) {
-        if (!mMieUploaded) {
-            auto t = Scratch(VkScratch::MarchMieTable, VkDeviceSize(kMieCloudTable.count) * 4);
+        if (!state.mieUploaded) {
+            auto t = Scratch(state.mieTable, VkDeviceSize(kMieCloudTable.count) * 4);
             if (!t) return std::unexpected(t.error());
             CB_TRY(mContext->Upload(**t, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
-            mMieUploaded = true;
+            state.mieUploaded = true;
         }
-        table = &mScratch[size_t(VkScratch::MarchMieTable)];
+        table = &state.mieTable.buffer;
     }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
     // The ground's block and G (flag kMarchGpuGround); without the ground, the frame stands in, unread.
@@ -85,7 +99,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     if (params.ground.on) {
         const GroundGpu block =
             MakeGroundGpu(params.camera, params.origin, params.setup.voxelSize, MakeGroundLight(params), e.nx, e.ny);
-        auto b = Scratch(VkScratch::GroundFrame, sizeof block);
+        auto b = Scratch(state.ground, sizeof block);
         if (!b) return std::unexpected(b.error());
         CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(&block, 1))));
         groundBlock = *b;

@@ -11,6 +11,7 @@
 #include "impl_vk/BackendVk.h"
 #include "impl_vk/PairSortVk.h"
 #include "impl_vk/PushBlocks.h"
+#include "impl_vk/RenderSplatVkState.h"
 
 namespace cb::vk {
 namespace {
@@ -42,6 +43,7 @@ std::vector<RankPart> MakeRankParts(const SplatFrame& F, const FlatSplatOrder& f
 }  // namespace
 
 Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
+    RenderSplatVkState& state = mStages.Get<RenderSplatVkState>();
     // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
     if (p.phase.kind == PhaseKind::Mie)
         return MakeError("vk does not implement phase 'mie' in render_splat yet (issue 14)");
@@ -84,7 +86,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     frame.image[3] = tilesY;
     const uint32_t chunks = CeilDiv(voxels, ranksPerChunk);
     const std::vector<RankPart> rankParts = MakeRankParts(frame, flat);
-    // This stage's scratch buffers, one per VkScratch::Splat* slot (what each holds is said there).
+    // This stage's scratch buffers, one per slot of RenderSplatVkState (what each holds is said there).
     struct {
         DeviceBuffer *frame, *rankParts, *boxes, *candidates, *chunkSplats, *chunkPairs, *chunkOffsets, *chunkPairOffsets;
         DeviceBuffer* totals;
@@ -92,26 +94,26 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         DeviceBuffer* scanSums;
     } scratch{};
     // At least 16 bytes: a binding needs a buffer even when nothing is in it.
-    auto need = [&](DeviceBuffer*& buffer, VkScratch slot, VkDeviceSize bytes) -> Status {
+    auto need = [&](DeviceBuffer*& buffer, BufferSlot& slot, VkDeviceSize bytes) -> Status {
         auto b = Scratch(slot, std::max<VkDeviceSize>(bytes, 16));
         if (!b) return std::unexpected(b.error());
         buffer = *b;
         return {};
     };
-    CB_TRY(need(scratch.frame, VkScratch::SplatFrame, sizeof frame));
-    CB_TRY(need(scratch.rankParts, VkScratch::SplatRankParts, rankParts.size() * sizeof(RankPart)));
-    CB_TRY(need(scratch.boxes, VkScratch::SplatBoxes, boxes.size()));
-    CB_TRY(need(scratch.candidates, VkScratch::SplatCandidates, VkDeviceSize(chunks) * ranksPerChunk / 8));
-    CB_TRY(need(scratch.chunkSplats, VkScratch::SplatChunkSplats, VkDeviceSize(chunks) * 4));
-    CB_TRY(need(scratch.chunkPairs, VkScratch::SplatChunkPairs, VkDeviceSize(chunks) * 4));
-    CB_TRY(need(scratch.chunkOffsets, VkScratch::SplatChunkOffsets, VkDeviceSize(chunks + 1) * 4));
-    CB_TRY(need(scratch.chunkPairOffsets, VkScratch::SplatChunkPairOffsets, VkDeviceSize(chunks + 1) * 4));
+    CB_TRY(need(scratch.frame, state.frame, sizeof frame));
+    CB_TRY(need(scratch.rankParts, state.rankParts, rankParts.size() * sizeof(RankPart)));
+    CB_TRY(need(scratch.boxes, state.boxes, boxes.size()));
+    CB_TRY(need(scratch.candidates, state.candidates, VkDeviceSize(chunks) * ranksPerChunk / 8));
+    CB_TRY(need(scratch.chunkSplats, state.chunkSplats, VkDeviceSize(chunks) * 4));
+    CB_TRY(need(scratch.chunkPairs, state.chunkPairs, VkDeviceSize(chunks) * 4));
+    CB_TRY(need(scratch.chunkOffsets, state.chunkOffsets, VkDeviceSize(chunks + 1) * 4));
+    CB_TRY(need(scratch.chunkPairOffsets, state.chunkPairOffsets, VkDeviceSize(chunks + 1) * 4));
     // What the host reads back: the splats, the pairs, then splat_count.comp's 64 slots of
     // (visited, fragments low, high), which it adds into.
     constexpr uint32_t kStatSlots = 64;
-    CB_TRY(need(scratch.totals, VkScratch::SplatTotals, (2 + kStatSlots * 3) * 4));
+    CB_TRY(need(scratch.totals, state.totals, (2 + kStatSlots * 3) * 4));
     // The scans' block sums; sized again for the later, longer scans.
-    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(ScanSumsEntries(chunks)) * 4));
+    CB_TRY(need(scratch.scanSums, state.scanSums, VkDeviceSize(ScanSumsEntries(chunks)) * 4));
     CB_TRY(mContext->Upload(*scratch.frame, std::as_bytes(std::span(&frame, 1))));
     CB_TRY(mContext->Upload(*scratch.rankParts, std::as_bytes(std::span(rankParts))));
     CB_TRY(mContext->Upload(*scratch.boxes, std::as_bytes(std::span(boxes))));
@@ -177,19 +179,19 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (splatCount > kScanMaxEntries)
         return MakeError("vk: render_splat makes " + std::to_string(splatCount) + " splats, over the " +
                          std::to_string(kScanMaxEntries) + " its scan of their tiles can take");
-    CB_TRY(need(scratch.splats, VkScratch::Splats, VkDeviceSize(splatCount) * sizeof(Splat)));
-    CB_TRY(need(scratch.splatTiles, VkScratch::SplatTiles, VkDeviceSize(splatCount) * 4));
-    CB_TRY(need(scratch.pairOffsets, VkScratch::SplatPairOffsets, VkDeviceSize(splatCount + 1) * 4));
-    CB_TRY(need(scratch.keys[0], VkScratch::SplatKeys, VkDeviceSize(pairCount) * 4));
-    CB_TRY(need(scratch.values[0], VkScratch::SplatValues, VkDeviceSize(pairCount) * 4));
+    CB_TRY(need(scratch.splats, state.splats, VkDeviceSize(splatCount) * sizeof(Splat)));
+    CB_TRY(need(scratch.splatTiles, state.splatTiles, VkDeviceSize(splatCount) * 4));
+    CB_TRY(need(scratch.pairOffsets, state.pairOffsets, VkDeviceSize(splatCount + 1) * 4));
+    CB_TRY(need(scratch.keys[0], state.keys[0], VkDeviceSize(pairCount) * 4));
+    CB_TRY(need(scratch.values[0], state.values[0], VkDeviceSize(pairCount) * 4));
     const VkDeviceSize swapBytes = sortPlan.digits ? VkDeviceSize(pairCount) * 4 : 0;
-    CB_TRY(need(scratch.keys[1], VkScratch::SplatKeysSwap, swapBytes));
-    CB_TRY(need(scratch.values[1], VkScratch::SplatValuesSwap, swapBytes));
-    CB_TRY(need(scratch.sortCounts, VkScratch::SplatSortCounts, VkDeviceSize(sortPlan.CountEntries()) * 4));
-    CB_TRY(need(scratch.sortOffsets, VkScratch::SplatSortOffsets, (VkDeviceSize(sortPlan.CountEntries()) + 1) * 4));
-    CB_TRY(need(scratch.tileBases, VkScratch::SplatTileBases, VkDeviceSize(screenTiles + 1) * 4));
+    CB_TRY(need(scratch.keys[1], state.keys[1], swapBytes));
+    CB_TRY(need(scratch.values[1], state.values[1], swapBytes));
+    CB_TRY(need(scratch.sortCounts, state.sortCounts, VkDeviceSize(sortPlan.CountEntries()) * 4));
+    CB_TRY(need(scratch.sortOffsets, state.sortOffsets, (VkDeviceSize(sortPlan.CountEntries()) + 1) * 4));
+    CB_TRY(need(scratch.tileBases, state.tileBases, VkDeviceSize(screenTiles + 1) * 4));
     const uint32_t longestScan = std::max({chunks, splatCount, sortPlan.CountEntries()});
-    CB_TRY(need(scratch.scanSums, VkScratch::SplatScanSums, VkDeviceSize(ScanSumsEntries(longestScan)) * 4));
+    CB_TRY(need(scratch.scanSums, state.scanSums, VkDeviceSize(ScanSumsEntries(longestScan)) * 4));
     const DeviceBuffer* writeBuffers[] = {common[0],            common[1],      common[2],
                                           common[3],            common[4],      common[5],
                                           scratch.chunkOffsets, scratch.splats, scratch.splatTiles,
@@ -207,7 +209,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const DeviceBuffer* groundG = scratch.frame;
     if (p.ground.on) {
         const GroundGpu block = MakeGroundGpu(p.camera, p.origin, p.voxelSize, MakeGroundLight(p), e.nx, e.ny);
-        auto b = Scratch(VkScratch::GroundFrame, sizeof block);
+        auto b = Scratch(state.ground, sizeof block);
         if (!b) return std::unexpected(b.error());
         CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(&block, 1))));
         groundBlock = *b;

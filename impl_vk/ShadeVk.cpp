@@ -5,7 +5,7 @@
 // shade_up.comp). A share [m0, m1) of the sweep (SPEC 13) computes the slices
 // m0 .. m1 - 1 in visiting order; at f > 1 the share with m = 0 also down-samples
 // q and the share ending at nw up-samples into T. The coarse q and T
-// (VkScratch::ShadeCoarseQ/T) carry the sweep from one share to the next.
+// (ShadeVkState's coarseQ and coarseT) carry the sweep from one share to the next.
 // The reference path, one shade_slice.comp dispatch per slice, is what a CPU
 // device (lavapipe) runs by default (BackendVk::ShadeSweep; the tests compare the
 // two byte for byte).
@@ -14,6 +14,7 @@
 #include "core/pipeline/ShadePlan.h"
 #include "impl_vk/BackendVk.h"
 #include "impl_vk/PushBlocks.h"
+#include "impl_vk/ShadeVkState.h"
 
 namespace cb::vk {
 namespace {
@@ -42,7 +43,15 @@ uint32_t ShadeBlockSteps(int u0, int v0) {
 
 }  // namespace
 
+uint64_t ShadeVkState::ScratchBytes(const Scene& scene) const {
+    const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
+    if (f == 1) return 0;
+    const Extent3 e = scene.grid.size;
+    return 2 * Extent3{CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)}.Count() * 4;
+}
+
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    ShadeVkState& state = mStages.Get<ShadeVkState>();
     const int f = params.resolution;
     CB_TRY(CheckShadeResolution("vk", f));
     const Extent3 e = q.Extent();
@@ -58,9 +67,9 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const DeviceBuffer* shadeQ = &Dev(q);
     const DeviceBuffer* shadeT = &Dev(T);
     if (f > 1) {
-        auto cq = Scratch(VkScratch::ShadeCoarseQ, coarseBytes);
+        auto cq = Scratch(state.coarseQ, coarseBytes);
         if (!cq) return std::unexpected(cq.error());
-        auto ct = Scratch(VkScratch::ShadeCoarseT, coarseBytes);
+        auto ct = Scratch(state.coarseT, coarseBytes);
         if (!ct) return std::unexpected(ct.error());
         shadeQ = *cq;
         shadeT = *ct;

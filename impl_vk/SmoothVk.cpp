@@ -8,14 +8,16 @@
 
 #include "impl_vk/BackendVk.h"
 #include "impl_vk/PushBlocks.h"
+#include "impl_vk/SmoothVkState.h"
 
 namespace cb::vk {
 
 Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange slices) {
+    SmoothVkState& state = mStages.Get<SmoothVkState>();
     if (radius < 0 || radius > 2) return MakeError("vk: smooth radius must be 0, 1 or 2");
     const Extent3 e = cld.Extent();
     const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
-    const std::optional<SmoothSweep> sweep = std::exchange(mSmoothSweep, std::nullopt);
+    const std::optional<SmoothVkState::Sweep> sweep = std::exchange(state.sweep, std::nullopt);
     if (k0 >= k1) {
         mLastDeviceMs = 0.0;
         return {};
@@ -28,9 +30,9 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
     auto pipeline =
         mContext->GetPipeline("smooth", 4, slices.IsWhole(e.nz) ? PipelineRange::Whole : PipelineRange::Share);
     if (!pipeline) return std::unexpected(pipeline.error());
-    auto sumX = Scratch(VkScratch::SmoothSumX, e.Count() * 4);
+    auto sumX = Scratch(state.sumX, e.Count() * 4);
     if (!sumX) return std::unexpected(sumX.error());
-    auto sumXY = Scratch(VkScratch::SmoothSumXY, e.Count() * 4);
+    auto sumXY = Scratch(state.sumXY, e.Count() * 4);
     if (!sumXY) return std::unexpected(sumXY.error());
     SmoothPush push{e.nx, e.ny, e.nz, (e.nx + 31) / 32, radius, 1.0f / float(SmoothNormaliser(radius)), 0, 0, 0};
     const DeviceBuffer* buffers[] = {&Dev(cld), *sumX, *sumXY, &Dev(q)};
@@ -43,7 +45,7 @@ Status BackendVk::Smooth(int radius, const Buffer& cld, Buffer& q, SliceRange sl
             rec.DispatchRange(**pipeline, buffers, &push, sizeof push, push.first, push.end);
         }
     }));
-    if (k1 < e.nz) mSmoothSweep = SmoothSweep{&cld, radius, k1, sum1};
+    if (k1 < e.nz) state.sweep = SmoothVkState::Sweep{&cld, radius, k1, sum1};
     return {};
 }
 

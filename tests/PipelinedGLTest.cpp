@@ -1,9 +1,10 @@
-// Pipelined timing on gl (core/pipeline/Backend.h, "Pipelined timing"; issue 16): a
-// step's stage calls recorded in one batch give the same bytes as the same
-// calls one by one; the batch waits for the device once, plus once for each
-// host value or read back inside it; EndBatch gives one device time per
-// interval. Also: a renderer's image is downloaded from the pixel buffer it
-// passed through, and never stale.
+// Pipelined timing on gl (core/pipeline/Backend.h, "Pipelined timing"), what
+// only gl does; what every GPU backend does is PipelinedGpuTest.cpp. A whole
+// step's batch waits once (density's cover and render_splat's stats deferred,
+// its box visibility worked out on the device), and each read back inside it
+// once more; how render_splat skips in a batch follows the rasterizer; a
+// renderer's image is downloaded from the pixel buffer it passed through, and
+// never stale; layered passes give the bytes of one draw per slice.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -148,80 +149,6 @@ SubmissionCounts PipeDelta(const SubmissionCounts& before, const SubmissionCount
     return {after.submissions - before.submissions, after.hostWaits - before.hostWaits};
 }
 
-// The whole step in one batch gives the bytes, cover count and splat stats of
-// the same calls made one by one (render_splat skips empty boxes in its vertex
-// shader in a batch, by host runs otherwise: the same image, splats and voxels
-// visited), and one device time for each of its 8 intervals.
-TEST(PipelinedGL, BatchedStepEqualsCallsOneByOne) {
-    auto A = PipeMakeGl(), B = PipeMakeGl();
-    if (!A || !B) GTEST_SKIP() << "no gl backend here";
-    const PipeInputs in;
-    PipeStep a = PipeBuffers(*A), s = PipeBuffers(*B);
-    ASSERT_TRUE(PipeRun(*A, in, a, true, PipeNoMark).has_value());
-    ASSERT_TRUE(B->BeginBatch().has_value());
-    Status run = PipeRun(*B, in, s, true, PipeMark);
-    auto ms = B->EndBatch();
-    ASSERT_TRUE(run.has_value()) << run.error().message;
-    ASSERT_TRUE(ms.has_value()) << ms.error().message;
-    EXPECT_EQ(ms->size(), 8u);  // region, ca init, ca step, smooth, density, shade, shadow, render_splat
-    for (double t : *ms) EXPECT_TRUE(std::isfinite(t) && t >= 0) << t;
-    const auto expected = PipeOutputs(*A, a, true), got = PipeOutputs(*B, s, true);
-    ASSERT_EQ(expected.size(), got.size());
-    for (size_t n = 0; n < expected.size(); ++n) EXPECT_EQ(expected[n], got[n]) << "output " << n;
-    // The cover and the splat stats come after EndBatch, with the marks of their calls: density
-    // follows 4 marks (region, ca init, ca step, smooth), render_splat 7. The calls left the
-    // caller's values as they were.
-    EXPECT_EQ(s.covered, 0u);
-    EXPECT_EQ(s.stats.splats, 0u);
-    const std::vector<DeferredHostResult> deferred = B->TakeDeferredResults();
-    ASSERT_EQ(deferred.size(), 2u);
-    EXPECT_EQ(deferred[0].mark, 4u);
-    ASSERT_TRUE(deferred[0].coveredColumns.has_value());
-    EXPECT_FALSE(deferred[0].splat.has_value());
-    EXPECT_EQ(*deferred[0].coveredColumns, a.covered);
-    EXPECT_GT(a.covered, 0u);
-    EXPECT_EQ(deferred[1].mark, 7u);
-    ASSERT_TRUE(deferred[1].splat.has_value());
-    EXPECT_FALSE(deferred[1].coveredColumns.has_value());
-    EXPECT_EQ(a.stats.splats, deferred[1].splat->splats);
-    EXPECT_EQ(a.stats.voxelsVisited, deferred[1].splat->voxelsVisited);
-    EXPECT_EQ(a.stats.fragments, deferred[1].splat->fragments);
-    EXPECT_GT(a.stats.splats, 0u);
-    EXPECT_TRUE(B->TakeDeferredResults().empty());  // each result once
-    // Some boxes are empty in the bands: the skipping has voxels to skip.
-    const auto bands = test::Read<uint8_t>(*A, *a.bands);
-    EXPECT_GT(std::count(bands.begin(), bands.end(), uint8_t(0)), 0) << "no empty box: the test skips nothing";
-    EXPECT_LT(a.stats.voxelsVisited, kPipeGrid.Count());
-}
-
-// Calls that return no host value: one by one, each submits and waits; in a
-// batch, one submission and one wait (EndBatch's) for all five.
-TEST(PipelinedGL, ABatchWaitsOnceOneByOneWaitsPerCall) {
-    auto b = PipeMakeGl();
-    if (!b) GTEST_SKIP() << "no gl backend here";
-    const PipeInputs in;
-    PipeStep s = PipeBuffers(*b);
-    SubmissionCounts before = b->Submissions();
-    ASSERT_TRUE(PipeRun(*b, in, s, false, PipeNoMark).has_value());
-    SubmissionCounts d = PipeDelta(before, b->Submissions());
-    EXPECT_EQ(d.submissions, 5u);  // region, ca init, ca step, smooth, shade
-    EXPECT_EQ(d.hostWaits, 5u);
-
-    before = b->Submissions();
-    ASSERT_TRUE(b->BeginBatch().has_value());
-    ASSERT_TRUE(PipeRun(*b, in, s, false, PipeMark).has_value());  // marks after shade: an empty last interval, 0 ms
-    auto ms = b->EndBatch();
-    ASSERT_TRUE(ms.has_value()) << ms.error().message;
-    d = PipeDelta(before, b->Submissions());
-    EXPECT_EQ(d.submissions, 1u);
-    EXPECT_EQ(d.hostWaits, 1u);
-    ASSERT_EQ(ms->size(), 6u);
-    double total = 0;
-    for (size_t n = 0; n < 5; ++n) total += (*ms)[n];
-    EXPECT_GT(total, 0.0);
-    EXPECT_EQ((*ms)[5], 0.0);
-}
-
 // A whole step's batch waits once, at EndBatch: density's cover and
 // render_splat's stats are read after it (deferred), and render_splat's box
 // visibility is worked out on the device. Each read back inside a batch waits
@@ -290,17 +217,6 @@ TEST(PipelinedGL, SplatSkipAutoFollowsTheRasterizer) {
     EXPECT_EQ(statsA[1].splat->splats, statsD[1].splat->splats);
     EXPECT_EQ(statsA[1].splat->voxelsVisited, statsD[1].splat->voxelsVisited);
     EXPECT_EQ(statsA[1].splat->fragments, statsD[1].splat->fragments);
-}
-
-TEST(PipelinedGL, BatchesDoNotNestAndEndNeedsABegin) {
-    auto b = PipeMakeGl();
-    if (!b) GTEST_SKIP() << "no gl backend here";
-    EXPECT_FALSE(b->EndBatch().has_value());
-    ASSERT_TRUE(b->BeginBatch().has_value());
-    EXPECT_FALSE(b->BeginBatch().has_value());
-    auto ms = b->EndBatch();
-    ASSERT_TRUE(ms.has_value());
-    EXPECT_EQ(*ms, std::vector<double>{0.0});
 }
 
 // The image comes from the renderer's pixel buffer right after the call, from

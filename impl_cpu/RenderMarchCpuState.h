@@ -1,0 +1,25 @@
+// The ray marcher's state on cpu (RenderMarchCpu.cpp).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/scene/Scene.h"
+
+namespace cb::cpu {
+
+// One voxel of the ray marcher's formed volume: q_alpha and T side by side,
+// so a trilinear sample of both touches one set of cache lines.
+struct MarchQT {
+    float q, t;
+};
+
+struct RenderMarchCpuState {
+    static constexpr Stage kStage = Stage::RenderMarch;
+    std::vector<MarchQT> volume;  // the padded (q_alpha, T) volume
+    std::vector<uint8_t> bricks;  // skipping: 1 per empty brick
+    // The padded volume and one byte per brick.
+    uint64_t ScratchBytes(const Scene& scene) const;
+};
+
+}  // namespace cb::cpu

@@ -1,0 +1,23 @@
+// The splat renderer's state on gl (RenderSplatGL.cpp).
+#pragma once
+
+#include <cstdint>
+
+#include "core/scene/Scene.h"
+#include "impl_gl/ScratchGL.h"
+
+namespace cb::gl {
+
+struct RenderSplatGLState {
+    static constexpr Stage kStage = Stage::RenderSplat;
+    TextureSlot target;    // the RGBA32F image
+    BufferSlot order;      // the flattened shared order
+    BufferSlot frame;      // the shared frame block (core/math/Splat.h)
+    BufferSlot counters;   // the shader's counters (splats drawn), outside a batch
+    BufferSlot imageCopy;  // the pixel buffer the image passes through
+    BufferSlot ground;     // with the ground: the GroundGpu block (core/math/Ground.h)
+    // target.
+    uint64_t ScratchBytes(const Scene& scene) const;
+};
+
+}  // namespace cb::gl

@@ -1,0 +1,19 @@
+// Shade's state on vk (ShadeVk.cpp).
+#pragma once
+
+#include <cstdint>
+
+#include "core/scene/Scene.h"
+#include "impl_vk/ScratchVk.h"
+
+namespace cb::vk {
+
+struct ShadeVkState {
+    static constexpr Stage kStage = Stage::Shade;
+    // Resolution 2 or 4: q and T on the coarse grid, kept between the shares of a sweep.
+    BufferSlot coarseQ, coarseT;
+    // Below full resolution, coarseQ and coarseT: ceil(n / f) cells per axis.
+    uint64_t ScratchBytes(const Scene& scene) const;
+};
+
+}  // namespace cb::vk
