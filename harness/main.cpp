@@ -3,6 +3,7 @@
 // (harness/commands/), parses its options, prints help, runs it. docs/cli.md
 // describes the commands.
 #include <cstdio>
+#include <memory>
 #include <new>
 #include <string>
 #include <string_view>
@@ -78,6 +79,7 @@ int main(int argc, char** argv) {
     if (!command) return Usage("unknown command '" + cb::ShownArgument(name) + "'", MainHelp());
 
     cb::CommonOptions options;
+    const std::unique_ptr<cb::OwnOptions> own = command->makeOptions();
     options.commandLine.assign(argv, argv + argc);
     if (!command->keepsWarmup) options.overrides.push_back({"warmup_steps", "0"});
     bool sceneGiven = false;
@@ -91,7 +93,8 @@ int main(int argc, char** argv) {
             options.arguments.emplace_back(arg);
         } else if (const cb::OptionSpec* option = FindOption(*command, arg)) {
             const char* value = option->takesValue ? (n + 1 < argc ? argv[++n] : nullptr) : nullptr;
-            if (auto message = option->apply(options, value)) return Usage(*message, command->help);
+            auto message = option->apply ? option->apply(options, value) : option->applyOwn(*own, value);
+            if (message) return Usage(*message, command->help);
         } else if (arg.starts_with("-")) {
             return Usage("unknown option '" + cb::ShownArgument(arg) + "'" + OptionSuggestion(*command, arg),
                          command->help);
@@ -109,7 +112,7 @@ int main(int argc, char** argv) {
     // An allocation that fails anywhere outside an isolated backend's process
     // (which reports its own) ends the command with a message, not an abort.
     try {
-        return command->run(options);
+        return command->run(options, *own);
     } catch (const std::bad_alloc& e) {
         const std::string phase = cb::CurrentPhase();
         std::fflush(stdout);

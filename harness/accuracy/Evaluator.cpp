@@ -148,7 +148,7 @@ Result<ImageReferences::Loaded> ImageReferences::Load(const std::vector<SceneOve
     if (it == mCache.end()) {
         auto refScene = mSession.LoadVariant(physical);
         if (!refScene) return std::unexpected(refScene.error());
-        const float step = float(mSession.Options().referenceStep);
+        const float step = float(mEval.Measurement().referenceStep);
         if (!mSession.Options().quiet)
             std::fprintf(stderr, "reference render of %s%s%s at step %g voxel\n", scene->name.c_str(),
                          key.empty() ? "" : " with ", key.c_str(), double(step));

@@ -44,7 +44,8 @@ struct ReferenceRecord {
 
 class Evaluator {
   public:
-    Evaluator(const Session& session, ref::RayStart start) : mSession(session), mStart(start) {}
+    Evaluator(const Session& session, const MeasurementOptions& measurement, ref::RayStart start)
+        : mSession(session), mMeasurement(measurement), mStart(start) {}
 
     // q and D for a scene loaded with `overrides` (cached by the overrides that can change them).
     Result<const LightingInputs*> Inputs(const Scene& scene, const std::vector<SceneOverride>& overrides);
@@ -64,6 +65,8 @@ class Evaluator {
 
     const std::vector<ReferenceRecord>& Records() const { return mRecords; }
     const CommonOptions& Options() const { return mSession.Options(); }
+    // --repeat and --reference-step of the command that measures.
+    const MeasurementOptions& Measurement() const { return mMeasurement; }
     const Session& GetSession() const { return mSession; }
     // The reference renders of this process (harness/accuracy/ImageAccuracy.h), made on first use.
     ImageReferences& Images();
@@ -80,6 +83,7 @@ class Evaluator {
     }
 
     const Session& mSession;
+    const MeasurementOptions& mMeasurement;
     ref::RayStart mStart;
     std::string mLastReference;
     std::map<std::string, LightingInputs> mInputs;

@@ -76,8 +76,9 @@ json ImageRowJson(Stage renderer, const std::string& backend, const std::vector<
     return j;
 }
 
-Status MeasureImageRows(ImageReferences& refs, const Session& session, const std::vector<SceneOverride>& setting,
-                        std::span<const OpenedBackend> backends, std::span<const Stage> renderers, json& rows) {
+Status MeasureImageRows(ImageReferences& refs, const Session& session, int repeats,
+                        const std::vector<SceneOverride>& setting, std::span<const OpenedBackend> backends,
+                        std::span<const Stage> renderers, json& rows) {
     auto loaded = refs.Load(setting);
     if (!loaded) {
         // A setting the scene refuses (e.g. a light source that needs a stage the scene lacks).
@@ -92,7 +93,7 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, const std
             // A backend without the renderer has one "unsupported" row, at the scene's settings.
             if (slot.backend && !slot.backend->Supports(r) && !setting.empty()) continue;
             RenderAccuracy a = slot.backend ? MeasureRender(*slot.backend, r, loaded->scene, *loaded->in,
-                                                            loaded->reference->result.image, session.Options().repeats)
+                                                            loaded->reference->result.image, repeats)
                                             : RenderNotMeasured("unavailable", slot.reason);
             if (a.status != "ok" && !session.Options().quiet)
                 std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(r)).c_str(),
@@ -199,7 +200,7 @@ Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<Scene
     auto loaded = eval.Images().Load(setting);
     if (!loaded) return std::unexpected(loaded.error());
     const RenderAccuracy a = MeasureRender(backend, renderer, loaded->scene, *loaded->in,
-                                           loaded->reference->result.image, eval.Options().repeats);
+                                           loaded->reference->result.image, eval.Measurement().repeats);
     StageAccuracy out;
     out.status = a.status;
     out.detail = a.detail;
@@ -212,16 +213,17 @@ Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<Scene
 Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<const OpenedBackend> backends) {
     const Scene& scene = session.GetScene();
     ImageReferences& refs = eval.Images();
+    const int repeats = eval.Measurement().repeats;
     json rows = json::array();
     if (scene.stages.Has(Stage::RenderMarch)) {
         const Stage march[] = {Stage::RenderMarch};
-        CB_TRY(MeasureImageRows(refs, session, {}, backends, march, rows));
+        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, march, rows));
         for (const auto& v : MarchImageVariants(scene))
-            CB_TRY(MeasureImageRows(refs, session, v, backends, march, rows));
+            CB_TRY(MeasureImageRows(refs, session, repeats, v, backends, march, rows));
     }
     if (scene.stages.Has(Stage::RenderSplat)) {
         const Stage splat[] = {Stage::RenderSplat};
-        CB_TRY(MeasureImageRows(refs, session, {}, backends, splat, rows));
+        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, splat, rows));
     }
     return json{{"rows", rows}, {"references", refs.Records()}};
 }

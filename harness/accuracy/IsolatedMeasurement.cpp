@@ -48,9 +48,11 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
             if (!slot.backend)
                 row.result = NotMeasured("unavailable", slot.reason);
             else if (stage == Stage::Shade)
-                row.result = MeasureShade(*slot.backend, scene, *point->in, *point->reference, options.repeats);
+                row.result =
+                    MeasureShade(*slot.backend, scene, *point->in, *point->reference, eval.Measurement().repeats);
             else
-                row.result = MeasureShadow(*slot.backend, scene, *point->in, *point->reference, options.repeats);
+                row.result =
+                    MeasureShadow(*slot.backend, scene, *point->in, *point->reference, eval.Measurement().repeats);
             if (row.result.status != "ok" && !options.quiet)
                 std::fprintf(stderr, "%s %s %s: %s: %s\n", slot.name.c_str(), std::string(StageName(stage)).c_str(),
                              SettingsLabel(setting).c_str(), row.result.status.c_str(), row.result.detail.c_str());
@@ -63,14 +65,15 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
 namespace {
 
 // In the child: opens the backend and measures the plan.
-Result<json> MeasureHere(Session& session, const std::string& name, const std::vector<PlannedSetting>& plan,
-                         const MoreMeasurements& more, const std::function<void(size_t)>& progress) {
+Result<json> MeasureHere(Session& session, const MeasurementOptions& measurement, const std::string& name,
+                         const std::vector<PlannedSetting>& plan, const MoreMeasurements& more,
+                         const std::function<void(size_t)>& progress) {
     MarkPhase("opening backend");
     const std::vector<OpenedBackend> backends = session.OpenBackends({name});
     json out = {{"provenance", transfer::ToJson(session.BackendRecords().back())},
                 {"available", backends[0].backend != nullptr}};
     if (!backends[0].backend) return out;
-    Evaluator eval(session, ref::RayStart::VoxelExit);
+    Evaluator eval(session, measurement, ref::RayStart::VoxelExit);
     out["rows"] = json::array();
     for (size_t k = 0; k < plan.size(); ++k) {
         MarkPhase("measuring " + SettingsLabel(plan[k].setting));
@@ -95,7 +98,8 @@ Result<json> MeasureHere(Session& session, const std::string& name, const std::v
 
 }  // namespace
 
-Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, const std::vector<std::string>& names,
+Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, const MeasurementOptions& measurement,
+                                                           const std::vector<std::string>& names,
                                                            const std::vector<PlannedSetting>& plan,
                                                            const MoreMeasurements& more,
                                                            const std::function<void(size_t)>& progress) {
@@ -105,7 +109,7 @@ Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, con
         part.name = name;
         IsolatedOutcome outcome =
             RunIsolated("backend " + name, IsolationFrom(session.Options()), [&](const SendMessage&) -> json {
-                auto measured = MeasureHere(session, name, plan, more, progress);
+                auto measured = MeasureHere(session, measurement, name, plan, more, progress);
                 if (!measured) return {{"error", measured.error().message}};
                 return *measured;
             });

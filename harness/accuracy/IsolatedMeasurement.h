@@ -42,10 +42,12 @@ struct BackendMeasurement {
 // JSON comes back as BackendMeasurement::extra.
 using MoreMeasurements = std::function<Result<nlohmann::json>(Evaluator& eval, std::span<const OpenedBackend> backend)>;
 
-// Measures `plan` on each of `names`, each in its own process. An error in the
+// Measures `plan` on each of `names`, each in its own process, with the
+// command's --repeat and --reference-step (`measurement`). An error in the
 // measurement itself (not the backend's crash: the reference or the inputs)
 // ends it with the error. `progress` (optional) is called after each plan item in the child.
-Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, const std::vector<std::string>& names,
+Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, const MeasurementOptions& measurement,
+                                                           const std::vector<std::string>& names,
                                                            const std::vector<PlannedSetting>& plan,
                                                            const MoreMeasurements& more = {},
                                                            const std::function<void(size_t)>& progress = {});

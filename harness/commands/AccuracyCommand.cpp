@@ -239,7 +239,12 @@ void Emit(report::Report& report, report::Section section) {
     report.sections.push_back(std::move(section));
 }
 
-int Accuracy(const CommonOptions& options) {
+// accuracy's own options (docs/accuracy.md): --repeat, --reference-step and --switches.
+struct AccuracyOptions : MeasurementOptions {
+    bool switches = false;  // also the jumps at each option's switching points
+};
+
+int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
     auto session = Session::Open(options, "accuracy");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
@@ -276,7 +281,7 @@ int Accuracy(const CommonOptions& options) {
                 rows.push_back(transfer::ToJson(cells));
             extra["ray_start"] = {{"rows", rows}, {"doc", doc}};
         }
-        if (options.switches && scene.stages.Has(Stage::Shade)) {
+        if (own.switches && scene.stages.Has(Stage::Shade)) {
             auto sw = MeasureSwitches(eval, **session, backends);
             if (!sw) return MakeError("switches: " + sw.error().message);
             json errors = json::array(), jumps = json::array(), items = json::array();
@@ -294,7 +299,7 @@ int Accuracy(const CommonOptions& options) {
         }
         return extra;
     };
-    auto parts = MeasureEachBackend(**session, names, plan, more);
+    auto parts = MeasureEachBackend(**session, own, names, plan, more);
     if (!parts) {
         std::fprintf(stderr, "accuracy: %s\n", parts.error().message.c_str());
         return kExitFailed;
@@ -309,7 +314,7 @@ int Accuracy(const CommonOptions& options) {
                 {"grid", {scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz}},
                 {"step", scene.steps - 1},
                 {"reference_start", "voxel-exit"},
-                {"repeats", options.repeats},
+                {"repeats", own.repeats},
                 {"rows", json::array()}};
     report::Report report("Accuracy of " + scene.name);
     for (Stage stage : {Stage::Shade, Stage::Shadow}) {
@@ -341,7 +346,7 @@ int Accuracy(const CommonOptions& options) {
         anyRayStart = true;
     }
     if (anyRayStart) Emit(report, {"Reference ray start: voxel exit (default) vs voxel centre", {std::move(rayStart)}});
-    if (options.switches && scene.stages.Has(Stage::Shade)) {
+    if (own.switches && scene.stages.Has(Stage::Shade)) {
         // Rows by key, then by backend (the parts' order): a stable sort of the parts' rows in turn.
         SwitchResult sw = EmptySwitchResult();
         auto merged = [&](const char* name) {
@@ -395,7 +400,7 @@ int Accuracy(const CommonOptions& options) {
         }
         doc["image_rows"] = imageRows;
         doc["image_references"] = imageRefs;
-        doc["reference_step_voxels"] = options.referenceStep;
+        doc["reference_step_voxels"] = own.referenceStep;
         Emit(report, {"images: per-pixel max over channels of |C - C_ref| (linear HDR) against the exact reference "
                       "render, and PSNR (peak: the reference's largest value)",
                       {ImageRowsTable(imageRows)}});
@@ -422,9 +427,10 @@ const CommandRegistration kRegistration({
     .summary = "Measure every shade and shadow option against the exact (Embree) reference",
     .help = kHelp,
     .helpOrder = 4,
-    .extraOptions = WithIsolationOptions({RepeatOption(), FlagOption("--switches", &CommonOptions::switches),
+    .extraOptions = WithIsolationOptions({RepeatOption(), FlagOption("--switches", &AccuracyOptions::switches),
                                           ReferenceStepOption()}),
-    .run = Accuracy,
+    .makeOptions = MakeOwnOptions<AccuracyOptions>,
+    .run = RunWith(Accuracy),
 });
 
 }  // namespace

@@ -105,11 +105,19 @@ nlohmann::json IsolatedConformance(Session& session, const std::string& name, co
     return {{"rows", list}, {"backends", backends}};
 }
 
-int Conform(const CommonOptions& options) {
+// conform's own options (docs/cli.md).
+struct ConformOptions : OwnOptions {
+    std::string baseline;           // --baseline FILE: known failures
+    uint32_t flakeReruns = 0;       // --flake-reruns N
+    bool matrix = false;            // --matrix: the stages' choice settings (harness/conform/ConformMatrix.h)
+    std::vector<std::string> vary;  // --vary PATH=V1,V2,...
+};
+
+int Conform(const CommonOptions& options, const ConformOptions& own) {
     // The baseline is read before anything else runs: a bad one exits 3 with "file: line N: reason".
     std::optional<ConformBaseline> baseline;
-    if (!options.baseline.empty()) {
-        auto loaded = LoadConformBaseline(options.baseline);
+    if (!own.baseline.empty()) {
+        auto loaded = LoadConformBaseline(own.baseline);
         if (!loaded) {
             std::fprintf(stderr, "%s\n", loaded.error().message.c_str());
             return kExitBadScene;
@@ -117,8 +125,8 @@ int Conform(const CommonOptions& options) {
         baseline = std::move(*loaded);
     }
     std::vector<SweepAxis> axes;
-    if (!options.vary.empty()) {
-        auto parsed = ParseVaryAxes(options.vary);
+    if (!own.vary.empty()) {
+        auto parsed = ParseVaryAxes(own.vary);
         if (!parsed) {
             std::fprintf(stderr, "conform: %s\n", parsed.error().c_str());
             return kExitUsage;
@@ -134,9 +142,9 @@ int Conform(const CommonOptions& options) {
     for (const std::string& name : (*session)->RequestedBackends(BuiltBackends()))
         if (name != "cpu") names.push_back(name);
     // The cases: the scene alone, or --matrix's and --vary's, each validated before anything runs.
-    const bool byCase = options.matrix || !axes.empty();
+    const bool byCase = own.matrix || !axes.empty();
     std::vector<ConformCase> cases;
-    if (options.matrix)
+    if (own.matrix)
         cases = ConformMatrixCases(scene, options.glCaLayout, std::ranges::find(names, "gl") != names.end());
     for (ConformCase& c : ConformVaryCases(axes))
         if (std::ranges::none_of(cases, [&](const ConformCase& k) { return k.name == c.name; }))
@@ -229,10 +237,10 @@ int Conform(const CommonOptions& options) {
             // --flake-reruns: the backend's whole comparison in this case again (a single stage cannot be rerun
             // alone: its inputs are the CPU's of that step), until no row fails. A crash that then passes is
             // flaky too.
-            for (uint32_t attempt = 1; attempt <= options.flakeReruns && std::ranges::any_of(*got, IsConformFailure);
+            for (uint32_t attempt = 1; attempt <= own.flakeReruns && std::ranges::any_of(*got, IsConformFailure);
                  ++attempt) {
                 std::printf("backend %s%s: rerun %u of %u for its failing rows\n", name.c_str(),
-                            byCase ? (" in case " + c.name).c_str() : "", attempt, options.flakeReruns);
+                            byCase ? (" in case " + c.name).c_str() : "", attempt, own.flakeReruns);
                 bool crashedAgain = false;
                 auto again = runBackend(*caseSession, c.name, name, attempt, crashedAgain);
                 if (!again) return kExitFailed;
@@ -291,8 +299,8 @@ int Conform(const CommonOptions& options) {
             if (backend == "gl")
                 doc["coverage"]["ca"]["options"]["gl_ca_layout"] = gl::CaLayoutName(options.glCaLayout);
     }
-    doc["flake_reruns"] = options.flakeReruns;
-    doc["baseline"] = options.baseline;
+    doc["flake_reruns"] = own.flakeReruns;
+    doc["baseline"] = own.baseline;
     doc["report"] = report::RenderJson(report);
     const std::string path = (*session)->OutDir() + "/conform.json";
     if (Status s = (*session)->WriteJson(path, doc); !s) {
@@ -314,19 +322,21 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 2,
     .extraOptions = WithIsolationOptions({
-        TextOption("--baseline", &CommonOptions::baseline, "--baseline needs a file of known failures"),
-        FlagOption("--matrix", &CommonOptions::matrix),
-        ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary smooth.radius=0,2"),
-        {"--flake-reruns", "", true,
-         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-             char* end = nullptr;
-             const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
-             if (!v || !*v || *end || v[0] == '-' || n > 100) return "--flake-reruns needs a count from 0 to 100";
-             o.flakeReruns = uint32_t(n);
-             return std::nullopt;
-         }},
+        TextOption("--baseline", &ConformOptions::baseline, "--baseline needs a file of known failures"),
+        FlagOption("--matrix", &ConformOptions::matrix),
+        ListOption("--vary", &ConformOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary smooth.radius=0,2"),
+        OwnOption<ConformOptions>("--flake-reruns", true,
+                                  [](ConformOptions& o, const char* v) -> std::optional<std::string> {
+                                      char* end = nullptr;
+                                      const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
+                                      if (!v || !*v || *end || v[0] == '-' || n > 100)
+                                          return "--flake-reruns needs a count from 0 to 100";
+                                      o.flakeReruns = uint32_t(n);
+                                      return std::nullopt;
+                                  }),
     }),
-    .run = Conform,
+    .makeOptions = MakeOwnOptions<ConformOptions>,
+    .run = RunWith(Conform),
 });
 
 }  // namespace

@@ -177,7 +177,7 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 6,
     .keepsWarmup = true,
-    .run = Count,
+    .run = RunWith(Count),
 });
 
 }  // namespace

@@ -70,7 +70,7 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 3,
     .takesScene = false,
-    .run = Devices,
+    .run = RunWith(Devices),
 });
 
 }  // namespace

@@ -63,7 +63,12 @@ Status WriteReferenceDump(const Simulation& sim, const std::string& dir, int thr
 
 // Writes every output of the simulation's current step into DIR/step_tttt/ (created, or opened, from the
 // output folder's descriptor without following a link: MakeFolder).
-Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOptions& options) {
+// dump's own options (docs/cli.md).
+struct DumpOptions : OwnOptions {
+    bool reference = false;  // --reference: also the exact (Embree) reference of each step
+};
+
+Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOptions& options, const DumpOptions& own) {
     char folder[32];
     std::snprintf(folder, sizeof folder, "/step_%04u", s.CurrentStep());
     const std::string dir = outDir + folder;
@@ -85,11 +90,11 @@ Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOpt
             if (!paths) return std::unexpected(paths.error());
         }
     }
-    if (options.reference) CB_TRY(WriteReferenceDump(s, dir, options.cpuThreads));
+    if (own.reference) CB_TRY(WriteReferenceDump(s, dir, options.cpuThreads));
     return {};
 }
 
-int Dump(const CommonOptions& options) {
+int Dump(const CommonOptions& options, const DumpOptions& own) {
     auto session = Session::Open(options, "dump");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
@@ -108,7 +113,7 @@ int Dump(const CommonOptions& options) {
         std::fprintf(stderr, "%s\n", sim.error().message.c_str());
         return kExitFailed;
     }
-    auto observe = [&](const Simulation& s) { return WriteStep(s, outDir, options); };
+    auto observe = [&](const Simulation& s) { return WriteStep(s, outDir, options, own); };
     Progress progress("dump " + name, scene.steps, options.quiet);
     for (uint32_t t = 0; t < scene.steps; ++t) {
         StepRecord record;
@@ -130,8 +135,9 @@ const CommandRegistration kRegistration({
     .summary = "Write each step's canonical stage outputs as NumPy .npy files",
     .help = kHelp,
     .helpOrder = 1,
-    .extraOptions = {FlagOption("--reference", &CommonOptions::reference)},
-    .run = Dump,
+    .extraOptions = {FlagOption("--reference", &DumpOptions::reference)},
+    .makeOptions = MakeOwnOptions<DumpOptions>,
+    .run = RunWith(Dump),
 });
 
 }  // namespace

@@ -254,7 +254,7 @@ const CommandRegistration kRegistration({
     .takesScene = false,
     .takesArguments = true,
     .extraOptions = {TextOption("--out", &CommonOptions::outDir, "--out needs a folder")},
-    .run = Merge,
+    .run = RunWith(Merge),
 });
 
 }  // namespace

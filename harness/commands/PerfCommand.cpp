@@ -87,7 +87,7 @@ const CommandRegistration kRegistration({
     .helpOrder = 6,
     .takesScene = false,
     .rawArguments = true,
-    .run = Perf,
+    .run = RunWith(Perf),
 });
 
 }  // namespace

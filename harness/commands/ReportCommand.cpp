@@ -33,8 +33,14 @@ cannot be written, 2 for a bad command line (no input), 3 for an input that
 cannot be read or is not a cloudbench output (the message names the file).
 )";
 
-int Report(const CommonOptions& options) {
-    if (options.arguments.empty() && options.history.empty()) {
+// report's own options (docs/cli.md).
+struct ReportOptions : OwnOptions {
+    std::string history;  // --history FILE
+    std::string outFile;  // -o FILE; "" = report.html
+};
+
+int Report(const CommonOptions& options, const ReportOptions& own) {
+    if (options.arguments.empty() && own.history.empty()) {
         std::fprintf(stderr, "cloudbench: report needs a results, conform, accuracy or sweep file, or --history\n\n%s",
                      kHelp);
         return kExitUsage;
@@ -49,8 +55,8 @@ int Report(const CommonOptions& options) {
         for (html::ReportInput& input : *read) inputs.push_back(std::move(input));
     }
     std::vector<nlohmann::json> history;
-    if (!options.history.empty()) {
-        auto read = input::ReadHistory(options.history);
+    if (!own.history.empty()) {
+        auto read = input::ReadHistory(own.history);
         if (!read) {
             std::fprintf(stderr, "%s\n", read.error().message.c_str());
             return kExitBadScene;
@@ -60,13 +66,13 @@ int Report(const CommonOptions& options) {
     }
     std::string page;
     try {
-        page = html::RenderHtml(html::BuildReport(inputs, history, options.history));
+        page = html::RenderHtml(html::BuildReport(inputs, history, own.history));
     } catch (const nlohmann::json::exception& e) {
         // A field of the right name and the wrong type in one of the inputs.
         std::fprintf(stderr, "cloudbench: report: an input has an unexpected shape: %s\n", e.what());
         return kExitBadScene;
     }
-    const std::string out = options.outFile.empty() ? "report.html" : options.outFile;
+    const std::string out = own.outFile.empty() ? "report.html" : own.outFile;
     if (Status s = Session::WriteText(out, page); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
@@ -82,15 +88,17 @@ const CommandRegistration kRegistration({
     .helpOrder = 6,
     .takesScene = false,
     .takesArguments = true,
-    .extraOptions = {{"-o", "--output", true,
-                      [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                          if (!v) return "-o needs a file, e.g. -o report.html";
-                          if (!*v) return "-o: must not be empty";
-                          o.outFile = v;
-                          return std::nullopt;
+    .extraOptions = {{"-o",
+                      "--output",
+                      true,
+                      {},
+                      [](OwnOptions& own, const char* v) {
+                          return StoreText("-o", dynamic_cast<ReportOptions&>(own).outFile, v,
+                                           "-o needs a file, e.g. -o report.html");
                       }},
-                     TextOption("--history", &CommonOptions::history, "--history needs a file")},
-    .run = Report,
+                     TextOption("--history", &ReportOptions::history, "--history needs a file")},
+    .makeOptions = MakeOwnOptions<ReportOptions>,
+    .run = RunWith(Report),
 });
 
 }  // namespace

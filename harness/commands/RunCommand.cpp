@@ -53,26 +53,37 @@ constexpr const char* kHelpTail = R"(                     (the contexts and layo
 )";
 const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail + IsolationOptionsHelp();
 
-std::vector<OptionSpec> RunOptions() {
+// run's own options (docs/cli.md), besides crash isolation's.
+struct RunOptions : OwnOptions {
+    // --timing: "synchronized", "pipelined" or "both" (docs/performance.md, "Two ways to time a step").
+    std::string timing = "synchronized";
+    // --save-state DIR, --save-state-every N (0 = only at the end), --resume DIR (harness/run/SimulationState.h).
+    std::string saveState, resumeState;
+    uint32_t saveStateEvery = 0;
+};
+
+std::vector<OptionSpec> RunOptionSpecs() {
     std::vector<OptionSpec> options = IsolationOptions();
-    options.push_back({"--timing", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                           const std::string value = v ? v : "";
-                           if (value != "synchronized" && value != "pipelined" && value != "both")
-                               return "--timing: must be synchronized, pipelined or both" +
-                                      (v ? " (got '" + value + "')" : std::string());
-                           o.timing = value;
-                           return std::nullopt;
-                       }});
-    options.push_back(TextOption("--save-state", &CommonOptions::saveState, "--save-state needs a folder"));
-    options.push_back(TextOption("--resume", &CommonOptions::resumeState, "--resume needs a saved state's folder"));
-    options.push_back({"--save-state-every", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                           char* end = nullptr;
-                           const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
-                           if (!v || !*v || *end || v[0] == '-' || n == 0 || n > UINT32_MAX)
-                               return "--save-state-every needs a step count > 0";
-                           o.saveStateEvery = uint32_t(n);
-                           return std::nullopt;
-                       }});
+    options.push_back(
+        OwnOption<RunOptions>("--timing", true, [](RunOptions& o, const char* v) -> std::optional<std::string> {
+            const std::string value = v ? v : "";
+            if (value != "synchronized" && value != "pipelined" && value != "both")
+                return "--timing: must be synchronized, pipelined or both" +
+                       (v ? " (got '" + value + "')" : std::string());
+            o.timing = value;
+            return std::nullopt;
+        }));
+    options.push_back(TextOption("--save-state", &RunOptions::saveState, "--save-state needs a folder"));
+    options.push_back(TextOption("--resume", &RunOptions::resumeState, "--resume needs a saved state's folder"));
+    options.push_back(OwnOption<RunOptions>("--save-state-every", true,
+                                            [](RunOptions& o, const char* v) -> std::optional<std::string> {
+                                                char* end = nullptr;
+                                                const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
+                                                if (!v || !*v || *end || v[0] == '-' || n == 0 || n > UINT32_MAX)
+                                                    return "--save-state-every needs a step count > 0";
+                                                o.saveStateEvery = uint32_t(n);
+                                                return std::nullopt;
+                                            }));
     return options;
 }
 
@@ -86,8 +97,8 @@ struct StateOptions {
 // and the top view; whatever fails is recorded in `run` and the rest goes on.
 // Each step's record is sent (to the parent, when isolated) as it is done.
 // Returns false when an output could not be written.
-bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::vector<std::string>& written,
-                const SendMessage& send, const StateOptions& state) {
+bool RunBackend(const Session& session, const RunOptions& own, Backend& backend, BackendRun& run,
+                std::vector<std::string>& written, const SendMessage& send, const StateOptions& state) {
     const Scene& scene = session.GetScene();
     const std::string& outDir = session.OutDir();
     const CommonOptions& options = session.Options();
@@ -96,7 +107,7 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
     if (sim && state.resume) {
         MarkPhase("restoring the saved state");
         if (Status s = RestoreSimulationState(**sim, *state.resume); !s)
-            sim = std::unexpected(Error{options.resumeState + ": " + s.error().message});
+            sim = std::unexpected(Error{own.resumeState + ": " + s.error().message});
     }
     if (!sim) {
         run.status = "failed";
@@ -111,15 +122,15 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
     // The state after the steps so far, in --save-state's folder (written whole or not at all).
     auto saveState = [&]() {
         MarkPhase("saving the state");
-        if (Status s = SaveSimulationState(**sim, options.saveState, state.sceneHash); !s)
+        if (Status s = SaveSimulationState(**sim, own.saveState, state.sceneHash); !s)
             failed(s.error());
         else if (!options.quiet)
-            std::fprintf(stderr, "%s: state saved at step %u\n", options.saveState.c_str(), (*sim)->CurrentStep());
+            std::fprintf(stderr, "%s: state saved at step %u\n", own.saveState.c_str(), (*sim)->CurrentStep());
     };
     Progress progress(run.name, scene.steps, options.quiet);
     for (uint32_t t = (*sim)->CurrentStep(); t < scene.steps; ++t) {
         StepRecord record;
-        (*sim)->SetTiming(TimingOfStep(options.timing, t));
+        (*sim)->SetTiming(TimingOfStep(own.timing, t));
         if (Status status = (*sim)->Step(record); !status) {
             run.status = "failed";
             run.error = "step " + std::to_string(t) + ": " + status.error().message;
@@ -128,10 +139,10 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
         send({{"step", transfer::ToJson(record)}});
         run.steps.push_back(record);
         progress.Update(t + 1);
-        if (options.saveStateEvery && (t + 1) % options.saveStateEvery == 0 && t + 1 < scene.steps) saveState();
+        if (own.saveStateEvery && (t + 1) % own.saveStateEvery == 0 && t + 1 < scene.steps) saveState();
     }
     // A failed step leaves no state to save: the last one saved (if any) stays.
-    if (!options.saveState.empty() && run.status == "ok") saveState();
+    if (!own.saveState.empty() && run.status == "ok") saveState();
     MarkPhase("writing frames");
     // The last frame of each renderer and camera.
     for (Resource image : kAllResources) {
@@ -173,8 +184,8 @@ bool RunBackend(const Session& session, Backend& backend, BackendRun& run, std::
 // One backend's whole run, in its own process when isolated: opens it (so no
 // GL, Vulkan or TBB state exists in the parent), runs it, writes its frames.
 // Sends {"opened": ...} and each {"step": ...}; returns the rest.
-nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, const SendMessage& send,
-                                  const StateOptions& state) {
+nlohmann::json IsolatedBackendRun(Session& session, const RunOptions& own, const std::string& name,
+                                  const SendMessage& send, const StateOptions& state) {
     MarkPhase("opening backend");
     std::vector<OpenedBackend> opened = session.OpenBackends({name}, &session.GetScene());
     OpenedBackend& slot = opened[0];
@@ -193,7 +204,7 @@ nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, con
             {"planned_bytes", planned}}}});
     std::vector<std::string> written;
     bool allWritten = true;
-    if (slot.backend) allWritten = RunBackend(session, *slot.backend, run, written, send, state);
+    if (slot.backend) allWritten = RunBackend(session, own, *slot.backend, run, written, send, state);
     MarkPhase("closing backend");
     slot.backend.reset();
     return {{"status", run.status},
@@ -203,7 +214,7 @@ nlohmann::json IsolatedBackendRun(Session& session, const std::string& name, con
             {"all_written", allWritten}};
 }
 
-int Run(const CommonOptions& options) {
+int Run(const CommonOptions& options, const RunOptions& own) {
     auto session = Session::Open(options, "");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
@@ -211,20 +222,20 @@ int Run(const CommonOptions& options) {
     // --save-state and --resume: one backend's run; a saved state is read and checked whole before anything else.
     StateOptions state;
     std::optional<SimulationState> resumed;
-    if (!options.saveState.empty() || !options.resumeState.empty()) {
+    if (!own.saveState.empty() || !own.resumeState.empty()) {
         if (names.size() != 1) {
             std::fprintf(stderr, "%s: a saved state is one backend's run: name one with --backend\n",
-                         options.saveState.empty() ? "--resume" : "--save-state");
+                         own.saveState.empty() ? "--resume" : "--save-state");
             return kExitUsage;
         }
         state.sceneHash = SceneSettingsHash(SceneWithOverrides((*session)->ScenePath(), options.overrides));
     }
-    if (options.saveStateEvery && options.saveState.empty()) {
+    if (own.saveStateEvery && own.saveState.empty()) {
         std::fprintf(stderr, "--save-state-every: needs --save-state DIR\n");
         return kExitUsage;
     }
-    if (!options.resumeState.empty()) {
-        auto loaded = ReadSimulationState(options.resumeState, scene, state.sceneHash);
+    if (!own.resumeState.empty()) {
+        auto loaded = ReadSimulationState(own.resumeState, scene, state.sceneHash);
         if (!loaded) {
             std::fprintf(stderr, "%s\n", loaded.error().message.c_str());
             return kExitBadScene;
@@ -236,7 +247,7 @@ int Run(const CommonOptions& options) {
     std::printf("scene %s: %ux%ux%u voxels, %u steps (%u warm-up)\n", scene.name.c_str(), scene.grid.size.nx,
                 scene.grid.size.ny, scene.grid.size.nz, scene.steps, scene.warmupSteps);
 
-    if (resumed) std::printf("resuming %s at step %u\n", options.resumeState.c_str(), resumed->step);
+    if (resumed) std::printf("resuming %s at step %u\n", own.resumeState.c_str(), resumed->step);
     std::vector<BackendRun> runs;
     std::map<std::string, nlohmann::json> failures;  // by backend: why its process gave no result
     std::vector<std::string> written;
@@ -265,7 +276,7 @@ int Run(const CommonOptions& options) {
     const IsolationSettings isolation = IsolationFrom(options);
     for (size_t i = 0; i < names.size(); ++i) {
         IsolatedOutcome outcome = RunIsolated("backend " + names[i], isolation, [&](const SendMessage& send) {
-            return IsolatedBackendRun(**session, names[i], send, state);
+            return IsolatedBackendRun(**session, own, names[i], send, state);
         });
         // What the backend's process sent before it ended is kept, whatever became of it.
         BackendRun run;
@@ -326,8 +337,9 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 0,
     .keepsWarmup = true,
-    .extraOptions = RunOptions(),
-    .run = Run,
+    .extraOptions = RunOptionSpecs(),
+    .makeOptions = MakeOwnOptions<RunOptions>,
+    .run = RunWith(Run),
 });
 
 }  // namespace

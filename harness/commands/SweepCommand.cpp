@@ -122,21 +122,29 @@ std::expected<std::vector<std::vector<SceneOverride>>, int> Points(const Session
     return points;
 }
 
-int Sweep(const CommonOptions& options) {
-    if (options.vary.empty()) {
+// sweep's own options (docs/cli.md), besides --repeat and --reference-step.
+struct SweepOptions : MeasurementOptions {
+    std::vector<std::string> vary;  // --vary PATH=V1,V2,...
+    std::string metric = "max";     // --metric: max, mean or p99
+    int shardIndex = 0;             // --shard I/N: share I (1-based) of N; shardCount 0 = not sharded
+    int shardCount = 0;
+};
+
+int Sweep(const CommonOptions& options, const SweepOptions& own) {
+    if (own.vary.empty()) {
         std::fprintf(stderr, "sweep: needs at least one --vary PATH=V1,V2,...\n");
         return kExitUsage;
     }
-    if (options.metric != "max" && options.metric != "mean" && options.metric != "p99") {
-        std::fprintf(stderr, "sweep: --metric: must be max, mean or p99, got '%s'\n", options.metric.c_str());
+    if (own.metric != "max" && own.metric != "mean" && own.metric != "p99") {
+        std::fprintf(stderr, "sweep: --metric: must be max, mean or p99, got '%s'\n", own.metric.c_str());
         return kExitUsage;
     }
-    auto axes = ParseVaryAxes(options.vary);
+    auto axes = ParseVaryAxes(own.vary);
     if (!axes) {
         std::fprintf(stderr, "sweep: %s\n", axes.error().c_str());
         return kExitUsage;
     }
-    const bool sharded = options.shardCount > 0;
+    const bool sharded = own.shardCount > 0;
     if (sharded)
         for (const Axis& a : *axes)
             for (size_t i = 0; i < a.values.size(); ++i)
@@ -157,19 +165,19 @@ int Sweep(const CommonOptions& options) {
     std::printf(
         "sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "
         "%s error\n",
-        scene.name.c_str(), points->size(), names.size(), options.repeats, options.metric.c_str());
+        scene.name.c_str(), points->size(), names.size(), own.repeats, own.metric.c_str());
     if (sharded)
         std::printf("shard %d/%d: points k with k %% %d == %d (the Pareto marks are within the shard)\n",
-                    options.shardIndex, options.shardCount, options.shardCount, options.shardIndex - 1);
+                    own.shardIndex, own.shardCount, own.shardCount, own.shardIndex - 1);
     const std::vector<Stage> stages = SweepStages(*axes);
     // With --shard I/N, the points whose global index k has k % N == I-1.
     std::vector<size_t> planPoint;
     for (size_t k = 0; k < points->size(); ++k)
-        if (!sharded || int(k % size_t(options.shardCount)) == options.shardIndex - 1) planPoint.push_back(k);
+        if (!sharded || int(k % size_t(own.shardCount)) == own.shardIndex - 1) planPoint.push_back(k);
     // Each backend measures every point in a process of its own (harness/accuracy/IsolatedMeasurement.h).
     std::vector<PlannedSetting> plan;
     for (size_t k : planPoint) plan.push_back({(*points)[k], stages});
-    auto parts = MeasureEachBackend(**session, names, plan, {}, [&](size_t n) {
+    auto parts = MeasureEachBackend(**session, own, names, plan, {}, [&](size_t n) {
         if (!options.quiet) std::fprintf(stderr, "sweep: point %zu/%zu done\n", n + 1, plan.size());
     });
     if (!parts) {
@@ -188,14 +196,14 @@ int Sweep(const CommonOptions& options) {
         while (item + 1 < plan.size() && SettingsLabel(rows[i].settings) != SettingsLabel(plan[item].setting)) ++item;
         rowPoint.push_back(planPoint[item]);
     }
-    MarkPareto(rows, options.metric);
+    MarkPareto(rows, own.metric);
 
     json doc = {{"format", "cloudbench-sweep/1"},
                 {"scene", scene.name},
                 {"grid", {scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz}},
                 {"step", scene.steps - 1},
-                {"metric", options.metric},
-                {"repeats", options.repeats},
+                {"metric", own.metric},
+                {"repeats", own.repeats},
                 {"reference_start", "voxel-exit"},
                 {"references", ReferencesJson(FirstRecords(*parts), options.cpuThreads)}};
     if (sharded) {
@@ -205,13 +213,13 @@ int Sweep(const CommonOptions& options) {
             shardRows.push_back(transfer::ToJson(rows[i]));
             shardRows.back()["point"] = rowPoint[i];
         }
-        doc["shard"] = {{"index", options.shardIndex},
-                        {"count", options.shardCount},
+        doc["shard"] = {{"index", own.shardIndex},
+                        {"count", own.shardCount},
                         {"points", points->size()},
                         {"rows", std::move(shardRows)}};
     }
     const int written =
-        WriteSweepOutputs(std::move(doc), scene.name, options.metric, *axes, stages, rows, (*session)->OutDir(),
+        WriteSweepOutputs(std::move(doc), scene.name, own.metric, *axes, stages, rows, (*session)->OutDir(),
                           [&](const std::string& path, json d) { return (*session)->WriteJson(path, std::move(d)); });
     if (written != kExitOk) return written;
     return anyCrashed ? kExitFailed : kExitOk;
@@ -223,23 +231,23 @@ const CommandRegistration kRegistration({
     .help = kHelp,
     .helpOrder = 5,
     .extraOptions = WithIsolationOptions(
-        {ListOption("--vary", &CommonOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
-         TextOption("--metric", &CommonOptions::metric, "--metric needs max, mean or p99"),
-         RepeatOption(),
+        {ListOption("--vary", &SweepOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
+         TextOption("--metric", &SweepOptions::metric, "--metric needs max, mean or p99"), RepeatOption(),
          ReferenceStepOption(),
-         {"--shard", "", true,
-          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-              const std::string bad = "--shard needs I/N with 1 <= I <= N, e.g. --shard 2/8";
-              if (!v) return bad;
-              int index = 0, count = 0, used = 0;
-              if (std::sscanf(v, "%d/%d%n", &index, &count, &used) != 2 || v[used] != '\0' || index < 1 ||
-                  count < index || count > 1000000)
-                  return bad + ", got '" + v + "'";
-              o.shardIndex = index;
-              o.shardCount = count;
-              return std::nullopt;
-          }}}),
-    .run = Sweep,
+         OwnOption<SweepOptions>("--shard", true,
+                                 [](SweepOptions& o, const char* v) -> std::optional<std::string> {
+                                     const std::string bad = "--shard needs I/N with 1 <= I <= N, e.g. --shard 2/8";
+                                     if (!v) return bad;
+                                     int index = 0, count = 0, used = 0;
+                                     if (std::sscanf(v, "%d/%d%n", &index, &count, &used) != 2 || v[used] != '\0' ||
+                                         index < 1 || count < index || count > 1000000)
+                                         return bad + ", got '" + v + "'";
+                                     o.shardIndex = index;
+                                     o.shardCount = count;
+                                     return std::nullopt;
+                                 })}),
+    .makeOptions = MakeOwnOptions<SweepOptions>,
+    .run = RunWith(Sweep),
 });
 
 }  // namespace

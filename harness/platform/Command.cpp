@@ -103,21 +103,16 @@ OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field) {
             }};
 }
 
-OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing) {
-    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                if (!v) return missing;
-                if (!*v) return std::string(name) + ": must not be empty";
-                o.*field = v;
-                return std::nullopt;
-            }};
+std::optional<std::string> StoreText(std::string_view name, std::string& field, const char* value,
+                                     const std::string& missing) {
+    if (!value) return missing;
+    if (!*value) return std::string(name) + ": must not be empty";
+    field = value;
+    return std::nullopt;
 }
 
-OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOptions::*field, std::string missing) {
-    return {name, "", true, [=](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                if (!v) return missing;
-                (o.*field).push_back(v);
-                return std::nullopt;
-            }};
+OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing) {
+    return {name, "", true, [=](CommonOptions& o, const char* v) { return StoreText(name, o.*field, v, missing); }};
 }
 
 std::span<const std::string_view> KnownBackends() {
@@ -177,23 +172,25 @@ std::string GlOptionsHelp() {
 }
 
 OptionSpec RepeatOption() {
-    return {"--repeat", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                const std::optional<int> repeats = PositiveInt(v, 10000);
-                if (!repeats) return "--repeat needs a number from 1";
-                o.repeats = *repeats;
-                return std::nullopt;
-            }};
+    return OwnOption<MeasurementOptions>("--repeat", true,
+                                         [](MeasurementOptions& o, const char* v) -> std::optional<std::string> {
+                                             const std::optional<int> repeats = PositiveInt(v, 10000);
+                                             if (!repeats) return "--repeat needs a number from 1";
+                                             o.repeats = *repeats;
+                                             return std::nullopt;
+                                         });
 }
 
 OptionSpec ReferenceStepOption() {
-    return {"--reference-step", "", true, [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-                char* end = nullptr;
-                const double step = std::strtod(v, &end);
-                if (end == v || *end != '\0' || !(step >= 1.0 / 1024 && step <= 1))
-                    return "--reference-step needs a number of voxel edges in [1/1024, 1]";
-                o.referenceStep = step;
-                return std::nullopt;
-            }};
+    return OwnOption<MeasurementOptions>("--reference-step", true,
+                                         [](MeasurementOptions& o, const char* v) -> std::optional<std::string> {
+                                             char* end = nullptr;
+                                             const double step = v ? std::strtod(v, &end) : 0;
+                                             if (!v || end == v || *end != '\0' || !(step >= 1.0 / 1024 && step <= 1))
+                                                 return "--reference-step needs a number of voxel edges in [1/1024, 1]";
+                                             o.referenceStep = step;
+                                             return std::nullopt;
+                                         });
 }
 
 CommandRegistration::CommandRegistration(Command command) {

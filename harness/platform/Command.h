@@ -4,7 +4,9 @@
 // CommandRegistration; docs/cli.md and CONTRIBUTING.md describe them.
 #pragma once
 
+#include <concepts>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -28,7 +30,9 @@ enum ExitCode : int {
     kExitRegression = 6,  // perf compare: a confirmed performance regression
 };
 
-// What the command line sets; every command reads the fields its options fill.
+// What every command shares on the command line: the scene and its
+// overrides, the backends (which, their options, and how they run: crash
+// isolation) and the output. A command's own options are its OwnOptions.
 struct CommonOptions {
     std::optional<std::string> scene;      // name in scenes/ or a path; none = kDefaultScene; "" is refused
     std::vector<std::string> backends;     // empty = the command's default
@@ -42,49 +46,53 @@ struct CommonOptions {
     // Crash isolation (harness/platform/Isolation.h): --no-isolation, --backend-timeout SECONDS (0 = none).
     bool noIsolation = false;
     double backendTimeout = 3600;
-    // conform: --baseline FILE (known failures) and --flake-reruns N (docs/cli.md).
-    std::string baseline;
-    uint32_t flakeReruns = 0;
-    // conform --matrix: compare over the built-in option set (harness/conform/ConformMatrix.h).
-    bool matrix = false;
-    // Accuracy (docs/accuracy.md): dump --reference; sweep --vary PATH=V1,V2;
-    // timed calls per measurement; accuracy --switches; sweep --metric.
-    bool reference = false;
-    std::vector<std::string> vary;
-    int repeats = 5;
-    bool switches = false;
-    // accuracy and sweep: the step of the exact reference render, voxel edges (--reference-step).
-    double referenceStep = 0.125;
-    std::string metric = "max";
-    // sweep --shard I/N: share I (1-based) of N; shardCount 0 = not sharded.
-    int shardIndex = 0;
-    int shardCount = 0;
     // The positional arguments of a command that takes them rather than a scene
     // (Command::takesArguments: report's files), or, for a command with
     // Command::rawArguments (perf), every argument after its name, unparsed.
     std::vector<std::string> arguments;
-    // report: --history FILE and -o FILE (docs/cli.md).
-    std::string history;
-    std::string outFile;
-    // run --timing: "synchronized", "pipelined" or "both" (docs/performance.md, "Two ways to time a step").
-    std::string timing = "synchronized";
-    // run --save-state DIR, --save-state-every N (0 = only at the end), --resume DIR (harness/run/SimulationState.h).
-    std::string saveState, resumeState;
-    uint32_t saveStateEvery = 0;
     // argv as given, for the provenance of the outputs.
     std::vector<std::string> commandLine;
 
     BackendOptions Backend() const;
 };
 
-// One command-line option. `apply` stores the value (nullptr for a flag) and
-// returns a usage message when the value is missing or wrong.
+// A command's own options: a struct deriving from this (RunOptions in
+// RunCommand.cpp, ConformOptions, ...), made fresh for each command line
+// (Command::makeOptions) and filled by the command's own OptionSpecs.
+struct OwnOptions {
+    virtual ~OwnOptions() = default;
+};
+
+// The own options of the commands that measure against the exact reference
+// (accuracy, sweep): timed calls per measurement (--repeat) and the step of
+// the exact reference render in voxel edges (--reference-step).
+struct MeasurementOptions : OwnOptions {
+    int repeats = 5;
+    double referenceStep = 0.125;
+};
+
+// One command-line option. Its apply function stores the value (nullptr for a
+// flag) and returns a usage message when the value is missing or wrong: a
+// shared option's `apply` into CommonOptions, a command's own option's
+// `applyOwn` into the command's OwnOptions. One of the two is set.
 struct OptionSpec {
+    using Apply = std::function<std::optional<std::string>(CommonOptions&, const char* value)>;
+    using ApplyOwn = std::function<std::optional<std::string>(OwnOptions&, const char* value)>;
     std::string_view name;
     std::string_view alias;  // "" = none
     bool takesValue = false;
-    std::function<std::optional<std::string>(CommonOptions&, const char* value)> apply;
+    Apply apply;
+    ApplyOwn applyOwn = {};
 };
+
+// A command's own option of options type `Own`: `apply` gets them as Own.
+template <typename Own>
+requires std::derived_from<Own, OwnOptions> OptionSpec OwnOption(
+    std::string_view name, bool takesValue, std::function<std::optional<std::string>(Own&, const char* value)> apply) {
+    return {name, "", takesValue, {}, [apply](OwnOptions& own, const char* value) {
+                return apply(dynamic_cast<Own&>(own), value);
+            }};
+}
 
 // A flag that sets `field`.
 OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field);
@@ -92,7 +100,33 @@ OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field);
 // is the usage message when the value is missing. TextOption refuses an empty
 // value: "--x: must not be empty".
 OptionSpec TextOption(std::string_view name, std::string CommonOptions::*field, std::string missing);
-OptionSpec ListOption(std::string_view name, std::vector<std::string> CommonOptions::*field, std::string missing);
+// What TextOption does with a value: `missing` for none, a refusal for "", else stores it.
+std::optional<std::string> StoreText(std::string_view name, std::string& field, const char* value,
+                                     const std::string& missing);
+
+// The same for a command's own options.
+template <typename Own>
+requires std::derived_from<Own, OwnOptions> OptionSpec FlagOption(std::string_view name, bool Own::*field) {
+    return OwnOption<Own>(name, false, [field](Own& o, const char*) -> std::optional<std::string> {
+        o.*field = true;
+        return std::nullopt;
+    });
+}
+template <typename Own>
+requires std::derived_from<Own, OwnOptions> OptionSpec TextOption(std::string_view name, std::string Own::*field,
+                                                                  std::string missing) {
+    return OwnOption<Own>(name, true, [=](Own& o, const char* v) { return StoreText(name, o.*field, v, missing); });
+}
+template <typename Own>
+requires std::derived_from<Own, OwnOptions> OptionSpec ListOption(std::string_view name,
+                                                                  std::vector<std::string> Own::*field,
+                                                                  std::string missing) {
+    return OwnOption<Own>(name, true, [=](Own& o, const char* v) -> std::optional<std::string> {
+        if (!v) return missing;
+        (o.*field).push_back(v);
+        return std::nullopt;
+    });
+}
 
 // Every backend name the registry knows, built in this build or not, sorted: cpu, gl, vk.
 std::span<const std::string_view> KnownBackends();
@@ -111,9 +145,9 @@ std::span<const OptionSpec> SceneCommandOptions();
 // The help lines of --gl-context and --gl-ca-layout, their values listed from
 // the options' name tables, the default first.
 std::string GlOptionsHelp();
-// --repeat N, shared by accuracy and sweep.
+// --repeat N and --reference-step X (the exact reference render's step in
+// voxel edges, [1/1024, 1]) into MeasurementOptions (accuracy, sweep).
 OptionSpec RepeatOption();
-// --reference-step X: the exact reference render's step in voxel edges, (0, 1] (accuracy, sweep).
 OptionSpec ReferenceStepOption();
 
 struct Command {
@@ -131,8 +165,28 @@ struct Command {
     // passes them in CommonOptions::arguments and handles only --help.
     bool rawArguments = false;
     std::vector<OptionSpec> extraOptions = {};  // besides SceneCommandOptions()
-    std::function<int(const CommonOptions&)> run;
+    // Makes the command's own options, which its extraOptions fill and `run`
+    // reads (MakeOwnOptions<T>); by default, none.
+    std::function<std::unique_ptr<OwnOptions>()> makeOptions = [] { return std::make_unique<OwnOptions>(); };
+    std::function<int(const CommonOptions&, const OwnOptions&)> run;
 };
+
+template <typename Own>
+std::unique_ptr<OwnOptions> MakeOwnOptions() {
+    return std::make_unique<Own>();
+}
+// Command::run from a run function of the command's own options type.
+template <typename Own>
+requires std::derived_from<Own, OwnOptions> std::function<int(const CommonOptions&, const OwnOptions&)> RunWith(
+    int (*run)(const CommonOptions&, const Own&)) {
+    return [run](const CommonOptions& common, const OwnOptions& own) {
+        return run(common, dynamic_cast<const Own&>(own));
+    };
+}
+// Command::run from a command without options of its own.
+inline std::function<int(const CommonOptions&, const OwnOptions&)> RunWith(int (*run)(const CommonOptions&)) {
+    return [run](const CommonOptions& common, const OwnOptions&) { return run(common); };
+}
 
 // Adds a command to the registry at static initialisation.
 struct CommandRegistration {
