@@ -38,13 +38,6 @@ namespace {
 constexpr Extent3 kPipeGrid{40, 36, 12};
 constexpr uint32_t kPipeTile = 8, kPipeBand = 4;
 
-std::vector<uint8_t> PipeBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
-    Pcg32 rng(seed);
-    std::vector<uint8_t> bits(e.Count());
-    for (uint8_t& b : bits) b = rng.Below(oneIn) == 0 ? 1 : 0;
-    return bits;
-}
-
 std::vector<float> PipeQ(const Extent3& e, uint32_t seed) {
     Pcg32 rng(seed);
     std::vector<float> q(e.Count());
@@ -66,9 +59,9 @@ class PipelinedGpu : public test::BackendTest {
         const Extent3 tiles{CeilDiv(e.nx, kPipeTile), CeilDiv(e.ny, kPipeTile), 1};
         const Extent3 bands{tiles.nx, tiles.ny, CeilDiv(e.nz, kPipeBand)};
         mEllipsoids = test::RandomEllipsoids(e, 5);
-        mHum = test::MakeFilled(b, BufferFormat::Bits, e, PipeBits(e, 1, 2));
-        mAct = test::MakeFilled(b, BufferFormat::Bits, e, PipeBits(e, 2, 3));
-        mCld = test::MakeFilled(b, BufferFormat::Bits, e, PipeBits(e, 3, 3));
+        mHum = test::MakeFilled(b, BufferFormat::Bits, e, test::RandomBits(e, 1, 2));
+        mAct = test::MakeFilled(b, BufferFormat::Bits, e, test::RandomBits(e, 2, 3));
+        mCld = test::MakeFilled(b, BufferFormat::Bits, e, test::RandomBits(e, 3, 3));
         mQPrev = test::MakeFilled(b, BufferFormat::F32, e, PipeQ(e, 4));
         mTilesPrev = test::MakeBuffer(b, BufferFormat::U8, tiles);
         mBandsPrev = test::MakeBuffer(b, BufferFormat::U8, bands);
@@ -253,7 +246,7 @@ TEST_P(PipelinedGpu, OneSubmissionAndOneWaitPerBatchAndOneMorePerDownload) {
     const auto q = test::Read<float>(*mBackend, *mQ);
     before = mBackend->Submissions();
     ASSERT_TRUE(mBackend->BeginBatch().has_value());
-    const auto otherCld = PipeBits(kPipeGrid, 9, 2);
+    const auto otherCld = test::RandomBits(kPipeGrid, 9, 2);
     ASSERT_TRUE(mBackend->Upload(*mCld, std::as_bytes(std::span(otherCld))).has_value());
     Step(false, false);
     EXPECT_NE(test::Read<float>(*mBackend, *mQ), q) << "the download did not see the upload's step";
@@ -328,7 +321,7 @@ TEST_P(PipelinedVk, OneByOneRegionUploadsItsListsAndEveryOtherCallSubmitsOnce) {
 }
 
 TEST_P(PipelinedVk, AnUploadInABatchIsSeenByLaterCallsOnly) {
-    const auto before = PipeBits(kPipeGrid, 11, 3), after = PipeBits(kPipeGrid, 12, 2);
+    const auto before = test::RandomBits(kPipeGrid, 11, 3), after = test::RandomBits(kPipeGrid, 12, 2);
     auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kPipeGrid, before);
     auto q1 = test::MakeBuffer(*mBackend, BufferFormat::F32, kPipeGrid);
     auto q2 = test::MakeBuffer(*mBackend, BufferFormat::F32, kPipeGrid);
@@ -342,7 +335,7 @@ TEST_P(PipelinedVk, AnUploadInABatchIsSeenByLaterCallsOnly) {
 
     // Two uploads into cld in one batch, each read by the call after it: bytes
     // staged in memory the first copy still reads would reach both calls.
-    const auto neither = PipeBits(kPipeGrid, 13, 4);
+    const auto neither = test::RandomBits(kPipeGrid, 13, 4);
     ASSERT_TRUE(mBackend->Upload(*cld, std::as_bytes(std::span(neither))).has_value());
     ASSERT_TRUE(mBackend->BeginBatch().has_value());
     ASSERT_TRUE(mBackend->Upload(*cld, std::as_bytes(std::span(before))).has_value());

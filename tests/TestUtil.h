@@ -37,6 +37,15 @@ inline std::vector<float> GaussianBlobField(const Extent3& e, std::initializer_l
     return q;
 }
 
+// A bit field's canonical bytes (one 0 or 1 per voxel), each voxel 1 with
+// probability 1 / oneIn, from Pcg32(seed).
+inline std::vector<uint8_t> RandomBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
+    Pcg32 rng(seed);
+    std::vector<uint8_t> bits(e.Count());
+    for (uint8_t& b : bits) b = rng.Below(oneIn) == 0 ? 1 : 0;
+    return bits;
+}
+
 // 25 ellipsoids of random centres (some past the grid's sides), radii and yaw.
 inline std::vector<RasterEllipsoid> RandomEllipsoids(const Extent3& e, uint32_t seed) {
     Pcg32 rng(seed);

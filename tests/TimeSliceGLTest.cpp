@@ -17,13 +17,6 @@
 namespace cb {
 namespace {
 
-std::vector<uint8_t> GlsBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
-    Pcg32 rng(seed);
-    std::vector<uint8_t> bits(e.Count());
-    for (uint8_t& b : bits) b = rng.Below(oneIn) == 0 ? 1 : 0;
-    return bits;
-}
-
 std::unique_ptr<Backend> GlsMake(bool rgba8) {
     BackendOptions o;
     if (rgba8) o.glCaLayout = gl::CaLayout::Rgba8;
@@ -83,10 +76,10 @@ TEST(TimeSliceGL, SmoothSharesSeeACldChangedInPlace) {
     const Extent3 e{37, 29, 11};
     auto A = GlsMake(false);
     if (!A) GTEST_SKIP() << "no gl backend here";
-    auto cld = test::MakeFilled(*A, BufferFormat::Bits, e, GlsBits(e, 1, 3));
+    auto cld = test::MakeFilled(*A, BufferFormat::Bits, e, test::RandomBits(e, 1, 3));
     auto q = test::MakeBuffer(*A, BufferFormat::F32, e), w = test::MakeBuffer(*A, BufferFormat::F32, e);
     for (uint32_t k = 0; k < e.nz; k += 2) ASSERT_TRUE(A->Smooth(2, *cld, *q, {k, k + 2}));
-    const auto zzNew = GlsBits(e, 2, 3);
+    const auto zzNew = test::RandomBits(e, 2, 3);
     ASSERT_TRUE(A->Upload(*cld, std::as_bytes(std::span(zzNew))));
     for (uint32_t k = 0; k < e.nz; k += 2) ASSERT_TRUE(A->Smooth(2, *cld, *q, {k, k + 2}));
     ASSERT_TRUE(A->Smooth(2, *cld, *w));

@@ -128,13 +128,6 @@ class TimeSliceStages : public test::BackendTest {
 
 };
 
-std::vector<uint8_t> RandomBits(const Extent3& e, uint32_t seed, uint32_t oneIn) {
-    Pcg32 rng(seed);
-    std::vector<uint8_t> bits(e.Count());
-    for (uint8_t& b : bits) b = rng.Below(oneIn) == 0 ? 1 : 0;
-    return bits;
-}
-
 // A sparse q with exact zeros, so occupancy has empty tiles and bands.
 std::vector<float> SparseQ(const Extent3& e, uint32_t seed) {
     Pcg32 rng(seed);
@@ -154,9 +147,9 @@ TEST_P(TimeSliceStages, CaStepInSlicesOfK) {
     const auto ellipsoids = test::RandomEllipsoids(kGrid, 7);
     auto region = Patterned(BufferFormat::U8, kGrid);
     ASSERT_TRUE(mBackend->Region(ellipsoids, *region));
-    auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 1, 2));
-    auto act = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 2, 3));
-    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 3, 4));
+    auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 1, 2));
+    auto act = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 2, 3));
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 3, 4));
     auto hum1 = Patterned(BufferFormat::Bits, kGrid), act1 = Patterned(BufferFormat::Bits, kGrid),
          cld1 = Patterned(BufferFormat::Bits, kGrid);
     // A distinct wind shift per slice, both signs.
@@ -178,9 +171,9 @@ TEST_P(TimeSliceStages, CaStepInSlicesOfK) {
 }
 
 TEST_P(TimeSliceStages, SmoothInSlicesOfK) {
-    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 4, 3));
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 4, 3));
     auto q = Patterned(BufferFormat::F32, kGrid);
-    auto otherCld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 9, 2));
+    auto otherCld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 9, 2));
     auto otherQ = Patterned(BufferFormat::F32, kGrid);
     for (int radius : {0, 1, 2})
         ExpectSharesEqualWhole(
@@ -191,7 +184,7 @@ TEST_P(TimeSliceStages, SmoothInSlicesOfK) {
 
 TEST_P(TimeSliceStages, DensityInRowsOfTilesAndTheCoverCountsAddUp) {
     auto q = test::MakeFilled(*mBackend, BufferFormat::F32, kGrid, SparseQ(kGrid, 5));
-    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 6, 40));
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 6, 40));
     DensityParams p;
     p.tile = 8, p.band = 4;  // 5 x 4 tiles, 3 bands: the last row and band are partial
     const uint32_t tilesX = CeilDiv(kGrid.nx, p.tile), tilesY = CeilDiv(kGrid.ny, p.tile);
@@ -267,9 +260,9 @@ TEST_P(TimeSliceStages, EachShareWritesItsSlicesAndNothingElse) {
         "region", {region.get()}, [&](SliceRange s) { return mBackend->Region(ellipsoids, *region, s); }, {{3, 5}},
         {3, 5}, sliceK);
 
-    auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 1, 2));
-    auto act = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 2, 3));
-    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, RandomBits(kGrid, 3, 4));
+    auto hum = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 1, 2));
+    auto act = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 2, 3));
+    auto cld = test::MakeFilled(*mBackend, BufferFormat::Bits, kGrid, test::RandomBits(kGrid, 3, 4));
     ASSERT_TRUE(mBackend->Region(ellipsoids, *region));
     auto hum1 = Patterned(BufferFormat::Bits, kGrid), act1 = Patterned(BufferFormat::Bits, kGrid),
          cld1 = Patterned(BufferFormat::Bits, kGrid);
