@@ -1,6 +1,10 @@
 #include "impl_cpu/BackendCpu.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <thread>
 
@@ -20,6 +24,19 @@ BufferCpu::BufferCpu(BufferFormat format, Extent3 extent) : Buffer(format, exten
 
 BackendCpu::BackendCpu(int threads) : mArena(threads > 0 ? threads : tbb::task_arena::automatic) {
     mStages.Get<SmoothCpuState>().threads = std::max(Threads(), 1);
+}
+
+void BackendCpu::BusyFor(double ms) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
+    mArena.execute([&] {
+        tbb::parallel_for(
+            0, Threads(), 1,
+            [until](int) {
+                while (std::chrono::steady_clock::now() < until) {
+                }
+            },
+            tbb::static_partitioner());
+    });
 }
 
 std::string BackendCpu::Device() const {

@@ -67,6 +67,8 @@ class BackendCpu : public Backend {
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     int Threads() const { return mArena.max_concurrency(); }
+    // Every thread of the arena spins until `ms` from now.
+    void BusyFor(double ms) override;
 
   private:
     // The stage objects (core/pipeline/StageObjects.h): what each stage keeps

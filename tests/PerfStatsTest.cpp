@@ -56,6 +56,41 @@ TEST(PerfStats, BootstrapIsDeterministic) {
     EXPECT_DOUBLE_EQ(constant.high, 1.5);
 }
 
+// Test the sign-flip test on cases counted by hand: the sums of +-1 +-2 +-3 are 6, 4, 2, 0, 0, -2, -4, -6.
+TEST(PerfStats, SignFlipCountsPatterns) {
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>{1, 2, 3}, 0, 0), 1.0 / 8);   // only 6 >= 6
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>{1, -2, 3}, 0, 0), 3.0 / 8);  // 6, 4, 2 >= 2
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>{-1, -2, -3}, 0, 0), 1.0);    // all >= -6
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>{}, 0, 0), 1.0);
+    // Zeros flip to themselves: {0, 0, 1} has 8 patterns, 4 with the sum 1.
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>{0, 0, 1}, 0, 0), 4.0 / 8);
+    EXPECT_DOUBLE_EQ(SmallestSignFlipP(10, 999), 1.0 / 1024);
+    // Above 16 pairs the patterns are drawn: 17 equal positive differences are beaten by none of 999.
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>(17, 1.0), 999, 3), 1.0 / 1000);
+    EXPECT_DOUBLE_EQ(SmallestSignFlipP(17, 999), 1.0 / 1000);
+}
+
+// Test the two-sample test on a case counted by hand: the 6 ways to pick two of {1, 2, 3, 4} as x give
+// mean differences 2, 1, 0, 0, -1, -2.
+TEST(PerfStats, PermutationCountsSplits) {
+    const std::vector<double> x = {3, 4}, y = {1, 2};
+    EXPECT_DOUBLE_EQ(PermutationGreater(x, y, 0, 0), 1.0 / 6);
+    EXPECT_DOUBLE_EQ(PermutationGreater(y, x, 0, 0), 1.0);
+    EXPECT_DOUBLE_EQ(PermutationGreater(std::vector<double>{1, 4}, std::vector<double>{2, 3}, 0, 0), 4.0 / 6);
+    EXPECT_DOUBLE_EQ(PermutationGreater(std::vector<double>{}, y, 0, 0), 1.0);
+    EXPECT_DOUBLE_EQ(SmallestPermutationP(2, 2, 0), 1.0 / 6);
+}
+
+// Test that the quantile interpolates linearly between order statistics (NumPy's default).
+TEST(PerfStats, QuantileInterpolates) {
+    const std::vector<double> v = {4, 1, 3, 2};  // sorted 1 2 3 4: q at position 3q
+    EXPECT_DOUBLE_EQ(Quantile(v, 0), 1);
+    EXPECT_DOUBLE_EQ(Quantile(v, 0.25), 1.75);
+    EXPECT_DOUBLE_EQ(Quantile(v, 0.5), 2.5);
+    EXPECT_DOUBLE_EQ(Quantile(v, 1), 4);
+    EXPECT_TRUE(std::isnan(Quantile(std::vector<double>{}, 0.5)));
+}
+
 // Test that a series shorter than two minimum segments has no change point, and a clean step is found.
 TEST(PerfStats, ChangePointsNeedTwoSegments) {
     ChangePointSettings s;

@@ -21,7 +21,8 @@ appear in the victim's folder, and the link must still be there. GROUP is one of
   sweep     sweep.json, sweep.md, sweep.png, a shard's sweep.json and sweep.png,
             merge's sweep.json, sweep.png and history.jsonl
   named     files the user names: report -o FILE and its temporary name,
-            perf compare --json FILE, perf export --gbench OUT,
+            perf compare --json FILE, perf compare --keep DIR (its manifest and side folders),
+            perf export --gbench OUT,
             perf history --json FILE
   count     count --out FILE and its temporary name (CLOUDBENCH must be a build
             that counts: without -march=native, valgrind installed)
@@ -251,6 +252,10 @@ def group_named():
                  lambda f: ["perf", "export", "--gbench", os.path.join(f, "gbench.json"), results])
     refused_case("perf history --json", "changes.json",
                  lambda f: ["perf", "history", history, "--json", os.path.join(f, "changes.json")])
+    keep = lambda f: ["perf", "compare", "--interleave", CLI, CLI, "ci-small", "--backend", "cpu", "--rounds", "1",  # noqa: E731
+                      "--steps", "3", "--set", "warmup_steps=0", "--quiet", "--keep", f]
+    refused_case("perf compare --keep manifest", "interleave.json", keep)
+    refused_case("perf compare --keep side folder", "base", keep, folder_link=True)
     suite = os.path.join(WORK, "inputs", "suite.json")
     refused_case("perf record --history", "history.jsonl",
                  lambda f: ["perf", "record", "--suite", suite, "--history", os.path.join(f, "history.jsonl"),

@@ -60,6 +60,10 @@ for name in ("region", "ca", "smooth", "density"):
         fail(f"{name}: {len(samples)} samples, expected 2 x 12")
     if abs(stages[name]["median_ms"] - float(np.median(samples))) > 1e-12:
         fail(f"{name}: median_ms is not the median of samples_ms")
+    # Each run's samples apart too, in the order pooled, so that perf compare can test over the runs.
+    runs = stages[name].get("runs_ms")
+    if runs is None or [len(x) for x in runs] != [12, 12] or runs[0] + runs[1] != samples:
+        fail(f"{name}: runs_ms must hold the two runs' 12 samples each, pooled in samples_ms: {runs}")
 if r["instructions"] != {"ci-small": {"cpu": {"region": 123456, "ca": 654321}}}:
     fail(f"instructions not merged: {r['instructions']}")
 

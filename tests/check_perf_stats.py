@@ -1,13 +1,13 @@
 #!/usr/bin/python3
 """Checks `cloudbench perf compare`, `perf history` and `perf export` against
-independent oracles: SciPy for the Mann-Whitney U p-values and the bootstrap
-interval, NumPy for the medians, Holm's step-down written here from its
-definition, the marks and exit codes from the documented rule (docs/cli.md).
-The samples are made here with a fixed seed; no expected number comes from
-cloudbench's own output.
+independent oracles: SciPy for the permutation tests over rounds and runs, the
+Mann-Whitney U p-values and the bootstrap intervals, NumPy for the medians and
+quantiles, Holm's step-down written here from its definition, the marks and
+exit codes from the documented rule (docs/cli.md). The samples are made here
+with a fixed seed; no expected number comes from cloudbench's own output.
 
 usage: check_perf_stats.py CLOUDBENCH WORKDIR CASE
-CASE: compare, instructions, inputs, history, changepoints, gbench
+CASE: compare, rounds, runs, instructions, inputs, history, changepoints, gbench
 """
 import json
 import os
@@ -101,8 +101,9 @@ def case_compare():
         close(c["base_median"], float(np.median(base)), 1e-12, f"{k} base median")
         close(c["head_median"], float(np.median(head)), 1e-12, f"{k} head median")
         close(c["ratio"], float(np.median(head) / np.median(base)), 1e-12, f"{k} ratio")
+        check(c["test"] == "steps", f"{k}: one run a side must be tested on its steps: {c['test']}")
         if k not in tested:
-            check(c["mark"] == "~" and not c["regression"] and c["p_slower"] is None, f"{k}: too few samples: {c}")
+            check(c["mark"] == "?" and not c["regression"] and c["p_slower"] is None, f"{k}: too few samples: {c}")
             continue
         close(c["p_slower"], slower[k], 1e-9, f"{k} p slower")
         close(c["p_faster"], faster[k], 1e-9, f"{k} p faster")
@@ -133,8 +134,20 @@ def case_compare():
         f"{WORK}/gl.json", expect=6)
     check(json.load(open(f"{WORK}/gl.json"))["comparisons"][0]["threshold"] == 2.0, "--threshold gl=2")
     run("perf", "compare", f"{WORK}/gl-base.json", f"{WORK}/gl-head.json", "--threshold", "=2", expect=2)
-    # A file compared with itself: no regression.
-    run("perf", "compare", f"{WORK}/base.json", f"{WORK}/base.json", expect=0)
+    # A stage that cannot be judged is named in a warning and in the JSON.
+    check("warning: 1 of 7 time comparisons could not be judged (marked ?): s/cpu/render_splat" in p.stdout,
+          f"the unjudged stage must be warned about: {p.stdout}")
+    check(doc["unjudged"] == ["s/cpu/render_splat"], f"unjudged: {doc['unjudged']}")
+    # A file compared with itself: no regression, and a warning.
+    p = run("perf", "compare", f"{WORK}/base.json", f"{WORK}/base.json", expect=0)
+    check("BASE and HEAD are the same file" in p.stderr, f"comparing a file with itself must warn: {p.stderr}")
+    # The folder a `run --out` wrote is read as its results.json.
+    os.makedirs(f"{WORK}/run-folder", exist_ok=True)
+    shutil.copy(f"{WORK}/base.json", f"{WORK}/run-folder/results.json")
+    run("perf", "compare", f"{WORK}/run-folder", f"{WORK}/base.json", expect=0)
+    os.makedirs(f"{WORK}/empty-folder", exist_ok=True)
+    p = run("perf", "compare", f"{WORK}/empty-folder", f"{WORK}/base.json", expect=3)
+    check("empty-folder: is a folder without a results.json" in p.stderr, f"a folder without results: {p.stderr}")
     # HEAD failed: marked x, exit 1 (no regression to report).
     results_json(f"{WORK}/failed.json", "s", {}, status="crashed")
     p = run("perf", "compare", f"{WORK}/base.json", f"{WORK}/failed.json", expect=1)
@@ -143,6 +156,135 @@ def case_compare():
     p = run("perf", "compare", f"{WORK}/failed.json", f"{WORK}/base.json", expect=0)
     check(p.stdout.count("| ! ") == len(stages), "every stage absent from BASE must be marked !")
     print("perf compare: ok")
+
+
+def kept_interleave(folder, scene, rounds):
+    """A kept interleave written by hand: rounds[k] = {stage: (base samples, head samples)}, ABBA order."""
+    shutil.rmtree(folder, ignore_errors=True)
+    runs = []
+    for k, stages in enumerate(rounds):
+        for side in (("base", "head") if k % 2 == 0 else ("head", "base")):
+            name = f"{side}/r{k + 1:02d}-{scene}"
+            os.makedirs(f"{folder}/{name}")
+            results_json(f"{folder}/{name}/results.json", scene,
+                         {st: v[0 if side == "base" else 1] for st, v in stages.items()})
+            runs.append({"side": side, "scene": scene, "round": k, "folder": name, "exit": 0, "load": [1, 1, 1]})
+    with open(f"{folder}/interleave.json", "w") as f:
+        json.dump({"format": "cloudbench-interleave/1", "base": "a", "head": "b", "scenes": [scene],
+                   "rounds": len(rounds), "order": "ABBA", "runs": runs}, f)
+
+
+def sign_flip_p(d):
+    """SciPy's exact paired permutation test (the signs flipped) that mean(d) > 0."""
+    return stats.permutation_test((d,), np.mean, permutation_type="samples", alternative="greater",
+                                  n_resamples=np.inf).pvalue
+
+
+def case_rounds():
+    rng = np.random.RandomState(11)
+    K = 10
+    # Per round and stage: each run's steps. "smooth" is 1.25x slower in every round; "region" has two modes
+    # (a free or a busy second core: 0.7 or 1.3 ms) mixed differently in each run, with no change; "ca" is
+    # 1.05x slower (significant, within the 1.1 threshold); "density" is 1.3x faster.
+    def steps(n, median, spread=0.02):
+        return np.round(median * np.exp(rng.normal(0, spread, n)), 5)
+    def modal(n):
+        busy = rng.rand() < 0.5
+        return np.round(np.where(rng.rand(n) < (0.8 if busy else 0.2), 1.3, 0.7) * np.exp(rng.normal(0, 0.02, n)), 5)
+    rounds = []
+    for k in range(K):
+        load = np.exp(rng.normal(0, 0.05))  # the round's machine speed, shared by both of its runs
+        rounds.append({"smooth": (steps(30, 1.0 * load), steps(30, 1.25 * load)),
+                       "region": (modal(30), modal(30)),
+                       "ca": (steps(30, 2.0 * load), steps(30, 2.1 * load)),
+                       "density": (steps(30, 0.5 * load), steps(30, 0.5 / 1.3 * load)),
+                       "shade": (steps(3, 2.0 * load, 0.2), steps(3, 2.0 * load, 0.2))})
+    kept = f"{WORK}/kept"
+    kept_interleave(kept, "s", rounds)
+    p = run("perf", "compare", kept, "--json", f"{WORK}/rounds.json", expect=6)
+    doc = json.load(open(f"{WORK}/rounds.json"))
+    rows = {c["stage"]: c for c in doc["comparisons"]}
+    names = sorted(rows)
+    d = {st: np.array([np.log(np.median(r[st][1]) / np.median(r[st][0])) for r in rounds]) for st in names}
+    slower = [sign_flip_p(d[st]) for st in names]
+    faster = [sign_flip_p(-d[st]) for st in names]
+    slower_holm, faster_holm = dict(zip(names, holm(slower))), dict(zip(names, holm(faster)))
+    for i, st in enumerate(names):
+        c = rows[st]
+        check(c["test"] == "rounds" and c["pairs"] == K, f"{st}: paired by round: {c['test']}, {c['pairs']}")
+        close(c["ratio"], float(np.exp(d[st].mean())), 1e-9, f"{st} ratio")
+        close(c["p_slower"], slower[i], 1e-9, f"{st} p slower")
+        close(c["p_faster"], faster[i], 1e-9, f"{st} p faster")
+        close(c["p_slower_holm"], slower_holm[st], 1e-9, f"{st} Holm p slower")
+        ci = stats.bootstrap((d[st],), lambda x, axis: np.exp(np.mean(x, axis=axis)), method="percentile",
+                             n_resamples=20000, random_state=1, confidence_level=0.95).confidence_interval
+        close(c["ratio_ci"][0], ci.low, 0.02, f"{st} interval low")
+        close(c["ratio_ci"][1], ci.high, 0.02, f"{st} interval high")
+        ratio = np.exp(d[st].mean())
+        expected = "+" if slower_holm[st] < ALPHA and ratio > 1.1 else \
+            "-" if faster_holm[st] < ALPHA and ratio < 1 / 1.1 else "~"
+        check(c["mark"] == expected, f"{st}: mark {c['mark']}, expected {expected}")
+    check([c["stage"] for c in doc["comparisons"] if c["regression"]] == ["smooth"],
+          f"only smooth is slower: {[(c['stage'], c['mark']) for c in doc['comparisons']]}")
+    check(rows["density"]["mark"] == "-" and rows["region"]["mark"] == "~", "density faster, region unchanged")
+    check("interleaved (ABBA), 10 rounds, kept in" in p.stdout, f"the mode line: {p.stdout}")
+    # Steps pooled over the runs, as a Mann-Whitney test takes them, make region's two modes a large
+    # difference whenever the mixes differ; the rounds do not.
+    check(rows["region"]["p_slower"] > 0.01 and rows["region"]["p_faster"] > 0.01, f"region: {rows['region']}")
+    # --run-quantile: another statistic of each run's steps.
+    run("perf", "compare", kept, "--run-quantile", "0.25", "--json", f"{WORK}/q25.json", expect=6)
+    q = {c["stage"]: c for c in json.load(open(f"{WORK}/q25.json"))["comparisons"]}
+    d25 = np.array([np.log(np.quantile(r["smooth"][1], 0.25) / np.quantile(r["smooth"][0], 0.25)) for r in rounds])
+    close(q["smooth"]["ratio"], float(np.exp(d25.mean())), 1e-9, "smooth ratio of 25th percentiles")
+    # Four rounds cannot reach p < 0.01 over five tests (5 x 2^-4 = 0.31): every stage is '?', with a warning.
+    kept_interleave(f"{WORK}/kept4", "s", rounds[:4])
+    p = run("perf", "compare", f"{WORK}/kept4", "--json", f"{WORK}/rounds4.json", expect=0)
+    doc = json.load(open(f"{WORK}/rounds4.json"))
+    check(all(c["mark"] == "?" for c in doc["comparisons"]) and len(doc["unjudged"]) == 5,
+          f"4 rounds: {[(c['stage'], c['mark']) for c in doc['comparisons']]}")
+    check("warning: 5 of 5 time comparisons could not be judged" in p.stdout, p.stdout)
+    # A run's folder must be its side's and one name deep: nothing outside the kept folder is read.
+    manifest = json.load(open(f"{kept}/interleave.json"))
+    manifest["runs"][0]["folder"] = "base/../../elsewhere"
+    with open(f"{kept}/interleave.json", "w") as f:
+        json.dump(manifest, f)
+    p = run("perf", "compare", kept, expect=3)
+    check("/runs/0/folder: must be base/NAME" in p.stderr, f"a folder outside the kept one: {p.stderr}")
+    print("perf compare rounds: ok")
+
+
+def case_runs():
+    rng = np.random.RandomState(13)
+    # Two history records of several runs each ("runs_ms", as perf record --repeat writes), not interleaved:
+    # a two-sample permutation test over the runs' log medians.
+    def runs(n, median, spread):
+        return [list(np.round(median * np.exp(rng.normal(0, spread)) * np.exp(rng.normal(0, 0.02, 20)), 5))
+                for _ in range(n)]
+    sides = {"base": {"region": runs(5, 1.0, 0.05), "ca": runs(5, 1.0, 0.05)},
+             "head": {"region": runs(6, 1.0, 0.05), "ca": runs(6, 2.6, 0.05)}}
+    path = f"{WORK}/runs.jsonl"
+    with open(path, "w") as f:
+        for rid, side in (("r1", "base"), ("r2", "head")):
+            results = {"s": {"cpu": {st: {"samples_ms": [v for r in rs for v in r], "runs_ms": rs}
+                                     for st, rs in sides[side].items()}}}
+            f.write(json.dumps({"format": "cloudbench-perf/1", "id": rid, "results": results}) + "\n")
+    p = run("perf", "compare", f"{path}@r1", f"{path}@r2", "--json", f"{WORK}/runs.json", expect=6)
+    rows = {c["stage"]: c for c in json.load(open(f"{WORK}/runs.json"))["comparisons"]}
+    logs = {side: {st: np.log([np.median(r) for r in rs]) for st, rs in v.items()} for side, v in sides.items()}
+    names = sorted(rows)
+    slower = [stats.permutation_test((logs["head"][st], logs["base"][st]), lambda x, y: np.mean(x) - np.mean(y),
+                                     permutation_type="independent", alternative="greater",
+                                     n_resamples=np.inf).pvalue for st in names]
+    slower_holm = dict(zip(names, holm(slower)))
+    for i, st in enumerate(names):
+        c = rows[st]
+        check(c["test"] == "runs" and c["base_runs"] == 5 and c["head_runs"] == 6, f"{st}: {c}")
+        close(c["p_slower"], slower[i], 1e-9, f"{st} p slower")
+        close(c["ratio"], float(np.exp(logs["head"][st].mean() - logs["base"][st].mean())), 1e-9, f"{st} ratio")
+        expected = "+" if slower_holm[st] < ALPHA and c["ratio"] > SEPARATE_THRESHOLD else "~"
+        check(c["mark"] == expected, f"{st}: mark {c['mark']}, expected {expected}")
+    check(rows["ca"]["regression"] and not rows["region"]["regression"], "ca is 2.6x slower, region the same")
+    print("perf compare runs: ok")
 
 
 def case_instructions():
@@ -245,25 +387,49 @@ def case_gbench():
         print(f"SKIP: {compare_py} is not installed (Debian's libbenchmark-tools)")
         sys.exit(77)
     rng = np.random.RandomState(5)
-    results_json(f"{WORK}/g-base.json", "s", {"region": 1 + 0.01 * rng.rand(30), "ca": 2 + 0.01 * rng.rand(30)})
-    results_json(f"{WORK}/g-head.json", "s", {"region": 1 + 0.01 * rng.rand(30), "ca": 4 + 0.01 * rng.rand(30)})
+    # Five runs a side, each of 30 steps; ca is 2x slower in HEAD, region the same.
+    files = {"base": [], "head": []}
+    for side, ca in (("base", 2.0), ("head", 4.0)):
+        for n in range(5):
+            path = f"{WORK}/g-{side}-{n}.json"
+            results_json(path, "s", {"region": 1 + 0.01 * rng.rand(30), "ca": ca + 0.01 * rng.rand(30)})
+            files[side].append(path)
     for side in ("base", "head"):
-        run("perf", "export", "--gbench", f"{WORK}/g-{side}.gbench.json", f"{WORK}/g-{side}.json", expect=0)
+        run("perf", "export", "--gbench", f"{WORK}/g-{side}.gbench.json", *files[side], expect=0)
+    # Google Benchmark's rows for repetitions: one per run (its mean time per step), then the aggregates.
+    doc = json.load(open(f"{WORK}/g-base.gbench.json"))
+    ca_rows = [r for r in doc["benchmarks"] if r["run_name"] == "s/cpu/ca"]
+    check([r["run_type"] for r in ca_rows] == ["iteration"] * 5 + ["aggregate"] * 3, f"rows: {ca_rows}")
+    check([r.get("aggregate_name") for r in ca_rows[5:]] == ["mean", "median", "stddev"], f"aggregates: {ca_rows}")
+    check([r["name"] for r in ca_rows[5:]] == ["s/cpu/ca_mean", "s/cpu/ca_median", "s/cpu/ca_stddev"], "names")
+    check(all(r["time_unit"] == "us" and r["repetitions"] == 5 for r in ca_rows), f"units: {ca_rows}")
+    per_run = [np.mean(json.load(open(f))["backends"]["cpu"]["stages"]["ca"]["samples_ms"]) * 1000
+               for f in files["base"]]
+    for r, v in zip(ca_rows[:5], per_run):
+        close(r["real_time"], v, 1e-12, "a repetition's time: the run's mean step in us")
+        check(r["iterations"] == 30, "a run's steps are its iterations")
+    close(ca_rows[5]["real_time"], np.mean(per_run), 1e-12, "_mean")
+    close(ca_rows[6]["real_time"], np.median(per_run), 1e-12, "_median")
+    close(ca_rows[7]["real_time"], np.std(per_run, ddof=1), 1e-9, "_stddev")
     p = subprocess.run(["/usr/bin/python3", compare_py, "-d", f"{WORK}/g-cmp.json", "--no-color", "benchmarks",
                         f"{WORK}/g-base.gbench.json", f"{WORK}/g-head.gbench.json"],
                        capture_output=True, text=True, timeout=120)
     check(p.returncode == 0, f"compare.py failed: {p.stdout}\n{p.stderr}")
-    rows = {r["name"]: r for r in json.load(open(f"{WORK}/g-cmp.json")) if r["name"] != "OVERALL_GEOMEAN"}
-    check(set(rows) == {"s/cpu/region", "s/cpu/ca"}, f"compare.py saw {sorted(rows)}")
-    # compare.py's time change is (head - base) / base of the mean over repetitions.
-    b = rows["s/cpu/ca"]["measurements"][0]
-    check(abs(b["time"] - 1.0) < 0.02, f"compare.py's change for b: {b}")
-    check(rows["s/cpu/ca"]["utest"]["time_pvalue"] < 0.05, "compare.py's U test must see b's change")
+    rows = [r for r in json.load(open(f"{WORK}/g-cmp.json")) if r["name"] != "OVERALL_GEOMEAN"]
+    by_name = {r["name"]: r for r in rows}
+    check({"s/cpu/region", "s/cpu/ca", "s/cpu/ca_median", "s/cpu/region_median"} <= set(by_name),
+          f"compare.py saw {sorted(by_name)}")
+    # compare.py's change of the median aggregate, and its U test over the five runs a side.
+    close(by_name["s/cpu/ca_median"]["measurements"][0]["time"], 1.0, 0.02, "compare.py's change for ca")
+    check(by_name["s/cpu/ca"]["utest"]["time_pvalue"] < 0.05, "compare.py's U test must see ca's change")
+    check(by_name["s/cpu/ca"]["utest"]["nr_of_repetitions"] == 5, "the U test draws on the five runs")
+    check(by_name["s/cpu/region"]["utest"]["time_pvalue"] > 0.05, "region did not change")
+    check("s/cpu/ca" in p.stdout and "s/cpu/ca_median" in p.stdout, f"compare.py's table: {p.stdout}")
     print("perf export gbench: ok")
 
 
 if __name__ == "__main__":
     shutil.rmtree(WORK, ignore_errors=True)
     os.makedirs(WORK)
-    {"compare": case_compare, "instructions": case_instructions, "inputs": case_inputs, "history": case_history,
+    {"compare": case_compare, "rounds": case_rounds, "runs": case_runs, "instructions": case_instructions, "inputs": case_inputs, "history": case_history,
      "changepoints": case_changepoints, "gbench": case_gbench}[CASE]()

@@ -1,8 +1,16 @@
 #include "core/pipeline/Backend.h"
 
+#include <chrono>
+
 #include "core/base/ProcessMemory.h"
 
 namespace cb {
+
+void Backend::BusyFor(double ms) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
+    while (std::chrono::steady_clock::now() < until) {
+    }
+}
 
 size_t CanonicalElementBytes(BufferFormat format) { return format == BufferFormat::F32 ? 4 : 1; }
 

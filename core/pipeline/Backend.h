@@ -172,6 +172,11 @@ class Backend {
     // Device time of the last stage call in ms, for backends that measure it
     // (GPU timestamp queries); nullopt where wall time is all there is.
     virtual std::optional<double> LastDeviceMs() const { return std::nullopt; }
+    // Keeps the backend busy for `ms` of wall time the way its stages' own work
+    // does, for the test-only slowdown switch (harness/run/StageCall.cpp). By
+    // default the calling thread spins; the CPU backend spins on every thread
+    // of its task arena, so that its workers stay awake and in the arena.
+    virtual void BusyFor(double ms);
 
     // ---- Pipelined timing (docs/performance.md, "Two ways to time a step") ----
     // Between BeginBatch and EndBatch a backend may record stage calls and

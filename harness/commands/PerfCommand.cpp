@@ -18,46 +18,55 @@ constexpr const char* kHelp = R"(usage: cloudbench perf record [--suite FILE] [-
                               [--backend LIST] [--instructions FILE]
        cloudbench perf compare BASE HEAD [compare options]
        cloudbench perf compare --interleave BASE_BINARY HEAD_BINARY SCENE...
-                              [--rounds K] [--backend LIST] [--steps N] [--set PATH=VALUE]...
-                              [compare options]
+                              [--rounds K] [--keep DIR] [--backend LIST] [--steps N]
+                              [--set PATH=VALUE]... [compare options]
+       cloudbench perf compare DIR [compare options]
        cloudbench perf history FILE [--metric time|instructions] [--min-change F]
                               [--min-segment N] [--json FILE]
-       cloudbench perf export --gbench OUT SOURCE
+       cloudbench perf export --gbench OUT SOURCE...
 
 record   runs the suite (default: thesis-low, thesis-medium, thesis-high, each as
          `cloudbench run` with its own steps, on every built backend; --suite
          FILE: docs/cli.md) and appends one record to the history (default:
          $CLOUDBENCH_HISTORY, else $XDG_DATA_HOME/cloudbench/history.jsonl, else
          ~/.local/share/cloudbench/history.jsonl). --repeat N runs each scene N
-         times and pools the samples. It also counts each scene's CPU
+         times and keeps each run's samples. It also counts each scene's CPU
          instructions (`cloudbench count`) when this build can (no
          -march=native: the exact preset; valgrind installed), else the
          record's "instructions_not_counted" says why; --instructions FILE
          merges a `cloudbench count` output instead.
-compare  compares per-step stage times (median ratio with a 95 % bootstrap
-         interval, one-sided Mann-Whitney U tests with Holm's correction) and
-         instruction counts. BASE and HEAD: a results.json, a count output, a
+compare  compares stage times run by run, each run's median step (a
+         ratio with a 95 % bootstrap interval, one-sided permutation tests
+         over the runs, Holm's correction) and instruction counts. BASE and
+         HEAD: a results.json, a `run --out` folder, a count output, a
          history (its last record), FILE@ID or FILE@-N (N-th record from the
-         end). --interleave runs BASE_BINARY and HEAD_BINARY alternately
-         (A B A B ..., K rounds, default 5) and pools each side's samples.
-         Marks: + slower, - faster, ~ not significant or within the threshold,
-         x failed or missing in HEAD, ! new.
-  --threshold [BACKEND=]R  a time regression needs a median ratio above R
-                  (default 1.5; gl and vk 3, software drivers here)
+         end). --interleave runs BASE_BINARY and HEAD_BINARY alternately in
+         ABBA order, K rounds (default: enough for every stage to be judged),
+         and pairs the runs by round; --keep DIR keeps every run and
+         DIR/interleave.json, which `perf compare DIR` judges again. Marks:
+         + slower, - faster, ~ not significant or within the threshold,
+         ? cannot be judged (too few rounds or samples), x failed or missing
+         in HEAD, ! new.
+  --threshold [BACKEND=]R  a time regression needs a ratio above R
+                  (default 1.1; gl and vk 3, software drivers here)
   --separate-threshold R  used instead when BASE and HEAD were not run
                   interleaved (default 2.0)
-  --floor MS      and the medians to differ by more than MS (default 0.05)
   --alpha A       and a Holm-adjusted p below A (default 0.01)
+  --run-quantile Q  each run's statistic: this quantile of its steps
+                  (default 0.5, the median)
+  --floor MS      one run a side (its steps tested): and the medians to
+                  differ by more than MS (default 0.05)
   --instruction-threshold F  an instruction count regresses above 1 + F
                   (default 0.02)
   --json FILE     also write every comparison as JSON
 history  marks step changes in each stage's median over the records (binary
          segmentation, permutation test) and what changed in the provenance.
-export   writes SOURCE (as for compare) as Google Benchmark JSON for compare.py.
+export   writes the SOURCEs (as for compare, their runs pooled) as Google
+         Benchmark JSON for compare.py, a run per repetition.
 
-Exit codes: 0 no regression (an inconclusive result passes), 1 a run failed
-or an output could not be written, 2 bad command line, 3 a bad input file,
-6 a confirmed regression.
+Exit codes: 0 no regression (an inconclusive result passes, with a warning
+naming each stage marked ?), 1 a run failed or an output could not be
+written, 2 bad command line, 3 a bad input file, 6 a confirmed regression.
 )";
 
 }  // namespace

@@ -70,7 +70,8 @@ bool WriteJsonFile(const std::string& path, const json& doc) {
     return true;
 }
 
-TemporaryFolder::TemporaryFolder() {
+TemporaryFolder::TemporaryFolder(bool create) {
+    if (!create) return;
     const char* base = std::getenv("TMPDIR");
     std::string pattern = std::string(base && *base ? base : "/tmp") + "/cloudbench-perf-XXXXXX";
     if (char* made = ::mkdtemp(pattern.data())) path = made;
@@ -82,7 +83,8 @@ TemporaryFolder::~TemporaryFolder() {
 }
 
 std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
-                           const std::string& out, const std::string& log, perf::Side& side, bool& failed) {
+                           const std::string& out, const std::string& log, perf::Side& side, bool& failed, int round,
+                           int* exitCode) {
     std::vector<std::string> argv = {binary, "run", scene, "--out", out, "--quiet"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     auto rc = perf::RunChild(argv, log);
@@ -90,6 +92,7 @@ std::optional<int> RunInto(const std::string& binary, const std::string& scene, 
         std::fprintf(stderr, "%s\n", rc.error().message.c_str());
         return kExitFailed;
     }
+    if (exitCode) *exitCode = *rc;
     if (*rc == kExitUsage || *rc == kExitBadScene) {
         std::fprintf(stderr, "perf: %s run %s exited %d (see its message above)\n", binary.c_str(), scene.c_str(), *rc);
         return *rc;
@@ -106,7 +109,7 @@ std::optional<int> RunInto(const std::string& binary, const std::string& scene, 
         std::fprintf(stderr, "perf: %s run %s exited %d\n", binary.c_str(), scene.c_str(), *rc);
         failed = true;
     }
-    if (Status s = perf::AddResults(side, results->doc); !s) {
+    if (Status s = perf::AddResults(side, results->doc, round); !s) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
     }

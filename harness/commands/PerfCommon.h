@@ -56,18 +56,21 @@ std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& 
 // "PATH: cannot write: <strerror>" and returns false.
 bool WriteJsonFile(const std::string& path, const json& doc);
 
-// A temporary folder for runs' outputs, removed when this goes out of scope.
+// A temporary folder for runs' outputs, removed when this goes out of scope;
+// none (an empty path) unless `create`.
 struct TemporaryFolder {
-    TemporaryFolder();
+    explicit TemporaryFolder(bool create = true);
     ~TemporaryFolder();
     std::string path;
 };
 
 // One `cloudbench run` of `scene` by `binary` into `out`, its results added to
-// `side`. Returns the exit code the perf command should end with at once (a
-// bad scene or command line), or nullopt to go on; `failed` is set when the
-// run failed.
+// `side` as one run measured in `round` (-1 outside an interleave). Returns the
+// exit code the perf command should end with at once (a bad scene or command
+// line), or nullopt to go on; `failed` is set when the run failed, and
+// `exitCode` (when given) receives the run's own exit code.
 std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
-                           const std::string& out, const std::string& log, perf::Side& side, bool& failed);
+                           const std::string& out, const std::string& log, perf::Side& side, bool& failed,
+                           int round = -1, int* exitCode = nullptr);
 
 }  // namespace cb::perf_command

@@ -3,12 +3,20 @@
 // run`), prints the comparison with its regression verdict and writes --json.
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
 #include <tuple>
 
 #include "core/base/ShownText.h"
 #include "harness/commands/PerfCommon.h"
+#include "harness/platform/OutputFolder.h"
 #include "harness/report/ReportModel.h"
 
 namespace cb::perf_command {
@@ -23,12 +31,29 @@ std::string SideSummary(const perf::Side& side) {
     return text;
 }
 
+// "median" for 0.5, "25th percentile" otherwise.
+std::string RunStatisticName(double quantile) {
+    return quantile == 0.5 ? "median" : Num("%g", quantile * 100) + "th percentile";
+}
+
+// What a row's test drew on: "8 rounds", "5+5 runs", "100+100 steps".
+std::string TestedOn(const perf::Comparison& c) {
+    if (c.test == "rounds") return std::to_string(c.pairs) + (c.pairs == 1 ? " round" : " rounds");
+    if (c.test == "runs") return std::to_string(c.baseRuns) + "+" + std::to_string(c.headRuns) + " runs";
+    if (c.test == "steps") return std::to_string(c.baseCount) + "+" + std::to_string(c.headCount) + " steps";
+    return "";
+}
+
 json ComparisonJson(const perf::Comparison& c) {
     auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
     return {{"scene", c.scene},
             {"backend", c.backend},
             {"stage", c.stage},
             {"metric", c.metric},
+            {"test", c.test},
+            {"base_runs", c.baseRuns},
+            {"head_runs", c.headRuns},
+            {"pairs", c.pairs},
             {"base_count", c.baseCount},
             {"head_count", c.headCount},
             {"base_median", number(c.baseMedian)},
@@ -61,14 +86,16 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
     std::string own;
     for (const auto& [backend, unused] : settings.backendThreshold)
         own += ", " + backend + " " + Num("%gx", perf::ThresholdOf(settings, backend));
-    header.items.push_back({"gate", "+ when slower by more than " + Num("%gx", outcome.threshold) + own + " and " +
-                                        Num("%g ms", settings.floorMs) + ", Holm-adjusted p < " +
-                                        Num("%g", settings.alpha) + "; instructions: more than " +
+    header.items.push_back({"gate", "+ when slower by more than " + Num("%gx", outcome.threshold) + own +
+                                        ", Holm-adjusted p < " + Num("%g", settings.alpha) + " over runs (each run's " +
+                                        RunStatisticName(settings.runQuantile) +
+                                        " step; interleaved runs paired by round); one run a side: its steps, and " +
+                                        Num("%g ms", settings.floorMs) + "; instructions: more than " +
                                         Num("%g %%", settings.instructionThreshold * 100)});
     section.blocks.push_back(header);
     report::Table table({report::Column(""), report::Column("scene"), report::Column("backend"),
                          report::Column("stage"), report::Column("base"), report::Column("head"),
-                         report::Column("ratio").AlignRight(), report::Column("95% CI"),
+                         report::Column("ratio").AlignRight(), report::Column("95% CI"), report::Column("tested on"),
                          report::Column("p slower (Holm)").AlignRight(), report::Column("note")});
     for (const perf::Comparison& c : outcome.rows) {
         const bool time = c.metric == "time";
@@ -77,7 +104,7 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
             {std::string(1, c.mark), c.scene, c.backend, c.stage + (time ? "" : " (instructions)"),
              Num(f, c.baseMedian), Num(f, c.headMedian), Num("%.3f", c.ratio),
              std::isnan(c.interval.low) ? "" : Num("%.3f", c.interval.low) + "-" + Num("%.3f", c.interval.high),
-             Num("%.2g", c.pSlowerHolm), c.note});
+             TestedOn(c), Num("%.2g", c.pSlowerHolm), c.note});
     }
     section.blocks.push_back(table);
     rep.sections.push_back(section);
@@ -97,6 +124,14 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
     } else {
         std::printf("no regression\n");
     }
+    if (const size_t unjudged = outcome.Unjudged()) {
+        std::printf("warning: %zu of %zu time comparisons could not be judged (marked ?):", unjudged,
+                    size_t(std::count_if(outcome.rows.begin(), outcome.rows.end(),
+                                         [](const perf::Comparison& c) { return c.metric == "time"; })));
+        for (const perf::Comparison& c : outcome.rows)
+            if (c.mark == '?') std::printf(" %s/%s/%s", c.scene.c_str(), c.backend.c_str(), c.stage.c_str());
+        std::printf("; more rounds (--rounds) or more samples a run make them testable\n");
+    }
     if (!jsonPath.empty()) {
         json doc = {{"format", "cloudbench-perf-compare/1"},
                     {"base", {{"label", base.label}, {"date", base.date}, {"provenance", base.provenance}}},
@@ -109,15 +144,93 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
                     {"alpha", settings.alpha},
                     {"instruction_threshold", settings.instructionThreshold},
                     {"comparisons", json::array()},
+                    {"run_statistic", RunStatisticName(settings.runQuantile)},
                     {"regressions", outcome.Regressions()},
+                    {"unjudged", json::array()},
                     {"exit_code", code},
                     {"report", report::RenderJson(rep)}};
-        for (const perf::Comparison& c : outcome.rows) doc["comparisons"].push_back(ComparisonJson(c));
+        for (const perf::Comparison& c : outcome.rows) {
+            doc["comparisons"].push_back(ComparisonJson(c));
+            if (c.mark == '?') doc["unjudged"].push_back(c.scene + "/" + c.backend + "/" + c.stage);
+        }
         for (const auto& [backend, unused] : settings.backendThreshold)
             doc["backend_thresholds"][backend] = perf::ThresholdOf(settings, backend);
         if (!WriteJsonFile(jsonPath, doc) && code == kExitOk) code = kExitFailed;
     }
     return code;
+}
+
+// ABBA: BASE first in even rounds, HEAD first in odd ones, so that a drift in
+// the machine's speed over a round falls on both sides alike.
+std::array<int, 2> InterleavedOrder(int round) { return round % 2 == 0 ? std::array{0, 1} : std::array{1, 0}; }
+
+std::string InterleavedMode(int rounds) {
+    return "interleaved (ABBA), " + std::to_string(rounds) + (rounds == 1 ? " round" : " rounds");
+}
+
+// "r03-thesis-low": the round (1-based) and the scene's file stem, kept to a plain name.
+std::string KeptRunName(int round, const std::string& scene) {
+    std::string stem = std::filesystem::path(scene).stem().string(), name;
+    for (char c : stem) name += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '_';
+    char prefix[16];
+    std::snprintf(prefix, sizeof prefix, "r%02d-", round + 1);
+    return prefix + name;
+}
+
+// The 1, 5 and 15 minute load averages (/proc/loadavg); empty where there is none.
+json LoadAverage() {
+    double load[3];
+    if (::getloadavg(load, 3) != 3) return json::array();
+    return {std::round(load[0] * 100) / 100, std::round(load[1] * 100) / 100, std::round(load[2] * 100) / 100};
+}
+
+// --keep's folder: created (with its parents) when missing, claimed like any
+// output folder, and its base/ and head/ made inside it without following links.
+Status ClaimKeptFolder(const std::string& folder) {
+    if (auto made = OpenFolderForWriting(folder, true); !made) return std::unexpected(made.error());
+    CB_TRY(ClaimOutputFolder(folder, "perf compare"));
+    for (const char* side : {"/base", "/head"})
+        if (auto made = OpenFolderForWriting(folder + side, true); !made) return std::unexpected(made.error());
+    return {};
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    return std::filesystem::equivalent(a, b, ec);
+}
+
+// The rounds at which a sign-flip test over the rounds can be judged for every
+// time comparison the first round found, with one round to spare: the
+// smallest K with (comparisons) x 2^-K < alpha, plus one, so that a slowdown
+// with one discordant round of the smallest size is still caught.
+int RoundsToJudge(const perf::Side& base, const perf::Side& head, double alpha) {
+    size_t comparisons = 0;
+    for (const auto& [scene, backends] : head.runs)
+        for (const auto& [backend, stages] : backends)
+            for (const auto& [stage, runs] : stages)
+                if (auto s = base.runs.find(scene); s != base.runs.end())
+                    if (auto b = s->second.find(backend); b != s->second.end() && b->second.count(stage)) ++comparisons;
+    int rounds = 1;
+    while (double(std::max<size_t>(comparisons, 1)) * std::ldexp(1.0, -rounds) >= alpha) ++rounds;
+    return rounds + 1;
+}
+
+// `perf compare FOLDER`: the verdict again from a kept interleave's runs.
+int CompareKept(const std::string& folder, perf::CompareSettings settings, const std::string& jsonPath) {
+    auto sides = perf::LoadInterleave(folder);
+    if (!sides) {
+        std::fprintf(stderr, "%s\n", sides.error().message.c_str());
+        return kExitBadScene;
+    }
+    int rounds = 0;
+    for (const perf::Side& side : *sides)
+        for (const auto& [scene, backends] : side.runs)
+            for (const auto& [backend, stages] : backends)
+                for (const auto& [stage, runs] : stages)
+                    for (const perf::RunSamples& run : runs) rounds = std::max(rounds, run.round + 1);
+    settings.interleaved = true;
+    return PrintComparison((*sides)[0], (*sides)[1], settings, InterleavedMode(rounds) + ", kept in " + folder,
+                           jsonPath);
 }
 
 }  // namespace
@@ -126,7 +239,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     ParsedArgs a;
     if (auto m = Parse(args,
                        {"--threshold", "--separate-threshold", "--floor", "--alpha", "--instruction-threshold",
-                        "--json", "--rounds", "--backend", "--steps", "--set"},
+                        "--json", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile"},
                        {"--interleave", "--quiet"}, a))
         return Usage(*m);
     perf::CompareSettings settings;
@@ -152,13 +265,17 @@ int ComparePerf(const std::vector<std::string>& args) {
     for (auto [name, low, high, field] :
          {std::tuple{"--separate-threshold", 1.0, 1e6, &settings.separateThreshold},
           std::tuple{"--floor", 0.0, 1e9, &settings.floorMs}, std::tuple{"--alpha", 1e-12, 1.0, &settings.alpha},
-          std::tuple{"--instruction-threshold", 0.0, 1e6, &settings.instructionThreshold}})
+          std::tuple{"--instruction-threshold", 0.0, 1e6, &settings.instructionThreshold},
+          std::tuple{"--run-quantile", 0.0, 1.0, &settings.runQuantile}})
         if (auto m = NumberOption(a, name, low, high, *field)) return Usage(*m);
     const std::string jsonPath = a.Value("--json");
     if (!a.Has("--interleave")) {
-        for (const char* o : {"--rounds", "--backend", "--steps", "--set"})
+        for (const char* o : {"--rounds", "--backend", "--steps", "--set", "--keep"})
             if (a.Has(o)) return Usage(std::string(o) + " is for perf compare --interleave");
-        if (a.positional.size() != 2) return Usage("perf compare needs BASE and HEAD");
+        if (a.positional.size() == 1 && std::filesystem::is_directory(a.positional[0]))
+            return CompareKept(a.positional[0], settings, jsonPath);
+        if (a.positional.size() != 2)
+            return Usage("perf compare needs BASE and HEAD, or the FOLDER of a kept interleave");
         perf::Side sides[2];
         for (int n = 0; n < 2; ++n) {
             if (a.positional[n].empty()) return Usage(std::string(n ? "HEAD" : "BASE") + ": must not be empty");
@@ -169,12 +286,20 @@ int ComparePerf(const std::vector<std::string>& args) {
             }
             sides[n] = std::move(*side);
         }
+        if (SameFile(a.positional[0], a.positional[1]))
+            std::fprintf(stderr,
+                         "perf compare: warning: BASE and HEAD are the same file (%s): nothing is compared "
+                         "but the file with itself\n",
+                         ShownArgument(a.positional[0]).c_str());
         settings.interleaved = false;
         return PrintComparison(sides[0], sides[1], settings, "separate files", jsonPath);
     }
     if (a.positional.size() < 3) return Usage("perf compare --interleave needs BASE_BINARY HEAD_BINARY SCENE...");
-    double rounds = 5;
+    // Without --rounds, the rounds follow from the first: as many as every time comparison needs to be judged.
+    double rounds = 0;
     if (auto m = NumberOption(a, "--rounds", 1, 1000, rounds)) return Usage(*m);
+    const bool autoRounds = rounds == 0;
+    if (autoRounds) rounds = 1;
     std::vector<std::string> extra;
     if (a.Has("--backend")) extra.insert(extra.end(), {"--backend", a.Value("--backend")});
     if (a.Has("--steps")) extra.insert(extra.end(), {"--steps", a.Value("--steps")});
@@ -183,31 +308,75 @@ int ComparePerf(const std::vector<std::string>& args) {
     const std::string binaries[2] = {a.positional[0], a.positional[1]};
     for (const std::string& b : binaries)
         if (::access(b.c_str(), X_OK) != 0) return Usage("'" + ShownArgument(b) + "' is not an executable file");
+    if (binaries[0] == binaries[1] && !a.Has("--quiet"))
+        std::fprintf(stderr, "perf compare: BASE_BINARY and HEAD_BINARY are the same file: a null comparison\n");
     const std::vector<std::string> scenes(a.positional.begin() + 2, a.positional.end());
-    TemporaryFolder temporary;
-    if (temporary.path.empty()) {
+    // The runs' outputs go to --keep's folder, or to a temporary one removed at the end.
+    TemporaryFolder temporary(!a.Has("--keep"));
+    const std::string folder = a.Has("--keep") ? a.Value("--keep") : temporary.path;
+    if (folder.empty()) {
         std::fprintf(stderr, "perf compare: cannot create a temporary folder\n");
         return kExitFailed;
     }
+    if (a.Has("--keep"))
+        if (Status claimed = ClaimKeptFolder(folder); !claimed) {
+            std::fprintf(stderr, "%s\n", claimed.error().message.c_str());
+            return kExitFailed;
+        }
+    json manifest = {{"format", perf::kInterleaveFormat},
+                     {"base", binaries[0]},
+                     {"head", binaries[1]},
+                     {"scenes", scenes},
+                     {"rounds", int(rounds)},
+                     {"order", "ABBA"},
+                     {"run_options", extra},
+                     {"runs", json::array()}};
     perf::Side sides[2];
     sides[0].label = binaries[0] + " (BASE)";
     sides[1].label = binaries[1] + " (HEAD)";
     bool failed = false;
-    for (int round = 0; round < int(rounds); ++round)
-        for (size_t s = 0; s < scenes.size(); ++s)
-            for (int n = 0; n < 2; ++n) {
+    std::optional<int> stop;  // the exit code to end with at once
+    auto runRound = [&](int round) {
+        for (size_t s = 0; s < scenes.size() && !stop; ++s)
+            for (int n : InterleavedOrder(round)) {
                 if (!a.Has("--quiet"))
-                    std::fprintf(stderr, "perf compare: round %d of %d, %s, %s\n", round + 1, int(rounds),
+                    std::fprintf(stderr, "perf compare: round %d of %s, %s, %s\n", round + 1,
+                                 autoRounds && round == 0 ? "(counting)" : std::to_string(int(rounds)).c_str(),
                                  scenes[s].c_str(), n ? "HEAD" : "BASE");
-                const std::string out =
-                    temporary.path + "/" + std::to_string(round) + "-" + std::to_string(s) + (n ? "-head" : "-base");
-                if (auto code =
-                        RunInto(binaries[n], scenes[s], extra, out, temporary.path + "/runs.log", sides[n], failed))
-                    return *code;
+                const std::string side = n ? "head" : "base";
+                const std::string name = side + "/" + KeptRunName(round, scenes[s]);
+                json run = {
+                    {"side", side}, {"scene", scenes[s]}, {"round", round}, {"folder", name}, {"load", LoadAverage()}};
+                const auto start = std::chrono::steady_clock::now();
+                int exitCode = -1;
+                if (auto code = RunInto(binaries[n], scenes[s], extra, folder + "/" + name, folder + "/runs.log",
+                                        sides[n], failed, round, &exitCode)) {
+                    stop = *code;
+                    return;
+                }
+                run["exit"] = exitCode;
+                run["seconds"] =
+                    std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * 1000) /
+                    1000;
+                manifest["runs"].push_back(run);
+                // Rewritten after each run, so that a comparison cut short keeps what it measured.
+                if (a.Has("--keep") && !WriteJsonFile(folder + "/" + perf::kInterleaveFile, manifest)) {
+                    stop = kExitFailed;
+                    return;
+                }
             }
+    };
+    for (int round = 0; round < int(rounds) && !stop; ++round) runRound(round);
+    if (autoRounds && !stop) {
+        rounds = RoundsToJudge(sides[0], sides[1], settings.alpha);
+        manifest["rounds"] = int(rounds);
+        if (!a.Has("--quiet"))
+            std::fprintf(stderr, "perf compare: %d rounds, enough for each comparison to be judged\n", int(rounds));
+        for (int round = 1; round < int(rounds) && !stop; ++round) runRound(round);
+    }
+    if (stop) return *stop;
     settings.interleaved = true;
-    const int code = PrintComparison(sides[0], sides[1], settings,
-                                     "interleaved, " + std::to_string(int(rounds)) + " rounds", jsonPath);
+    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds)), jsonPath);
     return code == kExitOk && failed ? kExitFailed : code;
 }
 

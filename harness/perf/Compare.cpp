@@ -7,7 +7,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <numeric>
 
+#include "core/base/ShownText.h"
 #include "harness/perf/History.h"
 #include "harness/report/InputFormats.h"
 
@@ -16,13 +18,25 @@ namespace {
 
 using nlohmann::json;
 
+// One stage's samples in a history record: "runs_ms" run by run when the
+// record has it, otherwise "samples_ms" as one run.
+std::vector<RunSamples> RecordRuns(const json& entry) {
+    std::vector<RunSamples> runs;
+    if (entry.contains("runs_ms")) {
+        for (const json& run : entry.at("runs_ms")) runs.push_back({-1, run.get<std::vector<double>>()});
+    } else {
+        runs.push_back({-1, entry.at("samples_ms").get<std::vector<double>>()});
+    }
+    return runs;
+}
+
 Status AddRecord(Side& side, const json& record) {
     try {
         for (const auto& [scene, backends] : record.at("results").items())
             for (const auto& [backend, stages] : backends.items())
                 for (const auto& [stage, entry] : stages.items()) {
-                    auto& samples = side.samplesMs[scene][backend][stage];
-                    for (const json& v : entry.at("samples_ms")) samples.push_back(v.get<double>());
+                    auto& runs = side.runs[scene][backend][stage];
+                    for (RunSamples& run : RecordRuns(entry)) runs.push_back(std::move(run));
                 }
         if (record.contains("failures"))
             for (const auto& [scene, backends] : record["failures"].items())
@@ -39,7 +53,13 @@ Status AddRecord(Side& side, const json& record) {
 
 }  // namespace
 
-Status AddResults(Side& side, const json& results) {
+std::vector<double> Pooled(const std::vector<RunSamples>& runs) {
+    std::vector<double> pooled;
+    for (const RunSamples& run : runs) pooled.insert(pooled.end(), run.ms.begin(), run.ms.end());
+    return pooled;
+}
+
+Status AddResults(Side& side, const json& results, int round) {
     if (!results.is_object() || results.value("format", json()) != "cloudbench-results/1")
         return MakeError(side.label + ": not a results.json (format cloudbench-results/1)");
     try {
@@ -52,10 +72,8 @@ Status AddResults(Side& side, const json& results) {
                     status + (entry.contains("error") ? ": " + entry.value("error", "") : "");
             }
             if (!entry.contains("stages")) continue;
-            for (const auto& [stage, stats] : entry["stages"].items()) {
-                auto& samples = side.samplesMs[scene][backend][stage];
-                for (const json& v : stats.at("samples_ms")) samples.push_back(v.get<double>());
-            }
+            for (const auto& [stage, stats] : entry["stages"].items())
+                side.runs[scene][backend][stage].push_back({round, stats.at("samples_ms").get<std::vector<double>>()});
         }
         if (side.provenance.empty() && results.contains("provenance")) {
             side.provenance = results["provenance"];
@@ -89,6 +107,15 @@ Result<Side> LoadSide(const std::string& spec) {
         selector = spec.substr(at + 1);
         selected = true;
     }
+    if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+        if (selected) return MakeError(spec + ": '@' selects a record of a history, and " + path + " is a folder");
+        if (::stat((path + "/" + kInterleaveFile).c_str(), &st) == 0)
+            return MakeError(path + ": is a kept interleave (it holds " + kInterleaveFile +
+                             "); compare it alone: perf compare " + path);
+        path += "/results.json";  // the folder a `run --out` wrote
+        if (::stat(path.c_str(), &st) != 0)
+            return MakeError(spec + ": is a folder without a results.json (a `run --out` folder has one)");
+    }
     Side side;
     side.label = spec;
     // A record alone is read as a history of one (input::ReadDocumentOrHistory).
@@ -120,12 +147,51 @@ Result<Side> LoadSide(const std::string& spec) {
     return side;
 }
 
+Result<std::array<Side, 2>> LoadInterleave(const std::string& folder) {
+    const std::string manifestPath = folder + "/" + kInterleaveFile;
+    if (struct stat st{}; ::lstat(manifestPath.c_str(), &st) != 0 && errno == ENOENT)
+        return MakeError(folder + ": not a kept interleave (it has no " + kInterleaveFile +
+                         "); perf compare takes BASE and HEAD, or a folder that --interleave --keep wrote");
+    static constexpr input::Format kManifest[] = {input::Format::Interleave};
+    auto manifest = input::ReadCloudbenchFile(manifestPath, kManifest);
+    if (!manifest) return std::unexpected(manifest.error());
+    const json& doc = manifest->doc;
+    std::array<Side, 2> sides;
+    sides[0].label = doc["base"].get<std::string>() + " (BASE)";
+    sides[1].label = doc["head"].get<std::string>() + " (HEAD)";
+    for (size_t n = 0; n < doc["runs"].size(); ++n) {
+        const json& run = doc["runs"][n];
+        const std::string side = run["side"].get<std::string>(), name = run["folder"].get<std::string>();
+        // A run's folder is its side's, one name deep: nothing outside the kept folder is read.
+        const std::string prefix = side + "/", leaf = name.substr(std::min(name.size(), prefix.size()));
+        if (name.rfind(prefix, 0) != 0 || leaf.empty() || leaf[0] == '.' || leaf.find('/') != std::string::npos)
+            return MakeError(manifestPath + ": /runs/" + std::to_string(n) + "/folder: must be " + prefix +
+                             "NAME, got '" + ShownText(name, false, 200) + "'");
+        static constexpr input::Format kResults[] = {input::Format::Results};
+        auto results = input::ReadCloudbenchFile(folder + "/" + name + "/results.json", kResults);
+        if (!results) {
+            // A run that wrote no results was reported when it ran (its exit code is in the manifest).
+            if (run.value("exit", 0) != 0) continue;
+            return std::unexpected(results.error());
+        }
+        CB_TRY(AddResults(sides[side == "head"], results->doc, run["round"].get<int>()));
+    }
+    return sides;
+}
+
 json RecordSections(const Side& side) {
     json results = json::object(), failures = json::object(), instructions = json::object();
-    for (const auto& [scene, backends] : side.samplesMs)
+    for (const auto& [scene, backends] : side.runs)
         for (const auto& [backend, stages] : backends)
-            for (const auto& [stage, samples] : stages)
-                results[scene][backend][stage] = {{"samples_ms", samples}, {"median_ms", Median(samples)}};
+            for (const auto& [stage, runs] : stages) {
+                const std::vector<double> samples = Pooled(runs);
+                json& entry = results[scene][backend][stage];
+                entry = {{"samples_ms", samples}, {"median_ms", Median(samples)}};
+                if (runs.size() > 1) {
+                    entry["runs_ms"] = json::array();
+                    for (const RunSamples& run : runs) entry["runs_ms"].push_back(run.ms);
+                }
+            }
     for (const auto& [scene, backends] : side.failures)
         for (const auto& [backend, why] : backends) failures[scene][backend] = why;
     for (const auto& [scene, backends] : side.instructions)
@@ -178,56 +244,150 @@ double ThresholdOf(const CompareSettings& s, const std::string& backend) {
     return s.interleaved ? threshold : std::max(threshold, s.separateThreshold);
 }
 
+namespace {
+
+// The statistic of each run's steps, as logs, for the runs that have steps.
+std::vector<std::pair<int, double>> RunLogs(const std::vector<RunSamples>& runs, double quantile) {
+    std::vector<std::pair<int, double>> logs;
+    for (const RunSamples& run : runs) {
+        const double v = Quantile(run.ms, quantile);
+        if (run.ms.empty() || !(v > 0)) continue;  // a zero time has no ratio
+        logs.emplace_back(run.round, std::log(v));
+    }
+    return logs;
+}
+
+// `v` as printf's %g.
+std::string General(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
+double MeanOf(const std::vector<double>& v) {
+    return v.empty() ? NAN : std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
+}
+
+// Fills c's test of time from the runs of both sides: pSlower, pFaster, the
+// ratio, its interval and `test`; returns the smallest p the test could give
+// (1 when it cannot test). Rows whose sides are single runs test the steps.
+double TestTime(Comparison& c, const std::vector<RunSamples>& baseRuns, const std::vector<RunSamples>& headRuns,
+                const CompareSettings& s) {
+    const auto b = RunLogs(baseRuns, s.runQuantile), h = RunLogs(headRuns, s.runQuantile);
+    c.baseRuns = b.size(), c.headRuns = h.size();
+    std::vector<double> bl, hl;
+    for (const auto& [round, v] : b) bl.push_back(v);
+    for (const auto& [round, v] : h) hl.push_back(v);
+    c.baseMedian = std::exp(MeanOf(bl)), c.headMedian = std::exp(MeanOf(hl));
+    // Interleaved: the rounds both sides ran in, each a pair.
+    std::vector<double> d;
+    if (s.interleaved)
+        for (const auto& [round, hv] : h)
+            if (round >= 0)
+                for (const auto& [baseRound, bv] : b)
+                    if (baseRound == round) d.push_back(hv - bv);
+    if (!d.empty()) {
+        c.test = "rounds";
+        c.pairs = d.size();
+        c.ratio = std::exp(MeanOf(d));
+        c.interval = BootstrapExpMean(d, s.confidence, s.resamples, s.seed);
+        std::vector<double> negated(d.size());
+        std::transform(d.begin(), d.end(), negated.begin(), [](double v) { return -v; });
+        c.pSlower = SignFlipGreater(d, s.permutations, s.seed);
+        c.pFaster = SignFlipGreater(negated, s.permutations, s.seed);
+        return SmallestSignFlipP(d.size(), s.permutations);
+    }
+    if (bl.size() > 1 || hl.size() > 1) {
+        c.test = "runs";
+        c.ratio = c.headMedian / c.baseMedian;
+        c.pSlower = PermutationGreater(hl, bl, s.permutations, s.seed);
+        c.pFaster = PermutationGreater(bl, hl, s.permutations, s.seed);
+        return SmallestPermutationP(hl.size(), bl.size(), s.permutations);
+    }
+    // One run a side: its steps, as if independent.
+    c.test = "steps";
+    const std::vector<double> bs = Pooled(baseRuns), hs = Pooled(headRuns);
+    c.baseMedian = Median(bs), c.headMedian = Median(hs), c.ratio = c.headMedian / c.baseMedian;
+    if (bs.size() < s.minSamples || hs.size() < s.minSamples) return 1;
+    c.interval = BootstrapRatioOfMedians(bs, hs, s.confidence, s.resamples, s.seed);
+    c.pSlower = MannWhitneyGreater(hs, bs).p;
+    c.pFaster = MannWhitneyGreater(bs, hs).p;
+    return 0;
+}
+
+}  // namespace
+
+size_t CompareOutcome::Unjudged() const {
+    return size_t(std::count_if(rows.begin(), rows.end(), [](const Comparison& c) { return c.mark == '?'; }));
+}
+
 CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings& s) {
     CompareOutcome out;
     out.separate = !s.interleaved;
     out.threshold = ThresholdOf(s, "");
-    std::vector<size_t> tested;  // rows with a test, for Holm's correction
-    for (const auto& [scene, backend, stage] : Keys(base.samplesMs, head.samplesMs)) {
+    std::vector<size_t> tested;     // rows with a test, for Holm's correction
+    std::vector<double> smallestP;  // the smallest p each tested row's test can give
+    for (const auto& [scene, backend, stage] : Keys(base.runs, head.runs)) {
         Comparison c;
         c.scene = scene, c.backend = backend, c.stage = stage, c.metric = "time";
-        const std::vector<double>* b = Find(base.samplesMs, scene, backend, stage);
-        const std::vector<double>* h = Find(head.samplesMs, scene, backend, stage);
-        if (b) c.baseCount = b->size(), c.baseMedian = Median(*b);
-        if (h) c.headCount = h->size(), c.headMedian = Median(*h);
-        if (c.baseCount && c.headCount) c.ratio = c.headMedian / c.baseMedian;
+        const std::vector<RunSamples>* b = Find(base.runs, scene, backend, stage);
+        const std::vector<RunSamples>* h = Find(head.runs, scene, backend, stage);
+        if (b) c.baseCount = Pooled(*b).size();
+        if (h) c.headCount = Pooled(*h).size();
         const std::string headFailure = Failure(head, scene, backend);
         if (!headFailure.empty() || !c.headCount) {
             c.mark = 'x';
             c.note = headFailure.empty() ? "no samples in HEAD" : "HEAD: " + headFailure;
+            if (c.baseCount) c.baseMedian = Median(Pooled(*b));
         } else if (!c.baseCount) {
             c.mark = '!';
             c.note = "new: no samples in BASE";
-        } else if (c.baseCount < s.minSamples || c.headCount < s.minSamples) {
-            c.note = "too few samples to test (at least " + std::to_string(s.minSamples) + " a side)";
+            c.headMedian = Median(Pooled(*h));
+        } else if (const double smallest = TestTime(c, *b, *h, s); std::isnan(c.pSlower)) {
+            c.mark = '?';
+            c.note = "cannot judge: one run a side with fewer than " + std::to_string(s.minSamples) + " samples";
         } else {
-            c.interval = BootstrapRatioOfMedians(*b, *h, s.confidence, s.resamples, s.seed);
-            c.pSlower = MannWhitneyGreater(*h, *b).p;
-            c.pFaster = MannWhitneyGreater(*b, *h).p;
             tested.push_back(out.rows.size());
+            smallestP.push_back(smallest);
         }
         out.rows.push_back(c);
     }
     std::vector<double> slower, faster;
     for (size_t i : tested) slower.push_back(out.rows[i].pSlower), faster.push_back(out.rows[i].pFaster);
+    // A row whose test cannot reach alpha after Holm's correction (its smallest p times the number of
+    // tests) cannot be judged, and says so; it still counts in the correction of the others. A row with
+    // no test at all is not one of the family.
+    const size_t family = tested.size();
     const std::vector<double> slowerHolm = HolmAdjusted(slower), fasterHolm = HolmAdjusted(faster);
     for (size_t n = 0; n < tested.size(); ++n) {
         Comparison& c = out.rows[tested[n]];
+        c.threshold = ThresholdOf(s, c.backend);
+        if (smallestP[n] * double(family) >= s.alpha) {
+            c.mark = '?';
+            c.note = c.test == "rounds"
+                         ? "cannot judge: " + std::to_string(c.pairs) + " rounds cannot reach Holm-adjusted p < " +
+                               General(s.alpha) + " over " + std::to_string(family) + " tests"
+                         : "cannot judge: " + std::to_string(c.baseRuns) + " and " + std::to_string(c.headRuns) +
+                               " runs cannot reach Holm-adjusted p < " + General(s.alpha) + " over " +
+                               std::to_string(family) + " tests";
+            continue;
+        }
         c.pSlowerHolm = slowerHolm[n];
         c.pFasterHolm = fasterHolm[n];
         const bool slowerSignificant = c.pSlowerHolm < s.alpha, fasterSignificant = c.pFasterHolm < s.alpha;
+        // Only the step test has an absolute floor: with runs as the samples, the ratio decides.
         const double difference = c.headMedian - c.baseMedian;
-        c.threshold = ThresholdOf(s, c.backend);
-        if (slowerSignificant && c.ratio > c.threshold && difference > s.floorMs) {
+        const double floor = c.test == "steps" ? s.floorMs : 0;
+        if (slowerSignificant && c.ratio > c.threshold && difference > floor) {
             c.mark = '+';
             c.regression = true;
             c.note = "regression";
-        } else if (fasterSignificant && c.ratio < 1 / c.threshold && -difference > s.floorMs) {
+        } else if (fasterSignificant && c.ratio < 1 / c.threshold && -difference > floor) {
             c.mark = '-';
             c.note = "improvement";
         } else if (slowerSignificant || fasterSignificant) {
-            c.note = std::abs(difference) <= s.floorMs ? "significant, under the floor"
-                                                       : "significant, within the threshold";
+            c.note =
+                std::abs(difference) <= floor ? "significant, under the floor" : "significant, within the threshold";
         } else {
             c.note = "not significant";
         }

@@ -1,8 +1,10 @@
 // What `perf compare` compares: the per-step samples of each scene x backend x
-// stage (and instruction counts) of two sides, each loaded from a results.json,
-// a history record or a `count` output, or pooled from interleaved runs.
+// stage, run by run (and instruction counts), of two sides, each loaded from a
+// results.json (or the folder `run --out` wrote), a history record or a
+// `count` output, or from interleaved runs (kept or not).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -18,56 +20,92 @@ namespace cb::perf {
 template <typename T>
 using ByStage = std::map<std::string, std::map<std::string, std::map<std::string, T>>>;  // scene, backend, stage
 
+// One `cloudbench run`'s per-step samples of one stage: the unit the gate's
+// tests draw on, since steps within a run share its machine state.
+struct RunSamples {
+    int round = -1;  // the interleaved round it ran in (0-based); -1 outside an interleave
+    std::vector<double> ms;
+};
+
 struct Side {
     std::string label;  // what it was loaded from: "FILE", "FILE@ID"
     std::string date;   // when it was measured (ISO 8601); "" when unknown
     nlohmann::json provenance = nlohmann::json::object();
-    ByStage<std::vector<double>> samplesMs;                              // per-step wall times, pooled over runs
+    ByStage<std::vector<RunSamples>> runs;                               // per-step wall times, run by run
     std::map<std::string, std::map<std::string, std::string>> failures;  // scene, backend: why it gave no result
     ByStage<double> instructions;                                        // `cloudbench count`: exact per-stage counts
 };
 
-// Adds a results.json document's samples (pooled with any already there),
-// its failed backends and, when `side` has none yet, its provenance and date.
-// Error: "LABEL: reason" for a document that is not cloudbench-results/1.
-Status AddResults(Side& side, const nlohmann::json& results);
+// Every run's samples, one after another.
+std::vector<double> Pooled(const std::vector<RunSamples>& runs);
+
+// Adds a results.json document's samples as one more run (measured in
+// `round`), its failed backends and, when `side` has none yet, its provenance
+// and date. Error: "LABEL: reason" for a document that is not cloudbench-results/1.
+Status AddResults(Side& side, const nlohmann::json& results, int round = -1);
 // Adds an {"instructions": {scene: {backend: {stage: count}}}} section.
 Status AddInstructions(Side& side, const nlohmann::json& doc);
 
 // The side a BASE or HEAD argument names: "FILE" (a results.json, a count
-// output or a history, whose last record is taken), "FILE@ID" or "FILE@-N"
-// (a history record). Errors name the argument.
+// output or a history, whose last record is taken), "FOLDER" (the folder a
+// `run --out` wrote: its results.json), "FILE@ID" or "FILE@-N" (a history
+// record). Errors name the argument.
 Result<Side> LoadSide(const std::string& spec);
 
-// A history record's "results", "failures" and "instructions" sections from a side.
+// What `perf compare --interleave --keep FOLDER` keeps (docs/cli.md): every
+// run's output folder, and FOLDER/interleave.json listing the runs in the
+// order they ran, with their side, scene, round, exit code and the load average.
+inline constexpr const char* kInterleaveFormat = "cloudbench-interleave/1";
+inline constexpr const char* kInterleaveFile = "interleave.json";
+
+// Both sides of a kept interleave, each run in its round. Errors name the file.
+Result<std::array<Side, 2>> LoadInterleave(const std::string& folder);
+
+// A history record's "results", "failures" and "instructions" sections from a
+// side: each stage's pooled "samples_ms" and "median_ms", and "runs_ms" (the
+// samples run by run) when there was more than one run.
 nlohmann::json RecordSections(const Side& side);
 
+// How `perf compare` judges a stage's time (docs/cli.md, "perf"; why, in
+// docs/performance.md, "The regression gate"). The run is the sample: each run
+// gives one statistic of its steps (their `runQuantile`). Interleaved sides
+// are paired by round, and the test is a sign-flip permutation test over the
+// rounds' log-ratios; other sides of several runs each take a two-sample
+// permutation test over the runs' logs. Only a side of a single run falls back
+// to its steps (a Mann-Whitney U test that takes them as independent, which
+// they are not: hence the wider separate threshold and the floor).
 struct CompareSettings {
-    double threshold = 1.5;  // a slowdown ratio of medians above this (and the rest) is a regression
+    double threshold = 1.1;  // a slowdown ratio above this (and significant) is a regression
     // Per backend, instead of `threshold`: OpenGL and Vulkan run on software drivers (llvmpipe, lavapipe)
     // that share the CPU, and moved up to 2.28x between identical builds (reports/perf/walltime.md).
     std::map<std::string, double> backendThreshold = {{"gl", 3.0}, {"vk", 3.0}};
     double separateThreshold = 2.0;  // used instead when the sides were not measured interleaved
     bool interleaved = false;
-    double floorMs = 0.05;               // and the medians differ by more than this
+    double runQuantile = 0.5;            // the statistic of a run's steps
+    double floorMs = 0.05;               // one run a side: and the medians differ by more than this
     double alpha = 0.01;                 // family-wise, after Holm's correction
     double instructionThreshold = 0.02;  // relative change of an exact count
     double confidence = 0.95;
     int resamples = 2000;
+    int permutations = 9999;  // where a permutation test is not drawn exactly
     uint64_t seed = 20260101;
-    size_t minSamples = 20;  // fewer on a side: reported, never tested (the normal approximation needs about 20)
+    size_t minSamples = 20;  // one run a side: fewer steps on a side cannot be tested
 };
 
 struct Comparison {
     std::string scene, backend, stage;
     std::string metric;  // "time" (ms) or "instructions"
-    size_t baseCount = 0, headCount = 0;
+    std::string test;    // "rounds" (paired by round), "runs" (two samples of runs), "steps" (one run a side)
+    size_t baseRuns = 0, headRuns = 0, pairs = 0;            // runs a side; rounds with a run on both sides
+    size_t baseCount = 0, headCount = 0;                     // steps (samples) a side, over its runs
     double baseMedian = NAN, headMedian = NAN, ratio = NAN;  // ratio = head / base
     double threshold = NAN;                                  // the ratio a regression must exceed
     Interval interval{NAN, NAN};
-    double pSlower = NAN, pFaster = NAN;          // one-sided Mann-Whitney
+    double pSlower = NAN, pFaster = NAN;          // one-sided
     double pSlowerHolm = NAN, pFasterHolm = NAN;  // Holm-adjusted over every time comparison
-    char mark = '~';  // + slower, - faster, ~ not significant or small, x failed or missing in HEAD, ! new
+    // + slower, - faster, ~ not significant or within the threshold, ? cannot be judged (too few runs or
+    // samples to reach alpha), x failed or missing in HEAD, ! new
+    char mark = '~';
     bool regression = false;
     std::string note;
 };
@@ -78,6 +116,7 @@ struct CompareOutcome {
     bool separate = false;
     bool headFailed = false;  // some row is 'x'
     size_t Regressions() const;
+    size_t Unjudged() const;  // rows marked '?'
 };
 
 // The wall-time threshold of `backend`: its own or the default, at least

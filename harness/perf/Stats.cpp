@@ -9,8 +9,8 @@
 namespace cb::perf {
 namespace {
 
-// NumPy's default quantile: linear interpolation between order statistics.
-double Quantile(std::vector<double>& sorted, double q) {
+// NumPy's default quantile of sorted values: linear interpolation between order statistics.
+double SortedQuantile(std::vector<double>& sorted, double q) {
     const double position = q * double(sorted.size() - 1);
     const size_t below = size_t(std::floor(position));
     const size_t above = std::min(below + 1, sorted.size() - 1);
@@ -44,6 +44,24 @@ std::pair<size_t, double> BestSplit(std::span<const double> x, int minSegment) {
     return best;
 }
 
+// Floating-point sums of one arrangement in another order can differ in the
+// last bits: a permuted statistic within this relative distance of the
+// observed one counts as at least as large (SciPy's permutation_test does the same).
+constexpr double kPermutationTolerance = 1e-14;
+
+// p from `asLarge` of `total` arrangements, exact or random (SciPy's adjustment of 1 for random ones).
+double PermutationP(uint64_t asLarge, uint64_t total, bool exact) {
+    return exact ? double(asLarge) / double(total) : double(asLarge + 1) / double(total + 1);
+}
+
+// C(n, k), saturating at UINT64_MAX.
+uint64_t Binomial(size_t n, size_t k) {
+    k = std::min(k, n - k);
+    long double c = 1;
+    for (size_t i = 1; i <= k; ++i) c = c * (long double)(n - k + i) / (long double)i;
+    return c >= (long double)UINT64_MAX ? UINT64_MAX : uint64_t(std::llround(c));
+}
+
 void Segment(std::span<const double> series, size_t offset, const ChangePointSettings& s, std::mt19937_64& rng,
              std::vector<size_t>& found) {
     const auto [split, statistic] = BestSplit(series, s.minSegment);
@@ -68,6 +86,101 @@ void Segment(std::span<const double> series, size_t offset, const ChangePointSet
 double Median(std::span<const double> values) {
     std::vector<double> copy(values.begin(), values.end());
     return MedianInPlace(copy);
+}
+
+double Quantile(std::span<const double> values, double q) {
+    if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> sorted(values.begin(), values.end());
+    std::sort(sorted.begin(), sorted.end());
+    return SortedQuantile(sorted, q);
+}
+
+double SignFlipGreater(std::span<const double> d, int permutations, uint64_t seed) {
+    const size_t n = d.size();
+    if (n == 0) return 1;
+    const double observed = std::accumulate(d.begin(), d.end(), 0.0);
+    const double atLeast = observed - std::abs(observed) * kPermutationTolerance;
+    uint64_t asLarge = 0;
+    if (n < 64 && (uint64_t(1) << n) <= kExactPermutations) {
+        const uint64_t patterns = uint64_t(1) << n;
+        for (uint64_t signs = 0; signs < patterns; ++signs) {
+            double sum = 0;
+            for (size_t i = 0; i < n; ++i) sum += (signs >> i & 1) ? -d[i] : d[i];
+            asLarge += sum >= atLeast;
+        }
+        return PermutationP(asLarge, patterns, true);
+    }
+    std::mt19937_64 rng(seed);
+    for (int r = 0; r < permutations; ++r) {
+        double sum = 0;
+        for (size_t i = 0; i < n; ++i) sum += (rng() & 1) ? -d[i] : d[i];
+        asLarge += sum >= atLeast;
+    }
+    return PermutationP(asLarge, uint64_t(permutations), false);
+}
+
+double PermutationGreater(std::span<const double> x, std::span<const double> y, int permutations, uint64_t seed) {
+    if (x.empty() || y.empty()) return 1;
+    std::vector<double> pooled(x.begin(), x.end());
+    pooled.insert(pooled.end(), y.begin(), y.end());
+    const size_t n = pooled.size(), nx = x.size();
+    const double total = std::accumulate(pooled.begin(), pooled.end(), 0.0);
+    auto statistic = [&](double sumX) { return sumX / double(nx) - (total - sumX) / double(n - nx); };
+    const double observed = statistic(std::accumulate(x.begin(), x.end(), 0.0));
+    const double atLeast = observed - std::abs(observed) * kPermutationTolerance;
+    uint64_t asLarge = 0;
+    if (const uint64_t splits = Binomial(n, nx); splits <= kExactPermutations) {
+        // Every choice of nx of the n values as x, in lexicographic order of their indices.
+        std::vector<size_t> chosen(nx);
+        std::iota(chosen.begin(), chosen.end(), 0);
+        for (uint64_t count = 0; count < splits; ++count) {
+            double sumX = 0;
+            for (size_t i : chosen) sumX += pooled[i];
+            asLarge += statistic(sumX) >= atLeast;
+            size_t i = nx;
+            while (i > 0 && chosen[i - 1] == n - nx + i - 1) --i;
+            if (i == 0) break;
+            ++chosen[i - 1];
+            for (size_t j = i; j < nx; ++j) chosen[j] = chosen[j - 1] + 1;
+        }
+        return PermutationP(asLarge, splits, true);
+    }
+    std::mt19937_64 rng(seed);
+    for (int r = 0; r < permutations; ++r) {
+        std::shuffle(pooled.begin(), pooled.end(), rng);
+        asLarge += statistic(std::accumulate(pooled.begin(), pooled.begin() + std::ptrdiff_t(nx), 0.0)) >= atLeast;
+    }
+    return PermutationP(asLarge, uint64_t(permutations), false);
+}
+
+double SmallestSignFlipP(size_t pairs, int permutations) {
+    if (pairs == 0) return 1;
+    if (pairs < 64 && (uint64_t(1) << pairs) <= kExactPermutations) return std::ldexp(1.0, -int(pairs));
+    return 1 / double(permutations + 1);
+}
+
+double SmallestPermutationP(size_t nx, size_t ny, int permutations) {
+    if (nx == 0 || ny == 0) return 1;
+    const uint64_t splits = Binomial(nx + ny, nx);
+    return splits <= kExactPermutations ? 1 / double(splits) : 1 / double(permutations + 1);
+}
+
+Interval BootstrapExpMean(std::span<const double> d, double confidence, int resamples, uint64_t seed) {
+    if (d.empty() || resamples < 1) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        return {nan, nan};
+    }
+    std::mt19937_64 rng(seed);
+    std::uniform_int_distribution<size_t> pick(0, d.size() - 1);
+    std::vector<double> means;
+    means.reserve(size_t(resamples));
+    for (int r = 0; r < resamples; ++r) {
+        double sum = 0;
+        for (size_t i = 0; i < d.size(); ++i) sum += d[pick(rng)];
+        means.push_back(std::exp(sum / double(d.size())));
+    }
+    std::sort(means.begin(), means.end());
+    return {SortedQuantile(means, (1 - confidence) / 2), SortedQuantile(means, (1 + confidence) / 2)};
 }
 
 UTestResult MannWhitneyGreater(std::span<const double> x, std::span<const double> y) {
@@ -130,7 +243,7 @@ Interval BootstrapRatioOfMedians(std::span<const double> base, std::span<const d
         ratios.push_back(MedianInPlace(h) / MedianInPlace(b));
     }
     std::sort(ratios.begin(), ratios.end());
-    return {Quantile(ratios, (1 - confidence) / 2), Quantile(ratios, (1 + confidence) / 2)};
+    return {SortedQuantile(ratios, (1 - confidence) / 2), SortedQuantile(ratios, (1 + confidence) / 2)};
 }
 
 std::vector<size_t> ChangePoints(std::span<const double> series, const ChangePointSettings& settings) {

@@ -1,7 +1,8 @@
 // The statistics of `perf compare` and `perf history` (docs/cli.md, "perf"):
-// medians, a one-sided Mann-Whitney U test, Holm's correction, a bootstrap
-// interval for a ratio of medians, and change points in a series. Each
-// formula is checked against SciPy in tests/check_perf_stats.py.
+// medians and quantiles, one-sided permutation tests over runs (paired sign
+// flips, two samples), a one-sided Mann-Whitney U test, Holm's correction,
+// bootstrap intervals, and change points in a series. Each formula is checked
+// against SciPy in tests/check_perf_stats.py.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +14,38 @@ namespace cb::perf {
 // The median, averaging the two middle values of an even count (NumPy's);
 // NaN for no values.
 double Median(std::span<const double> values);
+
+// The q-quantile by linear interpolation between order statistics (NumPy's
+// default); NaN for no values.
+double Quantile(std::span<const double> values, double q);
+
+// Permutation tests drawn exactly when there are at most kExactPermutations
+// arrangements, otherwise from `permutations` random ones (fixed seed).
+inline constexpr uint64_t kExactPermutations = 1 << 16;
+
+// The one-sided paired permutation test that the differences `d` have a
+// positive mean: each difference's sign is flipped at random (the two sides of
+// a pair are exchangeable under the null). p is the fraction of the 2^n sign
+// patterns (the observed one included) whose sum is at least the observed sum:
+// scipy.stats.permutation_test((d,), mean, permutation_type="samples",
+// alternative="greater"); with random patterns, (1 + as large) / (1 +
+// permutations). p = 1 for no differences. The smallest p n differences can
+// give is 2^-n.
+double SignFlipGreater(std::span<const double> d, int permutations, uint64_t seed);
+
+// The one-sided two-sample permutation test that mean(x) > mean(y): the pooled
+// values are split at random into groups of the two sizes.
+// scipy.stats.permutation_test((x, y), mean(x) - mean(y),
+// permutation_type="independent", alternative="greater"), exact over all
+// C(n, |x|) splits when there are at most kExactPermutations. p = 1 when either
+// side is empty. The smallest p is 1 / C(n, |x|).
+double PermutationGreater(std::span<const double> x, std::span<const double> y, int permutations, uint64_t seed);
+
+// The smallest p SignFlipGreater (of `pairs` differences) or
+// PermutationGreater (of sizes nx, ny) can give with `permutations` random
+// arrangements where they are not exact.
+double SmallestSignFlipP(size_t pairs, int permutations);
+double SmallestPermutationP(size_t nx, size_t ny, int permutations);
 
 struct UTestResult {
     double u = 0;  // U of `x`: the number of pairs (x_i, y_j) with x_i > y_j, ties counting 1/2
@@ -41,6 +74,10 @@ struct Interval {
 // (linear interpolation, NumPy's default). Deterministic for a given seed.
 Interval BootstrapRatioOfMedians(std::span<const double> base, std::span<const double> head, double confidence,
                                  int resamples, uint64_t seed);
+
+// The percentile bootstrap interval of exp(mean(d)) for log-ratios `d`:
+// `resamples` times, d is resampled with replacement. Deterministic for a seed.
+Interval BootstrapExpMean(std::span<const double> d, double confidence, int resamples, uint64_t seed);
 
 // Change points in `series` by binary segmentation: the split that maximises
 // sqrt(nL nR / n) |mean(left) - mean(right)| (both sides at least minSegment

@@ -194,7 +194,8 @@ Node InstructionsSection() { return ByStage(Integer(0, 1e19)); }
 
 Node PerfRecordSchema() {
     // A report tolerates a missing median (it uses the samples'); perf compare needs the samples.
-    const Node result = Object({{"samples_ms", Samples(), true}, {"median_ms", Nullable(Ms())}});
+    const Node result =
+        Object({{"samples_ms", Samples(), true}, {"median_ms", Nullable(Ms())}, {"runs_ms", ArrayOf(Samples())}});
     // An object naming any of scene, backend and stage, or the text "scene/backend/stage" (docs/cli.md, "report").
     const Node changePoint = Either(OpenObject({{"scene", Text()}, {"backend", Text()}, {"stage", Text()}}), Text());
     return Object({{"format", TextOf({"cloudbench-perf/1"}), true},
@@ -338,6 +339,26 @@ Node AccuracySchema() {
                    {"provenance", Provenance()}});
 }
 
+// What `perf compare --interleave --keep` keeps (harness/perf/Compare.h): each run's folder is
+// "base/NAME" or "head/NAME", a name of its own inside the kept folder.
+Node InterleaveSchema() {
+    const Node run = Object({{"side", TextOf({"base", "head"}), true},
+                             {"scene", Text(), true},
+                             {"round", Integer(0, 1e6), true},
+                             {"folder", Text(), true},
+                             {"exit", Integer(-1, 255)},
+                             {"seconds", Number(0, 1e12)},
+                             {"load", ArrayOf(Number(0, 1e6), 3, 3)}});
+    return Object({{"format", TextOf({"cloudbench-interleave/1"}), true},
+                   {"base", Text(), true},
+                   {"head", Text(), true},
+                   {"scenes", Names(), true},
+                   {"rounds", Integer(1, 1e6), true},
+                   {"order", TextOf({"ABBA"})},
+                   {"run_options", Names()},
+                   {"runs", ArrayOf(run), true}});
+}
+
 Node SuiteSchema() {
     return Object({{"scenes", ArrayOf(Object({{"scene", Text(), true}, {"set", Names()}}), 1), true}});
 }
@@ -357,6 +378,7 @@ const Described kFormats[] = {
     {Format::Conform, "cloudbench-conform/1", "a conform.json", ConformSchema},
     {Format::Accuracy, "cloudbench-accuracy/1", "an accuracy.json", AccuracySchema},
     {Format::Suite, "", "a perf suite", SuiteSchema},
+    {Format::Interleave, "cloudbench-interleave/1", "a kept interleave's interleave.json", InterleaveSchema},
 };
 
 const Described& Lookup(Format format) {

@@ -16,8 +16,12 @@ namespace {
 
 // The test-only slowdown switch, CLOUDBENCH_TEST_SLOWDOWN=<stage>:<factor>
 // (docs/cli.md): the named stage's time becomes `factor` times its own, by
-// spinning for (factor - 1) times the call's time after it, inside the timed
-// record. It exists so that the performance gate's tests can plant a known
+// keeping the backend busy for (factor - 1) times the call's time right after
+// it, inside the timed record (Backend::BusyFor: on the CPU, every thread of
+// its arena, as a stage doing more work would). A spin on the calling thread
+// alone let the CPU backend's workers fall asleep, and waking them slowed the
+// next stage; a spin in TBB's default arena moved them out of the backend's.
+// It exists so that the performance gate's tests can plant a known
 // regression; nothing else reads it.
 struct Slowdown {
     std::string stage;
@@ -43,12 +47,6 @@ const std::optional<Slowdown>& TestSlowdown() {
     return slowdown;
 }
 
-void SpinFor(double ms) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
-    while (std::chrono::steady_clock::now() < until) {
-    }
-}
-
 }  // namespace
 
 Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
@@ -60,7 +58,7 @@ Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageH
     Status status = AdapterOf(stage)(backend, scene, host, buffers, record);
     if (const auto& slowdown = TestSlowdown(); slowdown && slowdown->stage == StageName(stage)) {
         const auto start = std::chrono::steady_clock::now();
-        SpinFor((slowdown->factor - 1) * (record.ms - before));
+        backend.BusyFor((slowdown->factor - 1) * (record.ms - before));
         record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
     if (!status && !Describe(stage).renderer)
