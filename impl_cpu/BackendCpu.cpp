@@ -4,10 +4,10 @@
 #include <tbb/partitioner.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <thread>
 
+#include "core/base/ProcessCpuTime.h"
 #include "core/base/ProcessMemory.h"
 #include "core/scene/Scene.h"
 #include "impl_cpu/CaKernels.h"
@@ -26,16 +26,12 @@ BackendCpu::BackendCpu(int threads) : mArena(threads > 0 ? threads : tbb::task_a
     mStages.Get<SmoothCpuState>().threads = std::max(Threads(), 1);
 }
 
-void BackendCpu::BusyFor(double ms) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
+void BackendCpu::BusyFor(double wallMs, double cpuMs) {
+    // Equal shares, so that the threads finish together as a balanced stage's do.
+    const double share = std::min(cpuMs / Threads(), wallMs);
     mArena.execute([&] {
         tbb::parallel_for(
-            0, Threads(), 1,
-            [until](int) {
-                while (std::chrono::steady_clock::now() < until) {
-                }
-            },
-            tbb::static_partitioner());
+            0, Threads(), 1, [&](int) { SpinCpuFor(share); }, tbb::static_partitioner());
     });
 }
 

@@ -68,7 +68,7 @@ class BackendCpu : public Backend {
 
     int Threads() const { return mArena.max_concurrency(); }
     // Every thread of the arena spins until `ms` from now.
-    void BusyFor(double ms) override;
+    void BusyFor(double wallMs, double cpuMs) override;
 
   private:
     // The stage objects (core/pipeline/StageObjects.h): what each stage keeps

@@ -7,7 +7,7 @@ exit codes from the documented rule (docs/cli.md). The samples are made here
 with a fixed seed; no expected number comes from cloudbench's own output.
 
 usage: check_perf_stats.py CLOUDBENCH WORKDIR CASE
-CASE: compare, rounds, runs, instructions, inputs, history, changepoints, gbench
+CASE: compare, rounds, clock, runs, instructions, inputs, history, changepoints, gbench
 """
 import json
 import os
@@ -38,10 +38,14 @@ def close(a, b, rel, what):
     check(abs(a - b) <= rel * max(abs(a), abs(b)), f"{what}: {a!r} vs {b!r} (relative tolerance {rel})")
 
 
-def results_json(path, scene, stages, backend="cpu", status="ok", commit="0" * 40, date="2026-01-01T00:00:00Z"):
+def results_json(path, scene, stages, backend="cpu", status="ok", commit="0" * 40, date="2026-01-01T00:00:00Z",
+                 cpu=None):
+    """cpu: {stage: samples} of the process's CPU time beside the wall times, for the stages it names."""
+    entries = {name: {"samples_ms": [float(v) for v in samples]} for name, samples in stages.items()}
+    for name, samples in (cpu or {}).items():
+        entries[name]["cpu"] = {"samples_ms": [float(v) for v in samples]}
     doc = {"format": "cloudbench-results/1", "scene": {"name": scene},
-           "backends": {backend: {"status": status, "stages": {
-               name: {"samples_ms": [float(v) for v in samples]} for name, samples in stages.items()}}},
+           "backends": {backend: {"status": status, "stages": entries}},
            "provenance": {"git": {"commit": commit, "dirty": False}, "date": date}}
     with open(path, "w") as f:
         json.dump(doc, f)
@@ -158,17 +162,20 @@ def case_compare():
     print("perf compare: ok")
 
 
-def kept_interleave(folder, scene, rounds):
-    """A kept interleave written by hand: rounds[k] = {stage: (base samples, head samples)}, ABBA order."""
+def kept_interleave(folder, scene, rounds, cpu_rounds=None, load=1):
+    """A kept interleave written by hand: rounds[k] = {stage: (base samples, head samples)}, ABBA order;
+    cpu_rounds[k] the same for the CPU times; every run started at load average `load`."""
     shutil.rmtree(folder, ignore_errors=True)
     runs = []
     for k, stages in enumerate(rounds):
         for side in (("base", "head") if k % 2 == 0 else ("head", "base")):
             name = f"{side}/r{k + 1:02d}-{scene}"
             os.makedirs(f"{folder}/{name}")
-            results_json(f"{folder}/{name}/results.json", scene,
-                         {st: v[0 if side == "base" else 1] for st, v in stages.items()})
-            runs.append({"side": side, "scene": scene, "round": k, "folder": name, "exit": 0, "load": [1, 1, 1]})
+            n = 0 if side == "base" else 1
+            results_json(f"{folder}/{name}/results.json", scene, {st: v[n] for st, v in stages.items()},
+                         cpu={st: v[n] for st, v in cpu_rounds[k].items()} if cpu_rounds else None)
+            runs.append({"side": side, "scene": scene, "round": k, "folder": name, "exit": 0,
+                         "load": [load, load, load]})
     with open(f"{folder}/interleave.json", "w") as f:
         json.dump({"format": "cloudbench-interleave/1", "base": "a", "head": "b", "scenes": [scene],
                    "rounds": len(rounds), "order": "ABBA", "runs": runs}, f)
@@ -251,6 +258,53 @@ def case_rounds():
     p = run("perf", "compare", kept, expect=3)
     check("/runs/0/folder: must be base/NAME" in p.stderr, f"a folder outside the kept one: {p.stderr}")
     print("perf compare rounds: ok")
+
+
+def case_clock():
+    rng = np.random.RandomState(17)
+    K = 12
+    # A loaded machine: each run's wall times sit in one of two modes (the second core free or taken), and
+    # its CPU times do not. "region" does 1.3x the work in HEAD: its CPU time shows it in every round, its
+    # wall time is buried under the modes. "ca" waits longer in HEAD (wall 1.5x) at the same CPU time.
+    def steps(n, median, spread=0.02):
+        return np.round(median * np.exp(rng.normal(0, spread, n)), 5)
+    wall, cpu = [], []
+    for k in range(K):
+        mode = [1.0 if rng.rand() < 0.5 else 1.9 for _ in range(2)]  # each run's share of a core
+        wall.append({"region": (steps(30, 1.0 * mode[0]), steps(30, 1.3 * mode[1])),
+                     "ca": (steps(30, 2.0), steps(30, 3.0))})
+        cpu.append({"region": (steps(30, 1.9), steps(30, 1.9 * 1.3)), "ca": (steps(30, 3.8), steps(30, 3.8))})
+    kept = f"{WORK}/kept-clock"
+    kept_interleave(kept, "s", wall, cpu, load=9)
+    for clock, rounds, slower in (("cpu", cpu, "region"), ("wall", wall, "ca")):
+        p = run("perf", "compare", kept, "--clock", clock, "--json", f"{WORK}/{clock}.json", expect=6)
+        doc = json.load(open(f"{WORK}/{clock}.json"))
+        check(doc["clock"] == clock, f"--clock {clock}: the JSON says {doc['clock']}")
+        check(f"clock: {clock}" in p.stdout, f"--clock {clock}: the header must say it: {p.stdout}")
+        rows = {c["stage"]: c for c in doc["comparisons"]}
+        names = sorted(rows)
+        d = {st: np.array([np.log(np.median(r[st][1]) / np.median(r[st][0])) for r in rounds]) for st in names}
+        holm_p = dict(zip(names, holm([sign_flip_p(d[st]) for st in names])))
+        for st in names:
+            close(rows[st]["ratio"], float(np.exp(d[st].mean())), 1e-9, f"--clock {clock}: {st} ratio")
+            close(rows[st]["p_slower_holm"], holm_p[st], 1e-9, f"--clock {clock}: {st} Holm p")
+        check([c["stage"] for c in doc["comparisons"] if c["regression"]] == [slower],
+              f"--clock {clock}: only {slower} is slower: {[(c['stage'], c['mark']) for c in doc['comparisons']]}")
+        # Runs that started at load 9 on this machine's cores: wall times get a warning, CPU times need none.
+        loaded = "warning: the machine was loaded" in p.stdout
+        check(loaded == (clock == "wall" and os.cpu_count() < 9), f"--clock {clock}: the load warning: {p.stdout}")
+    # Results without CPU times (written before cloudbench measured them) cannot be compared on it.
+    results_json(f"{WORK}/old.json", "s", {"region": [1.0] * 20})
+    p = run("perf", "compare", f"{WORK}/old.json", f"{WORK}/old.json", "--clock", "cpu", expect=3)
+    check("old.json: /backends/cpu/stages/region: has no \"cpu\" time" in p.stderr, p.stderr)
+    # A history keeps wall times only.
+    with open(f"{WORK}/h.jsonl", "w") as f:
+        f.write(json.dumps(record("r1", "1" * 40, {"region": 1.0})) + "\n")
+    p = run("perf", "compare", f"{WORK}/h.jsonl", f"{WORK}/old.json", "--clock", "cpu", expect=3)
+    check("h.jsonl: a history keeps wall times only" in p.stderr, p.stderr)
+    p = run("perf", "compare", f"{WORK}/old.json", f"{WORK}/old.json", "--clock", "device", expect=2)
+    check("--clock: needs wall or cpu, got 'device'" in p.stderr + p.stdout, p.stderr)
+    print("perf compare clock: ok")
 
 
 def case_runs():
@@ -392,7 +446,9 @@ def case_gbench():
     for side, ca in (("base", 2.0), ("head", 4.0)):
         for n in range(5):
             path = f"{WORK}/g-{side}-{n}.json"
-            results_json(path, "s", {"region": 1 + 0.01 * rng.rand(30), "ca": ca + 0.01 * rng.rand(30)})
+            # The CPU time of two threads: about twice the wall time.
+            results_json(path, "s", {"region": 1 + 0.01 * rng.rand(30), "ca": ca + 0.01 * rng.rand(30)},
+                         cpu={"region": 2 + 0.01 * rng.rand(30), "ca": 2 * ca + 0.01 * rng.rand(30)})
             files[side].append(path)
     for side in ("base", "head"):
         run("perf", "export", "--gbench", f"{WORK}/g-{side}.gbench.json", *files[side], expect=0)
@@ -411,6 +467,17 @@ def case_gbench():
     close(ca_rows[5]["real_time"], np.mean(per_run), 1e-12, "_mean")
     close(ca_rows[6]["real_time"], np.median(per_run), 1e-12, "_median")
     close(ca_rows[7]["real_time"], np.std(per_run, ddof=1), 1e-9, "_stddev")
+    per_run_cpu = [np.mean(json.load(open(f))["backends"]["cpu"]["stages"]["ca"]["cpu"]["samples_ms"]) * 1000
+                   for f in files["base"]]
+    for r, v in zip(ca_rows[:5], per_run_cpu):
+        close(r["cpu_time"], v, 1e-12, "a repetition's CPU time: the run's mean CPU time per step in us")
+    close(ca_rows[6]["cpu_time"], np.median(per_run_cpu), 1e-12, "_median CPU time")
+    # A history has wall times only: cpu_time repeats them.
+    with open(f"{WORK}/g-h.jsonl", "w") as f:
+        f.write(json.dumps(record("r1", "1" * 40, {"ca": 2.0})) + "\n")
+    run("perf", "export", "--gbench", f"{WORK}/g-h.gbench.json", f"{WORK}/g-h.jsonl", expect=0)
+    check(all(r["cpu_time"] == r["real_time"] for r in json.load(open(f"{WORK}/g-h.gbench.json"))["benchmarks"]),
+          "a history's cpu_time repeats its wall time")
     p = subprocess.run(["/usr/bin/python3", compare_py, "-d", f"{WORK}/g-cmp.json", "--no-color", "benchmarks",
                         f"{WORK}/g-base.gbench.json", f"{WORK}/g-head.gbench.json"],
                        capture_output=True, text=True, timeout=120)
@@ -431,5 +498,5 @@ def case_gbench():
 if __name__ == "__main__":
     shutil.rmtree(WORK, ignore_errors=True)
     os.makedirs(WORK)
-    {"compare": case_compare, "rounds": case_rounds, "runs": case_runs, "instructions": case_instructions, "inputs": case_inputs, "history": case_history,
+    {"compare": case_compare, "rounds": case_rounds, "clock": case_clock, "runs": case_runs, "instructions": case_instructions, "inputs": case_inputs, "history": case_history,
      "changepoints": case_changepoints, "gbench": case_gbench}[CASE]()

@@ -2,7 +2,7 @@
 # statistics against SciPy, the history's records, and the CI gate on this
 # machine (an identical build passes, a planted slowdown fails with exit 6).
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
-foreach(case compare rounds runs instructions inputs history changepoints gbench)
+foreach(case compare rounds clock runs instructions inputs history changepoints gbench)
   add_test(NAME Perf.Stats.${case}
            COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_stats.py ${cli} ${cli_out}/perf-${case} ${case})
   set_tests_properties(Perf.Stats.${case} PROPERTIES PASS_REGULAR_EXPRESSION ": ok" SKIP_RETURN_CODE 77 TIMEOUT 300)

@@ -10,8 +10,10 @@ one stage, beside Google Benchmark's compare.py on the same runs
       planted pairs (HEAD is CLOUDBENCH with CLOUDBENCH_TEST_SLOWDOWN=STAGE:F).
       The pairs of every kind and scene alternate, so that a change in the
       machine's load falls on all of them. A pair already kept is not run again.
-  gate_trial.py judge CLOUDBENCH WORKDIR [--markdown FILE] [--csv FILE] [-- COMPARE OPTIONS]
-      judges every kept pair again with CLOUDBENCH's `perf compare WORKDIR/pairs/ID`
+  gate_trial.py judge CLOUDBENCH WORKDIR [--clock cpu|wall] [--first-rounds K] [--markdown FILE] [--csv FILE]
+                     [-- COMPARE OPTIONS]
+      judges every kept pair again, on the CPU clock (the default, as the gate
+      runs in CI) or on wall time, with CLOUDBENCH's `perf compare WORKDIR/pairs/ID`
       (and the compare options given after --) and with compare.py on the
       same runs (`perf export --gbench` of each side; a stage is flagged when
       compare.py's U test gives p < 0.05 and its median is more than 5 % slower)
@@ -19,18 +21,21 @@ one stage, beside Google Benchmark's compare.py on the same runs
       step pooled, one-sided Mann-Whitney, Holm, ratio over --pooled-threshold,
       1.1), and prints the table: false alarms, planted slowdowns caught, wrong-stage
       flags, the planted stage's and its neighbours' measured ratios, the load
-      average over the runs and what a pair cost.
+      average over the runs and what a pair cost. --first-rounds K judges only
+      each pair's first K rounds (a trimmed copy, WORKDIR/pairs/ID/first-K).
 
 collect options: --rounds K (default: perf compare's own), --null N (40), --planted N (8 a scene and
 factor), --stage S (smooth), --factors F,F (1.25,1.5), --null-scenes
 (ci-small,thesis-low,thesis-medium), --planted-scenes (thesis-low,thesis-medium),
---steps N and --set PATH=VALUE (passed to every run).
+--steps N and --set PATH=VALUE (passed to every run), --clock (the verdict
+logged as each pair ends; the runs are the same on either clock).
 """
 import argparse
 import glob
 import json
 import math
 import os
+import shutil
 import stat
 import statistics
 import subprocess
@@ -86,7 +91,7 @@ def collect(args):
         start = time.time()
         rounds = ["--rounds", str(args.rounds)] if args.rounds else []
         p = subprocess.run([cli, "perf", "compare", "--interleave", cli, head, scene, "--backend", "cpu", *rounds,
-                            "--keep", keep, "--quiet", *extra],
+                            "--clock", args.clock, "--keep", keep, "--quiet", *extra],
                            capture_output=True, text=True, env=env)
         seconds = time.time() - start
         if p.returncode not in (0, 6):
@@ -98,9 +103,30 @@ def collect(args):
               f"{open('/proc/loadavg').read().split()[0]}", flush=True)
 
 
-def gate_flags(cli, keep, options):
+def first_rounds(keep, rounds):
+    """A copy of the kept pair KEEP holding only its first ROUNDS rounds (KEEP/first-ROUNDS), to judge what fewer
+    rounds would have said on the same runs."""
+    manifest = json.load(open(os.path.join(keep, "interleave.json")))
+    if rounds >= manifest["rounds"]:
+        return keep
+    trimmed = os.path.join(keep, f"first-{rounds}")
+    if not os.path.exists(os.path.join(trimmed, "interleave.json")):
+        manifest["rounds"] = rounds
+        manifest["runs"] = [r for r in manifest["runs"] if r["round"] < rounds]
+        for r in manifest["runs"]:
+            os.makedirs(os.path.join(trimmed, r["folder"]), exist_ok=True)
+            results = os.path.join(keep, r["folder"], "results.json")
+            if os.path.exists(results):
+                shutil.copyfile(results, os.path.join(trimmed, r["folder"], "results.json"))
+        with open(os.path.join(trimmed, "interleave.json"), "w") as f:
+            json.dump(manifest, f, indent=1)
+    return trimmed
+
+
+def gate_flags(cli, keep, clock, options):
     out = os.path.join(keep, "judged.json")
-    p = subprocess.run([cli, "perf", "compare", keep, "--json", out, *options], capture_output=True, text=True)
+    p = subprocess.run([cli, "perf", "compare", keep, "--clock", clock, "--json", out, *options],
+                       capture_output=True, text=True)
     if p.returncode not in (0, 6):
         sys.exit(f"{keep}: perf compare exited {p.returncode}\n{p.stdout}\n{p.stderr}")
     doc = json.load(open(out))
@@ -109,8 +135,10 @@ def gate_flags(cli, keep, options):
         {c["stage"] for c in rows if c["mark"] == "?"}
 
 
-def compare_py_flags(cli, keep):
-    """compare.py's verdict on the same runs: U test p < 0.05 and the median more than 5 % slower."""
+def compare_py_flags(cli, keep, clock):
+    """compare.py's verdict on the same runs: U test p < 0.05 and the median more than 5 % slower, on its "Time"
+    columns (wall time) or its "CPU" ones (perf export's cpu_time)."""
+    column = "cpu" if clock == "cpu" else "time"
     manifest = json.load(open(os.path.join(keep, "interleave.json")))
     files = {}
     for side in ("base", "head"):
@@ -126,12 +154,12 @@ def compare_py_flags(cli, keep):
             continue
         name = row["name"].rsplit("_median", 1)[0]
         utest = next((r["utest"] for r in json.load(open(dump)) if r["name"] == name and r["utest"]), {})
-        if utest and utest["time_pvalue"] < 0.05 and row["measurements"][0]["time"] > 0.05:
+        if utest and utest[f"{column}_pvalue"] < 0.05 and row["measurements"][0][column] > 0.05:
             flagged.add(name.split("/")[-1])
     return flagged
 
 
-def pooled_steps_flags(keep, threshold, alpha=0.01):
+def pooled_steps_flags(keep, clock, threshold, alpha=0.01):
     """What a gate on the steps pooled over each side's runs would flag (the gate before runs were the sample):
     one-sided Mann-Whitney U (SciPy, asymptotic), Holm over the stages, the ratio of medians over `threshold`."""
     import numpy as np
@@ -143,7 +171,8 @@ def pooled_steps_flags(keep, threshold, alpha=0.01):
         if not os.path.exists(path):
             continue
         for stage, v in json.load(open(path))["backends"]["cpu"].get("stages", {}).items():
-            pooled[r["side"]].setdefault(stage, []).extend(v["samples_ms"])
+            samples = v["cpu"]["samples_ms"] if clock == "cpu" else v["samples_ms"]
+            pooled[r["side"]].setdefault(stage, []).extend(samples)
     names = sorted(set(pooled["base"]) & set(pooled["head"]))
     p = [stats.mannwhitneyu(pooled["head"][s], pooled["base"][s], alternative="greater", method="asymptotic").pvalue
          for s in names]
@@ -170,20 +199,25 @@ def judge(args):
     ratios, neighbours, loads, seconds, unjudged = {}, {}, [], {}, {}
     for path in pairs:
         keep = os.path.dirname(path)
+        if args.first_rounds:
+            keep = first_rounds(keep, args.first_rounds)
         pair = json.load(open(path))
         scene, factor = pair["scene"], pair["factor"]
         stage = pair["stage"] or trial["stage"]
         kind = "identical" if factor is None else f"x{factor:g}"
         manifest = json.load(open(os.path.join(keep, "interleave.json")))
         loads += [r["load"][0] for r in manifest["runs"] if r.get("load")]
-        seconds.setdefault(scene, []).append(pair["seconds"])
-        flags, measured, cannot = gate_flags(cli, keep, args.options)
+        # A trimmed pair costs its share of the whole pair's time.
+        seconds.setdefault(scene, []).append(
+            pair["seconds"] * manifest["rounds"] / json.load(open(os.path.join(os.path.dirname(path),
+                                                                               "interleave.json")))["rounds"])
+        flags, measured, cannot = gate_flags(cli, keep, args.clock, args.options)
         for s in cannot:
             unjudged[s] = unjudged.get(s, 0) + 1
         verdicts = {"perf compare": flags}
         if os.path.exists(COMPARE_PY):
-            verdicts["compare.py"] = compare_py_flags(cli, keep)
-        verdicts["pooled steps"] = pooled_steps_flags(keep, args.pooled_threshold)
+            verdicts["compare.py"] = compare_py_flags(cli, keep, args.clock)
+        verdicts["pooled steps"] = pooled_steps_flags(keep, args.clock, args.pooled_threshold)
         for method, flagged in verdicts.items():
             t = tally[method].setdefault((scene, kind), [0, 0, 0])
             t[0] += 1
@@ -200,10 +234,12 @@ def judge(args):
         else:
             for s, r in measured.items():
                 neighbours.setdefault((scene, "identical", s), []).append(r)
-    rounds = sorted({json.load(open(os.path.join(os.path.dirname(p), "interleave.json")))["rounds"] for p in pairs})
+    rounds = sorted({min(json.load(open(os.path.join(os.path.dirname(p), "interleave.json")))["rounds"],
+                         args.first_rounds or math.inf) for p in pairs})
     lines = [f"Trial of {len(pairs)} pairs, {'/'.join(map(str, rounds))} rounds each (ABBA), cpu backend, run options "
              f"{' '.join(trial['run_options']) or '(none)'}; planted stage `{trial['stage']}`; judged with "
-             f"`perf compare {' '.join(args.options)}`.", "",
+             f"`perf compare --clock {args.clock} {' '.join(args.options)}`"
+             f"{' (compare.py on its CPU columns, pooled steps of CPU time)' if args.clock == 'cpu' else ''}.", "",
              f"Load average (1 min) at the start of each run: median {statistics.median(loads):.2f}, "
              f"{min(loads):.2f} to {max(loads):.2f}." if loads else "", "",
              "| method | scene | pairs | false alarms / caught | wrong-stage flags |", "|---|---|---|---|---|"]
@@ -237,7 +273,8 @@ def write_runs_csv(path, pairs):
     """Each run's statistics per stage, for re-checking a verdict without the kept folders."""
     import numpy as np
     with open(path, "w") as f:
-        f.write("pair,scene,planted,side,round,load1,stage,steps,median_ms,q25_ms,q10_ms,min_ms\n")
+        f.write("pair,scene,planted,side,round,load1,stage,steps,median_ms,q25_ms,q10_ms,min_ms,"
+                "cpu_median_ms,cpu_q25_ms,cpu_min_ms\n")
         for pair_path in pairs:
             keep = os.path.dirname(pair_path)
             pair = json.load(open(pair_path))
@@ -248,9 +285,11 @@ def write_runs_csv(path, pairs):
                     continue
                 for stage, v in sorted(json.load(open(results))["backends"]["cpu"].get("stages", {}).items()):
                     a = np.array(v["samples_ms"])
+                    c = np.array(v["cpu"]["samples_ms"]) if "cpu" in v else None
+                    cpu = f"{np.median(c):.6g},{np.quantile(c, 0.25):.6g},{c.min():.6g}" if c is not None else ",,"
                     f.write(f"{os.path.basename(keep)},{pair['scene']},{planted},{r['side']},{r['round']},"
                             f"{r['load'][0] if r.get('load') else ''},{stage},{len(a)},{np.median(a):.6g},"
-                            f"{np.quantile(a, 0.25):.6g},{np.quantile(a, 0.1):.6g},{a.min():.6g}\n")
+                            f"{np.quantile(a, 0.25):.6g},{np.quantile(a, 0.1):.6g},{a.min():.6g},{cpu}\n")
 
 
 def main():
@@ -268,12 +307,18 @@ def main():
     parser.add_argument("--planted-scenes", type=lambda s: s.split(","), default=["thesis-low", "thesis-medium"])
     parser.add_argument("--steps", type=int)
     parser.add_argument("--set", action="append", default=[])
+    parser.add_argument("--first-rounds", type=int, help="judge: only each pair's first K rounds")
+    parser.add_argument("--clock", choices=["cpu", "wall"], default="cpu",
+                        help="the time every method judges: the process's CPU time (the gate in CI) or wall time")
     parser.add_argument("--markdown")
     parser.add_argument("--csv", help="judge: also write each run's statistics per stage to this file")
     parser.add_argument("--pooled-threshold", type=float, default=1.1,
                         help="judge: the ratio the pooled-steps gate needs (the gate before runs were the sample)")
-    parser.add_argument("options", nargs="*", help="judge: perf compare options, after --")
-    args = parser.parse_args()
+    # Everything after "--" goes to perf compare as it is.
+    argv = sys.argv[1:]
+    cut = argv.index("--") if "--" in argv else len(argv)
+    args = parser.parse_args(argv[:cut])
+    args.options = argv[cut + 1:]
     collect(args) if args.action == "collect" else judge(args)
 
 

@@ -1,16 +1,13 @@
 #include "core/pipeline/Backend.h"
 
-#include <chrono>
+#include <algorithm>
 
+#include "core/base/ProcessCpuTime.h"
 #include "core/base/ProcessMemory.h"
 
 namespace cb {
 
-void Backend::BusyFor(double ms) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
-    while (std::chrono::steady_clock::now() < until) {
-    }
-}
+void Backend::BusyFor(double wallMs, double cpuMs) { SpinCpuFor(std::min(wallMs, cpuMs)); }
 
 size_t CanonicalElementBytes(BufferFormat format) { return format == BufferFormat::F32 ? 4 : 1; }
 

@@ -172,11 +172,15 @@ class Backend {
     // Device time of the last stage call in ms, for backends that measure it
     // (GPU timestamp queries); nullopt where wall time is all there is.
     virtual std::optional<double> LastDeviceMs() const { return std::nullopt; }
-    // Keeps the backend busy for `ms` of wall time the way its stages' own work
-    // does, for the test-only slowdown switch (harness/run/StageCall.cpp). By
-    // default the calling thread spins; the CPU backend spins on every thread
-    // of its task arena, so that its workers stay awake and in the arena.
-    virtual void BusyFor(double ms);
+    // Does the work of a call that took `wallMs` of wall time and `cpuMs` of
+    // the process's CPU time, the way the backend's stages do theirs, for the
+    // test-only slowdown switch (harness/run/StageCall.cpp): its threads spin
+    // until together they have used `cpuMs` of CPU time, in equal shares of
+    // at most `wallMs` each, so that both clocks grow as for a balanced stage
+    // doing more work. By
+    // default the calling thread spins; the CPU backend spins on the threads of
+    // its task arena, so that its workers stay awake and in the arena.
+    virtual void BusyFor(double wallMs, double cpuMs);
 
     // ---- Pipelined timing (docs/performance.md, "Two ways to time a step") ----
     // Between BeginBatch and EndBatch a backend may record stage calls and

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/base/CallgrindRequests.h"
+#include "core/base/ProcessCpuTime.h"
 #include "core/pipeline/Backend.h"
 #include "core/pipeline/StageDescriptor.h"
 #include "core/scene/Scene.h"
@@ -67,6 +68,7 @@ struct FrameRecord {
 // What one call measured and returned besides its buffers.
 struct StageCallRecord {
     double ms = 0;                           // wall time of the backend's calls
+    double cpuMs = 0;                        // the process's CPU time over them (core/base/ProcessCpuTime.h)
     std::optional<double> deviceMs;          // where the backend measures it (not with markBatch)
     std::optional<uint32_t> coveredColumns;  // density
     std::vector<FrameRecord> frames;         // renderers, one per camera
@@ -81,7 +83,7 @@ struct StageCallRecord {
 using StageAdapter = Status (*)(Backend& backend, const Scene& scene, const StageHostInputs& host,
                                 const StageBuffers& buffers, StageCallRecord& record);
 
-// Runs one backend call, adding its wall and device time to the record.
+// Runs one backend call, adding its wall, CPU and device time to the record.
 // Under callgrind the call alone (not the clock reads) is counted as one dump
 // named by `label` (core/base/CallgrindRequests.h).
 // With host.markBatch (pipelined timing) it first starts the batch's next
@@ -96,9 +98,11 @@ Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& l
         record.marks.push_back(frame);
     }
     const auto start = std::chrono::steady_clock::now();
+    const double cpuStart = ProcessCpuMs();
     counted.Begin();
     Status status = call();
     counted.End();
+    record.cpuMs += ProcessCpuMs() - cpuStart;
     record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (markBatch) return status;
     if (auto device = backend.LastDeviceMs()) record.deviceMs = record.deviceMs.value_or(0) + *device;

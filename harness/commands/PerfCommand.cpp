@@ -54,6 +54,10 @@ compare  compares stage times run by run, each run's median step (a
   --alpha A       and a Holm-adjusted p below A (default 0.01)
   --run-quantile Q  each run's statistic: this quantile of its steps
                   (default 0.5, the median)
+  --clock wall|cpu  the stage time compared: wall (default) or the
+                  process's CPU time over the stage's calls, which other
+                  jobs on a shared machine do not change (results.json files,
+                  run folders and interleaved runs)
   --floor MS      one run a side (its steps tested): and the medians to
                   differ by more than MS (default 0.05)
   --instruction-threshold F  an instruction count regresses above 1 + F

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <thread>
 #include <tuple>
 
 #include "core/base/ShownText.h"
@@ -78,7 +79,11 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
     report::Section section;
     section.title = "";
     report::KeyValues header;
-    header.items = {{"BASE", SideSummary(base)}, {"HEAD", SideSummary(head)}, {"mode", mode}};
+    header.items = {
+        {"BASE", SideSummary(base)},
+        {"HEAD", SideSummary(head)},
+        {"mode", mode},
+        {"clock", head.clock == perf::Clock::Cpu ? "cpu (the process's CPU time over each stage's calls)" : "wall"}};
     if (outcome.separate)
         header.items.push_back(
             {"note", "BASE and HEAD were measured at different times, not interleaved: the wider threshold " +
@@ -137,6 +142,7 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
                     {"base", {{"label", base.label}, {"date", base.date}, {"provenance", base.provenance}}},
                     {"head", {{"label", head.label}, {"date", head.date}, {"provenance", head.provenance}}},
                     {"mode", mode},
+                    {"clock", perf::ClockName(head.clock)},
                     {"separate", outcome.separate},
                     {"threshold", outcome.threshold},
                     {"backend_thresholds", json::object()},
@@ -184,6 +190,18 @@ json LoadAverage() {
     return {std::round(load[0] * 100) / 100, std::round(load[1] * 100) / 100, std::round(load[2] * 100) / 100};
 }
 
+// On the wall clock, a warning when a run started with more jobs ready to run
+// than the machine has cores: the CPU backend's wall times then follow the
+// other jobs (a stage gets one core or two), and CPU time does not.
+void WarnIfLoaded(double peakLoad, perf::Clock clock) {
+    const unsigned cores = std::thread::hardware_concurrency();
+    if (clock != perf::Clock::Wall || cores == 0 || peakLoad <= double(cores)) return;
+    std::printf(
+        "warning: the machine was loaded (1-minute load average up to %.2f on %u cores): wall times "
+        "follow the other jobs; on a shared machine compare CPU time (--clock cpu)\n",
+        peakLoad, cores);
+}
+
 // --keep's folder: created (with its parents) when missing, claimed like any
 // output folder, and its base/ and head/ made inside it without following links.
 Status ClaimKeptFolder(const std::string& folder) {
@@ -199,10 +217,15 @@ bool SameFile(const std::string& a, const std::string& b) {
     return std::filesystem::equivalent(a, b, ec);
 }
 
-// The rounds at which a sign-flip test over the rounds can be judged for every
-// time comparison the first round found, with one round to spare: the
-// smallest K with (comparisons) x 2^-K < alpha, plus one, so that a slowdown
-// with one discordant round of the smallest size is still caught.
+// The rounds at which a sign-flip test over the rounds still reaches alpha,
+// after Holm over every time comparison the first round found, for a
+// slowdown with two rounds against it: the smallest K with
+// (comparisons) x (1 + K + K (K - 1) / 2) x 2^-K < alpha. With at most two
+// discordant rounds, each no larger than any two concordant ones together,
+// the sign patterns that sum to as much as the observed one flip at most two
+// rounds: at most 1 + K + K (K - 1) / 2 of the 2^K. One round against it
+// (K + 1 patterns) was not enough margin on a loaded 2-core runner
+// (docs/performance.md, "The regression gate").
 int RoundsToJudge(const perf::Side& base, const perf::Side& head, double alpha) {
     size_t comparisons = 0;
     for (const auto& [scene, backends] : head.runs)
@@ -211,13 +234,16 @@ int RoundsToJudge(const perf::Side& base, const perf::Side& head, double alpha) 
                 if (auto s = base.runs.find(scene); s != base.runs.end())
                     if (auto b = s->second.find(backend); b != s->second.end() && b->second.count(stage)) ++comparisons;
     int rounds = 1;
-    while (double(std::max<size_t>(comparisons, 1)) * std::ldexp(1.0, -rounds) >= alpha) ++rounds;
-    return rounds + 1;
+    auto patterns = [](int k) { return 1.0 + k + k * (k - 1) / 2.0; };
+    while (double(std::max<size_t>(comparisons, 1)) * patterns(rounds) * std::ldexp(1.0, -rounds) >= alpha) ++rounds;
+    return rounds;
 }
 
 // `perf compare FOLDER`: the verdict again from a kept interleave's runs.
-int CompareKept(const std::string& folder, perf::CompareSettings settings, const std::string& jsonPath) {
-    auto sides = perf::LoadInterleave(folder);
+int CompareKept(const std::string& folder, perf::CompareSettings settings, perf::Clock clock,
+                const std::string& jsonPath) {
+    double peakLoad = 0;
+    auto sides = perf::LoadInterleave(folder, clock, &peakLoad);
     if (!sides) {
         std::fprintf(stderr, "%s\n", sides.error().message.c_str());
         return kExitBadScene;
@@ -229,8 +255,10 @@ int CompareKept(const std::string& folder, perf::CompareSettings settings, const
                 for (const auto& [stage, runs] : stages)
                     for (const perf::RunSamples& run : runs) rounds = std::max(rounds, run.round + 1);
     settings.interleaved = true;
-    return PrintComparison((*sides)[0], (*sides)[1], settings, InterleavedMode(rounds) + ", kept in " + folder,
-                           jsonPath);
+    const int code =
+        PrintComparison((*sides)[0], (*sides)[1], settings, InterleavedMode(rounds) + ", kept in " + folder, jsonPath);
+    WarnIfLoaded(peakLoad, clock);
+    return code;
 }
 
 }  // namespace
@@ -239,7 +267,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     ParsedArgs a;
     if (auto m = Parse(args,
                        {"--threshold", "--separate-threshold", "--floor", "--alpha", "--instruction-threshold",
-                        "--json", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile"},
+                        "--json", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile", "--clock"},
                        {"--interleave", "--quiet"}, a))
         return Usage(*m);
     perf::CompareSettings settings;
@@ -268,18 +296,25 @@ int ComparePerf(const std::vector<std::string>& args) {
           std::tuple{"--instruction-threshold", 0.0, 1e6, &settings.instructionThreshold},
           std::tuple{"--run-quantile", 0.0, 1.0, &settings.runQuantile}})
         if (auto m = NumberOption(a, name, low, high, *field)) return Usage(*m);
+    perf::Clock clock = perf::Clock::Wall;
+    if (a.Has("--clock")) {
+        const std::string name = a.Value("--clock");
+        if (name != "wall" && name != "cpu")
+            return Usage("--clock: needs wall or cpu, got '" + ShownArgument(name) + "'");
+        clock = name == "cpu" ? perf::Clock::Cpu : perf::Clock::Wall;
+    }
     const std::string jsonPath = a.Value("--json");
     if (!a.Has("--interleave")) {
         for (const char* o : {"--rounds", "--backend", "--steps", "--set", "--keep"})
             if (a.Has(o)) return Usage(std::string(o) + " is for perf compare --interleave");
         if (a.positional.size() == 1 && std::filesystem::is_directory(a.positional[0]))
-            return CompareKept(a.positional[0], settings, jsonPath);
+            return CompareKept(a.positional[0], settings, clock, jsonPath);
         if (a.positional.size() != 2)
             return Usage("perf compare needs BASE and HEAD, or the FOLDER of a kept interleave");
         perf::Side sides[2];
         for (int n = 0; n < 2; ++n) {
             if (a.positional[n].empty()) return Usage(std::string(n ? "HEAD" : "BASE") + ": must not be empty");
-            auto side = perf::LoadSide(a.positional[n]);
+            auto side = perf::LoadSide(a.positional[n], clock);
             if (!side) {
                 std::fprintf(stderr, "%s\n", side.error().message.c_str());
                 return kExitBadScene;
@@ -334,6 +369,8 @@ int ComparePerf(const std::vector<std::string>& args) {
     perf::Side sides[2];
     sides[0].label = binaries[0] + " (BASE)";
     sides[1].label = binaries[1] + " (HEAD)";
+    for (perf::Side& side : sides) side.clock = clock;
+    double peakLoad = 0;
     bool failed = false;
     std::optional<int> stop;  // the exit code to end with at once
     auto runRound = [&](int round) {
@@ -347,6 +384,7 @@ int ComparePerf(const std::vector<std::string>& args) {
                 const std::string name = side + "/" + KeptRunName(round, scenes[s]);
                 json run = {
                     {"side", side}, {"scene", scenes[s]}, {"round", round}, {"folder", name}, {"load", LoadAverage()}};
+                if (!run["load"].empty()) peakLoad = std::max(peakLoad, run["load"][0].get<double>());
                 const auto start = std::chrono::steady_clock::now();
                 int exitCode = -1;
                 if (auto code = RunInto(binaries[n], scenes[s], extra, folder + "/" + name, folder + "/runs.log",
@@ -377,6 +415,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     if (stop) return *stop;
     settings.interleaved = true;
     const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds)), jsonPath);
+    WarnIfLoaded(peakLoad, clock);
     return code == kExitOk && failed ? kExitFailed : code;
 }
 

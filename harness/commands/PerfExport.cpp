@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <tuple>
 
 #include "harness/commands/PerfCommon.h"
 
@@ -17,9 +18,10 @@ namespace {
 // runs. compare.py's U test then draws on runs, the unit that varies (it needs
 // two repetitions a side, and asks for nine). Every row is in microseconds, one
 // unit whatever the times, since compare.py drops a benchmark whose unit
-// differs between its two files. cpu_time repeats the wall time: cloudbench
-// measures no CPU time.
-json GbenchJson(const perf::Side& side) {
+// differs between its two files. cpu_time is the process's CPU time over the
+// stage's calls, per step, from `cpu` (the same sources on the CPU clock)
+// where it has the stage run for run; otherwise (a history) it repeats the wall time.
+json GbenchJson(const perf::Side& side, const perf::Side& cpu) {
     const json& p = side.provenance;
     const json machine = p.is_object() ? p.value("machine", json::object()) : json::object();
     json doc = {{"context",
@@ -37,34 +39,52 @@ json GbenchJson(const perf::Side& side) {
         for (const auto& [backend, stages] : backends)
             for (const auto& [stage, runs] : stages) {
                 const std::string name = scene + "/" + backend + "/" + stage;
-                std::vector<double> usPerStep;
+                // Each run's mean step in us, of the runs with steps; `steps` their counts.
+                auto meanSteps = [](const std::vector<perf::RunSamples>& of, std::vector<size_t>* steps) {
+                    std::vector<double> us;
+                    for (const perf::RunSamples& run : of)
+                        if (!run.ms.empty()) {
+                            us.push_back(std::accumulate(run.ms.begin(), run.ms.end(), 0.0) * 1000 /
+                                         double(run.ms.size()));
+                            if (steps) steps->push_back(run.ms.size());
+                        }
+                    return us;
+                };
                 std::vector<size_t> steps;
-                for (const perf::RunSamples& run : runs)
-                    if (!run.ms.empty()) {
-                        usPerStep.push_back(std::accumulate(run.ms.begin(), run.ms.end(), 0.0) * 1000 /
-                                            double(run.ms.size()));
-                        steps.push_back(run.ms.size());
-                    }
+                const std::vector<double> usPerStep = meanSteps(runs, &steps);
                 if (usPerStep.empty()) continue;
-                auto row = [&](const std::string& rowName, const char* type, double us, size_t iterations) {
-                    return json{{"name", rowName},  {"family_index", family},   {"per_family_instance_index", 0},
-                                {"run_name", name}, {"run_type", type},         {"repetitions", usPerStep.size()},
-                                {"threads", 1},     {"iterations", iterations}, {"real_time", us},
-                                {"cpu_time", us},   {"time_unit", "us"}};
+                std::vector<double> cpuPerStep = usPerStep;
+                if (auto s = cpu.runs.find(scene); s != cpu.runs.end())
+                    if (auto b = s->second.find(backend); b != s->second.end())
+                        if (auto st = b->second.find(stage); st != b->second.end())
+                            if (auto c = meanSteps(st->second, nullptr); c.size() == usPerStep.size()) cpuPerStep = c;
+                auto row = [&](const std::string& rowName, const char* type, double us, double cpuUs,
+                               size_t iterations) {
+                    return json{{"name", rowName},   {"family_index", family},   {"per_family_instance_index", 0},
+                                {"run_name", name},  {"run_type", type},         {"repetitions", usPerStep.size()},
+                                {"threads", 1},      {"iterations", iterations}, {"real_time", us},
+                                {"cpu_time", cpuUs}, {"time_unit", "us"}};
                 };
                 for (size_t i = 0; i < usPerStep.size(); ++i) {
-                    json r = row(name, "iteration", usPerStep[i], steps[i]);
+                    json r = row(name, "iteration", usPerStep[i], cpuPerStep[i], steps[i]);
                     r["repetition_index"] = i;
                     doc["benchmarks"].push_back(r);
                 }
-                const double n = double(usPerStep.size());
-                const double mean = std::accumulate(usPerStep.begin(), usPerStep.end(), 0.0) / n;
-                double squares = 0;
-                for (double v : usPerStep) squares += (v - mean) * (v - mean);
-                const double stddev = usPerStep.size() > 1 ? std::sqrt(squares / (n - 1)) : 0;
-                for (auto [aggregate, value] : {std::pair{"mean", mean}, std::pair{"median", perf::Median(usPerStep)},
-                                                std::pair{"stddev", stddev}}) {
-                    json r = row(name + "_" + aggregate, "aggregate", value, usPerStep.size());
+                struct Aggregates {
+                    double mean, median, stddev;
+                };
+                auto aggregates = [](const std::vector<double>& v) {
+                    const double n = double(v.size());
+                    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / n;
+                    double squares = 0;
+                    for (double x : v) squares += (x - mean) * (x - mean);
+                    return Aggregates{mean, perf::Median(v), v.size() > 1 ? std::sqrt(squares / (n - 1)) : 0};
+                };
+                const Aggregates wall = aggregates(usPerStep), cpuTime = aggregates(cpuPerStep);
+                for (auto [aggregate, value, cpuValue] :
+                     {std::tuple{"mean", wall.mean, cpuTime.mean}, std::tuple{"median", wall.median, cpuTime.median},
+                      std::tuple{"stddev", wall.stddev, cpuTime.stddev}}) {
+                    json r = row(name + "_" + aggregate, "aggregate", value, cpuValue, usPerStep.size());
                     r["aggregate_name"] = aggregate;
                     r["aggregate_unit"] = "time";
                     doc["benchmarks"].push_back(r);
@@ -81,8 +101,22 @@ int Export(const std::vector<std::string>& args) {
     if (auto m = Parse(args, {"--gbench"}, {}, a)) return Usage(*m);
     if (!a.Has("--gbench")) return Usage("perf export needs --gbench OUT");
     if (a.positional.empty()) return Usage("perf export needs a SOURCE");
-    // Several sources are one side, their runs pooled.
-    perf::Side side;
+    // Several sources are one side, their runs pooled; on the CPU clock too, where every source has it.
+    perf::Side side, cpu;
+    bool everyCpu = true;
+    auto pool = [](perf::Side& into, perf::Side&& one) {
+        if (into.label.empty()) {
+            into = std::move(one);
+            return;
+        }
+        into.label += " " + one.label;
+        for (auto& [scene, backends] : one.runs)
+            for (auto& [backend, stages] : backends)
+                for (auto& [stage, runs] : stages) {
+                    auto& to = into.runs[scene][backend][stage];
+                    to.insert(to.end(), runs.begin(), runs.end());
+                }
+    };
     for (const std::string& source : a.positional) {
         if (source.empty()) return Usage("perf export: SOURCE must not be empty");
         auto one = perf::LoadSide(source);
@@ -90,19 +124,14 @@ int Export(const std::vector<std::string>& args) {
             std::fprintf(stderr, "%s\n", one.error().message.c_str());
             return kExitBadScene;
         }
-        if (side.label.empty()) {
-            side = std::move(*one);
-            continue;
-        }
-        side.label += " " + one->label;
-        for (auto& [scene, backends] : one->runs)
-            for (auto& [backend, stages] : backends)
-                for (auto& [stage, runs] : stages) {
-                    auto& into = side.runs[scene][backend][stage];
-                    into.insert(into.end(), runs.begin(), runs.end());
-                }
+        pool(side, std::move(*one));
+        if (auto onCpu = perf::LoadSide(source, perf::Clock::Cpu); onCpu && everyCpu)
+            pool(cpu, std::move(*onCpu));
+        else
+            everyCpu = false;
     }
-    return WriteJsonFile(a.Value("--gbench"), GbenchJson(side)) ? kExitOk : kExitFailed;
+    if (!everyCpu) cpu = perf::Side{};
+    return WriteJsonFile(a.Value("--gbench"), GbenchJson(side, cpu)) ? kExitOk : kExitFailed;
 }
 
 }  // namespace cb::perf_command

@@ -72,8 +72,18 @@ Status AddResults(Side& side, const json& results, int round) {
                     status + (entry.contains("error") ? ": " + entry.value("error", "") : "");
             }
             if (!entry.contains("stages")) continue;
-            for (const auto& [stage, stats] : entry["stages"].items())
-                side.runs[scene][backend][stage].push_back({round, stats.at("samples_ms").get<std::vector<double>>()});
+            for (const auto& [stage, stats] : entry["stages"].items()) {
+                std::vector<double> samples = stats.at("samples_ms").get<std::vector<double>>();
+                if (side.clock == Clock::Cpu && !samples.empty()) {
+                    // A stage with wall-time samples has its CPU time beside them, from cloudbench 2026-12 on.
+                    if (!stats.contains("cpu"))
+                        return MakeError(side.label + ": /backends/" + backend + "/stages/" + stage +
+                                         ": has no \"cpu\" time (written before cloudbench measured it); "
+                                         "compare wall times (--clock wall) or run it again");
+                    samples = stats["cpu"].at("samples_ms").get<std::vector<double>>();
+                }
+                side.runs[scene][backend][stage].push_back({round, std::move(samples)});
+            }
         }
         if (side.provenance.empty() && results.contains("provenance")) {
             side.provenance = results["provenance"];
@@ -97,7 +107,7 @@ Status AddInstructions(Side& side, const json& doc) {
     return {};
 }
 
-Result<Side> LoadSide(const std::string& spec) {
+Result<Side> LoadSide(const std::string& spec, Clock clock) {
     // "FILE@SELECTOR" names a record of a history; a file whose own name holds '@' is taken whole.
     std::string path = spec, selector;
     bool selected = false;
@@ -118,6 +128,7 @@ Result<Side> LoadSide(const std::string& spec) {
     }
     Side side;
     side.label = spec;
+    side.clock = clock;
     // A record alone is read as a history of one (input::ReadDocumentOrHistory).
     static constexpr input::Format kSides[] = {input::Format::Results, input::Format::Count,
                                                input::Format::Instructions};
@@ -139,6 +150,10 @@ Result<Side> LoadSide(const std::string& spec) {
         return side;
     }
     auto& history = std::get<input::History>(*read);
+    if (clock == Clock::Cpu)
+        return MakeError(spec +
+                         ": a history keeps wall times only; --clock cpu compares results.json files, "
+                         "`run --out` folders and interleaved runs");
     input::PrintWarnings(history);
     auto record = SelectRecord(history.records, path, selected ? selector : "-1");
     if (!record) return std::unexpected(record.error());
@@ -147,7 +162,7 @@ Result<Side> LoadSide(const std::string& spec) {
     return side;
 }
 
-Result<std::array<Side, 2>> LoadInterleave(const std::string& folder) {
+Result<std::array<Side, 2>> LoadInterleave(const std::string& folder, Clock clock, double* peakLoad) {
     const std::string manifestPath = folder + "/" + kInterleaveFile;
     if (struct stat st{}; ::lstat(manifestPath.c_str(), &st) != 0 && errno == ENOENT)
         return MakeError(folder + ": not a kept interleave (it has no " + kInterleaveFile +
@@ -159,9 +174,12 @@ Result<std::array<Side, 2>> LoadInterleave(const std::string& folder) {
     std::array<Side, 2> sides;
     sides[0].label = doc["base"].get<std::string>() + " (BASE)";
     sides[1].label = doc["head"].get<std::string>() + " (HEAD)";
+    for (Side& side : sides) side.clock = clock;
     for (size_t n = 0; n < doc["runs"].size(); ++n) {
         const json& run = doc["runs"][n];
         const std::string side = run["side"].get<std::string>(), name = run["folder"].get<std::string>();
+        if (peakLoad && run.contains("load") && !run["load"].empty())
+            *peakLoad = std::max(*peakLoad, run["load"][0].get<double>());
         // A run's folder is its side's, one name deep: nothing outside the kept folder is read.
         const std::string prefix = side + "/", leaf = name.substr(std::min(name.size(), prefix.size()));
         if (name.rfind(prefix, 0) != 0 || leaf.empty() || leaf[0] == '.' || leaf.find('/') != std::string::npos)

@@ -27,11 +27,18 @@ struct RunSamples {
     std::vector<double> ms;
 };
 
+// Which of a stage's times the samples are: its wall time, or the process's
+// CPU time over its calls (results.json's "cpu"; docs/results.md), which does
+// not follow other jobs on the machine (docs/performance.md, "The regression gate").
+enum class Clock { Wall, Cpu };
+inline const char* ClockName(Clock clock) { return clock == Clock::Cpu ? "cpu" : "wall"; }
+
 struct Side {
     std::string label;  // what it was loaded from: "FILE", "FILE@ID"
+    Clock clock = Clock::Wall;  // the clock of `runs`, chosen before loading
     std::string date;   // when it was measured (ISO 8601); "" when unknown
     nlohmann::json provenance = nlohmann::json::object();
-    ByStage<std::vector<RunSamples>> runs;                               // per-step wall times, run by run
+    ByStage<std::vector<RunSamples>> runs;                               // per-step times, run by run
     std::map<std::string, std::map<std::string, std::string>> failures;  // scene, backend: why it gave no result
     ByStage<double> instructions;                                        // `cloudbench count`: exact per-stage counts
 };
@@ -39,9 +46,10 @@ struct Side {
 // Every run's samples, one after another.
 std::vector<double> Pooled(const std::vector<RunSamples>& runs);
 
-// Adds a results.json document's samples as one more run (measured in
-// `round`), its failed backends and, when `side` has none yet, its provenance
-// and date. Error: "LABEL: reason" for a document that is not cloudbench-results/1.
+// Adds a results.json document's samples on the side's clock as one more run
+// (measured in `round`), its failed backends and, when `side` has none yet, its
+// provenance and date. Error: "LABEL: reason" for a document that is not
+// cloudbench-results/1, or that lacks a stage's CPU time on the CPU clock.
 Status AddResults(Side& side, const nlohmann::json& results, int round = -1);
 // Adds an {"instructions": {scene: {backend: {stage: count}}}} section.
 Status AddInstructions(Side& side, const nlohmann::json& doc);
@@ -49,8 +57,9 @@ Status AddInstructions(Side& side, const nlohmann::json& doc);
 // The side a BASE or HEAD argument names: "FILE" (a results.json, a count
 // output or a history, whose last record is taken), "FOLDER" (the folder a
 // `run --out` wrote: its results.json), "FILE@ID" or "FILE@-N" (a history
-// record). Errors name the argument.
-Result<Side> LoadSide(const std::string& spec);
+// record). Errors name the argument. A history keeps wall times only: on the
+// CPU clock a history is refused.
+Result<Side> LoadSide(const std::string& spec, Clock clock = Clock::Wall);
 
 // What `perf compare --interleave --keep FOLDER` keeps (docs/cli.md): every
 // run's output folder, and FOLDER/interleave.json listing the runs in the
@@ -59,7 +68,9 @@ inline constexpr const char* kInterleaveFormat = "cloudbench-interleave/1";
 inline constexpr const char* kInterleaveFile = "interleave.json";
 
 // Both sides of a kept interleave, each run in its round. Errors name the file.
-Result<std::array<Side, 2>> LoadInterleave(const std::string& folder);
+// `peakLoad` (when given) receives the highest 1-minute load average a run started at.
+Result<std::array<Side, 2>> LoadInterleave(const std::string& folder, Clock clock = Clock::Wall,
+                                           double* peakLoad = nullptr);
 
 // A history record's "results", "failures" and "instructions" sections from a
 // side: each stage's pooled "samples_ms" and "median_ms", and "runs_ms" (the

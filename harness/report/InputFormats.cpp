@@ -44,8 +44,10 @@ std::vector<Field> SummaryFields(bool withSamples) {
     return fields;
 }
 Node Summary() { return Object(SummaryFields(true)); }
-Node SummaryWithDevice() {
+// A stage's wall-time summary with its CPU and device times beside it.
+Node SummaryWithClocks() {
     std::vector<Field> fields = SummaryFields(true);
+    fields.push_back({"cpu", Summary()});
     fields.push_back({"device", Summary()});
     return Object(std::move(fields));
 }
@@ -111,7 +113,7 @@ Node FrameCamera(const Counter<Stats> (&counters)[N]) {
 }
 
 Node TimingMode(const char* callTime) {
-    const Node call = Object({{callTime, Summary(), true}, {"device", Summary()}});
+    const Node call = Object({{callTime, Summary(), true}, {"cpu", Summary()}, {"device", Summary()}});
     return Object({{"steps", Count(), true},
                    {"step_ms", Summary(), true},
                    {"submissions", CountSummary(), true},
@@ -150,7 +152,7 @@ Node ResultsBackend() {
         {"device", Text()},
         {"planned_bytes", Count()},
         {"steps_completed", Count()},
-        {"stages", MapOf(KeyRule::Stage, SummaryWithDevice())},
+        {"stages", MapOf(KeyRule::Stage, SummaryWithClocks())},
         {"host", MapOf(KeyRule::Any, Summary())},
         {"transfers", MapOf(KeyRule::Any, Summary())},
         {"stage_runs", MapOf(KeyRule::Stage, stageRuns)},

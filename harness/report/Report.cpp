@@ -20,12 +20,15 @@ double Quantile(const std::vector<double>& sorted, double p) {
 
 }  // namespace
 
-std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage, bool device, TimingMode mode) {
+std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage, StageClock clock,
+                                 TimingMode mode) {
     std::vector<double> out;
     for (const StepRecord& r : run.steps) {
         const std::optional<double>& wall =
             mode == TimingMode::Pipelined ? r.hostMs[size_t(stage)] : r.stageMs[size_t(stage)];
-        const std::optional<double>& sample = device ? r.deviceMs[size_t(stage)] : wall;
+        const std::optional<double>& sample = clock == StageClock::Device ? r.deviceMs[size_t(stage)]
+                                              : clock == StageClock::Cpu  ? r.cpuMs[size_t(stage)]
+                                                                          : wall;
         if (r.step >= scene.warmupSteps && wall && sample) out.push_back(*sample);
     }
     return out;

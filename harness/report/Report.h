@@ -126,11 +126,15 @@ Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::
 // The post-warm-up samples of a BackendRun that results.json (ResultsJson.cpp) and `run`'s timing
 // section (TimingSection.cpp) both read.
 
-// Post-warm-up samples of one stage measured in `mode`: synchronized, its wall
-// time; pipelined, its host recording time; or (device) its device time, where
-// the backend measured it, from the steps that measured the stage in `mode`.
-std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage, bool device = false,
-                                 TimingMode mode = TimingMode::Synchronized);
+// Which of a stage's times a sample is: its wall time (pipelined, the host's
+// recording time), the process's CPU time over its calls (synchronized only),
+// or its device time (where the backend measures it).
+enum class StageClock { Wall, Cpu, Device };
+
+// Post-warm-up samples of one stage on `clock`, from the steps that measured
+// the stage in `mode`.
+std::vector<double> StageSamples(const Scene& scene, const BackendRun& run, Stage stage,
+                                 StageClock clock = StageClock::Wall, TimingMode mode = TimingMode::Synchronized);
 
 // The share of the grid's columns that `columns` covered columns are.
 double CoverFraction(const Scene& scene, uint32_t columns);

@@ -57,8 +57,10 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
         for (Stage stage : kAllStages) {
             if (!scene.stages.Has(stage)) continue;
             nlohmann::json entry = {
-                {pipelined ? "host" : "wall", SummaryJson(StageSamples(scene, run, stage, false, mode))}};
-            const std::vector<double> device = StageSamples(scene, run, stage, true, mode);
+                {pipelined ? "host" : "wall", SummaryJson(StageSamples(scene, run, stage, StageClock::Wall, mode))}};
+            const std::vector<double> cpu = StageSamples(scene, run, stage, StageClock::Cpu, mode);
+            if (!cpu.empty()) entry["cpu"] = SummaryJson(cpu);
+            const std::vector<double> device = StageSamples(scene, run, stage, StageClock::Device, mode);
             if (!device.empty()) entry["device"] = SummaryJson(device);
             stages[std::string(StageName(stage))] = entry;
         }
@@ -111,7 +113,9 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         for (Stage stage : kAllStages) {
             if (!scene.stages.Has(stage)) continue;
             nlohmann::json entry = SummaryJson(StageSamples(scene, run, stage));
-            const std::vector<double> device = StageSamples(scene, run, stage, /*device=*/true);
+            const std::vector<double> cpu = StageSamples(scene, run, stage, StageClock::Cpu);
+            if (!cpu.empty()) entry["cpu"] = SummaryJson(cpu);  // the process's CPU time over the stage's calls
+            const std::vector<double> device = StageSamples(scene, run, stage, StageClock::Device);
             if (!device.empty()) entry["device"] = SummaryJson(device);  // GPU timestamps, without submission
             timing[std::string(StageName(stage))] = entry;
         }

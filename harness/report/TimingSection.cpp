@@ -46,7 +46,7 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
     for (Stage stage : kAllStages) {
         if (!scene.stages.Has(stage)) continue;
         table.rows.push_back(TimingRow(std::string(StageName(stage)), StageSamples(scene, run, stage),
-                                       StageSamples(scene, run, stage, true)));
+                                       StageSamples(scene, run, stage, StageClock::Device)));
     }
     // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's count of `what`.
     auto frameRows = [&](Stage renderer, const std::string& label, std::string_view what, auto count) {
@@ -132,16 +132,17 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         // Pipelined, a stage's call time is the host's recording; its time is the device's.
         bool anyDevice = false;
         for (Stage stage : kAllStages)
-            anyDevice |=
-                scene.stages.Has(stage) && !StageSamples(scene, run, stage, true, TimingMode::Pipelined).empty();
+            anyDevice |= scene.stages.Has(stage) &&
+                         !StageSamples(scene, run, stage, StageClock::Device, TimingMode::Pipelined).empty();
         std::string stages = anyDevice ? "  pipelined per stage, median device ms (host recording ms):"
                                        : "  pipelined per stage, no device clock; median host recording ms:";
         const char* sep = " ";
         for (Stage stage : kAllStages) {
             if (!scene.stages.Has(stage)) continue;
-            const std::vector<double> host = StageSamples(scene, run, stage, false, TimingMode::Pipelined);
+            const std::vector<double> host = StageSamples(scene, run, stage, StageClock::Wall, TimingMode::Pipelined);
             if (host.empty()) continue;
-            const std::vector<double> device = StageSamples(scene, run, stage, true, TimingMode::Pipelined);
+            const std::vector<double> device =
+                StageSamples(scene, run, stage, StageClock::Device, TimingMode::Pipelined);
             const std::string name(StageName(stage));
             if (!anyDevice)
                 std::snprintf(line, sizeof line, "%s %.3f", name.c_str(), Summarize(host).median);

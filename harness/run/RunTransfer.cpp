@@ -21,11 +21,12 @@ void CountersFromJson(const json& j, const Counter<Stats> (&counters)[N], Stats&
 }  // namespace
 
 json ToJson(const StepRecord& r) {
-    json stageMs = json::array(), hostMs = json::array(), deviceMs = json::array(), frames = json::array(),
-         skipped = json::array();
+    json stageMs = json::array(), hostMs = json::array(), cpuMs = json::array(), deviceMs = json::array(),
+         frames = json::array(), skipped = json::array();
     for (size_t s = 0; s < kStageCount; ++s) {
         stageMs.push_back(Optional(r.stageMs[s]));
         hostMs.push_back(Optional(r.hostMs[s]));
+        cpuMs.push_back(Optional(r.cpuMs[s]));
         deviceMs.push_back(Optional(r.deviceMs[s]));
         skipped.push_back(r.skippedUnchanged[s]);
     }
@@ -46,6 +47,7 @@ json ToJson(const StepRecord& r) {
             {"timing", TimingModeName(r.timing)},
             {"stage_ms", stageMs},
             {"host_ms", hostMs},
+            {"cpu_ms", cpuMs},
             {"submissions", r.submissions},
             {"host_waits", r.hostWaits},
             {"batches", r.batches},
@@ -67,6 +69,7 @@ StepRecord StepFromJson(const json& j) {
         r.stageMs[s] = OptionalFrom<double>(j.at("stage_ms").at(s));
         r.deviceMs[s] = OptionalFrom<double>(j.at("device_ms").at(s));
         r.hostMs[s] = OptionalFrom<double>(j.at("host_ms").at(s));
+        r.cpuMs[s] = OptionalFrom<double>(j.at("cpu_ms").at(s));
     }
     r.timing = j.at("timing").get<std::string>() == "pipelined" ? TimingMode::Pipelined : TimingMode::Synchronized;
     r.submissions = j.at("submissions").get<uint64_t>();

@@ -216,6 +216,7 @@ void Simulation::AddCallTimes(Stage stage, const StageCallRecord& call, StepReco
     // A stage's (a renderer's: over its frames) time in a step is the sum over its calls.
     std::optional<double>& wall = Pipelined() ? target.hostMs[size_t(stage)] : target.stageMs[size_t(stage)];
     wall = wall.value_or(0) + call.ms;
+    if (!Pipelined()) target.cpuMs[size_t(stage)] = target.cpuMs[size_t(stage)].value_or(0) + call.cpuMs;
     if (call.deviceMs) target.deviceMs[size_t(stage)] = target.deviceMs[size_t(stage)].value_or(0) + *call.deviceMs;
     for (const std::optional<size_t>& frame : call.marks) {
         std::optional<size_t> index;
@@ -490,6 +491,7 @@ void Simulation::CommitAhead(StepRecord& record) {
     if (mScene.stages.Has(Stage::Region)) mRaster = mRasterAhead;
     record.stageMs = mAhead.stageMs;
     record.hostMs = mAhead.hostMs;
+    record.cpuMs = mAhead.cpuMs;
     record.deviceMs = mAhead.deviceMs;
     record.skippedUnchanged = mAhead.skippedUnchanged;
     if (mAhead.coveredColumns) mLastCoveredColumns = mAhead.coveredColumns;

@@ -76,6 +76,9 @@ struct StepRecord {
     // return before their work is done, so this is not the stage's time).
     // Exactly one of stageMs and hostMs is set for a stage that ran.
     std::array<std::optional<double>, kStageCount> hostMs{};
+    // Synchronized: the process's CPU time over each stage's calls, ms, on all
+    // its threads (core/base/ProcessCpuTime.h); set with stageMs.
+    std::array<std::optional<double>, kStageCount> cpuMs{};
     // Device time of each stage in ms, where the backend measures it:
     // synchronized, LastDeviceMs() after each call; pipelined, the batch's
     // intervals (Backend::EndBatch) of the stage's calls.

@@ -4,10 +4,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/base/ProcessCpuTime.h"
 #include "core/plan/StageGraph.h"
 #include "harness/platform/Isolation.h"
 
@@ -15,14 +18,16 @@ namespace cb {
 namespace {
 
 // The test-only slowdown switch, CLOUDBENCH_TEST_SLOWDOWN=<stage>:<factor>
-// (docs/cli.md): the named stage's time becomes `factor` times its own, by
-// keeping the backend busy for (factor - 1) times the call's time right after
-// it, inside the timed record (Backend::BusyFor: on the CPU, every thread of
-// its arena, as a stage doing more work would). A spin on the calling thread
-// alone let the CPU backend's workers fall asleep, and waking them slowed the
-// next stage; a spin in TBB's default arena moved them out of the backend's.
-// It exists so that the performance gate's tests can plant a known
-// regression; nothing else reads it.
+// (docs/cli.md): the named stage does `factor` times its own work. Right
+// before each call, inside its timed record, the backend spins for (factor -
+// 1) times the wall and CPU time the stage's previous call took
+// (Backend::BusyFor; the first call is not slowed, and is a warm-up step).
+// Before, not after: the threads a stage leaves idle spin on into the next
+// stage, and work added after the call would change what the next stage's
+// CPU time holds. A spin on the calling thread alone let the CPU backend's
+// workers fall asleep, and waking them slowed the stage; a spin in TBB's
+// default arena moved them out of the backend's; a spin for a wall time did
+// less work when other jobs took the cores.
 struct Slowdown {
     std::string stage;
     double factor = 1;
@@ -47,6 +52,24 @@ const std::optional<Slowdown>& TestSlowdown() {
     return slowdown;
 }
 
+// The slowed stage's last call on each backend, without its spin.
+struct CallTimes {
+    double wallMs = 0, cpuMs = 0;
+};
+std::mutex gCallsLock;
+std::map<std::string, CallTimes> gCalls;
+
+std::optional<CallTimes> PreviousCall(const std::string& backend) {
+    std::lock_guard lock(gCallsLock);
+    const auto found = gCalls.find(backend);
+    return found == gCalls.end() ? std::nullopt : std::optional(found->second);
+}
+
+void RememberCall(const std::string& backend, CallTimes times) {
+    std::lock_guard lock(gCallsLock);
+    gCalls[backend] = times;
+}
+
 }  // namespace
 
 Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageHostInputs& host,
@@ -54,13 +77,19 @@ Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageH
     // Where a crash happens, for the parent of an isolated backend (harness/platform/Isolation.h).
     MarkPhase(StageName(stage), host.step);
     InjectTestFault(backend.Name(), StageName(stage));
-    const double before = record.ms;
+    const auto& slowdown = TestSlowdown();
+    const bool slowed = slowdown && slowdown->stage == StageName(stage);
+    if (slowed)
+        if (const auto previous = PreviousCall(backend.Name())) {
+            const auto start = std::chrono::steady_clock::now();
+            const double cpuStart = ProcessCpuMs();
+            backend.BusyFor((slowdown->factor - 1) * previous->wallMs, (slowdown->factor - 1) * previous->cpuMs);
+            record.cpuMs += ProcessCpuMs() - cpuStart;
+            record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        }
+    const double before = record.ms, cpuBefore = record.cpuMs;
     Status status = AdapterOf(stage)(backend, scene, host, buffers, record);
-    if (const auto& slowdown = TestSlowdown(); slowdown && slowdown->stage == StageName(stage)) {
-        const auto start = std::chrono::steady_clock::now();
-        backend.BusyFor((slowdown->factor - 1) * (record.ms - before));
-        record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    }
+    if (slowed) RememberCall(backend.Name(), {record.ms - before, record.cpuMs - cpuBefore});
     if (!status && !Describe(stage).renderer)
         return MakeError(std::string(StageName(stage)) + ": " + status.error().message);
     return status;

@@ -29,13 +29,20 @@ FloatImage Copy(const OIIO::ImageBuf& buffer) {
     return out;
 }
 
+// OIIO's errors on one line ("a; b"), as every "cannot write" message is: libpng's come in several.
+std::string OneLine(std::string text) {
+    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+    for (size_t at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) text.replace(at, 1, "; ");
+    return text;
+}
+
 // OIIO's PNG writer can report success on a full disk, so the file is read
 // back whole. ImageInput, not ImageBuf: the shared image cache could answer
 // with an earlier file of the same name.
 std::string Write(const std::string& path, const std::string& format, ImageView image, bool eightBit) {
     OIIO::ImageBuf buffer = Wrap(image);
     if (eightBit) buffer.set_write_format(OIIO::TypeDesc::UINT8);
-    if (!buffer.write(path, OIIO::TypeUnknown, format)) return buffer.geterror();
+    if (!buffer.write(path, OIIO::TypeUnknown, format)) return OneLine(buffer.geterror());
     auto in = OIIO::ImageInput::create(format);
     OIIO::ImageSpec got;
     std::vector<float> pixels(size_t(image.width) * size_t(image.height) * size_t(image.channels));
@@ -43,7 +50,7 @@ std::string Write(const std::string& path, const std::string& format, ImageView 
                        got.nchannels == image.channels &&
                        in->read_image(0, 0, 0, image.channels, OIIO::TypeDesc::FLOAT, pixels.data());
     if (whole) return "";
-    return "it does not read back whole (" + (in ? in->geterror() : OIIO::geterror()) + ")";
+    return "it does not read back whole (" + OneLine(in ? in->geterror() : OIIO::geterror()) + ")";
 }
 
 std::string Read(const std::string& path, int channels, FloatImage& image) {
