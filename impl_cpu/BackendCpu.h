@@ -67,7 +67,7 @@ class BackendCpu : public Backend {
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     int Threads() const { return mArena.max_concurrency(); }
-    // Every thread of the arena spins until `ms` from now.
+    // Every thread of the arena spins for an equal share of `cpuMs` of CPU time, at most `wallMs` each.
     void BusyFor(double wallMs, double cpuMs) override;
 
   private:

@@ -177,9 +177,9 @@ class Backend {
     // test-only slowdown switch (harness/run/StageCall.cpp): its threads spin
     // until together they have used `cpuMs` of CPU time, in equal shares of
     // at most `wallMs` each, so that both clocks grow as for a balanced stage
-    // doing more work. By
-    // default the calling thread spins; the CPU backend spins on the threads of
-    // its task arena, so that its workers stay awake and in the arena.
+    // doing more work. By default the calling thread spins; the CPU backend
+    // spins on the threads of its task arena, so that its workers stay awake
+    // and in the arena.
     virtual void BusyFor(double wallMs, double cpuMs);
 
     // ---- Pipelined timing (docs/performance.md, "Two ways to time a step") ----

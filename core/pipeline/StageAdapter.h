@@ -83,6 +83,25 @@ struct StageCallRecord {
 using StageAdapter = Status (*)(Backend& backend, const Scene& scene, const StageHostInputs& host,
                                 const StageBuffers& buffers, StageCallRecord& record);
 
+// Adds the wall and CPU time from its construction to Stop() to a record. The
+// CPU clock is a system call (about 0.8 us here, against 0.03 us for the wall
+// clock), so it is read outside the wall-time interval: a 14 us stage's wall
+// time would otherwise grow by a tenth.
+class CallClock {
+  public:
+    explicit CallClock(StageCallRecord& record)
+        : mRecord(record), mCpuStart(ProcessCpuMs()), mStart(std::chrono::steady_clock::now()) {}
+    void Stop() {
+        mRecord.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - mStart).count();
+        mRecord.cpuMs += ProcessCpuMs() - mCpuStart;
+    }
+
+  private:
+    StageCallRecord& mRecord;
+    double mCpuStart;
+    std::chrono::steady_clock::time_point mStart;
+};
+
 // Runs one backend call, adding its wall, CPU and device time to the record.
 // Under callgrind the call alone (not the clock reads) is counted as one dump
 // named by `label` (core/base/CallgrindRequests.h).
@@ -97,13 +116,11 @@ Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& l
         backend.MarkBatch();
         record.marks.push_back(frame);
     }
-    const auto start = std::chrono::steady_clock::now();
-    const double cpuStart = ProcessCpuMs();
+    CallClock clock(record);
     counted.Begin();
     Status status = call();
     counted.End();
-    record.cpuMs += ProcessCpuMs() - cpuStart;
-    record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    clock.Stop();
     if (markBatch) return status;
     if (auto device = backend.LastDeviceMs()) record.deviceMs = record.deviceMs.value_or(0) + *device;
     return status;

@@ -1,6 +1,5 @@
 #include "harness/run/StageCall.h"
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <iterator>
@@ -10,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "core/base/ProcessCpuTime.h"
 #include "core/plan/StageGraph.h"
 #include "harness/platform/Isolation.h"
 
@@ -81,11 +79,9 @@ Status CallStage(Stage stage, Backend& backend, const Scene& scene, const StageH
     const bool slowed = slowdown && slowdown->stage == StageName(stage);
     if (slowed)
         if (const auto previous = PreviousCall(backend.Name())) {
-            const auto start = std::chrono::steady_clock::now();
-            const double cpuStart = ProcessCpuMs();
+            CallClock clock(record);
             backend.BusyFor((slowdown->factor - 1) * previous->wallMs, (slowdown->factor - 1) * previous->cpuMs);
-            record.cpuMs += ProcessCpuMs() - cpuStart;
-            record.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            clock.Stop();
         }
     const double before = record.ms, cpuBefore = record.cpuMs;
     Status status = AdapterOf(stage)(backend, scene, host, buffers, record);
