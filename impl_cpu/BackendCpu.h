@@ -12,6 +12,7 @@
 #include "impl_cpu/BitField.h"
 #include "impl_cpu/CaCpuState.h"
 #include "impl_cpu/NoiseCpuState.h"
+#include "impl_cpu/RenderLayersCpuState.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 #include "impl_cpu/RenderSplatCpuState.h"
 #include "impl_cpu/ShadeCpuState.h"
@@ -65,6 +66,7 @@ class BackendCpu : public Backend {
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     int Threads() const { return mArena.max_concurrency(); }
     // Every thread of the arena spins for an equal share of `cpuMs` of CPU time, at most `wallMs` each.
@@ -73,9 +75,9 @@ class BackendCpu : public Backend {
   private:
     // The stage objects (core/pipeline/StageObjects.h): what each stage keeps
     // between calls so that steady-state steps do not allocate, in its <Stage>CpuState.h.
-    using StagesCpu =
-        StageObjects<NothingKept<Stage::Region>, CaCpuState, SmoothCpuState, NothingKept<Stage::Density>, ShadeCpuState,
-                     NothingKept<Stage::Shadow>, RenderSplatCpuState, NoiseCpuState, RenderMarchCpuState>;
+    using StagesCpu = StageObjects<NothingKept<Stage::Region>, CaCpuState, SmoothCpuState, NothingKept<Stage::Density>,
+                                   ShadeCpuState, NothingKept<Stage::Shadow>, RenderSplatCpuState, NoiseCpuState,
+                                   RenderMarchCpuState, RenderLayersCpuState>;
 
     tbb::task_arena mArena;
     StagesCpu mStages;

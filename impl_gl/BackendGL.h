@@ -29,6 +29,7 @@
 #include "impl_gl/GLContext.h"
 #include "impl_gl/NoiseGLState.h"
 #include "impl_gl/RegionGLState.h"
+#include "impl_gl/RenderLayersGLState.h"
 #include "impl_gl/RenderMarchGLState.h"
 #include "impl_gl/RenderSplatGLState.h"
 #include "impl_gl/ScratchGL.h"
@@ -115,12 +116,14 @@ class BackendGL final : public Backend {
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
   private:
     // The stage objects (core/pipeline/StageObjects.h): each stage's textures,
     // buffer objects and what it keeps between calls, in its <Stage>GLState.h.
-    using StagesGL = StageObjects<RegionGLState, CaGLState, SmoothGLState, DensityGLState, ShadeGLState,
-                                  NothingKept<Stage::Shadow>, RenderSplatGLState, NoiseGLState, RenderMarchGLState>;
+    using StagesGL =
+        StageObjects<RegionGLState, CaGLState, SmoothGLState, DensityGLState, ShadeGLState, NothingKept<Stage::Shadow>,
+                     RenderSplatGLState, NoiseGLState, RenderMarchGLState, RenderLayersGLState>;
 
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8)
         : mContext(std::move(context)), mSoftwareRasterizer(mContext->SoftwareRasterizer()) {
@@ -176,6 +179,16 @@ class BackendGL final : public Backend {
     // on the device, through the pixel buffer in `copy`: the target's rows, top
     // first, in RGB floats are exactly the canonical layout.
     void CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, BufferSlot& copy, Buffer& image);
+    // render_march's and render_layers' padded (q_alpha, T) volume (PaddedVolumeGL.cpp): whether its storage
+    // buffer fits this driver's storage blocks (an error names `stage`), and the pass that forms it.
+    Status CheckPaddedVolumeFits(const Extent3& grid, const char* stage);
+    // march_volume.frag into `volume`'s RG32F layers: q_alpha = Lerp(qPrev, qCur, alpha) and T (null: 1), the
+    // border (0, 1) or with `wrap` the opposite edge's voxels in x and y; copied into `copy`, which it returns,
+    // a storage buffer of (q_alpha, T) pairs in the padded index order.
+    Result<GLuint> FormPaddedVolume(TextureSlot& volume, BufferSlot& copy, const Buffer& qPrev, const Buffer& qCur,
+                                    const Buffer* T, float alpha, bool wrap);
+    // kMieCloudTable's values in `table`, uploaded on the first call (`uploaded`).
+    GLuint MiePhaseTable(BufferSlot& table, bool& uploaded);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the
     // context's framebuffer as colour attachments 0, 1, ... and makes them the
     // draw buffers; the other attachments are detached.

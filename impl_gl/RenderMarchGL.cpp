@@ -47,8 +47,6 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_march: the image is not (3, width, height)");
     const Functions& f = mContext->F();
-    auto volumeProgram = PassProgram("march_volume");
-    if (!volumeProgram) return std::unexpected(volumeProgram.error());
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "gl: render_march"));
     const MarchGpu block = MakeMarchGpu(params, e);
     // The program specialised for this call's option bits and phase kind (render_march.frag).
@@ -63,12 +61,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     }
 
     const GLsizei px = GLsizei(e.nx + 2), py = GLsizei(e.ny + 2), pz = GLsizei(e.nz + 2);
-    const size_t volumeBytes = size_t(px) * size_t(py) * size_t(pz) * 8;
-    GLint maxStorage = 0;
-    f.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxStorage);
-    if (volumeBytes > size_t(uint32_t(maxStorage)))
-        return MakeError("gl: render_march: the padded volume takes " + std::to_string(volumeBytes) +
-                         " bytes; this driver's storage blocks hold " + std::to_string(maxStorage));
+    CB_TRY(CheckPaddedVolumeFits(e, "render_march"));
     const uint32_t B = block.flags[3];
     const auto brickCounts = MarchBrickCounts(e, B);
 
@@ -80,21 +73,10 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, counters);
 
     // 1. The padded (q_alpha, T) volume.
-    const GLuint volume = Scratch(state.volume, GL_TEXTURE_2D_ARRAY, GL_RG32F, px, py, pz);
-    f.UseProgram(*volumeProgram);
-    f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
-    f.BindTextureUnit(1, Tex(*in.qCur).Texture());
-    f.BindTextureUnit(2, Tex(shadeLight ? *in.T : *in.qCur).Texture());
-    f.Uniform3i(f.GetUniformLocation(*volumeProgram, "grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
-    f.Uniform1f(f.GetUniformLocation(*volumeProgram, "alpha"), params.alpha);
-    f.Uniform1i(f.GetUniformLocation(*volumeProgram, "hasT"), shadeLight ? 1 : 0);
-    f.Viewport(0, 0, px, py);
-    CB_TRY(DrawLayers(*volumeProgram, uint32_t(pz), {volume}));
-    const GLuint volumeCopy = ScratchBuffer(state.volumeCopy, volumeBytes);
-    f.BindBuffer(GL_PIXEL_PACK_BUFFER, volumeCopy);
-    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    f.GetTextureImage(volume, 0, GL_RG, GL_FLOAT, GLsizei(volumeBytes), nullptr);
-    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    auto formed = FormPaddedVolume(state.volume, state.volumeCopy, *in.qPrev, *in.qCur, shadeLight ? in.T : nullptr,
+                                   params.alpha, false);
+    if (!formed) return std::unexpected(formed.error());
+    const GLuint volume = state.volume.name.Get(), volumeCopy = *formed;
 
     // 2. The bricks: empty iff q_alpha = 0 over the brick grown by one voxel.
     GLuint bricksCopy = volumeCopy;  // bound to the unused binding without skipping
@@ -117,14 +99,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     // 3. The rays.
     GLuint phaseTable = volumeCopy;  // bound to the unused binding unless the phase is Mie
-    if (params.setup.phase.kind == PhaseKind::Mie) {
-        const size_t tableBytes = size_t(kMieCloudTable.count) * 4;
-        phaseTable = ScratchBuffer(state.phaseTable, tableBytes);
-        if (!state.mieUploaded) {
-            f.NamedBufferSubData(phaseTable, 0, GLsizeiptr(tableBytes), kMieCloudTable.values);
-            state.mieUploaded = true;
-        }
-    }
+    if (params.setup.phase.kind == PhaseKind::Mie) phaseTable = MiePhaseTable(state.phaseTable, state.mieUploaded);
     const GLuint blockBuffer = ScratchBuffer(state.block, sizeof block);
     f.NamedBufferSubData(blockBuffer, 0, sizeof block, &block);
     const GLuint target = Scratch(state.target, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));

@@ -16,6 +16,7 @@
 #include "impl_vk/DensityVkState.h"
 #include "impl_vk/NoiseVkState.h"
 #include "impl_vk/RegionVkState.h"
+#include "impl_vk/RenderLayersVkState.h"
 #include "impl_vk/RenderMarchVkState.h"
 #include "impl_vk/RenderSplatVkState.h"
 #include "impl_vk/ScratchVk.h"
@@ -64,6 +65,7 @@ class BackendVk final : public Backend {
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
 
     // Pipelined timing (core/pipeline/Backend.h): the context records the batch into one
     // command buffer (VulkanContext::BeginBatch); a Download inside it, and
@@ -100,8 +102,9 @@ class BackendVk final : public Backend {
   private:
     // The stage objects (core/pipeline/StageObjects.h): each stage's device
     // buffers and what it keeps between calls, in its <Stage>VkState.h.
-    using StagesVk = StageObjects<RegionVkState, CaVkState, SmoothVkState, DensityVkState, ShadeVkState,
-                                  NothingKept<Stage::Shadow>, RenderSplatVkState, NoiseVkState, RenderMarchVkState>;
+    using StagesVk =
+        StageObjects<RegionVkState, CaVkState, SmoothVkState, DensityVkState, ShadeVkState, NothingKept<Stage::Shadow>,
+                     RenderSplatVkState, NoiseVkState, RenderMarchVkState, RenderLayersVkState>;
 
     explicit BackendVk(std::unique_ptr<VulkanContext> context) : mContext(std::move(context)) {}
     // Records with `fn`, submits, waits and keeps the device time (defined below the class).

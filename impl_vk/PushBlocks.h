@@ -216,7 +216,8 @@ using PushFloat8 = std::array<float, 8>;  // GLSL float[8]
     X(uint32_t, ny) \
     X(uint32_t, nz) \
     X(uint32_t, hasT) \
-    X(float, alpha)
+    X(float, alpha) \
+    X(uint32_t, wrap)
 #define CB_VK_MARCH_BRICKS_PUSH(X) \
     X(uint32_t, px) \
     X(uint32_t, py) \

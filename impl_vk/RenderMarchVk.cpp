@@ -106,7 +106,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         groundG = &Dev(*in.G);
     }
 
-    const MarchVolumePush volumePush{e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha};
+    const MarchVolumePush volumePush{e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha, 0u};
     const MarchBricksPush brickPush{
         px, py, pz, B, frame.bricks[0], frame.bricks[1], frame.bricks[2], shadeLight ? 2u : 1u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),

@@ -51,26 +51,28 @@ void Compare(const char* name, const std::vector<Kind>& kinds, uint32_t ulps, co
 #if CLOUDBENCH_HAVE_VK
 
 std::vector<Words> GlslTwin::Run(uint32_t fn, const std::vector<Words>& inputs, const SplatFrame& frame,
-                                 const MarchGpu& march) {
+                                 const MarchGpu& march, const LayersGpu& layers) {
     vk::VulkanContext& ctx = *sContext;
     const VkDeviceSize bytes = inputs.size() * sizeof(Words);
-    auto pipeline = ctx.GetPipeline("twin", 5, kSpirv_twin);
+    auto pipeline = ctx.GetPipeline("twin", 6, kSpirv_twin);
     auto in = ctx.CreateBuffer(bytes);
     auto out = ctx.CreateBuffer(bytes);
     auto frameBuffer = ctx.CreateBuffer(sizeof frame);
     auto marchBuffer = ctx.CreateBuffer(sizeof march);
     auto table = ctx.CreateBuffer(kMieCloudTable.count * 4);
+    auto layersBuffer = ctx.CreateBuffer(sizeof layers);
     std::vector<Words> result(inputs.size());
-    if (!pipeline || !in || !out || !frameBuffer || !marchBuffer || !table) {
+    if (!pipeline || !in || !out || !frameBuffer || !marchBuffer || !table || !layersBuffer) {
         ADD_FAILURE() << "could not set up the twin pipeline";
         return result;
     }
     EXPECT_TRUE(ctx.Upload(*in, std::as_bytes(std::span(inputs))));
     EXPECT_TRUE(ctx.Upload(*frameBuffer, std::as_bytes(std::span(&frame, 1))));
     EXPECT_TRUE(ctx.Upload(*marchBuffer, std::as_bytes(std::span(&march, 1))));
+    EXPECT_TRUE(ctx.Upload(*layersBuffer, std::as_bytes(std::span(&layers, 1))));
     EXPECT_TRUE(ctx.Upload(*table, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
     const struct { uint32_t fn, count; } push{fn, uint32_t(inputs.size())};
-    const vk::DeviceBuffer* buffers[] = {&*in, &*out, &*frameBuffer, &*marchBuffer, &*table};
+    const vk::DeviceBuffer* buffers[] = {&*in, &*out, &*frameBuffer, &*marchBuffer, &*table, &*layersBuffer};
     auto ran = ctx.Run("twin", [&](vk::VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, push.count);
     });
@@ -81,6 +83,7 @@ std::vector<Words> GlslTwin::Run(uint32_t fn, const std::vector<Words>& inputs, 
     ctx.DestroyBuffer(*frameBuffer);
     ctx.DestroyBuffer(*marchBuffer);
     ctx.DestroyBuffer(*table);
+    ctx.DestroyBuffer(*layersBuffer);
     return result;
 }
 

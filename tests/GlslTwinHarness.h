@@ -18,6 +18,7 @@
 
 #include "core/math/Random.h"
 #include "core/math/Splat.h"
+#include "core/pipeline/LayersGpu.h"
 #include "core/pipeline/MarchGpu.h"
 #if CLOUDBENCH_HAVE_VK
 #include "impl_vk/VulkanContext.h"
@@ -57,6 +58,12 @@ inline Words WF(std::initializer_list<float> floats) {
     size_t n = 0;
     for (float f : floats) w[n++] = Bits(f);
     return w;
+}
+
+// twin.comp's synthetic padded volume (march.glsl's and layers.glsl's fetches): (q, T) of padded index i from a hash.
+inline std::array<float, 2> TwinPaddedQT(uint32_t i) {
+    return {float(LowBias32(i) >> 8) * (1.0f / 16777216.0f),
+            float(LowBias32(i ^ 0x9E3779B9u) >> 8) * (1.0f / 16777216.0f)};
 }
 
 // Floats next to x: x itself and one ulp either side.
@@ -99,9 +106,9 @@ class GlslTwin : public ::testing::Test {
         if (!sContext) GTEST_SKIP() << sSkipReason;
     }
 
-    // Runs twin.comp's function `fn` on `inputs` with `frame`, `march` and kMieCloudTable bound.
+    // Runs twin.comp's function `fn` on `inputs` with `frame`, `march`, kMieCloudTable and `layers` bound.
     static std::vector<Words> Run(uint32_t fn, const std::vector<Words>& inputs, const SplatFrame& frame,
-                                  const MarchGpu& march = MarchGpu{});
+                                  const MarchGpu& march = MarchGpu{}, const LayersGpu& layers = LayersGpu{});
 
     static inline std::unique_ptr<vk::VulkanContext> sContext;
     static inline std::string sSkipReason;

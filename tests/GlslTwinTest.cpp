@@ -158,10 +158,7 @@ TEST_F(GlslTwin, MakeSplatEqualsItsCppTwin) {
 
 constexpr uint32_t kPixelRayFn = 43, kPaddedSamplerFn = 44, kMieLookupFn = 35, kPowderFn = 41;
 
-// twin.comp's synthetic padded volume: (q, T) of padded index i from a hash.
-std::array<float, 2> TwinPaddedQT(uint32_t i) {
-    return {float(LowBias32(i) >> 8) * (1.0f / 16777216.0f), float(LowBias32(i ^ 0x9E3779B9u) >> 8) * (1.0f / 16777216.0f)};
-}
+using test::TwinPaddedQT;
 
 // The CPU's padded sampler (impl_cpu/RenderMarchCpu.cpp MarchPaddedVolume) over that volume:
 // taps at clamp(p, 0, n) + 1/2, floored, in a volume of (n + 2) voxels per axis.

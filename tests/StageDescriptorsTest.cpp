@@ -12,7 +12,7 @@ namespace {
 // Test that the list expands consistently: names round-trip, SPEC sections
 // are the documented ones, and each descriptor sits at its stage's index.
 TEST(StageList, NamesSectionsAndDescriptorsAgree) {
-    EXPECT_EQ(kStageCount, 9u);
+    EXPECT_EQ(kStageCount, 10u);
     for (Stage s : kAllStages) {
         EXPECT_EQ(ParseStage(StageName(s)), s);
         EXPECT_EQ(Describe(s).stage, s);
@@ -20,6 +20,9 @@ TEST(StageList, NamesSectionsAndDescriptorsAgree) {
     EXPECT_EQ(StageName(Stage::RenderSplat), "render_splat");
     EXPECT_EQ(StageSpecSection(Stage::Shade), "6");
     EXPECT_EQ(StageSpecSection(Stage::Noise), "10a");
+    EXPECT_EQ(StageName(Stage::RenderLayers), "render_layers");
+    EXPECT_EQ(StageSpecSection(Stage::RenderLayers), "15");
+    EXPECT_FALSE(IsSplatPipelineStage(Stage::RenderLayers));
     EXPECT_TRUE(IsSplatPipelineStage(Stage::Ca));
     EXPECT_FALSE(IsSplatPipelineStage(Stage::RenderMarch));
     EXPECT_FALSE(ParseStage("smoth").has_value());

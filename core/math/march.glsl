@@ -96,17 +96,27 @@ void ClipRayToBox(vec3 o, vec3 d, vec3 size, inout float tMin, inout float tMax)
     }
 }
 
+// The unit direction of the ray through the centre of pixel (x, y), row 0 at
+// the top, and (cosForward) the cosine of its angle to the view axis
+// (core/math/March.h PixelRayDirection).
+vec3 PixelRayDirection(vec3 forward, vec3 right, vec3 up, float focal, uvec2 image, uint x, uint y,
+                       out float cosForward) {
+    precise float u = (float(x) + 0.5 - 0.5 * float(image.x)) / focal;
+    precise float v = (0.5 * float(image.y) - (float(y) + 0.5)) / focal;
+    precise vec3 d;
+    for (int i = 0; i < 3; ++i) d[i] = forward[i] + u * right[i] + v * up[i];
+    precise float inv = 1.0 / sqrt(MarchDot(d, d));
+    cosForward = inv;
+    precise vec3 unit = vec3(d.x * inv, d.y * inv, d.z * inv);
+    return unit;
+}
+
 // The camera ray of pixel (x, y), row 0 at the top (core/math/March.h MakePixelRay).
 MarchRayGeometry MakePixelRay(MarchGpu m, uint x, uint y) {
-    const float focal = m.eye.w;
-    precise float u = (float(x) + 0.5 - 0.5 * float(m.image.x)) / focal;
-    precise float v = (0.5 * float(m.image.y) - (float(y) + 0.5)) / focal;
-    precise vec3 d;
-    for (int i = 0; i < 3; ++i) d[i] = m.forward[i] + u * m.right[i] + v * m.up[i];
-    precise float inv = 1.0 / sqrt(MarchDot(d, d));
+    float inv;
     MarchRayGeometry r;
     r.origin = m.eye.xyz;
-    r.dir = vec3(d.x * inv, d.y * inv, d.z * inv);
+    r.dir = PixelRayDirection(m.forward.xyz, m.right.xyz, m.up.xyz, m.eye.w, m.image.xy, x, y, inv);
     precise float perDepth = 1.0 / (m.up.w * inv);
     r.tMin = m.forward.w * perDepth;
     r.tMax = m.right.w * perDepth;
@@ -121,24 +131,27 @@ struct MarchTaps {
     vec3 w;
 };
 
-MarchTaps MarchTapsAt(MarchGpu m, vec3 p) {
-    precise float cx = clamp(p.x, 0.0, m.size.x) + 0.5;
-    precise float cy = clamp(p.y, 0.0, m.size.y) + 0.5;
-    precise float cz = clamp(p.z, 0.0, m.size.z) + 0.5;
+// The taps of a padded volume over the box [0, size] with strides px, pxy
+// (render_march's and render_layers': MarchFetchQT reads it).
+MarchTaps PaddedTapsAt(vec3 size, uint px, uint pxy, vec3 p) {
+    precise float cx = clamp(p.x, 0.0, size.x) + 0.5;
+    precise float cy = clamp(p.y, 0.0, size.y) + 0.5;
+    precise float cz = clamp(p.z, 0.0, size.z) + 0.5;
     const uint i = uint(cx), j = uint(cy), k = uint(cz);
     MarchTaps t;
-    t.base = i + m.strides.x * j + m.strides.y * k;
+    t.base = i + px * j + pxy * k;
     precise vec3 w = vec3(cx - float(i), cy - float(j), cz - float(k));
     t.w = w;
     return t;
 }
 
+MarchTaps MarchTapsAt(MarchGpu m, vec3 p) { return PaddedTapsAt(m.size.xyz, m.strides.x, m.strides.y, p); }
+
 // Lerp per component, unfused (core/math/Shading.h Lerp).
 vec2 MarchLerp2(vec2 a, vec2 b, float t) { return vec2(Lerp(a.x, b.x, t), Lerp(a.y, b.y, t)); }
 
-// (q_alpha, T) trilinear at the taps.
-vec2 MarchBlend(MarchGpu m, MarchTaps t) {
-    const uint px = m.strides.x, pxy = m.strides.y;
+// (q_alpha, T) trilinear at the taps of a padded volume with strides px, pxy.
+vec2 PaddedBlend(uint px, uint pxy, MarchTaps t) {
     const uint a = t.base, b = t.base + pxy;
     const vec2 c00 = MarchLerp2(MarchFetchQT(a), MarchFetchQT(a + 1u), t.w.x);
     const vec2 c10 = MarchLerp2(MarchFetchQT(a + px), MarchFetchQT(a + px + 1u), t.w.x);
@@ -146,6 +159,8 @@ vec2 MarchBlend(MarchGpu m, MarchTaps t) {
     const vec2 c11 = MarchLerp2(MarchFetchQT(b + px), MarchFetchQT(b + px + 1u), t.w.x);
     return MarchLerp2(MarchLerp2(c00, c10, t.w.y), MarchLerp2(c01, c11, t.w.y), t.w.z);
 }
+
+vec2 MarchBlend(MarchGpu m, MarchTaps t) { return PaddedBlend(m.strides.x, m.strides.y, t); }
 
 float MarchSampleQ(MarchGpu m, vec3 p) { return MarchBlend(m, MarchTapsAt(m, p)).x; }
 

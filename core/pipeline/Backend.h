@@ -31,6 +31,7 @@
 #include "core/stages/density/DensityTypes.h"
 #include "core/stages/noise/NoiseTypes.h"
 #include "core/stages/region/RegionTypes.h"
+#include "core/stages/render_layers/RenderLayersTypes.h"
 #include "core/stages/render_march/RenderMarchTypes.h"
 #include "core/stages/render_splat/RenderSplatTypes.h"
 #include "core/stages/shade/ShadeTypes.h"
@@ -133,8 +134,14 @@ Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Exten
 #define CB_MARCH_ENTRIES(X) \
     X(RenderMarch, RenderMarch, (const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats))
 
+// The layered renderer (SPEC 15): the same image layout, the layers of
+// core/math/Layers.h composited back to front (GPU: core/math/layers.glsl).
+#define CB_LAYERS_ENTRIES(X)      \
+    X(RenderLayers, RenderLayers, \
+      (const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats))
+
 // Every entry point.
-#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X) CB_NOISE_ENTRIES(X) CB_MARCH_ENTRIES(X)
+#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X) CB_NOISE_ENTRIES(X) CB_MARCH_ENTRIES(X) CB_LAYERS_ENTRIES(X)
 
 // In a backend's class: declares the override of one entry.
 #define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;

@@ -62,7 +62,8 @@ struct FrameRecord {
     bool pipelined = false;          // drawn in a batch (pipelined timing)
     std::optional<double> deviceMs;  // its device time, where the backend measures it
     SplatStats stats;
-    MarchStats march;  // render_march's counters
+    MarchStats march;    // render_march's counters
+    LayersStats layers;  // render_layers' counters
 };
 
 // What one call measured and returned besides its buffers.

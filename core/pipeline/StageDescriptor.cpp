@@ -38,7 +38,9 @@ BufferFormat ResourceFormat(Resource resource) {
     return BufferFormat::F32;
 }
 
-bool IsPerCamera(Resource resource) { return resource == Resource::SplatImage || resource == Resource::MarchImage; }
+bool IsPerCamera(Resource resource) {
+    return resource == Resource::SplatImage || resource == Resource::MarchImage || resource == Resource::LayersImage;
+}
 
 Extent3 ResourceExtent(Resource resource, const Scene& scene) {
     const Extent3 grid = scene.grid.size;
@@ -60,6 +62,7 @@ Extent3 ResourceExtent(Resource resource, const Scene& scene) {
             return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), CeilDiv(grid.nz, band)};
         case Resource::SplatImage:
         case Resource::MarchImage:
+        case Resource::LayersImage:
             return {3, scene.render.width, scene.render.height};
     }
     return grid;

@@ -32,7 +32,8 @@ namespace cb {
     X(T, "T", F32, "T")                   /* transmittance toward the sun, grid */  \
     X(Shadow, "G", F32, "shadow")         /* ground shadow, (nx, ny, 1) */          \
     X(SplatImage, "image_splat", F32, "") /* (3, width, height) per camera */       \
-    X(MarchImage, "image_march", F32, "")
+    X(MarchImage, "image_march", F32, "")                                           \
+    X(LayersImage, "image_layers", F32, "")
 
 enum class Resource : uint8_t {
 #define CB_RESOURCE_ENUM(name, text, format, file) name,

@@ -120,6 +120,28 @@ void CheckSunSpeed(const Scene& scene, Validator& check) {
                      check);
 }
 
+// Tiling repeats q with the grid's period: only a source that is periodic on that period may feed it, and only
+// the renderers that read the volume periodically may run with it.
+void CheckTiling(const Scene& scene, Validator& check) {
+    if (!scene.grid.tiling) return;
+    if (!scene.stages.Has(Stage::Noise) || scene.stages.Has(Stage::Ca) || scene.stages.Has(Stage::Smooth)) {
+        check.Fail("grid.tiling",
+                   "needs a source of q that repeats with the grid's period: the stage \"noise\" (the automaton's "
+                   "volume does not wrap at the grid's sides)");
+        return;
+    }
+    const NoiseDetail& detail = scene.noise.detail;
+    if (detail.enabled && (scene.grid.size.nx % detail.size != 0 || scene.grid.size.ny % detail.size != 0))
+        check.Fail("grid.tiling", "noise.detail.size (" + std::to_string(detail.size) +
+                                      ") must divide grid.size's nx and ny (" + std::to_string(scene.grid.size.nx) +
+                                      ", " + std::to_string(scene.grid.size.ny) +
+                                      ") for the detail volume to repeat with the grid");
+    for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch})
+        if (scene.stages.Has(renderer))
+            check.Fail("grid.tiling", Quote(StageName(renderer)) +
+                                          " does not repeat the volume yet; only render_layers honours tiling");
+}
+
 void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& sections, Validator& check) {
     if (sections.stageList) CheckStageInputs(scene.stages, check);
     // Every renderer draws one image per camera.
@@ -132,7 +154,7 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
         }))
         check.Fail("render.slices_per_frame",
                    "time-slicing spreads a step over the frames drawn between steps, and "
-                   "no renderer is enabled; enable render_splat or render_march, or remove it");
+                   "no renderer is enabled; enable render_splat, render_march or render_layers, or remove it");
 
     // The ground is lit through G: the stage that computes it must run.
     if (scene.render.ground.on && !scene.stages.Has(Stage::Shadow))
@@ -141,6 +163,7 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
                    "through; enable it or remove render.ground");
 
     if (sections.steps) CheckSunSpeed(scene, check);
+    CheckTiling(scene, check);
     CheckOpticalDepths(scene, check);
     CheckLightningPosition(scene, check);
 

@@ -10,6 +10,7 @@
 #include "core/stages/density/Density.h"
 #include "core/stages/noise/Noise.h"
 #include "core/stages/region/Region.h"
+#include "core/stages/render_layers/RenderLayers.h"
 #include "core/stages/render_march/RenderMarch.h"
 #include "core/stages/render_splat/RenderSplat.h"
 #include "core/stages/shade/Shade.h"
@@ -21,7 +22,7 @@ namespace {
 
 constexpr std::string_view kTopKeys[] = {
     "name", "description", "grid",  "steps", "warmup_steps", "stages", "ca",    "ellipsoids", "smooth", "density",
-    "sun",  "lighting",    "phase", "shade", "shadow",       "render", "march", "lightning",  "noise"};
+    "sun",  "lighting",    "phase", "shade", "shadow",       "render", "march", "lightning",  "noise",  "layers"};
 
 }  // namespace
 
@@ -79,6 +80,7 @@ SectionsRead ReadSceneSections(const Json& root, const std::string& label, Valid
     ReadMarch(root, check, scene.stages, scene.march);
     ReadLightning(root, check, scene.lightning);
     ReadNoise(root, check, scene.noise);
+    ReadLayers(root, check, sizeOk ? std::optional(scene.grid.size.nz) : std::nullopt, scene.layers);
     return sections;
 }
 

@@ -7,6 +7,7 @@
 #include "core/stages/density/Density.h"
 #include "core/stages/noise/Noise.h"
 #include "core/stages/region/Region.h"
+#include "core/stages/render_layers/RenderLayers.h"
 #include "core/stages/render_march/RenderMarch.h"
 #include "core/stages/render_splat/RenderSplat.h"
 #include "core/stages/shade/Shade.h"

@@ -18,6 +18,7 @@
 #include "core/stages/density/DensityTypes.h"
 #include "core/stages/noise/NoiseTypes.h"
 #include "core/stages/region/RegionTypes.h"
+#include "core/stages/render_layers/RenderLayersTypes.h"
 #include "core/stages/render_march/RenderMarchTypes.h"
 #include "core/stages/render_splat/RenderSplatTypes.h"
 #include "core/stages/shade/ShadeTypes.h"
@@ -30,6 +31,9 @@ struct GridSettings {
     Extent3 size{64, 16, 64};
     double voxelSize = 50.0;                // metres per voxel edge (h)
     std::array<double, 3> origin{0, 0, 0};  // world position of voxel corner (0,0,0), metres
+    // The density and the light repeat in x and y with the grid's period (SPEC 15); renderers that honour it
+    // read (x mod nx h, y mod ny h, z). Off: outside the box is empty.
+    bool tiling = false;
 };
 
 // One keyframe of a sun path: the sun's angles at a step.
@@ -138,6 +142,7 @@ struct Scene {
     MarchSettings march;          // stage render_march (section `march`)
     LightningSettings lightning;  // the point light of render_march (section `lightning`)
     NoiseSettings noise;          // stage `noise` (SPEC 10a)
+    LayersSettings layers;        // stage render_layers (section `layers`)
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

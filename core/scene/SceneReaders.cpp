@@ -14,7 +14,7 @@ namespace {
 
 constexpr Stage kDefaultStages[] = {Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density};
 
-constexpr std::string_view kGridKeys[] = {"size", "voxel_size", "origin"};
+constexpr std::string_view kGridKeys[] = {"size", "voxel_size", "origin", "tiling"};
 
 }  // namespace
 
@@ -42,6 +42,9 @@ bool ReadGrid(const Json& root, Validator& check, GridSettings& grid) {
     }
     if (const Json* v = Validator::Find(*section, "origin")) {
         if (auto a = check.Numbers<3>(*v, "grid.origin", kFinite)) grid.origin = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "tiling")) {
+        if (auto b = check.Boolean(*v, "grid.tiling")) grid.tiling = *b;
     }
     return sizeOk;
 }

@@ -19,16 +19,17 @@ namespace cb {
 
 // X(Enum, "name", "SPEC section", splat pipeline?): a stage of the splat
 // pipeline (SPEC 2-8) is one every backend implements.
-#define CB_STAGES(X)                                                                               \
-    X(Region, "region", "2", true)              /* ellipsoids -> uint8 region volume R */          \
-    X(Ca, "ca", "3", true)                      /* cellular automaton on hum/act/cld bit fields */ \
-    X(Smooth, "smooth", "4", true)              /* binomial smoothing cld -> q */                  \
-    X(Density, "density", "5", true)            /* column sums D, tile/band occupancy, cover */    \
-    X(Shade, "shade", "6", true)                /* light attenuation T by inverse shear-warp */    \
-    X(Shadow, "shadow", "7", true)              /* ground shadow G */                              \
-    X(RenderSplat, "render_splat", "8", true)   /* point-sprite splatting */                       \
-    X(RenderMarch, "render_march", "10", false) /* per-pixel ray march */                          \
-    X(Noise, "noise", "10a", false)             /* noise-formed density */
+#define CB_STAGES(X)                                                                                 \
+    X(Region, "region", "2", true)                /* ellipsoids -> uint8 region volume R */          \
+    X(Ca, "ca", "3", true)                        /* cellular automaton on hum/act/cld bit fields */ \
+    X(Smooth, "smooth", "4", true)                /* binomial smoothing cld -> q */                  \
+    X(Density, "density", "5", true)              /* column sums D, tile/band occupancy, cover */    \
+    X(Shade, "shade", "6", true)                  /* light attenuation T by inverse shear-warp */    \
+    X(Shadow, "shadow", "7", true)                /* ground shadow G */                              \
+    X(RenderSplat, "render_splat", "8", true)     /* point-sprite splatting */                       \
+    X(RenderMarch, "render_march", "10", false)   /* per-pixel ray march */                          \
+    X(Noise, "noise", "10a", false)               /* noise-formed density */                         \
+    X(RenderLayers, "render_layers", "15", false) /* Wang's instanced horizontal layers */
 
 enum class Stage : uint8_t {
 #define CB_STAGE_ENUM(name, text, spec, splat) name,

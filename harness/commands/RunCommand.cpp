@@ -155,10 +155,12 @@ bool RunBackend(const Session& session, const RunOptions& own, Backend& backend,
                 continue;
             }
             const std::string stem = outDir + "/" + FrameFileStem(renderer, scene.render.cameras[n].name, run.name);
-            // The ray marcher's frames are HDR: its PNG is tone-mapped with the scene's exposure.
+            // The ray marcher's and the layers' frames are HDR: their PNG is tone-mapped with the scene's exposure.
             std::optional<FrameToneMap> toneMap;
             if (renderer == Stage::RenderMarch)
                 toneMap = FrameToneMap{scene.march.toneMap, float(scene.march.exposure)};
+            if (renderer == Stage::RenderLayers)
+                toneMap = FrameToneMap{scene.layers.toneMap, float(scene.layers.exposure)};
             auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, true, toneMap);
             if (paths)
                 written.insert(written.end(), paths->begin(), paths->end());

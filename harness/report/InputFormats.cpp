@@ -159,6 +159,7 @@ Node ResultsBackend() {
         {"loop", loop},
         {"frames", MapOf(KeyRule::PathName, FrameCamera(kSplatCounters))},
         {"march_frames", MapOf(KeyRule::PathName, FrameCamera(kMarchCounters))},
+        {"layers_frames", MapOf(KeyRule::PathName, FrameCamera(kLayersCounters))},
         {"cover", ArrayOf(Fraction())},
         {"cover_summary", Object({{"mean", Fraction(), true},
                                   {"median", Fraction(), true},

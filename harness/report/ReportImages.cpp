@@ -20,6 +20,8 @@ std::string_view RendererFileName(Stage renderer) {
             return "splat";
         case Stage::RenderMarch:
             return "march";
+        case Stage::RenderLayers:
+            return "layers";
         default:
             return StageName(renderer);
     }

@@ -65,7 +65,7 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
             stages[std::string(StageName(stage))] = entry;
         }
         nlohmann::json frames = nlohmann::json::object();
-        for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch}) {
+        for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch, Stage::RenderLayers}) {
             if (!scene.stages.Has(renderer)) continue;
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> wall, device;
@@ -181,6 +181,9 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             b["frames"] = framesJson(Stage::RenderSplat, ResultsCounters(kSplatCounters, &FrameRecord::stats));
         if (scene.stages.Has(Stage::RenderMarch))
             b["march_frames"] = framesJson(Stage::RenderMarch, ResultsCounters(kMarchCounters, &FrameRecord::march));
+        if (scene.stages.Has(Stage::RenderLayers))
+            b["layers_frames"] =
+                framesJson(Stage::RenderLayers, ResultsCounters(kLayersCounters, &FrameRecord::layers));
         if (scene.stages.Has(Stage::Density)) {
             nlohmann::json cover = nlohmann::json::array();
             std::vector<double> after;

@@ -71,6 +71,9 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
               [&](const FrameRecord& f) { return f.stats.*splatCount.member; });
     frameRows(Stage::RenderMarch, "march", marchCount.name,
               [&](const FrameRecord& f) { return f.march.*marchCount.member; });
+    const auto& layersCount = ReportedCounter(kLayersCounters);
+    frameRows(Stage::RenderLayers, "layers", layersCount.name,
+              [&](const FrameRecord& f) { return f.layers.*layersCount.member; });
     if (scene.stages.Has(Stage::Region)) {
         std::vector<double> host;
         for (const StepRecord& r : run.steps)

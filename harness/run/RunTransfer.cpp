@@ -38,7 +38,8 @@ json ToJson(const StepRecord& r) {
                           {"ms", D(f.ms)},
                           {"pipelined", f.pipelined},
                           {"device_ms", Optional(f.deviceMs)},
-                          {"march", CountersJson(f.march, kMarchCounters)}});
+                          {"march", CountersJson(f.march, kMarchCounters)},
+                          {"layers", CountersJson(f.layers, kLayersCounters)}});
         frames.back().update(CountersJson(f.stats, kSplatCounters));
     }
     json frameMs = json::array();
@@ -93,6 +94,7 @@ StepRecord StepFromJson(const json& j) {
         frame.deviceMs = OptionalFrom<double>(f.at("device_ms"));
         CountersFromJson(f, kSplatCounters, frame.stats);
         if (const auto m = f.find("march"); m != f.end()) CountersFromJson(*m, kMarchCounters, frame.march);
+        if (const auto m = f.find("layers"); m != f.end()) CountersFromJson(*m, kLayersCounters, frame.layers);
         r.frames.push_back(std::move(frame));
     }
     return r;

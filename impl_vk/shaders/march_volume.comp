@@ -3,7 +3,9 @@
 // padded volume, (nx+2) x (ny+2) x (nz+2), one invocation per padded voxel.
 // Voxel (i, j, k) sits at padded (i+1, j+1, k+1) and holds q_alpha =
 // Lerp(q_prev, q_cur, alpha) and, with the light source "shade", T; the border
-// holds (0, 1). With "shade" the volume is (q, T) pairs, else q alone.
+// holds (0, 1), or with `wrap` (render_layers' tiling) the opposite edge's voxels
+// in x and y (core/math/Layers.h LayersPaddedSource). With "shade" the volume is
+// (q, T) pairs, else q alone.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
 
@@ -12,7 +14,14 @@ layout(std430, binding = 0) readonly buffer QPrev { float qPrev[]; };
 layout(std430, binding = 1) readonly buffer QCur { float qCur[]; };
 layout(std430, binding = 2) readonly buffer Shade { float shadeT[]; };  // read only with hasT
 layout(std430, binding = 3) writeonly buffer Volume { float volume[]; };
-layout(push_constant) uniform Params { uint nx, ny, nz, hasT; float alpha; } pc;
+layout(push_constant) uniform Params { uint nx, ny, nz, hasT; float alpha; uint wrap; } pc;
+
+// The voxel padded index i stands for along an axis of n voxels; -1 for the border.
+int PaddedSource(uint i, uint n, bool wrap) {
+    if (i >= 1u && i <= n) return int(i) - 1;
+    if (!wrap) return -1;
+    return i == 0u ? int(n) - 1 : 0;
+}
 
 void main() {
     const uint px = pc.nx + 2u, py = pc.ny + 2u;
@@ -20,8 +29,10 @@ void main() {
     if (i >= px) return;
     const uint padded = i + px * (j + py * k);
     float q = 0.0, t = 1.0;
-    if (i >= 1u && j >= 1u && k >= 1u && i <= pc.nx && j <= pc.ny && k <= pc.nz) {
-        const uint v = (i - 1u) + pc.nx * ((j - 1u) + pc.ny * (k - 1u));
+    const int vi = PaddedSource(i, pc.nx, pc.wrap != 0u), vj = PaddedSource(j, pc.ny, pc.wrap != 0u);
+    const int vk = PaddedSource(k, pc.nz, false);
+    if (vi >= 0 && vj >= 0 && vk >= 0) {
+        const uint v = uint(vi) + pc.nx * (uint(vj) + pc.ny * uint(vk));
         q = Lerp(qPrev[v], qCur[v], pc.alpha);
         if (pc.hasT != 0u) t = shadeT[v];
     }

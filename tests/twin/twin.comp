@@ -11,6 +11,7 @@
 #include "noise.glsl"
 #include "march.glsl"
 #include "ground.glsl"
+#include "layers.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In { uint inWords[]; };
@@ -18,6 +19,7 @@ layout(std430, binding = 1) writeonly buffer Out { uint outWords[]; };
 layout(std430, binding = 2) readonly buffer Frame { SplatFrame frame; };
 layout(std430, binding = 3) readonly buffer March { MarchGpu march; };
 layout(std430, binding = 4) readonly buffer MieTable { float mieTable[]; };  // kMieCloudTable
+layout(std430, binding = 5) readonly buffer Layers { LayersGpu layers; };
 layout(push_constant) uniform Params { uint fn, count; } pc;
 
 // march.glsl's volume: a hash of the padded index (tests/GlslTwinTest.cpp TwinPaddedQT);
@@ -217,6 +219,59 @@ void main() {
             PutF(6u, MarchSampleQ(march, p));
             PutF(7u, SunLightMarch(march, p));
             PutF(8u, PointLightMarch(march, p));
+            break;
+        }
+        // With the bound LayersGpu (tests/GlslTwinLayersTest.cpp).
+        case 60u: {
+            const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
+            PutF(0u, r.dir.x);
+            PutF(1u, r.dir.y);
+            PutF(2u, r.dir.z);
+            PutF(3u, r.tNear);
+            PutF(4u, r.tFar);
+            const LayersWalk w = LayersWalkOf(layers, r.dir.z);
+            PutI(5u, w.first);
+            PutI(6u, w.step);
+            PutU(7u, w.count);
+            break;
+        }
+        case 61u: {
+            const MarchTaps t = PaddedTapsAt(layers.size.xyz, layers.phase.z, layers.phase.w, vec3(F(0u), F(1u), F(2u)));
+            const vec2 qt = PaddedBlend(layers.phase.z, layers.phase.w, t);
+            PutU(0u, t.base);
+            PutF(1u, t.w.x);
+            PutF(2u, t.w.y);
+            PutF(3u, t.w.z);
+            PutF(4u, qt.x);
+            PutF(5u, qt.y);
+            PutF(6u, LayersWrap(F(3u), F(4u), F(5u)));
+            PutF(7u, LayerHeight(layers, U(6u)));
+            break;
+        }
+        case 62u: {
+            const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
+            const float sunPhase = LayersPhase(layers, MarchDot(layers.sun.xyz, r.dir));
+            const LayerFragmentResult f = LayerFragment(layers, r, sunPhase, U(2u));
+            PutU(0u, f.crossed ? 1u : 0u);
+            PutU(1u, f.drawn ? 1u : 0u);
+            PutF(2u, f.alpha);
+            PutF(3u, f.color.x);
+            PutF(4u, f.color.y);
+            PutF(5u, f.color.z);
+            PutF(6u, sunPhase);
+            const vec3 over = LayersOver(vec3(F(3u), F(4u), F(5u)), f.alpha, f.color);
+            PutF(7u, over.x);
+            PutF(8u, over.y);
+            PutF(9u, over.z);
+            break;
+        }
+        case 63u: {
+            const LayersPixelResult p = LayersPixel(layers, U(0u), U(1u));
+            PutF(0u, p.color.x);
+            PutF(1u, p.color.y);
+            PutF(2u, p.color.z);
+            PutU(3u, p.fragments);
+            PutU(4u, p.drawn);
             break;
         }
         case 27u: {

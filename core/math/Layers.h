@@ -1,0 +1,194 @@
+// The layered renderer's algorithm (SPEC 15; Wang, Ji and Zhang, sections 4 and 5):
+// N horizontal layers around the eye, each fragment the crossing of a pixel's
+// ray with one layer plane, composited back to front. One per-fragment
+// function, LayerFragment, which the CPU and Vulkan run in a per-pixel loop
+// (LayersPixel) and OpenGL's fragment shader runs once per rasterised layer,
+// and its GLSL twin core/math/layers.glsl. Decisions where SPEC is silent:
+// docs/pipeline.md, "Layered renderer".
+//
+// Voxel units throughout, as in core/math/March.h: a point p has world
+// position origin + h p and t along a ray is in voxel edges.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/math/March.h"
+
+namespace cb {
+
+struct LayersSetup {
+    Vec3 eye{};             // the eye, voxel units
+    Vec3 size{1, 1, 1};     // the grid (nx, ny, nz)
+    Vec3 invSize{1, 1, 1};  // 1 / size: the tiling's wrap
+    float voxelSize = 1;    // h, metres
+    uint32_t count = 1;     // N layers
+    float spacing = 1;      // nz / N, voxel edges between layers
+    float outer2 = 0;       // extent^2, voxel edges^2: a fragment's horizontal distance from the eye is within
+    float maxLength = 1;    // l_max, voxel edges: the most path one fragment stands for
+    float sigmaH = 1;       // sigma h (MarchOpticalDepthPerVoxel)
+    bool tiling = false;    // the volume repeats in x and y; else a fragment outside the box is empty
+    Vec3 sun{0, 0, 1};      // unit, toward the sun
+    Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
+    PhaseParams phase;
+};
+
+// The voxel that padded index i stands for along an axis of n voxels: voxel
+// i - 1 inside; the border (i = 0 and n + 1) is outside (-1), or with `wrap`
+// the opposite edge's voxel (n - 1 and 0).
+inline int64_t LayersPaddedSource(uint32_t i, uint32_t n, bool wrap) {
+    if (i >= 1 && i <= n) return int64_t(i) - 1;
+    if (!wrap) return -1;
+    return i == 0 ? int64_t(n) - 1 : 0;
+}
+
+// Layer i's plane: z_i = (i + 1/2) nz / N (voxel units, above the grid's base).
+inline float LayerHeight(const LayersSetup& s, uint32_t i) { return (float(i) + 0.5f) * s.spacing; }
+
+// x reduced into [0, n] (n x, n y periodic): x - n floor(x / n), with 1 / n
+// from the host so that every backend rounds the same product.
+inline float LayersWrap(float x, float n, float invN) { return x - n * std::floor(x * invN); }
+
+// The padded (q, T) volume's taps at voxel-unit point p, as core/math/March.h's
+// padded sampler (impl_cpu/RenderMarchCpu.cpp): p clamped to [0, n], plus
+// 1/2, floored. With tiling the volume's horizontal border holds the opposite
+// edge's voxels, so a wrapped point in [0, n] reads across the seam.
+struct LayersTaps {
+    uint32_t base = 0;  // padded index i + px (j + py k)
+    float wx = 0, wy = 0, wz = 0;
+};
+inline LayersTaps LayersTapsAt(const Vec3& size, const Vec3& p) {
+    const float cx = std::clamp(p[0], 0.0f, size[0]) + 0.5f;
+    const float cy = std::clamp(p[1], 0.0f, size[1]) + 0.5f;
+    const float cz = std::clamp(p[2], 0.0f, size[2]) + 0.5f;
+    const uint32_t i = uint32_t(cx), j = uint32_t(cy), k = uint32_t(cz);
+    const uint32_t px = uint32_t(size[0]) + 2u, py = uint32_t(size[1]) + 2u;
+    return {i + px * (j + py * k), cx - float(i), cy - float(j), cz - float(k)};
+}
+
+// Trilinear (q, T) from the taps; fetch(paddedIndex) returns the pair.
+template <class Fetch>
+inline std::array<float, 2> LayersBlend(const Vec3& size, const LayersTaps& t, Fetch&& fetch) {
+    const uint32_t px = uint32_t(size[0]) + 2u, pxy = px * (uint32_t(size[1]) + 2u);
+    std::array<float, 2> out{};
+    const std::array<float, 2> a0 = fetch(t.base), a1 = fetch(t.base + 1u), a2 = fetch(t.base + px),
+                               a3 = fetch(t.base + px + 1u), b0 = fetch(t.base + pxy), b1 = fetch(t.base + pxy + 1u),
+                               b2 = fetch(t.base + pxy + px), b3 = fetch(t.base + pxy + px + 1u);
+    for (int f = 0; f < 2; ++f) {
+        const float c00 = Lerp(a0[f], a1[f], t.wx), c10 = Lerp(a2[f], a3[f], t.wx);
+        const float c01 = Lerp(b0[f], b1[f], t.wx), c11 = Lerp(b2[f], b3[f], t.wx);
+        out[f] = Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
+    }
+    return out;
+}
+
+// One pixel's ray as the layers see it: its direction (PixelRayDirection) and
+// the distances of the near and far planes along it (voxel edges).
+struct LayersRay {
+    Vec3 dir{};
+    float tNear = 0, tFar = 0;
+};
+inline LayersRay MakeLayersRay(const CameraFrame& c, float voxelSize, uint32_t x, uint32_t y) {
+    const PixelDirection p = PixelRayDirection(c, x, y);
+    const float perDepth = 1.0f / (voxelSize * p.cosForward);
+    return {p.dir, c.nearPlane * perDepth, c.farPlane * perDepth};
+}
+
+// Layer i's fragment on a ray: drawn iff the ray crosses the plane at a
+// distance t between the near and far planes, within the extent horizontally
+// and (without tiling) inside the box, where q > 0. Its opacity is beer's,
+// alpha = 1 - exp(-sigma h q l), l = min(spacing / |d_z|, l_max); its colour
+// c = sun T P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
+struct LayerFragmentResult {
+    bool crossed = false;  // the plane is met in range (a counted fragment)
+    bool drawn = false;    // and q > 0 there
+    float alpha = 0;
+    Vec3 color{};
+};
+template <class Fetch>
+inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& ray, float sunPhase, uint32_t i,
+                                         Fetch&& fetch) {
+    LayerFragmentResult f;
+    const float dz = ray.dir[2];
+    if (!(std::fabs(dz) >= 1e-20f)) return f;
+    const float z = LayerHeight(s, i);
+    const float invDz = 1.0f / dz;
+    const float t = (z - s.eye[2]) * invDz;
+    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
+    const float hx = ray.dir[0] * t, hy = ray.dir[1] * t;
+    if (!(hx * hx + hy * hy <= s.outer2)) return f;
+    float x = s.eye[0] + hx, y = s.eye[1] + hy;
+    if (s.tiling) {
+        x = LayersWrap(x, s.size[0], s.invSize[0]);
+        y = LayersWrap(y, s.size[1], s.invSize[1]);
+    } else if (!(x >= 0.0f && x <= s.size[0] && y >= 0.0f && y <= s.size[1])) {
+        return f;
+    }
+    f.crossed = true;
+    const std::array<float, 2> qt = LayersBlend(s.size, LayersTapsAt(s.size, Vec3{x, y, z}), fetch);
+    if (!(qt[0] > 0.0f)) return f;
+    f.drawn = true;
+    const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
+    f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
+    const float gain = qt[1] * sunPhase;
+    f.color = {s.sunRadiance[0] * gain + s.ambient[0], s.sunRadiance[1] * gain + s.ambient[1],
+               s.sunRadiance[2] * gain + s.ambient[2]};
+    return f;
+}
+
+// C <- alpha c + (1 - alpha) C, per channel: the blend every backend uses
+// (OpenGL's SRC_ALPHA, ONE_MINUS_SRC_ALPHA).
+inline Vec3 LayersOver(const Vec3& C, float alpha, const Vec3& c) {
+    const float keep = 1.0f - alpha;
+    return {alpha * c[0] + keep * C[0], alpha * c[1] + keep * C[1], alpha * c[2] + keep * C[2]};
+}
+
+// The layers one ray crosses, back to front: those on its side of the eye,
+// the farthest first (SPEC 15's order: decreasing |z_i - z_eye|). first is
+// the farthest, and the walk moves by step (-1 upward, +1 downward) for count
+// layers; count 0 when the ray is level or no layer lies on its side.
+struct LayersWalk {
+    int first = 0, step = 0;
+    uint32_t count = 0;
+};
+inline LayersWalk LayersWalkOf(const LayersSetup& s, float dz) {
+    LayersWalk w;
+    if (dz > 0.0f) {
+        // Layers above the eye: i from N - 1 down to the lowest with z_i > eye z.
+        uint32_t lowest = s.count;
+        while (lowest > 0 && LayerHeight(s, lowest - 1) > s.eye[2]) --lowest;
+        w = {int(s.count) - 1, -1, s.count - lowest};
+    } else if (dz < 0.0f) {
+        uint32_t above = 0;  // layers below the eye: i from 0 up to the highest with z_i < eye z
+        while (above < s.count && LayerHeight(s, above) < s.eye[2]) ++above;
+        w = {0, 1, above};
+    }
+    return w;
+}
+
+struct LayersPixelResult {
+    Vec3 color{};
+    uint32_t fragments = 0;  // crossings in range
+    uint32_t drawn = 0;      // of them with q > 0
+};
+
+// One pixel: the background, then every layer the ray crosses, back to front.
+template <class Fetch>
+inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersRay& ray, Fetch&& fetch) {
+    LayersPixelResult r;
+    r.color = s.background;
+    const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+    const LayersWalk w = LayersWalkOf(s, ray.dir[2]);
+    for (uint32_t n = 0; n < w.count; ++n) {
+        const uint32_t i = uint32_t(w.first + w.step * int(n));
+        const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i, fetch);
+        r.fragments += f.crossed ? 1u : 0u;
+        if (!f.drawn) continue;
+        ++r.drawn;
+        r.color = LayersOver(r.color, f.alpha, f.color);
+    }
+    return r;
+}
+
+}  // namespace cb

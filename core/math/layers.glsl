@@ -1,0 +1,152 @@
+// GLSL twin of core/math/Layers.h (SPEC 15): a pixel's ray, the padded (q, T)
+// taps with the tiling's wrap, one layer's fragment, the back-to-front walk and
+// the per-pixel loop. The same operations in the same order, `precise` where
+// the CPU (built with -ffp-contract=off) rounds each product.
+//
+// Include after random.glsl, shading.glsl and march.glsl, whose pixel ray,
+// padded sampler (PaddedTapsAt, PaddedBlend), SegmentTransmittance and Mie
+// lookup it uses. The including shader defines march.glsl's MarchFetchQT as the
+// layers' padded (q_alpha, T) volume, (nx+2) x (ny+2) x (nz+2) with voxel
+// (i, j, k) at (i+1, j+1, k+1), and MarchPhaseTableValue (phase Mie only).
+#ifndef CLOUDBENCH_LAYERS_GLSL
+#define CLOUDBENCH_LAYERS_GLSL
+
+// core/pipeline/LayersGpu.h, row for row.
+struct LayersGpu {
+    vec4 eye;          // xyz voxel units; w focalPx
+    vec4 forward;      // w near (metres)
+    vec4 right;        // w far (metres)
+    vec4 up;           // w voxel size h (metres)
+    vec4 size;         // xyz grid; w sigma h
+    vec4 invSize;      // xyz 1 / size; w spacing nz / N
+    vec4 sun;          // xyz toward the sun; w phase g
+    vec4 sunRadiance;  // rgb; w extent^2
+    vec4 ambient;      // rgb; w Mie index per radian
+    vec4 background;   // rgb; w l_max
+    uvec4 image;       // width, height, N, flags
+    uvec4 phase;       // kind, Mie count, px, px * py
+};
+
+const uint kLayersTiling = 1u;
+const uint kLayersPhaseMie = 3u;  // PhaseKind::Mie
+
+float LayerHeight(LayersGpu s, uint i) {
+    precise float z = (float(i) + 0.5) * s.invSize.w;
+    return z;
+}
+
+float LayersWrap(float x, float n, float invN) {
+    precise float w = x - n * floor(x * invN);
+    return w;
+}
+
+struct LayersRay {
+    vec3 dir;
+    float tNear, tFar;
+};
+
+// core/math/Layers.h MakeLayersRay (PixelRayDirection, then the planes' distances).
+LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
+    float inv;
+    LayersRay r;
+    r.dir = PixelRayDirection(s.forward.xyz, s.right.xyz, s.up.xyz, s.eye.w, s.image.xy, x, y, inv);
+    precise float perDepth = 1.0 / (s.up.w * inv);
+    r.tNear = s.forward.w * perDepth;
+    r.tFar = s.right.w * perDepth;
+    return r;
+}
+
+// P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
+float LayersPhase(LayersGpu s, float cosTheta) {
+    if (s.phase.x == kLayersPhaseMie) return SampleMiePhase(s.ambient.w, s.phase.y, cosTheta);
+    return PhaseValue(s.phase.x, s.sun.w, cosTheta);
+}
+
+struct LayerFragmentResult {
+    bool crossed, drawn;
+    float alpha;
+    vec3 color;
+};
+
+// core/math/Layers.h LayerFragment.
+LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, uint i) {
+    LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
+    const float dz = ray.dir.z;
+    if (!(abs(dz) >= 1e-20)) return f;
+    const float z = LayerHeight(s, i);
+    precise float invDz = 1.0 / dz;
+    precise float t = (z - s.eye.z) * invDz;
+    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0)) return f;
+    precise float hx = ray.dir.x * t, hy = ray.dir.y * t;
+    precise float r2 = hx * hx + hy * hy;
+    if (!(r2 <= s.sunRadiance.w)) return f;
+    precise float x = s.eye.x + hx, y = s.eye.y + hy;
+    if ((s.image.w & kLayersTiling) != 0u) {
+        x = LayersWrap(x, s.size.x, s.invSize.x);
+        y = LayersWrap(y, s.size.y, s.invSize.y);
+    } else if (!(x >= 0.0 && x <= s.size.x && y >= 0.0 && y <= s.size.y)) {
+        return f;
+    }
+    f.crossed = true;
+    const vec2 qt = PaddedBlend(s.phase.z, s.phase.w, PaddedTapsAt(s.size.xyz, s.phase.z, s.phase.w, vec3(x, y, z)));
+    if (!(qt.x > 0.0)) return f;
+    f.drawn = true;
+    precise float length = min(s.invSize.w * abs(invDz), s.background.w);
+    precise float alpha = 1.0 - SegmentTransmittance(s.size.w, qt.x, length);
+    f.alpha = alpha;
+    precise float gain = qt.y * sunPhase;
+    precise vec3 c = vec3(s.sunRadiance.x * gain + s.ambient.x, s.sunRadiance.y * gain + s.ambient.y,
+                          s.sunRadiance.z * gain + s.ambient.z);
+    f.color = c;
+    return f;
+}
+
+vec3 LayersOver(vec3 C, float alpha, vec3 c) {
+    precise float keep = 1.0 - alpha;
+    precise vec3 r = vec3(alpha * c.x + keep * C.x, alpha * c.y + keep * C.y, alpha * c.z + keep * C.z);
+    return r;
+}
+
+struct LayersWalk {
+    int first, step;
+    uint count;
+};
+
+LayersWalk LayersWalkOf(LayersGpu s, float dz) {
+    LayersWalk w = LayersWalk(0, 0, 0u);
+    const uint n = s.image.z;
+    if (dz > 0.0) {
+        uint lowest = n;
+        while (lowest > 0u && LayerHeight(s, lowest - 1u) > s.eye.z) --lowest;
+        w = LayersWalk(int(n) - 1, -1, n - lowest);
+    } else if (dz < 0.0) {
+        uint above = 0u;
+        while (above < n && LayerHeight(s, above) < s.eye.z) ++above;
+        w = LayersWalk(0, 1, above);
+    }
+    return w;
+}
+
+struct LayersPixelResult {
+    vec3 color;
+    uint fragments, drawn;
+};
+
+// core/math/Layers.h LayersPixel: the background, then the layers the ray crosses, back to front.
+LayersPixelResult LayersPixel(LayersGpu s, uint x, uint y) {
+    LayersPixelResult r = LayersPixelResult(s.background.xyz, 0u, 0u);
+    const LayersRay ray = MakeLayersRay(s, x, y);
+    const float sunPhase = LayersPhase(s, MarchDot(s.sun.xyz, ray.dir));
+    const LayersWalk w = LayersWalkOf(s, ray.dir.z);
+    for (uint n = 0u; n < w.count; ++n) {
+        const uint i = uint(w.first + w.step * int(n));
+        const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i);
+        r.fragments += f.crossed ? 1u : 0u;
+        if (!f.drawn) continue;
+        ++r.drawn;
+        r.color = LayersOver(r.color, f.alpha, f.color);
+    }
+    return r;
+}
+
+#endif  // CLOUDBENCH_LAYERS_GLSL

@@ -1,0 +1,112 @@
+#include "core/stages/render_layers/RenderLayers.h"
+
+#include <algorithm>
+#include <string>
+#include <string_view>
+
+#include "core/scene/SceneReaders.h"
+
+namespace cb::scene_io {
+namespace {
+
+constexpr std::string_view kLayersKeys[] = {"count", "extent", "max_length", "exposure", "tone_map"};
+
+// At most this many layers per voxel edge of height: SPEC 15 measures up to 4; more only multiplies the work.
+constexpr uint32_t kMaxLayersPerVoxel = 16;
+
+}  // namespace
+
+void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, LayersSettings& layers) {
+    const Json* section = check.Section(root, "", "layers", kLayersKeys);
+    if (!section) return;
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    if (const Json* v = find("count")) {
+        // 16 layers per voxel of height (the grid's nz).
+        const int64_t most = nz ? int64_t(kMaxLayersPerVoxel) * *nz : int64_t(kU32Max);
+        if (auto n = check.Integer(*v, "layers.count", 1, most)) layers.count = uint32_t(*n);
+    }
+    if (const Json* v = find("extent")) {
+        if (auto d = check.Number(*v, "layers.extent", kSinglePositive)) layers.extent = *d;
+    }
+    if (const Json* v = find("max_length")) {
+        if (auto d = check.Number(*v, "layers.max_length", kSinglePositive)) layers.maxLength = *d;
+    }
+    if (const Json* v = find("exposure")) {
+        if (auto d = check.Number(*v, "layers.exposure", kSinglePositive)) layers.exposure = *d;
+    }
+    if (const Json* v = find("tone_map")) {
+        if (auto b = check.Boolean(*v, "layers.tone_map")) layers.toneMap = *b;
+    }
+}
+
+}  // namespace cb::scene_io
+
+namespace cb {
+namespace {
+
+// SPEC 15: SPEC 8's image rule.
+CompareRule LayersImageRule(const Scene&) { return {CompareRule::Kind::Image, 2.0 / 255.0, 0.001, 8.0 / 255.0}; }
+
+// Like the other renderers, the layers interpolate q between the last two steps.
+std::vector<Resource> LayersPrevious(const Scene&) { return {Resource::Q}; }
+
+}  // namespace
+
+LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uint32_t step, uint32_t frame,
+                              uint32_t frames) {
+    LayersParams p;
+    p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
+    const float h = float(sc.grid.voxelSize);
+    p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
+    LayersSetup& s = p.setup;
+    const Extent3 e = sc.grid.size;
+    for (int a = 0; a < 3; ++a) s.eye[a] = (p.camera.eye[a] - p.origin[a]) / h;
+    s.size = {float(e.nx), float(e.ny), float(e.nz)};
+    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
+    s.voxelSize = h;
+    s.count = sc.layers.count > 0 ? sc.layers.count : e.nz;
+    s.spacing = float(double(e.nz) / double(s.count));
+    const double extent = (sc.layers.extent > 0 ? sc.layers.extent : camera.farPlane) / sc.grid.voxelSize;
+    s.outer2 = float(std::min(extent * extent, 1e36));
+    s.maxLength = float(sc.layers.maxLength > 0 ? sc.layers.maxLength : double(e.nz));
+    s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
+    s.tiling = sc.grid.tiling;
+    s.sun = sc.sun.DirectionAt(step);
+    s.sunRadiance = sc.sun.Radiance();
+    s.ambient = sc.lighting.Ambient();
+    s.background = sc.lighting.Background();
+    s.phase = sc.phase;
+    p.alpha = sc.render.FrameAlpha(frame, frames);
+    return p;
+}
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const StageDescriptor& DescribeRenderLayers() {
+    static const StageDescriptor descriptor{
+        .stage = Stage::RenderLayers,
+        .section = "layers",
+        .reads = {Resource::Q, Resource::T},
+        .readsPrevious = LayersPrevious,
+        .writes = {Resource::LayersImage},
+        .outputStepsOnly = true,
+        .renderer = true,
+        .symbol = "image",
+        .rule = LayersImageRule,
+    };
+    return descriptor;
+}
+#pragma GCC diagnostic pop
+
+Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
+                        StageCallRecord& record) {
+    return RenderEachCamera(
+        Stage::RenderLayers, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+            const LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            return timed(
+                [&] { return backend.RenderLayers(p, in, *io.Current(Resource::LayersImage, n), &frame.layers); });
+        });
+}
+
+}  // namespace cb

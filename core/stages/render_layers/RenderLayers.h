@@ -1,0 +1,30 @@
+// Stage `render_layers` (SPEC 15, docs/contract.md): Wang, Ji and Zhang's layered renderer,
+// N horizontal layers around the eye composited back to front, lit by shade's T.
+// Its home: the types (RenderLayersTypes.h), the reader of its section, its parameters from a scene,
+// its descriptor and its call adapter.
+#pragma once
+
+#include <cstdint>
+
+#include "core/pipeline/StageAdapter.h"
+#include "core/pipeline/StageDescriptor.h"
+#include "core/scene/SectionReader.h"
+#include "core/stages/render_layers/RenderLayersTypes.h"
+
+namespace cb {
+
+namespace scene_io {
+// `nz` is the grid's, when its size was read: the layer count is checked against it.
+void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, LayersSettings& layers);
+}  // namespace scene_io
+
+// The layered renderer's parameters for one camera at `step` (the sun), frame `frame` of a step of `frames`
+// frames (its alpha).
+LayersParams MakeLayersParams(const Scene& scene, const CameraSettings& camera, uint32_t step, uint32_t frame = 0,
+                              uint32_t frames = 0);
+
+const StageDescriptor& DescribeRenderLayers();
+Status CallRenderLayers(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io,
+                        StageCallRecord& record);
+
+}  // namespace cb

@@ -1,0 +1,56 @@
+// Stage `render_layers`'s types (SPEC 15, docs/contract.md): the layered renderer's settings
+// (section `layers`), its parameters, inputs and counters. Fields, units and defaults in docs/scenes.md.
+// The scene (core/scene/Scene.h) and the backend interface (core/pipeline/Backend.h) include
+// this header; the stage's reader, parameters, descriptor and call are beside it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <iterator>
+
+#include "core/base/Counter.h"
+#include "core/math/Camera.h"
+#include "core/math/Layers.h"
+
+namespace cb {
+
+class Buffer;  // core/pipeline/Backend.h
+
+struct LayersSettings {
+    uint32_t count = 0;     // N; 0: the grid's nz (one layer on each voxel-centre plane)
+    double extent = 0;      // metres, the layers' horizontal radius around the eye; 0: each camera's far plane
+    double maxLength = 0;   // l_max, voxel edges; 0: the grid's nz (a fragment stands for at most the slab seen
+                            // straight through)
+    double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
+    bool toneMap = true;    // PNG only; false: clamp(exposure C)
+};
+
+// Inputs of the layered renderer besides its buffers: the kernel's constants
+// (core/math/Layers.h, voxel units) and what the backend needs to feed it.
+struct LayersParams {
+    CameraFrame camera;
+    LayersSetup setup;
+    std::array<float, 3> origin{0, 0, 0};  // world position of voxel corner (0, 0, 0)
+    float alpha = 0.5f;                    // q_alpha = (1 - alpha) q_prev + alpha q_cur
+};
+
+struct LayersInputs {
+    const Buffer* qPrev = nullptr;  // F32 volume
+    const Buffer* qCur = nullptr;   // F32 volume
+    const Buffer* T = nullptr;      // F32 volume: shade's T
+};
+
+struct LayersStats {
+    uint64_t fragments = 0;  // layer crossings within range (near / far planes, extent, box without tiling)
+    uint64_t drawn = 0;      // of them with q_alpha > 0: blended
+};
+
+// The layered renderer's counters (core/base/Counter.h).
+inline constexpr Counter<LayersStats> kLayersCounters[] = {
+    {"fragments", &LayersStats::fragments, CounterShown::ResultsAndReport},
+    {"drawn", &LayersStats::drawn, CounterShown::Results},
+};
+static_assert(ReportedCounter(kLayersCounters).name == "fragments");
+static_assert(sizeof(LayersStats) == std::size(kLayersCounters) * sizeof(uint64_t), "a LayersStats member is unlisted");
+
+}  // namespace cb

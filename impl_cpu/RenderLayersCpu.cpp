@@ -1,0 +1,85 @@
+// The layered renderer on the CPU (SPEC 15): per call, q_alpha and T are formed
+// once into a padded volume of (q, T) pairs (core/math/Layers.h's taps: the
+// border holds (0, 1), or with tiling the opposite edge's voxels), then every
+// pixel runs LayersPixel, the layers its ray crosses back to front, TBB over
+// 8 x 8 pixel tiles. A pixel's loop is the fastest form here: it touches only
+// the layers on its side of the eye, where OpenGL rasterises every layer.
+#include <tbb/blocked_range.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+
+#include "core/math/Layers.h"
+#include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/RenderLayersCpuState.h"
+
+namespace cb::cpu {
+
+uint64_t RenderLayersCpuState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    return SaturatingMul(uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull), 2 * sizeof(float));
+}
+
+Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats) {
+    RenderLayersCpuState& state = mStages.Get<RenderLayersCpuState>();
+    if (!in.qPrev || !in.qCur || !in.T) return MakeError("cpu: render_layers needs q and T");
+    const Extent3 e = in.qCur->Extent();
+    if (in.qPrev->Extent() != e || in.T->Extent() != e)
+        return MakeError("cpu: render_layers: q_prev, q_cur and T differ in size");
+    const uint32_t W = params.camera.width, H = params.camera.height;
+    if (image.Extent() != Extent3{3, W, H}) return MakeError("cpu: render_layers: the image is not (3, width, height)");
+    const float* qPrev = static_cast<const BufferCpu*>(in.qPrev)->F32();
+    const float* qCur = static_cast<const BufferCpu*>(in.qCur)->F32();
+    const float* T = static_cast<const BufferCpu*>(in.T)->F32();
+    float* out = static_cast<BufferCpu&>(image).F32();
+    const LayersSetup& s = params.setup;
+    const size_t px = size_t(e.nx) + 2, py = size_t(e.ny) + 2, pz = size_t(e.nz) + 2;
+    std::atomic<uint64_t> fragments{0}, drawn{0};
+
+    mArena.execute([&] {
+        // 1. The padded volume: voxel (i, j, k) at (i + 1, j + 1, k + 1); LayersPaddedSource names each border's.
+        state.volume.resize(px * py * pz);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, pz), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t k = r.begin(); k < r.end(); ++k)
+                for (size_t j = 0; j < py; ++j) {
+                    std::array<float, 2>* row = state.volume.data() + px * (j + py * k);
+                    const int64_t vk = LayersPaddedSource(uint32_t(k), e.nz, false);
+                    const int64_t vj = LayersPaddedSource(uint32_t(j), e.ny, s.tiling);
+                    for (size_t i = 0; i < px; ++i) {
+                        const int64_t vi = LayersPaddedSource(uint32_t(i), e.nx, s.tiling);
+                        if (vi < 0 || vj < 0 || vk < 0) {
+                            row[i] = {0.0f, 1.0f};
+                            continue;
+                        }
+                        const size_t v = size_t(vi) + size_t(e.nx) * (size_t(vj) + size_t(e.ny) * size_t(vk));
+                        row[i] = {Lerp(qPrev[v], qCur[v], params.alpha), T[v]};
+                    }
+                }
+        });
+        // 2. The pixels.
+        const std::array<float, 2>* volume = state.volume.data();
+        auto fetch = [volume](uint32_t i) { return volume[i]; };
+        tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8),
+                          [&](const tbb::blocked_range2d<uint32_t>& r) {
+                              uint64_t nFragments = 0, nDrawn = 0;
+                              for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
+                                  for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
+                                      const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
+                                      const LayersPixelResult p = LayersPixel(s, ray, fetch);
+                                      float* o = out + 3 * (size_t(x) + size_t(W) * y);
+                                      o[0] = p.color[0];
+                                      o[1] = p.color[1];
+                                      o[2] = p.color[2];
+                                      nFragments += p.fragments;
+                                      nDrawn += p.drawn;
+                                  }
+                              fragments += nFragments;
+                              drawn += nDrawn;
+                          });
+    });
+    if (stats) *stats = {fragments, drawn};
+    return {};
+}
+
+}  // namespace cb::cpu

@@ -1,0 +1,62 @@
+// The padded (q_alpha, T) volume that render_march and render_layers read by
+// index (march.glsl's MarchFetchQT), and the Mie table both look up.
+#include <string>
+
+#include "core/math/Shading.h"
+#include "impl_gl/BackendGL.h"
+
+namespace cb::gl {
+namespace {
+
+size_t PaddedVolumeBytes(const Extent3& e) { return size_t(e.nx + 2) * size_t(e.ny + 2) * size_t(e.nz + 2) * 8; }
+
+}  // namespace
+
+Status BackendGL::CheckPaddedVolumeFits(const Extent3& grid, const char* stage) {
+    GLint maxStorage = 0;
+    mContext->F().GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxStorage);
+    const size_t bytes = PaddedVolumeBytes(grid);
+    if (bytes > size_t(uint32_t(maxStorage)))
+        return MakeError(std::string("gl: ") + stage + ": the padded volume takes " + std::to_string(bytes) +
+                         " bytes; this driver's storage blocks hold " + std::to_string(maxStorage));
+    return {};
+}
+
+Result<GLuint> BackendGL::FormPaddedVolume(TextureSlot& volume, BufferSlot& copy, const Buffer& qPrev,
+                                           const Buffer& qCur, const Buffer* T, float alpha, bool wrap) {
+    const Functions& f = mContext->F();
+    auto program = PassProgram("march_volume");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = qCur.Extent();
+    const GLsizei px = GLsizei(e.nx + 2), py = GLsizei(e.ny + 2), pz = GLsizei(e.nz + 2);
+    const GLuint texture = Scratch(volume, GL_TEXTURE_2D_ARRAY, GL_RG32F, px, py, pz);
+    f.UseProgram(*program);
+    f.BindTextureUnit(0, Tex(qPrev).Texture());
+    f.BindTextureUnit(1, Tex(qCur).Texture());
+    f.BindTextureUnit(2, Tex(T ? *T : qCur).Texture());
+    f.Uniform3i(f.GetUniformLocation(*program, "grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1f(f.GetUniformLocation(*program, "alpha"), alpha);
+    f.Uniform1i(f.GetUniformLocation(*program, "hasT"), T ? 1 : 0);
+    f.Uniform1i(f.GetUniformLocation(*program, "wrap"), wrap ? 1 : 0);
+    f.Viewport(0, 0, px, py);
+    CB_TRY(DrawLayers(*program, uint32_t(pz), {texture}));
+    const size_t bytes = PaddedVolumeBytes(e);
+    const GLuint buffer = ScratchBuffer(copy, bytes);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(texture, 0, GL_RG, GL_FLOAT, GLsizei(bytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    return buffer;
+}
+
+GLuint BackendGL::MiePhaseTable(BufferSlot& table, bool& uploaded) {
+    const size_t bytes = size_t(kMieCloudTable.count) * 4;
+    const GLuint buffer = ScratchBuffer(table, bytes);
+    if (!uploaded) {
+        mContext->F().NamedBufferSubData(buffer, 0, GLsizeiptr(bytes), kMieCloudTable.values);
+        uploaded = true;
+    }
+    return buffer;
+}
+
+}  // namespace cb::gl

@@ -1,0 +1,91 @@
+// Stage `render_layers` (SPEC 15) on OpenGL, Wang, Ji and Zhang's way:
+//   1. march_volume: the padded (q_alpha, T) volume (render_march's step 1 with
+//      `wrap` under tiling), copied on the device into a storage buffer;
+//   2. one screen quad drawn instanced N times (render_layers.vert: instance n
+//      is the n-th layer back to front, cut by a clip distance to the side of
+//      the horizon the layer lies on), blended SRC_ALPHA, ONE_MINUS_SRC_ALPHA over
+//      the background; each fragment is LayerFragment of core/math/layers.glsl on
+//      its pixel's ray (render_layers.frag), the counters by storage-buffer atomics.
+// The RGBA32F target's rows come back top row first and pass through a pixel
+// buffer into the (3, width, height) image, as render_march's.
+#include "core/pipeline/LayersGpu.h"
+#include "impl_gl/BackendGL.h"
+#include "impl_gl/RenderLayersGLState.h"
+
+namespace cb::gl {
+
+uint64_t RenderLayersGLState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    uint64_t bytes = 2 * uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2) * 8;
+    bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
+    if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    return bytes;
+}
+
+Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats) {
+    RenderLayersGLState& state = mStages.Get<RenderLayersGLState>();
+    if (!in.qPrev || !in.qCur || !in.T) return MakeError("gl: render_layers needs q and T");
+    const Extent3 e = in.qCur->Extent();
+    if (in.qPrev->Extent() != e || in.T->Extent() != e)
+        return MakeError("gl: render_layers: q_prev, q_cur and T differ in size");
+    const uint32_t W = params.camera.width, H = params.camera.height;
+    if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_layers: the image is not (3, width, height)");
+    const Functions& f = mContext->F();
+    auto layersProgram = mContext->Program("render_layers");
+    if (!layersProgram) return std::unexpected(layersProgram.error());
+    CB_TRY(CheckPaddedVolumeFits(e, "render_layers"));
+    const LayersGpu block = MakeLayersGpu(params);
+    const std::vector<uint32_t> order = LayersDrawOrder(params.setup);
+
+    Timing timer(*this);
+    f.BindVertexArray(mContext->EmptyVao());
+    const GLuint counters = ScratchBuffer(state.counters, 4 * 4);
+    const uint32_t zero[4] = {};
+    f.NamedBufferSubData(counters, 0, sizeof zero, zero);
+
+    // 1. The padded (q_alpha, T) volume.
+    auto volumeCopy =
+        FormPaddedVolume(state.volume, state.volumeCopy, *in.qPrev, *in.qCur, in.T, params.alpha, params.setup.tiling);
+    if (!volumeCopy) return std::unexpected(volumeCopy.error());
+    f.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+    // 2. The layers, instanced, back to front over the background.
+    GLuint phaseTable = *volumeCopy;  // bound to the unused binding unless the phase is Mie
+    if (params.setup.phase.kind == PhaseKind::Mie) phaseTable = MiePhaseTable(state.phaseTable, state.mieUploaded);
+    const GLuint blockBuffer = ScratchBuffer(state.block, sizeof block);
+    f.NamedBufferSubData(blockBuffer, 0, sizeof block, &block);
+    const GLuint orderBuffer = ScratchBuffer(state.order, order.size() * 4);
+    f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(order.size() * 4), order.data());
+    const GLuint target = Scratch(state.target, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));
+    CB_TRY(BindTargets({{target, -1}}));
+    const LayersSetup& s = params.setup;
+    const float background[4] = {s.background[0], s.background[1], s.background[2], 1};
+    f.ClearNamedFramebufferfv(mContext->Framebuffer(), GL_COLOR, 0, background);
+    f.UseProgram(*layersProgram);
+    f.BindBufferBase(GL_UNIFORM_BUFFER, 0, blockBuffer);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, orderBuffer);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, *volumeCopy);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, phaseTable);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, counters);
+    f.Enable(GL_BLEND);
+    f.BlendEquation(GL_FUNC_ADD);
+    f.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    f.Viewport(0, 0, GLsizei(W), GLsizei(H));
+    f.Enable(GL_CLIP_DISTANCE0);
+    Draw(GL_TRIANGLE_STRIP, 0, 4, GLsizei(s.count));
+    f.Disable(GL_CLIP_DISTANCE0);
+    f.Disable(GL_BLEND);
+
+    CopyTargetToImage(target, W, H, state.imageCopy, image);
+    timer.Stop();
+    if (stats) {
+        f.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        uint32_t words[4] = {};
+        WaitingRead(ReadKind::Buffer, counters, 0, 0, 0, sizeof words, words);
+        const auto wide = [&words](int n) { return uint64_t(words[2 * n]) | uint64_t(words[2 * n + 1]) << 32; };
+        *stats = {wide(0), wide(1)};
+    }
+    return mContext->Check("render_layers");
+}
+
+}  // namespace cb::gl

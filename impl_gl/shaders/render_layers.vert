@@ -1,0 +1,37 @@
+// Stage `render_layers` (SPEC 15): one mesh, a screen quad (its corners from
+// gl_VertexID, a triangle strip), drawn instanced N times; instance n is layer
+// layerOrder[n], so the layers arrive back to front (core/pipeline/LayersGpu.h
+// LayersDrawOrder). The plane is rasterised exactly: render_layers.frag meets
+// each pixel's own ray with the layer's plane, as the CPU does. The quad is cut
+// by a clip distance to the pixels whose ray climbs toward the layer (d_z of
+// the layer's sign, two pixels of margin): a layer above the eye covers the
+// sky above the horizon, one below the ground below it, so the rasteriser
+// still skips the side of the eye a layer cannot be seen on. A world-space
+// quad as large as the extent lost fragments to the near-plane clip's
+// rounding (docs/pipeline.md, "Layered renderer").
+layout(std140, binding = 0) uniform LayersBlock { LayersGpu layers; };
+layout(std430, binding = 1) readonly buffer LayersOrder { uint layerOrder[]; };
+flat out uint layerIndex;
+out float gl_ClipDistance[1];
+
+// march.glsl's fetches: the vertex stage reads no volume.
+vec2 MarchFetchQT(uint paddedIndex) { return vec2(0.0, 1.0); }
+bool MarchBrickEmpty(uint brick) { return false; }
+float MarchPhaseTableValue(uint i) { return 1.0; }
+
+void main() {
+    const uint i = layerOrder[gl_InstanceID];
+    layerIndex = i;
+    const vec2 ndc = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
+    // Window row y is the image's row y from the top (render_march.frag), so the corner's pixel coordinates are
+    // ((ndc + 1) / 2) (W, H), and its ray (MakeLayersRay, unnormalised) forward + u right + v up.
+    const float W = float(layers.image.x), H = float(layers.image.y), focal = layers.eye.w;
+    const float u = ((ndc.x + 1.0) * 0.5 * W - 0.5 * W) / focal;
+    const float v = (0.5 * H - (ndc.y + 1.0) * 0.5 * H) / focal;
+    const float dz = layers.forward.z + u * layers.right.z + v * layers.up.z;
+    const float height = LayerHeight(layers, i) - layers.eye.z;
+    const float side = height > 0.0 ? 1.0 : (height < 0.0 ? -1.0 : 0.0);
+    const float margin = 2.0 * length(vec2(layers.right.z, layers.up.z)) / focal;
+    gl_ClipDistance[0] = side == 0.0 ? -1.0 : side * dz + margin;
+    gl_Position = vec4(ndc, 0.0, 1.0);
+}

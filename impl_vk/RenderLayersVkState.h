@@ -1,0 +1,22 @@
+// The layered renderer's state on vk (RenderLayersVk.cpp).
+#pragma once
+
+#include <cstdint>
+
+#include "core/scene/Scene.h"
+#include "impl_vk/ScratchVk.h"
+
+namespace cb::vk {
+
+struct RenderLayersVkState {
+    static constexpr Stage kStage = Stage::RenderLayers;
+    BufferSlot frame;     // the constants (core/pipeline/LayersGpu.h), 192 bytes
+    BufferSlot volume;    // the padded (q_alpha, T) volume, wrapped horizontally with tiling
+    BufferSlot mieTable;  // kMieCloudTable's values, uploaded once (mieUploaded; only with phase Mie)
+    BufferSlot stats;     // the LayersStats counters, 64-bit as two words each
+    bool mieUploaded = false;
+    // The constants, the padded volume, the Mie table with phase Mie, the counters.
+    uint64_t ScratchBytes(const Scene& scene) const;
+};
+
+}  // namespace cb::vk

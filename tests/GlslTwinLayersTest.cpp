@@ -1,0 +1,150 @@
+// The GLSL twin of core/math/Layers.h (core/math/layers.glsl), run by
+// tests/twin/twin.comp with blocks from MakeLayersGpu: the pixel's ray and the
+// walk over its layers, the padded taps and the tiling's wrap, one layer's
+// fragment and the blend, the whole pixel. Bit-exact on lavapipe (no function
+// here calls the driver's exp: SegmentTransmittance is the project's own);
+// within 4 ulps on other devices, as GlslTwinTest.cpp's cases.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "core/math/Layers.h"
+#include "core/pipeline/LayersGpu.h"
+#include "tests/GlslTwinHarness.h"
+
+namespace cb {
+namespace {
+
+using test::Bits;
+using test::Compare;
+using test::Float;
+using test::Kind;
+using test::TwinPaddedQT;
+using test::Uniform;
+using test::W;
+using test::WF;
+using test::Words;
+
+constexpr uint32_t kLayersRayFn = 60, kLayersTapsFn = 61, kLayerFragmentFn = 62, kLayersPixelFn = 63;
+
+// A random layered call: a grid up to 40 x 40 x 24, a camera below, inside or above it, tiled or not, a layer
+// count from a quarter to four per voxel, an extent that cuts some rays, every phase.
+LayersParams RandomLayersParams(Pcg32& r) {
+    const Extent3 e{1 + r.Below(40), 1 + r.Below(40), 1 + r.Below(24)};
+    const float h = Uniform(r, 0.5, 100);
+    CameraSettings camera;
+    for (int a = 0; a < 3; ++a) {
+        const double extent = double(h) * (a == 0 ? e.nx : a == 1 ? e.ny : e.nz);
+        camera.eye[a] = r.Uniform(-extent, 2 * extent);
+        camera.target[a] = r.Uniform(-extent, 2 * extent);
+    }
+    camera.fovDeg = r.Uniform(20, 90);
+    camera.nearPlane = r.Uniform(0.01, 2 * h);
+    camera.farPlane = r.Below(2) ? 1e6 : r.Uniform(10 * h, 80 * h);
+    LayersParams p;
+    p.camera = MakeCameraFrame(camera, 1 + r.Below(300), 1 + r.Below(200));
+    LayersSetup& s = p.setup;
+    for (int a = 0; a < 3; ++a) s.eye[a] = p.camera.eye[a] / h;
+    s.size = {float(e.nx), float(e.ny), float(e.nz)};
+    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
+    s.voxelSize = h;
+    s.count = std::max(1u, uint32_t(e.nz * Uniform(r, 0.25, 4)));
+    s.spacing = float(double(e.nz) / s.count);
+    const float extent = Uniform(r, 2, 200);
+    s.outer2 = extent * extent;
+    s.maxLength = Uniform(r, 0.5, 30);
+    s.sigmaH = Uniform(r, 0, 2);
+    s.tiling = r.Below(2) == 1;
+    s.sun = SunDirection(r.Uniform(-0.2, 1.55), r.Uniform(0, 6.28));
+    s.sunRadiance = {Uniform(r, 0, 3), Uniform(r, 0, 3), Uniform(r, 0, 3)};
+    s.ambient = {Uniform(r, 0, 0.4), Uniform(r, 0, 0.4), Uniform(r, 0, 0.4)};
+    s.background = {Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1)};
+    const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
+    s.phase = {kinds[r.Below(4)], Uniform(r, -0.9, 0.9)};
+    return p;
+}
+
+std::vector<Words> PixelInputs(Pcg32& r, const CameraFrame& c, uint32_t layers) {
+    const uint32_t w = c.width, h = c.height;
+    std::vector<Words> in = {W({0, 0, 0}), W({w - 1, 0, layers - 1}), W({0, h - 1, 0}), W({w - 1, h - 1, layers / 2})};
+    for (int n = 0; n < 600; ++n) in.push_back(W({r.Below(w), r.Below(h), r.Below(layers)}));
+    return in;
+}
+
+auto TwinFetch = [](uint32_t i) { return TwinPaddedQT(i); };
+
+#if CLOUDBENCH_HAVE_VK
+
+using test::GlslTwin;
+
+// Test that MakeLayersRay and LayersWalkOf, the padded taps with LayersWrap and LayerHeight, LayerFragment with
+// LayersOver, and LayersPixel equal their C++ twins on random calls and pixels, corners included; and that the
+// cases reach both outcomes of a fragment (drawn and not).
+TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
+    Pcg32 rng(0x1a7e);
+    const uint32_t ulps = sExact ? 0 : 4;
+    uint32_t drawn = 0, fragments = 0;
+    for (int call = 0; call < 24; ++call) {
+        const LayersParams p = RandomLayersParams(rng);
+        const LayersSetup& s = p.setup;
+        const LayersGpu g = MakeLayersGpu(p);
+        const std::vector<Words> pixels = PixelInputs(rng, p.camera, s.count);
+        std::vector<Kind> rayKinds(5, Kind::F);
+        rayKinds.insert(rayKinds.end(), {Kind::I, Kind::I, Kind::U});
+        Compare("MakeLayersRay", rayKinds, ulps, pixels, Run(kLayersRayFn, pixels, {}, {}, g),
+                [&](const Words& in, Words& out) {
+                    const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
+                    const LayersWalk w = LayersWalkOf(s, r.dir[2]);
+                    out = W({Bits(r.dir[0]), Bits(r.dir[1]), Bits(r.dir[2]), Bits(r.tNear), Bits(r.tFar),
+                             uint32_t(w.first), uint32_t(w.step), w.count});
+                });
+        std::vector<Words> points;
+        for (int n = 0; n < 600; ++n) {
+            const float x = Uniform(rng, -3 * s.size[0], 3 * s.size[0]);
+            const float nx = s.size[0];
+            points.push_back(WF({Uniform(rng, -1, s.size[0] + 1), Uniform(rng, -1, s.size[1] + 1),
+                                 Uniform(rng, -1, s.size[2] + 1), x, nx, s.invSize[0]}));
+            points.back()[6] = rng.Below(s.count);
+        }
+        std::vector<Kind> tapKinds = {Kind::U, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F};
+        Compare("LayersTaps", tapKinds, ulps, points, Run(kLayersTapsFn, points, {}, {}, g),
+                [&](const Words& in, Words& out) {
+                    const LayersTaps t = LayersTapsAt(s.size, {Float(in[0]), Float(in[1]), Float(in[2])});
+                    const auto qt = LayersBlend(s.size, t, TwinFetch);
+                    out = W({t.base, Bits(t.wx), Bits(t.wy), Bits(t.wz), Bits(qt[0]), Bits(qt[1]),
+                             Bits(LayersWrap(Float(in[3]), Float(in[4]), Float(in[5]))), Bits(LayerHeight(s, in[6]))});
+                });
+        std::vector<Words> fragmentsIn = pixels;
+        for (Words& w : fragmentsIn) {
+            w[3] = Bits(Uniform(rng, 0, 1)), w[4] = Bits(Uniform(rng, 0, 1)), w[5] = Bits(Uniform(rng, 0, 1));
+        }
+        std::vector<Kind> fragmentKinds = {Kind::U, Kind::U};
+        fragmentKinds.insert(fragmentKinds.end(), 8, Kind::F);
+        Compare("LayerFragment", fragmentKinds, ulps, fragmentsIn, Run(kLayerFragmentFn, fragmentsIn, {}, {}, g),
+                [&](const Words& in, Words& out) {
+                    const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
+                    const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, r.dir));
+                    const LayerFragmentResult f = LayerFragment(s, r, sunPhase, in[2], TwinFetch);
+                    const Vec3 over = LayersOver({Float(in[3]), Float(in[4]), Float(in[5])}, f.alpha, f.color);
+                    out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]), Bits(f.color[1]),
+                             Bits(f.color[2]), Bits(sunPhase), Bits(over[0]), Bits(over[1]), Bits(over[2])});
+                    drawn += f.drawn ? 1 : 0;
+                });
+        const std::vector<Kind> pixelKinds = {Kind::F, Kind::F, Kind::F, Kind::U, Kind::U};
+        Compare("LayersPixel", pixelKinds, ulps, pixels, Run(kLayersPixelFn, pixels, {}, {}, g),
+                [&](const Words& in, Words& out) {
+                    const LayersPixelResult r =
+                        LayersPixel(s, MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]), TwinFetch);
+                    out = W({Bits(r.color[0]), Bits(r.color[1]), Bits(r.color[2]), r.fragments, r.drawn});
+                    fragments += r.fragments;
+                });
+    }
+    // Both outcomes are well represented: fragments drawn, and pixels whose rays cross layers.
+    EXPECT_GT(drawn, 500u);
+    EXPECT_GT(fragments, 5000u);
+}
+
+#endif  // CLOUDBENCH_HAVE_VK
+
+}  // namespace
+}  // namespace cb

@@ -1,0 +1,33 @@
+# render_layers through the CLI: `run` writes its frames and counters, and it conforms on every built backend
+# through `cloudbench conform` (SPEC 8's image rule; exit 5 on a failure), with the Khronos validation layer on
+# (any message fails the test, as does a backend that skips the stage). Included from tests/CMakeLists.txt where
+# `cli` and `cli_out` are set; march_backends comes from march_conform.cmake.
+set(layers_cases
+    # The shipped small scene: tiled, 8 layers, the eye below, inside and above the layer.
+    "Small|layers-small"
+    # Not tiled, half and twice the layers, a short l_max, the Mie phase, an odd grid and image.
+    "UntiledHalfLayersMie|layers-small|--set|grid.tiling=false|--set|layers.count=4|--set|phase.function=\"mie\"|--set|grid.size=[31,29,9]|--set|render.width=67|--set|render.height=45"
+    "TwiceLayersShortPathCornetteShanks|layers-small|--set|layers.count=16|--set|layers.max_length=1.5|--set|phase.function=\"cornette-shanks\"|--set|layers.extent=6000")
+foreach(entry ${layers_cases})
+  string(REPLACE "|" ";" fields "${entry}")
+  list(POP_FRONT fields name scene)
+  add_test(NAME Cli.ConformLayers${name}
+           COMMAND ${CMAKE_COMMAND} -E env CLOUDBENCH_VK_VALIDATION=1
+                   ${cli} conform ${scene} --backend ${march_backends} --out ${cli_out}/conform-layers-${name} ${fields})
+  set_tests_properties(Cli.ConformLayers${name} PROPERTIES
+                       FAIL_REGULAR_EXPRESSION "vk validation|render_layers +(vk|gl) +(fail|skipped)")
+endforeach()
+# `run` writes each camera's frame as EXR and PNG and the counters in results.json's layers_frames.
+set(cli_layers_script [=[d="$1"; rm -rf "$d"; set -e
+"$0" run layers-small --backend cpu --quiet --out "$d" >/dev/null
+for c in below inside above; do test -s "$d/frame-layers-$c-cpu.png" && test -s "$d/frame-layers-$c-cpu.exr"; done
+/usr/bin/python3 - "$d" <<'PY'
+import json, sys
+frames = json.load(open(sys.argv[1] + "/results.json"))["backends"]["cpu"]["layers_frames"]
+for camera in ("below", "inside", "above"):
+    f = frames[camera]
+    assert 0 < f["drawn"][-1] <= f["fragments"][-1], (camera, f)
+print("frames and counters")
+PY]=])
+add_test(NAME Cli.LayersRunWritesFrames COMMAND /bin/sh -c "${cli_layers_script}" ${cli} ${cli_out}/layers-run)
+set_tests_properties(Cli.LayersRunWritesFrames PROPERTIES TIMEOUT 120 PASS_REGULAR_EXPRESSION "frames and counters")
