@@ -55,6 +55,7 @@ LayersParams RandomLayersParams(Pcg32& r) {
     s.maxLength = Uniform(r, 0.5, 30);
     s.sigmaH = Uniform(r, 0, 2);
     s.tiling = r.Below(2) == 1;
+    s.drift = {Uniform(r, -2, 2) * s.size[0], Uniform(r, -2, 2) * s.size[1]};
     s.sun = SunDirection(r.Uniform(-0.2, 1.55), r.Uniform(0, 6.28));
     s.sunRadiance = {Uniform(r, 0, 3), Uniform(r, 0, 3), Uniform(r, 0, 3)};
     s.ambient = {Uniform(r, 0, 0.4), Uniform(r, 0, 0.4), Uniform(r, 0, 0.4)};

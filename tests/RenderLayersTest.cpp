@@ -183,6 +183,36 @@ TEST_P(RenderLayersAll, HomogeneousLayerIsTheSlabsClosedForm) {
         }
 }
 
+// Test Wang, Ji and Zhang's wind (eq. 18) on every backend: with tiling, a drift of whole voxels (3, -2) gives the
+// image of the volume rolled by those voxels without drift, to float rounding of the shifted coordinates.
+TEST_P(RenderLayersAll, WindDriftIsTheVolumeRolledDownwind) {
+    const Extent3 e{12, 10, 6};
+    for (const auto& eye : Eyes(e)) {
+        LayersCase drifted = BlobLayers(e);
+        drifted.params = CameraLayers(e, eye, {0.5 * e.nx, 0.6 * e.ny, 0.5 * e.nz}, 40, 30, 6, true);
+        drifted.params.setup.drift = {3.0f, -2.0f};
+        LayersCase rolled = drifted;
+        rolled.params.setup.drift = {0.0f, 0.0f};
+        auto roll = [&](const std::vector<float>& v) {
+            std::vector<float> out(v.size());
+            for (uint32_t k = 0; k < e.nz; ++k)
+                for (uint32_t j = 0; j < e.ny; ++j)
+                    for (uint32_t i = 0; i < e.nx; ++i)
+                        out[(i + 3) % e.nx + e.nx * ((j + e.ny - 2) % e.ny + size_t(e.ny) * k)] =
+                            v[i + e.nx * (j + size_t(e.ny) * k)];
+            return out;
+        };
+        rolled.qPrev = roll(drifted.qPrev), rolled.qCur = roll(drifted.qCur), rolled.T = roll(drifted.T);
+        const LayersImage a = RenderLayersOn(*mBackend, drifted), b = RenderLayersOn(*mBackend, rolled);
+        ASSERT_TRUE(a.ok && b.ok);
+        double worst = 0;
+        for (size_t i = 0; i < a.rgb.size(); ++i) worst = std::max(worst, double(std::fabs(a.rgb[i] - b.rgb[i])));
+        EXPECT_LT(worst, 1e-5) << "eye z " << eye[2];
+        EXPECT_EQ(a.stats.drawn, b.stats.drawn);
+        EXPECT_GT(a.stats.drawn, 0u);
+    }
+}
+
 // The independent path of SPEC 15's last rule: a front-to-back march over the ray's crossings of the layer
 // planes, t_i = (z_i - z_eye) / d_z with segment l = min(spacing / |d_z|, l_max), L += T_view (1 - tau) c,
 // T_view *= tau, sampled by TrilinearSample of core/math/March.h with the taps wrapped by the test itself.
@@ -214,7 +244,7 @@ Vec3 LayerPlaneMarch(const LayersCase& c, uint32_t x, uint32_t y) {
     std::sort(crossings.begin(), crossings.end());
     double L[3] = {0, 0, 0}, Tv = 1;
     for (const auto& [t, i] : crossings) {
-        double px = s.eye[0] + ray.dir[0] * t, py = s.eye[1] + ray.dir[1] * t;
+        double px = s.eye[0] + ray.dir[0] * t - s.drift[0], py = s.eye[1] + ray.dir[1] * t - s.drift[1];
         if (!s.tiling && (px < 0 || px > e.nx || py < 0 || py > e.ny)) continue;
         if (s.tiling) {
             px -= e.nx * std::floor(px / e.nx);
@@ -243,6 +273,7 @@ TEST(RenderLayersCpu, EqualsAMarchAtTheLayerPlanes) {
                 LayersCase c = BlobLayers(e);
                 c.params = CameraLayers(e, eye, {0.5 * e.nx, 0.6 * e.ny, 0.5 * e.nz}, 48, 36, count, tiling);
                 c.params.setup.maxLength = 3.0f;
+                if (count == 3) c.params.setup.drift = {2.3f, -1.7f};
                 const LayersImage im = RenderLayersOn(cpu, c);
                 ASSERT_TRUE(im.ok);
                 double worst = 0;
@@ -278,6 +309,7 @@ TEST_P(RenderLayersGpu, MatchesTheCpu) {
                 c.params = CameraLayers(e, eye, {0.5 * e.nx, 0.6 * e.ny, 0.5 * e.nz}, 37, 29, count, tiling);
                 c.params.setup.phase = phases[n++ % 4];
                 if (count == 4) c.params.setup.maxLength = 2.5f;
+                if (count == 15) c.params.setup.drift = {1.37f, -0.61f};
                 const LayersImage want = RenderLayersOn(cpu, c);
                 const LayersImage got = RenderLayersOn(*mBackend, c);
                 ASSERT_TRUE(want.ok && got.ok);

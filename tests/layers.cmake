@@ -7,7 +7,9 @@ set(layers_cases
     "Small|layers-small"
     # Not tiled, half and twice the layers, a short l_max, the Mie phase, an odd grid and image.
     "UntiledHalfLayersMie|layers-small|--set|grid.tiling=false|--set|layers.count=4|--set|phase.function=\"mie\"|--set|grid.size=[31,29,9]|--set|render.width=67|--set|render.height=45"
-    "TwiceLayersShortPathCornetteShanks|layers-small|--set|layers.count=16|--set|layers.max_length=1.5|--set|phase.function=\"cornette-shanks\"|--set|layers.extent=6000")
+    "TwiceLayersShortPathCornetteShanks|layers-small|--set|layers.count=16|--set|layers.max_length=1.5|--set|phase.function=\"cornette-shanks\"|--set|layers.extent=6000"
+    # The wind's drift (eq. 18) over three steps, with alpha interpolating between them.
+    "WindThreeSteps|layers-small|--steps|3|--set|layers.wind=[170,-45]|--set|render.alpha=0.4")
 foreach(entry ${layers_cases})
   string(REPLACE "|" ";" fields "${entry}")
   list(POP_FRONT fields name scene)

@@ -29,6 +29,9 @@ struct LayersSetup {
     float maxLength = 1;    // l_max, voxel edges: the most path one fragment stands for
     float sigmaH = 1;       // sigma h (MarchOpticalDepthPerVoxel)
     bool tiling = false;    // the volume repeats in x and y; else a fragment outside the box is empty
+    // The wind's drift of the volume's coordinates (Wang, Ji and Zhang, eq. 18), voxel units: a fragment at
+    // (x, y) reads the volume at (x - drift x, y - drift y). With tiling reduced into [0, n) on the host.
+    std::array<float, 2> drift{0, 0};
     Vec3 sun{0, 0, 1};      // unit, toward the sun
     Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
     PhaseParams phase;
@@ -118,7 +121,7 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
     const float hx = ray.dir[0] * t, hy = ray.dir[1] * t;
     if (!(hx * hx + hy * hy <= s.outer2)) return f;
-    float x = s.eye[0] + hx, y = s.eye[1] + hy;
+    float x = (s.eye[0] + hx) - s.drift[0], y = (s.eye[1] + hy) - s.drift[1];
     if (s.tiling) {
         x = LayersWrap(x, s.size[0], s.invSize[0]);
         y = LayersWrap(y, s.size[1], s.invSize[1]);

@@ -25,6 +25,7 @@ struct LayersGpu {
     vec4 background;   // rgb; w l_max
     uvec4 image;       // width, height, N, flags
     uvec4 phase;       // kind, Mie count, px, px * py
+    vec4 drift;        // xy the wind's drift (voxel units)
 };
 
 const uint kLayersTiling = 1u;
@@ -80,7 +81,7 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     precise float hx = ray.dir.x * t, hy = ray.dir.y * t;
     precise float r2 = hx * hx + hy * hy;
     if (!(r2 <= s.sunRadiance.w)) return f;
-    precise float x = s.eye.x + hx, y = s.eye.y + hy;
+    precise float x = (s.eye.x + hx) - s.drift.x, y = (s.eye.y + hy) - s.drift.y;
     if ((s.image.w & kLayersTiling) != 0u) {
         x = LayersWrap(x, s.size.x, s.invSize.x);
         y = LayersWrap(y, s.size.y, s.invSize.y);

@@ -30,8 +30,9 @@ struct LayersGpu {
     std::array<float, 4> background;   // rgb; w: l_max (voxel edges)
     std::array<uint32_t, 4> image;     // width, height, N, LayersGpuFlag bits
     std::array<uint32_t, 4> phase;     // PhaseKind, the Mie table's count, padded strides px, px * py
+    std::array<float, 4> drift;        // xy: the wind's drift (voxel units); zw: unused
 };
-static_assert(sizeof(LayersGpu) == 12 * 16, "LayersGpu is twelve 16-byte rows");
+static_assert(sizeof(LayersGpu) == 13 * 16, "LayersGpu is thirteen 16-byte rows");
 
 LayersGpu MakeLayersGpu(const LayersParams& params);
 

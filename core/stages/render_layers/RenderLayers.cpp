@@ -1,6 +1,7 @@
 #include "core/stages/render_layers/RenderLayers.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <string_view>
 
@@ -9,7 +10,7 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLayersKeys[] = {"count", "extent", "max_length", "exposure", "tone_map"};
+constexpr std::string_view kLayersKeys[] = {"count", "extent", "max_length", "wind", "exposure", "tone_map"};
 
 // At most this many layers per voxel edge of height: SPEC 15 measures up to 4; more only multiplies the work.
 constexpr uint32_t kMaxLayersPerVoxel = 16;
@@ -30,6 +31,9 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
     }
     if (const Json* v = find("max_length")) {
         if (auto d = check.Number(*v, "layers.max_length", kSinglePositive)) layers.maxLength = *d;
+    }
+    if (const Json* v = find("wind")) {
+        if (auto a = check.Numbers<2>(*v, "layers.wind", Range{.lo = -1e6, .hi = 1e6})) layers.wind = *a;
     }
     if (const Json* v = find("exposure")) {
         if (auto d = check.Number(*v, "layers.exposure", kSinglePositive)) layers.exposure = *d;
@@ -58,6 +62,7 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
     const float h = float(sc.grid.voxelSize);
     p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
+    p.alpha = sc.render.FrameAlpha(frame, frames);
     LayersSetup& s = p.setup;
     const Extent3 e = sc.grid.size;
     for (int a = 0; a < 3; ++a) s.eye[a] = (p.camera.eye[a] - p.origin[a]) / h;
@@ -71,12 +76,20 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     s.maxLength = float(sc.layers.maxLength > 0 ? sc.layers.maxLength : double(e.nz));
     s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
     s.tiling = sc.grid.tiling;
+    // The drift at the frame's time, in double on the host; with tiling reduced modulo the period, so the
+    // per-fragment float stays within a tile of the eye whatever the step.
+    const double time = double(step) - 1.0 + double(p.alpha);
+    for (int a = 0; a < 2; ++a) {
+        double d = time * sc.layers.wind[a] / sc.grid.voxelSize;
+        const double n = a == 0 ? e.nx : e.ny;
+        if (s.tiling) d -= n * std::floor(d / n);
+        s.drift[a] = float(d);
+    }
     s.sun = sc.sun.DirectionAt(step);
     s.sunRadiance = sc.sun.Radiance();
     s.ambient = sc.lighting.Ambient();
     s.background = sc.lighting.Background();
     s.phase = sc.phase;
-    p.alpha = sc.render.FrameAlpha(frame, frames);
     return p;
 }
 

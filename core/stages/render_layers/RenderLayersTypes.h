@@ -21,6 +21,9 @@ struct LayersSettings {
     double extent = 0;      // metres, the layers' horizontal radius around the eye; 0: each camera's far plane
     double maxLength = 0;   // l_max, voxel edges; 0: the grid's nz (a fragment stands for at most the slab seen
                             // straight through)
+    // The wind (Wang, Ji and Zhang, eq. 18): the clouds drift by this many metres per step in x and y, at the
+    // frame's time step - 1 + alpha (as q's interpolation).
+    std::array<double, 2> wind{0, 0};
     double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
     bool toneMap = true;    // PNG only; false: clamp(exposure C)
 };
