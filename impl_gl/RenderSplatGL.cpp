@@ -8,7 +8,9 @@
 namespace cb::gl {
 
 uint64_t RenderSplatGLState::ScratchBytes(const Scene& scene) const {
-    return uint64_t(scene.render.width) * scene.render.height * 16;
+    uint64_t bytes = uint64_t(scene.render.width) * scene.render.height * 16;
+    if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    return bytes;
 }
 
 // render_splat: GL_POINTS in the shared order, one vertex per voxel; culling
@@ -17,9 +19,6 @@ uint64_t RenderSplatGLState::ScratchBytes(const Scene& scene) const {
 // read into a pixel buffer and one upload from it give the canonical (3, W, H) image.
 Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
     RenderSplatGLState& state = mStages.Get<RenderSplatGLState>();
-    // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
-    if (p.phase.kind == PhaseKind::Mie)
-        return MakeError("gl does not implement phase 'mie' in render_splat yet (issue 14)");
     if (!p.order || !in.qPrev || !in.qCur || !in.T)
         return MakeError("gl: render_splat needs q (both steps), T and an order");
     if (image.Extent().nx != 3) return MakeError("gl: render_splat image must have extent (3, width, height)");
@@ -126,6 +125,10 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, orderBuffer);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counters);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, frameBuffer);
+    // splat.vert's phase table: kMieCloudTable with phase Mie; else the frame stands in, unread.
+    const GLuint phaseTable =
+        p.phase.kind == PhaseKind::Mie ? MiePhaseTable(state.phaseTable, state.mieUploaded) : frameBuffer;
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, phaseTable);
     f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());
     f.BindTextureUnit(2, Tex(*in.T).Texture());

@@ -16,7 +16,9 @@ struct RenderSplatGLState {
     BufferSlot counters;   // the shader's counters (splats drawn), outside a batch
     BufferSlot imageCopy;  // the pixel buffer the image passes through
     BufferSlot ground;     // with the ground: the GroundGpu block (core/math/Ground.h)
-    // target.
+    BufferSlot phaseTable;  // phase mie: kMieCloudTable's values, uploaded once (mieUploaded)
+    bool mieUploaded = false;
+    // target; with phase mie the table.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -59,6 +59,10 @@ Result<DeviceBuffer*> BackendVk::ScratchHolding(BufferSlot& slot, std::span<cons
     return b;
 }
 
+Result<DeviceBuffer*> BackendVk::MiePhaseTable(BufferSlot& slot) {
+    return ScratchHolding(slot, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count)), 0);
+}
+
 Result<std::unique_ptr<Buffer>> BackendVk::CreateBuffer(BufferFormat format, Extent3 extent) {
     if (extent.Count() == 0) return MakeError("vk: cannot create an empty buffer");
     auto device = mContext->CreateBuffer(DeviceBytes(format, extent));

@@ -117,6 +117,9 @@ class BackendVk final : public Backend {
     // slots the host writes and no shader does (the shares of a stage upload
     // the same list once).
     Result<DeviceBuffer*> ScratchHolding(BufferSlot& slot, std::span<const std::byte> bytes, VkDeviceSize minSize);
+    // The slot's buffer holding kMieCloudTable's values (uploaded once, by ScratchHolding): the phase_table.glsl
+    // table of the renderers with phase Mie.
+    Result<DeviceBuffer*> MiePhaseTable(BufferSlot& slot);
 
     std::unique_ptr<VulkanContext> mContext;
     StagesVk mStages;  // after mContext: their buffers are destroyed before it

@@ -49,13 +49,9 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
     if (!statsBuffer) return std::unexpected(statsBuffer.error());
     const DeviceBuffer* table = *frameBuffer;  // unread without phase Mie; a binding needs a buffer
     if (params.setup.phase.kind == PhaseKind::Mie) {
-        if (!state.mieUploaded) {
-            auto t = Scratch(state.mieTable, VkDeviceSize(kMieCloudTable.count) * 4);
-            if (!t) return std::unexpected(t.error());
-            CB_TRY(mContext->Upload(**t, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
-            state.mieUploaded = true;
-        }
-        table = &state.mieTable.buffer;
+        auto t = MiePhaseTable(state.mieTable);
+        if (!t) return std::unexpected(t.error());
+        table = *t;
     }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
 

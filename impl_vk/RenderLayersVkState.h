@@ -12,9 +12,8 @@ struct RenderLayersVkState {
     static constexpr Stage kStage = Stage::RenderLayers;
     BufferSlot frame;     // the constants (core/pipeline/LayersGpu.h), 208 bytes
     BufferSlot volume;    // the padded (q_alpha, T) volume, wrapped horizontally with tiling
-    BufferSlot mieTable;  // kMieCloudTable's values, uploaded once (mieUploaded; only with phase Mie)
+    BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
     BufferSlot stats;     // the LayersStats counters, 64-bit as two words each
-    bool mieUploaded = false;
     // The constants, the padded volume, the Mie table with phase Mie, the counters.
     uint64_t ScratchBytes(const Scene& scene) const;
 };

@@ -84,13 +84,9 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     }
     const DeviceBuffer* table = *frameBuffer;
     if (mie) {
-        if (!state.mieUploaded) {
-            auto t = Scratch(state.mieTable, VkDeviceSize(kMieCloudTable.count) * 4);
-            if (!t) return std::unexpected(t.error());
-            CB_TRY(mContext->Upload(**t, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
-            state.mieUploaded = true;
-        }
-        table = &state.mieTable.buffer;
+        auto t = MiePhaseTable(state.mieTable);
+        if (!t) return std::unexpected(t.error());
+        table = *t;
     }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
     // The ground's block and G (flag kMarchGpuGround); without the ground, the frame stands in, unread.

@@ -16,10 +16,9 @@ struct RenderMarchVkState {
     BufferSlot frame;     // the constants (core/pipeline/MarchGpu.h), 256 bytes
     BufferSlot volume;    // the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha
     BufferSlot bricks;    // one word per brick, 1 iff empty (only with skipping)
-    BufferSlot mieTable;  // kMieCloudTable's values, uploaded once (mieUploaded; only with phase Mie)
+    BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
     BufferSlot stats;     // the MarchStats counters, 64-bit as two words each
     BufferSlot ground;    // with the ground: the GroundGpu block (core/math/Ground.h)
-    bool mieUploaded = false;
     // The constants, the padded volume, a word per brick with skipping, the
     // Mie table with phase Mie, the counters.
     uint64_t ScratchBytes(const Scene& scene) const;

@@ -44,9 +44,6 @@ std::vector<RankPart> MakeRankParts(const SplatFrame& F, const FlatSplatOrder& f
 
 Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& image, SplatStats* stats) {
     RenderSplatVkState& state = mStages.Get<RenderSplatVkState>();
-    // The GLSL PhaseValue has no table yet: refuse rather than draw with another phase.
-    if (p.phase.kind == PhaseKind::Mie)
-        return MakeError("vk does not implement phase 'mie' in render_splat yet (issue 14)");
     if (!p.order || !in.qPrev || !in.qCur || !in.T)
         return MakeError("vk: render_splat needs q (both steps), T and an order");
     const Extent3 e = in.qCur->Extent();
@@ -121,7 +118,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     Pipeline* pipes[kPipes] = {};
     const char* names[kPipes] = {"splat_count",  "scan",           "splat_write",    "splat_pairs",
                                  "radix_sort",   "splat_ranges",   "splat_composite", "splat_boxes"};
-    const uint32_t bindings[kPipes] = {10, 3, 10, 4, 5, 2, 6, 3};
+    const uint32_t bindings[kPipes] = {11, 3, 11, 4, 5, 2, 6, 3};
     for (int n = 0; n < kPipes; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -129,6 +126,13 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     }
     const DeviceBuffer* common[6] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T),
                                      scratch.rankParts, scratch.boxes, scratch.frame};
+    // splat_ranks.glsl's phase table: kMieCloudTable with phase Mie; else the frame stands in, unread.
+    const DeviceBuffer* phaseTable = scratch.frame;
+    if (p.phase.kind == PhaseKind::Mie) {
+        auto t = MiePhaseTable(state.mieTable);
+        if (!t) return std::unexpected(t.error());
+        phaseTable = *t;
+    }
     double deviceMs = 0;
     auto run = [&](const char* what, auto&& record) -> Status {
         CB_TRY(Record(what, record));
@@ -141,9 +145,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     // 1. Splats and (screen tile, splat) pairs per chunk of ranks, their offsets,
     //    and both totals, which size everything after: the one host wait.
     SplatChunksPush chunkPush{chunks, kTileSize};
-    const DeviceBuffer* countBuffers[] = {common[0],           common[1],          common[2],          common[3],
-                                          common[4],           common[5],          scratch.chunkSplats, scratch.chunkPairs,
-                                          scratch.candidates, scratch.totals};
+    const DeviceBuffer* countBuffers[] = {common[0],          common[1],      common[2],           common[3],
+                                          common[4],          common[5],      scratch.chunkSplats, scratch.chunkPairs,
+                                          scratch.candidates, scratch.totals, phaseTable};
     const SplatBoxesPush boxPush{CeilDiv(uint32_t(boxes.size()), 4)};
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
@@ -192,10 +196,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     CB_TRY(need(scratch.tileBases, state.tileBases, VkDeviceSize(screenTiles + 1) * 4));
     const uint32_t longestScan = std::max({chunks, splatCount, sortPlan.CountEntries()});
     CB_TRY(need(scratch.scanSums, state.scanSums, VkDeviceSize(ScanSumsEntries(longestScan)) * 4));
-    const DeviceBuffer* writeBuffers[] = {common[0],            common[1],      common[2],
-                                          common[3],            common[4],      common[5],
-                                          scratch.chunkOffsets, scratch.splats, scratch.splatTiles,
-                                          scratch.candidates};
+    const DeviceBuffer* writeBuffers[] = {
+        common[0],      common[1],          common[2],          common[3], common[4], common[5], scratch.chunkOffsets,
+        scratch.splats, scratch.splatTiles, scratch.candidates, phaseTable};
     SplatPairsPush pairPush{splatCount, tilesX, kTileSize};
     const DeviceBuffer* pairBuffers[] = {scratch.splats, scratch.pairOffsets, scratch.keys[0], scratch.values[0]};
     // One invocation per splat, in rows of kRowGroups workgroups (splat_tiles.glsl LinearInvocation).

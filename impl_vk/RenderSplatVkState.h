@@ -29,8 +29,11 @@ struct RenderSplatVkState {
     BufferSlot tileBases;    // the first sorted pair of each screen tile, and the pairs
     BufferSlot scanSums;     // the block sums of its scans (scan.comp)
     BufferSlot ground;       // with the ground: the GroundGpu block (core/math/Ground.h)
-    // The lists depend on the clouds: not counted.
-    uint64_t ScratchBytes(const Scene&) const { return 0; }
+    BufferSlot mieTable;     // with phase Mie: kMieCloudTable's values (MiePhaseTable)
+    // The Mie table with phase Mie; the lists depend on the clouds: not counted.
+    uint64_t ScratchBytes(const Scene& scene) const {
+        return scene.phase.kind == PhaseKind::Mie ? uint64_t(kMieCloudTable.count) * 4 : 0;
+    }
 };
 
 }  // namespace cb::vk

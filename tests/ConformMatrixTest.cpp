@@ -49,8 +49,7 @@ TEST(ConformMatrix, CiSmallCasesByHand) {
         // henyey-greenstein with scattering is the case above, under its own name.
         "phase.function=none+shade.scattering.enabled=true",
         "phase.function=cornette-shanks+shade.scattering.enabled=true",
-        "phase.function=mie+shade.scattering.enabled=true+"
-        "stages=[\"region\",\"ca\",\"smooth\",\"density\",\"shade\",\"shadow\"]",
+        "phase.function=mie+shade.scattering.enabled=true",
         "shadow.form=thesis",
         "shadow.form=wang",
         "render.culling=false",
@@ -104,16 +103,14 @@ TEST(ConformMatrix, EveryValueCoveredAndEveryCaseLoads) {
         EXPECT_TRUE(covered([](const Scene& s) { return s.shade.storage; }, e.value)) << e.name;
     for (const auto& e : kShadowFormNames)
         EXPECT_TRUE(covered([](const Scene& s) { return s.shadow.form; }, e.value)) << e.name;
-    // Every phase function reaches shade (with scattering on); all but mie reach render_splat too.
+    // Every phase function reaches shade (with scattering on) and render_splat.
     for (const auto& e : kPhaseKindNames) {
         EXPECT_TRUE(std::ranges::any_of(scenes, [&](const Scene& s) {
             return s.phase.kind == e.value && s.shade.scattering && s.stages.Has(Stage::Shade);
         })) << e.name;
-        if (e.value != PhaseKind::Mie) {
-            EXPECT_TRUE(std::ranges::any_of(scenes, [&](const Scene& s) {
-                return s.phase.kind == e.value && s.stages.Has(Stage::RenderSplat);
-            })) << e.name;
-        }
+        EXPECT_TRUE(std::ranges::any_of(scenes, [&](const Scene& s) {
+            return s.phase.kind == e.value && s.stages.Has(Stage::RenderSplat);
+        })) << e.name;
     }
     for (bool b : {false, true}) {
         EXPECT_TRUE(covered([](const Scene& s) { return s.shade.scattering; }, b));
@@ -124,20 +121,16 @@ TEST(ConformMatrix, EveryValueCoveredAndEveryCaseLoads) {
     for (int w : {0, 1, 2})
         EXPECT_TRUE(covered([](const Scene& s) { return PrincipalAxis(s.sun.Direction()); }, w)) << w;
     // One option at a time: one override a case, but two for the sun's angles, and the phase's
-    // scattering (and stages for mie) that let shade see it; none for gl's layout.
+    // scattering that lets shade see it; none for gl's layout.
     for (size_t k = 1; k < cases.size(); ++k) {
         const std::string& n = cases[k].name;
-        const size_t want = cases[k].glCaLayout                   ? 0
-                            : n.starts_with("sun.")               ? 2
-                            : n.starts_with("phase.function=mie") ? 3
-                            : n.starts_with("phase.")             ? 2
-                                                                  : 1;
+        const size_t want = cases[k].glCaLayout ? 0 : n.starts_with("sun.") ? 2 : n.starts_with("phase.") ? 2 : 1;
         EXPECT_EQ(cases[k].overrides.size(), want) << n;
     }
 }
 
 // Test that a case equal to the scene is dropped, and only the stages the scene runs get cases:
-// without shade, the phase reaches render_splat alone (no scattering override, no mie).
+// without shade, the phase reaches render_splat alone (no scattering override).
 TEST(ConformMatrix, OnlyWhatTheSceneRuns) {
     Scene scene = MatrixTestCiSmall();
     scene.stages = StageSet{Stage::Region, Stage::Ca, Stage::Smooth, Stage::Density, Stage::RenderSplat};
@@ -151,6 +144,7 @@ TEST(ConformMatrix, OnlyWhatTheSceneRuns) {
         "smooth.radius=1",
         "phase.function=none",
         "phase.function=henyey-greenstein",
+        "phase.function=mie",
         "render.culling=true",
         "render.skipping=false",
         "ca.wind_shift=[]",

@@ -96,7 +96,8 @@ TEST_P(Conformance, Shadow) {
 }
 
 // Test the splat renderer from four cameras (outside, inside, straight down,
-// partly out of view) with culling and skipping on, the last two cameras over
+// partly out of view), each with its own phase function (HG, Mie, Cornette-Shanks,
+// Mie), with culling and skipping on, the last two cameras over
 // the ground lit through a G (core/math/Ground.h): per channel |d| <= 2/255
 // on 99.9 % of pixels and <= 8/255 everywhere (SPEC 8). A failure writes the
 // difference image and names the worst pixel.
@@ -125,6 +126,11 @@ TEST_P(Conformance, RenderSplat) {
     cameras[3].eye = {-cx * 2, cy, cz};
     cameras[3].target = {cx * 4, cy * 3, cz};
     const uint32_t W = 96, H = 72;
+    // A phase function per camera, so that every PhaseKind is drawn (Mie through phase_table.glsl's table).
+    const PhaseParams phases[4] = {{PhaseKind::HenyeyGreenstein, 0.6f},
+                                   {PhaseKind::Mie, 0},
+                                   {PhaseKind::CornetteShanks, 0.7f},
+                                   {PhaseKind::Mie, 0}};
     Backend* backends[2] = {&mCpu, mBackend.get()};
     const DensityParams density{8, 4, {}};
     for (size_t c = 0; c < cameras.size(); ++c) {
@@ -153,6 +159,7 @@ TEST_P(Conformance, RenderSplat) {
             p.voxelSize = h;
             p.splatDiameter = 1.5f * h;
             p.sun = SunDirection(0.5, 0.8);
+            p.phase = phases[c];
             p.sunRadiance = {1.5f, 1.4f, 1.3f};
             p.ambient = {0.2f, 0.25f, 0.3f};
             p.background = {0.4f, 0.5f, 0.8f};

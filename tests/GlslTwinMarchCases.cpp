@@ -38,7 +38,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
             for (float x : AndNeighbours(float(std::cos(double(i) / perRadian))))
                 edges.push_back(W({Bits(perRadian), count, Bits(std::clamp(x, -1.0f, 1.0f))}));
         for (float x : {1.5f, -1.5f, 1.0f, -1.0f}) edges.push_back(W({Bits(perRadian), count, Bits(x)}));
-        c.push_back({"SampleMiePhase",
+        c.push_back({"SamplePhaseTable",
                      35,
                      {Kind::F},
                      [perRadian, count](Pcg32& r, Words& in) {

@@ -92,7 +92,9 @@ SplatFrame RandomSplatFrame(Pcg32& r) {
     F.eye[3] = f.nearPlane;
     F.forward[3] = f.focalPx;
     F.sun[3] = Uniform(r, -0.9, 0.9);
-    F.sunRadiance[3] = float(r.Below(3));
+    F.sunRadiance[3] = float(r.Below(4));  // every PhaseKind, Mie (3) with the table its frame names
+    F.right[3] = kMieCloudTable.indexPerRadian;
+    F.up[3] = float(kMieCloudTable.count);
     F.ambient[3] = 0.3f;
     F.background[3] = 0.6f;
     F.origin[3] = 50;
@@ -266,7 +268,7 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
     }
 }
 
-// Test issue 14 item 3: the Mie table lookup by hand (SampleMiePhase, with the
+// Test issue 14 item 3: the Mie table lookup by hand (SamplePhaseTable, with the
 // table bound as a storage buffer) equals the CPU's SamplePhaseTable(kMieCloudTable, .)
 // on 2^18 + 1 cosines evenly over [-1, 1]; the worst difference in ulps is
 // printed (0 on lavapipe: the same operations, each rounded once).

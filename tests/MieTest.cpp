@@ -29,8 +29,6 @@
 
 #include "core/math/Mie.h"
 #include "core/math/Shading.h"
-#include "core/pipeline/Backend.h"
-#include "registry/Registry.h"
 
 namespace cb {
 namespace {
@@ -365,26 +363,6 @@ TEST(MieTable, MidpointInterpolationError) {
     }
     EXPECT_LT(worst, 0.015) << "at " << worstDeg << " degrees";
     RecordProperty("midpoint_max_relative_error", std::to_string(worst) + " at " + std::to_string(worstDeg));
-}
-
-// Test that the GPU splat renderers refuse a Mie scene (their GLSL phase has no table yet) instead of
-// drawing it with another phase function.
-TEST(MieTable, GpuSplatRefusesMie) {
-    for (const char* name : {"gl", "vk"}) {
-        auto backend = CreateBackend(name);
-        if (!backend) {
-            std::printf("not available here: %s (%s)\n", name, backend.error().message.c_str());
-            continue;
-        }
-        auto image = (*backend)->CreateBuffer(BufferFormat::F32, {3, 4, 4});
-        ASSERT_TRUE(image) << image.error().message;
-        SplatParams p;
-        p.phase.kind = PhaseKind::Mie;
-        const Status s = (*backend)->RenderSplat(p, SplatInputs{}, **image, nullptr);
-        ASSERT_FALSE(s) << name;
-        EXPECT_NE(s.error().message.find("does not implement phase 'mie' in render_splat"), std::string::npos)
-            << s.error().message;
-    }
 }
 
 }  // namespace

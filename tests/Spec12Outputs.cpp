@@ -41,7 +41,7 @@ double PhaseMax(const PhaseParams& phase) {
     return std::numeric_limits<double>::infinity();
 }
 
-// The documented range of element `index` of a resource. Images (SPEC 8, 10):
+// The documented range of element `index` of a resource. Images (SPEC 8, 10, 15):
 // each pixel is a convex combination (compositing with alpha in [0, 1], or
 // T_view weights summing to 1) of the background and of colours
 // sun*T*P^ + ambient with T in [0, 1], so each channel lies between
@@ -63,7 +63,8 @@ Bounds DocumentedBounds(Resource r, const Scene& s, size_t index) {
         case Resource::T:
         case Resource::Shadow: return {0, 1};                 // SPEC 6, 7
         case Resource::SplatImage:
-        case Resource::MarchImage: {
+        case Resource::MarchImage:
+        case Resource::LayersImage: {  // SPEC 15: the same blend, from the background
             const size_t c = index % 3;
             const double sun = double(s.sun.Radiance()[c]), ambient = s.lighting.ambient[c], bg = s.lighting.background[c];
             const double lo = std::min(bg, ambient), hi = std::max(bg, sun * PhaseMax(s.phase) + ambient);

@@ -22,8 +22,8 @@ struct alignas(16) SplatFrame {
     uint32_t image[4];      // width, height, (backend), (backend)
     float eye[4];           // xyz, near plane
     float forward[4];       // xyz, focal length in pixels
-    float right[4];         // xyz, 0
-    float up[4];            // xyz, 0
+    float right[4];         // xyz, kMieCloudTable's index per radian (read with phase Mie)
+    float up[4];            // xyz, kMieCloudTable's count (likewise)
     float sun[4];           // xyz toward the sun, phase g
     float sunRadiance[4];   // rgb, phase kind
     float ambient[4];       // rgb, q_min

@@ -3,11 +3,11 @@
 // the per-pixel loop. The same operations in the same order, `precise` where
 // the CPU (built with -ffp-contract=off) rounds each product.
 //
-// Include after random.glsl, shading.glsl and march.glsl, whose pixel ray,
-// padded sampler (PaddedTapsAt, PaddedBlend), SegmentTransmittance and Mie
-// lookup it uses. The including shader defines march.glsl's MarchFetchQT as the
+// Include after random.glsl, shading.glsl, phase_table.glsl and march.glsl,
+// whose pixel ray, padded sampler (PaddedTapsAt, PaddedBlend), SegmentTransmittance
+// and phase it uses. The including shader defines march.glsl's MarchFetchQT as the
 // layers' padded (q_alpha, T) volume, (nx+2) x (ny+2) x (nz+2) with voxel
-// (i, j, k) at (i+1, j+1, k+1), and MarchPhaseTableValue (phase Mie only).
+// (i, j, k) at (i+1, j+1, k+1), and PhaseTableValue (phase Mie only).
 #ifndef CLOUDBENCH_LAYERS_GLSL
 #define CLOUDBENCH_LAYERS_GLSL
 
@@ -29,7 +29,6 @@ struct LayersGpu {
 };
 
 const uint kLayersTiling = 1u;
-const uint kLayersPhaseMie = 3u;  // PhaseKind::Mie
 
 float LayerHeight(LayersGpu s, uint i) {
     precise float z = (float(i) + 0.5) * s.invSize.w;
@@ -58,10 +57,7 @@ LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
 }
 
 // P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
-float LayersPhase(LayersGpu s, float cosTheta) {
-    if (s.phase.x == kLayersPhaseMie) return SampleMiePhase(s.ambient.w, s.phase.y, cosTheta);
-    return PhaseValue(s.phase.x, s.sun.w, cosTheta);
-}
+float LayersPhase(LayersGpu s, float cosTheta) { return PhaseOf(s.phase.x, s.sun.w, s.ambient.w, s.phase.y, cosTheta); }
 
 struct LayerFragmentResult {
     bool crossed, drawn;

@@ -4,13 +4,13 @@
 // step with the C++; the same operations in the same order, `precise` where
 // the CPU (built with -ffp-contract=off) rounds each product.
 //
-// Include after random.glsl and shading.glsl. The including shader declares
+// Include after random.glsl, shading.glsl and phase_table.glsl. The including shader declares
 // the block that holds a MarchGpu (core/pipeline/MarchGpu.h) and DEFINES:
 //   vec2  MarchFetchQT(uint paddedIndex);  // (q_alpha, T) of the padded volume:
 //         (nx+2) x (ny+2) x (nz+2), voxel (i, j, k) at padded (i+1, j+1, k+1),
 //         index i + px (j + py k); the border reads (0, 1)
 //   bool  MarchBrickEmpty(uint brick);     // bx + Bx (by + By bz); skipping only
-//   float MarchPhaseTableValue(uint i);    // kMieCloudTable.values[i]; Mie only
+//   float PhaseTableValue(uint i);         // phase_table.glsl's; Mie only
 #ifndef CLOUDBENCH_MARCH_GLSL
 #define CLOUDBENCH_MARCH_GLSL
 
@@ -41,13 +41,11 @@ const uint kMarchPointLight = 8u;
 const uint kMarchSkipping = 16u;
 const uint kMarchLightMarch = 32u;
 const uint kMarchGround = 64u;  // the background is the ground (core/math/ground.glsl), per pixel
-const uint kMarchPhaseMie = 3u;  // PhaseKind::Mie
 const uint kMarchStreamOther = 3u;
 const float kMarchFloatMax = 3.402823466e+38;
 
 vec2 MarchFetchQT(uint paddedIndex);
 bool MarchBrickEmpty(uint brick);
-float MarchPhaseTableValue(uint i);
 
 // ---- Rays ----
 
@@ -184,20 +182,8 @@ float PowderTerm(float c, float lightT) { return 1.0 - pow(max(lightT, 0.0), c);
 
 float PointLightFalloff(float distance2, float minDistance2) { return 1.0 / max(distance2, minDistance2); }
 
-// The Mie table linearly interpolated in theta (core/math/Shading.h SamplePhaseTable),
-// read by hand: hardware filtering's few fractional weight bits would break conformance.
-float SampleMiePhase(float indexPerRadian, uint count, float cosTheta) {
-    const float theta = ArcCos(clamp(cosTheta, -1.0, 1.0));
-    precise float x = clamp(theta * indexPerRadian, 0.0, float(count - 1u));
-    const uint i = min(uint(x), count - 2u);
-    return Lerp(MarchPhaseTableValue(i), MarchPhaseTableValue(i + 1u), x - float(i));
-}
-
 // P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
-float MarchPhase(MarchGpu m, float cosTheta) {
-    if (m.flags.y == kMarchPhaseMie) return SampleMiePhase(m.ambient.w, m.strides.z, cosTheta);
-    return PhaseValue(m.flags.y, m.sun.w, cosTheta);
-}
+float MarchPhase(MarchGpu m, float cosTheta) { return PhaseOf(m.flags.y, m.sun.w, m.ambient.w, m.strides.z, cosTheta); }
 
 // 1/d per component; FLT_MAX where d is (nearly) zero.
 vec3 InverseDirection(vec3 d) {

@@ -1,5 +1,6 @@
 // GLSL twin of core/math/Splat.h (SPEC 8): the frame block, the splat of a voxel,
-// a pixel's alpha. Needs shading.glsl before it. Must stay in step with the C++.
+// a pixel's alpha. Needs shading.glsl and phase_table.glsl before it (MakeSplat reads the
+// Mie table with phase Mie). Must stay in step with the C++.
 #ifndef CLOUDBENCH_SPLAT_GLSL
 #define CLOUDBENCH_SPLAT_GLSL
 
@@ -57,7 +58,7 @@ bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
     if (!SplatFinite(px) || !SplatFinite(py) || !SplatFinite(size)) return false;
     precise float len = sqrt(dx * dx + dy * dy + dz * dz);
     precise float cosTheta = (F.sun.x * dx + F.sun.y * dy + F.sun.z * dz) / len;
-    precise float light = t * PhaseValue(uint(F.sunRadiance.w), F.sun.w, cosTheta);
+    precise float light = t * PhaseOf(uint(F.sunRadiance.w), F.sun.w, F.right.w, uint(F.up.w), cosTheta);
     s.px = px;
     s.py = py;
     s.size = size;

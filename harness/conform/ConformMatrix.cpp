@@ -17,14 +17,6 @@ struct Candidate {
     std::vector<std::string> onlyBackends;
 };
 
-// The stages of `scene` less `drop`, as a JSON list for --set stages=...
-std::string StagesWithout(const Scene& scene, Stage drop) {
-    std::string list;
-    for (Stage s : kAllStages)
-        if (scene.stages.Has(s) && s != drop) list += (list.empty() ? "\"" : ",\"") + std::string(StageName(s)) + "\"";
-    return "[" + list + "]";
-}
-
 }  // namespace
 
 std::optional<std::string> ConformSceneValue(const Scene& scene, const std::string& path) {
@@ -53,12 +45,6 @@ std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sce
         for (const auto& [name, kind] : kPhaseKindNames) {
             Candidate c{{{"phase.function", std::string(name)}}, {}, {}};
             if (shade) c.overrides.push_back({std::string(ShadeScatteringSetting().path), "true"});
-            if (kind == PhaseKind::Mie) {
-                // render_splat on gl and vk refuses a Mie scene (docs/scenes.md, issue 14): compared without it,
-                // and only where shade (P(0) of the table) still sees it.
-                if (!shade) continue;
-                if (splat) c.overrides.push_back({"stages", StagesWithout(scene, Stage::RenderSplat)});
-            }
             candidates.push_back(std::move(c));
         }
     };

@@ -12,7 +12,7 @@ flat in uint layerIndex;
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return layersQT[paddedIndex]; }
-float MarchPhaseTableValue(uint i) { return layersPhaseTable[i]; }
+float PhaseTableValue(uint i) { return layersPhaseTable[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here
 
 void LayersCount(uint n) {

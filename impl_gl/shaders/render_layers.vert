@@ -17,7 +17,7 @@ out float gl_ClipDistance[1];
 // march.glsl's fetches: the vertex stage reads no volume.
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(0.0, 1.0); }
 bool MarchBrickEmpty(uint brick) { return false; }
-float MarchPhaseTableValue(uint i) { return 1.0; }
+float PhaseTableValue(uint i) { return 1.0; }
 
 void main() {
     const uint i = layerOrder[gl_InstanceID];

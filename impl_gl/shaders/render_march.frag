@@ -17,7 +17,7 @@ layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return marchQT[paddedIndex]; }
 bool MarchBrickEmpty(uint brick) { return marchBrickEmpty[brick] != 0u; }
-float MarchPhaseTableValue(uint i) { return marchPhaseTable[i]; }
+float PhaseTableValue(uint i) { return marchPhaseTable[i]; }
 float GroundFetchG(uint i, uint j) { return texelFetch(groundShadow, ivec3(i, j, 0), 0).r; }
 
 // Adds v to the 64-bit counter n; a carry out of the low word goes to the high one.

@@ -1,6 +1,9 @@
 // Stage `render_splat`: one fragment of a point sprite. Keeps SPEC 8's
 // coverage (px - s/2 <= x + 0.5 < px + s/2, likewise y) and gives the
 // kernel-weighted alpha; blending (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) composites.
+// Unread: the fragment makes no splat (MakeSplat, which reads the table, is the vertex shader's).
+float PhaseTableValue(uint i) { return 0.0; }
+
 flat in vec4 colour;
 flat in vec3 splat;
 layout(location = 0) out vec4 result;

@@ -12,6 +12,8 @@ layout(binding = 5) uniform usampler2DArray bandsCurMap;
 uniform int deviceSkip;
 uniform ivec2 tileBand;
 layout(std430, binding = 2) readonly buffer Frame { SplatFrame F; };  // misc.z: the largest point size
+layout(std430, binding = 3) readonly buffer PhaseTable { float phaseTable[]; };  // read with phase Mie only
+float PhaseTableValue(uint i) { return phaseTable[i]; }
 layout(binding = 0) uniform sampler2DArray qPrev;
 layout(binding = 1) uniform sampler2DArray qCur;
 layout(binding = 2) uniform sampler2DArray transmittance;

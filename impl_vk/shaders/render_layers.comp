@@ -8,6 +8,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "random.glsl"
 #include "shading.glsl"
+#include "phase_table.glsl"
 #include "march.glsl"
 #include "layers.glsl"
 
@@ -20,7 +21,7 @@ layout(std430, binding = 3) writeonly buffer Image { float image[]; };
 layout(std430, binding = 4) buffer Stats { uint stats[]; };
 
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
-float MarchPhaseTableValue(uint i) { return mieTable[i]; }
+float PhaseTableValue(uint i) { return mieTable[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here
 
 shared uint gCounts[2];

@@ -3,6 +3,7 @@
 // two pipelines, so that no tap branches on the light source.
 #include "random.glsl"
 #include "shading.glsl"
+#include "phase_table.glsl"
 #include "march.glsl"
 #include "ground.glsl"
 
@@ -28,7 +29,7 @@ vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(volume[paddedIndex], 1.0); }
 #endif
 bool MarchBrickEmpty(uint brick) { return brickEmpty[brick] != 0u; }
-float MarchPhaseTableValue(uint i) { return mieTable[i]; }
+float PhaseTableValue(uint i) { return mieTable[i]; }
 float GroundFetchG(uint i, uint j) { return groundG[i + ground.grid.x * j]; }
 
 shared uint gCounts[4];

@@ -7,6 +7,7 @@
 // loads and the same trip count.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
+#include "phase_table.glsl"
 #include "splat.glsl"
 #include "ground.glsl"
 layout(local_size_x = 64) in;

@@ -4,6 +4,7 @@
 // sort by tile (radix_sort.comp) keeps within each tile.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
+#include "phase_table.glsl"
 #include "splat.glsl"
 #include "splat_tiles.glsl"
 layout(local_size_x = 64) in;

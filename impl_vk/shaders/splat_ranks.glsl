@@ -6,6 +6,7 @@
 #define CLOUDBENCH_SPLAT_RANKS_GLSL
 #extension GL_EXT_shader_8bit_storage : require
 #include "shading.glsl"
+#include "phase_table.glsl"
 #include "splat.glsl"
 
 layout(std430, binding = 0) readonly buffer QPrev { float qPrev[]; };
@@ -19,6 +20,9 @@ layout(std430, binding = 3) readonly buffer RankParts { uvec4 rankPart[]; };
 layout(std430, binding = 4) readonly buffer Boxes { uint8_t boxVisible[]; };
 // grid.w: voxels per chunk of ranks; image.zw: screen tiles across and down.
 layout(std430, binding = 5) readonly buffer Frame { SplatFrame F; };
+// Read with phase Mie only: kMieCloudTable's values (F.right.w index per radian, F.up.w count).
+layout(std430, binding = 10) readonly buffer PhaseTable { float phaseTable[]; };
+float PhaseTableValue(uint i) { return phaseTable[i]; }
 
 uint AxisSize(uint axis) { return axis == 0u ? F.grid.x : (axis == 1u ? F.grid.y : F.grid.z); }
 

@@ -6,6 +6,7 @@
 #include "random.glsl"
 #include "rules.glsl"
 #include "shading.glsl"
+#include "phase_table.glsl"
 #include "automaton.glsl"
 #include "splat.glsl"
 #include "noise.glsl"
@@ -31,7 +32,7 @@ vec2 MarchFetchQT(uint i) {
 bool MarchBrickEmpty(uint brick) { return brick % 3u == 0u; }
 // ground.glsl's G: a hash of the cell (tests/GlslTwinMarchCases.cpp TwinGroundG).
 float GroundFetchG(uint i, uint j) { return float(LowBias32(i + 4096u * j) >> 8u) * (1.0 / 16777216.0); }
-float MarchPhaseTableValue(uint i) { return mieTable[i]; }
+float PhaseTableValue(uint i) { return mieTable[i]; }
 
 MarchGpu ZeroMarch() {
     return MarchGpu(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0),
@@ -153,7 +154,7 @@ void main() {
             break;
         // ---- march.glsl ----
         case 34u: PutF(0u, ArcCos(F(0u))); break;
-        case 35u: PutF(0u, SampleMiePhase(F(0u), U(1u), F(2u))); break;
+        case 35u: PutF(0u, SamplePhaseTable(F(0u), U(1u), F(2u))); break;
         case 36u: {
             MarchGpu m = ZeroMarch();
             m.flags.y = U(0u);
