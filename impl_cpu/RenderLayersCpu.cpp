@@ -60,13 +60,14 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
         // 2. The pixels.
         const std::array<float, 2>* volume = state.volume.data();
         auto fetch = [volume](uint32_t i) { return volume[i]; };
+        const LayersWalks walks = MakeLayersWalks(s);
         tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8),
                           [&](const tbb::blocked_range2d<uint32_t>& r) {
                               uint64_t nFragments = 0, nDrawn = 0;
                               for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
                                   for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
                                       const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
-                                      const LayersPixelResult p = LayersPixel(s, ray, fetch);
+                                      const LayersPixelResult p = LayersPixel(s, walks, ray, fetch);
                                       float* o = out + 3 * (size_t(x) + size_t(W) * y);
                                       o[0] = p.color[0];
                                       o[1] = p.color[1];

@@ -134,8 +134,8 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         const std::vector<Kind> pixelKinds = {Kind::F, Kind::F, Kind::F, Kind::U, Kind::U};
         Compare("LayersPixel", pixelKinds, ulps, pixels, Run(kLayersPixelFn, pixels, {}, {}, g),
                 [&](const Words& in, Words& out) {
-                    const LayersPixelResult r =
-                        LayersPixel(s, MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]), TwinFetch);
+                    const LayersPixelResult r = LayersPixel(
+                        s, MakeLayersWalks(s), MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]), TwinFetch);
                     out = W({Bits(r.color[0]), Bits(r.color[1]), Bits(r.color[2]), r.fragments, r.drawn});
                     fragments += r.fragments;
                 });

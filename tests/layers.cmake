@@ -33,3 +33,10 @@ print("frames and counters")
 PY]=])
 add_test(NAME Cli.LayersRunWritesFrames COMMAND /bin/sh -c "${cli_layers_script}" ${cli} ${cli_out}/layers-run)
 set_tests_properties(Cli.LayersRunWritesFrames PROPERTIES TIMEOUT 120 PASS_REGULAR_EXPRESSION "frames and counters")
+# tools/wang_fps.py keeps working: one quick round on every built backend, a track average per scene and backend with
+# the paper's figure beside it, and no backend left unmeasured. Not a measurement.
+add_test(NAME Cli.WangFpsQuick COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/../tools/wang_fps.py --quick
+                                       --cli ${cli} --backends ${march_backends} --out ${cli_out}/wang-fps-quick)
+set_tests_properties(Cli.WangFpsQuick PROPERTIES TIMEOUT 180
+  PASS_REGULAR_EXPRESSION "\\| wang-20km \\| cpu \\| track average \\|[^\n]*up to 390 fps.*\\| wang-90km \\| cpu \\| track average \\|[^\n]*still exceeding 350 fps"
+  FAIL_REGULAR_EXPRESSION "not measured")

@@ -170,19 +170,29 @@ inline LayersWalk LayersWalkOf(const LayersSetup& s, float dz) {
     return w;
 }
 
+// The walks of one call: LayersWalkOf depends on the ray only through the sign
+// of d_z, so a call makes both once (rays up, rays down) rather than per pixel.
+struct LayersWalks {
+    LayersWalk up, down;
+};
+inline LayersWalks MakeLayersWalks(const LayersSetup& s) { return {LayersWalkOf(s, 1.0f), LayersWalkOf(s, -1.0f)}; }
+
 struct LayersPixelResult {
     Vec3 color{};
     uint32_t fragments = 0;  // crossings in range
     uint32_t drawn = 0;      // of them with q > 0
 };
 
-// One pixel: the background, then every layer the ray crosses, back to front.
+// One pixel: the background, then every layer the ray crosses, back to front
+// (walks: MakeLayersWalks(s)).
 template <class Fetch>
-inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersRay& ray, Fetch&& fetch) {
+inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersWalks& walks, const LayersRay& ray,
+                                     Fetch&& fetch) {
     LayersPixelResult r;
     r.color = s.background;
     const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
-    const LayersWalk w = LayersWalkOf(s, ray.dir[2]);
+    const float dz = ray.dir[2];
+    const LayersWalk w = dz > 0.0f ? walks.up : dz < 0.0f ? walks.down : LayersWalk{};
     for (uint32_t n = 0; n < w.count; ++n) {
         const uint32_t i = uint32_t(w.first + w.step * int(n));
         const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i, fetch);

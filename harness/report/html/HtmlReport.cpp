@@ -146,7 +146,8 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
             Str(Obj(input.doc, "scene"), "warmup_steps", "?") + " warm-up). Backends: " + backends +
             ". The source documents' figures were measured on other hardware and scenes (the thesis's 256x32x256 "
             "volume; "
-            "Olajos's are whole ray-marched frames): a sense of scale, not a comparison of methods."});
+            "Olajos's are whole ray-marched frames; Wang, Ji and Zhang's whole layered frames with the light "
+            "precomputed): a sense of scale, not a comparison of methods."});
         timing.blocks.emplace_back(TimingTable(input.doc));
         timing.blocks.emplace_back(TimingBoxes(input));
         out.sections.push_back(std::move(timing));
