@@ -29,6 +29,7 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
         return MakeError("cpu: render_layers: q_prev, q_cur and T differ in size");
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("cpu: render_layers: the image is not (3, width, height)");
+    if (params.setup.wang && !params.setup.map) return MakeError("cpu: render_layers: wang opacity needs its map");
     const float* qPrev = static_cast<const BufferCpu*>(in.qPrev)->F32();
     const float* qCur = static_cast<const BufferCpu*>(in.qCur)->F32();
     const float* T = static_cast<const BufferCpu*>(in.T)->F32();

@@ -19,6 +19,7 @@ uint64_t RenderLayersGLState::ScratchBytes(const Scene& scene) const {
     uint64_t bytes = 2 * uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2) * 8;
     bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
     if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    if (scene.layers.wang.enabled) bytes += uint64_t(scene.grid.size.nx) * scene.grid.size.ny * 4;
     return bytes;
 }
 
@@ -30,6 +31,7 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
         return MakeError("gl: render_layers: q_prev, q_cur and T differ in size");
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_layers: the image is not (3, width, height)");
+    if (params.setup.wang && !params.setup.map) return MakeError("gl: render_layers: wang opacity needs its map");
     const Functions& f = mContext->F();
     auto layersProgram = mContext->Program("render_layers");
     if (!layersProgram) return std::unexpected(layersProgram.error());
@@ -67,6 +69,13 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, *volumeCopy);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, phaseTable);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, counters);
+    GLuint map = *volumeCopy;  // likewise unless the opacity is wang
+    if (s.wang) {
+        const size_t bytes = size_t(e.nx) * e.ny * 4;
+        map = ScratchBuffer(state.map, bytes);
+        f.NamedBufferSubData(map, 0, GLsizeiptr(bytes), s.map);
+    }
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, map);
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
     f.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);

@@ -18,8 +18,9 @@ struct RenderLayersGLState {
     BufferSlot phaseTable;  // phase mie: kMieCloudTable's values, uploaded once (mieUploaded)
     BufferSlot counters;    // the shader's LayersStats counters
     BufferSlot imageCopy;   // the pixel buffer the image passes through
+    BufferSlot map;         // wang opacity: the modulation map, nx * ny floats
     bool mieUploaded = false;
-    // volume and its copy, target and the RGB32F image copy; with phase mie the table.
+    // volume and its copy, target and the RGB32F image copy; with phase mie the table; with wang the map.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -23,6 +23,7 @@ constexpr uint32_t kLayersStatWords = 4;  // fragments, drawn (low, high each)
 uint64_t RenderLayersVkState::ScratchBytes(const Scene& scene) const {
     uint64_t bytes = sizeof(LayersGpu) + MarchVolumeBytes(scene.grid.size, true) + kLayersStatWords * 4;
     if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    if (scene.layers.wang.enabled) bytes += uint64_t(scene.grid.size.nx) * scene.grid.size.ny * 4;
     return bytes;
 }
 
@@ -34,12 +35,13 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
         return MakeError("vk: render_layers: q_prev, q_cur and T differ in size");
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("vk: render_layers: the image is not (3, width, height)");
+    if (params.setup.wang && !params.setup.map) return MakeError("vk: render_layers: wang opacity needs its map");
 
     const LayersGpu frame = MakeLayersGpu(params);
     const uint32_t px = e.nx + 2, py = e.ny + 2, pz = e.nz + 2;
     auto volumePipe = mContext->GetPipeline("march_volume", 4);
     if (!volumePipe) return std::unexpected(volumePipe.error());
-    auto layersPipe = mContext->GetPipeline("render_layers", 5);
+    auto layersPipe = mContext->GetPipeline("render_layers", 6);
     if (!layersPipe) return std::unexpected(layersPipe.error());
     auto frameBuffer = Scratch(state.frame, sizeof frame);
     if (!frameBuffer) return std::unexpected(frameBuffer.error());
@@ -53,11 +55,18 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
         if (!t) return std::unexpected(t.error());
         table = *t;
     }
+    const DeviceBuffer* map = *frameBuffer;  // likewise without wang opacity
+    if (params.setup.wang) {
+        const std::span<const float> m(params.setup.map, size_t(e.nx) * e.ny);
+        auto b = ScratchHolding(state.map, std::as_bytes(m), 0);
+        if (!b) return std::unexpected(b.error());
+        map = *b;
+    }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
 
     const MarchVolumePush volumePush{e.nx, e.ny, e.nz, 1u, params.alpha, params.setup.tiling ? 1u : 0u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), *volume};
-    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table, &Dev(image), *statsBuffer};
+    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table, &Dev(image), *statsBuffer, map};
     CB_TRY(Record("render_layers", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(**volumePipe, volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);

@@ -14,7 +14,8 @@ struct RenderLayersVkState {
     BufferSlot volume;    // the padded (q_alpha, T) volume, wrapped horizontally with tiling
     BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
     BufferSlot stats;     // the LayersStats counters, 64-bit as two words each
-    // The constants, the padded volume, the Mie table with phase Mie, the counters.
+    BufferSlot map;       // wang opacity: the modulation map, nx * ny floats (uploaded when it changes)
+    // The constants, the padded volume, the Mie table with phase Mie, the counters, the map with wang.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -542,7 +542,7 @@ std::vector<TwinCase> Cases() {
                       }()},
                      [](const Words& in, Words& out) {
                          out[0] = Bits(noise::Threshold(Float(in[0]), Float(in[1])));
-                         out[1] = Bits(noise::CoverageModulate(Float(in[0]), Float(in[2]), Float(in[3]), Float(in[4])));
+                         out[1] = Bits(CoverageModulate(Float(in[0]), Float(in[2]), Float(in[3]), Float(in[4])));
                          out[2] = Bits(noise::Erode(Float(in[0]), Float(in[5]), Float(in[6])));
                          out[3] = uint32_t(noise::WrapIndex(Int(in[7]), Int(in[8])));
                          out[4] = Bits(std::round(Float(in[9])));

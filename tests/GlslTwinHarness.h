@@ -66,6 +66,9 @@ inline std::array<float, 2> TwinPaddedQT(uint32_t i) {
             float(LowBias32(i ^ 0x9E3779B9u) >> 8) * (1.0f / 16777216.0f)};
 }
 
+// twin.comp's synthetic modulation map (layers.glsl's LayersMapValue): m of column index i from a hash.
+inline float TwinLayersMap(uint32_t i) { return float(LowBias32(i ^ 0x51ED27u) >> 8) * (1.0f / 16777216.0f); }
+
 // Floats next to x: x itself and one ulp either side.
 inline std::vector<float> AndNeighbours(float x) {
     return {std::nextafter(x, -INFINITY), x, std::nextafter(x, INFINITY)};

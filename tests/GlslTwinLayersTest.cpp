@@ -28,8 +28,9 @@ using test::Words;
 constexpr uint32_t kLayersRayFn = 60, kLayersTapsFn = 61, kLayerFragmentFn = 62, kLayersPixelFn = 63;
 
 // A random layered call: a grid up to 40 x 40 x 24, a camera below, inside or above it, tiled or not, a layer
-// count from a quarter to four per voxel, an extent that cuts some rays, every phase.
-LayersParams RandomLayersParams(Pcg32& r) {
+// count from a quarter to four per voxel, an extent that cuts some rays, every phase, beer or wang opacity (the
+// map TwinLayersMap, held in `map`).
+LayersParams RandomLayersParams(Pcg32& r, std::vector<float>& map) {
     const Extent3 e{1 + r.Below(40), 1 + r.Below(40), 1 + r.Below(24)};
     const float h = Uniform(r, 0.5, 100);
     CameraSettings camera;
@@ -62,6 +63,12 @@ LayersParams RandomLayersParams(Pcg32& r) {
     s.background = {Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1)};
     const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
     s.phase = {kinds[r.Below(4)], Uniform(r, -0.9, 0.9)};
+    s.wang = r.Below(2) == 1;
+    s.coverage = Uniform(r, 0, 1);
+    s.density = Uniform(r, 0.5, 8);
+    map.resize(size_t(e.nx) * e.ny);
+    for (uint32_t i = 0; i < map.size(); ++i) map[i] = test::TwinLayersMap(i);
+    s.map = map.data();
     return p;
 }
 
@@ -86,7 +93,8 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
     const uint32_t ulps = sExact ? 0 : 4;
     uint32_t drawn = 0, fragments = 0;
     for (int call = 0; call < 24; ++call) {
-        const LayersParams p = RandomLayersParams(rng);
+        std::vector<float> map;
+        const LayersParams p = RandomLayersParams(rng, map);
         const LayersSetup& s = p.setup;
         const LayersGpu g = MakeLayersGpu(p);
         const std::vector<Words> pixels = PixelInputs(rng, p.camera, s.count);

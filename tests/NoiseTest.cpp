@@ -248,9 +248,9 @@ TEST(Noise, ThresholdCoverageAndErosion) {
     EXPECT_EQ(noise::Threshold(0.1f, 0.35f), 0.0f);
     EXPECT_EQ(noise::Threshold(1.7f, 0.35f), 1.0f);
     EXPECT_NEAR(noise::Threshold(0.675f, 0.35f), 0.5f, 1e-6f);
-    EXPECT_NEAR(noise::CoverageModulate(0.8f, 0.3f, 0.6f, 2.0f), 2 * (0.8f - 0.7f), 1e-6f);  // eq. 16
-    EXPECT_EQ(noise::CoverageModulate(0.6f, 0.3f, 0.6f, 2.0f), 0.0f);
-    EXPECT_NEAR(noise::CoverageModulate(0.55f, 0.0f, 1.0f, 1.0f), 0.55f, 1e-7f);  // eq. 14 with m = 0
+    EXPECT_NEAR(CoverageModulate(0.8f, 0.3f, 0.6f, 2.0f), 2 * (0.8f - 0.7f), 1e-6f);  // eq. 16
+    EXPECT_EQ(CoverageModulate(0.6f, 0.3f, 0.6f, 2.0f), 0.0f);
+    EXPECT_NEAR(CoverageModulate(0.55f, 0.0f, 1.0f, 1.0f), 0.55f, 1e-7f);  // eq. 14 with m = 0
     EXPECT_EQ(noise::Erode(0.4f, 0.0f, 0.3f), 0.4f);
     EXPECT_NEAR(noise::Erode(1.0f, 0.7f, 0.5f), 1.0f, 1e-7f);
     EXPECT_NEAR(noise::Erode(0.35f, 0.7f, 0.5f), 0.0f, 1e-7f);

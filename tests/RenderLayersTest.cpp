@@ -90,6 +90,16 @@ LayersCase BlobLayers(const Extent3& e) {
     return c;
 }
 
+// q = `q` in both steps and T = 1 everywhere.
+LayersCase UniformLayers(const Extent3& e, float q) {
+    LayersCase c;
+    c.grid = e;
+    c.qPrev.assign(e.Count(), q);
+    c.qCur = c.qPrev;
+    c.T.assign(e.Count(), 1.0f);
+    return c;
+}
+
 class RenderLayersAll : public test::BackendTest {
   protected:
     void SetUp() override {
@@ -148,11 +158,7 @@ TEST_P(RenderLayersAll, HomogeneousLayerIsTheSlabsClosedForm) {
     };
     for (uint32_t count : {6u, 3u, 12u})
         for (const View& v : views) {
-            LayersCase c;
-            c.grid = e;
-            c.qPrev.assign(e.Count(), 1.0f);
-            c.qCur = c.qPrev;
-            c.T.assign(e.Count(), 1.0f);
+            LayersCase c = UniformLayers(e, 1.0f);
             c.params = CameraLayers(e, v.eye, v.target, 40, 30, count, true);
             LayersSetup& s = c.params.setup;
             s.maxLength = 1e30f;  // uncapped: the closed form holds at every elevation
@@ -180,6 +186,69 @@ TEST_P(RenderLayersAll, HomogeneousLayerIsTheSlabsClosedForm) {
                 }
             // float rounding of N blends and N exps: measured below 1e-6 on every backend.
             EXPECT_LT(worst, 1e-5) << "count " << count << " eye z " << v.eye[2];
+        }
+}
+
+// Test the wang opacity (Wang, Ji and Zhang's eq. 16) on every backend, by hand: q = 0.8 and T = 1 everywhere, untiled,
+// coverage 0.7 and density 1.5, and a map that is 0 on the columns x < 6 and 1 on the others. A layer crossed over
+// the first columns has alpha = min(1.5 max(0.8 - (0 + 1 - 0.7), 0), 1) = 1 - 1/4 (= 0.75 within float), over the
+// others 1.5 max(0.8 - 1.3, 0) = 0; so a pixel whose crossings all lie at 0.5 < x < 5.5 and 0.5 < y < 7.5 (where the
+// bilinear map is 0 and the trilinear q is 0.8 q_z, q_z = min(1, z + 1/2, nz + 1/2 - z) of the layer's height) is
+// lit (1 - K) + background K, K the product of (1 - alpha(0.8 q_z)) over its crossings, and one whose crossings
+// all lie at x > 6.5 is the background bit for bit (it blends alpha 0). Seen from above and below, with 6 and 12
+// layers (12 puts the outer layers on the grid's half-voxel rim, where q_z < 1).
+TEST_P(RenderLayersAll, WangOpacityIsEq16OfQAndTheMap) {
+    const Extent3 e{12, 8, 6};
+    std::vector<float> map(size_t(e.nx) * e.ny);
+    for (uint32_t j = 0; j < e.ny; ++j)
+        for (uint32_t i = 0; i < e.nx; ++i) map[i + e.nx * j] = i < 6 ? 0.0f : 1.0f;
+    const std::array<double, 3> eyes[] = {{6, 4, 40}, {6, 4, -34}};
+    for (uint32_t count : {6u, 12u})
+        for (const auto& eye : eyes) {
+            LayersCase c = UniformLayers(e, 0.8f);
+            c.params = CameraLayers(e, eye, {6, 4, 3}, 48, 32, count, false);
+            LayersSetup& s = c.params.setup;
+            s.wang = true;
+            s.coverage = 0.7f;
+            s.density = 1.5f;
+            s.map = map.data();
+            const LayersImage im = RenderLayersOn(*mBackend, c);
+            ASSERT_TRUE(im.ok);
+            uint32_t lit = 0, clear = 0;
+            double worst = 0;
+            for (uint32_t y = 0; y < 32; ++y)
+                for (uint32_t x = 0; x < 48; ++x) {
+                    const LayersRay ray = MakeLayersRay(c.params.camera, 1.0f, x, y);
+                    double lo = 1e30, hi = -1e30, keep = 1;
+                    bool rim = false;
+                    int k = 0;
+                    for (uint32_t i = 0; i < count; ++i) {
+                        const double z = (i + 0.5) * double(e.nz) / count, t = (z - s.eye[2]) / ray.dir[2];
+                        const double px = s.eye[0] + ray.dir[0] * t, py = s.eye[1] + ray.dir[1] * t;
+                        if (!(t > 0) || px < 0 || px > e.nx || py < 0 || py > e.ny) continue;
+                        lo = std::min(lo, px), hi = std::max(hi, px), ++k;
+                        rim = rim || px < 0.5 || py < 0.5 || py > e.ny - 0.5;
+                        const double q = 0.8 * std::min({1.0, z + 0.5, e.nz + 0.5 - z});
+                        keep *= 1 - std::min(1.5 * std::max(q - 0.3, 0.0), 1.0);
+                    }
+                    const float* got = &im.rgb[3 * (x + 48 * y)];
+                    if (k > 0 && lo > 6.5) {
+                        ++clear;
+                        for (int ch = 0; ch < 3; ++ch)
+                            ASSERT_EQ(std::bit_cast<uint32_t>(got[ch]), std::bit_cast<uint32_t>(s.background[ch]));
+                    } else if (k > 0 && hi < 5.5 && !rim) {
+                        ++lit;
+                        const double phase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+                        for (int ch = 0; ch < 3; ++ch) {
+                            const double want =
+                                (s.sunRadiance[ch] * phase + s.ambient[ch]) * (1 - keep) + s.background[ch] * keep;
+                            worst = std::max(worst, std::fabs(got[ch] - want) / std::max(1.0, want));
+                        }
+                    }
+                }
+            EXPECT_GT(lit, 20u) << "count " << count << " eye z " << eye[2];
+            EXPECT_GT(clear, 20u) << "count " << count << " eye z " << eye[2];
+            EXPECT_LT(worst, 1e-5) << "count " << count << " eye z " << eye[2];  // float rounding of k blends
         }
 }
 
@@ -310,6 +379,15 @@ TEST_P(RenderLayersGpu, MatchesTheCpu) {
                 c.params.setup.phase = phases[n++ % 4];
                 if (count == 4) c.params.setup.maxLength = 2.5f;
                 if (count == 15) c.params.setup.drift = {1.37f, -0.61f};
+                // The wang opacity with a map that varies per column, in every third case.
+                std::vector<float> map(size_t(e.nx) * e.ny);
+                for (size_t i = 0; i < map.size(); ++i) map[i] = float((i * 2654435761u) % 997) / 2000.0f;
+                if (n % 3 == 0) {
+                    c.params.setup.wang = true;
+                    c.params.setup.coverage = 0.9f;
+                    c.params.setup.density = 3.0f;
+                    c.params.setup.map = map.data();
+                }
                 const LayersImage want = RenderLayersOn(cpu, c);
                 const LayersImage got = RenderLayersOn(*mBackend, c);
                 ASSERT_TRUE(want.ok && got.ok);

@@ -9,7 +9,10 @@ set(layers_cases
     "UntiledHalfLayersMie|layers-small|--set|grid.tiling=false|--set|layers.count=4|--set|phase.function=\"mie\"|--set|grid.size=[31,29,9]|--set|render.width=67|--set|render.height=45"
     "TwiceLayersShortPathCornetteShanks|layers-small|--set|layers.count=16|--set|layers.max_length=1.5|--set|phase.function=\"cornette-shanks\"|--set|layers.extent=6000"
     # The wind's drift (eq. 18) over three steps, with alpha interpolating between them.
-    "WindThreeSteps|layers-small|--steps|3|--set|layers.wind=[170,-45]|--set|render.alpha=0.4")
+    "WindThreeSteps|layers-small|--steps|3|--set|layers.wind=[170,-45]|--set|render.alpha=0.4"
+    # Wang, Ji and Zhang's opacity (eq. 16) with its modulation map, tiled and not.
+    "WangOpacity|layers-small|--set|layers.wang={\"coverage\":0.8,\"density\":2.5,\"frequency\":[2,1]}"
+    "WangOpacityUntiled|layers-small|--set|grid.tiling=false|--set|layers.wang={\"coverage\":0.9,\"octaves\":2}")
 foreach(entry ${layers_cases})
   string(REPLACE "|" ";" fields "${entry}")
   list(POP_FRONT fields name scene)

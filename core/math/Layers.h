@@ -32,6 +32,11 @@ struct LayersSetup {
     // The wind's drift of the volume's coordinates (Wang, Ji and Zhang, eq. 18), voxel units: a fragment at
     // (x, y) reads the volume at (x - drift x, y - drift y). With tiling reduced into [0, n) on the host.
     std::array<float, 2> drift{0, 0};
+    // The opacity: beer's, or with `wang` Wang, Ji and Zhang's eq. 16, CoverageModulate(q, m, coverage,
+    // density), m the modulation map: nx * ny values at the column centres, x fastest (its own tiling).
+    bool wang = false;
+    float coverage = 1, density = 1;
+    const float* map = nullptr;
     Vec3 sun{0, 0, 1};      // unit, toward the sun
     Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
     PhaseParams phase;
@@ -86,6 +91,26 @@ inline std::array<float, 2> LayersBlend(const Vec3& size, const LayersTaps& t, F
     return out;
 }
 
+// The modulation map at voxel-unit (x, y), x in [0, nx] and y in [0, ny]:
+// bilinear between the column centres, the columns wrapping with tiling and
+// clamped to the edge ones without.
+inline float LayersMapAt(const LayersSetup& s, float x, float y) {
+    const int nx = int(s.size[0]), ny = int(s.size[1]);
+    const float u = x - 0.5f, v = y - 0.5f;
+    const float fu = std::floor(u), fv = std::floor(v);
+    const float wu = u - fu, wv = v - fv;
+    int i0 = int(fu), i1 = i0 + 1, j0 = int(fv), j1 = j0 + 1;
+    if (s.tiling) {
+        i0 = i0 < 0 ? i0 + nx : i0, i1 = i1 >= nx ? i1 - nx : i1;
+        j0 = j0 < 0 ? j0 + ny : j0, j1 = j1 >= ny ? j1 - ny : j1;
+    } else {
+        i0 = std::clamp(i0, 0, nx - 1), i1 = std::clamp(i1, 0, nx - 1);
+        j0 = std::clamp(j0, 0, ny - 1), j1 = std::clamp(j1, 0, ny - 1);
+    }
+    const float* m = s.map;
+    return Lerp(Lerp(m[i0 + nx * j0], m[i1 + nx * j0], wu), Lerp(m[i0 + nx * j1], m[i1 + nx * j1], wu), wv);
+}
+
 // One pixel's ray as the layers see it: its direction (PixelRayDirection) and
 // the distances of the near and far planes along it (voxel edges).
 struct LayersRay {
@@ -101,7 +126,8 @@ inline LayersRay MakeLayersRay(const CameraFrame& c, float voxelSize, uint32_t x
 // Layer i's fragment on a ray: drawn iff the ray crosses the plane at a
 // distance t between the near and far planes, within the extent horizontally
 // and (without tiling) inside the box, where q > 0. Its opacity is beer's,
-// alpha = 1 - exp(-sigma h q l), l = min(spacing / |d_z|, l_max); its colour
+// alpha = 1 - exp(-sigma h q l), l = min(spacing / |d_z|, l_max), or wang's
+// (eq. 16 of q and the map, without a path length); its colour
 // c = sun T P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
 struct LayerFragmentResult {
     bool crossed = false;  // the plane is met in range (a counted fragment)
@@ -132,8 +158,12 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     const std::array<float, 2> qt = LayersBlend(s.size, LayersTapsAt(s.size, Vec3{x, y, z}), fetch);
     if (!(qt[0] > 0.0f)) return f;
     f.drawn = true;
-    const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
-    f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
+    if (s.wang) {
+        f.alpha = CoverageModulate(qt[0], LayersMapAt(s, x, y), s.coverage, s.density);
+    } else {
+        const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
+        f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
+    }
     const float gain = qt[1] * sunPhase;
     f.color = {s.sunRadiance[0] * gain + s.ambient[0], s.sunRadiance[1] * gain + s.ambient[1],
                s.sunRadiance[2] * gain + s.ambient[2]};

@@ -21,6 +21,7 @@
 #include "core/math/Grid.h"
 #include "core/math/NoiseSettings.h"
 #include "core/math/Random.h"
+#include "core/math/Shading.h"
 
 namespace cb::noise {
 
@@ -248,12 +249,6 @@ inline float HeightDistribution(float h, float a, float b) { return (1.0f - std:
 
 // Threshold q = clamp((v - c) / (1 - c), 0, 1), c in [0, 1): c -> 0, 1 -> 1.
 inline float Threshold(float v, float c) { return Clamp01((v - c) / (1.0f - c)); }
-
-// Wang eq. 16: q = D max(v - (m + 1 - C), 0), clamped to 1.
-inline float CoverageModulate(float v, float m, float coverage, float density) {
-    const float excess = v - (m + 1.0f - coverage);
-    return std::min(density * (excess > 0.0f ? excess : 0.0f), 1.0f);
-}
 
 // Schneider's erosion by detail noise d in [0, 1] with strength s in [0, 1):
 // remap(v, s d, 1, 0, 1) = (v - s d) / (1 - s d).

@@ -136,6 +136,14 @@ inline float StorageQuantum(StorageFormat format) {
 // a (1 - t) + b t (the build never fuses it into an FMA). GLSL twin: shading.glsl Lerp.
 inline float Lerp(float a, float b, float t) { return a * (1.0f - t) + b * t; }
 
+// Wang, Ji and Zhang's eq. 16: D max(v - (m + 1 - C), 0), clamped to 1, for a value v in [0, 1], the 2-D
+// modulation map m, coverage C and density factor D: the noise stage's coverage form of q, and
+// render_layers' `wang` opacity.
+inline float CoverageModulate(float v, float m, float coverage, float density) {
+    const float excess = v - (m + 1.0f - coverage);
+    return std::min(density * (excess > 0.0f ? excess : 0.0f), 1.0f);
+}
+
 // ---- Phase functions (SPEC 9), normalised so that isotropic gives 1 ----------
 
 enum class PhaseKind : uint8_t { None, HenyeyGreenstein, CornetteShanks, Mie };

@@ -7,7 +7,8 @@
 // whose pixel ray, padded sampler (PaddedTapsAt, PaddedBlend), SegmentTransmittance
 // and phase it uses. The including shader defines march.glsl's MarchFetchQT as the
 // layers' padded (q_alpha, T) volume, (nx+2) x (ny+2) x (nz+2) with voxel
-// (i, j, k) at (i+1, j+1, k+1), and PhaseTableValue (phase Mie only).
+// (i, j, k) at (i+1, j+1, k+1), PhaseTableValue (phase Mie only) and
+//   float LayersMapValue(uint i);  // the modulation map, nx * ny, x fastest (wang opacity only)
 #ifndef CLOUDBENCH_LAYERS_GLSL
 #define CLOUDBENCH_LAYERS_GLSL
 
@@ -25,10 +26,13 @@ struct LayersGpu {
     vec4 background;   // rgb; w l_max
     uvec4 image;       // width, height, N, flags
     uvec4 phase;       // kind, Mie count, px, px * py
-    vec4 drift;        // xy the wind's drift (voxel units)
+    vec4 drift;        // xy the wind's drift (voxel units); z coverage C, w density D_w (wang)
 };
 
 const uint kLayersTiling = 1u;
+const uint kLayersWang = 2u;
+
+float LayersMapValue(uint i);
 
 float LayerHeight(LayersGpu s, uint i) {
     precise float z = (float(i) + 0.5) * s.invSize.w;
@@ -59,6 +63,28 @@ LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
 // P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
 float LayersPhase(LayersGpu s, float cosTheta) { return PhaseOf(s.phase.x, s.sun.w, s.ambient.w, s.phase.y, cosTheta); }
 
+// core/math/Layers.h LayersMapAt.
+float LayersMapAt(LayersGpu s, float x, float y) {
+    const int nx = int(s.size.x), ny = int(s.size.y);
+    precise float u = x - 0.5, v = y - 0.5;
+    const float fu = floor(u), fv = floor(v);
+    precise float wu = u - fu, wv = v - fv;
+    int i0 = int(fu), i1 = i0 + 1, j0 = int(fv), j1 = j0 + 1;
+    if ((s.image.w & kLayersTiling) != 0u) {
+        i0 = i0 < 0 ? i0 + nx : i0;
+        i1 = i1 >= nx ? i1 - nx : i1;
+        j0 = j0 < 0 ? j0 + ny : j0;
+        j1 = j1 >= ny ? j1 - ny : j1;
+    } else {
+        i0 = clamp(i0, 0, nx - 1);
+        i1 = clamp(i1, 0, nx - 1);
+        j0 = clamp(j0, 0, ny - 1);
+        j1 = clamp(j1, 0, ny - 1);
+    }
+    return Lerp(Lerp(LayersMapValue(uint(i0 + nx * j0)), LayersMapValue(uint(i1 + nx * j0)), wu),
+                Lerp(LayersMapValue(uint(i0 + nx * j1)), LayersMapValue(uint(i1 + nx * j1)), wu), wv);
+}
+
 struct LayerFragmentResult {
     bool crossed, drawn;
     float alpha;
@@ -88,9 +114,13 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     const vec2 qt = PaddedBlend(s.phase.z, s.phase.w, PaddedTapsAt(s.size.xyz, s.phase.z, s.phase.w, vec3(x, y, z)));
     if (!(qt.x > 0.0)) return f;
     f.drawn = true;
-    precise float length = min(s.invSize.w * abs(invDz), s.background.w);
-    precise float alpha = 1.0 - SegmentTransmittance(s.size.w, qt.x, length);
-    f.alpha = alpha;
+    if ((s.image.w & kLayersWang) != 0u) {
+        f.alpha = CoverageModulate(qt.x, LayersMapAt(s, x, y), s.drift.z, s.drift.w);
+    } else {
+        precise float length = min(s.invSize.w * abs(invDz), s.background.w);
+        precise float alpha = 1.0 - SegmentTransmittance(s.size.w, qt.x, length);
+        f.alpha = alpha;
+    }
     precise float gain = qt.y * sunPhase;
     precise vec3 c = vec3(s.sunRadiance.x * gain + s.ambient.x, s.sunRadiance.y * gain + s.ambient.y,
                           s.sunRadiance.z * gain + s.ambient.z);

@@ -1,6 +1,6 @@
 // GLSL twin of core/math/Noise.h (SPEC 10a): Perlin, simplex and Worley noise, fBm,
 // and the forming of q (height distribution, towers, detail erosion, threshold
-// or coverage). Needs random.glsl. Line by line the same operations as the C++
+// or coverage). Needs random.glsl and shading.glsl (CoverageModulate). Line by line the same operations as the C++
 // (built with -ffp-contract=off), written `precise` so nothing is fused.
 //
 // The shader that includes this defines NoiseWord(index): word `index` of the
@@ -205,12 +205,6 @@ float NoiseThreshold(float v, float c) {
     return NoiseClamp01(r);
 }
 
-float NoiseCoverageModulate(float v, float m, float coverage, float density) {
-    precise float excess = v - (m + 1.0 - coverage);
-    precise float r = density * (excess > 0.0 ? excess : 0.0);
-    return r < 1.0 ? r : 1.0;  // std::min(r, 1)
-}
-
 float NoiseErode(float v, float d, float strength) {
     precise float e = strength * d;
     precise float r = (v - e) / (1.0 - e);
@@ -304,7 +298,7 @@ float NoiseQ(float offsets[8], uint i, uint j, uint k) {
     precise float v = base * NoiseFloat(NoiseWord(kNoiseHeights) + k) + NoiseTowersAt(i, j, k);
     if (NoiseWord(kNoiseDetailOn) != 0u) v = NoiseErode(v, NoiseDetailAt(offsets, i, j, k), NoiseFloat(kNoiseStrength));
     if (NoiseWord(kNoiseCoverageOn) != 0u)
-        return NoiseCoverageModulate(v, NoiseMapAt(offsets, i, j), NoiseFloat(kNoiseCoverage), NoiseFloat(kNoiseDensity));
+        return CoverageModulate(v, NoiseMapAt(offsets, i, j), NoiseFloat(kNoiseCoverage), NoiseFloat(kNoiseDensity));
     return NoiseThreshold(v, NoiseFloat(kNoiseThresholdWord));
 }
 

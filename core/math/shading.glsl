@@ -130,6 +130,13 @@ float ArcCos(float x) {
     return result;
 }
 
+// Wang, Ji and Zhang's eq. 16 (core/math/Shading.h CoverageModulate).
+float CoverageModulate(float v, float m, float coverage, float density) {
+    precise float excess = v - (m + 1.0 - coverage);
+    precise float r = density * (excess > 0.0 ? excess : 0.0);
+    return r < 1.0 ? r : 1.0;  // std::min(r, 1)
+}
+
 // kappa = max(0, 1 - rho^2)^2 at splat coordinate (a, b) (core/math/Shading.h SplatKernel).
 float SplatKernel(float a, float b) {
     precise float x = 2.0 * a - 1.0, y = 2.0 * b - 1.0;

@@ -20,10 +20,11 @@ LayersGpu MakeLayersGpu(const LayersParams& params) {
     g.sunRadiance = {s.sunRadiance[0], s.sunRadiance[1], s.sunRadiance[2], s.outer2};
     g.ambient = {s.ambient[0], s.ambient[1], s.ambient[2], kMieCloudTable.indexPerRadian};
     g.background = {s.background[0], s.background[1], s.background[2], s.maxLength};
-    g.image = {c.width, c.height, s.count, s.tiling ? uint32_t(kLayersGpuTiling) : 0u};
+    g.image = {c.width, c.height, s.count,
+               (s.tiling ? uint32_t(kLayersGpuTiling) : 0u) | (s.wang ? uint32_t(kLayersGpuWang) : 0u)};
     const uint32_t px = uint32_t(s.size[0]) + 2u, py = uint32_t(s.size[1]) + 2u;
     g.phase = {uint32_t(s.phase.kind), kMieCloudTable.count, px, px * py};
-    g.drift = {s.drift[0], s.drift[1], 0.0f, 0.0f};
+    g.drift = {s.drift[0], s.drift[1], s.coverage, s.density};
     return g;
 }
 

@@ -15,6 +15,7 @@ namespace cb {
 // LayersGpu.image.w bits.
 enum LayersGpuFlag : uint32_t {
     kLayersGpuTiling = 1u << 0,  // the volume repeats in x and y
+    kLayersGpuWang = 1u << 1,    // wang opacity (eq. 16 with the modulation map)
 };
 
 struct LayersGpu {
@@ -30,7 +31,7 @@ struct LayersGpu {
     std::array<float, 4> background;   // rgb; w: l_max (voxel edges)
     std::array<uint32_t, 4> image;     // width, height, N, LayersGpuFlag bits
     std::array<uint32_t, 4> phase;     // PhaseKind, the Mie table's count, padded strides px, px * py
-    std::array<float, 4> drift;        // xy: the wind's drift (voxel units); zw: unused
+    std::array<float, 4> drift;        // xy: the wind's drift (voxel units); z: coverage C; w: density D_w
 };
 static_assert(sizeof(LayersGpu) == 13 * 16, "LayersGpu is thirteen 16-byte rows");
 

@@ -8,11 +8,13 @@ layout(std430, binding = 2) readonly buffer LayersVolume { vec2 layersQT[]; };
 layout(std430, binding = 3) readonly buffer LayersPhaseTable { float layersPhaseTable[]; };
 // fragments, drawn: 64-bit sums as (low, high) word pairs.
 layout(std430, binding = 4) buffer LayersCounters { uint layersCounters[]; };
+layout(std430, binding = 5) readonly buffer LayersMap { float layersMap[]; };  // read with wang opacity only
 flat in uint layerIndex;
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return layersQT[paddedIndex]; }
 float PhaseTableValue(uint i) { return layersPhaseTable[i]; }
+float LayersMapValue(uint i) { return layersMap[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here
 
 void LayersCount(uint n) {

@@ -18,6 +18,7 @@ out float gl_ClipDistance[1];
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(0.0, 1.0); }
 bool MarchBrickEmpty(uint brick) { return false; }
 float PhaseTableValue(uint i) { return 1.0; }
+float LayersMapValue(uint i) { return 0.0; }
 
 void main() {
     const uint i = layerOrder[gl_InstanceID];

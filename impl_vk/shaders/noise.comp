@@ -4,6 +4,7 @@
 // the step's offsets.
 #extension GL_GOOGLE_include_directive : require
 #include "random.glsl"
+#include "shading.glsl"
 #include "noise.glsl"
 
 layout(local_size_x = 64) in;

@@ -19,9 +19,11 @@ layout(std430, binding = 2) readonly buffer Mie { float mieTable[]; };  // read 
 layout(std430, binding = 3) writeonly buffer Image { float image[]; };
 // Words 2 n, 2 n + 1: counter n (low, high) of fragments, drawn.
 layout(std430, binding = 4) buffer Stats { uint stats[]; };
+layout(std430, binding = 5) readonly buffer Map { float layersMap[]; };  // read with wang opacity only
 
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
 float PhaseTableValue(uint i) { return mieTable[i]; }
+float LayersMapValue(uint i) { return layersMap[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here
 
 shared uint gCounts[2];

@@ -33,6 +33,8 @@ bool MarchBrickEmpty(uint brick) { return brick % 3u == 0u; }
 // ground.glsl's G: a hash of the cell (tests/GlslTwinMarchCases.cpp TwinGroundG).
 float GroundFetchG(uint i, uint j) { return float(LowBias32(i + 4096u * j) >> 8u) * (1.0 / 16777216.0); }
 float PhaseTableValue(uint i) { return mieTable[i]; }
+// layers.glsl's modulation map: a hash of the column index (tests/GlslTwinHarness.h TwinLayersMap).
+float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1.0 / 16777216.0); }
 
 MarchGpu ZeroMarch() {
     return MarchGpu(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0),
@@ -142,7 +144,7 @@ void main() {
         }
         case 32u:
             PutF(0u, NoiseThreshold(F(0u), F(1u)));
-            PutF(1u, NoiseCoverageModulate(F(0u), F(2u), F(3u), F(4u)));
+            PutF(1u, CoverageModulate(F(0u), F(2u), F(3u), F(4u)));
             PutF(2u, NoiseErode(F(0u), F(5u), F(6u)));
             PutI(3u, NoiseWrapIndex(I(7u), I(8u)));
             PutF(4u, NoiseRound(F(9u)));

@@ -144,32 +144,34 @@ void ReadDetail(const Json& root, Validator& check, NoiseDetail& detail) {
         CheckFrequencies(detail.fbm, &detail.frequency, 1, "noise.detail.frequency", check);
 }
 
-void ReadCoverage(const Json& root, Validator& check, NoiseCoverage& coverage) {
-    const Json* section = check.Section(root, "noise", "coverage", kCoverageKeys);
+}  // namespace
+
+void ReadCoverage(const Json& parent, std::string_view parentField, std::string_view key, Validator& check,
+                  NoiseCoverage& coverage) {
+    const Json* section = check.Section(parent, parentField, key, kCoverageKeys);
     if (!section) return;
     coverage.enabled = true;
+    const std::string path = std::string(parentField) + "." + std::string(key) + ".";
+    auto field = [&](const char* name) { return path + name; };
     if (const Json* v = Validator::Find(*section, "coverage")) {
-        if (auto d = check.Number(*v, "noise.coverage.coverage", kProbability)) coverage.coverage = *d;
+        if (auto d = check.Number(*v, field("coverage"), kProbability)) coverage.coverage = *d;
     }
     if (const Json* v = Validator::Find(*section, "density")) {
-        if (auto d = check.Number(*v, "noise.coverage.density", Range{.lo = 0, .hi = 1e6})) coverage.density = *d;
+        if (auto d = check.Number(*v, field("density"), Range{.lo = 0, .hi = 1e6})) coverage.density = *d;
     }
     if (const Json* v = Validator::Find(*section, "frequency")) {
-        if (auto n = check.Integers<2>(*v, "noise.coverage.frequency", 1, kMaxLatticeFrequency))
+        if (auto n = check.Integers<2>(*v, field("frequency"), 1, kMaxLatticeFrequency))
             coverage.frequency = {uint32_t((*n)[0]), uint32_t((*n)[1])};
     }
     if (const Json* v = Validator::Find(*section, "octaves")) {
-        if (auto n = check.Integer(*v, "noise.coverage.octaves", 1, 16)) coverage.octaves = uint32_t(*n);
+        if (auto n = check.Integer(*v, field("octaves"), 1, 16)) coverage.octaves = uint32_t(*n);
     }
     if (const Json* v = Validator::Find(*section, "gain")) {
-        if (auto d = check.Number(*v, "noise.coverage.gain", Range{.lo = 0, .loOpen = true, .hi = 1}))
-            coverage.gain = *d;
+        if (auto d = check.Number(*v, field("gain"), Range{.lo = 0, .loOpen = true, .hi = 1})) coverage.gain = *d;
     }
     const FbmSettings map{NoiseBasis::Perlin, coverage.octaves, coverage.gain, 2, false};
-    CheckFrequencies(map, coverage.frequency.data(), 2, "noise.coverage.frequency", check);
+    CheckFrequencies(map, coverage.frequency.data(), 2, field("frequency"), check);
 }
-
-}  // namespace
 
 void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise) {
     const Json* section = check.Section(root, "", "noise", kNoiseKeys);
@@ -199,7 +201,7 @@ void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise) {
         if (auto d = check.Number(*v, "noise.threshold", Range{.lo = 0, .hi = kMaxFraction})) noise.threshold = *d;
     }
     ReadDetail(*section, check, noise.detail);
-    ReadCoverage(*section, check, noise.coverage);
+    ReadCoverage(*section, "noise", "coverage", check, noise.coverage);
     if (const Json* v = find("drift")) {
         if (auto a = check.Numbers<3>(*v, "noise.drift", Range{.lo = -kMaxVoxels, .hi = kMaxVoxels})) noise.drift = *a;
     }

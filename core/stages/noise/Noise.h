@@ -15,6 +15,10 @@ namespace cb {
 
 namespace scene_io {
 void ReadNoise(const Json& root, Validator& check, NoiseSettings& noise);
+// Section `key` of `parent` (at `parentField`) as Wang, Ji and Zhang's eq. 15-16 settings: coverage, density and
+// the 2-D map's frequency, octaves and gain (noise.coverage, and render_layers' layers.wang); enabled when present.
+void ReadCoverage(const Json& parent, std::string_view parentField, std::string_view key, Validator& check,
+                  NoiseCoverage& coverage);
 }  // namespace scene_io
 
 // Points into scene.noise: the scene must outlive the parameters.

@@ -5,12 +5,14 @@
 #include <string>
 #include <string_view>
 
+#include "core/math/Noise.h"
 #include "core/scene/SceneReaders.h"
+#include "core/stages/noise/Noise.h"
 
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLayersKeys[] = {"count", "extent", "max_length", "wind", "exposure", "tone_map"};
+constexpr std::string_view kLayersKeys[] = {"count", "extent", "max_length", "wind", "wang", "exposure", "tone_map"};
 
 // At most this many layers per voxel edge of height: SPEC 15 measures up to 4; more only multiplies the work.
 constexpr uint32_t kMaxLayersPerVoxel = 16;
@@ -35,6 +37,7 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
     if (const Json* v = find("wind")) {
         if (auto a = check.Numbers<2>(*v, "layers.wind", Range{.lo = -1e6, .hi = 1e6})) layers.wind = *a;
     }
+    ReadCoverage(*section, "layers", "wang", check, layers.wang);
     if (const Json* v = find("exposure")) {
         if (auto d = check.Number(*v, "layers.exposure", kSinglePositive)) layers.exposure = *d;
     }
@@ -90,7 +93,25 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     s.ambient = sc.lighting.Ambient();
     s.background = sc.lighting.Background();
     s.phase = sc.phase;
+    s.wang = sc.layers.wang.enabled;
+    s.coverage = float(sc.layers.wang.coverage);
+    s.density = float(sc.layers.wang.density);
     return p;
+}
+
+std::vector<float> MakeLayersMap(const Scene& sc, uint32_t step) {
+    if (!sc.layers.wang.enabled) return {};
+    NoiseSettings settings = sc.noise;  // its seed and drift; the map alone is evaluated
+    settings.coverage = sc.layers.wang;
+    settings.detail.enabled = false;
+    settings.towers.clear();
+    const Extent3 e = sc.grid.size;
+    const noise::NoiseForm form(settings, e);
+    const noise::StepOffsets offsets = form.Offsets(step);
+    std::vector<float> map(size_t(e.nx) * e.ny);
+    for (uint32_t j = 0; j < e.ny; ++j)
+        for (uint32_t i = 0; i < e.nx; ++i) map[i + size_t(e.nx) * j] = form.Map(offsets, i, j);
+    return map;
 }
 
 #pragma GCC diagnostic push
@@ -113,9 +134,11 @@ const StageDescriptor& DescribeRenderLayers() {
 
 Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
                         StageCallRecord& record) {
+    const std::vector<float> map = MakeLayersMap(sc, host.step);  // one per call, for every camera
     return RenderEachCamera(
         Stage::RenderLayers, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            const LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            p.setup.map = map.empty() ? nullptr : map.data();
             const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
             return timed(
                 [&] { return backend.RenderLayers(p, in, *io.Current(Resource::LayersImage, n), &frame.layers); });

@@ -19,9 +19,13 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
 }  // namespace scene_io
 
 // The layered renderer's parameters for one camera at `step` (the sun), frame `frame` of a step of `frames`
-// frames (its alpha).
+// frames (its alpha). With layers.wang the caller points setup.map at MakeLayersMap's values.
 LayersParams MakeLayersParams(const Scene& scene, const CameraSettings& camera, uint32_t step, uint32_t frame = 0,
                               uint32_t frames = 0);
+// With layers.wang, the modulation map m at `step`: the noise stage's weather map (core/math/Noise.h
+// NoiseForm::Map) with layers.wang's frequency, octaves and gain, the scene's noise seed and drift, at each column
+// centre (nx * ny values, x fastest); empty without.
+std::vector<float> MakeLayersMap(const Scene& scene, uint32_t step);
 
 const StageDescriptor& DescribeRenderLayers();
 Status CallRenderLayers(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io,

@@ -11,6 +11,7 @@
 #include "core/base/Counter.h"
 #include "core/math/Camera.h"
 #include "core/math/Layers.h"
+#include "core/math/NoiseSettings.h"
 
 namespace cb {
 
@@ -24,6 +25,9 @@ struct LayersSettings {
     // The wind (Wang, Ji and Zhang, eq. 18): the clouds drift by this many metres per step in x and y, at the
     // frame's time step - 1 + alpha (as q's interpolation).
     std::array<double, 2> wind{0, 0};
+    // Enabled: the opacity is Wang, Ji and Zhang's eq. 16 (coverage C, density factor D_w) of q and a 2-D
+    // modulation map m of the noise stage's weather-map form (frequency, octaves, gain); else beer's.
+    NoiseCoverage wang;
     double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
     bool toneMap = true;    // PNG only; false: clamp(exposure C)
 };
