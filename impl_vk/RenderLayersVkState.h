@@ -10,7 +10,7 @@ namespace cb::vk {
 
 struct RenderLayersVkState {
     static constexpr Stage kStage = Stage::RenderLayers;
-    BufferSlot frame;     // the constants (core/pipeline/LayersGpu.h), 208 bytes
+    BufferSlot frame;     // the constants (core/pipeline/LayersGpu.h), 224 bytes
     BufferSlot volume;    // the padded (q_alpha, T) volume, wrapped horizontally with tiling
     BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
     BufferSlot stats;     // the LayersStats counters, 64-bit as two words each

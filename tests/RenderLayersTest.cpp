@@ -16,8 +16,10 @@
 
 #include "core/math/Layers.h"
 #include "core/math/Shading.h"
+#include "core/plan/SceneLoad.h"
 #include "core/plan/StageGraph.h"
 #include "core/stages/render_layers/RenderLayers.h"
+#include "core/stages/shade/Shade.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/MarchTestUtil.h"
@@ -250,6 +252,48 @@ TEST_P(RenderLayersAll, WangOpacityIsEq16OfQAndTheMap) {
             EXPECT_GT(clear, 20u) << "count " << count << " eye z " << eye[2];
             EXPECT_LT(worst, 1e-5) << "count " << count << " eye z " << eye[2];  // float rounding of k blends
         }
+}
+
+// Test relighting's factor on every backend: T with lightScale 1/2 gives the image of T/2 (exact in float) with
+// lightScale 1, bit for bit, for the eye below, inside and above.
+TEST_P(RenderLayersAll, LightScaleScalesTBitForBit) {
+    const Extent3 e{11, 9, 6};
+    for (const auto& eye : Eyes(e)) {
+        LayersCase scaled = BlobLayers(e);
+        scaled.params = CameraLayers(e, eye, {0.5 * e.nx, 0.6 * e.ny, 0.5 * e.nz}, 31, 23, 6, true);
+        LayersCase halved = scaled;
+        scaled.params.setup.lightScale = 0.5f;
+        for (float& t : halved.T) t *= 0.5f;
+        const LayersImage a = RenderLayersOn(*mBackend, scaled), b = RenderLayersOn(*mBackend, halved);
+        ASSERT_TRUE(a.ok && b.ok);
+        EXPECT_GT(a.stats.drawn, 0u);
+        for (size_t i = 0; i < a.rgb.size(); ++i)
+            ASSERT_EQ(std::bit_cast<uint32_t>(a.rgb[i]), std::bit_cast<uint32_t>(b.rgb[i])) << "eye z " << eye[2];
+    }
+}
+
+// Test what relighting asks of the host: shade lights toward the first step's sun at every step, so the loop
+// shades once, and each frame scales T by max(0, s0 . s); without it shade follows the sun and the factor is 1.
+TEST(RenderLayersRelight, ShadesOnceAndScalesByTheSunsCosine) {
+    const std::string path = std::string(CLOUDBENCH_SCENES_DIR) + "/layers-small.json";
+    const std::vector<SceneOverride> moving = {{"steps", "6"},
+                                               {"sun.speed", R"({"azimuth_deg": 20, "elevation_deg": -4})"}};
+    std::vector<SceneOverride> relit = moving;
+    relit.push_back({"layers.relight", R"("vector")"});
+    Result<Scene> plain = LoadScene(path, moving), vector = LoadScene(path, relit);
+    ASSERT_TRUE(plain && vector) << (plain ? vector.error().message : plain.error().message);
+    const Vec3 s0 = vector->sun.DirectionAt(0);
+    for (uint32_t step : {0u, 3u, 5u}) {
+        const Vec3 s = vector->sun.DirectionAt(step);
+        EXPECT_EQ(ShadeSunAt(*vector, step), s0) << step;
+        EXPECT_EQ(MakeShadeParams(*vector, step).sun, s0) << step;
+        EXPECT_EQ(ShadeSunAt(*plain, step), s) << step;
+        const float cosine = s0[0] * s[0] + s0[1] * s[1] + s0[2] * s[2];
+        EXPECT_NEAR(MakeLayersParams(*vector, vector->render.cameras[0], step).setup.lightScale, cosine, 1e-6f);
+        EXPECT_EQ(MakeLayersParams(*vector, vector->render.cameras[0], step).setup.sun, s) << step;
+        EXPECT_EQ(MakeLayersParams(*plain, plain->render.cameras[0], step).setup.lightScale, 1.0f) << step;
+    }
+    EXPECT_LT(MakeLayersParams(*vector, vector->render.cameras[0], 5).setup.lightScale, 0.9f);  // the sun moved
 }
 
 // Test Wang, Ji and Zhang's wind (eq. 18) on every backend: with tiling, a drift of whole voxels (3, -2) gives the

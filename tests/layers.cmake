@@ -12,7 +12,9 @@ set(layers_cases
     "WindThreeSteps|layers-small|--steps|3|--set|layers.wind=[170,-45]|--set|render.alpha=0.4"
     # Wang, Ji and Zhang's opacity (eq. 16) with its modulation map, tiled and not.
     "WangOpacity|layers-small|--set|layers.wang={\"coverage\":0.8,\"density\":2.5,\"frequency\":[2,1]}"
-    "WangOpacityUntiled|layers-small|--set|grid.tiling=false|--set|layers.wang={\"coverage\":0.9,\"octaves\":2}")
+    "WangOpacityUntiled|layers-small|--set|grid.tiling=false|--set|layers.wang={\"coverage\":0.9,\"octaves\":2}"
+    # Relighting under a moving sun: T shaded once, scaled per step.
+    "RelightMovingSun|layers-small|--steps|3|--set|sun.speed={\"azimuth_deg\":12}|--set|layers.relight=\"vector\"")
 foreach(entry ${layers_cases})
   string(REPLACE "|" ";" fields "${entry}")
   list(POP_FRONT fields name scene)
@@ -43,3 +45,23 @@ add_test(NAME Cli.WangFpsQuick COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_D
 set_tests_properties(Cli.WangFpsQuick PROPERTIES TIMEOUT 180
   PASS_REGULAR_EXPRESSION "\\| wang-20km \\| cpu \\| track average \\|[^\n]*up to 390 fps.*\\| wang-90km \\| cpu \\| track average \\|[^\n]*still exceeding 350 fps"
   FAIL_REGULAR_EXPRESSION "not measured")
+# Relighting (layers.relight "vector") shades once under a moving sun, where "shade" shades every step; and
+# tools/relight_error.py keeps working (one quick round: a row per step and camera, and shade's time both ways).
+set(cli_relight_script [=[d="$1"; rm -rf "$d"; set -e
+for m in shade vector; do
+  "$0" run layers-small --backend cpu --quiet --out "$d/$m" --steps 3 --set render.every_steps=1 \
+    --set 'sun.speed={"azimuth_deg":15}' --set "layers.relight=\"$m\"" >/dev/null
+done
+/usr/bin/python3 - "$d" <<'PY'
+import json, sys
+runs = {m: json.load(open(f"{sys.argv[1]}/{m}/results.json"))["backends"]["cpu"]["stage_runs"]["shade"]["ran"]
+        for m in ("shade", "vector")}
+assert runs == {"shade": 3, "vector": 1}, runs
+print("relight: ok")
+PY]=])
+add_test(NAME Cli.LayersRelightShadesOnce COMMAND bash -c "${cli_relight_script}" ${cli} ${cli_out}/relight)
+set_tests_properties(Cli.LayersRelightShadesOnce PROPERTIES PASS_REGULAR_EXPRESSION "relight: ok")
+add_test(NAME Cli.RelightErrorQuick COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/../tools/relight_error.py
+                                            --quick --cli ${cli} --out ${cli_out}/relight-quick)
+set_tests_properties(Cli.RelightErrorQuick PROPERTIES TIMEOUT 120
+  PASS_REGULAR_EXPRESSION "\\| 2 \\| [0-9.]+ \\| below \\| [0-9.e-]+ \\| [0-9.]+ \\|.*relight vector: [0-9.]+")

@@ -38,6 +38,7 @@ struct LayersSetup {
     float coverage = 1, density = 1;
     const float* map = nullptr;
     Vec3 sun{0, 0, 1};      // unit, toward the sun
+    float lightScale = 1;   // T's factor: 1, or with relighting max(0, s0 . s) (SPEC 15)
     Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
     PhaseParams phase;
 };
@@ -128,7 +129,7 @@ inline LayersRay MakeLayersRay(const CameraFrame& c, float voxelSize, uint32_t x
 // and (without tiling) inside the box, where q > 0. Its opacity is beer's,
 // alpha = 1 - exp(-sigma h q l), l = min(spacing / |d_z|, l_max), or wang's
 // (eq. 16 of q and the map, without a path length); its colour
-// c = sun T P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
+// c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
 struct LayerFragmentResult {
     bool crossed = false;  // the plane is met in range (a counted fragment)
     bool drawn = false;    // and q > 0 there
@@ -164,7 +165,7 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
         const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
         f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
     }
-    const float gain = qt[1] * sunPhase;
+    const float gain = (qt[1] * s.lightScale) * sunPhase;
     f.color = {s.sunRadiance[0] * gain + s.ambient[0], s.sunRadiance[1] * gain + s.ambient[1],
                s.sunRadiance[2] * gain + s.ambient[2]};
     return f;

@@ -27,6 +27,7 @@ struct LayersGpu {
     uvec4 image;       // width, height, N, flags
     uvec4 phase;       // kind, Mie count, px, px * py
     vec4 drift;        // xy the wind's drift (voxel units); z coverage C, w density D_w (wang)
+    vec4 light;        // x T's factor (relighting); yzw unused
 };
 
 const uint kLayersTiling = 1u;
@@ -121,7 +122,7 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
         precise float alpha = 1.0 - SegmentTransmittance(s.size.w, qt.x, length);
         f.alpha = alpha;
     }
-    precise float gain = qt.y * sunPhase;
+    precise float gain = (qt.y * s.light.x) * sunPhase;
     precise vec3 c = vec3(s.sunRadiance.x * gain + s.ambient.x, s.sunRadiance.y * gain + s.ambient.y,
                           s.sunRadiance.z * gain + s.ambient.z);
     f.color = c;

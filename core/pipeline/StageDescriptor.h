@@ -119,9 +119,9 @@ struct StageDescriptor {
     bool outputStepsOnly = false;
     // Skipped when none of its inputs changed since it last ran.
     bool skipsUnchangedInputs = false;
-    // Reads the sun's direction at the step (a host input): with
-    // skipsUnchangedInputs, a change of direction counts as a changed input.
-    bool readsSun = false;
+    // The sun's direction it receives at the step (a host input), nullptr: it reads none. With
+    // skipsUnchangedInputs, a change of that direction counts as a changed input.
+    Vec3 (*sunAt)(const Scene& scene, uint32_t step) = nullptr;
     // True when its outputs depend on the step itself in this scene (a time
     // coordinate): it then runs every step despite skipsUnchangedInputs.
     // nullptr: never (a stage with no inputs and no time runs once).

@@ -142,6 +142,17 @@ void CheckTiling(const Scene& scene, Validator& check) {
                                           " does not repeat the volume yet; only render_layers honours tiling");
 }
 
+// Relighting shades once, for the first step's sun: a renderer other than render_layers would read that T as if
+// it were shaded at its own step's sun.
+void CheckRelight(const Scene& scene, Validator& check) {
+    if (scene.layers.relight != LayersRelight::Vector) return;
+    for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch})
+        if (scene.stages.Has(renderer))
+            check.Fail("layers.relight", "\"vector\" shades once, for the first step's sun, and " +
+                                             Quote(StageName(renderer)) +
+                                             " would light with that T at every step; run it without relighting");
+}
+
 void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& sections, Validator& check) {
     if (sections.stageList) CheckStageInputs(scene.stages, check);
     // Every renderer draws one image per camera.
@@ -164,6 +175,7 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
 
     if (sections.steps) CheckSunSpeed(scene, check);
     CheckTiling(scene, check);
+    CheckRelight(scene, check);
     CheckOpticalDepths(scene, check);
     CheckLightningPosition(scene, check);
 

@@ -83,10 +83,10 @@ std::vector<uint64_t> Simulation::InputVersions(Stage stage, uint32_t step) cons
     const StageDescriptor& d = Describe(stage);
     for (Resource r : d.reads) versions.push_back(mSlots[size_t(r)].version);
     for (Resource r : d.optionalReads) versions.push_back(mSlots[size_t(r)].version);  // 0 when never written
-    if (d.readsSun) {
+    if (d.sunAt) {
         // The sun's direction at the step as the stage receives it (single precision): a stage re-runs when it
         // differs in any bit from the direction of its last run, and only then.
-        const Vec3 s = mScene.sun.DirectionAt(step);
+        const Vec3 s = d.sunAt(mScene, step);
         for (float c : s) versions.push_back(std::bit_cast<uint32_t>(c));
     }
     return versions;

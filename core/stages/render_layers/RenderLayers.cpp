@@ -12,7 +12,12 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLayersKeys[] = {"count", "extent", "max_length", "wind", "wang", "exposure", "tone_map"};
+constexpr std::string_view kLayersKeys[] = {"count", "extent",  "max_length", "wind",
+                                            "wang",  "relight", "exposure",   "tone_map"};
+constexpr std::array<NamedValue<LayersRelight>, 2> kLayersRelightNames{{
+    {"shade", LayersRelight::Shade},
+    {"vector", LayersRelight::Vector},
+}};
 
 // At most this many layers per voxel edge of height: SPEC 15 measures up to 4; more only multiplies the work.
 constexpr uint32_t kMaxLayersPerVoxel = 16;
@@ -38,6 +43,9 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
         if (auto a = check.Numbers<2>(*v, "layers.wind", Range{.lo = -1e6, .hi = 1e6})) layers.wind = *a;
     }
     ReadCoverage(*section, "layers", "wang", check, layers.wang);
+    if (const Json* v = find("relight")) {
+        if (auto kind = check.Choice(*v, "layers.relight", kLayersRelightNames)) layers.relight = *kind;
+    }
     if (const Json* v = find("exposure")) {
         if (auto d = check.Number(*v, "layers.exposure", kSinglePositive)) layers.exposure = *d;
     }
@@ -89,6 +97,9 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
         s.drift[a] = float(d);
     }
     s.sun = sc.sun.DirectionAt(step);
+    // Relighting: shade's T is the first step's (ShadeSunAt); n . s = T (s0 . s) with n = T s0.
+    if (sc.layers.relight == LayersRelight::Vector)
+        s.lightScale = std::max(0.0f, MarchDot(sc.sun.DirectionAt(0), s.sun));
     s.sunRadiance = sc.sun.Radiance();
     s.ambient = sc.lighting.Ambient();
     s.background = sc.lighting.Background();

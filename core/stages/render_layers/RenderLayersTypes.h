@@ -17,6 +17,10 @@ namespace cb {
 
 class Buffer;  // core/pipeline/Backend.h
 
+// Where a layer fragment's light comes from (SPEC 15): shade's T at the frame's sun, or Wang, Ji and Zhang's
+// relighting: T shaded once for the first step's sun s0, scaled by max(0, s0 . s) for the frame's sun s.
+enum class LayersRelight : uint8_t { Shade, Vector };
+
 struct LayersSettings {
     uint32_t count = 0;     // N; 0: the grid's nz (one layer on each voxel-centre plane)
     double extent = 0;      // metres, the layers' horizontal radius around the eye; 0: each camera's far plane
@@ -28,6 +32,7 @@ struct LayersSettings {
     // Enabled: the opacity is Wang, Ji and Zhang's eq. 16 (coverage C, density factor D_w) of q and a 2-D
     // modulation map m of the noise stage's weather-map form (frequency, octaves, gain); else beer's.
     NoiseCoverage wang;
+    LayersRelight relight = LayersRelight::Shade;
     double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
     bool toneMap = true;    // PNG only; false: clamp(exposure C)
 };

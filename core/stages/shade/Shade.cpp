@@ -96,7 +96,7 @@ CompareRule ShadeRule(const Scene& scene) {
 // Time-slicing's shares (SliceRange): the sweep's slices, whose axis follows the sun at the step.
 uint32_t SweepSlices(const Scene& scene, uint32_t step) {
     ShadeParams p;  // the plan's slices depend on the sun and the resolution alone
-    p.sun = scene.sun.DirectionAt(step);
+    p.sun = ShadeSunAt(scene, step);
     p.resolution = scene.shade.resolution;
     return MakeShadePlan(p, scene.grid.size).nw;
 }
@@ -106,9 +106,13 @@ uint32_t SweepSlices(const Scene& scene, uint32_t step) {
 const ChoiceSetting& ShadeResolutionSetting() { return kShadeResolution; }
 const ChoiceSetting& ShadeScatteringSetting() { return kShadeScattering; }
 
+Vec3 ShadeSunAt(const Scene& sc, uint32_t step) {
+    return sc.layers.relight == LayersRelight::Vector ? sc.sun.DirectionAt(0) : sc.sun.DirectionAt(step);
+}
+
 ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
     ShadeParams p;
-    p.sun = sc.sun.DirectionAt(step);
+    p.sun = ShadeSunAt(sc, step);
     p.attenuation = sc.shade.attenuation;
     p.sigma = float(sc.shade.sigma);
     p.voxelSize = float(sc.grid.voxelSize);
@@ -133,7 +137,7 @@ const StageDescriptor& DescribeShade() {
         .writes = {Resource::T},
         .outputStepsOnly = true,
         .skipsUnchangedInputs = true,
-        .readsSun = true,
+        .sunAt = ShadeSunAt,
         .shareCount = SweepSlices,
         .symbol = "T",
         .rule = ShadeRule,

@@ -17,7 +17,9 @@ namespace scene_io {
 void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
 }  // namespace scene_io
 
-// The sun is the scene's at `step` (SunSettings::DirectionAt; step 0 is the fixed sun's).
+// The sun shade lights toward at `step`: the scene's (SunSettings::DirectionAt; step 0 is the fixed sun's), or
+// with layers.relight "vector" the first step's at every step (Wang, Ji and Zhang's relighting: shade once).
+Vec3 ShadeSunAt(const Scene& scene, uint32_t step);
 ShadeParams MakeShadeParams(const Scene& scene, uint32_t step = 0);
 
 // Two of its choice settings (its descriptor's `choices`), for the commands that set them.

@@ -69,7 +69,7 @@ const StageDescriptor& DescribeShadow() {
         .writes = {Resource::Shadow},
         .outputStepsOnly = true,
         .skipsUnchangedInputs = true,
-        .readsSun = true,
+        .sunAt = [](const Scene& sc, uint32_t step) { return sc.sun.DirectionAt(step); },
         .symbol = "G",
         .rule = ShadowRule,
         .choices = kShadowChoices,
