@@ -65,3 +65,21 @@ add_test(NAME Cli.RelightErrorQuick COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOU
                                             --quick --cli ${cli} --out ${cli_out}/relight-quick)
 set_tests_properties(Cli.RelightErrorQuick PROPERTIES TIMEOUT 120
   PASS_REGULAR_EXPRESSION "\\| 2 \\| [0-9.]+ \\| below \\| [0-9.e-]+ \\| [0-9.]+ \\|.*relight vector: [0-9.]+")
+# accuracy measures render_layers against the exact reference render at 1/2, 1, 2 and 4 layers per voxel (untiled:
+# the reference clips to the box), and more layers come closer to it; a tiled scene's rows say the reference does not
+# tile.
+set(cli_layers_accuracy_script [=[d="$1"; rm -rf "$d"; set -e
+"$0" accuracy layers-small --backend cpu --quiet --out "$d/untiled" --set grid.tiling=false >/dev/null
+"$0" accuracy layers-small --backend cpu --quiet --out "$d/tiled" >/dev/null
+/usr/bin/python3 - "$d" <<'PY'
+import json, sys
+rows = [r for r in json.load(open(sys.argv[1] + "/untiled/accuracy.json"))["image_rows"] if r["renderer"] == "render_layers"]
+psnr = {r["label"]: r["error"]["psnr_db"] for r in rows if r["status"] == "ok"}
+assert set(psnr) == {"(scene)", "layers.count=4", "layers.count=16", "layers.count=32"}, psnr
+assert psnr["layers.count=4"] < psnr["(scene)"] < psnr["layers.count=16"], psnr
+tiled = [r for r in json.load(open(sys.argv[1] + "/tiled/accuracy.json"))["image_rows"] if r["renderer"] == "render_layers"]
+assert tiled and all(r["status"] == "unsupported" and "grid.tiling" in r["detail"] for r in tiled), tiled
+print("layers accuracy: ok")
+PY]=])
+add_test(NAME Cli.LayersAccuracyOverLayerCounts COMMAND bash -c "${cli_layers_accuracy_script}" ${cli} ${cli_out}/layers-accuracy)
+set_tests_properties(Cli.LayersAccuracyOverLayerCounts PROPERTIES PASS_REGULAR_EXPRESSION "layers accuracy: ok")

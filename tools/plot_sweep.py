@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots a `cloudbench sweep` result: error against time, one series per backend,
-one panel per stage (shade, shadow; the two renderers render_march and
-render_splat share one "images" panel, one series per renderer x backend), the
+one panel per stage (shade, shadow; the renderers render_march, render_splat and
+render_layers share one "images" panel, one series per renderer x backend), the
 Pareto front marked.
 
 Usage: plot_sweep.py SWEEP_JSON OUT_PNG [NAME]
@@ -27,7 +27,7 @@ def plot(doc, source):
         raise Failure("matplotlib cannot be imported: %s" % e)
     metric = doc["metric"]
     rows = [r for r in doc["rows"] if r["status"] == "ok"]
-    renderers = ("render_march", "render_splat")
+    renderers = ("render_march", "render_splat", "render_layers")
     for r in rows:
         # The renderers' rows go in one panel, a series per renderer x backend.
         r["panel"] = "images" if r["stage"] in renderers else r["stage"]

@@ -14,14 +14,14 @@ namespace {
 // Paths whose value changes only the lighting stages, not q or D.
 bool LightingOnly(const std::string& path) {
     for (const char* prefix :
-         {"shade", "shadow", "sun", "phase", "render", "lighting", "description", "march", "lightning"})
+         {"shade", "shadow", "sun", "phase", "render", "lighting", "description", "march", "lightning", "layers"})
         if (path == prefix || path.starts_with(std::string(prefix) + ".")) return true;
     return false;
 }
 
 // Fields that change how a renderer computes the image but not the physical
 // model the reference renders (the reference fixes its own step, light,
-// epsilon, jitter and skipping, and reads no shade, shadow or density setting).
+// epsilon, jitter and skipping, and reads no shade, shadow, density or layers setting).
 bool MethodOnlyPath(const std::string& p) {
     for (const char* exact :
          {"march.step", "march.adaptive.enabled", "march.adaptive.kappa", "march.adaptive.start", "march.jitter",
@@ -30,7 +30,7 @@ bool MethodOnlyPath(const std::string& p) {
           "render.skipping", "repeats", "warmup_steps"})
         if (p == exact) return true;
     if (p == "shade.sigma") return false;
-    for (const char* prefix : {"shade.", "shadow.", "density."})
+    for (const char* prefix : {"shade.", "shadow.", "density.", "layers."})
         if (p.starts_with(prefix)) return true;
     return false;
 }

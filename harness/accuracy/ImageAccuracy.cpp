@@ -8,6 +8,7 @@
 
 #include "core/scene/SceneNames.h"
 #include "core/stages/density/Density.h"
+#include "core/stages/render_layers/RenderLayers.h"
 #include "core/stages/render_march/RenderMarch.h"
 #include "core/stages/render_splat/RenderSplat.h"
 #include "core/stages/shade/Shade.h"
@@ -107,8 +108,11 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, int repea
 
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats) {
-    if (renderer != Stage::RenderMarch && renderer != Stage::RenderSplat)
-        return RenderNotMeasured("failed", "not a renderer");
+    if (!Describe(renderer).renderer) return RenderNotMeasured("failed", "not a renderer");
+    // The reference render clips its rays to the box: it would not be the same (infinite) clouds.
+    if (scene.grid.tiling)
+        return RenderNotMeasured("unsupported",
+                                 "the exact reference render does not repeat the volume (grid.tiling) yet");
     if (!backend.Supports(renderer))
         return RenderNotMeasured("unsupported",
                                  backend.Name() + " does not implement " + std::string(StageName(renderer)) + " yet");
@@ -123,7 +127,7 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     RenderAccuracy a;
     // T from shade on this backend, untimed in the render's time.
     std::unique_ptr<Buffer> T;
-    const bool needsT = renderer == Stage::RenderSplat || scene.march.light == MarchLightSource::Shade;
+    const bool needsT = renderer != Stage::RenderMarch || scene.march.light == MarchLightSource::Shade;
     if (needsT) {
         if (!backend.Supports(Stage::Shade))
             return RenderNotMeasured("unsupported", backend.Name() + " does not implement shade, which feeds T");
@@ -141,6 +145,12 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
         const MarchParams p = MakeMarchParams(scene, camera, in.step);
         const MarchInputs inputs{q->get(), q->get(), T.get()};
         time = TimeRepeated(repeats, [&] { return backend.RenderMarch(p, inputs, **image, nullptr); });
+    } else if (renderer == Stage::RenderLayers) {
+        LayersParams p = MakeLayersParams(scene, camera, in.step);
+        const std::vector<float> map = MakeLayersMap(scene, in.step);  // timed with the render, as in a run
+        p.setup.map = map.empty() ? nullptr : map.data();
+        const LayersInputs inputs{q->get(), q->get(), T.get()};
+        time = TimeRepeated(repeats, [&] { return backend.RenderLayers(p, inputs, **image, nullptr); });
     } else {
         SplatParams p = MakeSplatParams(scene, camera);
         const SplatOrder order = MakeSplatOrder(p.camera, scene.grid.size, scene.grid.origin, scene.grid.voxelSize);
@@ -195,6 +205,15 @@ std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& sc) {
     return out;
 }
 
+std::vector<std::vector<SceneOverride>> LayersImageVariants(const Scene& sc) {
+    // SPEC 15's layers per voxel of height: 1/2, 1, 2 and 4 (N = nz/2 ... 4 nz), the scene's count left out.
+    std::vector<std::vector<SceneOverride>> out;
+    const uint32_t nz = sc.grid.size.nz, count = sc.layers.count > 0 ? sc.layers.count : nz;
+    for (uint32_t n : {nz / 2, nz, 2 * nz, 4 * nz})
+        if (n >= 1 && n != count) out.push_back({{"layers.count", std::to_string(n)}});
+    return out;
+}
+
 Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<SceneOverride>& setting, Stage renderer,
                                         Backend& backend) {
     auto loaded = eval.Images().Load(setting);
@@ -224,6 +243,12 @@ Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<co
     if (scene.stages.Has(Stage::RenderSplat)) {
         const Stage splat[] = {Stage::RenderSplat};
         CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, splat, rows));
+    }
+    if (scene.stages.Has(Stage::RenderLayers)) {
+        const Stage layers[] = {Stage::RenderLayers};
+        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, layers, rows));
+        for (const auto& v : LayersImageVariants(scene))
+            CB_TRY(MeasureImageRows(refs, session, repeats, v, backends, layers, rows));
     }
     return json{{"rows", rows}, {"references", refs.Records()}};
 }

@@ -26,7 +26,7 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
     const CommonOptions& options = eval.Options();
     for (Stage stage : stages) {
         if (!scene.stages.Has(stage)) continue;
-        if (stage == Stage::RenderMarch || stage == Stage::RenderSplat) {
+        if (Describe(stage).renderer) {
             for (const OpenedBackend& slot : backends) {
                 Row row{setting, slot.name, stage, {}, false};
                 if (!slot.backend)

@@ -7,7 +7,7 @@ using nlohmann::json;
 
 namespace {
 
-bool IsRenderer(Stage s) { return s == Stage::RenderMarch || s == Stage::RenderSplat; }
+bool IsRenderer(Stage s) { return Describe(s).renderer; }
 
 }  // namespace
 

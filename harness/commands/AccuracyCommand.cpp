@@ -248,9 +248,12 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
     auto session = Session::Open(options, "accuracy");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
-    const bool images = scene.stages.Has(Stage::RenderMarch) || scene.stages.Has(Stage::RenderSplat);
+    const bool images =
+        std::ranges::any_of(kAllStages, [&](Stage s) { return Describe(s).renderer && scene.stages.Has(s); });
     if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow) && !images) {
-        std::fprintf(stderr, "%s: stages: accuracy needs \"shade\", \"shadow\", \"render_march\" or \"render_splat\"\n",
+        std::fprintf(stderr,
+                     "%s: stages: accuracy needs \"shade\", \"shadow\" or a renderer (\"render_splat\", "
+                     "\"render_march\", \"render_layers\")\n",
                      scene.path.c_str());
         return kExitBadScene;
     }

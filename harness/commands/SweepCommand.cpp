@@ -31,11 +31,11 @@ accurate) per stage and writes DIR/sweep.json, DIR/sweep.md and DIR/sweep.png
 (error against time, one series per backend; needs python3 with matplotlib,
 otherwise the plot is skipped with a message).
 
-When a varied field belongs to the march, render, phase or lightning sections,
-the scene's renderers (render_march, render_splat) are measured too, against
-the exact reference render (see cloudbench help accuracy): per-pixel error =
-max over channels of |C - C_ref|, and PSNR; both renderers share one Pareto
-front and one panel of the plot.
+When a varied field belongs to the march, render, phase, lightning or layers
+sections, the scene's renderers (render_march, render_splat, render_layers) are
+measured too, against the exact reference render (see cloudbench help
+accuracy): per-pixel error = max over channels of |C - C_ref|, and PSNR; the
+renderers share one Pareto front and one panel of the plot.
 
 Options:
   --vary PATH=V1,... a field and its values; repeat for more fields

@@ -26,8 +26,8 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
     auto error = [&](const Row& r) {
         return metric == "mean" ? r.result.all.mean : metric == "p99" ? r.result.all.p99 : r.result.all.max;
     };
-    // The two renderers share one front: they make the same image.
-    auto group = [](Stage s) { return s == Stage::RenderSplat ? Stage::RenderMarch : s; };
+    // The renderers share one front: they make the same image.
+    auto group = [](Stage s) { return Describe(s).renderer ? Stage::RenderMarch : s; };
     for (Row& r : rows) {
         if (r.result.status != "ok") continue;
         r.pareto = true;
@@ -47,14 +47,14 @@ std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
     // Fields of the image sections: the renderers are measured (the scene's own,
     // MeasureSetting skips the others); fields that only a renderer reads measure nothing else.
     auto imagePath = [](const std::string& p, bool withPhase) {
-        for (const char* prefix : {"march.", "render.", "lightning.", "phase."})
+        for (const char* prefix : {"march.", "render.", "lightning.", "phase.", "layers."})
             if (p.starts_with(prefix) && (withPhase || std::string_view(prefix) != "phase.")) return true;
         return false;
     };
     const bool images = std::ranges::any_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, true); });
     const bool onlyImages = std::ranges::all_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, false); });
     std::vector<Stage> renderers;
-    if (images) renderers = {Stage::RenderMarch, Stage::RenderSplat};
+    if (images) renderers = {Stage::RenderMarch, Stage::RenderSplat, Stage::RenderLayers};
     if (onlyImages) return renderers;
     bool onlyShade = true, onlyShadow = true;
     for (const SweepAxis& a : axes) {
