@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <numbers>
 
 #include "core/scene/SceneNames.h"
 #include "core/stages/density/Density.h"
@@ -211,6 +212,19 @@ std::vector<std::vector<SceneOverride>> LayersImageVariants(const Scene& sc) {
     const uint32_t nz = sc.grid.size.nz, count = sc.layers.count > 0 ? sc.layers.count : nz;
     for (uint32_t n : {nz / 2, nz, 2 * nz, 4 * nz})
         if (n >= 1 && n != count) out.push_back({{"layers.count", std::to_string(n)}});
+    // Grazing views, where the paper's layers show gaps: one camera at the slab's mid-height, a quarter of the grid
+    // outside it in x, looking along +x raised by 1, 5 and 20 degrees.
+    const double h = sc.grid.voxelSize, nx = sc.grid.size.nx;
+    const std::array<double, 3> eye = {sc.grid.origin[0] - 0.25 * nx * h, sc.grid.origin[1] + 0.5 * sc.grid.size.ny * h,
+                                       sc.grid.origin[2] + 0.5 * nz * h};
+    for (double degrees : {1.0, 5.0, 20.0}) {
+        const double e = degrees * std::numbers::pi / 180, reach = nx * h;
+        const std::array<double, 3> target = {eye[0] + reach * std::cos(e), eye[1], eye[2] + reach * std::sin(e)};
+        out.push_back({{"render.cameras", "[{\"name\": \"elevation-" + Fmt("%.0f", degrees) + "\", \"eye\": [" +
+                                              Fmt("%.6g", eye[0]) + ", " + Fmt("%.6g", eye[1]) + ", " +
+                                              Fmt("%.6g", eye[2]) + "], \"target\": [" + Fmt("%.6g", target[0]) + ", " +
+                                              Fmt("%.6g", target[1]) + ", " + Fmt("%.6g", target[2]) + "]}]"}});
+    }
     return out;
 }
 

@@ -49,7 +49,8 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
 // The render_march settings accuracy measures, one at a time from the scene's
 // (docs/accuracy.md lists them); each is a list of overrides.
 std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& scene);
-// The render_layers settings: the layer count at 1/2, 1, 2 and 4 layers per voxel of height.
+// The render_layers settings: the layer count at 1/2, 1, 2 and 4 layers per voxel of height, and a camera
+// looking into the slab from its side at elevations of 1, 5 and 20 degrees (grazing views).
 std::vector<std::vector<SceneOverride>> LayersImageVariants(const Scene& scene);
 
 // Every image row of the session's scene on `backends` (one process's slot),
