@@ -148,7 +148,7 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
         time = TimeRepeated(repeats, [&] { return backend.RenderMarch(p, inputs, **image, nullptr); });
     } else if (renderer == Stage::RenderLayers) {
         LayersParams p = MakeLayersParams(scene, camera, in.step);
-        const std::vector<float> map = MakeLayersMap(scene, in.step);  // timed with the render, as in a run
+        const std::vector<float> map = MakeLayersMap(scene, in.step);  // before the timed calls, as in a run
         p.setup.map = map.empty() ? nullptr : map.data();
         const LayersInputs inputs{q->get(), q->get(), T.get()};
         time = TimeRepeated(repeats, [&] { return backend.RenderLayers(p, inputs, **image, nullptr); });

@@ -145,7 +145,8 @@ const StageDescriptor& DescribeRenderLayers() {
 
 Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
                         StageCallRecord& record) {
-    const std::vector<float> map = MakeLayersMap(sc, host.step);  // one per call, for every camera
+    // The wang map is host work shared by all backends, outside the stage time: one per call, for every camera.
+    const std::vector<float> map = MakeLayersMap(sc, host.step);
     return RenderEachCamera(
         Stage::RenderLayers, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
             LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
