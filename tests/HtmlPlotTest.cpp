@@ -151,6 +151,38 @@ TEST(HtmlPlot, ParetoFront) {
     EXPECT_EQ(Attributes(svg, "data-x"), (std::vector<std::string>{"1", "2", "3"}));
 }
 
+// Test that the renderers share one Pareto plot, a series per renderer and backend, beside one plot per other stage:
+// in a sweep (its rows) and in accuracy.json (its image rows), where they were drawn apart or not at all.
+TEST(HtmlPareto, RenderersShareOnePlot) {
+    auto row = [](const char* stage, const char* backend, double ms, double error) {
+        return nlohmann::json{{"stage", stage},
+                              {"backend", backend},
+                              {"status", "ok"},
+                              {"time", {{"median_ms", ms}}},
+                              {"error", {{"all", {{"max", error}}}}},
+                              {"settings", nlohmann::json::object()}};
+    };
+    ReportInput sweep{"s.json", InputKind::Sweep, {{"scene", "x"}, {"metric", "max"}}};
+    sweep.doc["rows"] = {row("shade", "cpu", 1, 0.1), row("render_march", "cpu", 10, 0.01),
+                         row("render_layers", "cpu", 2, 0.05), row("render_splat", "vk", 3, 0.2)};
+    const std::vector<report::Block> blocks = ParetoBlocks(sweep);
+    ASSERT_EQ(blocks.size(), 2u);
+    const std::string images = std::get<report::Figure>(blocks[1]).svg;
+    for (const char* series : {"march cpu", "layers cpu", "splat vk"})
+        EXPECT_NE(images.find(series), std::string::npos) << series;
+    EXPECT_EQ(images.find("shade"), std::string::npos);
+    ReportInput accuracy{"a.json", InputKind::Accuracy, {{"scene", "x"}}};
+    accuracy.doc["image_rows"] = {{{"renderer", "render_layers"},
+                                   {"backend", "gl"},
+                                   {"status", "ok"},
+                                   {"time", {{"median_ms", 4}}},
+                                   {"error", {{"max", 0.3}}}},
+                                  {{"renderer", "render_splat"}, {"backend", "gl"}, {"status", "failed"}}};
+    const std::vector<report::Block> image = ParetoBlocks(accuracy);
+    ASSERT_EQ(image.size(), 1u);
+    EXPECT_NE(std::get<report::Figure>(image[0]).svg.find("layers gl"), std::string::npos);
+}
+
 // Test base64 against RFC 4648's vectors.
 TEST(HtmlRender, Base64Rfc4648) {
     EXPECT_EQ(Base64(""), "");

@@ -1,6 +1,8 @@
 // The accuracy part of `cloudbench report` (ParetoBlocks,
 // harness/report/html/ReportSections.h): error against time per stage, with the
-// Pareto front.
+// Pareto front. The renderers (render_splat, render_march, render_layers) make
+// the same image, so they share one plot and one front, a series per renderer
+// and backend, as sweep.json's marks and tools/plot_sweep.py do.
 #include <algorithm>
 
 #include "harness/report/html/ReportJson.h"
@@ -8,54 +10,84 @@
 #include "harness/report/html/SvgPlot.h"
 
 namespace cb::html {
+namespace {
+
+bool IsRendererName(const std::string& stage) { return stage.starts_with("render_"); }
+
+// One measured setting: its plot ("images" for every renderer), series, time and error.
+struct ParetoPoint {
+    std::string plot, series, label;
+    double time = 0, error = 0;
+    bool marked = false;
+};
+
+std::string SettingsText(const json& row) {
+    std::string settings;
+    for (const auto& [k, v] : Obj(row, "settings").items())
+        settings += (settings.empty() ? "" : ", ") + k + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
+    return settings;
+}
+
+// The rows of sweep.json or accuracy.json (its stage rows, then its renderers' image rows) as points.
+std::vector<ParetoPoint> Points(const json& doc, const std::string& metric) {
+    std::vector<ParetoPoint> points;
+    auto add = [&](const json& row, const std::string& stage, const json& error) {
+        if (Str(row, "status") != "ok") return;
+        const auto t = Number(Obj(row, "time"), "median_ms");
+        const auto e = Number(error, metric.c_str());
+        if (!t || !e) return;
+        const std::string backend = Str(row, "backend");
+        const bool image = IsRendererName(stage);
+        const std::string series = image ? stage.substr(7) + " " + backend : backend;
+        points.push_back({image ? "images" : stage, series,
+                          series + " " + SettingsText(row) + ": " + Fixed(*t) + " ms, error " + Fixed(*e, "%.3g"), *t,
+                          *e, row.value("pareto", false)});
+    };
+    for (const json& row : Arr(doc, "rows")) add(row, Str(row, "stage"), Obj(Obj(row, "error"), "all"));
+    for (const json& row : Arr(doc, "image_rows")) add(row, Str(row, "renderer"), Obj(row, "error"));
+    return points;
+}
+
+}  // namespace
 
 std::vector<report::Block> ParetoBlocks(const ReportInput& input) {
     std::vector<report::Block> blocks;
     const json& doc = input.doc;
     const bool sweep = input.kind == InputKind::Sweep;
     const std::string metric = sweep ? Str(doc, "metric", "max") : "max";
-    std::vector<std::string> stages, backends;
-    for (const json& row : Arr(doc, "rows")) {
-        if (Str(row, "status") != "ok") continue;
-        const std::string stage = Str(row, "stage"), backend = Str(row, "backend");
-        if (std::ranges::find(stages, stage) == stages.end()) stages.push_back(stage);
-        if (std::ranges::find(backends, backend) == backends.end()) backends.push_back(backend);
+    const std::vector<ParetoPoint> points = Points(doc, metric);
+    std::vector<std::string> plots, series;
+    for (const ParetoPoint& p : points) {
+        if (std::ranges::find(plots, p.plot) == plots.end()) plots.push_back(p.plot);
+        if (std::ranges::find(series, p.series) == series.end()) series.push_back(p.series);
     }
-    std::ranges::sort(backends);
-    for (const std::string& stage : stages) {
+    std::ranges::sort(series);
+    for (const std::string& name : plots) {
         ScatterPlot plot;
-        plot.title = Str(doc, "scene") + ": " + stage + " (" + FileName(input.path) + ")";
+        const std::string what = name == "images" ? "the renderers' images" : name;
+        plot.title = Str(doc, "scene") + ": " + what + " (" + FileName(input.path) + ")";
         plot.xLabel = "median time of the stage (ms, log)";
         plot.yLabel = metric + " |error| vs the Embree reference";
         std::vector<std::pair<double, double>> all, marked;
-        for (const std::string& backend : backends) {
-            Series s{backend, {}, {}, {}, {}};
-            for (const json& row : Arr(doc, "rows")) {
-                if (Str(row, "status") != "ok" || Str(row, "stage") != stage || Str(row, "backend") != backend)
-                    continue;
-                const auto t = Number(Obj(row, "time"), "median_ms");
-                const auto e = Number(Obj(Obj(row, "error"), "all"), metric.c_str());
-                if (!t || !e) continue;
-                s.x.push_back(*t);
-                s.y.push_back(*e);
-                std::string settings;
-                for (const auto& [k, v] : Obj(row, "settings").items())
-                    settings +=
-                        (settings.empty() ? "" : ", ") + k + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
-                s.pointLabels.push_back(backend + " " + settings + ": " + Fixed(*t) + " ms, error " +
-                                        Fixed(*e, "%.3g"));
-                all.emplace_back(*t, *e);
-                if (row.value("pareto", false)) marked.emplace_back(*t, *e);
+        for (const std::string& seriesName : series) {
+            Series s{seriesName, {}, {}, {}, {}};
+            for (const ParetoPoint& p : points) {
+                if (p.plot != name || p.series != seriesName) continue;
+                s.x.push_back(p.time);
+                s.y.push_back(p.error);
+                s.pointLabels.push_back(p.label);
+                all.emplace_back(p.time, p.error);
+                if (p.marked) marked.emplace_back(p.time, p.error);
             }
             if (!s.x.empty()) plot.series.push_back(std::move(s));
         }
-        // sweep.json marks its front; for accuracy.json it is computed here over every backend's points.
+        // sweep.json marks its front; for accuracy.json it is computed here over every point of the plot.
         plot.front = sweep ? ParetoFront(marked) : ParetoFront(all);
         if (sweep) std::ranges::sort(plot.front);
         blocks.emplace_back(report::Figure{
             "pareto", RenderParetoPlot(plot),
-            "Error against time for " + stage +
-                ", one point per setting and backend; the dashed line joins the "
+            "Error against time for " + what +
+                ", one point per setting, renderer and backend; the dashed line joins the "
                 "points no other point beats in both (" +
                 std::string(sweep ? "as sweep.json marks them" : "computed over the rows of accuracy.json") + ")."});
     }
