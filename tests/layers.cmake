@@ -87,3 +87,16 @@ print("layers accuracy: ok")
 PY]=])
 add_test(NAME Cli.LayersAccuracyOverLayerCounts COMMAND bash -c "${cli_layers_accuracy_script}" ${cli} ${cli_out}/layers-accuracy)
 set_tests_properties(Cli.LayersAccuracyOverLayerCounts PROPERTIES PASS_REGULAR_EXPRESSION "layers accuracy: ok")
+# A sweep over layers.* measures render_layers alone (the scene's march would give the same image at every point).
+set(cli_layers_sweep_script [=[d="$1"; rm -rf "$d"; set -e
+"$0" sweep layers-small --backend cpu --quiet --out "$d" --set grid.tiling=false \
+  --set 'stages=["noise","density","shade","render_march","render_layers"]' --vary layers.count=4,16 >/dev/null
+/usr/bin/python3 - "$d" <<'PY'
+import json, sys
+rows = json.load(open(sys.argv[1] + "/sweep.json"))["rows"]
+assert {r["stage"] for r in rows} == {"render_layers"}, {r["stage"] for r in rows}
+assert len(rows) == 2 and all(r["status"] == "ok" for r in rows), rows
+print("layers sweep: ok")
+PY]=])
+add_test(NAME Cli.LayersSweepMeasuresLayersAlone COMMAND bash -c "${cli_layers_sweep_script}" ${cli} ${cli_out}/layers-sweep)
+set_tests_properties(Cli.LayersSweepMeasuresLayersAlone PROPERTIES PASS_REGULAR_EXPRESSION "layers sweep: ok")

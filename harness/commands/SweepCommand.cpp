@@ -35,7 +35,8 @@ When a varied field belongs to the march, render, phase, lightning or layers
 sections, the scene's renderers (render_march, render_splat, render_layers) are
 measured too, against the exact reference render (see cloudbench help
 accuracy): per-pixel error = max over channels of |C - C_ref|, and PSNR; the
-renderers share one Pareto front and one panel of the plot.
+renderers share one Pareto front and one panel of the plot. Fields of the
+layers section alone measure render_layers alone.
 
 Options:
   --vary PATH=V1,... a field and its values; repeat for more fields

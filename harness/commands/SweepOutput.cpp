@@ -51,6 +51,9 @@ std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
             if (p.starts_with(prefix) && (withPhase || std::string_view(prefix) != "phase.")) return true;
         return false;
     };
+    // layers.* is render_layers' alone: the other renderers would measure the same image at every point.
+    if (!axes.empty() && std::ranges::all_of(axes, [](const SweepAxis& a) { return a.path.starts_with("layers."); }))
+        return {Stage::RenderLayers};
     const bool images = std::ranges::any_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, true); });
     const bool onlyImages = std::ranges::all_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, false); });
     std::vector<Stage> renderers;
