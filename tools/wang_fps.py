@@ -84,10 +84,9 @@ def main():
         paper_fps, paper_words = PAPER_FPS.get(s, (None, ""))
         paper = f"{paper_words} ({1000 / paper_fps:.2f} ms)" if paper_fps else ""
         for b in backends:
-            ok = [r for r in runs[s][b] if "error" in r] == []
-            if not ok:
-                why = next(r["error"] for r in runs[s][b] if "error" in r)
-                print(f"| {s} | {b} | | not measured: {why} | | | {paper} |")
+            errors = [r["error"] for r in runs[s][b] if "error" in r]
+            if errors:
+                print(f"| {s} | {b} | | not measured: {errors[0]} | | | {paper} |")
                 continue
             cams = list(runs[s][b][0]["frames"])
             medians = []

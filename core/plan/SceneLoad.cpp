@@ -160,9 +160,7 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
         if (Describe(stage).renderer && scene.stages.Has(stage) && sections.cameras && scene.render.cameras.empty())
             check.Fail("render.cameras", Quote(StageName(stage)) + " needs at least one camera");
     // Time-slicing spreads a step over the frames drawn between steps: without a renderer there are none.
-    if (scene.render.slicesPerFrame > 0 && std::none_of(kAllStages.begin(), kAllStages.end(), [&](Stage s) {
-            return Describe(s).renderer && scene.stages.Has(s);
-        }))
+    if (scene.render.slicesPerFrame > 0 && !RunsARenderer(scene.stages))
         check.Fail("render.slices_per_frame",
                    "time-slicing spreads a step over the frames drawn between steps, and "
                    "no renderer is enabled; enable render_splat, render_march or render_layers, or remove it");

@@ -1,5 +1,6 @@
 #include "core/plan/StageGraph.h"
 
+#include <algorithm>
 #include <cassert>
 #include <iterator>
 
@@ -47,6 +48,10 @@ const StageDescriptor& Describe(Stage stage) {
     const StageDescriptor& d = kDescriptors[size_t(stage)]();
     assert(d.stage == stage && "each module describes its own stage");
     return d;
+}
+
+bool RunsARenderer(const StageSet& enabled) {
+    return std::ranges::any_of(kAllStages, [&](Stage s) { return Describe(s).renderer && enabled.Has(s); });
 }
 
 StageAdapter AdapterOf(Stage stage) { return kAdapters[size_t(stage)]; }

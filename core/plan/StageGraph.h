@@ -17,6 +17,8 @@ namespace cb {
 
 // The stage's descriptor, from its module.
 const StageDescriptor& Describe(Stage stage);
+// Whether any of `enabled` is a renderer (its descriptor's `renderer`).
+bool RunsARenderer(const StageSet& enabled);
 // The stage's call adapter, from its module (core/pipeline/StageAdapter.h).
 StageAdapter AdapterOf(Stage stage);
 

@@ -248,8 +248,7 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
     auto session = Session::Open(options, "accuracy");
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
-    const bool images =
-        std::ranges::any_of(kAllStages, [&](Stage s) { return Describe(s).renderer && scene.stages.Has(s); });
+    const bool images = RunsARenderer(scene.stages);
     if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow) && !images) {
         std::fprintf(stderr,
                      "%s: stages: accuracy needs \"shade\", \"shadow\" or a renderer (\"render_splat\", "

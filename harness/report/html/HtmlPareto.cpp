@@ -5,6 +5,7 @@
 // and backend, as sweep.json's marks and tools/plot_sweep.py do.
 #include <algorithm>
 
+#include "core/plan/StageGraph.h"
 #include "harness/report/html/ReportJson.h"
 #include "harness/report/html/ReportSections.h"
 #include "harness/report/html/SvgPlot.h"
@@ -12,7 +13,10 @@
 namespace cb::html {
 namespace {
 
-bool IsRendererName(const std::string& stage) { return stage.starts_with("render_"); }
+bool IsRendererName(const std::string& stage) {
+    const std::optional<Stage> s = ParseStage(stage);
+    return s && Describe(*s).renderer;
+}
 
 // One measured setting: its plot ("images" for every renderer), series, time and error.
 struct ParetoPoint {
