@@ -26,6 +26,109 @@ TexelFormat FormatOf(BufferFormat format) {
 
 }  // namespace
 
+GLLimits ReadGLLimits(const GLContext& context) {
+    GLint viewport[2] = {0, 0};
+    context.F().GetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
+    return {context.Integer(GL_MAX_TEXTURE_SIZE), context.Integer(GL_MAX_ARRAY_TEXTURE_LAYERS), viewport[0],
+            viewport[1]};
+}
+
+std::vector<DeviceLimit> DescribeGLLimits(const GLLimits& limits) {
+    // Every buffer is a 2-D texture array, a layer per z slice (an image's rows are its layers), and every pass
+    // draws one slice in one viewport; shade's volume has a layer per slice along the sun's principal axis.
+    return {
+        {"GL_MAX_TEXTURE_SIZE", uint64_t(limits.textureSize),
+         "grid nx and ny (nx + 2 and ny + 2 with render_march or render_layers) and render.width"},
+        {"GL_MAX_ARRAY_TEXTURE_LAYERS", uint64_t(limits.arrayLayers),
+         "grid nz (nz + 2 with render_march or render_layers), render.height, and with shade the grid's cells along "
+         "the sun's principal axis"},
+        {"GL_MAX_VIEWPORT_DIMS[0]", uint64_t(limits.viewportWidth),
+         "grid nx and render.width (render.width + " + std::to_string(2 * kSplatGuardPixels) +
+             " with render_splat)"},
+        {"GL_MAX_VIEWPORT_DIMS[1]", uint64_t(limits.viewportHeight),
+         "grid ny and render.height (render.height + " + std::to_string(2 * kSplatGuardPixels) +
+             " with render_splat)"},
+    };
+}
+
+namespace {
+
+// The sun's principal axes (0 x, 1 y, 2 z) at the steps shade runs, as ShadeSunAt picks the sun
+// (core/stages/shade/Shade.cpp): the first step's only when the sun stands still or the layers relight by vector.
+std::array<bool, 3> ShadeAxes(const Scene& scene) {
+    std::array<bool, 3> axes{};
+    const bool fixed = !scene.sun.Moves() || scene.layers.relight == LayersRelight::Vector;
+    const uint32_t steps = fixed ? 1 : std::max<uint32_t>(scene.steps, 1);
+    for (uint32_t step = 0; step < steps; ++step) axes[size_t(PrincipalAxis(scene.sun.DirectionAt(step)))] = true;
+    return axes;
+}
+
+}  // namespace
+
+std::optional<LimitExceeded> FindExceededGLLimit(const GLLimits& limits, const Scene& scene) {
+    const Extent3 e = scene.grid.size;
+    // `what` (`value`) past the limit `name` (`max`), because `why`.
+    auto past = [](const char* field, const std::string& what, uint64_t value, const char* name, GLint max,
+                   const std::string& why) -> std::optional<LimitExceeded> {
+        if (value <= uint64_t(std::max(max, 0))) return std::nullopt;
+        return LimitExceeded{field, "gl: " + what + " " + std::to_string(value) + " is more than this device's " +
+                                        name + " " + std::to_string(max) + " (" + why + ")"};
+    };
+    const char* kGrid = "grid.size";
+    std::optional<LimitExceeded> found;
+    auto check = [&](std::optional<LimitExceeded> result) {
+        if (!found) found = std::move(result);
+    };
+    const std::string buffer = "every grid buffer is a texture array";
+    check(past(kGrid, "nx", e.nx, "GL_MAX_TEXTURE_SIZE", limits.textureSize, buffer + " nx texels wide"));
+    check(past(kGrid, "ny", e.ny, "GL_MAX_TEXTURE_SIZE", limits.textureSize, buffer + " ny texels high"));
+    check(past(kGrid, "nz", e.nz, "GL_MAX_ARRAY_TEXTURE_LAYERS", limits.arrayLayers,
+               buffer + " with a layer per z slice"));
+    const std::string slice = "a pass draws a z slice in one viewport";
+    check(past(kGrid, "nx", e.nx, "GL_MAX_VIEWPORT_DIMS[0]", limits.viewportWidth, slice));
+    check(past(kGrid, "ny", e.ny, "GL_MAX_VIEWPORT_DIMS[1]", limits.viewportHeight, slice));
+    if (scene.stages.Has(Stage::Shade)) {
+        const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
+        const std::array<bool, 3> axes = ShadeAxes(scene);
+        const uint32_t n[3] = {e.nx, e.ny, e.nz};
+        const char* names[3] = {"nx", "ny", "nz"};
+        for (int axis = 0; axis < 3; ++axis)
+            if (axes[size_t(axis)])
+                check(past(kGrid, std::string(names[axis]) + (f > 1 ? " / shade.resolution" : ""),
+                           CeilDiv(n[axis], f), "GL_MAX_ARRAY_TEXTURE_LAYERS", limits.arrayLayers,
+                           std::string("shade keeps a texture array with a layer per slice along the sun's "
+                                       "principal axis, ") +
+                               "xyz"[axis] + " here"));
+    }
+    if (scene.stages.Has(Stage::RenderMarch) || scene.stages.Has(Stage::RenderLayers)) {
+        const std::string padded = "render_march and render_layers read a volume padded by one voxel each side";
+        check(past(kGrid, "nx + 2", uint64_t(e.nx) + 2, "GL_MAX_TEXTURE_SIZE", limits.textureSize, padded));
+        check(past(kGrid, "ny + 2", uint64_t(e.ny) + 2, "GL_MAX_TEXTURE_SIZE", limits.textureSize, padded));
+        check(past(kGrid, "nz + 2", uint64_t(e.nz) + 2, "GL_MAX_ARRAY_TEXTURE_LAYERS", limits.arrayLayers, padded));
+    }
+    if (scene.stages.Has(Stage::RenderSplat) || scene.stages.Has(Stage::RenderMarch) ||
+        scene.stages.Has(Stage::RenderLayers)) {
+        const uint32_t W = scene.render.width, H = scene.render.height;
+        const std::string image = "an image is a texture array with a layer per row";
+        check(past("render.width", "width", W, "GL_MAX_TEXTURE_SIZE", limits.textureSize, image));
+        check(past("render.height", "height", H, "GL_MAX_ARRAY_TEXTURE_LAYERS", limits.arrayLayers, image));
+        check(past("render.width", "width", W, "GL_MAX_VIEWPORT_DIMS[0]", limits.viewportWidth,
+                   "a renderer draws the image in one viewport"));
+        check(past("render.height", "height", H, "GL_MAX_VIEWPORT_DIMS[1]", limits.viewportHeight,
+                   "a renderer draws the image in one viewport"));
+        if (scene.stages.Has(Stage::RenderSplat)) {
+            const uint32_t guard = 2 * uint32_t(kSplatGuardPixels);
+            const std::string why =
+                "render_splat's viewport reaches " + std::to_string(kSplatGuardPixels) + " pixels past each side";
+            check(past("render.width", "width + " + std::to_string(guard), uint64_t(W) + guard,
+                       "GL_MAX_VIEWPORT_DIMS[0]", limits.viewportWidth, why));
+            check(past("render.height", "height + " + std::to_string(guard), uint64_t(H) + guard,
+                       "GL_MAX_VIEWPORT_DIMS[1]", limits.viewportHeight, why));
+        }
+    }
+    return found;
+}
+
 Result<std::unique_ptr<BackendGL>> BackendGL::Create(ContextKind context, CaLayout caLayout) {
     auto ctx = GLContext::Create(context);
     if (!ctx) return std::unexpected(ctx.error());

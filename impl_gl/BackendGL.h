@@ -52,6 +52,19 @@ class BufferGL final : public Buffer {
     GLuint mTexture;
 };
 
+// The limits of a context that bound what gl can run, as glGetIntegerv reports them.
+struct GLLimits {
+    GLint textureSize = 0;     // GL_MAX_TEXTURE_SIZE: every texture's width and height
+    GLint arrayLayers = 0;     // GL_MAX_ARRAY_TEXTURE_LAYERS: a texture array's layers
+    GLint viewportWidth = 0;   // GL_MAX_VIEWPORT_DIMS[0]: a pass's drawn width (a wider viewport is clamped)
+    GLint viewportHeight = 0;  // GL_MAX_VIEWPORT_DIMS[1]
+};
+GLLimits ReadGLLimits(const GLContext& context);
+// The limits as Backend::Limits lists them, each with what it bounds in a scene.
+std::vector<DeviceLimit> DescribeGLLimits(const GLLimits& limits);
+// The first setting of `scene` past `limits` on gl (Backend::ExceededLimit).
+std::optional<LimitExceeded> FindExceededGLLimit(const GLLimits& limits, const Scene& scene);
+
 class BackendGL final : public Backend {
   public:
     // An Error says why the context cannot be made here.
@@ -113,6 +126,12 @@ class BackendGL final : public Backend {
     // GL does not report available memory.
     uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
 
+    // The context's texture and viewport limits, read when the backend is made.
+    std::vector<DeviceLimit> Limits() const override { return DescribeGLLimits(mLimits); }
+    std::optional<LimitExceeded> ExceededLimit(const Scene& scene) const override {
+        return FindExceededGLLimit(mLimits, scene);
+    }
+
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
@@ -126,7 +145,9 @@ class BackendGL final : public Backend {
                      RenderSplatGLState, NoiseGLState, RenderMarchGLState, RenderLayersGLState>;
 
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8)
-        : mContext(std::move(context)), mSoftwareRasterizer(mContext->SoftwareRasterizer()) {
+        : mContext(std::move(context)),
+          mSoftwareRasterizer(mContext->SoftwareRasterizer()),
+          mLimits(ReadGLLimits(*mContext)) {
         mStages.Get<CaGLState>().rgba8 = rgba8;
     }
 
@@ -225,6 +246,7 @@ class BackendGL final : public Backend {
     bool mLayered = true, mLayeredFailed = false;
     SplatSkip mSplatSkip = SplatSkip::Auto;
     bool mSoftwareRasterizer = false;  // GLContext::SoftwareRasterizer, read once when made
+    GLLimits mLimits;                  // ReadGLLimits, read once when made
     std::vector<GLuint> mLayeredPrograms;
     uint64_t mDraws = 0;
     bool mPending = false;  // work recorded since the last submission

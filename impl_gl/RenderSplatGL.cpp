@@ -91,7 +91,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const FlatSplatOrder flat = FlattenSplatOrder(order);
     GLfloat pointRange[2] = {1, 1};
     f.GetFloatv(GL_POINT_SIZE_RANGE, pointRange);
-    constexpr float kGuard = 130;  // > the largest half splat plus the 2-pixel margin
+    constexpr float kGuard = kSplatGuardPixels;
 
     Timing timer(*this);
     const GLuint orderBuffer = ScratchBuffer(state.order, flat.indices.size() * 4);

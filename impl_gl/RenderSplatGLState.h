@@ -8,6 +8,10 @@
 
 namespace cb::gl {
 
+// Pixels the splat pass's viewport reaches past the image on each side (more than the largest half splat
+// plus the 2-pixel margin), so a splat centred outside the image still draws its part inside.
+inline constexpr int kSplatGuardPixels = 130;
+
 struct RenderSplatGLState {
     static constexpr Stage kStage = Stage::RenderSplat;
     TextureSlot target;    // the RGBA32F image

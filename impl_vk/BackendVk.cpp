@@ -25,6 +25,56 @@ VkDeviceSize DeviceBytes(BufferFormat format, const Extent3& e) {
 
 }  // namespace
 
+// Invocations a workgroup of the passes' one-dimensional dispatches runs (VulkanContext::Recorder::Dispatch).
+constexpr uint64_t kGroupInvocations = 64;
+
+std::vector<DeviceLimit> DescribeVkLimits(const VkPhysicalDeviceLimits& limits) {
+    return {
+        {"maxComputeWorkGroupCount[0]", limits.maxComputeWorkGroupCount[0],
+         "grid nx * ny * nz, at most " + std::to_string(kGroupInvocations) +
+             " times this (a pass dispatches one invocation per voxel, in workgroups of " +
+             std::to_string(kGroupInvocations) + " along x)"},
+        {"maxStorageBufferRange", limits.maxStorageBufferRange,
+         "the bytes of each buffer (a grid of floats: 4 * nx * ny * nz; an image: 12 * render.width * "
+         "render.height), each bound whole as a storage buffer"},
+    };
+}
+
+std::optional<LimitExceeded> FindExceededVkLimit(const VkPhysicalDeviceLimits& limits, const Scene& scene) {
+    const Extent3 e = scene.grid.size;
+    const uint64_t voxels = e.Count(), groups = (voxels + kGroupInvocations - 1) / kGroupInvocations;
+    if (groups > limits.maxComputeWorkGroupCount[0])
+        return LimitExceeded{"grid.size", "vk: nx * ny * nz " + std::to_string(voxels) + " needs " +
+                                              std::to_string(groups) + " workgroups, more than this device's " +
+                                              "maxComputeWorkGroupCount[0] " +
+                                              std::to_string(limits.maxComputeWorkGroupCount[0]) +
+                                              " (a pass dispatches one invocation per voxel, in workgroups of " +
+                                              std::to_string(kGroupInvocations) + " along x)"};
+    const uint64_t range = limits.maxStorageBufferRange;
+    // `what` of `bytes` bytes past maxStorageBufferRange.
+    auto past = [&](const char* field, const std::string& what, uint64_t bytes) -> std::optional<LimitExceeded> {
+        if (bytes <= range) return std::nullopt;
+        return LimitExceeded{field, "vk: " + what + " takes " + std::to_string(bytes) +
+                                        " bytes, more than this device's maxStorageBufferRange " +
+                                        std::to_string(range) + " (every buffer is bound whole as a storage buffer)"};
+    };
+    if (auto found = past("grid.size", "a grid buffer of floats", DeviceBytes(BufferFormat::F32, e))) return found;
+    if (scene.stages.Has(Stage::RenderMarch) || scene.stages.Has(Stage::RenderLayers))
+        if (auto found = past("grid.size", "the renderer's volume padded by one voxel each side",
+                              MarchVolumeBytes(e, scene.stages.Has(Stage::RenderLayers) ||
+                                                      scene.march.light == MarchLightSource::Shade)))
+            return found;
+    if (scene.stages.Has(Stage::RenderSplat) || scene.stages.Has(Stage::RenderMarch) ||
+        scene.stages.Has(Stage::RenderLayers)) {
+        const Extent3 image{3, scene.render.width, scene.render.height};
+        if (auto found = past("render.width",
+                              "an image of " + std::to_string(image.ny) + " x " + std::to_string(image.nz) + " pixels",
+                              DeviceBytes(BufferFormat::F32, image)))
+            return found;
+    }
+    return std::nullopt;
+}
+
 Result<std::unique_ptr<BackendVk>> BackendVk::Create(const std::string& device, bool validation) {
     auto context = VulkanContext::Create(device, validation);
     if (!context) return std::unexpected(Error{"vk: " + context.error().message});

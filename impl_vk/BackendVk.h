@@ -39,6 +39,11 @@ class BufferVk final : public Buffer {
     DeviceBuffer mBuffer;
 };
 
+// The device limits as Backend::Limits lists them, each with what it bounds in a scene.
+std::vector<DeviceLimit> DescribeVkLimits(const VkPhysicalDeviceLimits& limits);
+// The first setting of `scene` past `limits` on vk (Backend::ExceededLimit).
+std::optional<LimitExceeded> FindExceededVkLimit(const VkPhysicalDeviceLimits& limits, const Scene& scene);
+
 class BackendVk final : public Backend {
   public:
     // device: index, name substring or "" (first device); validation: Khronos layer on.
@@ -61,6 +66,11 @@ class BackendVk final : public Backend {
     uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
     // The largest device-local heap.
     std::optional<uint64_t> AvailableBytes() const override { return mContext->LargestDeviceLocalHeap(); }
+    // The device's workgroup count and storage buffer range.
+    std::vector<DeviceLimit> Limits() const override { return DescribeVkLimits(mContext->DeviceLimits()); }
+    std::optional<LimitExceeded> ExceededLimit(const Scene& scene) const override {
+        return FindExceededVkLimit(mContext->DeviceLimits(), scene);
+    }
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)

@@ -118,7 +118,7 @@ Result<std::vector<DeviceInfo>> ListDevices() {
             driver = driverProperties.driverName;
             if (driverProperties.driverInfo[0] != '\0') driver += std::string(" ") + driverProperties.driverInfo;
         }
-        out.push_back({n, p.deviceName, DeviceTypeName(p.deviceType), p.apiVersion, driver});
+        out.push_back({n, p.deviceName, DeviceTypeName(p.deviceType), p.apiVersion, driver, p.limits});
     }
     vkDestroyInstance(*instance, nullptr);
     if (out.empty()) return MakeError("no Vulkan device found (install mesa-vulkan-drivers for lavapipe)");
@@ -178,6 +178,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::Create(const std::string& 
     ctx->mDeviceName = props.deviceName;
     ctx->mCpuDevice = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     ctx->mTimestampPeriodNs = props.limits.timestampPeriod;
+    ctx->mLimits = props.limits;
     if (props.apiVersion < VK_API_VERSION_1_2) return MakeError(ctx->mDeviceName + " supports Vulkan below 1.2");
     vkGetPhysicalDeviceMemoryProperties(ctx->mPhysical, &ctx->mMemory);
 

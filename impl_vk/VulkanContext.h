@@ -30,6 +30,7 @@ struct DeviceInfo {
     std::string type;  // "cpu", "integrated GPU", "discrete GPU", ...
     uint32_t apiVersion;
     std::string driver;  // driver name and version info ("llvmpipe Mesa 22.3.6"); "?" before Vulkan 1.2
+    VkPhysicalDeviceLimits limits{};  // vkGetPhysicalDeviceProperties' limits
 };
 
 // The Vulkan devices on this machine; an Error says why there are none.
@@ -67,6 +68,8 @@ class VulkanContext {
     VulkanContext& operator=(const VulkanContext&) = delete;
 
     const std::string& DeviceName() const { return mDeviceName; }
+    // The device's limits (vkGetPhysicalDeviceProperties), read when the context is made.
+    const VkPhysicalDeviceLimits& DeviceLimits() const { return mLimits; }
     // Whether the device is the host's CPU (lavapipe): dispatches are cheap there, cells dear.
     bool CpuDevice() const { return mCpuDevice; }
     uint32_t ValidationMessages() const { return mValidationMessages; }
@@ -223,6 +226,7 @@ class VulkanContext {
     float mTimestampPeriodNs = 1;
     bool mTimestamps = false;
     std::string mDeviceName;
+    VkPhysicalDeviceLimits mLimits{};
     uint32_t mValidationMessages = 0;
     DeviceBuffer mStaging;
     VkDeviceMemory mStagingMemory = VK_NULL_HANDLE;

@@ -60,7 +60,7 @@ Result<std::vector<VulkanDeviceInfo>> ListVulkanDevices() {
         out.push_back({d.index, d.name, d.type,
                        std::to_string(VK_API_VERSION_MAJOR(d.apiVersion)) + "." +
                            std::to_string(VK_API_VERSION_MINOR(d.apiVersion)),
-                       d.driver});
+                       d.driver, vk::DescribeVkLimits(d.limits)});
     return out;
 #else
     return MakeError("not built in this build (configure with CLOUDBENCH_WITH_VK=ON)");
@@ -79,6 +79,7 @@ Result<std::vector<GLContextInfo>> ListGLContexts() {
             info.version = (*context)->String(GL_VERSION);
             info.maxTextureSize = (*context)->Integer(GL_MAX_TEXTURE_SIZE);
             info.maxArrayLayers = (*context)->Integer(GL_MAX_ARRAY_TEXTURE_LAYERS);
+            info.limits = gl::DescribeGLLimits(gl::ReadGLLimits(**context));
         } else {
             info.reason = context.error().message;
         }

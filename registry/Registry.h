@@ -38,6 +38,7 @@ struct VulkanDeviceInfo {
     std::string type;    // "cpu", "integrated GPU", "discrete GPU", ...
     std::string api;     // the device's Vulkan version, "1.3"
     std::string driver;  // driver name and version info; "?" before Vulkan 1.2
+    std::vector<DeviceLimit> limits;  // the limits the vk backend checks a scene against (Backend::Limits)
 };
 
 // The Vulkan devices here, in --vk-device index order. An Error says why there
@@ -54,6 +55,7 @@ struct GLContextInfo {
     // of W x H pixels has H layers), when available.
     int32_t maxTextureSize = 0;  // GL_MAX_TEXTURE_SIZE
     int32_t maxArrayLayers = 0;  // GL_MAX_ARRAY_TEXTURE_LAYERS
+    std::vector<DeviceLimit> limits;  // the limits the gl backend checks a scene against (Backend::Limits)
     std::string reason;    // why it cannot be created, when not
 };
 

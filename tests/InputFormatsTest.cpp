@@ -1,4 +1,4 @@
-// The one reader of input files (core/base/InputFile.h) and the schemas of the JSON
+// The one reader of input files (core/base/PathPolicy.h) and the schemas of the JSON
 // files cloudbench reads back (harness/platform/JsonInput.h, harness/report/InputFormats.h).
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 #include "core/base/Npy.h"
 #include "harness/platform/JsonInput.h"
 #include "harness/report/InputFormats.h"
@@ -68,7 +68,7 @@ TEST_F(InputFileTest, SizeLimit) {
     ASSERT_TRUE(ReadInputFile(at, kTiny));
     EXPECT_EQ(*ReadInputFile(at, kTiny), "12345678");
     EXPECT_EQ(ErrorOf(ReadInputFile(over, kTiny)), over + ": 9 bytes, more than the 8 bytes a tiny file may have");
-    EXPECT_EQ(ErrorOf(CheckInputFile(over, kTiny)), over + ": 9 bytes, more than the 8 bytes a tiny file may have");
+    EXPECT_EQ(ErrorOf(OpenInputFile(over, kTiny)), over + ": 9 bytes, more than the 8 bytes a tiny file may have");
 }
 
 // Test that a .npy whose shape claims more elements than its data holds is refused before any allocation

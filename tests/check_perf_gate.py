@@ -6,7 +6,13 @@ test-only CLOUDBENCH_TEST_SLOWDOWN switch fails with the regression exit code
 6, naming that stage and no other, whatever else the machine runs (CTest runs
 it beside other tests).
 
-usage: check_perf_gate.py CLOUDBENCH WORKDIR identical|slowdown
+The case `kept` checks that a verdict never improves on a second look: a
+short real interleave whose BASE runs exit 1 ends with exit 1 live and again
+from its kept folder (`perf compare DIR`), both naming each failed run; so
+does a kept run recorded as failed with no folder, and a kept folder cut short
+(fewer runs than its rounds); a kept folder with no run is refused (exit 3).
+
+usage: check_perf_gate.py CLOUDBENCH WORKDIR identical|slowdown|kept
 """
 import json
 import os
@@ -22,6 +28,90 @@ PLANTED_STAGE, PLANTED_FACTOR = "region", 2
 
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def wrapper(name, body):
+    """An executable script in WORK that runs the CLI under test as `body` says."""
+    path = os.path.join(WORK, name)
+    with open(path, "w") as f:
+        f.write(f"#!/bin/sh\n{body}\n")
+    os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR)
+    return path
+
+
+def compare(*args):
+    return subprocess.run([CLI, "perf", "compare", *args], capture_output=True, text=True, timeout=600)
+
+
+def failed_run_lines(stderr):
+    return sorted(line for line in stderr.splitlines() if line.startswith("perf compare: failed run: "))
+
+
+def check_kept():
+    # Two rounds of ci-small, 4 steps: about a second. BASE writes its results and exits 1.
+    failing = wrapper("failing-cloudbench", f'"{CLI}" "$@"\nexit 1')
+    fast = ["ci-small", "--rounds", "2", "--steps", "4", "--set", "warmup_steps=1", "--backend", "cpu", "--quiet"]
+    kept = os.path.join(WORK, "kept")
+    live = compare("--interleave", failing, CLI, *fast, "--keep", kept, "--json", os.path.join(WORK, "live.json"))
+    again = compare(kept, "--json", os.path.join(WORK, "again.json"))
+    expected = [f"perf compare: failed run: base run of ci-small in round {r} exited 1" for r in (1, 2)]
+    for what, p, path in (("live", live, "live.json"), ("from the kept folder", again, "again.json")):
+        if p.returncode != 1 or failed_run_lines(p.stderr) != expected:
+            fail(f"BASE runs exited 1: {what}: exit {p.returncode} (expected 1), failed runs "
+                 f"{failed_run_lines(p.stderr)}\n{p.stdout}\n{p.stderr}")
+        doc = json.load(open(os.path.join(WORK, path)))
+        runs = [(r["side"], r["scene"], r["round"], r["exit"], r["compared"]) for r in doc["failed_runs"]]
+        if doc["exit_code"] != 1 or runs != [("base", "ci-small", 0, 1, True), ("base", "ci-small", 1, 1, True)]:
+            fail(f"{what}: the JSON's exit_code {doc['exit_code']} and failed_runs {runs}")
+        if "no regression\n" in p.stdout:
+            fail(f"{what}: a failed run must not end with a plain 'no regression':\n{p.stdout}")
+
+    # A clean kept interleave passes; one run recorded as failed, with no folder, is named and exits 1.
+    clean = os.path.join(WORK, "clean")
+    p = compare("--interleave", CLI, CLI, *fast, "--keep", clean)
+    q = compare(clean)
+    if p.returncode != q.returncode or failed_run_lines(q.stderr):
+        fail(f"a clean interleave: live exit {p.returncode}, from the kept folder {q.returncode}\n{q.stderr}")
+    manifest_path = os.path.join(clean, "interleave.json")
+    manifest = json.load(open(manifest_path))
+    first = manifest["runs"][0]
+    shutil.rmtree(os.path.join(clean, first["folder"]))
+    manifest["runs"][0]["exit"] = 1
+    json.dump(manifest, open(manifest_path, "w"))
+    q = compare(clean)
+    line = (f"perf compare: failed run: {first['side']} run of ci-small in round 1 exited 1 "
+            "and wrote no valid results.json")
+    if q.returncode != 1 or failed_run_lines(q.stderr) != [line]:
+        fail(f"a kept run recorded as exit 1 without its folder: exit {q.returncode}\n{q.stderr}")
+
+    # A kept folder cut short (the last run missing) never passes: the live command it came from gave no verdict.
+    shutil.rmtree(clean)
+    compare("--interleave", CLI, CLI, *fast, "--keep", clean)
+    manifest = json.load(open(manifest_path))
+    manifest["runs"] = manifest["runs"][:-1]
+    json.dump(manifest, open(manifest_path, "w"))
+    q = compare(clean)
+    if q.returncode != 1 or "the interleave was cut short: 3 of 4 runs recorded" not in q.stderr:
+        fail(f"a kept interleave cut short: exit {q.returncode}\n{q.stderr}")
+
+    # No run recorded: refused as a bad input file, naming the file and the field.
+    manifest["runs"] = []
+    json.dump(manifest, open(manifest_path, "w"))
+    q = compare(clean)
+    if q.returncode != 3 or f"{manifest_path}: /runs: no run was recorded; nothing to compare" not in q.stderr:
+        fail(f"a kept interleave with no run: exit {q.returncode}\n{q.stderr}")
+    print("perf gate kept: ok")
+
+
+if CASE == "kept":
+    check_kept()
+    sys.exit(0)
+
 head = CLI
 if CASE == "slowdown":
     # HEAD is the same binary with the planted slowdown: a wrapper that sets the switch.

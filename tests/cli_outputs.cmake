@@ -104,3 +104,12 @@ set_tests_properties(Cli.PlotSweepFailsInOneLine PROPERTIES TIMEOUT 60 FAIL_REGU
                      PASS_REGULAR_EXPRESSION "^exit 1 lines 1\nplot_sweep.py: [^\n]*/missing.json: cannot read: \
 No such file or directory\nexit 1 lines 1\nplot_sweep.py: [^\n]*/cut.json: not JSON: [^\n]*\nexit 1 lines 1\n\
 plot_sweep.py: [^\n]*/none/p.png: cannot write: No such file or directory\n$")
+
+# Test every reader and writer of every command (scenes, results folders and the frames they list, histories,
+# suites, baselines, shards, kept interleaves, saved states; report -o, --json, --history, runs.log, run --out)
+# against a link out of its folder, a link inside it, a FIFO, a folder, /dev/zero, an empty file and a file too
+# large: the verdict, the exit code and the message the path policy gives (core/base/PathPolicy.h), and that
+# nothing of a file outside reaches an output.
+add_test(NAME Cli.PathPolicy COMMAND /usr/bin/python3 ${outputs_py}/check_path_policy.py ${cli} ${cli_out}/path-policy)
+set_tests_properties(Cli.PathPolicy PROPERTIES TIMEOUT 400 FAIL_REGULAR_EXPRESSION "FAIL: "
+                     PASS_REGULAR_EXPRESSION "every reader and writer follows the path policy")

@@ -67,4 +67,4 @@ add_test(NAME Cli.AccuracyBadReferenceStepExits2
          COMMAND ${CMAKE_COMMAND} -DCMD=${cli} "-DARGS=accuracy;ci-small;--reference-step;0" -DEXPECT=2
                  ${expect_exit})
 set_tests_properties(Cli.AccuracyBadReferenceStepExits2 PROPERTIES PASS_REGULAR_EXPRESSION
-                     "--reference-step needs a number")
+                     "--reference-step: needs a number of voxel edges")

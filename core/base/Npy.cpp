@@ -6,10 +6,10 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
-#include <fstream>
+#include <filesystem>
 #include <sstream>
 
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 
 namespace cb {
 namespace {
@@ -52,18 +52,27 @@ Status WriteNpy(int fd, const std::string& name, NpyType type, std::span<const u
 
 Status WriteNpy(const std::string& path, NpyType type, std::span<const uint64_t> shape,
                 std::span<const std::byte> data) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0) return MakeError(path + ": cannot write: " + std::strerror(errno));
+    Result<int> opened = OpenAppendFile(path);  // never through a link at `path`, never a FIFO
+    if (!opened) return std::unexpected(opened.error());
+    const int fd = *opened;
+    if (::ftruncate(fd, 0) != 0) {
+        const int error = errno;
+        ::close(fd);
+        return MakeError(path + ": cannot write: " + std::strerror(error));
+    }
     Status written = WriteNpy(fd, path, type, shape, data);
     if (::close(fd) != 0 && written) return MakeError(path + ": cannot write: " + std::strerror(errno));
     return written;
 }
 
 Result<NpyArray> ReadNpy(const std::string& path) {
-    // The whole file, checked as every input is (core/base/InputFile.h): a FIFO or a device is refused, not read.
+    // The whole file, checked as every input is (core/base/PathPolicy.h): a FIFO or a device is refused, not read.
     Result<std::string> file = ReadInputFile(path, kArrayInput);
     if (!file) return std::unexpected(file.error());
-    const std::string& bytes = *file;
+    return ParseNpy(*file, path);
+}
+
+Result<NpyArray> ParseNpy(const std::string& bytes, const std::string& path) {
     if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY\x01\x00", 8) != 0)
         return MakeError(path + ": not a version 1.0 .npy file");
     const size_t length = uint8_t(bytes[8]) | (size_t(uint8_t(bytes[9])) << 8);

@@ -29,5 +29,7 @@ struct NpyArray {
 
 // Reads what WriteNpy writes (|u1 or <f4, C order); anything else is an error.
 Result<NpyArray> ReadNpy(const std::string& path);
+// The array whose file's bytes are `bytes`; `path` names the file in errors.
+Result<NpyArray> ParseNpy(const std::string& bytes, const std::string& path);
 
 }  // namespace cb

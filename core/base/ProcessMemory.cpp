@@ -4,18 +4,20 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <string_view>
 
+#include "core/base/SystemFile.h"
+
 namespace cb {
 namespace {
+
 
 // Limits at or above this mean "no limit" (cgroup v1 writes 2^63 rounded down to a page).
 constexpr uint64_t kUnlimited = uint64_t(1) << 62;
 
 std::optional<uint64_t> ReadNumber(const std::string& path) {
-    std::ifstream in(path);
+    std::istringstream in(ReadSystemFile(path));
     std::string text;
     if (!(in >> text) || text == "max") return std::nullopt;
     try {
@@ -29,7 +31,7 @@ std::optional<uint64_t> ReadNumber(const std::string& path) {
 
 // A "Key: N kB" line of /proc/self/status or /proc/meminfo, in bytes.
 std::optional<uint64_t> ReadKilobytes(const char* path, std::string_view key) {
-    std::ifstream in(path);
+    std::istringstream in(ReadSystemFile(path));
     std::string line;
     while (std::getline(in, line)) {
         if (!line.starts_with(key) || line.size() <= key.size() || line[key.size()] != ':') continue;
@@ -48,7 +50,7 @@ struct CgroupMemory {
 // Version 2 ("0::/path" in /proc/self/cgroup) and version 1 (the "memory" controller); in a container the own
 // path is often not mounted, so every folder from it up to the mount is tried.
 std::optional<CgroupMemory> CgroupLimit() {
-    std::ifstream in("/proc/self/cgroup");
+    std::istringstream in(ReadSystemFile("/proc/self/cgroup"));
     std::string line;
     std::optional<CgroupMemory> best;
     while (std::getline(in, line)) {

@@ -167,6 +167,21 @@ struct DeferredHostResult {
     std::optional<SplatStats> splat;         // RenderSplat: *stats
 };
 
+// One limit of a backend's device that bounds the scenes it can run, as the
+// device reports it (glGetIntegerv, VkPhysicalDeviceLimits).
+struct DeviceLimit {
+    std::string name;    // the API's own name: "GL_MAX_TEXTURE_SIZE", "maxStorageBufferRange"
+    uint64_t value = 0;  // as the device reports it
+    std::string bounds;  // what it bounds in a scene: "grid nz and render.height"
+};
+
+// A scene setting past one of a backend's DeviceLimits: the scene field
+// ("grid.size", "render.height") and why, naming the backend and the limit.
+struct LimitExceeded {
+    std::string field;
+    std::string reason;
+};
+
 class Backend {
   public:
     virtual ~Backend() = default;
@@ -236,6 +251,12 @@ class Backend {
     // The memory its buffers and scratch can take (physical memory, a device
     // heap); nullopt when the backend cannot tell.
     virtual std::optional<uint64_t> AvailableBytes() const { return std::nullopt; }
+
+    // ---- Device limits (a scene past one is refused before any stage runs) ----
+    // The limits of this backend's device that bound what it can run; none here.
+    virtual std::vector<DeviceLimit> Limits() const { return {}; }
+    // The first setting of `scene` past one of Limits(), or nullopt when every pass of the scene fits them.
+    virtual std::optional<LimitExceeded> ExceededLimit(const Scene& /*scene*/) const { return std::nullopt; }
 
     // ---- Stages: one virtual per entry of CB_BACKEND_ENTRIES ----
     // Each returns "unsupported" here; a backend overrides the entries of the

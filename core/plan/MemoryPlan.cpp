@@ -37,4 +37,10 @@ Status CheckPlannedBytesFit(const Scene& scene, const Backend& backend) {
                      std::to_string(*available) + " bytes) available to it");
 }
 
+Status CheckDeviceLimits(const Scene& scene, const Backend& backend) {
+    const std::optional<LimitExceeded> exceeded = backend.ExceededLimit(scene);
+    if (!exceeded) return {};
+    return MakeError((scene.path.empty() ? scene.name : scene.path) + ": " + exceeded->field + ": " + exceeded->reason);
+}
+
 }  // namespace cb

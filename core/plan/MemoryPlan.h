@@ -3,6 +3,7 @@
 // estimate cannot drift from the allocation. The loader's check prices the
 // plan in the host layout (EstimateSceneBytes, here); at run time each
 // backend prices it in its own (Backend::BufferBytes, Backend::ScratchBytes).
+// Beside it, whether the scene is within the backend's device limits.
 #pragma once
 
 #include <cstdint>
@@ -31,5 +32,10 @@ uint64_t PlannedBytes(const Scene& scene, const Backend& backend);
 // Fails, naming the backend, the bytes needed and the bytes available, when
 // the backend reports its available memory and PlannedBytes exceeds it.
 Status CheckPlannedBytesFit(const Scene& scene, const Backend& backend);
+
+// Fails with `file: field: reason` (the scene's file, the setting, the backend
+// and the limit named) when a setting of `scene` is past one of the backend's
+// device limits (Backend::ExceededLimit); checked before any stage runs.
+Status CheckDeviceLimits(const Scene& scene, const Backend& backend);
 
 }  // namespace cb

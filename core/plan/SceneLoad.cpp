@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 #include "core/base/JsonDom.h"
 #include "core/base/ProcessMemory.h"
 #include "core/plan/MemoryPlan.h"

@@ -327,10 +327,8 @@ const CommandRegistration kRegistration({
         ListOption("--vary", &ConformOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary smooth.radius=0,2"),
         OwnOption<ConformOptions>("--flake-reruns", true,
                                   [](ConformOptions& o, const char* v) -> std::optional<std::string> {
-                                      char* end = nullptr;
-                                      const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
-                                      if (!v || !*v || *end || v[0] == '-' || n > 100)
-                                          return "--flake-reruns needs a count from 0 to 100";
+                                      long long n = 0;
+                                      if (auto why = ParseWholeNumber("--flake-reruns", v, 0, 100, n)) return why;
                                       o.flakeReruns = uint32_t(n);
                                       return std::nullopt;
                                   }),

@@ -13,11 +13,20 @@ constexpr const char* kHelp = R"(usage: cloudbench devices
 
 Lists the backends of this build, the Vulkan devices with the index and name
 that --vk-device takes, and the OpenGL contexts that --gl-context takes, each
-tried here: its GL_RENDERER and GL_VERSION and its texture limits
-(GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS: the largest render.width and
-render.height, and grid edges, gl can run), or why it cannot be created.
+tried here: its GL_RENDERER and GL_VERSION, or why it cannot be created. Under
+each device and context, its limits that bound a scene (for gl
+GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS and GL_MAX_VIEWPORT_DIMS, for
+vk maxComputeWorkGroupCount[0] and maxStorageBufferRange), with what each
+bounds: a scene past one is refused on that backend before any stage runs.
 Exits 4 when the Vulkan backend is built but finds no device.
 )";
+
+// A device's limits, one a line under it: the API's name, the value and what it bounds.
+void PrintLimits(const std::vector<DeviceLimit>& limits) {
+    for (const DeviceLimit& limit : limits)
+        std::printf("          %s %llu: %s\n", limit.name.c_str(), static_cast<unsigned long long>(limit.value),
+                    limit.bounds.c_str());
+}
 
 // Returns false when Vulkan is built and has no device.
 bool PrintVulkanDevices() {
@@ -28,9 +37,11 @@ bool PrintVulkanDevices() {
         return std::ranges::find(built, "vk") == built.end();
     }
     std::printf("Vulkan devices (--vk-device INDEX or a part of the name):\n");
-    for (const VulkanDeviceInfo& d : *devices)
+    for (const VulkanDeviceInfo& d : *devices) {
         std::printf("  %u  %s: %s, Vulkan %s, driver %s\n", d.index, d.name.c_str(), d.type.c_str(), d.api.c_str(),
                     d.driver.c_str());
+        PrintLimits(d.limits);
+    }
     return true;
 }
 
@@ -45,11 +56,7 @@ void PrintGLContexts() {
         const std::string name(gl::ContextKindName(c.kind));
         if (c.available) {
             std::printf("  %-7s %s: OpenGL %s\n", name.c_str(), c.renderer.c_str(), c.version.c_str());
-            // Every buffer is a 2-D texture array, one layer per slice: an image's rows are its layers.
-            std::printf(
-                "  %-7s texture limits: %d x %d, %d layers (render.height and grid nz at most %d on it, "
-                "render.width, grid nx and ny at most %d)\n",
-                "", c.maxTextureSize, c.maxTextureSize, c.maxArrayLayers, c.maxArrayLayers, c.maxTextureSize);
+            PrintLimits(c.limits);
         } else
             std::printf("  %-7s unavailable: %s\n", name.c_str(), c.reason.c_str());
     }

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 
 #include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
@@ -56,10 +55,19 @@ std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& 
     const std::string text = a.Value(name);
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
+    // A whole bound in full ("1000000", as docs/cli.md gives it), any other in %g ("1e-12").
+    auto bound = [](double b) { return Num(b == std::floor(b) && std::fabs(b) < 1e15 ? "%.0f" : "%g", b); };
     if (end == text.c_str() || *end != '\0' || !(v >= low && v <= high))
-        return name + ": needs a number in [" + Num("%g", low) + ", " + Num("%g", high) + "], got '" + ShownArgument(text) + "'";
+        return name + ": needs a number in [" + bound(low) + ", " + bound(high) + "], got '" + ShownArgument(text) +
+               "'";
     value = v;
     return std::nullopt;
+}
+
+std::optional<std::string> WholeNumberOption(const ParsedArgs& a, const std::string& name, long long low,
+                                             long long high, long long& value) {
+    if (!a.values.count(name)) return std::nullopt;
+    return ParseWholeNumber(name, a.Value(name).c_str(), low, high, value);
 }
 
 bool WriteJsonFile(const std::string& path, const json& doc) {
@@ -84,7 +92,7 @@ TemporaryFolder::~TemporaryFolder() {
 
 std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
                            const std::string& out, const std::string& log, perf::Side& side, bool& failed, int round,
-                           int* exitCode) {
+                           int* exitCode, bool* compared) {
     std::vector<std::string> argv = {binary, "run", scene, "--out", out, "--quiet"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     auto rc = perf::RunChild(argv, log);
@@ -113,6 +121,7 @@ std::optional<int> RunInto(const std::string& binary, const std::string& scene, 
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
     }
+    if (compared) *compared = true;
     return std::nullopt;
 }
 

@@ -47,9 +47,13 @@ std::optional<std::string> Parse(const std::vector<std::string>& args, const std
 // `v` printed with `format`; "" for NaN.
 std::string Num(const char* format, double v);
 
-// A number option in [low, high]; the usage message when it is not one.
+// A number option in [low, high]; the usage message when it is not one:
+// "NAME: needs a number in [LOW, HIGH], got 'TEXT'". `value` is left as it is when the option is absent.
 std::optional<std::string> NumberOption(const ParsedArgs& a, const std::string& name, double low, double high,
                                         double& value);
+// The same for a count: "NAME: needs a whole number in [LOW, HIGH], got 'TEXT'" (ParseWholeNumber).
+std::optional<std::string> WholeNumberOption(const ParsedArgs& a, const std::string& name, long long low,
+                                             long long high, long long& value);
 
 // Writes `doc` to `path` whole (Session::WriteText: a temporary file in the same
 // folder, renamed; never through a link); on failure prints
@@ -67,10 +71,12 @@ struct TemporaryFolder {
 // One `cloudbench run` of `scene` by `binary` into `out`, its results added to
 // `side` as one run measured in `round` (-1 outside an interleave). Returns the
 // exit code the perf command should end with at once (a bad scene or command
-// line), or nullopt to go on; `failed` is set when the run failed, and
-// `exitCode` (when given) receives the run's own exit code.
+// line), or nullopt to go on; `failed` is set when the run failed (it exited
+// other than 0, or wrote no valid results.json), `exitCode` (when given)
+// receives the run's own exit code and `compared` (when given) whether its
+// results were added.
 std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
                            const std::string& out, const std::string& log, perf::Side& side, bool& failed,
-                           int round = -1, int* exitCode = nullptr);
+                           int round = -1, int* exitCode = nullptr, bool* compared = nullptr);
 
 }  // namespace cb::perf_command

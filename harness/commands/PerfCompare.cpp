@@ -23,6 +23,9 @@
 namespace cb::perf_command {
 namespace {
 
+// The most rounds --rounds takes (each round is two runs a scene).
+constexpr long long kMaxRounds = 1000;
+
 std::string SideSummary(const perf::Side& side) {
     std::string text = side.label;
     const json& p = side.provenance;
@@ -71,9 +74,22 @@ json ComparisonJson(const perf::Comparison& c) {
             {"note", c.note}};
 }
 
-// Prints the comparison, writes --json, returns the exit code.
+// What an interleave (live or kept) adds to the verdict: the runs that failed, and whether fewer runs
+// were recorded than planned (a kept interleave cut short). Either makes a verdict without a regression exit 1.
+struct RunProblems {
+    std::vector<perf::FailedRun> failedRuns;
+    std::string cutShort;  // why the runs are fewer than planned; "" when they are all there
+};
+
+json FailedRunJson(const perf::FailedRun& run) {
+    return {
+        {"side", run.side}, {"scene", run.scene}, {"round", run.round}, {"exit", run.exit}, {"compared", run.compared}};
+}
+
+// Prints the comparison, writes --json, returns the exit code: 6 for a regression, else 1 when HEAD failed,
+// a run failed or the runs were cut short, else 0. Each failed run gets a line on stderr.
 int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::CompareSettings& settings,
-                    const std::string& mode, const std::string& jsonPath) {
+                    const std::string& mode, const std::string& jsonPath, const RunProblems& problems = {}) {
     const perf::CompareOutcome outcome = perf::Compare(base, head, settings);
     report::Report rep("perf compare");
     report::Section section;
@@ -126,9 +142,20 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
     } else if (outcome.headFailed) {
         code = kExitFailed;
         std::printf("no regression, but HEAD failed or lacks a measurement (marked x)\n");
+    } else if (const size_t failed = problems.failedRuns.size()) {
+        code = kExitFailed;
+        std::printf("no regression, but %zu %s failed (named on standard error)\n", failed,
+                    failed == 1 ? "run" : "runs");
+    } else if (!problems.cutShort.empty()) {
+        code = kExitFailed;
+        std::printf("no regression in what was measured, but %s\n", problems.cutShort.c_str());
     } else {
         std::printf("no regression\n");
     }
+    std::fflush(stdout);
+    for (const perf::FailedRun& run : problems.failedRuns)
+        std::fprintf(stderr, "perf compare: failed run: %s\n", perf::DescribeFailedRun(run).c_str());
+    if (!problems.cutShort.empty()) std::fprintf(stderr, "perf compare: %s\n", problems.cutShort.c_str());
     if (const size_t unjudged = outcome.Unjudged()) {
         std::printf("warning: %zu of %zu time comparisons could not be judged (marked ?):", unjudged,
                     size_t(std::count_if(outcome.rows.begin(), outcome.rows.end(),
@@ -153,6 +180,8 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
                     {"run_statistic", RunStatisticName(settings.runQuantile)},
                     {"regressions", outcome.Regressions()},
                     {"unjudged", json::array()},
+                    {"failed_runs", json::array()},
+                    {"cut_short", problems.cutShort},
                     {"exit_code", code},
                     {"report", report::RenderJson(rep)}};
         for (const perf::Comparison& c : outcome.rows) {
@@ -161,6 +190,7 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
         }
         for (const auto& [backend, unused] : settings.backendThreshold)
             doc["backend_thresholds"][backend] = perf::ThresholdOf(settings, backend);
+        for (const perf::FailedRun& run : problems.failedRuns) doc["failed_runs"].push_back(FailedRunJson(run));
         if (!WriteJsonFile(jsonPath, doc) && code == kExitOk) code = kExitFailed;
     }
     return code;
@@ -239,25 +269,25 @@ int RoundsToJudge(const perf::Side& base, const perf::Side& head, double alpha) 
     return rounds;
 }
 
-// `perf compare FOLDER`: the verdict again from a kept interleave's runs.
+// `perf compare FOLDER`: the verdict again from a kept interleave's runs, with the exit code the live
+// command ended with for the same runs.
 int CompareKept(const std::string& folder, perf::CompareSettings settings, perf::Clock clock,
                 const std::string& jsonPath) {
-    double peakLoad = 0;
-    auto sides = perf::LoadInterleave(folder, clock, &peakLoad);
-    if (!sides) {
-        std::fprintf(stderr, "%s\n", sides.error().message.c_str());
+    auto kept = perf::LoadInterleave(folder, clock);
+    if (!kept) {
+        std::fprintf(stderr, "%s\n", kept.error().message.c_str());
         return kExitBadScene;
     }
-    int rounds = 0;
-    for (const perf::Side& side : *sides)
-        for (const auto& [scene, backends] : side.runs)
-            for (const auto& [backend, stages] : backends)
-                for (const auto& [stage, runs] : stages)
-                    for (const perf::RunSamples& run : runs) rounds = std::max(rounds, run.round + 1);
+    RunProblems problems;
+    problems.failedRuns = kept->failedRuns;
+    if (kept->recordedRuns < kept->plannedRuns)
+        problems.cutShort = "the interleave was cut short: " + std::to_string(kept->recordedRuns) + " of " +
+                            std::to_string(kept->plannedRuns) + " runs recorded in " + folder + "/" +
+                            perf::kInterleaveFile;
     settings.interleaved = true;
-    const int code =
-        PrintComparison((*sides)[0], (*sides)[1], settings, InterleavedMode(rounds) + ", kept in " + folder, jsonPath);
-    WarnIfLoaded(peakLoad, clock);
+    const int code = PrintComparison(kept->sides[0], kept->sides[1], settings,
+                                     InterleavedMode(kept->rounds) + ", kept in " + folder, jsonPath, problems);
+    WarnIfLoaded(kept->peakLoad, clock);
     return code;
 }
 
@@ -331,8 +361,8 @@ int ComparePerf(const std::vector<std::string>& args) {
     }
     if (a.positional.size() < 3) return Usage("perf compare --interleave needs BASE_BINARY HEAD_BINARY SCENE...");
     // Without --rounds, the rounds follow from the first: as many as every time comparison needs to be judged.
-    double rounds = 0;
-    if (auto m = NumberOption(a, "--rounds", 1, 1000, rounds)) return Usage(*m);
+    long long rounds = 0;
+    if (auto m = WholeNumberOption(a, "--rounds", 1, kMaxRounds, rounds)) return Usage(*m);
     const bool autoRounds = rounds == 0;
     if (autoRounds) rounds = 1;
     std::vector<std::string> extra;
@@ -371,7 +401,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     sides[1].label = binaries[1] + " (HEAD)";
     for (perf::Side& side : sides) side.clock = clock;
     double peakLoad = 0;
-    bool failed = false;
+    RunProblems problems;
     std::optional<int> stop;  // the exit code to end with at once
     auto runRound = [&](int round) {
         for (size_t s = 0; s < scenes.size() && !stop; ++s)
@@ -387,11 +417,13 @@ int ComparePerf(const std::vector<std::string>& args) {
                 if (!run["load"].empty()) peakLoad = std::max(peakLoad, run["load"][0].get<double>());
                 const auto start = std::chrono::steady_clock::now();
                 int exitCode = -1;
+                bool runFailed = false, compared = false;
                 if (auto code = RunInto(binaries[n], scenes[s], extra, folder + "/" + name, folder + "/runs.log",
-                                        sides[n], failed, round, &exitCode)) {
+                                        sides[n], runFailed, round, &exitCode, &compared)) {
                     stop = *code;
                     return;
                 }
+                if (runFailed) problems.failedRuns.push_back({side, scenes[s], round, exitCode, compared});
                 run["exit"] = exitCode;
                 run["seconds"] =
                     std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * 1000) /
@@ -414,9 +446,9 @@ int ComparePerf(const std::vector<std::string>& args) {
     }
     if (stop) return *stop;
     settings.interleaved = true;
-    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds)), jsonPath);
+    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds)), jsonPath, problems);
     WarnIfLoaded(peakLoad, clock);
-    return code == kExitOk && failed ? kExitFailed : code;
+    return code;
 }
 
 }  // namespace cb::perf_command

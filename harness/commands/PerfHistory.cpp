@@ -55,9 +55,10 @@ int History(const std::vector<std::string>& args) {
     const std::string metric = a.Value("--metric", "time");
     if (metric != "time" && metric != "instructions") return Usage("--metric needs time or instructions");
     perf::ChangePointSettings settings;
-    double minChange = 0.1, minSegment = settings.minSegment;
+    double minChange = 0.1;
+    long long minSegment = settings.minSegment;
     if (auto m = NumberOption(a, "--min-change", 0, 100, minChange)) return Usage(*m);
-    if (auto m = NumberOption(a, "--min-segment", 1, 1e6, minSegment)) return Usage(*m);
+    if (auto m = WholeNumberOption(a, "--min-segment", 1, 1000000, minSegment)) return Usage(*m);
     settings.minChange = std::log1p(minChange);
     settings.minSegment = int(minSegment);
     auto records = perf::ReadHistory(a.positional[0]);

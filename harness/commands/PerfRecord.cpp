@@ -61,9 +61,8 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
     if (auto m = Parse(args, {"--suite", "--history", "--repeat", "--backend", "--instructions"}, {"--quiet"}, a))
         return Usage(*m);
     if (!a.positional.empty()) return Usage("perf record: unexpected argument '" + a.positional[0] + "'");
-    double repeat = 1;
-    if (auto m = NumberOption(a, "--repeat", 1, 1000, repeat)) return Usage(*m);
-    if (repeat != std::floor(repeat)) return Usage("--repeat: needs a whole number");
+    long long repeat = 1;
+    if (auto m = WholeNumberOption(a, "--repeat", 1, 1000, repeat)) return Usage(*m);
     std::vector<SuiteEntry> suite = DefaultSuite();
     if (a.Has("--suite")) {
         auto loaded = LoadSuite(a.Value("--suite"));

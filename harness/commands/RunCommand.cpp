@@ -75,15 +75,13 @@ std::vector<OptionSpec> RunOptionSpecs() {
         }));
     options.push_back(TextOption("--save-state", &RunOptions::saveState, "--save-state needs a folder"));
     options.push_back(TextOption("--resume", &RunOptions::resumeState, "--resume needs a saved state's folder"));
-    options.push_back(OwnOption<RunOptions>("--save-state-every", true,
-                                            [](RunOptions& o, const char* v) -> std::optional<std::string> {
-                                                char* end = nullptr;
-                                                const unsigned long n = v && *v ? std::strtoul(v, &end, 10) : 0;
-                                                if (!v || !*v || *end || v[0] == '-' || n == 0 || n > UINT32_MAX)
-                                                    return "--save-state-every needs a step count > 0";
-                                                o.saveStateEvery = uint32_t(n);
-                                                return std::nullopt;
-                                            }));
+    options.push_back(OwnOption<RunOptions>(
+        "--save-state-every", true, [](RunOptions& o, const char* v) -> std::optional<std::string> {
+            long long n = 0;
+            if (auto why = ParseWholeNumber("--save-state-every", v, 1, UINT32_MAX, n)) return why;
+            o.saveStateEvery = uint32_t(n);
+            return std::nullopt;
+        }));
     return options;
 }
 

@@ -237,7 +237,8 @@ const CommandRegistration kRegistration({
          ReferenceStepOption(),
          OwnOption<SweepOptions>("--shard", true,
                                  [](SweepOptions& o, const char* v) -> std::optional<std::string> {
-                                     const std::string bad = "--shard needs I/N with 1 <= I <= N, e.g. --shard 2/8";
+                                     const std::string bad =
+                                         "--shard needs I/N with 1 <= I <= N <= 1000000, e.g. --shard 2/8";
                                      if (!v) return bad;
                                      int index = 0, count = 0, used = 0;
                                      if (std::sscanf(v, "%d/%d%n", &index, &count, &used) != 2 || v[used] != '\0' ||

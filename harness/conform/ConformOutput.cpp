@@ -6,10 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 #include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
 #include "core/math/Shading.h"

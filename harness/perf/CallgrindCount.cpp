@@ -10,12 +10,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/base/CallgrindRequests.h"
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 
 extern char** environ;
 

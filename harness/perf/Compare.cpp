@@ -162,39 +162,58 @@ Result<Side> LoadSide(const std::string& spec, Clock clock) {
     return side;
 }
 
-Result<std::array<Side, 2>> LoadInterleave(const std::string& folder, Clock clock, double* peakLoad) {
+Result<KeptInterleave> LoadInterleave(const std::string& folder, Clock clock) {
     const std::string manifestPath = folder + "/" + kInterleaveFile;
     if (struct stat st{}; ::lstat(manifestPath.c_str(), &st) != 0 && errno == ENOENT)
         return MakeError(folder + ": not a kept interleave (it has no " + kInterleaveFile +
                          "); perf compare takes BASE and HEAD, or a folder that --interleave --keep wrote");
     static constexpr input::Format kManifest[] = {input::Format::Interleave};
-    auto manifest = input::ReadCloudbenchFile(manifestPath, kManifest);
+    auto manifest = input::ReadCloudbenchFileBeneath(folder, kInterleaveFile, kManifest);
     if (!manifest) return std::unexpected(manifest.error());
     const json& doc = manifest->doc;
-    std::array<Side, 2> sides;
+    // The live command writes the file after each run: a file without one was not written by it.
+    if (doc["runs"].empty()) return MakeError(manifestPath + ": /runs: no run was recorded; nothing to compare");
+    KeptInterleave kept;
+    std::array<Side, 2>& sides = kept.sides;
     sides[0].label = doc["base"].get<std::string>() + " (BASE)";
     sides[1].label = doc["head"].get<std::string>() + " (HEAD)";
     for (Side& side : sides) side.clock = clock;
+    kept.recordedRuns = doc["runs"].size();
+    kept.plannedRuns = doc["rounds"].get<size_t>() * doc["scenes"].size() * 2;
     for (size_t n = 0; n < doc["runs"].size(); ++n) {
         const json& run = doc["runs"][n];
         const std::string side = run["side"].get<std::string>(), name = run["folder"].get<std::string>();
-        if (peakLoad && run.contains("load") && !run["load"].empty())
-            *peakLoad = std::max(*peakLoad, run["load"][0].get<double>());
+        const int round = run["round"].get<int>(), exit = run.value("exit", 0);
+        kept.rounds = std::max(kept.rounds, round + 1);
+        if (run.contains("load") && !run["load"].empty())
+            kept.peakLoad = std::max(kept.peakLoad, run["load"][0].get<double>());
         // A run's folder is its side's, one name deep: nothing outside the kept folder is read.
         const std::string prefix = side + "/", leaf = name.substr(std::min(name.size(), prefix.size()));
         if (name.rfind(prefix, 0) != 0 || leaf.empty() || leaf[0] == '.' || leaf.find('/') != std::string::npos)
             return MakeError(manifestPath + ": /runs/" + std::to_string(n) + "/folder: must be " + prefix +
                              "NAME, got '" + ShownText(name, false, 200) + "'");
+        FailedRun failed{side, run["scene"].get<std::string>(), round, exit, false};
         static constexpr input::Format kResults[] = {input::Format::Results};
-        auto results = input::ReadCloudbenchFile(folder + "/" + name + "/results.json", kResults);
+        // Beneath the kept folder (core/base/PathPolicy.h): a run's folder linked out of it is refused.
+        auto results = input::ReadCloudbenchFileBeneath(folder, name + "/results.json", kResults);
         if (!results) {
-            // A run that wrote no results was reported when it ran (its exit code is in the manifest).
-            if (run.value("exit", 0) != 0) continue;
-            return std::unexpected(results.error());
+            // A failed run may have written nothing; one that exited 0 wrote its results, so their loss is damage.
+            if (exit == 0) return std::unexpected(results.error());
+            kept.failedRuns.push_back(std::move(failed));
+            continue;
         }
-        CB_TRY(AddResults(sides[side == "head"], results->doc, run["round"].get<int>()));
+        CB_TRY(AddResults(sides[side == "head"], results->doc, round));
+        if (exit != 0) {
+            failed.compared = true;
+            kept.failedRuns.push_back(std::move(failed));
+        }
     }
-    return sides;
+    return kept;
+}
+
+std::string DescribeFailedRun(const FailedRun& run) {
+    return run.side + " run of " + ShownText(run.scene, false, 200) + " in round " + std::to_string(run.round + 1) +
+           " exited " + std::to_string(run.exit) + (run.compared ? "" : " and wrote no valid results.json");
 }
 
 json RecordSections(const Side& side) {

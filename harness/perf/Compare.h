@@ -67,10 +67,35 @@ Result<Side> LoadSide(const std::string& spec, Clock clock = Clock::Wall);
 inline constexpr const char* kInterleaveFormat = "cloudbench-interleave/1";
 inline constexpr const char* kInterleaveFile = "interleave.json";
 
-// Both sides of a kept interleave, each run in its round. Errors name the file.
-// `peakLoad` (when given) receives the highest 1-minute load average a run started at.
-Result<std::array<Side, 2>> LoadInterleave(const std::string& folder, Clock clock = Clock::Wall,
-                                           double* peakLoad = nullptr);
+// A run of an interleave that failed: it exited other than 0, or wrote no valid results.json.
+// Either makes `perf compare` exit 1 when nothing regressed, live or from the kept folder.
+struct FailedRun {
+    std::string side;       // "base" or "head"
+    std::string scene;      // as the command line named it
+    int round = 0;          // 0-based
+    int exit = 0;           // the run's exit code
+    bool compared = false;  // its results.json was read and its samples compared
+};
+
+// What `perf compare FOLDER` judges: both sides, each run in its round, and what the live command
+// would have ended with besides the comparison.
+struct KeptInterleave {
+    std::array<Side, 2> sides;
+    std::vector<FailedRun> failedRuns;  // in the order they ran
+    int rounds = 0;                     // the rounds with a recorded run (the highest round + 1)
+    size_t recordedRuns = 0;
+    size_t plannedRuns = 0;  // rounds x scenes x 2: fewer recorded means the interleave was cut short
+    double peakLoad = 0;     // the highest 1-minute load average a run started at
+};
+
+// The kept interleave in `folder`. Errors name the file and field: no interleave.json, one that is not
+// the format, a run's folder outside its side's, a run that exited 0 without its results.json, and
+// "FOLDER/interleave.json: /runs: no run was recorded; nothing to compare".
+Result<KeptInterleave> LoadInterleave(const std::string& folder, Clock clock = Clock::Wall);
+
+// "base run of ci-small in round 1 exited 1" (the round 1-based, as the kept folders are named), with
+// "and wrote no valid results.json" when it was not compared.
+std::string DescribeFailedRun(const FailedRun& run);
 
 // A history record's "results", "failures" and "instructions" sections from a
 // side: each stage's pooled "samples_ms" and "median_ms", and "runs_ms" (the

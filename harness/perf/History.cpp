@@ -34,34 +34,26 @@ Result<std::vector<HistoryRecord>> ReadHistory(const std::string& path) {
 }
 
 Status AppendRecord(const std::string& path, const nlohmann::json& record) {
-    auto fail = [&] { return MakeError(path + ": cannot write: " + std::strerror(errno)); };
-    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    std::error_code ec;
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-    // Like every file the user names (docs/results.md, "Output folders"): its folder is followed, a link at its own
-    // name is refused, never appended through.
-    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0 && errno == ELOOP) return std::unexpected(LinkRefused(path));
-    if (fd < 0) return fail();
+    // Like every file the user names (core/base/PathPolicy.h): its folder is followed, a link at its own name is
+    // refused, never appended through, and a FIFO or a device is refused without blocking.
+    Result<int> opened = OpenAppendFile(path);
+    if (!opened) return std::unexpected(opened.error());
+    const int fd = *opened;
+    auto fail = [&] {
+        const int error = errno;
+        ::close(fd);
+        return MakeError(path + ": cannot write: " + std::strerror(error));
+    };
     std::string line = record.dump() + "\n";
     // A previous line cut short has no newline: end it, so this record stays readable.
     struct stat st {};
     if (::fstat(fd, &st) == 0 && st.st_size > 0) {
         char last = '\n';
-        const int reader = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-        if (reader >= 0) {
-            if (::pread(reader, &last, 1, st.st_size - 1) != 1) last = '\n';
-            ::close(reader);
-        }
+        if (::pread(fd, &last, 1, st.st_size - 1) != 1) last = '\n';
         if (last != '\n') line.insert(line.begin(), '\n');
     }
-    if (!WriteAll(fd, line) || ::fsync(fd) != 0) {
-        const int error = errno;
-        ::close(fd);
-        errno = error;
-        return fail();
-    }
-    if (::close(fd) != 0) return fail();
+    if (!WriteAll(fd, line) || ::fsync(fd) != 0) return fail();
+    if (::close(fd) != 0) return MakeError(path + ": cannot write: " + std::strerror(errno));
     return {};
 }
 

@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "harness/platform/OutputFolder.h"
+
 extern char** environ;
 
 namespace cb::perf {
@@ -17,14 +19,24 @@ Result<int> RunChild(const std::vector<std::string>& argv, const std::string& st
     std::vector<char*> args;
     for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
+    // The log is opened here, by the path policy (no link followed inside an output folder, no FIFO), and
+    // handed to the child as its standard output.
+    int logFd = -1;
+    if (!stdoutPath.empty()) {
+        const std::filesystem::path log(stdoutPath);
+        auto folder = OpenFolderForWriting(log.parent_path().string(), /*create=*/false);
+        if (!folder) return std::unexpected(folder.error());
+        auto opened = OpenFileAt(folder->Fd(), stdoutPath, log.filename().string(), WriteMode::Append);
+        if (!opened) return std::unexpected(opened.error());
+        logFd = *opened;
+    }
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    if (!stdoutPath.empty())
-        posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, stdoutPath.c_str(), O_WRONLY | O_CREAT | O_APPEND,
-                                         0644);
+    if (logFd >= 0) posix_spawn_file_actions_adddup2(&actions, logFd, STDOUT_FILENO);
     pid_t pid = 0;
     const int error = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
+    if (logFd >= 0) ::close(logFd);
     if (error != 0) return MakeError(argv[0] + ": cannot run: " + std::strerror(error));
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0)

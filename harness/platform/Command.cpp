@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -18,15 +19,6 @@ namespace {
 std::map<std::string_view, Command>& Registry() {
     static std::map<std::string_view, Command> registry;
     return registry;
-}
-
-// A positive integer in [1, max], or nullopt.
-std::optional<int> PositiveInt(const char* text, long max) {
-    if (!text) return std::nullopt;
-    char* end = nullptr;
-    const long value = std::strtol(text, &end, 10);
-    if (*end != '\0' || value < 1 || value > max) return std::nullopt;
-    return int(value);
 }
 
 // A name from the command line as a message shows it (core/base/ShownText.h): printable ASCII, the rest as \xNN, cut
@@ -82,9 +74,9 @@ std::vector<OptionSpec> MakeSceneCommandOptions() {
          }},
         {"--threads", "", true,
          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
-             const std::optional<int> threads = PositiveInt(v, 1024);
-             if (!threads) return "--threads needs a number from 1";
-             o.cpuThreads = *threads;
+             long long threads = 0;
+             if (auto why = ParseWholeNumber("--threads", v, 1, kMaxCpuThreads, threads)) return why;
+             o.cpuThreads = int(threads);
              return std::nullopt;
          }},
         Choice("--gl-context", &CommonOptions::glContext, gl::kContextKindNames),
@@ -95,6 +87,20 @@ std::vector<OptionSpec> MakeSceneCommandOptions() {
 }
 
 }  // namespace
+
+std::optional<std::string> ParseWholeNumber(std::string_view name, const char* value, long long low, long long high,
+                                            long long& out) {
+    const std::string needs =
+        std::string(name) + ": needs a whole number in [" + std::to_string(low) + ", " + std::to_string(high) + "]";
+    if (!value) return needs;
+    const std::string_view text = value;
+    long long parsed = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), parsed);
+    if (text.empty() || error != std::errc() || end != text.data() + text.size() || parsed < low || parsed > high)
+        return needs + ", got '" + Shown(text) + "'";
+    out = parsed;
+    return std::nullopt;
+}
 
 OptionSpec FlagOption(std::string_view name, bool CommonOptions::*field) {
     return {name, "", false, [=](CommonOptions& o, const char*) -> std::optional<std::string> {
@@ -174,23 +180,26 @@ std::string GlOptionsHelp() {
 OptionSpec RepeatOption() {
     return OwnOption<MeasurementOptions>("--repeat", true,
                                          [](MeasurementOptions& o, const char* v) -> std::optional<std::string> {
-                                             const std::optional<int> repeats = PositiveInt(v, 10000);
-                                             if (!repeats) return "--repeat needs a number from 1";
-                                             o.repeats = *repeats;
+                                             long long repeats = 0;
+                                             if (auto why = ParseWholeNumber("--repeat", v, 1, 10000, repeats))
+                                                 return why;
+                                             o.repeats = int(repeats);
                                              return std::nullopt;
                                          });
 }
 
 OptionSpec ReferenceStepOption() {
-    return OwnOption<MeasurementOptions>("--reference-step", true,
-                                         [](MeasurementOptions& o, const char* v) -> std::optional<std::string> {
-                                             char* end = nullptr;
-                                             const double step = v ? std::strtod(v, &end) : 0;
-                                             if (!v || end == v || *end != '\0' || !(step >= 1.0 / 1024 && step <= 1))
-                                                 return "--reference-step needs a number of voxel edges in [1/1024, 1]";
-                                             o.referenceStep = step;
-                                             return std::nullopt;
-                                         });
+    return OwnOption<MeasurementOptions>(
+        "--reference-step", true, [](MeasurementOptions& o, const char* v) -> std::optional<std::string> {
+            char* end = nullptr;
+            const double step = v ? std::strtod(v, &end) : 0;
+            const std::string needs = "--reference-step: needs a number of voxel edges in [1/1024, 1]";
+            if (!v) return needs;
+            if (end == v || *end != '\0' || !(step >= 1.0 / 1024 && step <= 1))
+                return needs + ", got '" + Shown(v) + "'";
+            o.referenceStep = step;
+            return std::nullopt;
+        });
 }
 
 CommandRegistration::CommandRegistration(Command command) {

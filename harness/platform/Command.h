@@ -139,6 +139,16 @@ std::optional<std::string> UnknownBackend(std::string_view option, std::string_v
 // (in `list` or already in `backends`), or a name not in KnownBackends().
 std::optional<std::string> ParseBackendList(std::string_view list, std::vector<std::string>& backends);
 
+// The most threads --threads takes: a fixed cap, so that a command line means the same on every machine
+// (above the machine's hardware threads TBB adds no threads; docs/cli.md).
+inline constexpr long long kMaxCpuThreads = 1024;
+
+// A whole number in [low, high] from an option's value (decimal digits, no sign or space), stored in `out`;
+// otherwise the usage message "NAME: needs a whole number in [LOW, HIGH], got 'TEXT'" (without ", got" when
+// the value is missing).
+std::optional<std::string> ParseWholeNumber(std::string_view name, const char* value, long long low, long long high,
+                                            long long& out);
+
 // The options every scene command accepts: --backend, --steps, --out, --set,
 // --threads, --gl-context, --gl-ca-layout, --vk-device, --quiet.
 std::span<const OptionSpec> SceneCommandOptions();

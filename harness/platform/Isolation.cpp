@@ -20,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/base/ShownText.h"
 #include "core/scene/Stage.h"
 #include "harness/platform/PosixIo.h"
 
@@ -357,8 +358,9 @@ std::vector<OptionSpec> IsolationOptions() {
          [](CommonOptions& o, const char* v) -> std::optional<std::string> {
              char* end = nullptr;
              const double seconds = v ? std::strtod(v, &end) : -1;
-             if (!v || !*v || *end || !(seconds >= 0) || seconds > 1e7)
-                 return "--backend-timeout needs seconds from 0 (0 = no timeout)";
+             const std::string needs = "--backend-timeout: needs seconds in [0, 10000000] (0 = no timeout)";
+             if (!v) return needs;
+             if (!*v || *end || !(seconds >= 0) || seconds > 1e7) return needs + ", got '" + ShownArgument(v) + "'";
              o.backendTimeout = seconds;
              return std::nullopt;
          }},

@@ -301,6 +301,13 @@ Node OpenObject(std::vector<Field> fields) {
 Node MapOf(KeyRule keys, Node value) { return Make({.kind = Kind::Map, .keys = keys, .value = std::move(value)}); }
 #pragma GCC diagnostic pop
 
+std::vector<std::string_view> FieldNames(const Node& schema) {
+    std::vector<std::string_view> names;
+    if (schema && schema->kind == Kind::Object)
+        for (const Field& f : schema->fields) names.push_back(f.name);
+    return names;
+}
+
 Status Validate(const nlohmann::json& value, const Node& schema, const std::string& label) {
     Checker checker;
     if (checker.Check(value, *schema)) return {};

@@ -1,5 +1,5 @@
 // The JSON files cloudbench reads back (docs/cli.md#input-files): read with
-// core/base/InputFile.h (a regular file of bounded size), parsed with duplicate
+// core/base/PathPolicy.h (a regular file of bounded size), parsed with duplicate
 // keys and nesting deeper than 64 refused, and checked against a schema before
 // any field is used, so that a reader after Validate() may use nlohmann's
 // accessors freely.
@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "core/base/Error.h"
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 
 namespace cb {
 
@@ -69,6 +69,9 @@ Node MapOf(KeyRule keys, Node value);
 
 // The first way `value` breaks `schema`, as "LABEL: POINTER: reason" (the root's pointer shown as "/").
 Status Validate(const nlohmann::json& value, const Node& schema, const std::string& label);
+
+// The field names of an object schema (Object or OpenObject), in their order; none for any other schema.
+std::vector<std::string_view> FieldNames(const Node& schema);
 
 }  // namespace schema
 

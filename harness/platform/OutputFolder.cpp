@@ -16,6 +16,7 @@
 #include <optional>
 #include <set>
 
+#include "core/base/PathPolicy.h"
 #include "harness/platform/PosixIo.h"
 
 namespace cb {
@@ -23,7 +24,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kLockName = ".cloudbench.lock";
-constexpr int kFolderFlags = O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC;
 
 struct ClaimedFolder {
     fs::path root;       // absolute and lexically normal
@@ -92,11 +92,11 @@ Result<OpenFolder> WalkDown(OpenFolder from, const fs::path& relative, bool crea
         const std::string name = part.string();
         if (name.empty() || name == ".") continue;
         const std::string shown = current.ShownChild(name);
-        int fd = openat(current.Fd(), name.c_str(), kFolderFlags);
+        int fd = OpenFolderAt(current.Fd(), name);
         if (fd < 0 && errno == ENOENT && create) {
             if (mkdirat(current.Fd(), name.c_str(), 0777) != 0 && errno != EEXIST)
                 return std::unexpected(Cannot(shown, errno));
-            fd = openat(current.Fd(), name.c_str(), kFolderFlags);
+            fd = OpenFolderAt(current.Fd(), name);
         }
         if (fd < 0) {
             const int error = errno;
@@ -219,22 +219,8 @@ std::string DescribeHolder(int lockFd) {
 
 // Opens (creating) the regular file `name` in `folder` for reading and writing, never through a link:
 // the lock and the journal, the two files cloudbench writes in place.
-Result<int> OpenInPlace(const OpenFolder& folder, const std::string& name, int flags) {
-    const std::string shown = folder.ShownChild(name);
-    const int fd =
-        openat(folder.Fd(), name.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC | flags, 0644);
-    if (fd < 0) {
-        const int error = errno;
-        if (error == ELOOP || IsLinkAt(folder.Fd(), name)) return std::unexpected(LinkRefused(shown));
-        return std::unexpected(Cannot(folder.Shown(), error));
-    }
-    struct stat info {};
-    if (fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
-        close(fd);
-        return MakeError(shown + ": not a regular file; cloudbench keeps its " +
-                         (name == kLockName ? "lock" : "journal") + " there (remove it)");
-    }
-    return fd;
+Result<int> OpenInPlace(const OpenFolder& folder, const std::string& name, WriteMode mode) {
+    return OpenFileAt(folder.Fd(), folder.ShownChild(name), name, mode);
 }
 
 }  // namespace
@@ -256,10 +242,6 @@ OpenFolder& OpenFolder::operator=(OpenFolder&& other) noexcept {
 std::string OpenFolder::ShownChild(std::string_view name) const {
     if (mShown.empty() || mShown == ".") return std::string(name);
     return mShown + (mShown.back() == '/' ? "" : "/") + std::string(name);
-}
-
-Error LinkRefused(const std::string& shown) {
-    return Error{shown + ": is a symbolic link; cloudbench does not write through links (remove it)"};
 }
 
 Result<OpenFolder> OpenFolderForWriting(const std::string& dir, bool create) {
@@ -284,7 +266,7 @@ Result<OpenFolder> OpenFolderForWriting(const std::string& dir, bool create) {
         fs::create_directories(shown, ec);
         if (ec) return std::unexpected(Cannot(shown, ec.value()));
     }
-    const int fd = open(shown.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    const int fd = OpenNamedFolder(shown);
     if (fd < 0) return std::unexpected(Cannot(shown, errno));
     return OpenFolder(fd, shown);
 }
@@ -320,7 +302,7 @@ Status RemoveTreeAt(const OpenFolder& folder, const std::string& name) {
         if (unlinkat(folder.Fd(), name.c_str(), 0) != 0 && errno != ENOENT) return cannot(errno);
         return {};
     }
-    const int fd = openat(folder.Fd(), name.c_str(), kFolderFlags);
+    const int fd = OpenFolderAt(folder.Fd(), name);
     if (fd < 0) return IsLinkAt(folder.Fd(), name) ? std::unexpected(LinkRefused(shown)) : cannot(errno);
     OpenFolder inside(fd, shown);
     const int listFd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
@@ -359,10 +341,10 @@ Status ClaimOutputFolder(const std::string& dir, std::string_view command) {
 
     // The folder itself is opened by the name the user gave, following links in it: the user named it.
     // Every name below it is then opened from this descriptor, without following links.
-    const int rootFd = open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    const int rootFd = OpenNamedFolder(dir);
     if (rootFd < 0) return cannot(errno);
     const OpenFolder folder(fcntl(rootFd, F_DUPFD_CLOEXEC, 0), dir);
-    auto lockFd = OpenInPlace(folder, kLockName, 0);
+    auto lockFd = OpenInPlace(folder, kLockName, WriteMode::InPlace);
     if (!lockFd) {
         close(rootFd);
         return std::unexpected(lockFd.error());
@@ -389,7 +371,7 @@ Status ClaimOutputFolder(const std::string& dir, std::string_view command) {
         close(claim.rootFd);
         return std::unexpected(std::move(error));
     };
-    auto journalFd = OpenInPlace(folder, journalName, O_APPEND);
+    auto journalFd = OpenInPlace(folder, journalName, WriteMode::Append);
     if (!journalFd) return fail(journalFd.error());
     claim.journalFd = *journalFd;
     auto previous = ReadWhole(claim.journalFd, claim.journalPath);

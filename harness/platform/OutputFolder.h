@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "core/base/Error.h"
+#include "core/base/PathPolicy.h"
 
 namespace cb {
 
@@ -80,9 +81,6 @@ class OpenFolder {
     int mFd;
     std::string mShown;
 };
-
-// "PATH: is a symbolic link; cloudbench does not write through links (remove it)".
-Error LinkRefused(const std::string& shown);
 
 // Opens the folder `dir` to write in it. Inside a folder this process has
 // claimed, the folders below the claimed one are opened from its descriptor one

@@ -4,11 +4,12 @@
 
 #include <algorithm>
 #include <ctime>
-#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "cloudbench_build_info.h"
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
+#include "core/base/SystemFile.h"
 
 namespace cb {
 namespace {
@@ -16,7 +17,7 @@ namespace {
 using nlohmann::json;
 
 std::string CpuModel() {
-    std::ifstream cpuinfo("/proc/cpuinfo");
+    std::istringstream cpuinfo(ReadSystemFile("/proc/cpuinfo"));
     for (std::string line; std::getline(cpuinfo, line);) {
         if (!line.starts_with("model name")) continue;
         const size_t colon = line.find(':');
@@ -64,7 +65,7 @@ void ApplyOverride(json& root, const SceneOverride& o) {
 }  // namespace
 
 json SceneWithOverrides(const std::string& path, std::span<const SceneOverride> overrides) {
-    // Read again as LoadScene read it (core/base/InputFile.h): the file may have changed since, even into a FIFO.
+    // Read again as LoadScene read it (core/base/PathPolicy.h): the file may have changed since, even into a FIFO.
     Result<std::string> text = ReadInputFile(path, kSceneInput);
     if (!text) return nullptr;
     json root = json::parse(*text, nullptr, /*allow_exceptions=*/false);

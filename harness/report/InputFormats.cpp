@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 
 #include "core/base/JsonDom.h"
+#include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
 #include "core/scene/Stage.h"
 
@@ -368,19 +370,20 @@ Node SuiteSchema() {
 
 struct Described {
     Format format;
-    std::string_view name, noun;
+    std::string_view name, noun;  // name: its "format" value; "" for a format recognised by its shape
     Node (*schema)();
+    std::string_view shapeKey = {};  // a format without a name: the key a document of it has
 };
 
 const Described kFormats[] = {
     {Format::Results, "cloudbench-results/1", "a results.json", ResultsSchema},
     {Format::PerfRecord, "cloudbench-perf/1", "a perf history record", PerfRecordSchema},
     {Format::Count, "cloudbench-count/1", "a count output", CountSchema},
-    {Format::Instructions, "", "an instruction file", InstructionsSchema},
+    {Format::Instructions, "", "an instruction file", InstructionsSchema, "instructions"},
     {Format::Sweep, "cloudbench-sweep/1", "a sweep.json", SweepSchema},
     {Format::Conform, "cloudbench-conform/1", "a conform.json", ConformSchema},
     {Format::Accuracy, "cloudbench-accuracy/1", "an accuracy.json", AccuracySchema},
-    {Format::Suite, "", "a perf suite", SuiteSchema},
+    {Format::Suite, "", "a perf suite", SuiteSchema, "scenes"},
     {Format::Interleave, "cloudbench-interleave/1", "a kept interleave's interleave.json", InterleaveSchema},
 };
 
@@ -399,9 +402,24 @@ std::optional<Format> Recognise(const json& doc) {
             if (!d.name.empty() && *it == d.name) return d.format;
         return std::nullopt;
     }
-    if (doc.contains("instructions")) return Format::Instructions;
-    if (doc.contains("scenes")) return Format::Suite;
+    for (const Described& d : kFormats)
+        if (d.name.empty() && doc.contains(d.shapeKey)) return d.format;
     return std::nullopt;
+}
+
+// The keys a document of one of `formats` is recognised by: "\"format\"", "\"scenes\"", "\"format\" or
+// \"instructions\"".
+std::string IdentifyingKeys(std::span<const Format> formats) {
+    std::vector<std::string_view> keys;
+    for (Format format : formats) {
+        const Described& d = Lookup(format);
+        const std::string_view key = d.name.empty() ? d.shapeKey : "format";
+        if (std::ranges::find(keys, key) == keys.end()) keys.push_back(key);
+    }
+    std::string out;
+    for (size_t i = 0; i < keys.size(); ++i)
+        out += (i == 0 ? "" : i + 1 == keys.size() ? " or " : ", ") + QuoteShown(keys[i]);
+    return out;
 }
 
 std::string Nouns(std::span<const Format> formats) {
@@ -429,6 +447,26 @@ const schema::Node& SchemaOf(Format format) {
 
 namespace {
 
+// For a document with no "format" that no accepted format recognises: its first key that none of them has and
+// that is a typo of one of their top-level fields ("scens" for a perf suite's "scenes"), as the schema names an
+// unknown field: "/scens: unknown field (did you mean "scenes"?)". nullopt when no key is that close. A typo
+// here is at most one edit in three letters of the shorter name ("fromat", not "foo" for "tool"): stricter than
+// a schema's "did you mean", because it decides which format the document was meant to be.
+std::optional<std::string> MisspelledKey(const json& doc, std::span<const Format> accepted) {
+    if (!doc.is_object() || doc.contains("format")) return std::nullopt;
+    std::vector<std::string_view> known;
+    for (Format format : accepted)
+        for (std::string_view name : FieldNames(SchemaOf(format))) known.push_back(name);
+    constexpr size_t kMaxKeyChars = 64;  // EditDistance is quadratic
+    for (const auto& [key, value] : doc.items()) {
+        if (key.size() > kMaxKeyChars || std::ranges::find(known, key) != known.end()) continue;
+        for (std::string_view name : known)
+            if (3 * EditDistance(key, name) <= std::min(key.size(), name.size()))
+                return "/" + scene_io::PointerToken(key) + ": unknown field (did you mean " + QuoteShown(name) + "?)";
+    }
+    return std::nullopt;
+}
+
 // `text` (from `path`) as one document of `accepted`; the errors of ReadCloudbenchFile. `orHistory`: a history
 // would do too, and the messages say so.
 Result<Document> ParseDocument(const std::string& text, const std::string& path, std::span<const Format> accepted,
@@ -440,10 +478,12 @@ Result<Document> ParseDocument(const std::string& text, const std::string& path,
         return MakeError(path + ": " + ShownText(doc.duplicates.front(), false, 200) + ": duplicate key");
     const std::optional<Format> format = Recognise(doc.root);
     if (!format || std::ranges::find(accepted, *format) == accepted.end()) {
+        if (std::optional<std::string> misspelled = MisspelledKey(doc.root, accepted); misspelled && !format)
+            return MakeError(path + ": " + *misspelled);
         std::string found = "not a JSON object";
         if (doc.root.is_object()) {
             const auto it = doc.root.find("format");
-            found = it == doc.root.end() ? "no \"format\""
+            found = it == doc.root.end() ? "no " + IdentifyingKeys(accepted)
                     : it->is_string()    ? "\"format\" is " + QuoteShown(it->get_ref<const std::string&>())
                                          : "\"format\" is not a string";
         }
@@ -478,8 +518,12 @@ Result<History> ParseHistory(const std::string& text, const std::string& path) {
         first = false;
         if (!doc.duplicates.empty())
             return MakeError(label + ": " + ShownText(doc.duplicates.front(), false, 200) + ": duplicate key");
-        if (Recognise(doc.root) != Format::PerfRecord)
+        if (Recognise(doc.root) != Format::PerfRecord) {
+            static constexpr Format kRecord[] = {Format::PerfRecord};
+            if (std::optional<std::string> misspelled = MisspelledKey(doc.root, kRecord))
+                return MakeError(label + ": " + *misspelled);
             return MakeError(label + ": not a cloudbench-perf/1 record (a perf history holds only records)");
+        }
         CB_TRY(schema::Validate(doc.root, SchemaOf(Format::PerfRecord), label));
         history.records.push_back({line, std::move(doc.root)});
     }
@@ -496,6 +540,14 @@ Result<Document> ReadCloudbenchFile(const std::string& path, std::span<const For
     if (!text) return std::unexpected(text.error());
     scene_io::JsonDocument doc = scene_io::ParseJsonDocument(*text);
     return ParseDocument(*text, path, accepted, doc);
+}
+
+Result<Document> ReadCloudbenchFileBeneath(const std::string& folder, const std::string& name,
+                                           std::span<const Format> accepted) {
+    Result<std::string> text = ReadInputBeneath(folder, name, kDocumentInput);
+    if (!text) return std::unexpected(text.error());
+    scene_io::JsonDocument doc = scene_io::ParseJsonDocument(*text);
+    return ParseDocument(*text, (std::filesystem::path(folder) / name).string(), accepted, doc);
 }
 
 void PrintWarnings(const History& history) {
@@ -523,7 +575,11 @@ Result<std::variant<Document, History>> ReadDocumentOrHistory(const std::string&
     }
     const size_t firstLineEnd = text->find('\n');
     scene_io::JsonDocument firstLine = scene_io::ParseJsonDocument(text->substr(0, firstLineEnd));
-    if (doc.failure && (firstLine.failure || Recognise(firstLine.root) != Format::PerfRecord)) {
+    // A first line that is a record but for a misspelled key is a history's, and ParseHistory names the key.
+    static constexpr Format kRecord[] = {Format::PerfRecord};
+    const bool firstIsRecord = !firstLine.failure && (Recognise(firstLine.root) == Format::PerfRecord ||
+                                                      MisspelledKey(firstLine.root, kRecord).has_value());
+    if (doc.failure && !firstIsRecord) {
         Result<Document> one = ParseDocument(*text, path, accepted, doc, /*orHistory=*/true);
         return MakeError(one.error().message + " (its first line is not a record either)");
     }

@@ -50,6 +50,10 @@ struct Document {
 // the field: "PATH: not a results.json or a count output ("format" is "cloudbench-sweep/1")", "PATH:
 // /backends/cpu/stages/region/samples_ms/3: must be a number in [0, 1e+09], got -1".
 Result<Document> ReadCloudbenchFile(const std::string& path, std::span<const Format> accepted);
+// The same for `name`, found inside the folder `folder`, read beneath it (core/base/PathPolicy.h): a link out of
+// the folder is refused. Errors name "FOLDER/NAME".
+Result<Document> ReadCloudbenchFileBeneath(const std::string& folder, const std::string& name,
+                                           std::span<const Format> accepted);
 
 // One record of a perf history (a line of JSON Lines), with where it was.
 struct HistoryRecord {

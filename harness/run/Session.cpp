@@ -71,8 +71,9 @@ Status CheckWritableFolder(const std::string& dir) {
     // A probe file proves that files can be created, written and removed here.
     const std::string probe = ".cloudbench-probe-" + std::to_string(getpid());
     CB_TRY(RemoveFileAt(*folder, probe, "a stale probe file"));
-    const int fd = openat(folder->Fd(), probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0) return cannot(errno);
+    auto opened = OpenFileAt(folder->Fd(), folder->ShownChild(probe), probe, WriteMode::CreateNew);
+    if (!opened) return std::unexpected(opened.error());
+    const int fd = *opened;
     const char byte = 0;
     const bool wrote = write(fd, &byte, 1) == 1;
     int error = wrote ? 0 : errno;
@@ -118,7 +119,8 @@ std::vector<OpenedBackend> Session::OpenBackends(const std::vector<std::string>&
             Status fits;
             if (scene) {
                 opened.plannedBytes = PlannedBytes(*scene, **backend);
-                fits = CheckPlannedBytesFit(*scene, **backend);
+                fits = CheckDeviceLimits(*scene, **backend);
+                if (fits) fits = CheckPlannedBytesFit(*scene, **backend);
             }
             if (missing.empty() && fits) {
                 opened.status = BackendStatus::Available;
@@ -187,18 +189,18 @@ Status Session::WriteAtomically(const std::string& path, const std::function<Sta
     CB_TRY(RecordOutput(path, OutputEvent::Writing));  // the output folder's journal (harness/platform/OutputFolder.h)
     auto folder = OpenFolderForWriting(target.parent_path().string(), /*create=*/false);
     if (!folder) return std::unexpected(folder.error());
-    CB_TRY(RefuseLinkAt(*folder, name));
+    CB_TRY(RefuseNonFileAt(folder->Fd(), path, name));  // a link, a FIFO, a device or a folder is never replaced
     // A temporary file left by a killed write is removed (a link there is refused), then the new one is
     // created exclusively: O_EXCL fails on any name already there, a link included, so nothing is opened
     // through a link planted after the removal.
     CB_TRY(RemoveFileAt(*folder, tempName, "a stale temporary file"));
     TemporaryFile temp;
-    temp.fd = openat(folder->Fd(), tempName.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (temp.fd < 0) {
-        const int error = errno;
+    auto created = OpenFileAt(folder->Fd(), folder->ShownChild(tempName), tempName, WriteMode::CreateNew);
+    if (!created) {
         if (Status link = RefuseLinkAt(*folder, tempName); !link) return link;
-        return MakeError(path + ": cannot write: " + std::strerror(error));
+        return MakeError(ReplaceAll(created.error().message, folder->ShownChild(tempName), path));
     }
+    temp.fd = *created;
     temp.path = "/proc/self/fd/" + std::to_string(temp.fd);
     errno = 0;
     Status written = write(temp);

@@ -40,6 +40,7 @@ Result<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene, Backe
         if (scene.stages.Has(stage) && !backend.Supports(stage))
             return MakeError(backend.Name() + " does not implement stage '" + std::string(StageName(stage)) + "' yet");
     }
+    CB_TRY(CheckDeviceLimits(scene, backend));
     CB_TRY(CheckPlannedBytesFit(scene, backend));
     std::unique_ptr<Simulation> sim(new Simulation(scene, backend, everyStepOutputs));
     CB_TRY(sim->Allocate());

@@ -110,7 +110,8 @@ struct StepRecord {
 class Simulation {
   public:
     // Allocates the enabled stages' buffers and computes the initial state.
-    // Refuses a backend that lacks an enabled stage, or whose available memory
+    // Refuses a backend that lacks an enabled stage, one whose device limits
+    // the scene exceeds (CheckDeviceLimits), or one whose available memory
     // the planned buffers and scratch exceed (CheckPlannedBytesFit).
     // everyStepOutputs: shade, shadow and render on every step (for dumps).
     static Result<std::unique_ptr<Simulation>> Create(const Scene& scene, Backend& backend,

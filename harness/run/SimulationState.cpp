@@ -35,8 +35,9 @@ Status FsyncFd(int fd, const std::string& shown) {
 // Creates the file `name` in `folder` (exclusively, never through a link) and writes it through `write`.
 Status WriteNewFile(const OpenFolder& folder, const std::string& name, const std::function<Status(int)>& write) {
     const std::string shown = folder.ShownChild(name);
-    const int fd = openat(folder.Fd(), name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0) return MakeError(shown + ": cannot write: " + std::strerror(errno));
+    auto opened = OpenFileAt(folder.Fd(), shown, name, WriteMode::CreateNew);
+    if (!opened) return std::unexpected(opened.error());
+    const int fd = *opened;
     Status written = write(fd);
     if (written) written = FsyncFd(fd, shown);
     if (close(fd) != 0 && written) written = MakeError(shown + ": cannot write: " + std::strerror(errno));
@@ -235,7 +236,7 @@ Status WriteSimulationState(const SimulationState& state, const std::string& dir
     if (exists) {
         struct stat manifest {};
         const int fd = S_ISDIR(info.st_mode)
-                           ? openat(parent->Fd(), name.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC)
+                           ? OpenFolderAt(parent->Fd(), name)
                            : -1;
         const bool saved =
             fd >= 0 && fstatat(fd, std::string(kSimulationStateManifest).c_str(), &manifest, AT_SYMLINK_NOFOLLOW) == 0;
@@ -250,7 +251,7 @@ Status WriteSimulationState(const SimulationState& state, const std::string& dir
     if (mkdirat(parent->Fd(), tempName.c_str(), 0777) != 0)
         return MakeError(dir + ": cannot write: cannot create " + tempShown + ": " + std::strerror(errno));
     auto written = [&]() -> Status {
-        const int tempFd = openat(parent->Fd(), tempName.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+        const int tempFd = OpenFolderAt(parent->Fd(), tempName);
         if (tempFd < 0) return MakeError(dir + ": cannot write: " + tempShown + ": " + std::strerror(errno));
         const OpenFolder temp(tempFd, tempShown);
         for (const SavedBuffer& b : state.buffers) {

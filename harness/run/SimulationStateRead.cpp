@@ -4,9 +4,8 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 #include "core/base/JsonDom.h"
 #include "core/base/Npy.h"
 #include "core/base/ShownText.h"
@@ -149,7 +148,7 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
     const std::string manifestPath = (fs::path(dir) / std::string(kSimulationStateManifest)).string();
     json m;
     {
-        Result<std::string> text = ReadInputFile(manifestPath, kDocumentInput);
+        Result<std::string> text = ReadInputBeneath(dir, std::string(kSimulationStateManifest), kDocumentInput);
         if (!text) return std::unexpected(text.error());
         scene_io::JsonDocument doc = scene_io::ParseJsonDocument(*text);
         if (doc.failure || !doc.root.is_object())
@@ -339,14 +338,16 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
         const PlannedBuffer& p = match->planned;
         const std::string path = (fs::path(dir) / fileName).string();
         const uint64_t bytes = p.extent.Count() * 4;  // the widest dtype: a wrong one is named as such below
-        std::error_code ec;
-        const auto size = fs::file_size(path, ec);
-        if (ec) return MakeError(path + ": cannot read: " + ec.message());
+        // Beneath the state's folder (core/base/PathPolicy.h): a link out of it is refused.
+        Result<OpenedInput> opened = OpenInputBeneath(dir, fileName, kArrayInput);
+        if (!opened) return std::unexpected(opened.error());
         // A header is at most a few hundred bytes; a bigger file is not this buffer (nor read whole into memory).
-        if (size > bytes + 4096)
-            return MakeError(path + ": size: " + std::to_string(size) + " bytes, more than a " +
+        if (opened->Bytes() > bytes + 4096)
+            return MakeError(path + ": size: " + std::to_string(opened->Bytes()) + " bytes, more than a " +
                              ShapeText(ShapeOf(p.extent)) + " array takes");
-        auto npy = ReadNpy(path);
+        Result<std::string> file = ReadOpenedInput(*opened, path, kArrayInput);
+        if (!file) return std::unexpected(file.error());
+        auto npy = ParseNpy(*file, path);
         if (!npy) {
             std::string reason = npy.error().message;
             if (reason.starts_with(path + ": ")) reason = reason.substr(path.size() + 2);

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <map>
 
-#include "core/base/InputFile.h"
+#include "core/base/PathPolicy.h"
 #include "harness/report/Report.h"
 #include "harness/report/html/ReportSections.h"
 #include "harness/report/images/ImageModule.h"
@@ -17,14 +17,34 @@ namespace {
 
 using nlohmann::json;
 
-Result<std::string> ReadBytes(const std::string& path) { return ReadInputFile(path, kArrayInput); }
+// "DIR/NAME", as messages show a file of the results folder.
+std::string ShownIn(const std::string& dir, const std::string& name) {
+    return (std::filesystem::path(dir) / name).string();
+}
 
-// The first three channels of an image file as linear floats, row 0 at the top.
-Result<images::FloatImage> ReadRgb(const images::Module& module, const std::string& path) {
-    CB_TRY(CheckInputFile(path, kArrayInput));  // OpenImageIO would block on a FIFO
+// The frame `name` that results.json lists, read beneath the results folder `dir`: a link out of it is refused
+// (core/base/PathPolicy.h), so a folder from elsewhere cannot embed this machine's files in the page.
+Result<std::string> ReadBytes(const std::string& dir, const std::string& name) {
+    return ReadInputBeneath(dir, name, kArrayInput);
+}
+
+// A frame to embed as it is: its bytes, which must be a PNG file (the page says "data:image/png").
+Result<std::string> ReadPng(const std::string& dir, const std::string& name) {
+    Result<std::string> bytes = ReadBytes(dir, name);
+    if (!bytes) return bytes;
+    static constexpr std::string_view kSignature{"\x89PNG\r\n\x1a\n", 8};
+    if (!bytes->starts_with(kSignature))
+        return MakeError(ShownIn(dir, name) + ": not a PNG file" + (bytes->empty() ? " (empty)" : ""));
+    return bytes;
+}
+
+// The first three channels of the image file `name` in `dir` as linear floats, row 0 at the top.
+Result<images::FloatImage> ReadRgb(const images::Module& module, const std::string& dir, const std::string& name) {
+    auto bytes = ReadBytes(dir, name);
+    if (!bytes) return std::unexpected(bytes.error());
     images::FloatImage image;
-    const std::string why = module.read(path, 3, image);
-    if (!why.empty()) return MakeError(path + ": cannot read: " + why);
+    const std::string why = module.decode(name, *bytes, 3, image);
+    if (!why.empty()) return MakeError(ShownIn(dir, name) + ": cannot read: " + why);
     return image;
 }
 
@@ -34,13 +54,15 @@ struct Difference {
     double gain = 1;
 };
 
-// |candidate - reference| scaled so that the image rule's limit is white.
-Result<Difference> DifferenceOf(const std::string& referencePath, const std::string& candidatePath) {
+// |candidate - reference| scaled so that the image rule's limit is white; both files are in `dir`.
+Result<Difference> DifferenceOf(const std::string& dir, const std::string& referenceName,
+                                const std::string& candidateName) {
+    const std::string referencePath = ShownIn(dir, referenceName), candidatePath = ShownIn(dir, candidateName);
     auto module = images::Load();
     if (!module) return MakeError(candidatePath + ": cannot compare: " + module.error().message);
-    auto reference = ReadRgb(**module, referencePath);
+    auto reference = ReadRgb(**module, dir, referenceName);
     if (!reference) return std::unexpected(reference.error());
-    auto candidate = ReadRgb(**module, candidatePath);
+    auto candidate = ReadRgb(**module, dir, candidateName);
     if (!candidate) return std::unexpected(candidate.error());
     const int w0 = reference->width, h0 = reference->height, w1 = candidate->width, h1 = candidate->height;
     if (w0 != w1 || h0 != h1)
@@ -78,7 +100,6 @@ std::vector<report::Block> FrameBlocks(const ReportInput& results) {
     if (auto it = results.doc.find("backends"); it != results.doc.end() && it->is_object())
         for (const auto& [name, b] : it->items()) backends.push_back(name);
     auto listed = [&](const std::string& name) { return std::ranges::find(files, name) != files.end(); };
-    auto at = [&](const std::string& name) { return (dir / name).string(); };
 
     // "frame-<renderer>-<camera>-<backend>.png" -> the view "<renderer>-<camera>", by backend in backends' order.
     std::map<std::string, std::vector<std::string>> views;
@@ -96,7 +117,7 @@ std::vector<report::Block> FrameBlocks(const ReportInput& results) {
         blocks.emplace_back(report::Paragraph{"View " + view + ":"});
         for (const std::string& backend : frameBackends) {
             const std::string name = "frame-" + view + "-" + backend + ".png";
-            auto bytes = ReadBytes(at(name));
+            auto bytes = ReadPng(dir.string(), name);
             if (!bytes) {
                 blocks.emplace_back(report::Paragraph{bytes.error().message});
                 continue;
@@ -112,7 +133,7 @@ std::vector<report::Block> FrameBlocks(const ReportInput& results) {
                     ? ".exr"
                     : ".png";
             const std::string a = "frame-" + view + "-" + reference + ext, b = "frame-" + view + "-" + backend + ext;
-            auto d = DifferenceOf(at(a), at(b));
+            auto d = DifferenceOf(dir.string(), a, b);
             if (!d) {
                 blocks.emplace_back(report::Paragraph{"No difference image: " + d.error().message});
                 continue;
@@ -131,7 +152,7 @@ std::vector<report::Block> FrameBlocks(const ReportInput& results) {
     for (const std::string& backend : backends) {
         const std::string name = "topview-" + backend + ".png";
         if (!listed(name)) continue;
-        auto bytes = ReadBytes(at(name));
+        auto bytes = ReadPng(dir.string(), name);
         if (bytes)
             blocks.emplace_back(report::Image{name, "density map from above, " + backend, std::move(*bytes)});
         else

@@ -15,7 +15,9 @@
 namespace cb::html {
 namespace {
 
-Result<ReportInput> ReadOne(const std::string& path) {
+// The report's input at `path` (a file the user named), or, with `folder`, the file `path` names inside the folder
+// the user named, read beneath it.
+Result<ReportInput> ReadOne(const std::string& path, const std::string& folder = "") {
     static constexpr std::array<std::pair<input::Format, InputKind>, 4> kFormats = {{
         {input::Format::Results, InputKind::Results},
         {input::Format::Conform, InputKind::Conform},
@@ -24,7 +26,9 @@ Result<ReportInput> ReadOne(const std::string& path) {
     }};
     static constexpr std::array<input::Format, 4> kAccepted = {input::Format::Results, input::Format::Conform,
                                                                input::Format::Accuracy, input::Format::Sweep};
-    auto read = input::ReadCloudbenchFile(path, kAccepted);
+    auto read = folder.empty()
+                    ? input::ReadCloudbenchFile(path, kAccepted)
+                    : input::ReadCloudbenchFileBeneath(folder, std::filesystem::path(path).filename().string(), kAccepted);
     if (!read) return std::unexpected(read.error());
     ReportInput in{path, InputKind::Results, std::move(read->doc)};
     for (const auto& [format, kind] : kFormats)
@@ -70,7 +74,7 @@ Result<std::vector<ReportInput>> ReadReportInput(const std::string& path) {
         const std::string file = (std::filesystem::path(path) / name).string();
         // A name that is there in any form (a link, a FIFO) is read, so that ReadOne says what is wrong with it.
         if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) continue;
-        auto one = ReadOne(file);
+        auto one = ReadOne(file, path);
         if (!one) return std::unexpected(one.error());
         inputs.push_back(std::move(*one));
     }

@@ -22,7 +22,7 @@
 namespace cb::images {
 
 // Bumped whenever Module changes, so that a stale module is refused by name.
-inline constexpr int kModuleVersion = 1;
+inline constexpr int kModuleVersion = 2;
 
 // The file name of the module, beside the executable.
 inline constexpr const char* kModuleFileName = "libcloudbench_images.so";
@@ -58,8 +58,9 @@ struct Module {
     // no extension), 8-bit when `eightBit`, float otherwise, then reads the
     // file back and checks that it holds the whole image.
     std::string (*write)(const std::string& path, const std::string& format, ImageView image, bool eightBit);
-    // Reads the first `channels` channels of the file at `path` as floats.
-    std::string (*read)(const std::string& path, int channels, FloatImage& image);
+    // The first `channels` channels, as floats, of the image file whose bytes are `bytes` (read by the path
+    // policy, core/base/PathPolicy.h); `name` is the file's name, whose extension says its format.
+    std::string (*decode)(const std::string& name, const std::string& bytes, int channels, FloatImage& image);
     // failthresh `limit`, warnthresh `tolerance`.
     Comparison (*compare)(ImageView a, ImageView b, float limit, float tolerance);
     // |a - b| per channel, times `gain` when it is not 1, clamped to [0, 1] when `clamp`.
