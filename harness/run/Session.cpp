@@ -72,7 +72,11 @@ Status CheckWritableFolder(const std::string& dir) {
     const std::string probe = ".cloudbench-probe-" + std::to_string(getpid());
     CB_TRY(RemoveFileAt(*folder, probe, "a stale probe file"));
     auto opened = OpenFileAt(folder->Fd(), folder->ShownChild(probe), probe, WriteMode::CreateNew);
-    if (!opened) return std::unexpected(opened.error());
+    if (!opened) {
+        // The probe is this process's own name: a failure to create it is the folder's, and names the folder.
+        const std::string message = opened.error().message, shown = folder->ShownChild(probe);
+        return MakeError(message.starts_with(shown) ? dir + message.substr(shown.size()) : message);
+    }
     const int fd = *opened;
     const char byte = 0;
     const bool wrote = write(fd, &byte, 1) == 1;

@@ -83,7 +83,8 @@ class Session {
     // output folder no link is followed). The finished file is checked (a
     // regular file, fsync'ed; a .npy reads back whole) and renamed to `path`
     // (renameat in the same folder). A symbolic link at `path` or at its
-    // temporary name is refused. On any failure the temporary file is removed,
+    // temporary name is refused, and so is a `path` that is a FIFO, a device
+    // or a folder (core/base/PathPolicy.h RefuseNonFileAt). On any failure the temporary file is removed,
     // `path` keeps its old contents, and the error names `path` (never the
     // temporary name) and the system's reason (strerror of errno).
     static Status WriteAtomically(const std::string& path, const std::function<Status(const TemporaryFile&)>& write);
