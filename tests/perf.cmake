@@ -18,3 +18,10 @@ foreach(case identical slowdown kept)
   set_tests_properties(Perf.Gate.${case} PROPERTIES PASS_REGULAR_EXPRESSION "perf gate ${case}: ok" TIMEOUT 600
                        RESOURCE_LOCK perf_gate)
 endforeach()
+# The gate's decision rules at their boundaries through the command: the rounds rule (alpha exactly at
+# m (1 + K + K(K-1)/2) 2^-K and one ulp above), and '?' with Holm's factor in the table, the warning and --json.
+foreach(case rounds unjudged)
+  add_test(NAME Perf.Boundary.${case}
+           COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_boundaries.py ${cli} ${cli_out}/perf-boundary-${case} ${case})
+  set_tests_properties(Perf.Boundary.${case} PROPERTIES PASS_REGULAR_EXPRESSION "perf boundaries ${case}: ok" TIMEOUT 300)
+endforeach()
