@@ -115,11 +115,12 @@ if CASE == "kept":
 base = head = CLI
 if CASE == "slowdown":
     # HEAD is the same binary with the planted slowdown: a wrapper that sets the switch. BASE is its control: the
-    # same wrapper with factor 1, which spins for nothing (docs/cli.md), so that the two sides differ in the planted
-    # spin alone. With BASE the bare binary, HEAD also differed in its environment (one variable more moves the
-    # stack and heap of every stage) and in the exec through /bin/sh: a systematic difference outside the planted
-    # stage, which 17 rounds can resolve (the likely cause of render_splat flagged at 1.104x in one of nine suite
-    # runs); a test of the gate must differ in the planted change alone.
+    # same wrapper with factor 1, which spins for no time but wakes the arena's threads as HEAD's spin does
+    # (docs/cli.md), so that the two sides differ in the planted spin's length alone. With BASE the bare binary,
+    # HEAD also differed in its environment (one variable more moves the stack and heap of every stage), in the
+    # exec through /bin/sh and in the wake of the workers before the planted stage: systematic differences outside
+    # it, which 17 rounds can resolve (render_splat flagged at 1.104x in one of nine suite runs; with a control
+    # that did not wake the workers, density, a 9 us stage, at 1.101x in one of seven runs under load 5).
     base = wrapper("control-cloudbench", f'CLOUDBENCH_TEST_SLOWDOWN={PLANTED_STAGE}:1 exec "{CLI}" "$@"')
     head = wrapper("slow-cloudbench", f'CLOUDBENCH_TEST_SLOWDOWN={PLANTED_STAGE}:{PLANTED_FACTOR} exec "{CLI}" "$@"')
 p = subprocess.run([CLI, "perf", "compare", "--interleave", base, head, "ci-small", "--backend", "cpu",
