@@ -400,7 +400,7 @@ def main():
     p.add_argument("--all-oracles", action="store_true", help="run every oracle on every mutant")
     p.add_argument("--oracles", default=",".join(ORACLES), help="which oracles, in order (default all three)")
     p.add_argument("-j", "--jobs", type=int, default=2, help="build and ctest parallelism (default 2)")
-    p.add_argument("--ctest-exclude", default="Exact|Fuzz|Perf|Sanitized|Bench",
+    p.add_argument("--ctest-exclude", default=r"^(Exact|Fuzz|Perf|Sanitized|Bench)\.",
                    help="tests CTest leaves out, a regex (Tools.MutantsApply is always left out)")
     p.add_argument("--conform-timeout", type=float, default=300, help="seconds for conform ci-small")
     p.add_argument("--ctest-timeout", type=float, default=2400, help="seconds for the whole CTest oracle")
