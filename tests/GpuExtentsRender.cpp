@@ -163,17 +163,7 @@ void ExtLayers(Backend& cpu, Backend& gpu, const ExtentCase& c) {
     const ExtVolumes v = ExtDenseVolumes(e);
     const MarchParams m = test::CameraParams(e, {e.nx - 1.5, 0.4 * e.ny, e.nz + 4.0 + e.ny},
                                              {e.nx - 0.5, 0.5 * e.ny, 0.0}, c.width, c.height);
-    LayersParams p;
-    p.camera = m.camera;
-    p.alpha = 0.3f;
-    LayersSetup& s = p.setup;
-    for (int a = 0; a < 3; ++a) s.eye[a] = m.camera.eye[a];
-    s.size = m.setup.size;
-    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
-    s.voxelSize = 1, s.count = e.nz, s.spacing = 1, s.outer2 = 1e10f, s.maxLength = float(e.nz), s.sigmaH = 0.3f;
-    s.tiling = c.option == 1;
-    s.sun = m.setup.sun, s.sunRadiance = m.setup.sunRadiance, s.ambient = m.setup.ambient;
-    s.background = m.setup.background, s.phase = m.setup.phase;
+    const LayersParams p = test::LayersFromCamera(m, e, e.nz, c.option == 1);
     Backend* backends[2] = {&cpu, &gpu};
     std::vector<float> rgb[2];
     LayersStats stats[2];

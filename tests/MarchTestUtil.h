@@ -47,4 +47,30 @@ inline MarchParams CameraParams(const Extent3& e, std::array<double, 3> eye, std
     return p;
 }
 
+// render_layers' parameters over grid e seen by m's camera (h = 1 m, origin 0, alpha 0.3): `count` layers at
+// spacing nz / count, beer opacity with sigma h 0.3 and l_max nz, an extent past every fragment, m's sun,
+// lighting and phase.
+inline LayersParams LayersFromCamera(const MarchParams& m, const Extent3& e, uint32_t count, bool tiling) {
+    LayersParams p;
+    p.camera = m.camera;
+    p.alpha = 0.3f;
+    LayersSetup& s = p.setup;
+    for (int a = 0; a < 3; ++a) s.eye[a] = m.camera.eye[a];
+    s.size = m.setup.size;
+    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
+    s.voxelSize = 1;
+    s.count = count;
+    s.spacing = float(double(e.nz) / count);
+    s.outer2 = 1e10f;
+    s.maxLength = float(e.nz);
+    s.sigmaH = 0.3f;
+    s.tiling = tiling;
+    s.sun = m.setup.sun;
+    s.sunRadiance = m.setup.sunRadiance;
+    s.ambient = m.setup.ambient;
+    s.background = m.setup.background;
+    s.phase = m.setup.phase;
+    return p;
+}
+
 }  // namespace cb::test

@@ -57,27 +57,7 @@ LayersImage RenderLayersOn(Backend& backend, const LayersCase& c) {
 // A camera from eye to target over grid e (h = 1 m, origin 0), N layers, HG 0.6, the sun at (0.7, 0.4) rad.
 LayersParams CameraLayers(const Extent3& e, std::array<double, 3> eye, std::array<double, 3> target, uint32_t w,
                           uint32_t h, uint32_t count, bool tiling) {
-    const MarchParams m = test::CameraParams(e, eye, target, w, h);
-    LayersParams p;
-    p.camera = m.camera;
-    p.alpha = 0.3f;
-    LayersSetup& s = p.setup;
-    for (int a = 0; a < 3; ++a) s.eye[a] = m.camera.eye[a];
-    s.size = m.setup.size;
-    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
-    s.voxelSize = 1;
-    s.count = count;
-    s.spacing = float(double(e.nz) / count);
-    s.outer2 = 1e10f;
-    s.maxLength = float(e.nz);
-    s.sigmaH = 0.3f;
-    s.tiling = tiling;
-    s.sun = m.setup.sun;
-    s.sunRadiance = m.setup.sunRadiance;
-    s.ambient = m.setup.ambient;
-    s.background = m.setup.background;
-    s.phase = m.setup.phase;
-    return p;
+    return test::LayersFromCamera(test::CameraParams(e, eye, target, w, h), e, count, tiling);
 }
 
 // Blobs that differ between the steps and a T that varies from voxel to voxel, with q = 0 in between.

@@ -50,19 +50,7 @@ MarchParams LeakCamera(uint32_t w, uint32_t h) {
 }
 
 LayersParams LeakLayersParams(bool tiling) {
-    const MarchParams m = LeakCamera(33, 25);
-    LayersParams p;
-    p.camera = m.camera;
-    p.alpha = 0.3f;
-    LayersSetup& s = p.setup;
-    for (int a = 0; a < 3; ++a) s.eye[a] = m.camera.eye[a];
-    s.size = m.setup.size;
-    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
-    s.voxelSize = 1, s.count = kLeakGrid.nz, s.spacing = 1, s.outer2 = 1e10f, s.maxLength = float(kLeakGrid.nz);
-    s.sigmaH = 0.3f, s.tiling = tiling;
-    s.sun = m.setup.sun, s.sunRadiance = m.setup.sunRadiance, s.ambient = m.setup.ambient;
-    s.background = m.setup.background, s.phase = m.setup.phase;
-    return p;
+    return test::LayersFromCamera(LeakCamera(33, 25), kLeakGrid, kLeakGrid.nz, tiling);
 }
 
 std::vector<float> LeakRenderLayers(Backend& b, const LayersParams& p) {
