@@ -2,7 +2,7 @@
 // harness/perf/Compare.h; the rules in docs/cli.md "perf compare" and
 // docs/performance.md "The regression gate"): whether a row can be judged at
 // all (its smallest reachable p times the Holm family against alpha), Holm's
-// step-down, the sign-flip test's exact mode at 15, 16 and 17 pairs, the
+// step-down, the sign-flip test's exact mode to 40 pairs and its draws at 41, the
 // ratio thresholds and the floor. Every expected p-value is a hand count of
 // sign patterns or splits (written out beside it); the boundaries that meet a
 // computed ratio take the ratio the gate computed as the threshold itself, so
@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -65,32 +67,80 @@ const Comparison& GateRow(const CompareOutcome& out, const std::string& stage, c
 
 std::vector<double> GateSame(size_t n, double v) { return std::vector<double>(n, v); }
 
-// Test the sign-flip test at the edge of its exact mode (2^16 patterns): at 15 and 16 pairs every pattern is
-// counted, so p is a hand count over 2^n; at 17 the patterns are drawn, p = (1 + as large) / (1 + draws).
-TEST(PerfGateBoundary, SignFlipExactAt15And16SampledAt17) {
+// Test the sign-flip test at the edge of its exact mode (kExactSignFlipPairs = 40): up to 40 pairs every pattern
+// is counted, so p is a hand count over 2^n; at 41 the patterns are drawn, p = (1 + as large) / (1 + draws).
+TEST(PerfGateBoundary, SignFlipExactTo40SampledAt41) {
     // All positive: only the observed pattern sums as high.
-    EXPECT_EQ(SignFlipGreater(GateSame(15, 0.1), 999, 5), std::ldexp(1.0, -15));
-    EXPECT_EQ(SignFlipGreater(GateSame(16, 0.1), 999, 5), std::ldexp(1.0, -16));
-    EXPECT_EQ(SmallestSignFlipP(15, 999), std::ldexp(1.0, -15));
-    EXPECT_EQ(SmallestSignFlipP(16, 999), std::ldexp(1.0, -16));
-    EXPECT_EQ(SmallestSignFlipP(17, 999), 1.0 / 1000);
+    for (int n : {16, 17, 25, 39, 40}) {
+        EXPECT_EQ(SignFlipGreater(GateSame(size_t(n), 0.1), 999, 5), std::ldexp(1.0, -n)) << n << " pairs";
+        EXPECT_EQ(SmallestSignFlipP(size_t(n), 999), std::ldexp(1.0, -n)) << n << " pairs";
+    }
+    EXPECT_EQ(SmallestSignFlipP(41, 999), 1.0 / 1000);
     // n differences of +-1, four of them -1: the observed sum n - 8 is reached by the patterns with at most four
-    // negative, sum over j <= 4 of C(n, j): 1941 of 2^15, 2517 of 2^16, 3214 of 2^17.
-    for (int n : {15, 16}) {
+    // negative, sum over j <= 4 of C(n, j): 3214 of 2^17 (the gate's 17 rounds), 15276 of 2^25, 92171 of 2^39,
+    // 102091 of 2^40.
+    const std::pair<int, double> counted[] = {{17, 3214}, {25, 15276}, {39, 92171}, {40, 102091}};
+    for (auto [n, count] : counted) {
         std::vector<double> d(size_t(n), 1.0);
         for (int i = 0; i < 4; ++i) d[size_t(3 * i + 1)] = -1.0;
-        EXPECT_EQ(SignFlipGreater(d, 999, 5), GateAtMostNegative(n, 4) / std::ldexp(1.0, n)) << n << " pairs";
+        EXPECT_EQ(GateAtMostNegative(n, 4), count) << n << " pairs";
+        EXPECT_EQ(SignFlipGreater(d, 999, 5), count / std::ldexp(1.0, n)) << n << " pairs";
     }
-    EXPECT_EQ(GateAtMostNegative(15, 4), 1941);
-    EXPECT_EQ(GateAtMostNegative(16, 4), 2517);
-    // 17 pairs: drawn. 9999 draws estimate 3214 / 131072 = 0.0245 (standard error 0.0015), on the grid of 1/10000.
-    std::vector<double> d17(17, 1.0);
-    for (int i = 0; i < 4; ++i) d17[size_t(3 * i + 1)] = -1.0;
-    const double p17 = SignFlipGreater(d17, 9999, 5);
-    EXPECT_NEAR(p17, 3214.0 / 131072.0, 5 * 0.0015);
-    EXPECT_NEAR(p17 * 10000, std::round(p17 * 10000), 1e-6);
-    // All positive at 17: no draw of 999 matches (each would with chance 2^-17), so p = 1 / 1000, not 2^-17.
-    EXPECT_EQ(SignFlipGreater(GateSame(17, 0.1), 999, 5), 1.0 / 1000);
+    // Unequal magnitudes, where the two halves' sums must meet: {3, -1, 2, 5, -4} sums to 5, and a pattern sums
+    // to 5 - 2 x (the values it flips), so it reaches 5 when those sum to at most 0: {}, {-1}, {-4}, {-1, -4},
+    // {3, -4}, {2, -4}, {3, -1, -4}, {2, -1, -4}, {3, 2, -1, -4}, {5, -1, -4}: 10 of 32.
+    EXPECT_EQ(SignFlipGreater(std::vector<double>{3, -1, 2, 5, -4}, 999, 5), 10.0 / 32);
+}
+
+// Test the met-in-the-middle count against every pattern summed in turn, the way it was counted before, on
+// random differences of 1 to 20 pairs (log-ratios of a few percent, as the gate sees).
+TEST(PerfGateBoundary, SignFlipHalvesCountAsEveryPattern) {
+    std::mt19937 random(7);
+    std::normal_distribution<double> logRatio(0.02, 0.1);
+    for (int trial = 0; trial < 60; ++trial) {
+        const size_t n = 1 + size_t(trial) % 20;
+        std::vector<double> d(n);
+        for (double& x : d) x = logRatio(random);
+        const double observed = std::accumulate(d.begin(), d.end(), 0.0);
+        uint64_t reach = 0;
+        for (uint64_t signs = 0; signs < (uint64_t(1) << n); ++signs) {
+            double sum = 0;
+            for (size_t i = 0; i < n; ++i) sum += (signs >> i & 1) ? -d[i] : d[i];
+            reach += sum >= observed - std::abs(observed) * 1e-14;
+        }
+        EXPECT_EQ(SignFlipGreater(d, 999, 5), double(reach) / std::ldexp(1.0, int(n))) << n << " pairs";
+    }
+}
+
+// Test the promise of the rounds rule at the gate's default, 17 rounds for one 7-stage scene: a slowdown with two
+// rounds against it is caught. Its p is 154 / 2^17 = 0.00117 (the patterns with at most two rounds negative,
+// 1 + 17 + 136), and Holm's 7 x 0.00117 = 0.0082 < 0.01. Drawn from 9999 patterns, p was (1 + X) / 10000 with X
+// binomial (9999, 0.00117), above 0.01 / 7 (X >= 14) with probability 0.29: the promise held only when counted.
+TEST(PerfGateBoundary, TwoRoundsAgainstCaughtAtSeventeen) {
+    GateRounds g;
+    std::vector<double> d = GateSame(17, std::log(1.25));
+    d[4] = d[11] = -std::log(1.25);
+    g.Add("region", d);
+    for (const char* quiet : {"ca", "density", "smooth", "shade", "shadow", "render_splat"})
+        g.Add(quiet, GateSame(17, 0.0));
+    const CompareOutcome out = Compare(g.base, g.head, GateInterleaved(0.01));
+    const Comparison& c = GateRow(out, "region");
+    EXPECT_EQ(c.pSlower, 154.0 / 131072.0);
+    EXPECT_DOUBLE_EQ(c.pSlowerHolm, 7 * 154.0 / 131072.0);
+    EXPECT_EQ(c.mark, '+') << c.note;
+}
+
+// Test the draws above the exact mode.
+TEST(PerfGateBoundary, SignFlipSampledAt41) {
+    // 41 pairs: drawn. Seventeen -1 of 41 reach the observed sum in sum over j <= 17 of C(41, j) of the 2^41
+    // patterns, p = 0.1744; 9999 draws estimate it (standard error 0.0038) on the grid of 1/10000.
+    std::vector<double> d41(41, 1.0);
+    for (int i = 0; i < 17; ++i) d41[size_t(2 * i + 1)] = -1.0;
+    const double p41 = SignFlipGreater(d41, 9999, 5);
+    EXPECT_NEAR(p41, GateAtMostNegative(41, 17) / std::ldexp(1.0, 41), 5 * 0.0038);
+    EXPECT_NEAR(p41 * 10000, std::round(p41 * 10000), 1e-6);
+    // All positive at 41: no draw of 999 matches (each would with chance 2^-41), so p = 1 / 1000, not 2^-41.
+    EXPECT_EQ(SignFlipGreater(GateSame(41, 0.1), 999, 5), 1.0 / 1000);
 }
 
 // Test the judgeable rule on the rounds test: a row is judged only when 2^-K x m < alpha (m the rows with a
@@ -135,11 +185,12 @@ TEST(PerfGateBoundary, RoundsJudgeableOnlyBelowAlphaOverHolmsFactor) {
     EXPECT_EQ(GateRow(out, "ca").mark, '+');
 }
 
-// Test the judgeable rule at 16 rounds, the last exact count: 2^-16 x m against alpha.
-TEST(PerfGateBoundary, SixteenRoundsJudgedExactly) {
+// Test the judgeable rule at 40 rounds, the last exact count: 2^-40 x m against alpha. At 41 the draws' smallest
+// p is 1 / (1 + 9999), so an alpha below it leaves the row '?' however the rounds agree.
+TEST(PerfGateBoundary, FortyRoundsJudgedExactlyFortyOneDrawn) {
     GateRounds g;
-    g.Add("region", GateSame(16, std::log(1.25)));
-    const double smallest = std::ldexp(1.0, -16);
+    g.Add("region", GateSame(40, std::log(1.25)));
+    const double smallest = std::ldexp(1.0, -40);
     CompareOutcome out = Compare(g.base, g.head, GateInterleaved(smallest));
     EXPECT_EQ(GateRow(out, "region").mark, '?');
     out = Compare(g.base, g.head, GateInterleaved(std::nextafter(smallest, 1.0)));
@@ -147,6 +198,12 @@ TEST(PerfGateBoundary, SixteenRoundsJudgedExactly) {
     EXPECT_EQ(c.mark, '+') << c.note;
     EXPECT_EQ(c.pSlower, smallest);
     EXPECT_EQ(c.pSlowerHolm, smallest);
+    GateRounds drawn;
+    drawn.Add("region", GateSame(41, std::log(1.25)));
+    EXPECT_EQ(GateRow(Compare(drawn.base, drawn.head, GateInterleaved(1e-4)), "region").mark, '?');
+    const Comparison& d = GateRow(Compare(drawn.base, drawn.head, GateInterleaved(std::nextafter(1e-4, 1.0))), "region");
+    EXPECT_EQ(d.mark, '+') << d.note;
+    EXPECT_EQ(d.pSlower, 1e-4);
 }
 
 // Test the judgeable rule on the runs test (sides not interleaved, several runs): its smallest p is 1 / C(n, |x|);

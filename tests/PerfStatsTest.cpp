@@ -65,9 +65,9 @@ TEST(PerfStats, SignFlipCountsPatterns) {
     // Zeros flip to themselves: {0, 0, 1} has 8 patterns, 4 with the sum 1.
     EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>{0, 0, 1}, 0, 0), 4.0 / 8);
     EXPECT_DOUBLE_EQ(SmallestSignFlipP(10, 999), 1.0 / 1024);
-    // Above 16 pairs the patterns are drawn: 17 equal positive differences are beaten by none of 999.
-    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>(17, 1.0), 999, 3), 1.0 / 1000);
-    EXPECT_DOUBLE_EQ(SmallestSignFlipP(17, 999), 1.0 / 1000);
+    // Above 40 pairs the patterns are drawn: 41 equal positive differences are beaten by none of 999.
+    EXPECT_DOUBLE_EQ(SignFlipGreater(std::vector<double>(41, 1.0), 999, 3), 1.0 / 1000);
+    EXPECT_DOUBLE_EQ(SmallestSignFlipP(41, 999), 1.0 / 1000);
 }
 
 // Test the two-sample test on a case counted by hand: the 6 ways to pick two of {1, 2, 3, 4} as x give

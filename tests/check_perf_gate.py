@@ -6,6 +6,12 @@ test-only CLOUDBENCH_TEST_SLOWDOWN switch fails with the regression exit code
 6, naming that stage and no other, whatever else the machine runs (CTest runs
 it beside other tests).
 
+The gate's alpha is 0.01 for users: with no change, a comparison is flagged
+with probability at most 0.01, so a test that asserted 'identical builds pass'
+at that alpha would fail one run in a hundred by design. These tests give
+`--alpha 0.0001` (25 rounds instead of 17 for ci-small's 7 stages): the same
+rules, with a false alarm once in ten thousand runs at most.
+
 The case `kept` checks that a verdict never improves on a second look: a
 short real interleave whose BASE runs exit 1 ends with exit 1 live and again
 from its kept folder (`perf compare DIR`), both naming each failed run; so
@@ -123,8 +129,11 @@ if CASE == "slowdown":
     # that did not wake the workers, density, a 9 us stage, at 1.101x in one of seven runs under load 5).
     base = wrapper("control-cloudbench", f'CLOUDBENCH_TEST_SLOWDOWN={PLANTED_STAGE}:1 exec "{CLI}" "$@"')
     head = wrapper("slow-cloudbench", f'CLOUDBENCH_TEST_SLOWDOWN={PLANTED_STAGE}:{PLANTED_FACTOR} exec "{CLI}" "$@"')
+GATE_ALPHA = 1e-4
+kept = os.path.join(WORK, "kept")
 p = subprocess.run([CLI, "perf", "compare", "--interleave", base, head, "ci-small", "--backend", "cpu",
-                    "--clock", "cpu", "--quiet", "--json", os.path.join(WORK, "compare.json")],
+                    "--clock", "cpu", "--alpha", str(GATE_ALPHA), "--quiet", "--keep", kept,
+                    "--json", os.path.join(WORK, "compare.json")],
                    capture_output=True, text=True, timeout=600)
 print(p.stdout)
 doc = json.load(open(os.path.join(WORK, "compare.json")))
@@ -141,7 +150,10 @@ else:
 if doc["clock"] != "cpu":
     print(f"FAIL: the gate compares CPU time, the JSON says {doc['clock']}")
     sys.exit(1)
-if doc["mode"].startswith("interleaved") is False or doc["separate"]:
+if doc["alpha"] != GATE_ALPHA:
+    print(f"FAIL: --alpha {GATE_ALPHA} given, the JSON says {doc['alpha']}")
+    sys.exit(1)
+if doc["mode"].startswith("interleaved (random order)") is False or doc["separate"]:
     print("FAIL: an interleaved comparison must say so and use the interleaved threshold")
     sys.exit(1)
 # The rounds perf compare chose: the smallest K at which a slowdown with two rounds against it still reaches
@@ -150,6 +162,15 @@ m = sum(1 for c in doc["comparisons"] if c["metric"] == "time")
 rounds = next(k for k in range(1, 100) if m * (1 + k + k * (k - 1) / 2) * 2.0 ** -k < doc["alpha"])
 if f"{rounds} rounds" not in doc["mode"]:
     print(f"FAIL: {m} comparisons need {rounds} rounds; perf compare ran: {doc['mode']}")
+    sys.exit(1)
+# Each round's order is a fair coin: across the rounds both orders occur and the pattern is not ABBA's
+# alternation (a fair coin gives one of those three patterns with probability 3 x 2^-25).
+manifest = json.load(open(os.path.join(kept, "interleave.json")))
+first = [run["side"] for n, run in enumerate(manifest["runs"]) if n % 2 == 0]
+abba = ["base" if r % 2 == 0 else "head" for r in range(len(first))]
+if manifest["order"] != "random" or len(set(first)) != 2 or first == abba:
+    print(f"FAIL: the order within each round must be drawn at random: order {manifest['order']}, "
+          f"first run of each round {first}")
     sys.exit(1)
 unjudged = [c["stage"] for c in doc["comparisons"] if c["mark"] == "?"]
 if unjudged or any(c["test"] != "rounds" for c in doc["comparisons"] if c["metric"] == "time"):

@@ -40,10 +40,11 @@ compare  compares stage times run by run, each run's median step (a
          over the runs, Holm's correction) and instruction counts. BASE and
          HEAD: a results.json, a `run --out` folder, a count output, a
          history (its last record), FILE@ID or FILE@-N (N-th record from the
-         end). --interleave runs BASE_BINARY and HEAD_BINARY alternately in
-         ABBA order, K rounds (default: enough for every stage to be judged),
-         and pairs the runs by round; --keep DIR keeps every run and
-         DIR/interleave.json, which `perf compare DIR` judges again. Marks:
+         end). --interleave runs BASE_BINARY and HEAD_BINARY in K rounds
+         (default: enough for every stage to be judged), one run each in
+         an order drawn at random every round, and pairs the runs by
+         round; --keep DIR keeps every run and DIR/interleave.json,
+         which `perf compare DIR` judges again. Marks:
          + slower, - faster, ~ not significant or within the threshold,
          ? cannot be judged (too few rounds or samples), x failed or missing
          in HEAD, ! new.

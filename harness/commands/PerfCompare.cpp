@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <random>
 #include <thread>
 #include <tuple>
 
@@ -196,12 +197,24 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
     return code;
 }
 
-// ABBA: BASE first in even rounds, HEAD first in odd ones, so that a drift in
-// the machine's speed over a round falls on both sides alike.
-std::array<int, 2> InterleavedOrder(int round) { return round % 2 == 0 ? std::array{0, 1} : std::array{1, 0}; }
+// The order of a round's two runs: a fair coin of its own for every round and scene, so that with no
+// change each round's log-ratio has either sign with probability 1/2 whatever the machine does, which
+// is what the sign-flip test assumes. A fixed order cannot promise that: ABBA puts one side's runs next
+// to each other at every round's end, and a load that lasts two runs then moves two rounds' ratios
+// alike (docs/performance.md, "Why the order is drawn").
+class PairOrder {
+public:
+    PairOrder() : coin_(std::random_device{}()) {}
+    std::array<int, 2> Next() { return coin_() & 1 ? std::array{1, 0} : std::array{0, 1}; }
 
-std::string InterleavedMode(int rounds) {
-    return "interleaved (ABBA), " + std::to_string(rounds) + (rounds == 1 ? " round" : " rounds");
+private:
+    std::mt19937 coin_;
+};
+
+// order: the manifest's "order": "random" (drawn a round at a time) or "ABBA" (kept by earlier versions).
+std::string InterleavedMode(int rounds, const std::string& order) {
+    return "interleaved (" + std::string(order == "random" ? "random order" : order) + "), " +
+           std::to_string(rounds) + (rounds == 1 ? " round" : " rounds");
 }
 
 // "r03-thesis-low": the round (1-based) and the scene's file stem, kept to a plain name.
@@ -286,7 +299,7 @@ int CompareKept(const std::string& folder, perf::CompareSettings settings, perf:
                             perf::kInterleaveFile;
     settings.interleaved = true;
     const int code = PrintComparison(kept->sides[0], kept->sides[1], settings,
-                                     InterleavedMode(kept->rounds) + ", kept in " + folder, jsonPath, problems);
+                                     InterleavedMode(kept->rounds, kept->order) + ", kept in " + folder, jsonPath, problems);
     WarnIfLoaded(kept->peakLoad, clock);
     return code;
 }
@@ -393,7 +406,7 @@ int ComparePerf(const std::vector<std::string>& args) {
                      {"head", binaries[1]},
                      {"scenes", scenes},
                      {"rounds", int(rounds)},
-                     {"order", "ABBA"},
+                     {"order", "random"},
                      {"run_options", extra},
                      {"runs", json::array()}};
     perf::Side sides[2];
@@ -403,9 +416,10 @@ int ComparePerf(const std::vector<std::string>& args) {
     double peakLoad = 0;
     RunProblems problems;
     std::optional<int> stop;  // the exit code to end with at once
+    PairOrder order;
     auto runRound = [&](int round) {
         for (size_t s = 0; s < scenes.size() && !stop; ++s)
-            for (int n : InterleavedOrder(round)) {
+            for (int n : order.Next()) {
                 if (!a.Has("--quiet"))
                     std::fprintf(stderr, "perf compare: round %d of %s, %s, %s\n", round + 1,
                                  autoRounds && round == 0 ? "(counting)" : std::to_string(int(rounds)).c_str(),
@@ -446,7 +460,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     }
     if (stop) return *stop;
     settings.interleaved = true;
-    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds)), jsonPath, problems);
+    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds), "random"), jsonPath, problems);
     WarnIfLoaded(peakLoad, clock);
     return code;
 }

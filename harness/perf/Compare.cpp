@@ -178,6 +178,7 @@ Result<KeptInterleave> LoadInterleave(const std::string& folder, Clock clock) {
     sides[0].label = doc["base"].get<std::string>() + " (BASE)";
     sides[1].label = doc["head"].get<std::string>() + " (HEAD)";
     for (Side& side : sides) side.clock = clock;
+    kept.order = doc.value("order", "ABBA");
     kept.recordedRuns = doc["runs"].size();
     kept.plannedRuns = doc["rounds"].get<size_t>() * doc["scenes"].size() * 2;
     for (size_t n = 0; n < doc["runs"].size(); ++n) {

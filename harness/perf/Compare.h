@@ -83,6 +83,7 @@ struct KeptInterleave {
     std::array<Side, 2> sides;
     std::vector<FailedRun> failedRuns;  // in the order they ran
     int rounds = 0;                     // the rounds with a recorded run (the highest round + 1)
+    std::string order = "ABBA";         // how each round's two runs were ordered: "random" or "ABBA"
     size_t recordedRuns = 0;
     size_t plannedRuns = 0;  // rounds x scenes x 2: fewer recorded means the interleave was cut short
     double peakLoad = 0;     // the highest 1-minute load average a run started at

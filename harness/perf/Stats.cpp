@@ -95,21 +95,45 @@ double Quantile(std::span<const double> values, double q) {
     return SortedQuantile(sorted, q);
 }
 
+// Every sum of +-v[i] over the 2^n sign patterns, ascending. The first pattern built is all plus, summed in
+// order, so the observed pattern's sum is met exactly.
+std::vector<double> SortedSignedSums(std::span<const double> v) {
+    std::vector<double> sums(size_t(1) << v.size());
+    size_t filled = 1;
+    for (double x : v) {
+        for (size_t i = 0; i < filled; ++i) {
+            sums[filled + i] = sums[i] - x;
+            sums[i] += x;
+        }
+        filled *= 2;
+    }
+    std::sort(sums.begin(), sums.end());
+    return sums;
+}
+
 double SignFlipGreater(std::span<const double> d, int permutations, uint64_t seed) {
     const size_t n = d.size();
     if (n == 0) return 1;
+    if (n <= kExactSignFlipPairs) {
+        // Meet in the middle: the 2^n pattern sums are every a + b, a from the first half's 2^(n/2) sums and b
+        // from the second's. The observed sum is formed the same way, so its own pattern always counts.
+        const std::span<const double> front = d.first(n / 2), back = d.subspan(n / 2);
+        const double observed = std::accumulate(front.begin(), front.end(), 0.0) +
+                                std::accumulate(back.begin(), back.end(), 0.0);
+        const double atLeast = observed - std::abs(observed) * kPermutationTolerance;
+        const std::vector<double> a = SortedSignedSums(front), b = SortedSignedSums(back);
+        // a + b grows with each of them, so the b that reach atLeast are a suffix that only lengthens as a grows.
+        uint64_t asLarge = 0;
+        size_t first = b.size();
+        for (double x : a) {
+            while (first > 0 && x + b[first - 1] >= atLeast) --first;
+            asLarge += b.size() - first;
+        }
+        return PermutationP(asLarge, uint64_t(1) << n, true);
+    }
     const double observed = std::accumulate(d.begin(), d.end(), 0.0);
     const double atLeast = observed - std::abs(observed) * kPermutationTolerance;
     uint64_t asLarge = 0;
-    if (n < 64 && (uint64_t(1) << n) <= kExactPermutations) {
-        const uint64_t patterns = uint64_t(1) << n;
-        for (uint64_t signs = 0; signs < patterns; ++signs) {
-            double sum = 0;
-            for (size_t i = 0; i < n; ++i) sum += (signs >> i & 1) ? -d[i] : d[i];
-            asLarge += sum >= atLeast;
-        }
-        return PermutationP(asLarge, patterns, true);
-    }
     std::mt19937_64 rng(seed);
     for (int r = 0; r < permutations; ++r) {
         double sum = 0;
@@ -155,7 +179,7 @@ double PermutationGreater(std::span<const double> x, std::span<const double> y, 
 
 double SmallestSignFlipP(size_t pairs, int permutations) {
     if (pairs == 0) return 1;
-    if (pairs < 64 && (uint64_t(1) << pairs) <= kExactPermutations) return std::ldexp(1.0, -int(pairs));
+    if (pairs <= kExactSignFlipPairs) return std::ldexp(1.0, -int(pairs));
     return 1 / double(permutations + 1);
 }
 

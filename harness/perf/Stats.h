@@ -19,18 +19,21 @@ double Median(std::span<const double> values);
 // default); NaN for no values.
 double Quantile(std::span<const double> values, double q);
 
-// Permutation tests drawn exactly when there are at most kExactPermutations
-// arrangements, otherwise from `permutations` random ones (fixed seed).
+// The two-sample permutation test counts every split when there are at most
+// kExactPermutations; the sign-flip test counts every pattern of up to
+// kExactSignFlipPairs differences (2^40, met in the middle: two halves of
+// 2^20 sums). Beyond, each draws `permutations` random ones (fixed seed).
 inline constexpr uint64_t kExactPermutations = 1 << 16;
+inline constexpr size_t kExactSignFlipPairs = 40;
 
 // The one-sided paired permutation test that the differences `d` have a
 // positive mean: each difference's sign is flipped at random (the two sides of
 // a pair are exchangeable under the null). p is the fraction of the 2^n sign
 // patterns (the observed one included) whose sum is at least the observed sum:
 // scipy.stats.permutation_test((d,), mean, permutation_type="samples",
-// alternative="greater"); with random patterns, (1 + as large) / (1 +
-// permutations). p = 1 for no differences. The smallest p n differences can
-// give is 2^-n.
+// alternative="greater", n_resamples=np.inf); above kExactSignFlipPairs,
+// random patterns give (1 + as large) / (1 + permutations). p = 1 for no
+// differences. The smallest p n differences can give is 2^-n, exactly.
 double SignFlipGreater(std::span<const double> d, int permutations, uint64_t seed);
 
 // The one-sided two-sample permutation test that mean(x) > mean(y): the pooled

@@ -359,7 +359,7 @@ Node InterleaveSchema() {
                    {"head", Text(), true},
                    {"scenes", Names(), true},
                    {"rounds", Integer(1, 1e6), true},
-                   {"order", TextOf({"ABBA"})},
+                   {"order", TextOf({"random", "ABBA"})},
                    {"run_options", Names()},
                    {"runs", ArrayOf(run), true}});
 }
