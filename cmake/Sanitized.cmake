@@ -1,4 +1,4 @@
-# The sanitized sub-build (issue 11; docs/fuzzing.md): the `cloudbench` CLI and the scene fuzzer compiled with
+# The sanitized sub-build (docs/fuzzing.md): the `cloudbench` CLI and the scene fuzzer compiled with
 # Debian's clang under AddressSanitizer and UBSan (float-cast-overflow included), every check fatal. A workflow
 # preset has one configure preset, so the release build drives this second build of the same source tree as an
 # ExternalProject in build/<preset>/sanitized. Only the CPU backend is built there: the bad-input tests are about

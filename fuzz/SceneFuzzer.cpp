@@ -1,5 +1,5 @@
-// libFuzzer target over the scene parser, `--set` overrides and the stage-parameter setup (issue 11;
-// docs/fuzzing.md). Built only in the sanitized clang sub-build (cmake/Sanitized.cmake).
+// libFuzzer target over the scene parser, `--set` overrides and the stage-parameter setup (docs/fuzzing.md).
+// Built only in the sanitized clang sub-build (cmake/Sanitized.cmake).
 //
 // Input format: the scene's JSON text, then optionally one NUL byte followed by `--set` overrides, one per
 // line, each PATH=VALUE split at the first '=' exactly as the command line splits `--set` (a line without

@@ -93,7 +93,7 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
                     const double u0 = (-quadB - root) * b.inv2A;
                     const double u1 = (-quadB + root) * b.inv2A;
                     // The span is clamped to [0, nx - 1] in double, and only then narrowed:
-                    // a huge ellipsoid's bounds exceed every integer type (issue 11).
+                    // a huge ellipsoid's bounds exceed every integer type.
                     const double iLo = std::max(0.0, std::ceil(el.center[0] + u0 - 0.5) - 1);
                     const double iHi = std::min(double(nx) - 1, std::floor(el.center[0] + u1 - 0.5) + 1);
                     if (!(iLo <= iHi)) continue;  // off the row, or NaN

@@ -93,7 +93,7 @@ class BackendGL final : public Backend {
     // memory while recorded work may be unfinished.
     SubmissionCounts Submissions() const override { return mCounts; }
     // Draw calls issued since the backend was made (a multi-draw counts once):
-    // the per-pass overhead of issue 16.
+    // the per-pass overhead.
     uint64_t Draws() const { return mDraws; }
     // Whether full-screen passes over slices are one layered, instanced draw
     // (GLContext::LayeredProgram) where the driver can, or one draw per slice

@@ -54,7 +54,7 @@ class GLContext {
     // gl_InstanceID (ARB_shader_viewport_layer_array) and passing that layer to
     // the fragment stage, whose `uniform int layer;` becomes `flat in int
     // layer;`. Set uniform "layer0" and draw the triangle with end - begin
-    // instances into layered targets (issue 16: one draw, not one per slice).
+    // instances into layered targets (one draw, not one per slice).
     // An Error where the driver cannot (the caller draws per slice).
     Result<GLuint> LayeredProgram(const std::string& name, const std::string& defines = "");
     // Compiles and links a program from full sources (vertex: nullptr for the

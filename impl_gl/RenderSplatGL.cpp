@@ -187,7 +187,7 @@ void BackendGL::CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, BufferS
     f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     f.TextureSubImage3D(Tex(image).Texture(), 0, 0, 0, 0, 3, GLsizei(W), GLsizei(H), GL_RED, GL_FLOAT, nullptr);
     f.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
-    // The pixel buffer keeps the canonical image: a Download reads it without a texture read back (issue 16).
+    // The pixel buffer keeps the canonical image: a Download reads it without a texture read back.
     KeepImageCopy(image, copySlot, imageBytes);
 }
 

@@ -2,7 +2,7 @@
 // region.comp): for each 16x16-voxel tile of each slice of a share, the
 // ellipsoids whose bounding box, widened by two voxels, reaches a voxel centre
 // of the tile. Built in time linear in the tiles plus the (tile, ellipsoid)
-// pairs it lists, not tiles times ellipsoids (issue 16 item 2).
+// pairs it lists, not tiles times ellipsoids.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // Stage `shade` (SPEC 6) on Vulkan: inverse shear-warp, 16 slices (8 at a
 // 45-degree tie) per shade_block.comp dispatch (tiles of the slice plane that
-// carry the dependency cone in shared memory; issue 16), with a barrier between
+// carry the dependency cone in shared memory), with a barrier between
 // dispatches; at resolution 2 or 4 on a coarse grid (shade_down.comp,
 // shade_up.comp). A share [m0, m1) of the sweep (SPEC 13) computes the slices
 // m0 .. m1 - 1 in visiting order; at f > 1 the share with m = 0 also down-samples

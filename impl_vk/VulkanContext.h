@@ -119,7 +119,7 @@ class VulkanContext {
     // waits; the query reads follow a fence wait and never block).
     uint64_t Submissions() const { return mSubmissions; }
     uint64_t HostWaits() const { return mHostWaits; }
-    // Cumulative: dispatches recorded (the per-dispatch overhead of issue 16).
+    // Cumulative: dispatches recorded (the per-dispatch overhead).
     uint64_t Dispatches() const { return mDispatches; }
 
     // The pipeline of a shader compiled into the build (impl_vk/shaders/<name>.comp).

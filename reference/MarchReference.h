@@ -1,4 +1,4 @@
-// The exact reference render of the ray marcher (SPEC 11, issue 13 item 5):
+// The exact reference render of the ray marcher (SPEC 11):
 // render_march's own per-ray kernel MarchRay (core/math/March.h) with a light
 // functor that returns the EXACT transmittance toward the sun and toward the
 // point light at each sample (TrilinearDepthTracer: the same trilinear field

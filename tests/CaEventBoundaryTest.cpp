@@ -1,4 +1,4 @@
-// Issue 17 item 2: constructed boundary cases for every event comparison of the
+// Constructed boundary cases for every event comparison of the
 // automaton (SPEC 1 and 3: an event fires iff rand24 < P, strictly), on every
 // kernel path. A random draw lands exactly on a threshold about once in 10^10
 // draws on the shipped scenes, so no differential test sees a `<=` for `<`; here

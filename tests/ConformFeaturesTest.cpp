@@ -1,4 +1,4 @@
-// conform's deqp-runner features (issue 17, item 4): the cover count compared
+// conform's deqp-runner features: the cover count compared
 // bit-exactly, --baseline, --flake-reruns' merge, the exit code and conform.csv.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// conform --matrix and --vary (issue 17, item 4): the built-in cases of a scene
+// conform --matrix and --vary: the built-in cases of a scene
 // and their names, worked out by hand from scenes/ci-small.json; every option
 // value covered; the cases of --vary; and the case in conform.csv, the
 // baseline, the reruns' merge and the coverage summary.

@@ -112,7 +112,7 @@ TEST(ConformRules, FaultsWithinTheRulePass) {
     }
 }
 
-// Test that unorm8 T is compared on its stored codes (SPEC 6, issue 16): one
+// Test that unorm8 T is compared on its stored codes (SPEC 6): one
 // code lower passes even where the float difference exceeds 1/255 by an ulp,
 // two codes lower fail. (Lower, since T = 1 is common and higher would clamp.)
 TEST(ConformRules, Unorm8ShadeIsComparedOnCodes) {

@@ -11,7 +11,7 @@ namespace cb::conformance {
 namespace {
 
 // Test shading for every option and several suns: max |dT| <= 1e-5 for fp32,
-// one stored code for fp16 and unorm8 (SPEC 6; issue 16: a float difference can
+// one stored code for fp16 and unorm8 (SPEC 6; a float difference can
 // exceed 1/255 by an ulp where the codes differ by one).
 TEST_P(Conformance, Shade) {
     if (auto why = SkipReason(Stage::Shade)) GTEST_SKIP() << *why;

@@ -69,7 +69,7 @@ TEST(Ellipsoids, ShrinkFactor) {
     EXPECT_EQ(e.ShrinkFactor(0), 1.0);
 }
 
-// Test that a shrink longer than 2^32 - 1 - age still shrinks: age + shrink_steps must not wrap (fuzzing, issue 11).
+// Test that a shrink longer than 2^32 - 1 - age still shrinks: age + shrink_steps must not wrap (found by fuzzing).
 TEST(Ellipsoids, ShrinkFactorWithLongestShrink) {
     Ellipsoid e{};
     e.lifetime = 10;

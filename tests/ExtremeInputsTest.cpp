@@ -1,4 +1,4 @@
-// Extreme but valid inputs (issue 11): huge ellipsoids in the CPU region and
+// Extreme but valid inputs: huge ellipsoids in the CPU region and
 // an extreme focal length in the splat renderer. Each case crashed, wrapped an
 // integer or produced NaN before the fix; none relies on a sanitizer to fail.
 #include <gtest/gtest.h>
@@ -31,7 +31,7 @@ void ExpectRegionEqualsBruteForce(const Extent3& e, const std::vector<RasterElli
 }
 
 // Test ellipsoids of semi-axes 1e10 voxels (the scene `size_mean` 1e10, `margin`
-// 3e10 of issue 11) on a tiny grid: a row span beyond 2^31 voxels on either side
+// 3e10) on a tiny grid: a row span beyond 2^31 voxels on either side
 // used to be narrowed to int32, wrap, and index the row buffer out of bounds
 // (SIGSEGV); beyond 2^63 the double-to-int64 conversion overflowed.
 TEST(ExtremeInputs, HugeEllipsoidsRegionEqualsBruteForce) {
@@ -147,7 +147,7 @@ TEST(ExtremeInputs, RenderSplatWithTinyFovIsFinite) {
 
 // Test that the shade plan's taps into the previous slice are -1, 0 or 1 for any sun vector, NaN and inf
 // components included, and are floor(s_u / |s_w|) (bilinear) for valid ones. A sun path from -1e308 to 1e308
-// degrees (issue 28, now refused at load) gave s = (NaN, NaN, 0.5): int(floor(NaN)) was INT_MIN, and the CPU's
+// degrees (now refused at load) gave s = (NaN, NaN, 0.5): int(floor(NaN)) was INT_MIN, and the CPU's
 // shade sized a scratch of 2^31 rows by it (std::bad_alloc at step 2).
 TEST(ExtremeInputs, ShadePlanTapsWithinOneCellForAnySun) {
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();

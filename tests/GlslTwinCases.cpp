@@ -156,7 +156,7 @@ std::vector<TwinCase> Cases() {
         }
     for (float x : AndNeighbours(Float(0x477ff000u))) halfEdges.push_back(WF({x}));
     // Every fp16 tie in [0, 1): the midpoint of codes h and h + 1 (exact in float) and
-    // one ulp either side, and the negated midpoint (issue 17: sparse GPU ties let a
+    // one ulp either side, and the negated midpoint (sparse GPU ties let a
     // wrong tie rounding survive).
     std::vector<Words> halfTies;
     for (uint32_t h = 0; h < 0x3C00u; ++h) {

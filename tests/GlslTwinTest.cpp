@@ -1,4 +1,4 @@
-// Every function of core/math against its C++ twin in core/ (issue 10, item 7):
+// Every function of core/math against its C++ twin in core/:
 // tests/twin/twin.comp runs the GLSL on a Vulkan device, on random inputs and
 // hand-picked edges (ties, zeros, boundaries), and each output is compared with
 // the C++ bit for bit.
@@ -268,7 +268,7 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
     }
 }
 
-// Test issue 14 item 3: the Mie table lookup by hand (SamplePhaseTable, with the
+// Test the Mie table lookup by hand (SamplePhaseTable, with the
 // table bound as a storage buffer) equals the CPU's SamplePhaseTable(kMieCloudTable, .)
 // on 2^18 + 1 cosines evenly over [-1, 1]; the worst difference in ulps is
 // printed (0 on lavapipe: the same operations, each rounded once).

@@ -1,4 +1,4 @@
-// The ground plane in the frame (issue 15 item 4; docs/pipeline.md, "The ground
+// The ground plane in the frame (docs/pipeline.md, "The ground
 // in the frame"): core/math/Ground.h's formulas against values worked out by hand,
 // both renderers on every backend against closed forms (an empty volume over a
 // ground of known G), the flat background where no ray meets the ground, and

@@ -1,4 +1,4 @@
-// The real-time loop (issue 15 items 2 and 3): frames between steps and a
+// The real-time loop: frames between steps and a
 // moving sun. Shade and shadow re-run exactly when the sun's direction or
 // their density input changed; every frame of a step has its own alpha; the
 // run's loop figures and stage counts add up.

@@ -1,4 +1,4 @@
-// Metamorphic invariant of both renderers (issue 17 item 3; docs/testing.md,
+// Metamorphic invariant of both renderers (docs/testing.md,
 // "Metamorphic invariants: culling, skipping, origin"): moving the grid's
 // corner and the cameras by an exactly representable offset changes no pixel
 // (docs/pipeline.md, "Floating point"). Every backend, ground on.

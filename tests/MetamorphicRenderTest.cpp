@@ -1,4 +1,4 @@
-// Metamorphic invariants of the renderers (issue 17 item 3; docs/testing.md,
+// Metamorphic invariants of the renderers (docs/testing.md,
 // "Metamorphic invariants: culling, skipping, origin"): culling and empty-space
 // skipping on or off give the same image bit for bit, on scenes built to
 // stress them (splats at the frustum's edges, cloud that appears and dissolves
@@ -21,7 +21,7 @@
 namespace cb {
 namespace {
 
-// ---- The frustum's edges, worked by hand (docs/issue17-audit.md 1g) -------------------
+// ---- The frustum's edges, worked by hand -------------------
 //
 // Grid 40 x 40 x 1, h = 1, origin 0, tile = band = 1. The eye (0.5, 20.5, 0.5)
 // looks along +x (target (10.5, 20.5, 0.5)), fov 90 on 64 x 64: f = 32. With

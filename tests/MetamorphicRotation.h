@@ -1,9 +1,9 @@
-// The 90-degree rotation about z of issue 17 item 3, shared by
+// The 90-degree rotation about z, shared by
 // tests/MetamorphicRotationTest.cpp (the mapping, the automaton and the field
 // stages) and tests/MetamorphicRotationImageTest.cpp (shade, shadow and the
 // renderers): the mapping and the fixtures.
 //
-// The mapping (docs/issue17-audit.md 3b): voxel (i, j, k) of an nx x ny x nz
+// The mapping: voxel (i, j, k) of an nx x ny x nz
 // grid is voxel (ny-1-j, i, k) of the turned ny x nx x nz grid; a world point
 // P goes to O + Rz90 (P - O) + (ny h, 0, 0), a direction d to Rz90 d, with
 // Rz90 (x, y, z) = (-y, x, z). Outputs of the turned scene are turned back

@@ -1,8 +1,8 @@
-// Issue 17 item 3, continued from tests/MetamorphicRotationTest.cpp (which
-// instantiates the fixtures on every backend): shading, the ground shadow and
-// both renderers turn with the grid and the sun within SPEC's tolerance, and a
-// camera turned about the grid sees the same image. The mapping is in
-// tests/MetamorphicRotation.h.
+// The 90-degree rotation about z, continued from
+// tests/MetamorphicRotationTest.cpp (which instantiates the fixtures on every
+// backend): shading, the ground shadow and both renderers turn with the grid
+// and the sun within SPEC's tolerance, and a camera turned about the grid sees
+// the same image. The mapping is in tests/MetamorphicRotation.h.
 #include <gtest/gtest.h>
 
 #include <algorithm>

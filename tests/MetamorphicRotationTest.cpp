@@ -1,4 +1,4 @@
-// Issue 17 item 3: the 90-degree rotation about z as a metamorphic invariant,
+// The 90-degree rotation about z as a metamorphic invariant,
 // on every backend. A scene turned by 90 degrees about z (the grid transposed
 // to ny x nx, the sun, the wind shifts, the ellipsoids and the cameras turned
 // with it) must give turned outputs: bit for bit for the integer stages, within

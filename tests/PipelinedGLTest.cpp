@@ -242,7 +242,7 @@ TEST(PipelinedGL, ImageDownloadFromThePixelBufferIsNeverStale) {
 }
 
 #if CLOUDBENCH_HAVE_GL
-// Layered passes (issue 16 item 3): one instanced draw over the slices gives
+// Layered passes: one instanced draw over the slices gives
 // the bytes of one draw per slice, and the draws per call drop to what the
 // passes need: ca init 1 (not nz), a step without wind 1, smooth 3 (not 3 nz),
 // density 4 (sum, cover, bands, tiles; not nz + bands + 2), shade's

@@ -1,4 +1,4 @@
-// The harness's two ways to time a step (issue 16 item 1; docs/performance.md,
+// The harness's two ways to time a step (docs/performance.md,
 // "Two ways to time a step"), against a CPU backend that plays a device: it
 // logs every stage call with the batch and the interval it fell in, gives each
 // call a known device cost (its number in the log), and counts a submission

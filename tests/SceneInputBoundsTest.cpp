@@ -1,4 +1,4 @@
-// Bounded input (issue 11, "Every bad input refused clearly"): scene files that are not regular files or are too
+// Bounded input, so that every bad input is refused clearly: scene files that are not regular files or are too
 // large, JSON nested too deep, echoed text kept short and free of control bytes, and derived sizes that must not wrap.
 #include <gtest/gtest.h>
 #include <sys/resource.h>

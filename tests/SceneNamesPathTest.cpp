@@ -1,5 +1,5 @@
 // Names that become path components (the scene's out/<name>, the cameras' frame files): the rule, its message,
-// and the echoed value kept safe to print (issue 11, "Nothing escapes its folder").
+// and the echoed value kept safe to print, so that nothing escapes its folder.
 #include <gtest/gtest.h>
 
 #include <string>

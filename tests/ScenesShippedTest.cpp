@@ -118,7 +118,7 @@ Scene LoadShipped(const char* name) {
     return scene.has_value() ? *scene : Scene{};
 }
 
-// Test that the noise-formed layer is what issue 13 item 6 asks for: a 128^3 volume formed by
+// Test that the noise-formed layer is a 128^3 volume formed by
 // `noise` with a 32^3 detail volume, shaded and ray-marched at 1280x720, one camera; and that the
 // track and the lightning scene use the same clouds.
 TEST(ScenesShipped, NoiseLayerSizes) {

@@ -1,4 +1,4 @@
-// Vulkan shade in blocks of slices (issue 16; impl_vk/shaders/shade_block.comp):
+// Vulkan shade in blocks of slices (impl_vk/shaders/shade_block.comp):
 // T must be byte for byte the per-slice reference path's (shade_slice.comp, one
 // dispatch per slice, BackendVk::ShadeSweep::PerSlice) at every
 // principal axis and sign, fractional and whole taps (45-degree ties: a tap

@@ -66,7 +66,7 @@ TEST(ShadingMath, StorageCodesAreTheStoredIntegers) {
     EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-24f), 1u);      // the smallest subnormal half
     EXPECT_EQ(StorageCode(StorageFormat::Fp16, 0x1p-14f), 0x400u);  // the smallest normal half
     for (uint32_t k = 0; k <= 255; ++k) ASSERT_EQ(StorageCode(StorageFormat::Unorm8, float(k) / 255.0f), k);
-    // Issue 16's case (on the H200 it was 214/255 against 215/255 as the GPU rounded them): neighbouring codes
+    // The H200's case (214/255 against 215/255 as the GPU rounded them): neighbouring codes
     // whose float difference exceeds 1/255 in single precision, here 127/255 and 128/255 (also 3, 7, 15, 31, 63).
     const float a = 127.0f / 255.0f, b = 128.0f / 255.0f;
     EXPECT_GT(b - a, 1.0f / 255.0f);

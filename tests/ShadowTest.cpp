@@ -53,7 +53,7 @@ TEST(Shadow, HandWorked) {
     for (float g : ShadowOnCpu(e, D, p)) EXPECT_TRUE(std::isfinite(g));
 }
 
-// Test the lookup height where the hand-worked case above cannot (issue 17):
+// Test the lookup height where the hand-worked case above cannot:
 // an odd nz = 7 at 45 degrees along +x reads 3.5 cells over, so with only
 // D(5, 2) = 2, cells 1 and 2 of row 2 read halfway between columns 4|5 and 5|6:
 // D = 1 for both, G = exp(-sigma h / s_z); a lookup with nz/2 in integers reads

@@ -1,4 +1,4 @@
-// Issue 17 item 1: independent tests of the formulas every backend takes from
+// Independent tests of the formulas every backend takes from
 // core/ (host-only code, or code with a GLSL twin that the twin test only
 // compares with this C++). A backend-vs-CPU comparison cannot see a bug here,
 // so every expected value below is hand-worked, a published vector, or a slow
@@ -244,7 +244,7 @@ TEST(SharedFormula, SplatOrderTies) {
 
 // ---- 1g. The frustum bound grown by the splat radius ------------------------------
 
-// The case worked in the issue-17 audit: grid 40 x 40 x 1, h = 1, origin 0, one
+// A case worked by hand: grid 40 x 40 x 1, h = 1, origin 0, one
 // voxel per box; eye (0.5, 20.5, 0.5) looking along +x, fov 90 degrees, 64 x 64
 // (f = 32 px), so right = forward x up = (0, -1, 0); splat diameter 4.
 struct SfFrustumCase {
@@ -455,7 +455,7 @@ TEST(SharedFormula, WindGridMovesCentres) {
 // ---- 1j. The ellipsoid list update -------------------------------------------------
 
 // Test the spawn and update order against an independent Python port of
-// docs/pipeline.md (the issue-17 audit): grid 16 x 8 x 4, seed 7, target 2,
+// docs/pipeline.md: grid 16 x 8 x 4, seed 7, target 2,
 // adaption 1, size (4,4,2) +- (1,1,.5), life 3 +- 0, margin 2, height (.25,.5),
 // wind (1,0), jitter .1. Draws: x, y, z, three semi-axes, yaw, life, then age
 // (Below(lifetime)) at the start; after moving (x then y jitter per item) and

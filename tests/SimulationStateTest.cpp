@@ -1,4 +1,4 @@
-// Save and restore (issue 17 item 3, the metamorphic invariant "a split run
+// Save and restore (the metamorphic invariant "a split run
 // equals the unsplit run"): a run of N steps, against k steps, the state saved
 // to a folder, read back into a FRESH Simulation and N-k more steps. Every
 // buffer the observer sees and every image must be bit-equal at every later

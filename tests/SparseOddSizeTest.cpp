@@ -1,4 +1,4 @@
-// Issue 17 item 3: sparse fields on grids whose sizes are not multiples of the
+// Sparse fields on grids whose sizes are not multiples of the
 // tile, band or word size, on every backend, against hand-derived outputs.
 //
 // The odd-size tests elsewhere fill every tile, so a read past the end of a row

@@ -1,5 +1,5 @@
 // SPEC 12, "Numerical stability at the extremes", as one suite run on every
-// backend (issue 11, item 7). Each item is a scene (ci-small with overrides)
+// backend. Each item is a scene (ci-small with overrides)
 // run through the Simulation with every output on every step. At each step,
 // every output array of every enabled stage (found through the stage
 // descriptors, so a new stage's outputs are checked too) is downloaded in

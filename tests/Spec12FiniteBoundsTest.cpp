@@ -283,7 +283,7 @@ using test::Parsed;
 std::string With(const std::string& fields) { return R"({"grid": {"size": [8, 8, 8]}, )" + fields + "}"; }
 
 // Test the phase peak's bound on both sides: the largest accepted g runs (above) and its next float is refused,
-// naming phase.g, the bound and the peak; so is g = 0.9999999 (issue 28: T was 94 % NaN with scattering).
+// naming phase.g, the bound and the peak; so is g = 0.9999999 (before the bound, T was 94 % NaN with scattering).
 TEST(FiniteBoundsRefused, PhasePeakJustPastTheBound) {
     for (PhaseKind kind : {PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks}) {
         const std::string name(PhaseKindName(kind));
@@ -344,7 +344,7 @@ TEST(FiniteBoundsRefused, LightningPositionJustPastTheBound) {
                         "distance from the grid in voxel edges) must be in [-1e+18, 1e+18], got -1000000000000000128"));
 }
 
-// Test the sun's azimuth bound just past it, fixed, on a path (the issue's +-1e308 over 2^32 steps, whose
+// Test the sun's azimuth bound just past it, fixed, on a path (+-1e308 over 2^32 steps, whose
 // interpolation overflowed to inf: the CPU ran out of memory in shade, gl and vk drew NaN) and at a speed.
 TEST(FiniteBoundsRefused, SunAzimuthJustPastTheBound) {
     const std::string reason =

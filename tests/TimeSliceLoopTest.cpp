@@ -1,4 +1,4 @@
-// Time-slicing in the loop (SPEC 13, issue 15 item 1): a run that spreads
+// Time-slicing in the loop (SPEC 13): a run that spreads
 // each step over the frames of the step before must see, step by step, the
 // same state, q, D, occupancy, T, G and images as the unsliced run, bit for
 // bit, on every backend; only when the work is done may differ. Also the

@@ -1,4 +1,4 @@
-# The bad-input corpus (tests/bad_inputs/, issue 11): every case through the release CLI, `run` and `dump` for
+# The bad-input corpus (tests/bad_inputs/): every case through the release CLI, `run` and `dump` for
 # scene cases. check_bad_inputs.py prints the outcome table; it fails on any wrong exit code or message, raw
 # control byte, oversized stderr, timeout, or NaN/Inf in the outputs of a case that exits 0.
 # Included from tests/CMakeLists.txt where `cli` is defined.

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""conform's deqp-runner features (issue 17, item 4): the cover count compared,
+"""conform's deqp-runner features: the cover count compared,
 conform.csv, --baseline and --flake-reruns, on ci-small against one backend.
 A mismatch is planted with the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH
 switch (harness/conform/Conform.h): <backend>:<row stage>[:<attempts it fails on>].

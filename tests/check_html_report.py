@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks `cloudbench report` end to end (issue 12, item 5): makes a small run, a
+"""Checks `cloudbench report` end to end: makes a small run, a
 conformance check and a sweep of SCENE, and a synthetic perf history with two planted
 steps (one listed by its record, one in the instruction counts left to the detector)
 and a half-written last line; writes the report; then loads the page

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Crash isolation (issue 11, item 1): a backend killed on purpose through
+"""Crash isolation: a backend killed on purpose through
 CLOUDBENCH_TEST_FAULT is reported with its signal or reason and its stage, the
 exit code is 1, and every other backend's results are kept in the JSON output.
 

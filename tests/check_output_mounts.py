@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Output folders on a full and on a read-only file system (issue 11), each a
+"""Output folders on a full and on a read-only file system, each a
 small tmpfs mounted in a private mount namespace (`unshare -rm`, or `unshare -m`
 as root); exits 77 (skipped) where neither may mount.
 

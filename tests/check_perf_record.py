@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""`cloudbench perf record` (issue 12, item 1): each record is one JSON line
+"""`cloudbench perf record`: each record is one JSON line
 appended to the history with the documented shape (docs/results.md); earlier
 lines are never rewritten; a line cut short is skipped with a warning naming
 the file and line, and the next record still starts a line of its own; a

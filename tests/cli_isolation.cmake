@@ -1,4 +1,4 @@
-# Crash isolation (issue 11, item 1; harness/platform/Isolation.h): backends killed on
+# Crash isolation (harness/platform/Isolation.h): backends killed on
 # purpose through the test-only CLOUDBENCH_TEST_FAULT switch (docs/cli.md).
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
 set(isolation_cases oom noisolation-oom parentkill)

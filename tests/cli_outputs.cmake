@@ -1,4 +1,4 @@
-# Coherent output folders (issue 11; docs/results.md#output-folders): one command per folder at a time (a lock),
+# Coherent output folders (docs/results.md#output-folders): one command per folder at a time (a lock),
 # and a run's outputs never mixed with the previous run's (a journal of written files, removed at the next start).
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
 set(outputs_py ${CMAKE_CURRENT_SOURCE_DIR})

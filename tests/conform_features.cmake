@@ -1,4 +1,4 @@
-# conform's deqp-runner features (issue 17, item 4): the cover count, conform.csv,
+# conform's deqp-runner features: the cover count, conform.csv,
 # --baseline, --flake-reruns and --matrix, against the first non-CPU backend built, with a
 # mismatch planted through the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH switch.
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
@@ -17,7 +17,7 @@ if(DEFINED conform_features_backend)
                          "conform features ${case}: ok" TIMEOUT 300)
   endforeach()
 endif()
-# ci-small-wind (a 3x2 wind grid of distinct, asymmetric vectors; issue 17 item 3f) on every built
+# ci-small-wind (a 3x2 wind grid of distinct, asymmetric vectors) on every built
 # backend, with the Khronos validation layer on; exit 4 (no backend besides the CPU could start) is a skip.
 add_test(NAME Cli.ConformCiSmallWind COMMAND ${cli} conform ci-small-wind --steps 4 --out ${cli_out}/conform-wind)
 set_tests_properties(Cli.ConformCiSmallWind PROPERTIES ENVIRONMENT CLOUDBENCH_VK_VALIDATION=1 SKIP_RETURN_CODE 4

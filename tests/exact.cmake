@@ -68,7 +68,7 @@ add_test(NAME Exact.TwiceTheVoxelsCountsMore COMMAND /usr/bin/python3 ${CMAKE_CU
 set_tests_properties(Exact.CountsIdenticalAcrossRuns Exact.TwiceTheVoxelsCountsMore PROPERTIES
                      FIXTURES_REQUIRED exact_counts DEPENDS "Exact.CountCiSmallA;Exact.CountCiSmallB;Exact.CountCiSmallWide")
 
-# perf record counts the suite's instructions itself when the build can (item 1 of issue 12): its record holds
+# perf record counts the suite's instructions itself when the build can: its record holds
 # ci-small's per-stage counts, within 1 % of a separate `count` of the same 14 steps. Not identical: the two
 # command lines allocate differently, and where the heap puts the buffers moves the counts of the vectorised
 # stages. Measured 2026-11-30 with one `count` binary under three glibc heap layouts (default, mmap_threshold=4096,

@@ -1,4 +1,4 @@
-# The ground in the frame (issue 15 item 4) through `cloudbench conform`: the shipped scene ground-shadow draws
+# The ground in the frame through `cloudbench conform`: the shipped scene ground-shadow draws
 # the ground lit through G with both renderers; every built backend renders from the CPU's inputs (G among them)
 # and is compared by SPEC 8's and SPEC 10's image rules (conform exits 5 on a failure). The Khronos validation
 # layer is on (CLOUDBENCH_VK_VALIDATION=1) and any message fails the test, as does a renderer that a backend skips.

@@ -1,4 +1,4 @@
-# `cloudbench report` (issue 12, item 5): a page from a real small run, conformance check and sweep of ci-small
+# `cloudbench report`: a page from a real small run, conformance check and sweep of ci-small
 # and a synthetic history, loaded in headless chromium (skipped, 77, without it; CI installs it through
 # tools/debian-packages.txt). Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
 add_test(NAME Cli.HtmlReport

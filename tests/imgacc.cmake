@@ -1,4 +1,4 @@
-# Image accuracy through the CLI (issue 13 item 5; docs/accuracy.md, "Images"). Included from
+# Image accuracy through the CLI (docs/accuracy.md, "Images"). Included from
 # tests/CMakeLists.txt where `cli` and `cli_out` are set. The scene tests/scenes/imgacc-small.json is
 # a 32x32x16 noise layer rendered at 64x48 by render_march and render_splat.
 # accuracy: image rows with finite errors and PSNR; a step 4x the scene's has a larger mean error than

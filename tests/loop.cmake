@@ -1,4 +1,4 @@
-# The real-time loop through the CLI (issue 15 items 2 and 3). Included from tests/CMakeLists.txt where `cli` and
+# The real-time loop through the CLI. Included from tests/CMakeLists.txt where `cli` and
 # `cli_out` are set.
 #
 # thesis-sunset on every built backend: 24 steps, 4 warm-up, a render every step after it, 4 frames a step. So the

@@ -1,4 +1,4 @@
-# render_march through the CLI (issue 13). Included from tests/CMakeLists.txt where `cli` and `cli_out` are set.
+# render_march through the CLI. Included from tests/CMakeLists.txt where `cli` and `cli_out` are set.
 # ci-small with the ray marcher: `run` writes the EXR and the tone-mapped PNG and the march counters; skipping
 # on and off write the same EXR pixels (skipping changes no sample, docs/pipeline.md) with fewer samples.
 set(cli_march_script [=[d="$1"; rm -rf "$d"; set -e

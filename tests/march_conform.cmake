@@ -1,4 +1,4 @@
-# render_march conforms on every built backend through `cloudbench conform` (issue 14 items 2 and 4): each
+# render_march conforms on every built backend through `cloudbench conform`: each
 # backend renders from the CPU's inputs and is compared by SPEC 10's rule (max |d| <= 1e-4 per linear channel
 # on 99.9 % of pixels; conform exits 5 on a failure). The Khronos validation layer is on
 # (CLOUDBENCH_VK_VALIDATION=1) and any message fails the test, as does a backend that skips the stage.
@@ -36,7 +36,7 @@ foreach(entry ${march_cases})
   set_tests_properties(Cli.ConformMarch${name} PROPERTIES
                        FAIL_REGULAR_EXPRESSION "vk validation|render_march +(vk|gl) +(fail|skipped)")
 endforeach()
-# conform reports a renderer's worst pixel with a difference image (issue 14 item 2): with powder (GLSL's pow
+# conform reports a renderer's worst pixel with a difference image: with powder (GLSL's pow
 # against glibc's, ~1e-7 apart) the GPU backends' images differ slightly, and each render_march row that
 # differs names diff-render_march-<backend>.exr in the output folder, whose largest value is the row's worst.
 set(march_diff_script [=[d="$1"; rm -rf "$d"; set -e

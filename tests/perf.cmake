@@ -1,4 +1,4 @@
-# Performance tracking (issue 12; `cloudbench perf`, docs/cli.md): the
+# Performance tracking (`cloudbench perf`, docs/cli.md): the
 # statistics against SciPy, the history's records, and the CI gate on this
 # machine (an identical build passes, a planted slowdown fails with exit 6).
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.

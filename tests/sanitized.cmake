@@ -48,7 +48,7 @@ function(sanitized_scene name codes text)
   sanitized_case(${name} "${codes}" run ${san_scenes}/${name}.json --backend cpu --quiet --out ${san_out}/${name})
 endfunction()
 
-# Runs that compute: every CPU stage, the dump path, and the extremes the issue found crashing.
+# Runs that compute: every CPU stage, the dump path, and the extremes that once crashed.
 set(fast --backend cpu --quiet --set warmup_steps=0)
 sanitized_case(RunCiSmallCpu 0 run ci-small --steps 3 ${fast} --out ${san_out}/run)
 sanitized_case(DumpCiSmallCpu 0 dump ci-small --steps 2 ${fast} --out ${san_out}/dump)

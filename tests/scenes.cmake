@@ -1,4 +1,4 @@
-# The shipped ray-march scenes through the CLI (issue 13 item 6). Included from tests/CMakeLists.txt where `cli`
+# The shipped ray-march scenes through the CLI. Included from tests/CMakeLists.txt where `cli`
 # and `cli_out` are set.
 # lightning.json flashes at step 2 of 4 and its clouds are static: the last frame of a 2-step run (before the
 # flash) and of a 4-step run (after it) must be the same pixels, and the 3-step run's last frame (the flash) must

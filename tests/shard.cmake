@@ -1,4 +1,4 @@
-# Sweep sharding and `cloudbench merge` (issue 12, item 7; docs/cli.md): two
+# Sweep sharding and `cloudbench merge` (docs/cli.md): two
 # shards as separate processes merge into the unsharded sweep's table, perf
 # histories merge with each record once, a shard set missing an index exits 3.
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.

@@ -1,4 +1,4 @@
-# Save and resume through the CLI (issue 17 item 3; docs/cli.md, run --save-state / --resume; harness/run/SimulationState.h).
+# Save and resume through the CLI (docs/cli.md, run --save-state / --resume; harness/run/SimulationState.h).
 # Included from tests/CMakeLists.txt where `cli`, `cli_out` and `expect_exit` are set.
 #
 # ci-small (on a 32 x 32 x 8 grid) for 9 steps (rendered every step after 1 warm-up, jittered, short-lived ellipsoids so some are born after

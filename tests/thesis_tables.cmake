@@ -1,4 +1,4 @@
-# Tables 8.2-8.4's image rule (issue 15 item 5, SPEC 8): culling and empty-space skipping never change the image.
+# Tables 8.2-8.4's image rule (SPEC 8): culling and empty-space skipping never change the image.
 # Included from tests/CMakeLists.txt where `cli` and `cli_out` are set.
 #
 # ci-small on every built backend (exit 4, a backend missing: the others still checked) under the three settings of

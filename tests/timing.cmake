@@ -1,4 +1,4 @@
-# The two ways to time a step (issue 16 item 1; docs/performance.md, "Two ways to time a step") through the CLI.
+# The two ways to time a step (docs/performance.md, "Two ways to time a step") through the CLI.
 # Included from tests/CMakeLists.txt where `cli`, `cli_out` and `expect_exit` are set.
 #
 # ci-small on every built backend (exit 4, no GPU backend here: the others still run), 8 steps of which 2 warm-up,

@@ -1,18 +1,18 @@
 #!/usr/bin/env bash
-# Issue 16 item 7: the measurements to make on a real GPU, in one call of a few minutes.
+# The measurements to make on a real GPU, in one call of a few minutes.
 # Here:       cmake --workflow --preset release, then pack the release build (cloudbench, cloudbench_tests,
 #             libcloudbench_images.so, the libraries they need, scenes/) into .gpu/ with an env.sh
-# GPU host:   . .gpu/env.sh && tools/gpu_issue16.sh "$OUT"      (carry .gpu; $OUT comes back)
+# GPU host:   . .gpu/env.sh && tools/gpu_table.sh "$OUT"      (carry .gpu; $OUT comes back)
 # Writes to DIR (default /tmp/gpu16): devices.txt, conform-*.txt, run-*.txt with their results.json,
-# gtest-*.txt, and summary.txt, the lines for a new dated report under reports/perf/
-# ("H200, after issue 16"). Every command has its own time limit, so one that hangs costs only itself.
+# gtest-*.txt, and summary.txt, the lines for a new dated report under reports/perf/. Every command has
+# its own time limit, so one that hangs costs only itself.
 set -uo pipefail
 out=${1:-/tmp/gpu16}
 mkdir -p "$out"
 cli=${CLOUDBENCH_CLI:-.gpu/cloudbench}
 tests=${CLOUDBENCH_TESTS:-.gpu/cloudbench_tests}
 scenes=${CLOUDBENCH_SCENES:-.gpu/scenes}
-[ -x "$cli" ] || { echo "gpu_issue16: no $cli; pack the release build into .gpu first" >&2; exit 1; }
+[ -x "$cli" ] || { echo "gpu_table: no $cli; pack the release build into .gpu first" >&2; exit 1; }
 step() {  # step NAME SECONDS COMMAND...: runs it, keeps its output and exit status
     local name=$1 limit=$2; shift 2
     echo "== $name: $*" | tee -a "$out/summary.txt"
@@ -21,11 +21,12 @@ step() {  # step NAME SECONDS COMMAND...: runs it, keeps its output and exit sta
     echo "   exit $?, $((SECONDS - t0)) s" | tee -a "$out/summary.txt"
 }
 step devices 60 "$cli" devices
-# Conformance on the GPU (SPEC's rules, storage quanta as integer codes; issue 16 item 6).
+# Conformance on the GPU (SPEC's rules, storage quanta as integer codes).
 step conform-ci-small 120 "$cli" conform "$scenes/ci-small.json" --gl-context egl --out "$out/conform-ci-small"
 step conform-thesis-medium 300 "$cli" conform "$scenes/thesis-medium.json" --gl-context egl --steps 120 \
     --out "$out/conform-thesis-medium"
-# The table of issue 16: thesis-medium per stage, both timing modes, both cameras every step.
+# The real-GPU table (docs/performance.md, "Real GPUs"): thesis-medium per stage, both timing modes, both
+# cameras every step.
 step run-thesis-medium 300 "$cli" run "$scenes/thesis-medium.json" --backend vk,gl,cpu --gl-context egl \
     --timing both --steps 140 --set warmup_steps=100 --set render.every_steps=1 --out "$out/run-thesis-medium"
 # thesis-high at 1920 x 1080 (the table's last row).

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Mutation testing for cloudbench (issue 17 item 5): plant each bug of tools/mutants.json in turn, rebuild, run the
+"""Mutation testing for cloudbench: plant each bug of tools/mutants.json in turn, rebuild, run the
 oracles cheapest first, and report which bugs the project's tests catch. docs/testing.md, "Mutation testing".
 
 Standard library only. It never edits the caller's checkout: it works in a separate git worktree (--tree DIR, or by

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The march CPU time per frame of scenes/noise-layer.json (issue 13 item 8, the 100 ms target), at the
+"""The march CPU time per frame of scenes/noise-layer.json (the 100 ms target), at the
 scene's step 0.5 and at Olajos's step 1: 5 interleaved rounds of runs with 1 and 3 frames (static clouds),
 march CPU per frame = (CPU(3 frames) - CPU(1 frame)) / 2, so start-up, noise, shade and writing the frame
 cancel. Run from the repository root; prints medians [min max]. reports/march/scenes.md has the results."""

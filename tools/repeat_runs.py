@@ -3,8 +3,8 @@
 
 Every run of every oracle on an unchanged, passing tree must pass, so any failure
 here is a false alarm: a test or a conformance row that depends on timing, load,
-scheduling or the machine rather than on the code. Issue 17 item 6 asks for 20
-runs on the noisy development machine; docs/testing.md records the result.
+scheduling or the machine rather than on the code. docs/testing.md records 20
+runs on the noisy development machine.
 
 Usage:
   /usr/bin/python3 tools/repeat_runs.py --runs 20 --build build/release \

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Splat against march on every backend (issue 14 item 5).
+"""Splat against march on every backend.
 
 Runs scenes/thesis-medium-both (the thesis-medium clouds drawn by both
 renderers, 1024x768, cameras "ground" and "above") once per backend per round,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The thesis's Tables 8.2, 8.3 and 8.4 on every backend (issue 15 item 5).
+"""The thesis's Tables 8.2, 8.3 and 8.4 on every backend.
 
 Renders the three thesis scenes (scenes/thesis-low, thesis-medium, thesis-high:
 256x256x32, 1024x768, cameras "ground" and "above") with render_splat under

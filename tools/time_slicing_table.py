@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Fizimayer's thesis, section 8.1.2 ("computation over multiple frames") on every backend (issue 15 item 1).
+"""Fizimayer's thesis, section 8.1.2 ("computation over multiple frames") on every backend.
 
 Runs thesis-medium (256x256x32, the automaton, shade and shadow, render_splat with its two cameras) with
 render.slices_per_frame = 0 (the whole step in one frame), 1, 4 and 32, rendering every step after the warm-up,

@@ -1,4 +1,4 @@
-// The ground plane in the frame (issue 15 item 4; docs/pipeline.md, "The
+// The ground plane in the frame (docs/pipeline.md, "The
 // ground in the frame"): the plane z = origin_z (SPEC 7) under the clouds, a
 // Lambertian surface of the scene's albedo lit by the sun through the ground
 // shadow G (Wang, Ji and Zhang, eq. 19) and by the ambient light. Both renderers take it

@@ -9,7 +9,7 @@
 // origin + h p, voxel (i, j, k) fills [i, i+1] x [j, j+1] x [k, k+1], and the
 // distance t along a ray is in voxel edges (metres = h t). The per-sample code
 // is scalar float without the standard library's containers, so the GLSL ports
-// (issue 14) can twin it line by line.
+// can twin it line by line.
 #pragma once
 
 #include <algorithm>

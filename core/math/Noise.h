@@ -4,7 +4,7 @@
 // towers, threshold) with Wang's coverage and density modulation.
 //
 // The per-sample functions are plain scalar code over a 256-byte permutation
-// table, with no containers, so the GLSL ports (issue 14) can twin them line
+// table, with no containers, so the GLSL ports can twin them line
 // by line. The lattice noises are templates over the scalar type only so that
 // the tests can evaluate the same formula in double (derivative checks); the
 // stage itself runs them in float. Decisions SPEC leaves open are recorded in

@@ -104,7 +104,7 @@ inline float RoundToStorage(StorageFormat format, float value) {
 // for k/255 in unorm8, the half's bit pattern in fp16, the float's bits in
 // fp32. Codes grow with the value and neighbouring stored values differ by
 // one, so SPEC 6's "one storage quantum" is |code difference| <= 1, compared
-// as integers: a float difference can exceed 1/255 by an ulp (issue 16).
+// as integers: a float difference can exceed 1/255 by an ulp.
 inline uint32_t StorageCode(StorageFormat format, float stored) {
     switch (format) {
         case StorageFormat::Fp32:

@@ -146,8 +146,8 @@ Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Exten
 // In a backend's class: declares the override of one entry.
 #define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;
 
-// What a backend has asked of its device since it was made (pipelined timing,
-// issue 16). A backend without a device (the CPU) counts nothing.
+// What a backend has asked of its device since it was made (pipelined timing).
+// A backend without a device (the CPU) counts nothing.
 struct SubmissionCounts {
     // Batches of commands handed to the device: vkQueueSubmit; on GL a flush or
     // finish that ends a batch of draws.

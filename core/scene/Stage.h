@@ -68,7 +68,7 @@ constexpr std::string_view StageSpecSection(Stage stage) {
 }
 
 // The stages of the thesis's splat pipeline (SPEC 2-8), which every backend
-// implements; render_march and noise are the CPU's alone until issue 14 ports them.
+// implements; render_march and noise, the ray-march path, are not among them.
 constexpr bool IsSplatPipelineStage(Stage stage) {
     switch (stage) {
 #define CB_STAGE_SPLAT(name, text, spec, splat) \

@@ -4,7 +4,7 @@
 // fragment pass evaluates the weight and MAX blending keeps the largest.
 // LAYERED (with GL_ARB_shader_viewport_layer_array): one draw for slices
 // layer0, layer0 + 1, ...: instance = (k - layer0) * count + ellipsoid, and the
-// vertex stage picks layer k of the layered target (issue 16).
+// vertex stage picks layer k of the layered target.
 layout(std430, binding = 0) readonly buffer Ellipsoids { float ellipsoid[]; };  // 8 floats each
 #ifdef LAYERED
 uniform int layer0;

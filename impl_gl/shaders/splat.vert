@@ -3,7 +3,7 @@
 // vertex id is the voxel's rank), so blending composites in that order. The
 // vertex shader reads the volumes and throws away voxels that make no splat
 // (section 6.2) by placing them outside the clip volume. With deviceSkip (in
-// a batch: issue 16) it also throws away the voxels of tile x band boxes empty
+// a batch) it also throws away the voxels of tile x band boxes empty
 // in both steps' bands, which the host's runs skip otherwise, and counts the rest.
 layout(std430, binding = 0) readonly buffer Order { uint orderIndex[]; };  // outer, middle, inner axis orders
 layout(std430, binding = 1) buffer Counters { uint splatCount; uint visitedCount; };

@@ -272,7 +272,7 @@ void Register() {
         benchmark::RegisterBenchmark(("Density/" + s).c_str(), BM_Density, s)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("Shade/" + s).c_str(), BM_Shade, s)
             ->Args({2, 1})->Args({2, 2})->Args({1, 1})->Unit(benchmark::kMillisecond);
-        if (s == "thesis-medium")  // the sun sweep of issue 16 item 4 (docs/performance.md)
+        if (s == "thesis-medium")  // the sun sweep (docs/performance.md)
             benchmark::RegisterBenchmark(("ShadeSun/" + s).c_str(), BM_ShadeSun, s)
                 ->ArgsProduct({{1, 2, 4, 8, 16}, {10, 25, 60, 90}, {60}})
                 ->ArgsProduct({{1, 2, 4, 8, 16}, {25, 45}, {0}})
