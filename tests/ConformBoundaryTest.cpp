@@ -231,5 +231,16 @@ TEST(ConformBoundary, StatusesAndExitCodes) {
     EXPECT_EQ(ConformExitCode(rows), 0);
 }
 
+// Test conform's last line: the rows counted by status in the order they first occur, and the verdict, pass or fail.
+TEST(ConformBoundary, SummaryLineCountsAndVerdict) {
+    EXPECT_EQ(ConformSummary({BoundaryStatusRow("region", "pass"), BoundaryStatusRow("ca", "fail"),
+                              BoundaryStatusRow("shade", "pass"), BoundaryStatusRow("shadow", "skipped")}),
+              "4 rows: 2 pass, 1 fail, 1 skipped; exit 5, a row does not conform");
+    EXPECT_EQ(ConformSummary({BoundaryStatusRow("shade", "pass")}), "1 row: 1 pass; exit 0, every compared row conforms");
+    EXPECT_EQ(ConformSummary({BoundaryStatusRow("(all)", "crashed"), BoundaryStatusRow("ca", "fail")}),
+              "2 rows: 1 crashed, 1 fail; exit 1, a backend failed or crashed");
+    EXPECT_EQ(ConformSummary({}), "0 rows; exit 4, no backend was compared");
+}
+
 }  // namespace
 }  // namespace cb

@@ -183,6 +183,28 @@ TEST(HtmlPareto, RenderersShareOnePlot) {
     EXPECT_NE(std::get<report::Figure>(image[0]).svg.find("layers gl"), std::string::npos);
 }
 
+// Test a sweep on PSNR: the front drawn is the rows sweep.json marks (higher PSNR is better, so a plain
+// lower-is-better front would keep one of them), on a PSNR axis; an infinite PSNR (null) is left out.
+TEST(HtmlPareto, PsnrSweepDrawsTheMarkedFront) {
+    auto row = [](double ms, nlohmann::json psnr, bool pareto) {
+        return nlohmann::json{{"stage", "render_march"},
+                              {"backend", "cpu"},
+                              {"status", "ok"},
+                              {"time", {{"median_ms", ms}}},
+                              {"error", {{"all", {{"max", 0.1}}}, {"psnr_db", psnr}}},
+                              {"settings", nlohmann::json::object()},
+                              {"pareto", pareto}};
+    };
+    ReportInput sweep{"s.json", InputKind::Sweep, {{"scene", "x"}, {"metric", "psnr"}}};
+    sweep.doc["rows"] = {row(1, 30, true), row(2, 28, false), row(3, 40, true), row(4, nullptr, true)};
+    const std::vector<report::Block> blocks = ParetoBlocks(sweep);
+    ASSERT_EQ(blocks.size(), 1u);
+    const std::string svg = std::get<report::Figure>(blocks[0]).svg;
+    EXPECT_NE(svg.find("class=\"front\" data-points=\"2\""), std::string::npos) << svg;
+    EXPECT_NE(svg.find("data-series=\"march cpu\" data-points=\"3\""), std::string::npos) << svg;
+    EXPECT_NE(svg.find("PSNR (dB)"), std::string::npos);
+}
+
 // Test base64 against RFC 4648's vectors.
 TEST(HtmlRender, Base64Rfc4648) {
     EXPECT_EQ(Base64(""), "");

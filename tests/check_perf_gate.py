@@ -1,10 +1,12 @@
 #!/usr/bin/python3
 """The CI performance gate on this machine, as docs/cli.md ("In CI") runs it:
 `perf compare --interleave --clock cpu` of one build with itself passes (exit
-0), and the same build with a slowdown planted in one stage through the
-test-only CLOUDBENCH_TEST_SLOWDOWN switch fails with the regression exit code
-6, naming that stage and no other, whatever else the machine runs (CTest runs
-it beside other tests).
+0), and the same build with a slowdown planted in one stage (`--plant
+STAGE:FACTOR`, which sets the test-only CLOUDBENCH_TEST_SLOWDOWN switch in
+HEAD's runs and its factor-1 control in BASE's) fails with the regression exit
+code 6, naming that stage and no other, whatever else the machine runs (CTest
+runs it beside other tests). The HTML report of the slowdown's --json file and
+of its kept folder shows that stage marked + and the verdict's exit code 6.
 
 The gate's alpha is 0.01 for users: with no change, a comparison is flagged
 with probability at most 0.01, so a test that asserted 'identical builds pass'
@@ -118,22 +120,21 @@ if CASE == "kept":
     check_kept()
     sys.exit(0)
 
-base = head = CLI
+plant = []
 if CASE == "slowdown":
-    # HEAD is the same binary with the planted slowdown: a wrapper that sets the switch. BASE is its control: the
-    # same wrapper with factor 1, which spins for no time but wakes the arena's threads as HEAD's spin does
-    # (docs/cli.md), so that the two sides differ in the planted spin's length alone. With BASE the bare binary,
-    # HEAD also differed in its environment (one variable more moves the stack and heap of every stage), in the
-    # exec through /bin/sh and in the wake of the workers before the planted stage: systematic differences outside
-    # it, which 17 rounds can resolve (render_splat flagged at 1.104x in one of nine suite runs; with a control
-    # that did not wake the workers, density, a 9 us stage, at 1.101x in one of seven runs under load 5).
-    base = wrapper("control-cloudbench", f'CLOUDBENCH_TEST_SLOWDOWN={PLANTED_STAGE}:1 exec "{CLI}" "$@"')
-    head = wrapper("slow-cloudbench", f'CLOUDBENCH_TEST_SLOWDOWN={PLANTED_STAGE}:{PLANTED_FACTOR} exec "{CLI}" "$@"')
+    # HEAD is the same binary with the planted slowdown; --plant gives BASE its control, the switch with factor 1,
+    # which spins for no time but wakes the arena's threads as HEAD's spin does (docs/cli.md), in an environment
+    # of the same length, so that the two sides differ in the planted spin's length alone. With BASE the bare
+    # binary, HEAD also differed in its environment (one variable more moves the stack and heap of every stage)
+    # and in the wake of the workers before the planted stage: systematic differences outside it, which 17 rounds
+    # can resolve (render_splat flagged at 1.104x in one of nine suite runs; with a control that did not wake the
+    # workers, density, a 9 us stage, at 1.101x in one of seven runs under load 5).
+    plant = ["--plant", f"{PLANTED_STAGE}:{PLANTED_FACTOR}"]
 GATE_ALPHA = 1e-4
 kept = os.path.join(WORK, "kept")
-p = subprocess.run([CLI, "perf", "compare", "--interleave", base, head, "ci-small", "--backend", "cpu",
+p = subprocess.run([CLI, "perf", "compare", "--interleave", CLI, CLI, "ci-small", "--backend", "cpu",
                     "--clock", "cpu", "--alpha", str(GATE_ALPHA), "--quiet", "--keep", kept,
-                    "--json", os.path.join(WORK, "compare.json")],
+                    "--json", os.path.join(WORK, "compare.json"), *plant],
                    capture_output=True, text=True, timeout=600)
 print(p.stdout)
 doc = json.load(open(os.path.join(WORK, "compare.json")))
@@ -176,4 +177,23 @@ unjudged = [c["stage"] for c in doc["comparisons"] if c["mark"] == "?"]
 if unjudged or any(c["test"] != "rounds" for c in doc["comparisons"] if c["metric"] == "time"):
     print(f"FAIL: every stage must be judged over the rounds; not judged: {unjudged}")
     sys.exit(1)
+if CASE == "slowdown":
+    # The plant is kept in interleave.json and in the verdict, and the HTML report of the --json file and of the
+    # kept folder (its compare.json) shows the planted stage marked + and the verdict's exit code 6.
+    planted = {"stage": PLANTED_STAGE, "factor": PLANTED_FACTOR}
+    if manifest.get("plant") != planted or doc.get("plant") != planted:
+        print(f"FAIL: --plant: interleave.json's plant {manifest.get('plant')}, the JSON's {doc.get('plant')}")
+        sys.exit(1)
+    for source in (os.path.join(WORK, "compare.json"), kept):
+        page_path = os.path.join(WORK, "report.html")
+        r = subprocess.run([CLI, "report", source, "-o", page_path], capture_output=True, text=True, timeout=120)
+        page = open(page_path).read() if r.returncode == 0 else ""
+        # A row of the comparison table: its mark, then scene, backend and stage.
+        row = f"<tr><td>+</td><td>ci-small</td><td>cpu</td><td>{PLANTED_STAGE}</td><td>time</td>"
+        flagged = [line for line in page.splitlines() if line.startswith("<tr><td>+</td>")]
+        if r.returncode != 0 or len(flagged) != 1 or not flagged[0].startswith(row) or \
+                f"Verdict: regression: ci-small/cpu/{PLANTED_STAGE} (x" not in page or "(exit code 6).</p>" not in page:
+            print(f"FAIL: report {source}: exit {r.returncode}; the page must mark {PLANTED_STAGE} alone with + and "
+                  f"give exit code 6; rows marked +: {flagged}\n{r.stderr}")
+            sys.exit(1)
 print(f"perf gate {CASE}: ok")

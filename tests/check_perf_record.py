@@ -3,7 +3,9 @@
 appended to the history with the documented shape (docs/results.md); earlier
 lines are never rewritten; a line cut short is skipped with a warning naming
 the file and line, and the next record still starts a line of its own; a
-`count` output's "instructions" are merged in.
+`count` output's "instructions" are merged in; each stage keeps its CPU times
+beside its wall times, run by run, so `--clock cpu` compares records, and a
+record without them (written before) is refused on that clock, naming it.
 
 usage: check_perf_record.py CLOUDBENCH WORKDIR
 """
@@ -64,6 +66,12 @@ for name in ("region", "ca", "smooth", "density"):
     runs = stages[name].get("runs_ms")
     if runs is None or [len(x) for x in runs] != [12, 12] or runs[0] + runs[1] != samples:
         fail(f"{name}: runs_ms must hold the two runs' 12 samples each, pooled in samples_ms: {runs}")
+    # The same runs' CPU times beside them (results.json's "cpu"), run by run.
+    cpu = stages[name].get("cpu")
+    if cpu is None or [len(x) for x in cpu.get("runs_ms", [])] != [12, 12] or \
+            cpu["runs_ms"][0] + cpu["runs_ms"][1] != cpu["samples_ms"] or \
+            abs(cpu["median_ms"] - float(np.median(cpu["samples_ms"]))) > 1e-12:
+        fail(f"{name}: cpu must hold the two runs' 12 CPU times each, pooled, and their median: {cpu}")
 if r["instructions"] != {"ci-small": {"cpu": {"region": 123456, "ca": 654321}}}:
     fail(f"instructions not merged: {r['instructions']}")
 
@@ -83,6 +91,29 @@ if p.returncode not in (0, 6) or f"{history}:2: skipped" not in p.stderr:
     fail(f"compare of the two records: exit {p.returncode}, stderr {p.stderr!r}")
 if "different times" not in p.stdout:
     fail("two records are measured at different times: the output must say so")
+
+# Records compare on the CPU clock; one written before records kept CPU times is refused there, named.
+p = subprocess.run([CLI, "perf", "compare", f"{history}@-2", f"{history}@-1", "--clock", "cpu"], capture_output=True,
+                   text=True, timeout=120)
+if p.returncode not in (0, 6) or "clock" not in p.stdout or "cpu" not in p.stdout:
+    fail(f"compare --clock cpu of two records: exit {p.returncode}\n{p.stdout}\n{p.stderr}")
+old = json.loads(lines[2])
+for entry in old["results"]["ci-small"]["cpu"].values():
+    entry.pop("cpu", None)
+old_history = os.path.join(WORK, "old.jsonl")
+open(old_history, "w").write(lines[0] + "\n" + json.dumps(old) + "\n")
+p = subprocess.run([CLI, "perf", "compare", f"{old_history}@-2", f"{old_history}@-1", "--clock", "cpu"],
+                   capture_output=True, text=True, timeout=120)
+if p.returncode != 3 or f"{old_history}@{old['id']} (line 2)" not in p.stderr or '"cpu"' not in p.stderr:
+    fail(f"--clock cpu on a record without CPU times must exit 3 naming it: {p.returncode} {p.stderr!r}")
+p = subprocess.run([CLI, "perf", "history", old_history, "--clock", "cpu"], capture_output=True, text=True,
+                   timeout=120)
+if p.returncode != 3 or f"{old_history}:2: record {old['id']}" not in p.stderr:
+    fail(f"history --clock cpu on a record without CPU times must exit 3 naming it: {p.returncode} {p.stderr!r}")
+# Without --clock, a history with such a record is searched on wall time, and says why.
+p = subprocess.run([CLI, "perf", "history", old_history], capture_output=True, text=True, timeout=120)
+if p.returncode != 0 or "clock wall" not in p.stdout or old["id"] not in p.stdout:
+    fail(f"history of a record without CPU times: exit {p.returncode}, wall clock naming it\n{p.stdout}{p.stderr}")
 
 # A bad suite file is a bad input (exit 3) and appends nothing.
 json.dump({"scenes": []}, open(suite, "w"))

@@ -7,7 +7,7 @@ exit codes from the documented rule (docs/cli.md). The samples are made here
 with a fixed seed; no expected number comes from cloudbench's own output.
 
 usage: check_perf_stats.py CLOUDBENCH WORKDIR CASE
-CASE: compare, rounds, clock, runs, instructions, inputs, history, changepoints, gbench
+CASE: compare, rounds, clock, runs, instructions, inputs, history, changepoints, verdicts, gbench
 """
 import json
 import os
@@ -297,11 +297,25 @@ def case_clock():
     results_json(f"{WORK}/old.json", "s", {"region": [1.0] * 20})
     p = run("perf", "compare", f"{WORK}/old.json", f"{WORK}/old.json", "--clock", "cpu", expect=3)
     check("old.json: /backends/cpu/stages/region: has no \"cpu\" time" in p.stderr, p.stderr)
-    # A history keeps wall times only.
+    # A record written before perf record kept CPU times is refused on the CPU clock, named with its line.
     with open(f"{WORK}/h.jsonl", "w") as f:
         f.write(json.dumps(record("r1", "1" * 40, {"region": 1.0})) + "\n")
     p = run("perf", "compare", f"{WORK}/h.jsonl", f"{WORK}/old.json", "--clock", "cpu", expect=3)
-    check("h.jsonl: a history keeps wall times only" in p.stderr, p.stderr)
+    check("h.jsonl@r1 (line 1): /results/s/cpu/region: has no \"cpu\" time" in p.stderr, p.stderr)
+    # Records with CPU times compare on them: the same wall times, CPU times twice as long in HEAD.
+    rng = np.random.RandomState(11)
+    with open(f"{WORK}/hc.jsonl", "w") as f:
+        for rid, cpu_ms in (("c1", 2.0), ("c2", 4.0)):
+            r = record(rid, "1" * 40, {"region": 1.0})
+            entry = r["results"]["s"]["cpu"]["region"]
+            samples = list(np.round(cpu_ms * np.exp(rng.normal(0, 0.05, 30)), 4))
+            entry["cpu"] = {"samples_ms": samples, "median_ms": float(np.median(samples))}
+            f.write(json.dumps(r) + "\n")
+    for clock, ratio in (("cpu", 2.0), ("wall", 1.0)):
+        p = run("perf", "compare", f"{WORK}/hc.jsonl@c1", f"{WORK}/hc.jsonl@c2", "--clock", clock, "--json",
+                f"{WORK}/hc-{clock}.json")
+        row = json.load(open(f"{WORK}/hc-{clock}.json"))["comparisons"][0]
+        close(row["ratio"], ratio, 0.1, f"records on --clock {clock}")
     p = run("perf", "compare", f"{WORK}/old.json", f"{WORK}/old.json", "--clock", "device", expect=2)
     check("--clock: needs wall or cpu, got 'device'" in p.stderr + p.stdout, p.stderr)
     print("perf compare clock: ok")
@@ -407,6 +421,18 @@ def case_history():
     run("perf", "compare", f"{path}@r1", f"{path}@-5", expect=3)    # no such record
     run("perf", "compare", f"{path}@r1", f"{path}@nope", expect=3)  # no such id
     run("perf", "compare", f"{path}@-2", path, expect=6)            # FILE alone: its last record
+    # A range pools its records' runs (one each here); its ends in file order, each as a record is named.
+    run("perf", "compare", f"{path}@r1:-1", f"{path}@-1", "--json", f"{WORK}/range.json")
+    row = json.load(open(f"{WORK}/range.json"))["comparisons"][0]
+    check(row["base_runs"] == 2 and row["head_runs"] == 1, f"r1:-1 pools two records' runs: {row}")
+    p = run("perf", "compare", f"{path}@-1:r1", f"{path}@-1", expect=3)
+    check(f"{path}@-1:r1: the range starts at line 3, after its end at line 1" in p.stderr, p.stderr)
+    run("perf", "compare", f"{path}@r1:nope", f"{path}@-1", expect=3)
+    # perf history's own options, refused with their range.
+    p = run("perf", "history", path, "--alpha", "0", expect=2)
+    check("--alpha: needs a number in [1e-12, 1], got '0'" in p.stderr, p.stderr)
+    p = run("perf", "history", path, "--clock", "device", expect=2)
+    check("--clock: needs wall or cpu, got 'device'" in p.stderr, p.stderr)
     print("perf history records: ok")
 
 
@@ -433,6 +459,48 @@ def case_changepoints():
     run("perf", "history", path, "--json", f"{WORK}/flat.json", expect=0)
     check(json.load(open(f"{WORK}/flat.json"))["change_points"] == [], "a flat history must have no change points")
     print("perf history change points: ok")
+
+
+def case_verdicts():
+    """perf history --json's verdict and reason for each series, on both sides of each rule's boundary: fewer than
+    2 x --min-segment records; a step under --min-change; a clean step the permutation test cannot reach at
+    alpha / m (2 / C(n, nL), worked here with math.comb) and one it can."""
+    import math
+    path = f"{WORK}/verdicts.jsonl"
+    series = {  # stage -> values over 12 records, each record's one run (noise-free, so each split is clean)
+        "region": [1.0] * 6 + [1.6] * 6,    # 6 | 6: 2 / C(12, 6) = 0.0022 <= 0.01: a change
+        "ca": [1.0] * 7 + [1.6] * 5,        # also 7 | 5 in 12: 2 / C(12, 5) = 0.0025: a change
+        "smooth": [1.0] * 6 + [1.05] * 6,   # 5 % < --min-change 10 %
+    }
+    with open(path, "w") as f:
+        for i in range(12):
+            results = {"s": {"cpu": {st: {"samples_ms": [v[i]] * 5, "median_ms": v[i]} for st, v in series.items()}}}
+            f.write(json.dumps({"format": "cloudbench-perf/1", "id": f"v{i:02d}", "results": results}) + "\n")
+
+    def verdicts(extra, name):
+        out = f"{WORK}/{name}.json"
+        run("perf", "history", path, "--alpha", "0.03", *extra, "--json", out, expect=0)
+        return {v["stage"]: v for v in json.load(open(out))["series"]}
+
+    # alpha 0.03 over 3 series: 0.01 each.
+    v = verdicts([], "v12")
+    check(v["region"]["verdict"] == "change" and v["region"]["change_points"][0]["index"] == 6, f"region: {v['region']}")
+    check(v["ca"]["verdict"] == "change" and v["ca"]["change_points"][0]["index"] == 7, f"ca: {v['ca']}")
+    check(v["smooth"]["reason"] == "below_min_change", f"smooth: {v['smooth']}")
+    check(abs(v["smooth"]["best_split"]["ratio"] - 1.05) < 1e-9, f"smooth's best split: {v['smooth']}")
+    # --min-segment 7: 12 records hold no split with 7 on each side; 14 would.
+    v = verdicts(["--min-segment", "7"], "v12s7")
+    check(all(x["reason"] == "too_few_records" for x in v.values()), f"12 records, --min-segment 7: {v}")
+    # The last 3 records dropped: region is 6 | 3 (2 / C(9, 3) = 0.024 > 0.01), ca 7 | 2 under --min-segment 3.
+    lines = open(path).read().splitlines()
+    open(path, "w").write("\n".join(lines[:9]) + "\n")
+    v = verdicts(["--min-segment", "3"], "v9")
+    reachable = 2 / math.comb(9, 3)
+    need = next(k for k in range(3, 50) if 2 / math.comb(2 * k, k) <= 0.01)  # 5: 2 / 252
+    check(v["region"]["reason"] == "cannot_reach", f"region, 6 | 3: {v['region']}")
+    close(v["region"]["best_split"]["reachable_p"], reachable, 1e-9, "the smallest p of a clean 6 | 3 step")
+    check(v["region"]["records_needed_each_side"] == need, f"records needed: {v['region']} vs {need}")
+    print("perf history verdicts: ok")
 
 
 def case_gbench():
@@ -472,7 +540,7 @@ def case_gbench():
     for r, v in zip(ca_rows[:5], per_run_cpu):
         close(r["cpu_time"], v, 1e-12, "a repetition's CPU time: the run's mean CPU time per step in us")
     close(ca_rows[6]["cpu_time"], np.median(per_run_cpu), 1e-12, "_median CPU time")
-    # A history has wall times only: cpu_time repeats them.
+    # A record without CPU times (written before records kept them): cpu_time repeats the wall times.
     with open(f"{WORK}/g-h.jsonl", "w") as f:
         f.write(json.dumps(record("r1", "1" * 40, {"ca": 2.0})) + "\n")
     run("perf", "export", "--gbench", f"{WORK}/g-h.gbench.json", f"{WORK}/g-h.jsonl", expect=0)
@@ -499,4 +567,4 @@ if __name__ == "__main__":
     shutil.rmtree(WORK, ignore_errors=True)
     os.makedirs(WORK)
     {"compare": case_compare, "rounds": case_rounds, "clock": case_clock, "runs": case_runs, "instructions": case_instructions, "inputs": case_inputs, "history": case_history,
-     "changepoints": case_changepoints, "gbench": case_gbench}[CASE]()
+     "changepoints": case_changepoints, "verdicts": case_verdicts, "gbench": case_gbench}[CASE]()

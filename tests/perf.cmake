@@ -2,7 +2,7 @@
 # statistics against SciPy, the history's records, and the CI gate on this
 # machine (an identical build passes, a planted slowdown fails with exit 6).
 # Included from tests/CMakeLists.txt, where `cli` and `cli_out` are defined.
-foreach(case compare rounds clock runs instructions inputs history changepoints gbench)
+foreach(case compare rounds clock runs instructions inputs history changepoints verdicts gbench)
   add_test(NAME Perf.Stats.${case}
            COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_stats.py ${cli} ${cli_out}/perf-${case} ${case})
   set_tests_properties(Perf.Stats.${case} PROPERTIES PASS_REGULAR_EXPRESSION ": ok" SKIP_RETURN_CODE 77 TIMEOUT 300)
@@ -10,6 +10,12 @@ endforeach()
 add_test(NAME Perf.Record
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_record.py ${cli} ${cli_out}/perf-record)
 set_tests_properties(Perf.Record PROPERTIES PASS_REGULAR_EXPRESSION "perf record: ok" TIMEOUT 600)
+# CI tracking from a history: records before and after a planted 1.5x step; perf history finds it in that
+# stage alone and perf compare of the records flags it alone (one at a time with the gate: each loads the other).
+add_test(NAME Perf.HistoryStep
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_history_step.py ${cli} ${cli_out}/perf-history-step)
+set_tests_properties(Perf.HistoryStep PROPERTIES PASS_REGULAR_EXPRESSION "perf history step: ok" TIMEOUT 300
+                     RESOURCE_LOCK perf_gate)
 # kept: the verdict from a kept folder is the live one (a failed run fails both; a kept folder with no run is refused).
 foreach(case identical slowdown kept)
   add_test(NAME Perf.Gate.${case}

@@ -2,7 +2,8 @@
 """Plots a `cloudbench sweep` result: error against time, one series per backend,
 one panel per stage (shade, shadow; the renderers render_march, render_splat and
 render_layers share one "images" panel, one series per renderer x backend), the
-Pareto front marked.
+Pareto front marked. With metric psnr the y axis is the PSNR in dB (higher is
+better) and an infinite PSNR (null) is a triangle labelled "inf" above the rest.
 
 Usage: plot_sweep.py SWEEP_JSON OUT_PNG [NAME]
 NAME is how messages name OUT_PNG (cloudbench passes /proc/self/fd/3, the
@@ -27,6 +28,18 @@ def plot(doc, source):
         raise Failure("matplotlib cannot be imported: %s" % e)
     metric = doc["metric"]
     rows = [r for r in doc["rows"] if r["status"] == "ok"]
+    psnr = metric == "psnr"
+    if psnr:
+        # PSNR (renderers only, higher is better); null is infinite (the image equals the reference): drawn as
+        # a triangle 10 dB above the highest finite value, labelled "inf".
+        finite = [r["error"]["psnr_db"] for r in rows if r["error"].get("psnr_db") is not None]
+        ceiling = (max(finite) + 10) if finite else 100.0
+    for r in rows:
+        if psnr:
+            value = r["error"].get("psnr_db")
+            r["y"], r["inf"] = (ceiling, True) if value is None else (value, False)
+        else:
+            r["y"], r["inf"] = r["error"]["all"][metric], False
     renderers = ("render_march", "render_splat", "render_layers")
     for r in rows:
         # The renderers' rows go in one panel, a series per renderer x backend.
@@ -46,25 +59,32 @@ def plot(doc, source):
         for backend in backends:
             mine = [r for r in stage_rows if r["series"] == backend]
             t = [r["time"]["median_ms"] for r in mine]
-            e = [r["error"]["all"][metric] for r in mine]
+            e = [r["y"] for r in mine]
             lo = [r["time"]["median_ms"] - r["time"]["q1_ms"] for r in mine]
             hi = [r["time"]["q3_ms"] - r["time"]["median_ms"] for r in mine]
             ax.errorbar(t, e, xerr=[lo, hi], fmt="o", capsize=2, label=backend, alpha=0.8,
                         color=colours[backend])
+            for r, x, y in zip(mine, t, e):
+                if r["inf"]:
+                    ax.plot([x], [y], marker="^", color=colours[backend])
+                    ax.annotate("inf", (x, y), textcoords="offset points", xytext=(4, -9), fontsize=7)
             if len(varied) <= 2 and len(mine) <= 24:
                 for r, x, y in zip(mine, t, e):
-                    label = ",".join(str(r["settings"].get(p, "")) for p in varied)
+                    label = ",".join(str(r["settings"].get(p, "any")) for p in varied)
                     ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
-        front = sorted((r["time"]["median_ms"], r["error"]["all"][metric]) for r in stage_rows if r.get("pareto"))
+        front = sorted((r["time"]["median_ms"], r["y"]) for r in stage_rows if r.get("pareto"))
         if front:
             ax.plot([p[0] for p in front], [p[1] for p in front], "k--", lw=1, label="Pareto front")
             ax.scatter([p[0] for p in front], [p[1] for p in front], s=120, facecolors="none", edgecolors="k")
         ax.set_xscale("log")
-        if all(r["error"]["all"][metric] > 0 for r in stage_rows):
+        if not psnr and all(r["y"] > 0 for r in stage_rows):
             ax.set_yscale("log")
         ax.set_xlabel("median time of the stage (ms)")
-        ax.set_ylabel(f"{metric} |error| against the exact reference render" if stage == "images"
-                      else f"{metric} |error| against the Embree reference")
+        if psnr:
+            ax.set_ylabel("PSNR (dB) against the exact reference render, higher is better")
+        else:
+            ax.set_ylabel(f"{metric} |error| against the exact reference render" if stage == "images"
+                          else f"{metric} |error| against the Embree reference")
         ax.set_title(f"{doc['scene']}: {stage}\nvarying {', '.join(varied)}", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)

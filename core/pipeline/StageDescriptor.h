@@ -136,7 +136,24 @@ struct StageDescriptor {
     CompareRule (*rule)(const Scene& scene) = nullptr;
     std::string_view ruleNote;  // how the rule depends on the scene, for the help ("" if it does not)
     std::span<const ChoiceSetting> choices;  // its settings with a few values each
+    // The scene fields its output depends on besides its input resources and kFieldsEveryStageReads, as
+    // dotted paths of the scene file; a section ("shade") stands for every field in it. A field it reads
+    // must be listed (sweep measures a stage once per distinct setting of these and of its inputs'
+    // writers' fields); one listed that it does not read only repeats rows.
+    std::span<const std::string_view> sceneFields;
 };
+
+// The fields every stage's output depends on: the grid's extent, the number of steps (the last step is
+// the one measured) and the stage list.
+inline constexpr std::string_view kFieldsEveryStageReads[] = {"grid.size", "steps", "stages"};
+
+// Whether a change of the field `path` changes the field `listed`: they are equal or one holds the other
+// ("shade" and "shade.storage", "render.cameras" and "render").
+constexpr bool FieldsOverlap(std::string_view path, std::string_view listed) {
+    const std::string_view shorter = path.size() < listed.size() ? path : listed;
+    const std::string_view longer = path.size() < listed.size() ? listed : path;
+    return longer.starts_with(shorter) && (longer.size() == shorter.size() || longer[shorter.size()] == '.');
+}
 
 // Helpers the stages' descriptors share.
 CompareRule BitExactRule(const Scene& scene);

@@ -19,10 +19,9 @@ bool LightingOnly(const std::string& path) {
     return false;
 }
 
-// Fields that change how a renderer computes the image but not the physical
-// model the reference renders (the reference fixes its own step, light,
-// epsilon, jitter and skipping, and reads no shade, shadow, density or layers setting).
-bool MethodOnlyPath(const std::string& p) {
+}  // namespace
+
+bool ReferenceRenderIgnores(std::string_view p) {
     for (const char* exact :
          {"march.step", "march.adaptive.enabled", "march.adaptive.kappa", "march.adaptive.start", "march.jitter",
           "march.light", "march.light_steps", "march.epsilon", "march.skipping.enabled", "march.skipping.brick",
@@ -34,8 +33,6 @@ bool MethodOnlyPath(const std::string& p) {
         if (p.starts_with(prefix)) return true;
     return false;
 }
-
-}  // namespace
 
 std::string Fmt(const char* format, double value) {
     char buffer[64];
@@ -91,7 +88,7 @@ Result<const ReferenceResult*> Evaluator::Reference(const Scene& scene, const Li
         const std::string item = mLastKey.substr(a, b - a);
         if (!item.starts_with("warmup_steps=")) label += item + ", ";
     }
-    label += "sun el " + Fmt("%.6f", scene.sun.elevationDeg) + " az " + Fmt("%.6f", scene.sun.azimuthDeg) +
+    label += "sun el " + Fmt("%.6g", scene.sun.elevationDeg) + " az " + Fmt("%.6g", scene.sun.azimuthDeg) +
              ", from the " + ref::RayStartName(start);
     auto it = mReferences.find(key);
     if (it == mReferences.end()) {
@@ -140,7 +137,7 @@ Result<ImageReferences::Loaded> ImageReferences::Load(const std::vector<SceneOve
     if (!in) return std::unexpected(in.error());
     std::vector<SceneOverride> physical;
     for (const SceneOverride& o : setting)
-        if (!MethodOnlyPath(o.path) && o.path != "phase.function") physical.push_back(o);
+        if (!ReferenceRenderIgnores(o.path) && o.path != "phase.function") physical.push_back(o);
     if (VariesPhase(setting)) physical.push_back({"phase.function", "mie"});
     std::string key;
     for (const SceneOverride& o : physical) key += (key.empty() ? "" : " ") + o.path + "=" + o.value;

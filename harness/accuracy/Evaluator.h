@@ -116,6 +116,11 @@ class ImageReferences {
     nlohmann::json mRecords = nlohmann::json::array();
 };
 
+// Whether a field changes how a renderer computes the image but not the physical model the reference
+// render computes (the reference fixes its own step, light, epsilon, jitter and skipping, and reads no
+// shade (but shade.sigma), shadow, density or layers setting): the reference is cached across it.
+bool ReferenceRenderIgnores(std::string_view path);
+
 // Whether a setting changes the physical model (the phase function): its
 // rows are measured against the reference with the Mie phase.
 bool VariesPhase(const std::vector<SceneOverride>& setting);

@@ -35,7 +35,8 @@ ImageErrorStats ImageErrors(std::span<const float> approx, std::span<const float
     }
     out.pixel = AbsoluteErrors(perPixel, zero);
     out.mse = n ? sq / double(3 * n) : 0.0;
-    if (out.mse > 0 && out.peak > 0) out.psnr = 10 * std::log10(out.peak * out.peak / out.mse);
+    if (out.peak <= 0) out.peak = 1;  // a black reference: the display's white
+    if (out.mse > 0) out.psnr = 10 * std::log10(out.peak * out.peak / out.mse);
     return out;
 }
 
@@ -107,13 +108,18 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, int repea
 
 }  // namespace
 
+std::optional<std::string> ReferenceRenderUnsupported(const Scene& scene) {
+    // The reference render clips its rays to the box: it would not be the same (infinite) clouds.
+    if (scene.grid.tiling)
+        return "the exact reference render does not repeat the volume (grid.tiling) yet; measure the untiled scene "
+               "with --set grid.tiling=false";
+    return std::nullopt;
+}
+
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats) {
     if (!Describe(renderer).renderer) return RenderNotMeasured("failed", "not a renderer");
-    // The reference render clips its rays to the box: it would not be the same (infinite) clouds.
-    if (scene.grid.tiling)
-        return RenderNotMeasured("unsupported",
-                                 "the exact reference render does not repeat the volume (grid.tiling) yet");
+    if (auto why = ReferenceRenderUnsupported(scene)) return RenderNotMeasured("unsupported", *why);
     if (!backend.Supports(renderer))
         return RenderNotMeasured("unsupported",
                                  backend.Name() + " does not implement " + std::string(StageName(renderer)) + " yet");
@@ -179,6 +185,10 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     a.timeMs = *time;
     std::vector<float> out(size_t(3) * scene.render.width * scene.render.height);
     if (Status s = backend.Download(**image, std::as_writable_bytes(std::span(out))); !s) return fail("", s.error());
+    // A NaN or infinity would make every statistic meaningless (and PSNR look perfect): a failed row.
+    if (const size_t bad = size_t(std::ranges::count_if(out, [](float v) { return !std::isfinite(v); })))
+        return RenderNotMeasured("failed", std::to_string(bad) + " of the image's " + std::to_string(out.size()) +
+                                               " channel values are not finite");
     a.error = ImageErrors(out, reference);
     return a;
 }
@@ -230,6 +240,10 @@ std::vector<std::vector<SceneOverride>> LayersImageVariants(const Scene& sc) {
 
 Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<SceneOverride>& setting, Stage renderer,
                                         Backend& backend) {
+    // Refused before the reference is rendered for nothing.
+    auto scene = eval.GetSession().LoadVariant(setting);
+    if (!scene) return std::unexpected(scene.error());
+    if (auto why = ReferenceRenderUnsupported(*scene)) return NotMeasured("unsupported", *why);
     auto loaded = eval.Images().Load(setting);
     if (!loaded) return std::unexpected(loaded.error());
     const RenderAccuracy a = MeasureRender(backend, renderer, loaded->scene, *loaded->in,

@@ -21,9 +21,10 @@
 
 namespace cb {
 
-// Errors of one image against the reference, 3 floats per pixel. PSNR =
-// 10 log10(peak^2 / MSE), peak = the reference image's largest channel value,
-// MSE over every channel of every pixel; nullopt when MSE = 0 (infinite).
+// Errors of one finite image against the reference, 3 floats per pixel. PSNR =
+// 10 log10(peak^2 / MSE), peak = the reference image's largest channel value
+// (1 when the reference is black), MSE over every channel of every pixel;
+// nullopt when MSE = 0 (infinite).
 struct ImageErrorStats {
     ErrorStats pixel;  // per-pixel max over channels of |d|
     double mse = 0, peak = 0;
@@ -43,6 +44,9 @@ struct RenderAccuracy {
     double prepMs = 0;
     ImageErrorStats error;
 };
+// Why the exact reference render cannot stand for this scene's image (a tiled grid), with the way round;
+// nullopt when it can.
+std::optional<std::string> ReferenceRenderUnsupported(const Scene& scene);
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats);
 

@@ -28,7 +28,7 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
         if (!scene.stages.Has(stage)) continue;
         if (Describe(stage).renderer) {
             for (const OpenedBackend& slot : backends) {
-                Row row{setting, slot.name, stage, {}, false};
+                Row row{setting, slot.name, stage, {}, false, false};
                 if (!slot.backend)
                     row.result = NotMeasured("unavailable", slot.reason);
                 else {
@@ -44,7 +44,7 @@ Status MeasureSetting(Evaluator& eval, const std::vector<SceneOverride>& setting
             continue;
         }
         for (const OpenedBackend& slot : backends) {
-            Row row{setting, slot.name, stage, {}, false};
+            Row row{setting, slot.name, stage, {}, false, false};
             if (!slot.backend)
                 row.result = NotMeasured("unavailable", slot.reason);
             else if (stage == Stage::Shade)
@@ -143,9 +143,9 @@ Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, con
 }
 
 std::vector<Row> MergeRows(const Scene& scene, const std::vector<PlannedSetting>& plan,
-                           const std::vector<BackendMeasurement>& parts) {
+                           const std::vector<BackendMeasurement>& parts, std::vector<size_t>* itemOf) {
     std::vector<Row> rows;
-    for (size_t k = 0; k < plan.size(); ++k)
+    for (size_t k = 0; k < plan.size(); ++k) {
         for (const BackendMeasurement& part : parts) {
             if (k < part.rows.size()) {
                 rows.insert(rows.end(), part.rows[k].begin(), part.rows[k].end());
@@ -154,7 +154,7 @@ std::vector<Row> MergeRows(const Scene& scene, const std::vector<PlannedSetting>
             // Not measured: the backend did not open, or its process died.
             for (Stage stage : plan[k].stages) {
                 if (!scene.stages.Has(stage)) continue;
-                Row row{plan[k].setting, part.name, stage, {}, false};
+                Row row{plan[k].setting, part.name, stage, {}, false, false};
                 if (part.failure)
                     row.result = NotMeasured(part.failure->status, part.failure->Describe());
                 else
@@ -162,6 +162,8 @@ std::vector<Row> MergeRows(const Scene& scene, const std::vector<PlannedSetting>
                 rows.push_back(std::move(row));
             }
         }
+        if (itemOf) itemOf->resize(rows.size(), k);
+    }
     return rows;
 }
 

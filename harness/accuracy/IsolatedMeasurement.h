@@ -55,8 +55,9 @@ Result<std::vector<BackendMeasurement>> MeasureEachBackend(Session& session, con
 // The rows of every backend, plan item by plan item, backend by backend; a
 // backend that did not open or whose process died has a row per planned
 // stage with its status ("unavailable", "crashed", ...) and the reason.
+// `itemOf` (optional) gets each row's plan item.
 std::vector<Row> MergeRows(const Scene& scene, const std::vector<PlannedSetting>& plan,
-                           const std::vector<BackendMeasurement>& parts);
+                           const std::vector<BackendMeasurement>& parts, std::vector<size_t>* itemOf = nullptr);
 // The reference records of the first backend that computed any.
 std::vector<ReferenceRecord> FirstRecords(const std::vector<BackendMeasurement>& parts);
 

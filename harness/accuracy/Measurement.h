@@ -24,6 +24,7 @@ struct Row {
     Stage stage = Stage::Shade;
     StageAccuracy result;
     bool pareto = false;
+    bool paretoTie = false;  // on the front, and tied with another row on it (MarkPareto)
 };
 
 // "(scene)" for no settings, else "path=value path=value".

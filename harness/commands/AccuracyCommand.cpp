@@ -43,7 +43,8 @@ error = max over channels of |C - C_ref|, with max, mean, p99 and PSNR.
 
 Options:
   --backend LIST     backends to measure (default: all built); unavailable ones
-                     are reported, and a stage a backend lacks is listed as unsupported
+                     are reported, and a stage a backend lacks is listed as
+                     unsupported; --backends is the same
   --repeat N         timed calls per measurement, after one warm-up (default 5)
   --switches         also cross the principal axis's 45-degree switches: error on
                      each side (1e-6 rad, 1e-3 rad, 1 degree) and the jump in T
@@ -54,10 +55,9 @@ Options:
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend and reference threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name
-  --gl-context CTX   OpenGL context: osmesa (default) or egl
   --quiet            no progress lines
 )";
-const std::string kHelp = kHelpText + IsolationOptionsHelp();
+const std::string kHelp = kHelpText + GlOptionsHelp() + IsolationOptionsHelp();
 
 // Every value of the stage's choice settings (its descriptor's) that differs from the scene's.
 std::vector<std::vector<SceneOverride>> OptionVariants(const Scene& scene, Stage stage) {

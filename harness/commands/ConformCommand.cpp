@@ -30,10 +30,13 @@ it is, writes DIR/conform.json and DIR/conform.csv, and exits 5 if any check
 fails. Stages a backend lacks are listed as skipped.
 
 Options:
-  --backend LIST     backends to check (default: all built; cpu is the reference)
+  --backend LIST     backends to check (default: all built; cpu is the reference);
+                     --backends is the same
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/conform)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
+  --threads N        CPU backend threads (default: all)
+  --quiet            no progress lines
   --vk-device DEV    Vulkan device: index or part of the name
   --baseline FILE    known failures, "stage,backend,status" a line (a conform.csv
                      will do): a listed failure is expected-fail and does not fail
@@ -160,8 +163,9 @@ int Conform(const CommonOptions& options, const ConformOptions& own) {
         caseScenes.push_back(std::move(*variant));
     }
     if (!(*session)->MakeOutDir()) return kExitFailed;
-    std::printf("conformance of scene %s (%ux%ux%u, %u steps) against the cpu backend\n", scene.name.c_str(),
-                scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps);
+    std::printf("conformance of scene %s (%ux%ux%u, %u %s) against the cpu backend\n", scene.name.c_str(),
+                scene.grid.size.nx, scene.grid.size.ny, scene.grid.size.nz, scene.steps,
+                scene.steps == 1 ? "step" : "steps");
     if (byCase) std::printf("%zu cases\n", cases.size());
     std::vector<ConformRow> rows;
     if (names.empty()) {
@@ -313,6 +317,7 @@ int Conform(const CommonOptions& options, const ConformOptions& own) {
         return kExitFailed;
     }
     std::printf("results: %s, %s\n", path.c_str(), csvPath.c_str());
+    std::printf("conform: %s\n", ConformSummary(rows).c_str());
     return ConformExitCode(rows);
 }
 

@@ -29,12 +29,17 @@ plain run's CPU time. Needs valgrind and a build without -march=native:
   build/exact/cloudbench count ci-small
 
 Options:
-  --backend cpu      the backend counted (only cpu: see docs/performance.md)
+  --backend cpu      the backend counted (only cpu: see docs/performance.md);
+                     --backends is the same
   --steps N          number of steps, warm-up included (same as --set steps=N)
   --out FILE         the JSON file written
   --set PATH=VALUE   override a scene field by its dotted path
-  --threads 1        the only thread count: at 2 threads counts vary by up to 9 %
+  --threads 1        the only thread count: at 2 threads counts vary from run
+                     to run (up to 0.57 %, docs/performance.md "Stable")
   --quiet            no progress lines
+  --gl-context, --gl-ca-layout, --vk-device
+                     accepted as by every scene command, and unused: only
+                     the CPU backend is counted
 
 Exit codes: 0 counted, 1 the counting run failed or FILE could not be written,
 2 bad command line, 3 bad scene, 4 this binary cannot count (built with
@@ -81,7 +86,7 @@ int CountChild(const CommonOptions& options) {
 int Count(const CommonOptions& options) {
     if (RunningOnValgrind()) return CountChild(options);
     if (options.cpuThreads > 1) {
-        std::fprintf(stderr, "cloudbench: count: --threads must be 1 (at 2 threads the counts vary by up to 9 %%)\n");
+        std::fprintf(stderr, "cloudbench: count: --threads must be 1 (at 2 threads the counts vary from run to run, up to 0.57 %% in docs/performance.md)\n");
         return kExitUsage;
     }
     auto session = Session::Open(options, "");

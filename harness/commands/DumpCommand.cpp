@@ -27,7 +27,7 @@ Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
 Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
 
 Options:
-  --backend NAME     the backend to dump (default: cpu)
+  --backend NAME     the backend to dump (default: cpu); --backends is the same
   --reference        also write T_ref.npy and shadow_ref.npy (docs/accuracy.md)
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/dump)

@@ -19,10 +19,11 @@ constexpr const char* kHelp = R"(usage: cloudbench perf record [--suite FILE] [-
        cloudbench perf compare BASE HEAD [compare options]
        cloudbench perf compare --interleave BASE_BINARY HEAD_BINARY SCENE...
                               [--rounds K] [--keep DIR] [--backend LIST] [--steps N]
-                              [--set PATH=VALUE]... [compare options]
+                              [--set PATH=VALUE]... [--plant STAGE:FACTOR]
+                              [compare options]
        cloudbench perf compare DIR [compare options]
-       cloudbench perf history FILE [--metric time|instructions] [--min-change F]
-                              [--min-segment N] [--json FILE]
+       cloudbench perf history FILE [--metric time|instructions] [--clock wall|cpu]
+                              [--alpha A] [--min-change F] [--min-segment N] [--json FILE]
        cloudbench perf export --gbench OUT SOURCE...
 
 record   runs the suite (default: thesis-low, thesis-medium, thesis-high, each as
@@ -30,7 +31,9 @@ record   runs the suite (default: thesis-low, thesis-medium, thesis-high, each a
          FILE: docs/cli.md) and appends one record to the history (default:
          $CLOUDBENCH_HISTORY, else $XDG_DATA_HOME/cloudbench/history.jsonl, else
          ~/.local/share/cloudbench/history.jsonl). --repeat N runs each scene N
-         times and keeps each run's samples. It also counts each scene's CPU
+         times and keeps each run's samples, wall and CPU time; for CI, record
+         with --repeat 3 and keep at least 8 records on each side of a step
+         (docs/cli.md, "perf record"). It also counts each scene's CPU
          instructions (`cloudbench count`) when this build can (no
          -march=native: the exact preset; valgrind installed), else the
          record's "instructions_not_counted" says why; --instructions FILE
@@ -40,11 +43,17 @@ compare  compares stage times run by run, each run's median step (a
          over the runs, Holm's correction) and instruction counts. BASE and
          HEAD: a results.json, a `run --out` folder, a count output, a
          history (its last record), FILE@ID or FILE@-N (N-th record from the
-         end). --interleave runs BASE_BINARY and HEAD_BINARY in K rounds
+         end), FILE@A:B (records A to B, their runs pooled: FILE@-8:-5).
+         --interleave runs BASE_BINARY and HEAD_BINARY in K rounds
          (default: enough for every stage to be judged), one run each in
          an order drawn at random every round, and pairs the runs by
-         round; --keep DIR keeps every run and DIR/interleave.json,
-         which `perf compare DIR` judges again. Marks:
+         round; --keep DIR keeps every run, DIR/interleave.json, which
+         `perf compare DIR` judges again, and the verdict, DIR/compare.json,
+         which `cloudbench report DIR` shows. --plant STAGE:FACTOR plants a
+         known slowdown to try the gate: HEAD's STAGE does FACTOR (in
+         [1, 1000]) times its work, BASE runs the factor-1 control (the
+         test-only CLOUDBENCH_TEST_SLOWDOWN, set in each side's
+         environment); interleave.json and the verdict record it. Marks:
          + slower, - faster, ~ not significant or within the threshold,
          ? cannot be judged (too few rounds or samples), x failed or missing
          in HEAD, ! new.
@@ -58,14 +67,17 @@ compare  compares stage times run by run, each run's median step (a
   --clock wall|cpu  the stage time compared: wall (default) or the
                   process's CPU time over the stage's calls, which other
                   jobs on a shared machine do not change (results.json files,
-                  run folders and interleaved runs)
+                  run folders, records written with CPU times, interleaved runs)
   --floor MS      one run a side (its steps tested): and the medians to
                   differ by more than MS (default 0.05)
   --instruction-threshold F  an instruction count regresses above 1 + F
                   (default 0.02)
   --json FILE     also write every comparison as JSON
-history  marks step changes in each stage's median over the records (binary
-         segmentation, permutation test) and what changed in the provenance.
+history  marks step changes in each stage's time over the records (binary
+         segmentation, permutation test at p <= A / series, --alpha A default
+         0.01) and what changed in the provenance; --json gives each series'
+         verdict and why. --clock: cpu by default where every record holds
+         CPU times (a shared runner's other jobs do not move them), else wall.
 export   writes the SOURCEs (as for compare, their runs pooled) as Google
          Benchmark JSON for compare.py, a run per repetition.
 

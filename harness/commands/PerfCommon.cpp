@@ -92,10 +92,10 @@ TemporaryFolder::~TemporaryFolder() {
 
 std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
                            const std::string& out, const std::string& log, perf::Side& side, bool& failed, int round,
-                           int* exitCode, bool* compared) {
+                           int* exitCode, bool* compared, const std::vector<std::string>& setEnv) {
     std::vector<std::string> argv = {binary, "run", scene, "--out", out, "--quiet"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    auto rc = perf::RunChild(argv, log);
+    auto rc = perf::RunChild(argv, log, setEnv);
     if (!rc) {
         std::fprintf(stderr, "%s\n", rc.error().message.c_str());
         return kExitFailed;

@@ -74,9 +74,10 @@ struct TemporaryFolder {
 // line), or nullopt to go on; `failed` is set when the run failed (it exited
 // other than 0, or wrote no valid results.json), `exitCode` (when given)
 // receives the run's own exit code and `compared` (when given) whether its
-// results were added.
+// results were added. `setEnv` ("NAME=VALUE" each) is set in the run's environment (perf::RunChild).
 std::optional<int> RunInto(const std::string& binary, const std::string& scene, const std::vector<std::string>& extra,
                            const std::string& out, const std::string& log, perf::Side& side, bool& failed,
-                           int round = -1, int* exitCode = nullptr, bool* compared = nullptr);
+                           int round = -1, int* exitCode = nullptr, bool* compared = nullptr,
+                           const std::vector<std::string>& setEnv = {});
 
 }  // namespace cb::perf_command

@@ -16,7 +16,9 @@
 #include <thread>
 #include <tuple>
 
+#include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
+#include "core/scene/Stage.h"
 #include "harness/commands/PerfCommon.h"
 #include "harness/platform/OutputFolder.h"
 #include "harness/report/ReportModel.h"
@@ -77,20 +79,30 @@ json ComparisonJson(const perf::Comparison& c) {
 
 // What an interleave (live or kept) adds to the verdict: the runs that failed, and whether fewer runs
 // were recorded than planned (a kept interleave cut short). Either makes a verdict without a regression exit 1.
+// The planted slowdown, if any, is shown in the header and the JSON.
 struct RunProblems {
     std::vector<perf::FailedRun> failedRuns;
     std::string cutShort;  // why the runs are fewer than planned; "" when they are all there
+    std::optional<perf::PlantedSlowdown> plant;
 };
+
+// "region x2 in HEAD (...)": how --plant ran the two sides.
+std::string PlantSummary(const perf::PlantedSlowdown& plant) {
+    return plant.stage + " x" + Num("%g", plant.factor) + " in HEAD, " + plant.stage +
+           " x1 in BASE (the control), through CLOUDBENCH_TEST_SLOWDOWN";
+}
 
 json FailedRunJson(const perf::FailedRun& run) {
     return {
         {"side", run.side}, {"scene", run.scene}, {"round", run.round}, {"exit", run.exit}, {"compared", run.compared}};
 }
 
-// Prints the comparison, writes --json, returns the exit code: 6 for a regression, else 1 when HEAD failed,
-// a run failed or the runs were cut short, else 0. Each failed run gets a line on stderr.
+// Prints the comparison, writes the JSON to each of `jsonPaths` (--json, a kept folder's compare.json), returns
+// the exit code: 6 for a regression, else 1 when HEAD failed, a run failed or the runs were cut short, else 0.
+// Each failed run gets a line on stderr.
 int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::CompareSettings& settings,
-                    const std::string& mode, const std::string& jsonPath, const RunProblems& problems = {}) {
+                    const std::string& mode, const std::vector<std::string>& jsonPaths,
+                    const RunProblems& problems = {}) {
     const perf::CompareOutcome outcome = perf::Compare(base, head, settings);
     report::Report rep("perf compare");
     report::Section section;
@@ -101,6 +113,7 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
         {"HEAD", SideSummary(head)},
         {"mode", mode},
         {"clock", head.clock == perf::Clock::Cpu ? "cpu (the process's CPU time over each stage's calls)" : "wall"}};
+    if (problems.plant) header.items.push_back({"planted", PlantSummary(*problems.plant)});
     if (outcome.separate)
         header.items.push_back(
             {"note", "BASE and HEAD were measured at different times, not interleaved: the wider threshold " +
@@ -163,9 +176,9 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
                                          [](const perf::Comparison& c) { return c.metric == "time"; })));
         for (const perf::Comparison& c : outcome.rows)
             if (c.mark == '?') std::printf(" %s/%s/%s", c.scene.c_str(), c.backend.c_str(), c.stage.c_str());
-        std::printf("; more rounds (--rounds) or more samples a run make them testable\n");
+        std::printf("; %s\n", perf::UnjudgedAdvice(base, head, settings, outcome).c_str());
     }
-    if (!jsonPath.empty()) {
+    if (!jsonPaths.empty()) {
         json doc = {{"format", "cloudbench-perf-compare/1"},
                     {"base", {{"label", base.label}, {"date", base.date}, {"provenance", base.provenance}}},
                     {"head", {{"label", head.label}, {"date", head.date}, {"provenance", head.provenance}}},
@@ -192,7 +205,9 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
         for (const auto& [backend, unused] : settings.backendThreshold)
             doc["backend_thresholds"][backend] = perf::ThresholdOf(settings, backend);
         for (const perf::FailedRun& run : problems.failedRuns) doc["failed_runs"].push_back(FailedRunJson(run));
-        if (!WriteJsonFile(jsonPath, doc) && code == kExitOk) code = kExitFailed;
+        if (problems.plant) doc["plant"] = {{"stage", problems.plant->stage}, {"factor", problems.plant->factor}};
+        for (const std::string& path : jsonPaths)
+            if (!WriteJsonFile(path, doc) && code == kExitOk) code = kExitFailed;
     }
     return code;
 }
@@ -282,6 +297,49 @@ int RoundsToJudge(const perf::Side& base, const perf::Side& head, double alpha) 
     return rounds;
 }
 
+// --json's path, if given, and `more` (a kept folder's compare.json).
+std::vector<std::string> JsonPaths(const std::string& jsonPath, const std::string& more = "") {
+    std::vector<std::string> paths;
+    for (const std::string& path : {jsonPath, more})
+        if (!path.empty()) paths.push_back(path);
+    return paths;
+}
+
+// --plant STAGE:FACTOR: a stage of core/scene/Stage.h and a factor in [1, 1000] as CLOUDBENCH_TEST_SLOWDOWN
+// takes it (harness/run/StageCall.cpp). Sets the environment each side runs with: HEAD's STAGE:FACTOR as given,
+// BASE's STAGE:1 padded with leading zeros to the same length (the switch reads "001" as 1), so that the two
+// environments differ in the factor's digits alone. The usage message on a bad value.
+std::optional<std::string> ParsePlant(const ParsedArgs& a, std::optional<perf::PlantedSlowdown>& plant,
+                                      std::vector<std::string> (&env)[2]) {
+    if (!a.values.count("--plant")) return std::nullopt;
+    if (a.values.at("--plant").size() > 1) return "--plant: given more than once; one stage is planted at a time";
+    const std::string text = a.Value("--plant");
+    const size_t colon = text.rfind(':');
+    if (colon == std::string::npos || colon == 0)
+        return "--plant: needs STAGE:FACTOR (e.g. region:2), got '" + ShownArgument(text) + "'";
+    const std::string stage = text.substr(0, colon), factorText = text.substr(colon + 1);
+    if (!ParseStage(stage)) {
+        std::vector<std::string_view> known;
+        for (Stage s : kAllStages) known.push_back(StageName(s));
+        std::string list;
+        for (std::string_view name : known) list += (list.empty() ? "" : ", ") + std::string(name);
+        const std::string_view best = ClosestName(stage, known);
+        return "--plant: unknown stage '" + ShownArgument(stage) + "' (known: " + list + ")" +
+               (best.empty() ? "" : "; did you mean '" + std::string(best) + "'?");
+    }
+    char* end = nullptr;
+    const double factor = factorText.empty() ? NAN : std::strtod(factorText.c_str(), &end);
+    if (factorText.empty() || !std::isdigit(static_cast<unsigned char>(factorText[0])) || *end != '\0' ||
+        !(factor >= 1 && factor <= 1000))
+        return "--plant: the factor of '" + ShownArgument(text) + "' must be a number in [1, 1000], got '" +
+               ShownArgument(factorText) + "'";
+    plant = perf::PlantedSlowdown{stage, factor};
+    const std::string variable = "CLOUDBENCH_TEST_SLOWDOWN=" + stage + ":";
+    env[0] = {variable + std::string(factorText.size() - 1, '0') + "1"};
+    env[1] = {variable + factorText};
+    return std::nullopt;
+}
+
 // `perf compare FOLDER`: the verdict again from a kept interleave's runs, with the exit code the live
 // command ended with for the same runs.
 int CompareKept(const std::string& folder, perf::CompareSettings settings, perf::Clock clock,
@@ -293,13 +351,15 @@ int CompareKept(const std::string& folder, perf::CompareSettings settings, perf:
     }
     RunProblems problems;
     problems.failedRuns = kept->failedRuns;
+    problems.plant = kept->plant;
     if (kept->recordedRuns < kept->plannedRuns)
         problems.cutShort = "the interleave was cut short: " + std::to_string(kept->recordedRuns) + " of " +
                             std::to_string(kept->plannedRuns) + " runs recorded in " + folder + "/" +
                             perf::kInterleaveFile;
     settings.interleaved = true;
     const int code = PrintComparison(kept->sides[0], kept->sides[1], settings,
-                                     InterleavedMode(kept->rounds, kept->order) + ", kept in " + folder, jsonPath, problems);
+                                     InterleavedMode(kept->rounds, kept->order) + ", kept in " + folder,
+                                     JsonPaths(jsonPath), problems);
     WarnIfLoaded(kept->peakLoad, clock);
     return code;
 }
@@ -310,7 +370,8 @@ int ComparePerf(const std::vector<std::string>& args) {
     ParsedArgs a;
     if (auto m = Parse(args,
                        {"--threshold", "--separate-threshold", "--floor", "--alpha", "--instruction-threshold",
-                        "--json", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile", "--clock"},
+                        "--json", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile", "--clock",
+                        "--plant"},
                        {"--interleave", "--quiet"}, a))
         return Usage(*m);
     perf::CompareSettings settings;
@@ -348,7 +409,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     }
     const std::string jsonPath = a.Value("--json");
     if (!a.Has("--interleave")) {
-        for (const char* o : {"--rounds", "--backend", "--steps", "--set", "--keep"})
+        for (const char* o : {"--rounds", "--backend", "--steps", "--set", "--keep", "--plant"})
             if (a.Has(o)) return Usage(std::string(o) + " is for perf compare --interleave");
         if (a.positional.size() == 1 && std::filesystem::is_directory(a.positional[0]))
             return CompareKept(a.positional[0], settings, clock, jsonPath);
@@ -370,13 +431,16 @@ int ComparePerf(const std::vector<std::string>& args) {
                          "but the file with itself\n",
                          ShownArgument(a.positional[0]).c_str());
         settings.interleaved = false;
-        return PrintComparison(sides[0], sides[1], settings, "separate files", jsonPath);
+        return PrintComparison(sides[0], sides[1], settings, "separate files", JsonPaths(jsonPath));
     }
     if (a.positional.size() < 3) return Usage("perf compare --interleave needs BASE_BINARY HEAD_BINARY SCENE...");
     // Without --rounds, the rounds follow from the first: as many as every time comparison needs to be judged.
     long long rounds = 0;
     if (auto m = WholeNumberOption(a, "--rounds", 1, kMaxRounds, rounds)) return Usage(*m);
     const bool autoRounds = rounds == 0;
+    std::optional<perf::PlantedSlowdown> plant;
+    std::vector<std::string> plantEnv[2];  // what --plant sets in each side's environment: BASE, HEAD
+    if (auto m = ParsePlant(a, plant, plantEnv)) return Usage(*m);
     if (autoRounds) rounds = 1;
     std::vector<std::string> extra;
     if (a.Has("--backend")) extra.insert(extra.end(), {"--backend", a.Value("--backend")});
@@ -386,7 +450,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     const std::string binaries[2] = {a.positional[0], a.positional[1]};
     for (const std::string& b : binaries)
         if (::access(b.c_str(), X_OK) != 0) return Usage("'" + ShownArgument(b) + "' is not an executable file");
-    if (binaries[0] == binaries[1] && !a.Has("--quiet"))
+    if (binaries[0] == binaries[1] && !plant && !a.Has("--quiet"))
         std::fprintf(stderr, "perf compare: BASE_BINARY and HEAD_BINARY are the same file: a null comparison\n");
     const std::vector<std::string> scenes(a.positional.begin() + 2, a.positional.end());
     // The runs' outputs go to --keep's folder, or to a temporary one removed at the end.
@@ -409,12 +473,14 @@ int ComparePerf(const std::vector<std::string>& args) {
                      {"order", "random"},
                      {"run_options", extra},
                      {"runs", json::array()}};
+    if (plant) manifest["plant"] = {{"stage", plant->stage}, {"factor", plant->factor}};
     perf::Side sides[2];
     sides[0].label = binaries[0] + " (BASE)";
     sides[1].label = binaries[1] + " (HEAD)";
     for (perf::Side& side : sides) side.clock = clock;
     double peakLoad = 0;
     RunProblems problems;
+    problems.plant = plant;
     std::optional<int> stop;  // the exit code to end with at once
     PairOrder order;
     auto runRound = [&](int round) {
@@ -433,7 +499,7 @@ int ComparePerf(const std::vector<std::string>& args) {
                 int exitCode = -1;
                 bool runFailed = false, compared = false;
                 if (auto code = RunInto(binaries[n], scenes[s], extra, folder + "/" + name, folder + "/runs.log",
-                                        sides[n], runFailed, round, &exitCode, &compared)) {
+                                        sides[n], runFailed, round, &exitCode, &compared, plantEnv[n])) {
                     stop = *code;
                     return;
                 }
@@ -460,7 +526,9 @@ int ComparePerf(const std::vector<std::string>& args) {
     }
     if (stop) return *stop;
     settings.interleaved = true;
-    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds), "random"), jsonPath, problems);
+    const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds), "random"),
+                                     JsonPaths(jsonPath, a.Has("--keep") ? folder + "/" + perf::kKeptVerdictFile : ""),
+                                     problems);
     WarnIfLoaded(peakLoad, clock);
     return code;
 }

@@ -54,6 +54,16 @@ Status AddInstructionsFile(perf::Side& side, const std::string& path) {
     return perf::AddInstructions(side, read->doc);
 }
 
+// Adds the CPU times of the results.json at `path` to `cpu`; false (with a
+// warning) when it cannot, and the record then keeps wall times alone.
+bool AddCpuTimes(perf::Side& cpu, const std::string& path) {
+    static constexpr input::Format kResults[] = {input::Format::Results};
+    auto results = input::ReadCloudbenchFile(path, kResults);
+    Status added = results ? perf::AddResults(cpu, results->doc) : Status(std::unexpected(results.error()));
+    if (!added) std::fprintf(stderr, "perf record: warning: no CPU times recorded: %s\n", added.error().message.c_str());
+    return bool(added);
+}
+
 }  // namespace
 
 int Record(const std::vector<std::string>& args, const CommonOptions& options) {
@@ -73,8 +83,10 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
         suite = *loaded;
     }
     const std::string historyPath = a.Value("--history", perf::DefaultHistoryPath());
-    perf::Side side;
+    perf::Side side, cpu;  // the same runs on the wall clock and on the CPU clock
     side.label = "record";
+    cpu.clock = perf::Clock::Cpu;
+    bool everyCpu = true;  // every run's results.json held its stages' CPU times
     if (a.Has("--instructions")) {
         const std::string path = a.Value("--instructions");
         side.label = path;
@@ -103,8 +115,11 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
             const auto runStart = std::chrono::steady_clock::now();
             if (!a.Has("--quiet"))
                 std::fprintf(stderr, "perf record: %s (%d of %d)\n", entry.scene.c_str(), r + 1, int(repeat));
-            if (auto code = RunInto(self, entry.scene, runArgs, out, temporary.path + "/runs.log", side, failed))
+            bool compared = false;
+            if (auto code = RunInto(self, entry.scene, runArgs, out, temporary.path + "/runs.log", side, failed, -1,
+                                    nullptr, &compared))
                 return *code;
+            if (compared && everyCpu) everyCpu = AddCpuTimes(cpu, out + "/results.json");
             if (!a.Has("--quiet"))
                 std::fprintf(stderr, "perf record: %s took %.1f s\n", entry.scene.c_str(),
                              std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count());
@@ -139,7 +154,8 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
         provenance.erase("scene");  // one per scene; the suite says which
         provenance["command_line"] = options.commandLine;
     }
-    const json sections = perf::RecordSections(side);
+    if (!everyCpu) cpu.runs.clear();  // a record's CPU times are all its runs' or none
+    const json sections = perf::RecordSections(side, cpu);
     json record = {{"format", perf::kRecordFormat},
                    {"id", perf::NewRecordId()},
                    {"time", side.date},

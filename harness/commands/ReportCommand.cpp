@@ -14,10 +14,12 @@ namespace {
 constexpr const char* kHelp = R"(usage: cloudbench report [RESULTS...] [--history FILE] [-o FILE]
 
 Writes one self-contained HTML page (no script, no network; plots as inline
-SVG, images embedded) from any of results.json, conform.json, accuracy.json
-and sweep.json (recognised by their "format"; a folder stands for those of
-them it holds) and a perf history (JSON Lines of cloudbench-perf/1 records):
-the provenance and the verdict with its exit code, the stage x backend
+SVG, images embedded) from any of results.json, conform.json, accuracy.json,
+sweep.json and `perf compare --json` files (recognised by their "format"; a
+folder stands for those of them it holds, a kept interleave `perf compare
+--keep DIR` for its verdict, DIR/compare.json) and a perf history (JSON Lines
+of cloudbench-perf/1 records): the provenance and the verdict with its exit
+code, the regression gate's comparison table with its marks, the stage x backend
 conformance matrix, per-stage timing tables beside the source documents'
 figures, box plots of the per-step times, history plots, the accuracy Pareto
 plots, the rendered frames with their difference images, and each input's own
@@ -41,7 +43,9 @@ struct ReportOptions : OwnOptions {
 
 int Report(const CommonOptions& options, const ReportOptions& own) {
     if (options.arguments.empty() && own.history.empty()) {
-        std::fprintf(stderr, "cloudbench: report needs a results, conform, accuracy or sweep file, or --history\n\n%s",
+        std::fprintf(stderr,
+                     "cloudbench: report needs a results, conform, accuracy, sweep or perf compare file, or "
+                     "--history\n\n%s",
                      kHelp);
         return kExitUsage;
     }
@@ -83,7 +87,7 @@ int Report(const CommonOptions& options, const ReportOptions& own) {
 
 const CommandRegistration kRegistration({
     .name = "report",
-    .summary = "Write one self-contained HTML page from results, conform, accuracy, sweep and history files",
+    .summary = "Write one HTML page from results, conform, accuracy, sweep, perf compare and history files",
     .help = kHelp,
     .helpOrder = 6,
     .takesScene = false,

@@ -6,6 +6,7 @@
 #include "harness/platform/Isolation.h"
 #include "harness/platform/OutputFolder.h"
 #include "harness/report/Report.h"
+#include "harness/report/html/ReportSections.h"
 #include "harness/run/RunTransfer.h"
 #include "harness/run/Session.h"
 #include "harness/run/Simulation.h"
@@ -18,15 +19,18 @@ constexpr const char* kHelpHead = R"(usage: cloudbench run [SCENE] [options]
 
 Runs SCENE (a name in scenes/ or a path to a .json file; default: thesis-medium)
 on each backend, prints a per-stage timing table (median and spread over the
-steps after warm-up), each camera's frame rate, the whole loop's frame rate
-(simulation and frames, wall time), how often each stage ran and skipped, and
-the cloud cover, and writes
+steps after warm-up, stages in the order a step runs them, "-" for a stage with
+no sample), each camera's frame rate, each renderer's time per camera frame
+beside the source documents' figures, the whole loop's frame rate (simulation
+and frames, wall time), how often each stage ran and skipped, and the cloud
+cover, and writes
 DIR/results.json, the last frame of each camera (DIR/frame-splat-<camera>-<backend>
 .exr and .png) and a top view of the last density map, DIR/topview-<backend>.png.
 
 Options:
   --backend LIST     comma-separated backends (cpu, gl, vk); default: all built.
-                     An unavailable backend is reported and the others still run.
+                     An unavailable backend is reported and the others still run;
+                     --backends is the same
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>)
   --set PATH=VALUE   override a scene field by its dotted path, validated like
@@ -35,7 +39,8 @@ Options:
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
 )";
 constexpr const char* kHelpTail = R"(                     (the contexts and layouts: docs/cli.md; cloudbench devices)
-  --quiet            no progress lines
+  --quiet            no progress lines (on stderr: the step, an estimate of the
+                     time left, and a line when a backend ends)
   --timing MODE      how a step is timed (docs/performance.md, "Two ways to time a
                      step"): synchronized (default; the thesis's way: each stage
                      completes before the next, per-stage wall and device times),
@@ -91,6 +96,15 @@ struct StateOptions {
     const SimulationState* resume = nullptr;  // read and checked before any backend opened
 };
 
+// A backend's section of the report: its timing table, then its renderers' time per camera
+// frame beside the source documents' figures (the comparison `cloudbench report` makes).
+report::Section RunSection(const Scene& scene, const BackendRun& run) {
+    report::Section section = TimingSection(scene, run);
+    for (const std::string& line : html::FrameFigureLines(ResultsJson(scene, {run}), run.name))
+        section.blocks.push_back(report::Paragraph{line});
+    return section;
+}
+
 // Steps the simulation to the end, then writes the last frame of each camera
 // and the top view; whatever fails is recorded in `run` and the rest goes on.
 // Each step's record is sent (to the parent, when isolated) as it is done.
@@ -139,6 +153,7 @@ bool RunBackend(const Session& session, const RunOptions& own, Backend& backend,
         progress.Update(t + 1);
         if (own.saveStateEvery && (t + 1) % own.saveStateEvery == 0 && t + 1 < scene.steps) saveState();
     }
+    progress.Finish();
     // A failed step leaves no state to save: the last one saved (if any) stays.
     if (!own.saveState.empty() && run.status == "ok") saveState();
     MarkPhase("writing frames");
@@ -260,7 +275,7 @@ int Run(const CommonOptions& options, const RunOptions& own) {
         report::Report timing("Run of " + scene.name);
         for (const BackendRun& run : runs)
             if (run.status != "unavailable" && run.status != "unsupported")
-                timing.sections.push_back(TimingSection(scene, run));
+                timing.sections.push_back(RunSection(scene, run));
         nlohmann::json doc = ResultsJson(scene, runs);
         for (const auto& [name, failure] : failures) doc["backends"][name]["failure"] = failure;
         doc["pending"] = nlohmann::json::array();
@@ -318,7 +333,7 @@ int Run(const CommonOptions& options, const RunOptions& own) {
             else
                 std::fprintf(stderr, "backend %s failed: %s\n", run.name.c_str(), run.error.c_str());
         }
-        if (available) std::printf("%s", report::RenderText(TimingSection(scene, run)).c_str());
+        if (available) std::printf("%s", report::RenderText(RunSection(scene, run)).c_str());
         runs.push_back(std::move(run));
         if (i + 1 < names.size()) anyFailed |= !writeResults(i + 1);
     }

@@ -1,7 +1,8 @@
-// `cloudbench sweep`: the cartesian product of --vary values, each point's
-// shade and shadow stages timed and compared with the exact reference on
-// every backend, the Pareto front marked; writes sweep.json, sweep.md and the
-// plot sweep.png (tools/plot_sweep.py).
+// `cloudbench sweep`: the cartesian product of --vary values; each stage the
+// varied fields reach (harness/accuracy/SweepFields.h) timed and compared with
+// the exact reference on every backend once per distinct setting of what it
+// reads, the Pareto front marked with its ties; writes sweep.json, sweep.md and
+// the plot sweep.png (tools/plot_sweep.py); exits as `report` judges sweep.json.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -11,7 +12,9 @@
 #include "harness/accuracy/AccuracyTransfer.h"
 #include "harness/accuracy/IsolatedMeasurement.h"
 #include "harness/accuracy/Measurement.h"
+#include "harness/accuracy/SweepFields.h"
 #include "harness/commands/SweepOutput.h"
+#include "harness/report/html/ReportInput.h"
 #include "harness/run/RunTransfer.h"
 
 namespace cb {
@@ -26,22 +29,30 @@ Runs the cartesian product of the --vary values (dotted scene paths, as for
 each point: the CPU simulates the scene to its last step, the Embree
 reference is computed for that q and sun, and every backend's shade and
 shadow stages are timed (median of --repeat calls, with quartiles) and
-compared with it. Marks the Pareto front (no other point as fast and as
-accurate) per stage and writes DIR/sweep.json, DIR/sweep.md and DIR/sweep.png
-(error against time, one series per backend; needs python3 with matplotlib,
-otherwise the plot is skipped with a message).
+compared with it. Marks the Pareto front (no other point clearly as fast and
+as accurate; ties within the timing noise marked *=) per stage and writes
+DIR/sweep.json, DIR/sweep.md and DIR/sweep.png (error against time, one
+series per backend; needs python3 with matplotlib, otherwise the plot is
+skipped with a message).
 
 When a varied field belongs to the march, render, phase, lightning or layers
 sections, the scene's renderers (render_march, render_splat, render_layers) are
 measured too, against the exact reference render (see cloudbench help
 accuracy): per-pixel error = max over channels of |C - C_ref|, and PSNR; the
-renderers share one Pareto front and one panel of the plot. Fields of the
-layers section alone measure render_layers alone.
+renderers share one Pareto front and one panel of the plot. A stage is measured
+only when a varied field can change its rows (the fields its descriptor reads,
+those of the stages that feed it, and for a renderer its reference), once per
+distinct setting of those fields; its rows list only them.
+
+Exit codes: 0 when a row was measured and none failed, 1 for a failed or
+crashed row, 4 when no row was measured (every row unsupported or
+unavailable), as `cloudbench report` judges sweep.json.
 
 Options:
   --vary PATH=V1,... a field and its values; repeat for more fields
-  --backend LIST     backends to measure (default: all built)
-  --metric M         error for the Pareto front: max (default), mean or p99
+  --backend LIST     backends to measure (default: all built); also --backends
+  --metric M         error for the Pareto front: max (default), mean or p99 of
+                     |error|, or psnr (renderers only; higher is better)
   --repeat N         timed calls per point, after one warm-up (default 5)
   --reference-step X the exact reference render's step in voxel edges
                      (default 0.125), when images are measured
@@ -51,6 +62,7 @@ Options:
   --threads N        CPU backend and reference threads (default: all)
   --vk-device DEV    Vulkan device: index or part of the name
   --gl-context CTX   OpenGL context: osmesa (default) or egl
+  --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8
   --shard I/N        measure only share I of N (1 <= I <= N): the points whose
                      index k (0-based, in the order above) has k % N == I-1;
                      every point is still validated. sweep.json gains a
@@ -92,13 +104,15 @@ std::expected<std::vector<Axis>, std::string> ParseVaryAxes(const std::vector<st
     for (const std::string& arg : vary) {
         const size_t eq = arg.find('=');
         if (eq == std::string::npos || eq == 0)
-            return std::unexpected("--vary '" + ShownArgument(arg) + "': expected PATH=V1,V2,... (a dotted scene path, '=', values)");
+            return std::unexpected("--vary '" + ShownArgument(arg) +
+                                   "': expected PATH=V1,V2,... (a dotted scene path, '=', values)");
         Axis axis{arg.substr(0, eq), SplitValues(arg.substr(eq + 1))};
         for (const std::string& v : axis.values)
             if (v.empty()) return std::unexpected("--vary '" + ShownArgument(arg) + "': empty value in the list");
         for (const Axis& other : axes)
             if (other.path == axis.path)
-                return std::unexpected("--vary '" + ShownArgument(arg) + "': " + ShownArgument(axis.path) + " is varied twice");
+                return std::unexpected("--vary '" + ShownArgument(arg) + "': " + ShownArgument(axis.path) +
+                                       " is varied twice");
         axes.push_back(std::move(axis));
     }
     // Before the product is made: 10 axes of 10 values would be 10^10 points.
@@ -126,18 +140,31 @@ std::expected<std::vector<std::vector<SceneOverride>>, int> Points(const Session
 // sweep's own options (docs/cli.md), besides --repeat and --reference-step.
 struct SweepOptions : MeasurementOptions {
     std::vector<std::string> vary;  // --vary PATH=V1,V2,...
-    std::string metric = "max";     // --metric: max, mean or p99
+    std::string metric = "max";     // --metric: max, mean, p99 or psnr
     int shardIndex = 0;             // --shard I/N: share I (1-based) of N; shardCount 0 = not sharded
     int shardCount = 0;
 };
+
+// What a stage list reads of the axes, for messages: "shade (shade.resolution), shadow (shade.sigma)".
+std::string SweepStagesText(const std::vector<Stage>& stages, const std::vector<Axis>& axes) {
+    std::string out;
+    for (Stage stage : stages) {
+        std::string read;
+        for (const Axis& a : axes)
+            if (RowDependsOn(stage, a.path)) read += (read.empty() ? "" : ", ") + a.path;
+        out += (out.empty() ? "" : "; ") + std::string(StageName(stage)) + " (" + read + ")";
+    }
+    return out;
+}
 
 int Sweep(const CommonOptions& options, const SweepOptions& own) {
     if (own.vary.empty()) {
         std::fprintf(stderr, "sweep: needs at least one --vary PATH=V1,V2,...\n");
         return kExitUsage;
     }
-    if (own.metric != "max" && own.metric != "mean" && own.metric != "p99") {
-        std::fprintf(stderr, "sweep: --metric: must be max, mean or p99, got '%s'\n", own.metric.c_str());
+    if (!IsSweepMetric(own.metric)) {
+        std::fprintf(stderr, "sweep: --metric: must be max, mean, p99 or psnr, got '%s'\n",
+                     ShownArgument(own.metric).c_str());
         return kExitUsage;
     }
     auto axes = ParseVaryAxes(own.vary);
@@ -145,6 +172,26 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
         std::fprintf(stderr, "sweep: %s\n", axes.error().c_str());
         return kExitUsage;
     }
+    const std::vector<Stage> reached = SweepStages(*axes);
+    if (reached.empty()) {
+        std::string paths;
+        for (const Axis& a : *axes) paths += (paths.empty() ? "" : ", ") + ShownArgument(a.path);
+        std::fprintf(stderr,
+                     "sweep: --vary: no measured stage (shade, shadow, the renderers) reads %s, so every point "
+                     "would measure the same; vary a field a stage reads (cloudbench help sweep)\n",
+                     paths.c_str());
+        return kExitUsage;
+    }
+    if (own.metric == "psnr")
+        for (Stage stage : reached)
+            if (!MetricApplies(own.metric, stage)) {
+                std::fprintf(stderr,
+                             "sweep: --metric psnr: PSNR is defined for the renderers' images only, and this sweep "
+                             "measures %s; use max, mean or p99, or vary only march., render., lightning. or "
+                             "layers. fields\n",
+                             SweepStagesText({stage}, *axes).c_str());
+                return kExitUsage;
+            }
     const bool sharded = own.shardCount > 0;
     if (sharded)
         for (const Axis& a : *axes)
@@ -163,21 +210,38 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
     if (!(*session)->MakeOutDir()) return kExitFailed;
     const std::vector<std::string> names = (*session)->RequestedBackends(BuiltBackends());
 
+    // The scene's stages among them (all of them when the stage list varies), each once per distinct setting
+    // of the fields it reads, at the first point that has it.
+    const bool stagesVary = std::ranges::any_of(*axes, [](const Axis& a) { return FieldsOverlap(a.path, "stages"); });
+    std::vector<Stage> stages;
+    for (Stage stage : reached)
+        if (stagesVary || scene.stages.Has(stage)) stages.push_back(stage);
+    if (stages.empty()) {
+        std::fprintf(stderr, "sweep: scene %s runs none of the stages the varied fields reach: %s; no row to measure\n",
+                     scene.name.c_str(), SweepStagesText(reached, *axes).c_str());
+        return kExitNoBackend;
+    }
+    const std::vector<std::vector<Stage>> measured = DistinctMeasurements(*points, stages);
+    size_t measurements = 0;
+    for (const auto& m : measured) measurements += m.size();
     std::printf(
-        "sweep of scene %s: %zu points x %zu backends, %d timed calls each, Pareto front on median time and "
-        "%s error\n",
-        scene.name.c_str(), points->size(), names.size(), own.repeats, own.metric.c_str());
+        "sweep of scene %s: %zu points x %zu backends, %zu stage measurements (%s), %d timed calls each, Pareto "
+        "front on median time and %s%s\n",
+        scene.name.c_str(), points->size(), names.size(), measurements, SweepStagesText(stages, *axes).c_str(),
+        own.repeats, own.metric.c_str(), own.metric == "psnr" ? " (higher is better)" : " error");
     if (sharded)
         std::printf("shard %d/%d: points k with k %% %d == %d (the Pareto marks are within the shard)\n",
                     own.shardIndex, own.shardCount, own.shardCount, own.shardIndex - 1);
-    const std::vector<Stage> stages = SweepStages(*axes);
-    // With --shard I/N, the points whose global index k has k % N == I-1.
+    // With --shard I/N, the points whose global index k has k % N == I-1; a point measures the stages whose
+    // setting it is the first to have.
     std::vector<size_t> planPoint;
-    for (size_t k = 0; k < points->size(); ++k)
-        if (!sharded || int(k % size_t(own.shardCount)) == own.shardIndex - 1) planPoint.push_back(k);
-    // Each backend measures every point in a process of its own (harness/accuracy/IsolatedMeasurement.h).
     std::vector<PlannedSetting> plan;
-    for (size_t k : planPoint) plan.push_back({(*points)[k], stages});
+    for (size_t k = 0; k < points->size(); ++k)
+        if ((!sharded || int(k % size_t(own.shardCount)) == own.shardIndex - 1) && !measured[k].empty()) {
+            planPoint.push_back(k);
+            plan.push_back({(*points)[k], measured[k]});
+        }
+    // Each backend measures every point in a process of its own (harness/accuracy/IsolatedMeasurement.h).
     auto parts = MeasureEachBackend(**session, own, names, plan, {}, [&](size_t n) {
         if (!options.quiet) std::fprintf(stderr, "sweep: point %zu/%zu done\n", n + 1, plan.size());
     });
@@ -186,17 +250,8 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
         return kExitFailed;
     }
     if (std::ranges::none_of(*parts, [](const BackendMeasurement& p) { return p.available; })) return kExitNoBackend;
-    const bool anyCrashed =
-        std::ranges::any_of(*parts, [](const BackendMeasurement& p) { return p.failure.has_value(); });
-    std::vector<Row> rows = MergeRows(scene, plan, *parts);
-    // MergeRows keeps the plan's order and every row carries its item's
-    // settings, so a walk over the plan gives each row its point (the values
-    // of an axis are distinct when sharded, so no two points share settings).
-    std::vector<size_t> rowPoint;
-    for (size_t i = 0, item = 0; i < rows.size(); ++i) {
-        while (item + 1 < plan.size() && SettingsLabel(rows[i].settings) != SettingsLabel(plan[item].setting)) ++item;
-        rowPoint.push_back(planPoint[item]);
-    }
+    std::vector<size_t> rowItem;
+    std::vector<Row> rows = MergeRows(scene, plan, *parts, &rowItem);
     MarkPareto(rows, own.metric);
 
     json doc = {{"format", "cloudbench-sweep/1"},
@@ -212,7 +267,7 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
         json shardRows = json::array();
         for (size_t i = 0; i < rows.size(); ++i) {
             shardRows.push_back(transfer::ToJson(rows[i]));
-            shardRows.back()["point"] = rowPoint[i];
+            shardRows.back()["point"] = planPoint[rowItem[i]];
         }
         doc["shard"] = {{"index", own.shardIndex},
                         {"count", own.shardCount},
@@ -223,7 +278,22 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
         WriteSweepOutputs(std::move(doc), scene.name, own.metric, *axes, stages, rows, (*session)->OutDir(),
                           [&](const std::string& path, json d) { return (*session)->WriteJson(path, std::move(d)); });
     if (written != kExitOk) return written;
-    return anyCrashed ? kExitFailed : kExitOk;
+    // The exit code `cloudbench report` gives this sweep.json (html::VerdictOf): 1 for a row that failed or
+    // crashed, 4 when none was measured.
+    html::ReportInput verdictInput{"sweep.json", html::InputKind::Sweep, {{"rows", json::array()}}};
+    for (const Row& r : rows) verdictInput.doc["rows"].push_back(RowJson(r));
+    const html::Verdict verdict = html::VerdictOf(verdictInput);
+    if (verdict.exitCode != kExitOk) {
+        // The verdict names the rows; for a failure, each distinct reason too (the verdict of no row names them).
+        std::string why;
+        for (const Row& r : rows)
+            if (verdict.exitCode == kExitFailed && r.result.status != "ok" && !r.result.detail.empty() &&
+                why.find(r.result.detail) == std::string::npos)
+                why += "\n  " + std::string(StageName(r.stage)) + " on " + r.backend + " " + r.result.status + ": " +
+                       r.result.detail;
+        std::fprintf(stderr, "sweep: %s (exit %d)%s\n", verdict.reason.c_str(), verdict.exitCode, why.c_str());
+    }
+    return verdict.exitCode;
 }
 
 const CommandRegistration kRegistration({
@@ -233,7 +303,7 @@ const CommandRegistration kRegistration({
     .helpOrder = 5,
     .extraOptions = WithIsolationOptions(
         {ListOption("--vary", &SweepOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
-         TextOption("--metric", &SweepOptions::metric, "--metric needs max, mean or p99"), RepeatOption(),
+         TextOption("--metric", &SweepOptions::metric, "--metric needs max, mean, p99 or psnr"), RepeatOption(),
          ReferenceStepOption(),
          OwnOption<SweepOptions>("--shard", true,
                                  [](SweepOptions& o, const char* v) -> std::optional<std::string> {

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <string_view>
 
+#include "harness/accuracy/SweepFields.h"
 #include "harness/platform/Command.h"
 #include "harness/run/Session.h"
 
@@ -22,62 +23,13 @@ namespace cb {
 
 using nlohmann::json;
 
-void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
-    auto error = [&](const Row& r) {
-        return metric == "mean" ? r.result.all.mean : metric == "p99" ? r.result.all.p99 : r.result.all.max;
-    };
-    // The renderers share one front: they make the same image.
-    auto group = [](Stage s) { return Describe(s).renderer ? Stage::RenderMarch : s; };
-    for (Row& r : rows) {
-        if (r.result.status != "ok") continue;
-        r.pareto = true;
-        for (const Row& o : rows) {
-            if (&o == &r || group(o.stage) != group(r.stage) || o.result.status != "ok") continue;
-            const double t = o.result.timeMs.median, e = error(o);
-            const double tr = r.result.timeMs.median, er = error(r);
-            if (t <= tr && e <= er && (t < tr || e < er)) {
-                r.pareto = false;
-                break;
-            }
-        }
-    }
-}
-
-std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
-    // Fields of the image sections: the renderers are measured (the scene's own,
-    // MeasureSetting skips the others); fields that only a renderer reads measure nothing else.
-    auto imagePath = [](const std::string& p, bool withPhase) {
-        for (const char* prefix : {"march.", "render.", "lightning.", "phase.", "layers."})
-            if (p.starts_with(prefix) && (withPhase || std::string_view(prefix) != "phase.")) return true;
-        return false;
-    };
-    // layers.* is render_layers' alone: the other renderers would measure the same image at every point.
-    if (!axes.empty() && std::ranges::all_of(axes, [](const SweepAxis& a) { return a.path.starts_with("layers."); }))
-        return {Stage::RenderLayers};
-    const bool images = std::ranges::any_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, true); });
-    const bool onlyImages = std::ranges::all_of(axes, [&](const SweepAxis& a) { return imagePath(a.path, false); });
-    std::vector<Stage> renderers;
-    if (images) renderers = {Stage::RenderMarch, Stage::RenderSplat, Stage::RenderLayers};
-    if (onlyImages) return renderers;
-    bool onlyShade = true, onlyShadow = true;
-    for (const SweepAxis& a : axes) {
-        onlyShade &= a.path.starts_with("shade.") && a.path != "shade.sigma";
-        onlyShadow &= a.path.starts_with("shadow.");
-    }
-    std::vector<Stage> stages;
-    if (!onlyShadow) stages.push_back(Stage::Shade);
-    if (!onlyShade) stages.push_back(Stage::Shadow);
-    stages.insert(stages.end(), renderers.begin(), renderers.end());
-    return stages;
-}
-
 namespace {
 
 // What became of the plot.
 enum class PlotOutcome {
     Plotted,
     NotPromised,  // no python3 with matplotlib: the JSON and the table stand without it (a note says so)
-    Failed,  // the plotter ran and failed: sweep.png is missing, and the command exits 1
+    Failed,       // the plotter ran and failed: sweep.png is missing, and the command exits 1
 };
 
 // Runs `argv` (argv[0] a path, or a name looked up on the PATH) with `fd` as its descriptor 3 and its standard
@@ -189,9 +141,13 @@ int WriteSweepOutputs(json doc, const std::string& sceneName, const std::string&
     doc["rows"] = json::array();
     for (const SweepAxis& a : axes) doc["vary"].push_back({{"path", a.path}, {"values", a.values}});
     report::Report report("Sweep of " + sceneName);
-    report.sections.push_back({"",
-                               {report::Paragraph{"Pareto front (*) on median time and " + metric +
-                                                  " |error| over all elements, per stage."}}});
+    const std::string error = metric == "psnr" ? "PSNR (higher is better)" : metric + " |error| over all elements";
+    report.sections.push_back(
+        {"",
+         {report::Paragraph{"Pareto front (*) on median time and " + error +
+                            ", per stage; *= marks a front row tied with another (the same error, overlapping q1-q3 "
+                            "times). A row lists the varied fields its stage reads; it stands for any value "
+                            "of the others."}}});
     for (Stage stage : stages) {
         report::Table table;
         for (const SweepAxis& a : axes) table.columns.emplace_back(a.path);
@@ -199,12 +155,18 @@ int WriteSweepOutputs(json doc, const std::string& sceneName, const std::string&
         table.columns.insert(table.columns.begin() + ptrdiff_t(axes.size()) + 1, report::Column("pareto"));
         for (const Row& r : rows) {
             if (r.stage != stage) continue;
-            doc["rows"].push_back(RowJson(r));
+            Row shown = r;
+            shown.settings = SettingsRead(r.stage, r.settings);
+            doc["rows"].push_back(RowJson(shown));
             doc["rows"].back()["pareto"] = r.pareto;
+            doc["rows"].back()["pareto_tie"] = r.paretoTie;
             std::vector<report::Cell> cells;
-            for (const SceneOverride& o : r.settings) cells.push_back(o.value);
+            for (const SweepAxis& a : axes) {
+                auto it = std::ranges::find(shown.settings, a.path, &SceneOverride::path);
+                cells.push_back(it != shown.settings.end() ? it->value : "any");
+            }
             for (report::Cell& cell : RowCells(r)) cells.push_back(std::move(cell));
-            cells.insert(cells.begin() + ptrdiff_t(axes.size()) + 1, r.pareto ? "*" : "");
+            cells.insert(cells.begin() + ptrdiff_t(axes.size()) + 1, r.paretoTie ? "*=" : r.pareto ? "*" : "");
             table.rows.push_back(std::move(cells));
         }
         if (table.rows.empty()) continue;

@@ -11,6 +11,8 @@
 
 #include "core/base/Error.h"
 #include "harness/accuracy/Measurement.h"
+#include "harness/accuracy/SweepFields.h"
+#include "harness/accuracy/SweepPareto.h"
 #include "harness/run/VaryAxes.h"
 
 namespace cb {
@@ -20,15 +22,6 @@ namespace cb {
 // sweep and conform.
 std::expected<std::vector<SweepAxis>, std::string> ParseVaryAxes(const std::vector<std::string>& vary);
 
-// Pareto front per stage: no other ok row is at least as fast and as accurate
-// (on `metric`: max, mean or p99) and strictly better in one.
-void MarkPareto(std::vector<Row>& rows, const std::string& metric);
-
-// The stages a sweep over `axes` measures: a stage is left out when every
-// varied field belongs to the other one (shadow's beer form reads
-// shade.sigma, so that one counts for both).
-std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes);
-
 // Writes `path` with `doc` (and whatever provenance the writer adds).
 using SweepJsonWriter = std::function<Status(const std::string& path, nlohmann::json doc)>;
 
@@ -36,7 +29,9 @@ using SweepJsonWriter = std::function<Status(const std::string& path, nlohmann::
 // prints the tables. `doc` holds the header fields (format, scene, grid,
 // step, metric, repeats, reference_start, references, and shard when there
 // is one); "vary", "rows" and "report" are added here. `rows` (their Pareto
-// marks already set) go out stage by stage, in their order within a stage.
+// marks already set) go out stage by stage, in their order within a stage,
+// each with the settings its stage reads (SettingsRead; "any" in the table's
+// other axis columns).
 // Returns kExitOk, or kExitFailed after the message when a file cannot be written.
 int WriteSweepOutputs(nlohmann::json doc, const std::string& sceneName, const std::string& metric,
                       const std::vector<SweepAxis>& axes, const std::vector<Stage>& stages,

@@ -87,6 +87,10 @@ void ApplyBaseline(std::vector<ConformRow>& rows, const ConformBaseline& baselin
 // The exit code of a finished conform (docs/cli.md): 1 broken or crashed (a row "failed", "crashed", ...),
 // then 5 for a failed check or an unexpected pass, 4 when nothing was compared, else 0.
 int ConformExitCode(const std::vector<ConformRow>& rows);
+// The last line conform prints, so that a failed run ends with its verdict too:
+// "16 rows: 14 pass, 1 fail, 1 skipped; exit 5, a row does not conform" (the
+// statuses in the order they first occur).
+std::string ConformSummary(const std::vector<ConformRow>& rows);
 
 // conform.csv: a header and one row per (stage, backend):
 // stage,backend,status,rule,worst,tolerance,detail (RFC 4180 quoting); when a

@@ -294,6 +294,26 @@ int ConformExitCode(const std::vector<ConformRow>& rows) {
     return compared ? kExitOk : kExitNoBackend;
 }
 
+std::string ConformSummary(const std::vector<ConformRow>& rows) {
+    std::vector<std::pair<std::string, size_t>> counts;
+    for (const ConformRow& r : rows) {
+        auto it = std::ranges::find(counts, r.status, &std::pair<std::string, size_t>::first);
+        if (it == counts.end())
+            counts.emplace_back(r.status, 1);
+        else
+            ++it->second;
+    }
+    std::string text = std::to_string(rows.size()) + (rows.size() == 1 ? " row" : " rows");
+    for (size_t k = 0; k < counts.size(); ++k)
+        text += (k ? ", " : ": ") + std::to_string(counts[k].second) + " " + counts[k].first;
+    const int code = ConformExitCode(rows);
+    const char* meaning = code == kExitOk            ? "every compared row conforms"
+                          : code == kExitFailed      ? "a backend failed or crashed"
+                          : code == kExitNoBackend   ? "no backend was compared"
+                                                     : "a row does not conform";
+    return text + "; exit " + std::to_string(code) + ", " + meaning;
+}
+
 namespace {
 std::string CsvField(const std::string& text) {
     if (text.find_first_of(",\"\r\n") == std::string::npos) return text;

@@ -30,13 +30,20 @@ std::vector<RunSamples> RecordRuns(const json& entry) {
     return runs;
 }
 
-Status AddRecord(Side& side, const json& record) {
+// Adds a record's runs on the side's clock. `name`: "FILE@ID (line L)", for errors.
+Status AddRecord(Side& side, const json& record, const std::string& name) {
     try {
         for (const auto& [scene, backends] : record.at("results").items())
             for (const auto& [backend, stages] : backends.items())
                 for (const auto& [stage, entry] : stages.items()) {
+                    const bool timed = !entry.at("samples_ms").empty();
+                    if (side.clock == Clock::Cpu && timed && !entry.contains("cpu"))
+                        return MakeError(name + ": /results/" + scene + "/" + backend + "/" + stage +
+                                         ": has no \"cpu\" time (recorded before perf record kept CPU times); "
+                                         "compare wall times (--clock wall), or records written since");
                     auto& runs = side.runs[scene][backend][stage];
-                    for (RunSamples& run : RecordRuns(entry)) runs.push_back(std::move(run));
+                    const json& times = side.clock == Clock::Cpu && timed ? entry.at("cpu") : entry;
+                    for (RunSamples& run : RecordRuns(times)) runs.push_back(std::move(run));
                 }
         if (record.contains("failures"))
             for (const auto& [scene, backends] : record["failures"].items())
@@ -46,8 +53,9 @@ Status AddRecord(Side& side, const json& record) {
         side.provenance = record.value("provenance", json::object());
         side.date = record.value("time", "");
     } catch (const json::exception& e) {
-        return MakeError(side.label + ": not a valid " + kRecordFormat + " record: " + e.what());
+        return MakeError(name + ": not a valid " + kRecordFormat + " record: " + e.what());
     }
+    ++side.records;
     return {};
 }
 
@@ -150,15 +158,16 @@ Result<Side> LoadSide(const std::string& spec, Clock clock) {
         return side;
     }
     auto& history = std::get<input::History>(*read);
-    if (clock == Clock::Cpu)
-        return MakeError(spec +
-                         ": a history keeps wall times only; --clock cpu compares results.json files, "
-                         "`run --out` folders and interleaved runs");
     input::PrintWarnings(history);
-    auto record = SelectRecord(history.records, path, selected ? selector : "-1");
-    if (!record) return std::unexpected(record.error());
-    side.label = path + "@" + (*record)->record.value("id", "-1");
-    CB_TRY(AddRecord(side, (*record)->record));
+    auto chosen = SelectRecords(history.records, path, selected ? selector : "-1");
+    if (!chosen) return std::unexpected(chosen.error());
+    // One record's runs, or a range's pooled; the side's provenance and date are its last record's.
+    const std::string firstId = chosen->front()->record.value("id", "?");
+    const std::string lastId = chosen->back()->record.value("id", "?");
+    side.label = path + "@" + firstId + (chosen->size() > 1 ? ":" + lastId : "");
+    for (const HistoryRecord* r : *chosen)
+        CB_TRY(AddRecord(side, r->record,
+                         path + "@" + r->record.value("id", "?") + " (line " + std::to_string(r->line) + ")"));
     return side;
 }
 
@@ -179,6 +188,8 @@ Result<KeptInterleave> LoadInterleave(const std::string& folder, Clock clock) {
     sides[1].label = doc["head"].get<std::string>() + " (HEAD)";
     for (Side& side : sides) side.clock = clock;
     kept.order = doc.value("order", "ABBA");
+    if (doc.contains("plant"))
+        kept.plant = PlantedSlowdown{doc["plant"]["stage"].get<std::string>(), doc["plant"]["factor"].get<double>()};
     kept.recordedRuns = doc["runs"].size();
     kept.plannedRuns = doc["rounds"].get<size_t>() * doc["scenes"].size() * 2;
     for (size_t n = 0; n < doc["runs"].size(); ++n) {
@@ -217,18 +228,30 @@ std::string DescribeFailedRun(const FailedRun& run) {
            " exited " + std::to_string(run.exit) + (run.compared ? "" : " and wrote no valid results.json");
 }
 
-json RecordSections(const Side& side) {
+namespace {
+std::string General(double v);
+template <typename T>
+const T* Find(const ByStage<T>& map, const std::string& scene, const std::string& backend, const std::string& stage);
+}  // namespace
+
+json RecordSections(const Side& side, const Side& cpu) {
     json results = json::object(), failures = json::object(), instructions = json::object();
+    auto times = [](const std::vector<RunSamples>& runs) {
+        const std::vector<double> samples = Pooled(runs);
+        json entry = {{"samples_ms", samples}, {"median_ms", Median(samples)}};
+        if (runs.size() > 1) {
+            entry["runs_ms"] = json::array();
+            for (const RunSamples& run : runs) entry["runs_ms"].push_back(run.ms);
+        }
+        return entry;
+    };
     for (const auto& [scene, backends] : side.runs)
         for (const auto& [backend, stages] : backends)
             for (const auto& [stage, runs] : stages) {
-                const std::vector<double> samples = Pooled(runs);
                 json& entry = results[scene][backend][stage];
-                entry = {{"samples_ms", samples}, {"median_ms", Median(samples)}};
-                if (runs.size() > 1) {
-                    entry["runs_ms"] = json::array();
-                    for (const RunSamples& run : runs) entry["runs_ms"].push_back(run.ms);
-                }
+                entry = times(runs);
+                const std::vector<RunSamples>* onCpu = Find(cpu.runs, scene, backend, stage);
+                if (onCpu && onCpu->size() == runs.size() && !entry["samples_ms"].empty()) entry["cpu"] = times(*onCpu);
             }
     for (const auto& [scene, backends] : side.failures)
         for (const auto& [backend, why] : backends) failures[scene][backend] = why;
@@ -280,6 +303,40 @@ double ThresholdOf(const CompareSettings& s, const std::string& backend) {
     auto own = s.backendThreshold.find(backend);
     const double threshold = own == s.backendThreshold.end() ? s.threshold : own->second;
     return s.interleaved ? threshold : std::max(threshold, s.separateThreshold);
+}
+
+std::string UnjudgedAdvice(const Side& base, const Side& head, const CompareSettings& s, const CompareOutcome& outcome) {
+    if (s.interleaved) return "more rounds (--rounds) or more samples a run make them testable";
+    if (!base.records && !head.records)
+        return "one run a side needs at least " + std::to_string(s.minSamples) +
+               " steps after warm-up; run with more steps, or compare interleaved runs (perf compare --interleave)";
+    size_t family = 0, runs = 0, records = 0;
+    for (const Comparison& c : outcome.rows)
+        if (c.metric == "time" && !std::isnan(c.pSlower)) {
+            ++family;
+            runs = std::max({runs, c.baseRuns, c.headRuns});
+        }
+    for (const Side* side : {&base, &head}) records = std::max(records, side->records);
+    const size_t needed = RunsToJudge(family, s);
+    if (needed == 0)
+        return "no number of runs reaches Holm-adjusted p < " + General(s.alpha) + " over " + std::to_string(family) +
+               " tests with " + std::to_string(s.permutations) + " permutations; raise --alpha";
+    // The runs a record holds: its --repeat.
+    const size_t perRecord = std::max<size_t>(1, records ? runs / records : 1);
+    const size_t k = (needed + perRecord - 1) / perRecord;
+    return "over " + std::to_string(family) + " tests, " + std::to_string(needed) +
+           " runs a side can reach Holm-adjusted p < " + General(s.alpha) + ": compare " + std::to_string(k) +
+           " records of perf record --repeat " + std::to_string(perRecord) + " a side (FILE@-" + std::to_string(2 * k) +
+           ":-" + std::to_string(k + 1) + " against FILE@-" + std::to_string(k) + ":-1 pools their runs), or record with --repeat " +
+           std::to_string(needed);
+}
+
+size_t RunsToJudge(size_t comparisons, const CompareSettings& s) {
+    const double family = double(std::max<size_t>(comparisons, 1));
+    if (family / double(s.permutations + 1) >= s.alpha) return 0;
+    size_t runs = 1;
+    while (family * SmallestPermutationP(runs, runs, s.permutations) >= s.alpha) ++runs;
+    return runs;
 }
 
 namespace {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@ struct Side {
     ByStage<std::vector<RunSamples>> runs;                               // per-step times, run by run
     std::map<std::string, std::map<std::string, std::string>> failures;  // scene, backend: why it gave no result
     ByStage<double> instructions;                                        // `cloudbench count`: exact per-stage counts
+    size_t records = 0;  // the history records pooled into it; 0 when it is not from a history
 };
 
 // Every run's samples, one after another.
@@ -57,8 +59,10 @@ Status AddInstructions(Side& side, const nlohmann::json& doc);
 // The side a BASE or HEAD argument names: "FILE" (a results.json, a count
 // output or a history, whose last record is taken), "FOLDER" (the folder a
 // `run --out` wrote: its results.json), "FILE@ID" or "FILE@-N" (a history
-// record). Errors name the argument. A history keeps wall times only: on the
-// CPU clock a history is refused.
+// record), "FILE@A:B" (the records from A to B, their runs pooled: History.h's
+// SelectRecords). Errors name the argument. On the CPU clock, a record that
+// holds no CPU times (written before perf record kept them) is refused, naming
+// its id and line.
 Result<Side> LoadSide(const std::string& spec, Clock clock = Clock::Wall);
 
 // What `perf compare --interleave --keep FOLDER` keeps (docs/cli.md): every
@@ -66,6 +70,9 @@ Result<Side> LoadSide(const std::string& spec, Clock clock = Clock::Wall);
 // order they ran, with their side, scene, round, exit code and the load average.
 inline constexpr const char* kInterleaveFormat = "cloudbench-interleave/1";
 inline constexpr const char* kInterleaveFile = "interleave.json";
+// The live command's verdict, its --json document, kept beside interleave.json when it reached one (`report
+// FOLDER` shows it).
+inline constexpr const char* kKeptVerdictFile = "compare.json";
 
 // A run of an interleave that failed: it exited other than 0, or wrote no valid results.json.
 // Either makes `perf compare` exit 1 when nothing regressed, live or from the kept folder.
@@ -75,6 +82,13 @@ struct FailedRun {
     int round = 0;          // 0-based
     int exit = 0;           // the run's exit code
     bool compared = false;  // its results.json was read and its samples compared
+};
+
+// `perf compare --interleave --plant STAGE:FACTOR` (docs/cli.md): HEAD runs with
+// CLOUDBENCH_TEST_SLOWDOWN=STAGE:FACTOR and BASE with STAGE:1, the control; kept in interleave.json's "plant".
+struct PlantedSlowdown {
+    std::string stage;
+    double factor = 1;  // in [1, 1000]
 };
 
 // What `perf compare FOLDER` judges: both sides, each run in its round, and what the live command
@@ -87,6 +101,7 @@ struct KeptInterleave {
     size_t recordedRuns = 0;
     size_t plannedRuns = 0;  // rounds x scenes x 2: fewer recorded means the interleave was cut short
     double peakLoad = 0;     // the highest 1-minute load average a run started at
+    std::optional<PlantedSlowdown> plant;  // --plant, when the interleave was run with it
 };
 
 // The kept interleave in `folder`. Errors name the file and field: no interleave.json, one that is not
@@ -99,9 +114,11 @@ Result<KeptInterleave> LoadInterleave(const std::string& folder, Clock clock = C
 std::string DescribeFailedRun(const FailedRun& run);
 
 // A history record's "results", "failures" and "instructions" sections from a
-// side: each stage's pooled "samples_ms" and "median_ms", and "runs_ms" (the
-// samples run by run) when there was more than one run.
-nlohmann::json RecordSections(const Side& side);
+// side on the wall clock: each stage's pooled "samples_ms" and "median_ms", and
+// "runs_ms" (the samples run by run) when there was more than one run; and
+// beside them "cpu", the same of `cpu` (the same runs on the CPU clock) where
+// it has the stage with as many runs.
+nlohmann::json RecordSections(const Side& side, const Side& cpu);
 
 // How `perf compare` judges a stage's time (docs/cli.md, "perf"; why, in
 // docs/performance.md, "The regression gate"). The run is the sample: each run
@@ -159,6 +176,19 @@ struct CompareOutcome {
 // The wall-time threshold of `backend`: its own or the default, at least
 // separateThreshold when the sides were not interleaved.
 double ThresholdOf(const CompareSettings& settings, const std::string& backend);
+
+// The fewest runs a side (as many on each) whose two-sample permutation test
+// can reach `alpha` after Holm's correction over `comparisons` tests: the
+// smallest n with comparisons x SmallestPermutationP(n, n) < alpha; 0 when no
+// number of runs can (alpha at or below comparisons / (permutations + 1)).
+size_t RunsToJudge(size_t comparisons, const CompareSettings& settings);
+
+// The advice that ends the warning on stages marked '?': more rounds for
+// interleaved sides; for history records, how many runs a side would be
+// judged and how to get them (a range of records a side, or perf record
+// --repeat); for results files, more steps or --interleave.
+std::string UnjudgedAdvice(const Side& base, const Side& head, const CompareSettings& settings,
+                           const CompareOutcome& outcome);
 
 CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings& settings);
 

@@ -81,6 +81,37 @@ Result<const HistoryRecord*> SelectRecord(const std::vector<HistoryRecord>& reco
     return match;
 }
 
+Result<std::vector<const HistoryRecord*>> SelectRecords(const std::vector<HistoryRecord>& records,
+                                                        const std::string& path, const std::string& selector) {
+    const size_t colon = selector.find(':');
+    if (colon == std::string::npos) {
+        auto one = SelectRecord(records, path, selector);
+        if (!one) return std::unexpected(one.error());
+        return std::vector<const HistoryRecord*>{*one};
+    }
+    if (records.empty()) return MakeError(path + "@" + ShownText(selector) + ": the history holds no record");
+    const std::string from = selector.substr(0, colon), to = selector.substr(colon + 1);
+    const HistoryRecord* first = &records.front();
+    const HistoryRecord* last = &records.back();
+    if (!from.empty()) {
+        auto r = SelectRecord(records, path, from);
+        if (!r) return std::unexpected(r.error());
+        first = *r;
+    }
+    if (!to.empty()) {
+        auto r = SelectRecord(records, path, to);
+        if (!r) return std::unexpected(r.error());
+        last = *r;
+    }
+    if (first > last)
+        return MakeError(path + "@" + ShownText(selector) + ": the range starts at line " +
+                         std::to_string(first->line) + ", after its end at line " + std::to_string(last->line) +
+                         " (write the earlier record first: FILE@-8:-5)");
+    std::vector<const HistoryRecord*> chosen;
+    for (const HistoryRecord* r = first; r <= last; ++r) chosen.push_back(r);
+    return chosen;
+}
+
 std::string NewRecordId() {
     const std::time_t now = std::time(nullptr);
     std::tm utc{};

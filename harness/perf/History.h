@@ -36,6 +36,13 @@ Status AppendRecord(const std::string& path, const nlohmann::json& record);
 Result<const HistoryRecord*> SelectRecord(const std::vector<HistoryRecord>& records, const std::string& path,
                                           const std::string& selector);
 
+// The records `selector` names, in file order: one record as SelectRecord, or
+// "A:B" every record from A to B inclusive, each end as SelectRecord (an empty
+// A the first record, an empty B the last). Error: "PATH@SELECTOR: ..." naming
+// what is wrong, including a range whose A comes after its B.
+Result<std::vector<const HistoryRecord*>> SelectRecords(const std::vector<HistoryRecord>& records,
+                                                        const std::string& path, const std::string& selector);
+
 // A new record id: the UTC time, compact, and 6 random hex digits ("20260101T120000Z-3fa2c1").
 std::string NewRecordId();
 

@@ -63,22 +63,39 @@ uint64_t Binomial(size_t n, size_t k) {
 }
 
 void Segment(std::span<const double> series, size_t offset, const ChangePointSettings& s, std::mt19937_64& rng,
-             std::vector<size_t>& found) {
+             ChangePointSearch& search) {
+    SegmentTest test;
+    test.begin = offset, test.end = offset + series.size();
     const auto [split, statistic] = BestSplit(series, s.minSegment);
-    if (statistic < 0) return;
+    if (statistic < 0) {
+        search.tests.push_back(test);
+        return;
+    }
     const std::span<const double> left = series.first(split), right = series.subspan(split);
-    if (std::abs(Median(right) - Median(left)) < s.minChange) return;
+    test.split = offset + split;
+    test.change = Median(right) - Median(left);
+    test.outcome = SegmentTest::Outcome::BelowMinChange;
+    if (std::abs(test.change) < s.minChange) {
+        search.tests.push_back(test);
+        return;
+    }
     std::vector<double> shuffled(series.begin(), series.end());
-    int asLarge = 0;
-    for (int n = 0; n < s.permutations; ++n) {
+    // p = (1 + asLarge) / (1 + permutations) exceeds alpha once asLarge reaches this: no need to go on.
+    const double hopeless = s.alpha * double(1 + s.permutations) - 1;
+    int asLarge = 0, drawn = 0;
+    while (drawn < s.permutations && double(asLarge) <= hopeless) {
         std::shuffle(shuffled.begin(), shuffled.end(), rng);
         if (BestSplit(shuffled, s.minSegment).second >= statistic) ++asLarge;
+        ++drawn;
     }
-    const double p = double(1 + asLarge) / double(1 + s.permutations);
-    if (p > s.alpha) return;
-    Segment(left, offset, s, rng, found);
-    found.push_back(offset + split);
-    Segment(right, offset + split, s, rng, found);
+    test.p = double(1 + asLarge) / double(1 + drawn);
+    test.outcome = test.p <= s.alpha && drawn == s.permutations ? SegmentTest::Outcome::Change
+                                                                  : SegmentTest::Outcome::NotSignificant;
+    search.tests.push_back(test);
+    if (test.outcome != SegmentTest::Outcome::Change) return;
+    Segment(left, offset, s, rng, search);
+    search.points.push_back(offset + split);
+    Segment(right, offset + split, s, rng, search);
 }
 
 }  // namespace
@@ -270,11 +287,15 @@ Interval BootstrapRatioOfMedians(std::span<const double> base, std::span<const d
     return {SortedQuantile(ratios, (1 - confidence) / 2), SortedQuantile(ratios, (1 + confidence) / 2)};
 }
 
-std::vector<size_t> ChangePoints(std::span<const double> series, const ChangePointSettings& settings) {
-    std::vector<size_t> found;
+ChangePointSearch SearchChangePoints(std::span<const double> series, const ChangePointSettings& settings) {
+    ChangePointSearch search;
     std::mt19937_64 rng(settings.seed);
-    Segment(series, 0, settings, rng, found);
-    return found;
+    Segment(series, 0, settings, rng, search);
+    return search;
+}
+
+std::vector<size_t> ChangePoints(std::span<const double> series, const ChangePointSettings& settings) {
+    return SearchChangePoints(series, settings).points;
 }
 
 }  // namespace cb::perf

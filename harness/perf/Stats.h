@@ -97,4 +97,24 @@ struct ChangePointSettings {
 };
 std::vector<size_t> ChangePoints(std::span<const double> series, const ChangePointSettings& settings);
 
+// What the search decided for each segment it looked at, in the order it
+// looked: the first is the whole series. A segment shorter than 2 minSegment
+// has no split (TooShort); otherwise its best split, the difference of its
+// sides' medians (right - left) and, when that reaches minChange, the
+// permutation p: shuffling stops once p cannot reach alpha, so a p above
+// alpha is estimated from the shuffles drawn.
+struct SegmentTest {
+    enum class Outcome { Change, TooShort, BelowMinChange, NotSignificant };
+    size_t begin = 0, end = 0;  // the segment, [begin, end) of the series
+    size_t split = 0;           // the first index after its best split; 0 when TooShort
+    double change = 0;          // median(right) - median(left), in the series' units
+    double p = 1;               // 1 when not tested
+    Outcome outcome = Outcome::TooShort;
+};
+struct ChangePointSearch {
+    std::vector<size_t> points;  // as ChangePoints
+    std::vector<SegmentTest> tests;
+};
+ChangePointSearch SearchChangePoints(std::span<const double> series, const ChangePointSettings& settings);
+
 }  // namespace cb::perf

@@ -219,12 +219,40 @@ const Command* FindCommand(std::string_view name) {
     return it == Registry().end() ? nullptr : &it->second;
 }
 
-std::string ResolveScenePath(const std::string& nameOrPath) {
+Result<std::vector<std::string>> SceneNamesIn(const std::string& folder) {
+    std::error_code error;
+    std::filesystem::directory_iterator it(folder, error);
+    if (error) return MakeError(folder + ": cannot list the folder: " + error.message());
+    std::vector<std::string> names;
+    for (; it != std::filesystem::directory_iterator(); it.increment(error)) {
+        const std::string file = it->path().filename().string();
+        if (file.size() > 5 && file.ends_with(".json")) names.push_back(file.substr(0, file.size() - 5));
+    }
+    if (error) return MakeError(folder + ": cannot list the folder: " + error.message());
+    std::ranges::sort(names);
+    return names;
+}
+
+Result<std::string> ResolveScenePath(const std::string& nameOrPath) {
     const std::string& name = nameOrPath.empty() ? std::string(kDefaultScene) : nameOrPath;
     if (name.find('/') != std::string::npos || name.ends_with(".json")) return name;
     const char* env = std::getenv("CLOUDBENCH_SCENES");
-    const std::filesystem::path dir = env ? std::filesystem::path(env) : std::filesystem::path(CLOUDBENCH_SCENES_DIR);
-    return (dir / (name + ".json")).string();
+    const std::string folder = env ? std::string(env) : std::string(CLOUDBENCH_SCENES_DIR);
+    const std::string path = (std::filesystem::path(folder) / (name + ".json")).string();
+    // Only a file that is not there makes the name unknown; any other failure is the loader's to name.
+    std::error_code error;
+    if (std::filesystem::symlink_status(path, error).type() != std::filesystem::file_type::not_found) return path;
+    // The folder, the path and the listed names are shown through ShownMessage; the argument is cut as usual.
+    std::string message = "SCENE: no scene named '" + Shown(name) + "' (no file " + path + ")";
+    Result<std::vector<std::string>> names = SceneNamesIn(folder);
+    if (!names) return MakeError(ShownMessage(message + "; " + names.error().message));
+    if (names->empty()) return MakeError(ShownMessage(message + "; " + folder + " holds no scene (*.json)"));
+    std::string list;
+    for (const std::string& known : *names) list += (list.empty() ? "" : ", ") + known;
+    message += "; the scenes there: " + list;
+    if (const std::string_view best = ClosestName(name, *names); !best.empty())
+        message += "; did you mean '" + std::string(best) + "'?";
+    return MakeError(ShownMessage(message));
 }
 
 }  // namespace cb

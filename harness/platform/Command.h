@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/base/Error.h"
 #include "core/pipeline/Backend.h"
 #include "core/scene/Scene.h"
 #include "registry/Registry.h"
@@ -207,8 +208,15 @@ struct CommandRegistration {
 std::vector<const Command*> RegisteredCommands();
 const Command* FindCommand(std::string_view name);
 
-// scenes/<name>.json for a bare name, the argument itself for a path.
-std::string ResolveScenePath(const std::string& nameOrPath);
+// The scene file a SCENE argument names: the argument itself for a path (it has a '/' or ends in ".json"), else
+// <folder>/<name>.json, the folder being $CLOUDBENCH_SCENES or the shipped scenes/. A bare name with no such file
+// is an error that lists the folder's scenes and suggests the nearest: "SCENE: no scene named 'wang20km' (no
+// file scenes/wang20km.json); the scenes there: ci-small, ...; did you mean 'wang-20km'?". A path is not checked
+// here: the loader's message names it.
+Result<std::string> ResolveScenePath(const std::string& nameOrPath);
+// The names of the scenes in `folder` (its *.json files without the suffix), sorted; an error when it cannot be
+// listed.
+Result<std::vector<std::string>> SceneNamesIn(const std::string& folder);
 inline constexpr const char* kDefaultScene = "thesis-medium";
 
 }  // namespace cb

@@ -8,6 +8,7 @@
 #include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
 #include "core/scene/Stage.h"
+#include "harness/report/PerfSchemas.h"
 
 namespace cb::input {
 namespace {
@@ -199,8 +200,13 @@ Node InstructionsSection() { return ByStage(Integer(0, 1e19)); }
 
 Node PerfRecordSchema() {
     // A report tolerates a missing median (it uses the samples'); perf compare needs the samples.
-    const Node result =
+    const Node times =
         Object({{"samples_ms", Samples(), true}, {"median_ms", Nullable(Ms())}, {"runs_ms", ArrayOf(Samples())}});
+    // The wall times, with the same runs' CPU times beside them ("cpu", from cloudbench 2026-12 on).
+    const Node result = Object({{"samples_ms", Samples(), true},
+                                {"median_ms", Nullable(Ms())},
+                                {"runs_ms", ArrayOf(Samples())},
+                                {"cpu", times}});
     // An object naming any of scene, backend and stage, or the text "scene/backend/stage" (docs/cli.md, "report").
     const Node changePoint = Either(OpenObject({{"scene", Text()}, {"backend", Text()}, {"stage", Text()}}), Text());
     return Object({{"format", TextOf({"cloudbench-perf/1"}), true},
@@ -257,7 +263,8 @@ Node MeasuredRow() {
                                      {"in_cloud", ErrorStats()},
                                      {"under_cloud", ErrorStats()},
                                      {"psnr_db", Nullable(Statistic())}})},
-                   {"pareto", Boolean()}});
+                   {"pareto", Boolean()},
+                   {"pareto_tie", Boolean()}});
 }
 
 // A row of a shard (harness/accuracy/AccuracyTransfer.h ToJson(Row)), read back by merge.
@@ -344,26 +351,6 @@ Node AccuracySchema() {
                    {"provenance", Provenance()}});
 }
 
-// What `perf compare --interleave --keep` keeps (harness/perf/Compare.h): each run's folder is
-// "base/NAME" or "head/NAME", a name of its own inside the kept folder.
-Node InterleaveSchema() {
-    const Node run = Object({{"side", TextOf({"base", "head"}), true},
-                             {"scene", Text(), true},
-                             {"round", Integer(0, 1e6), true},
-                             {"folder", Text(), true},
-                             {"exit", Integer(-1, 255)},
-                             {"seconds", Number(0, 1e12)},
-                             {"load", ArrayOf(Number(0, 1e6), 3, 3)}});
-    return Object({{"format", TextOf({"cloudbench-interleave/1"}), true},
-                   {"base", Text(), true},
-                   {"head", Text(), true},
-                   {"scenes", Names(), true},
-                   {"rounds", Integer(1, 1e6), true},
-                   {"order", TextOf({"random", "ABBA"})},
-                   {"run_options", Names()},
-                   {"runs", ArrayOf(run), true}});
-}
-
 Node SuiteSchema() {
     return Object({{"scenes", ArrayOf(Object({{"scene", Text(), true}, {"set", Names()}}), 1), true}});
 }
@@ -384,7 +371,8 @@ const Described kFormats[] = {
     {Format::Conform, "cloudbench-conform/1", "a conform.json", ConformSchema},
     {Format::Accuracy, "cloudbench-accuracy/1", "an accuracy.json", AccuracySchema},
     {Format::Suite, "", "a perf suite", SuiteSchema, "scenes"},
-    {Format::Interleave, "cloudbench-interleave/1", "a kept interleave's interleave.json", InterleaveSchema},
+    {Format::Interleave, "cloudbench-interleave/1", "a kept interleave's interleave.json", detail::InterleaveSchema},
+    {Format::PerfCompare, "cloudbench-perf-compare/1", "a perf compare --json file", detail::PerfCompareSchema},
 };
 
 const Described& Lookup(Format format) {
@@ -430,6 +418,9 @@ std::string Nouns(std::span<const Format> formats) {
 }
 
 }  // namespace
+
+schema::Node detail::ProvenanceSchema() { return Provenance(); }
+schema::Node detail::ReportBlockSchema() { return ReportBlock(); }
 
 std::string_view FormatName(Format format) { return Lookup(format).name; }
 std::string_view FormatNoun(Format format) { return Lookup(format).noun; }

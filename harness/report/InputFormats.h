@@ -2,7 +2,7 @@
 // (harness/platform/JsonInput.h), and the one reader of each: results.json (perf
 // compare, perf record, report), a perf history and its records (perf
 // compare, history, export, merge, report), a kept interleave's manifest
-// (perf compare, export), count outputs and instruction files (perf compare,
+// (perf compare, export), `perf compare --json` (report), count outputs and instruction files (perf compare,
 // perf record --instructions), sweep.json and its shards (merge, report),
 // conform.json and accuracy.json (report) and perf suites (perf record
 // --suite). docs/results.md describes the formats; a field
@@ -29,7 +29,7 @@ namespace cb::input {
 inline constexpr double kMaxSampleMs = 1e9;
 
 // The formats, by their "format" field.
-enum class Format { Results, PerfRecord, Count, Instructions, Sweep, Conform, Accuracy, Suite, Interleave };
+enum class Format { Results, PerfRecord, Count, Instructions, Sweep, Conform, Accuracy, Suite, Interleave, PerfCompare };
 
 // The "format" a file of `format` declares ("cloudbench-results/1"); "" for Instructions and Suite, which have
 // none.

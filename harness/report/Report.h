@@ -76,7 +76,8 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
 nlohmann::json TimingJson(const Scene& scene, const BackendRun& run);
 
 // One backend's section of `run`'s report: its device and steps, the
-// per-stage timing table (with each camera's frames) and the cover line.
+// per-stage timing table (stages in the order a step runs them, "-" for one
+// with no sample after warm-up; each camera's frames) and the cover line.
 report::Section TimingSection(const Scene& scene, const BackendRun& run);
 
 // Writes D as a grey top view (x right, y up, white = densest column), 8-bit

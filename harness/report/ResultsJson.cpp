@@ -89,9 +89,8 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
 }
 
 nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& runs) {
-    nlohmann::json stages = nlohmann::json::array();
-    for (Stage stage : kAllStages)
-        if (scene.stages.Has(stage)) stages.push_back(StageName(stage));
+    nlohmann::json stages = nlohmann::json::array();  // in the order a step runs them, as the reports list them
+    for (Stage stage : ScheduleStages(scene.stages)) stages.push_back(StageName(stage));
     nlohmann::json doc = {
         {"format", "cloudbench-results/1"},
         {"scene",

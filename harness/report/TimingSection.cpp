@@ -23,7 +23,10 @@ std::vector<report::Column> TimingColumns() {
 std::vector<report::Cell> TimingRow(const std::string& name, const std::vector<double>& samples,
                                     const std::vector<double>& device, std::string note = "") {
     const Summary s = Summarize(samples);
-    std::vector<report::Cell> row = {name, s.median, s.q1, s.q3, s.min, s.max};
+    // No sample (a stage that ran only in warm-up, or pipelined): "-", never a time of 0.
+    std::vector<report::Cell> row = {name};
+    for (double value : {s.median, s.q1, s.q3, s.min, s.max})
+        row.push_back(s.count == 0 ? report::Cell("-") : report::Cell(value));
     row.push_back(device.empty() ? report::Cell() : report::Cell(Summarize(device).median));
     row.push_back(note.empty() ? report::Cell() : report::Cell(std::move(note)));
     return row;
@@ -43,8 +46,9 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
     section.title = line;
     // Wall time; "device" follows where the backend measures GPU time.
     report::Table table(TimingColumns(), report::TextLayout::Columns);
-    for (Stage stage : kAllStages) {
-        if (!scene.stages.Has(stage)) continue;
+    // The stages in the order a step runs them.
+    const std::vector<Stage> schedule = ScheduleStages(scene.stages);
+    for (Stage stage : schedule) {
         table.rows.push_back(TimingRow(std::string(StageName(stage)), StageSamples(scene, run, stage),
                                        StageSamples(scene, run, stage, StageClock::Device)));
     }
@@ -140,8 +144,7 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         std::string stages = anyDevice ? "  pipelined per stage, median device ms (host recording ms):"
                                        : "  pipelined per stage, no device clock; median host recording ms:";
         const char* sep = " ";
-        for (Stage stage : kAllStages) {
-            if (!scene.stages.Has(stage)) continue;
+        for (Stage stage : schedule) {
             const std::vector<double> host = StageSamples(scene, run, stage, StageClock::Wall, TimingMode::Pipelined);
             if (host.empty()) continue;
             const std::vector<double> device =
@@ -162,8 +165,7 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
     if (!run.steps.empty()) {
         std::string runs = "  stage runs (" + std::to_string(run.steps.size()) + " steps):";
         const char* sep = " ";
-        for (Stage stage : kAllStages) {
-            if (!scene.stages.Has(stage)) continue;
+        for (Stage stage : schedule) {
             const StageRunCount c = CountStageRuns(run, stage);
             runs += sep + std::string(StageName(stage)) + " " + std::to_string(c.ran);
             if (c.skippedUnchanged) runs += " (" + std::to_string(c.skippedUnchanged) + " skipped, unchanged)";

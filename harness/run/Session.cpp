@@ -47,15 +47,19 @@ std::expected<std::unique_ptr<Session>, int> Session::Open(const CommonOptions& 
         std::fprintf(stderr, "cloudbench: SCENE: must not be empty (leave it out for %s)\n", kDefaultScene);
         return std::unexpected(kExitUsage);
     }
-    std::string path = ResolveScenePath(options.scene.value_or(kDefaultScene));
-    Result<Scene> scene = LoadScene(path, options.overrides);
+    Result<std::string> path = ResolveScenePath(options.scene.value_or(kDefaultScene));
+    if (!path) {
+        std::fprintf(stderr, "cloudbench: %s\n", path.error().message.c_str());
+        return std::unexpected(kExitBadScene);
+    }
+    Result<Scene> scene = LoadScene(*path, options.overrides);
     if (!scene) {
         std::fprintf(stderr, "%s\n", scene.error().message.c_str());
         return std::unexpected(kExitBadScene);
     }
     std::string outDir = options.outDir;
     if (outDir.empty()) outDir = "out/" + scene->name + (outSubfolder.empty() ? "" : "/" + std::string(outSubfolder));
-    return std::unique_ptr<Session>(new Session(options, std::move(path), std::move(*scene), std::move(outDir)));
+    return std::unique_ptr<Session>(new Session(options, std::move(*path), std::move(*scene), std::move(outDir)));
 }
 
 Result<Scene> Session::LoadVariant(std::span<const SceneOverride> extra) const {
@@ -263,19 +267,6 @@ Status Session::WriteNpy(const std::string& path, Backend& backend, const Buffer
 
 nlohmann::json Session::Provenance() const {
     return MakeProvenance(mOptions.commandLine, {mScenePath, &mScene, mOptions.overrides}, mBackends);
-}
-
-Progress::Progress(std::string label, uint32_t total, bool quiet)
-    : mLabel(std::move(label)), mTotal(total), mQuiet(quiet), mTty(isatty(STDERR_FILENO)) {}
-
-void Progress::Update(uint32_t done) {
-    if (mQuiet || mTotal < 20) return;
-    if (mTty) {
-        std::fprintf(stderr, "\r%s: step %u/%u", mLabel.c_str(), done, mTotal);
-        if (done == mTotal) std::fprintf(stderr, "\n");
-    } else if (done * 10 / mTotal != (done - 1) * 10 / mTotal) {
-        std::fprintf(stderr, "%s: step %u/%u\n", mLabel.c_str(), done, mTotal);
-    }
 }
 
 }  // namespace cb

@@ -18,6 +18,7 @@
 #include "core/scene/Scene.h"
 #include "harness/platform/Command.h"
 #include "harness/platform/Provenance.h"
+#include "harness/run/Progress.h"  // the commands' progress lines
 
 namespace cb {
 
@@ -132,17 +133,5 @@ Result<std::vector<T>> Download(Backend& backend, const Buffer& buffer, std::vec
         timesMs->push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     return data;
 }
-
-// Progress on stderr: a self-rewriting line on a terminal, a line per 10 % otherwise.
-class Progress {
-  public:
-    Progress(std::string label, uint32_t total, bool quiet);
-    void Update(uint32_t done);
-
-  private:
-    std::string mLabel;
-    uint32_t mTotal;
-    bool mQuiet, mTty;
-};
 
 }  // namespace cb

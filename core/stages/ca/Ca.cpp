@@ -65,6 +65,9 @@ CaStepParams MakeCaStepParams(const Scene& sc, uint32_t step) {
     return p;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kCaSceneFields[] = {"ca"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeCa() {
@@ -77,6 +80,7 @@ const StageDescriptor& DescribeCa() {
         .shareCount = SharesOfSlicesK,
         .symbol = "cld",
         .rule = BitExactRule,
+        .sceneFields = kCaSceneFields,
     };
     return descriptor;
 }

@@ -51,6 +51,9 @@ DensityParams MakeDensityParams(const Scene& sc) {
     return p;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kDensitySceneFields[] = {"density"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeDensity() {
@@ -64,6 +67,7 @@ const StageDescriptor& DescribeDensity() {
         .shareCount = RowsOfTiles,
         .symbol = "D",
         .rule = BitExactRule,
+        .sceneFields = kDensitySceneFields,
     };
     return descriptor;
 }

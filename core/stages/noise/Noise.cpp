@@ -222,6 +222,9 @@ bool NoiseAnimated(const Scene& scene) { return scene.noise.Animated(); }
 
 NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.noise, sc.grid.size}; }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kNoiseSceneFields[] = {"noise"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeNoise() {
@@ -233,6 +236,7 @@ const StageDescriptor& DescribeNoise() {
         .dependsOnStep = NoiseAnimated,
         .symbol = "q",
         .rule = NoiseRule,
+        .sceneFields = kNoiseSceneFields,
     };
     return descriptor;
 }

@@ -147,6 +147,9 @@ CompareRule RegionRule(const Scene&) { return {CompareRule::Kind::Quantised, 1, 
 
 }  // namespace
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kRegionSceneFields[] = {"ellipsoids", "ca.seed"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRegion() {
@@ -157,6 +160,7 @@ const StageDescriptor& DescribeRegion() {
         .shareCount = SharesOfSlicesK,
         .symbol = "R",
         .rule = RegionRule,
+        .sceneFields = kRegionSceneFields,
     };
     return descriptor;
 }

@@ -125,6 +125,22 @@ std::vector<float> MakeLayersMap(const Scene& sc, uint32_t step) {
     return map;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kRenderLayersSceneFields[] = {"layers",
+                                                         "noise",
+                                                         "sun",
+                                                         "lighting",
+                                                         "phase",
+                                                         "shade.sigma",
+                                                         "grid.voxel_size",
+                                                         "grid.origin",
+                                                         "grid.tiling",
+                                                         "render.width",
+                                                         "render.height",
+                                                         "render.cameras",
+                                                         "render.alpha",
+                                                         "render.frames_per_step"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderLayers() {
@@ -138,6 +154,7 @@ const StageDescriptor& DescribeRenderLayers() {
         .renderer = true,
         .symbol = "image",
         .rule = LayersImageRule,
+        .sceneFields = kRenderLayersSceneFields,
     };
     return descriptor;
 }

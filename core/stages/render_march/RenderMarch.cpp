@@ -198,6 +198,16 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kRenderMarchSceneFields[] = {"march",         "lightning",
+                                                        "sun",           "lighting",
+                                                        "phase",         "shade.sigma",
+                                                        "ca.seed",       "grid.voxel_size",
+                                                        "grid.origin",   "render.width",
+                                                        "render.height", "render.cameras",
+                                                        "render.alpha",  "render.frames_per_step",
+                                                        "render.ground"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderMarch() {
@@ -213,6 +223,7 @@ const StageDescriptor& DescribeRenderMarch() {
         .renderer = true,
         .symbol = "image",
         .rule = MarchImageRule,
+        .sceneFields = kRenderMarchSceneFields,
     };
     return descriptor;
 }

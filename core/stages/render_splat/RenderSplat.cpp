@@ -79,6 +79,10 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kRenderSplatSceneFields[] = {
+    "render", "sun", "lighting", "phase", "grid.voxel_size", "grid.origin", "density.tile", "density.band"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderSplat() {
@@ -94,6 +98,7 @@ const StageDescriptor& DescribeRenderSplat() {
         .symbol = "image",
         .rule = SplatImageRule,
         .choices = kSplatChoices,
+        .sceneFields = kRenderSplatSceneFields,
     };
     return descriptor;
 }

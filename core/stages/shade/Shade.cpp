@@ -127,6 +127,9 @@ ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
     return p;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kShadeSceneFields[] = {"shade", "sun", "phase", "grid.voxel_size", "layers.relight"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeShade() {
@@ -143,6 +146,7 @@ const StageDescriptor& DescribeShade() {
         .rule = ShadeRule,
         .ruleNote = "one storage quantum with fp16 or unorm8 storage",
         .choices = kShadeChoices,
+        .sceneFields = kShadeSceneFields,
     };
     return descriptor;
 }

@@ -59,6 +59,9 @@ ShadowParams MakeShadowParams(const Scene& sc, uint32_t step) {
     return p;
 }
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kShadowSceneFields[] = {"shadow", "shade.sigma", "sun", "grid.voxel_size"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeShadow() {
@@ -73,6 +76,7 @@ const StageDescriptor& DescribeShadow() {
         .symbol = "G",
         .rule = ShadowRule,
         .choices = kShadowChoices,
+        .sceneFields = kShadowSceneFields,
     };
     return descriptor;
 }

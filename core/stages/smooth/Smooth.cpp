@@ -36,6 +36,9 @@ void ReadSmooth(const Json& root, Validator& check, SmoothSettings& smooth) {
 
 namespace cb {
 
+// What its parameters read from the scene (StageDescriptor::sceneFields).
+constexpr std::string_view kSmoothSceneFields[] = {"smooth"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeSmooth() {
@@ -48,6 +51,7 @@ const StageDescriptor& DescribeSmooth() {
         .symbol = "q",
         .rule = BitExactRule,
         .choices = kSmoothChoices,
+        .sceneFields = kSmoothSceneFields,
     };
     return descriptor;
 }

@@ -35,10 +35,12 @@ std::string SettingsText(const json& row) {
 // The rows of sweep.json or accuracy.json (its stage rows, then its renderers' image rows) as points.
 std::vector<ParetoPoint> Points(const json& doc, const std::string& metric) {
     std::vector<ParetoPoint> points;
+    // psnr (sweep --metric psnr, renderers only) is the row's psnr_db; an infinite one (null: the image equals
+    // the reference) has no place on the axis and is left out of the plot.
     auto add = [&](const json& row, const std::string& stage, const json& error) {
         if (Str(row, "status") != "ok") return;
         const auto t = Number(Obj(row, "time"), "median_ms");
-        const auto e = Number(error, metric.c_str());
+        const auto e = metric == "psnr" ? Number(Obj(row, "error"), "psnr_db") : Number(error, metric.c_str());
         if (!t || !e) return;
         const std::string backend = Str(row, "backend");
         const bool image = IsRendererName(stage);
@@ -71,7 +73,9 @@ std::vector<report::Block> ParetoBlocks(const ReportInput& input) {
         const std::string what = name == "images" ? "the renderers' images" : name;
         plot.title = Str(doc, "scene") + ": " + what + " (" + FileName(input.path) + ")";
         plot.xLabel = "median time of the stage (ms, log)";
-        plot.yLabel = metric + " |error| vs the Embree reference";
+        plot.yLabel = metric == "psnr" ? "PSNR (dB) vs the exact reference render, higher is better"
+                                       : metric + " |error| vs the Embree reference";
+        plot.logY = metric != "psnr";  // decibels are a logarithm already
         std::vector<std::pair<double, double>> all, marked;
         for (const std::string& seriesName : series) {
             Series s{seriesName, {}, {}, {}, {}};
@@ -85,8 +89,9 @@ std::vector<report::Block> ParetoBlocks(const ReportInput& input) {
             }
             if (!s.x.empty()) plot.series.push_back(std::move(s));
         }
-        // sweep.json marks its front; for accuracy.json it is computed here over every point of the plot.
-        plot.front = sweep ? ParetoFront(marked) : ParetoFront(all);
+        // sweep.json marks its front (ties and PSNR's direction included); for accuracy.json it is computed here
+        // over every point of the plot.
+        plot.front = sweep ? marked : ParetoFront(all);
         if (sweep) std::ranges::sort(plot.front);
         blocks.emplace_back(report::Figure{
             "pareto", RenderParetoPlot(plot),

@@ -51,6 +51,12 @@ report::KeyValues ProvenanceItems(const json& provenance) {
     return kv;
 }
 
+// An input's provenance: its own, or for a perf compare file HEAD's (the file has none of its own).
+const json& ProvenanceOf(const ReportInput& input) {
+    return input.kind == InputKind::Compare ? Obj(Obj(input.doc, "head"), "provenance")
+                                            : Obj(input.doc, "provenance");
+}
+
 }  // namespace
 
 report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::vector<json>& history,
@@ -83,7 +89,7 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
     verdict.blocks.emplace_back(std::move(verdictTable));
     if (!inputs.empty()) {
         // The first input's provenance in short; every input's in full under "Provenance".
-        report::KeyValues summary = ProvenanceItems(Obj(inputs.front().doc, "provenance"));
+        report::KeyValues summary = ProvenanceItems(ProvenanceOf(inputs.front()));
         std::erase_if(summary.items, [](const auto& item) {
             return item.first != "commit" && item.first != "build" && item.first != "machine" && item.first != "date";
         });
@@ -130,6 +136,11 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
                                  std::move(matrix)}});
     }
 
+    // The regression gate: each perf compare file's verdict and table.
+    for (const ReportInput& input : inputs)
+        if (input.kind == InputKind::Compare)
+            out.sections.push_back({"Performance comparison (" + input.path + ")", CompareBlocks(input)});
+
     // Timing: tables beside the source documents' figures, distributions, frames.
     for (const ReportInput& input : inputs) {
         if (input.kind != InputKind::Results) continue;
@@ -144,8 +155,10 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
             "Median and quartiles of each stage's wall time per call over the steps after warm-up (" +
             Str(Obj(input.doc, "scene"), "steps", "?") + " steps, " +
             Str(Obj(input.doc, "scene"), "warmup_steps", "?") + " warm-up). Backends: " + backends +
-            ". The source documents' figures were measured on other hardware and scenes (the thesis's 256x32x256 "
-            "volume; "
+            ". A renderer's step draws every camera: its row `per camera frame` divides the step's time by the "
+            "frames a step draws (cameras x frames per rendering step), and the source documents' figures, a frame "
+            "each, stand beside that row. The source documents' figures were measured on other hardware and scenes "
+            "(the thesis's 256x32x256 volume; "
             "Olajos's are whole ray-marched frames; Wang, Ji and Zhang's whole layered frames with the light "
             "precomputed): a sense of scale, not a comparison of methods."});
         timing.blocks.emplace_back(TimingTable(input.doc));
@@ -173,15 +186,24 @@ report::Report BuildReport(const std::vector<ReportInput>& inputs, const std::ve
 
     Section provenance{"Provenance", {}};
     for (const ReportInput& input : inputs) {
+        if (input.kind == InputKind::Compare) {
+            for (const char* side : {"base", "head"}) {
+                provenance.blocks.emplace_back(report::Paragraph{input.path + " (perf compare, " +
+                                                                 (side[0] == 'b' ? "BASE" : "HEAD") + ": " +
+                                                                 Str(Obj(input.doc, side), "label") + ")"});
+                provenance.blocks.emplace_back(ProvenanceItems(Obj(Obj(input.doc, side), "provenance")));
+            }
+            continue;
+        }
         provenance.blocks.emplace_back(
             report::Paragraph{input.path + " (" + std::string(InputKindName(input.kind)) + ")"});
         provenance.blocks.emplace_back(ProvenanceItems(Obj(input.doc, "provenance")));
     }
     out.sections.push_back(std::move(provenance));
 
-    // Each input's own tables, as its command printed them.
+    // Each input's own tables, as its command printed them; a perf compare file's are its section above.
     for (const ReportInput& input : inputs) {
-        if (!input.doc.contains("report")) continue;
+        if (!input.doc.contains("report") || input.kind == InputKind::Compare) continue;
         const report::Report own = report::ReportFromJson(input.doc["report"]);
         for (const Section& s : own.sections)
             out.sections.push_back(

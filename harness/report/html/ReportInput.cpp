@@ -7,8 +7,10 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 
 #include "core/base/ShownText.h"
+#include "harness/perf/Compare.h"
 #include "harness/report/InputFormats.h"
 #include "harness/report/html/ReportJson.h"
 
@@ -18,14 +20,16 @@ namespace {
 // The report's input at `path` (a file the user named), or, with `folder`, the file `path` names inside the folder
 // the user named, read beneath it.
 Result<ReportInput> ReadOne(const std::string& path, const std::string& folder = "") {
-    static constexpr std::array<std::pair<input::Format, InputKind>, 4> kFormats = {{
+    static constexpr std::array<std::pair<input::Format, InputKind>, 5> kFormats = {{
         {input::Format::Results, InputKind::Results},
         {input::Format::Conform, InputKind::Conform},
         {input::Format::Accuracy, InputKind::Accuracy},
         {input::Format::Sweep, InputKind::Sweep},
+        {input::Format::PerfCompare, InputKind::Compare},
     }};
-    static constexpr std::array<input::Format, 4> kAccepted = {input::Format::Results, input::Format::Conform,
-                                                               input::Format::Accuracy, input::Format::Sweep};
+    static constexpr std::array<input::Format, 5> kAccepted = {input::Format::Results, input::Format::Conform,
+                                                               input::Format::Accuracy, input::Format::Sweep,
+                                                               input::Format::PerfCompare};
     auto read = folder.empty()
                     ? input::ReadCloudbenchFile(path, kAccepted)
                     : input::ReadCloudbenchFileBeneath(folder, std::filesystem::path(path).filename().string(), kAccepted);
@@ -58,6 +62,8 @@ std::string_view InputKindName(InputKind kind) {
             return "accuracy";
         case InputKind::Sweep:
             return "sweep";
+        case InputKind::Compare:
+            return "perf compare";
     }
     return "";
 }
@@ -70,16 +76,24 @@ Result<std::vector<ReportInput>> ReadReportInput(const std::string& path) {
         return std::vector<ReportInput>{std::move(*one)};
     }
     std::vector<ReportInput> inputs;
-    for (const char* name : {"results.json", "conform.json", "accuracy.json", "sweep.json"}) {
+    const auto there = [&](const char* name) {
+        return std::filesystem::exists(std::filesystem::symlink_status(std::filesystem::path(path) / name, ec));
+    };
+    if (there(perf::kInterleaveFile) && !there(perf::kKeptVerdictFile))
+        return MakeError((std::filesystem::path(path) / perf::kKeptVerdictFile).string() +
+                         ": missing: this kept interleave has no verdict (the live perf compare stopped before it); "
+                         "`cloudbench perf compare " + path + " --json FILE` judges its runs, and report takes FILE");
+    for (const char* name : {"results.json", "conform.json", "accuracy.json", "sweep.json", perf::kKeptVerdictFile}) {
         const std::string file = (std::filesystem::path(path) / name).string();
         // A name that is there in any form (a link, a FIFO) is read, so that ReadOne says what is wrong with it.
-        if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) continue;
+        if (!there(name)) continue;
         auto one = ReadOne(file, path);
         if (!one) return std::unexpected(one.error());
         inputs.push_back(std::move(*one));
     }
     if (inputs.empty())
-        return MakeError(path + ": no results.json, conform.json, accuracy.json or sweep.json in this folder");
+        return MakeError(path + ": no results.json, conform.json, accuracy.json, sweep.json or compare.json in this "
+                                "folder");
     return inputs;
 }
 
@@ -121,25 +135,62 @@ Verdict VerdictOf(const ReportInput& input) {
         }
         case InputKind::Accuracy:
         case InputKind::Sweep: {
-            std::string broken;
+            std::string broken, why;
             bool measured = false;
+            size_t reasons = 0;
             for (const json& r : Arr(doc, "rows")) {
                 const std::string status = Str(r, "status");
                 measured |= status == "ok";
                 if (!Finished(status))
                     broken +=
                         (broken.empty() ? "" : ", ") + Str(r, "stage") + " on " + Str(r, "backend") + " " + status;
+                // Why nothing was measured: the first few distinct reasons.
+                const std::string detail = Str(r, "detail");
+                if (status != "ok" && !detail.empty() && reasons < 3 && why.find(detail) == std::string::npos) {
+                    why += (why.empty() ? ": " : "; ") + Str(r, "stage") + " on " + Str(r, "backend") + " " +
+                           status + ": " + detail;
+                    ++reasons;
+                }
             }
             if (!broken.empty()) return {1, broken};
-            if (!measured) return {4, "no row was measured"};
+            if (!measured) return {4, "no row was measured" + why};
             return {};
+        }
+        case InputKind::Compare: {
+            // The exit code perf compare recorded, and why: the regressions, the rows HEAD lacks, the failed runs,
+            // the cut.
+            Verdict v{int(Number(doc, "exit_code").value_or(0)), ""};
+            std::string regressions, missing;
+            for (const json& c : Arr(doc, "comparisons")) {
+                const std::string name = Str(c, "scene") + "/" + Str(c, "backend") + "/" + Str(c, "stage") +
+                                         (Str(c, "metric") == "time" ? "" : " instructions");
+                const std::optional<double> ratio = Number(c, "ratio");
+                if (c.value("regression", false))
+                    regressions += (regressions.empty() ? "" : ", ") + name + " (x" +
+                                   (ratio ? Fixed(*ratio, "%.2f") : std::string("?")) + ")";
+                if (Str(c, "mark") == "x") missing += (missing.empty() ? "" : ", ") + name;
+            }
+            const size_t failed = Arr(doc, "failed_runs").size();
+            if (!regressions.empty())
+                v.reason = "regression: " + regressions;
+            else if (!missing.empty())
+                v.reason = "HEAD failed or lacks a measurement (x): " + missing;
+            else if (failed)
+                v.reason = std::to_string(failed) + (failed == 1 ? " run failed" : " runs failed");
+            else if (!Str(doc, "cut_short").empty())
+                v.reason = Str(doc, "cut_short");
+            else if (v.exitCode == 6)
+                v.reason = "regression";
+            else if (v.exitCode != 0)
+                v.reason = "perf compare could not write its output";
+            return v;
         }
     }
     return {};
 }
 
 int CombinedExitCode(const std::vector<Verdict>& verdicts) {
-    for (int code : {1, 5, 4})
+    for (int code : {1, 5, 6, 4})
         for (const Verdict& v : verdicts)
             if (v.exitCode == code) return code;
     for (const Verdict& v : verdicts)

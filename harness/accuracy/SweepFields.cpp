@@ -1,0 +1,85 @@
+#include "harness/accuracy/SweepFields.h"
+
+#include <algorithm>
+#include <initializer_list>
+#include <set>
+#include <string>
+
+#include "core/plan/StageGraph.h"
+#include "harness/accuracy/Evaluator.h"
+
+namespace cb {
+namespace {
+
+bool SweepFieldsListed(std::span<const std::string_view> fields, std::string_view path) {
+    return std::ranges::any_of(fields, [&](std::string_view f) { return FieldsOverlap(path, f); });
+}
+
+// Depth-first over the writers of the stage's inputs; `seen` stops at a stage that reads its own outputs.
+bool SweepFieldsReach(Stage stage, std::string_view path, std::set<Stage>& seen) {
+    if (!seen.insert(stage).second) return false;
+    const StageDescriptor& d = Describe(stage);
+    if (SweepFieldsListed(d.sceneFields, path)) return true;
+    std::vector<Resource> inputs = d.reads;
+    inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
+    for (Stage writer : kAllStages) {
+        const std::vector<Resource>& writes = Describe(writer).writes;
+        const bool feeds =
+            std::ranges::any_of(inputs, [&](Resource r) { return std::ranges::find(writes, r) != writes.end(); });
+        if (feeds && SweepFieldsReach(writer, path, seen)) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+bool StageOutputReads(Stage stage, std::string_view path) {
+    if (SweepFieldsListed(kFieldsEveryStageReads, path)) return true;
+    std::set<Stage> seen;
+    return SweepFieldsReach(stage, path, seen);
+}
+
+bool RowDependsOn(Stage stage, std::string_view path) {
+    if (StageOutputReads(stage, path)) return true;
+    return Describe(stage).renderer && StageOutputReads(Stage::RenderMarch, path) && !ReferenceRenderIgnores(path);
+}
+
+std::vector<SceneOverride> SettingsRead(Stage stage, std::span<const SceneOverride> setting) {
+    std::vector<SceneOverride> out;
+    for (const SceneOverride& o : setting)
+        if (RowDependsOn(stage, o.path)) out.push_back(o);
+    return out;
+}
+
+std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
+    // The renderers' reference render costs most: images are measured only when an image section varies.
+    const bool images = std::ranges::any_of(axes, [](const SweepAxis& a) {
+        return std::ranges::any_of(
+            std::initializer_list<std::string_view>{"march", "render", "lightning", "phase", "layers"},
+            [&](std::string_view section) { return FieldsOverlap(a.path, section); });
+    });
+    std::vector<Stage> candidates = {Stage::Shade, Stage::Shadow};
+    if (images) candidates.insert(candidates.end(), {Stage::RenderMarch, Stage::RenderSplat, Stage::RenderLayers});
+    std::vector<Stage> stages;
+    for (Stage stage : candidates)
+        if (std::ranges::any_of(axes, [&](const SweepAxis& a) { return RowDependsOn(stage, a.path); }))
+            stages.push_back(stage);
+    return stages;
+}
+
+std::vector<std::vector<Stage>> DistinctMeasurements(const std::vector<std::vector<SceneOverride>>& points,
+                                                     std::span<const Stage> stages) {
+    std::vector<std::vector<Stage>> out(points.size());
+    for (Stage stage : stages) {
+        std::set<std::vector<std::pair<std::string, std::string>>> seen;
+        for (size_t k = 0; k < points.size(); ++k) {
+            std::vector<std::pair<std::string, std::string>> key;
+            for (const SceneOverride& o : SettingsRead(stage, points[k])) key.emplace_back(o.path, o.value);
+            if (seen.insert(std::move(key)).second) out[k].push_back(stage);
+        }
+    }
+    // Each point's stages in the order of `stages`.
+    return out;
+}
+
+}  // namespace cb

@@ -1,0 +1,66 @@
+#include "harness/accuracy/SweepPareto.h"
+
+#include <limits>
+
+#include "core/plan/StageGraph.h"
+
+namespace cb {
+namespace {
+
+// The renderers share one front.
+Stage SweepParetoGroup(Stage s) { return Describe(s).renderer ? Stage::RenderMarch : s; }
+
+bool SweepClearlyFaster(const Row& a, const Row& b) { return a.result.timeMs.q3 < b.result.timeMs.q1; }
+
+bool SweepOnFront(const Row& r, std::string_view metric) {
+    return r.result.status == "ok" && MetricApplies(metric, r.stage);
+}
+
+}  // namespace
+
+bool IsSweepMetric(std::string_view metric) {
+    return metric == "max" || metric == "mean" || metric == "p99" || metric == "psnr";
+}
+
+bool MetricApplies(std::string_view metric, Stage stage) {
+    return IsSweepMetric(metric) && (metric != "psnr" || Describe(stage).renderer);
+}
+
+double MetricLoss(const Row& row, std::string_view metric) {
+    const ErrorStats& e = row.result.all;
+    if (metric == "psnr") return row.result.psnrDb ? -*row.result.psnrDb : -std::numeric_limits<double>::infinity();
+    return metric == "mean" ? e.mean : metric == "p99" ? e.p99 : e.max;
+}
+
+bool ParetoBeats(const Row& a, const Row& b, std::string_view metric) {
+    const double la = MetricLoss(a, metric), lb = MetricLoss(b, metric);
+    if (!(la <= lb) || SweepClearlyFaster(b, a)) return false;
+    return SweepClearlyFaster(a, b) || la < lb;
+}
+
+void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
+    for (Row& r : rows) {
+        r.pareto = false;
+        r.paretoTie = false;
+        if (!SweepOnFront(r, metric)) continue;
+        r.pareto = true;
+        for (const Row& o : rows)
+            if (&o != &r && SweepOnFront(o, metric) && SweepParetoGroup(o.stage) == SweepParetoGroup(r.stage) &&
+                ParetoBeats(o, r, metric)) {
+                r.pareto = false;
+                break;
+            }
+    }
+    for (Row& r : rows) {
+        if (!r.pareto) continue;
+        for (const Row& o : rows)
+            if (&o != &r && o.pareto && SweepParetoGroup(o.stage) == SweepParetoGroup(r.stage) &&
+                MetricLoss(o, metric) == MetricLoss(r, metric) && !SweepClearlyFaster(o, r) &&
+                !SweepClearlyFaster(r, o)) {
+                r.paretoTie = true;
+                break;
+            }
+    }
+}
+
+}  // namespace cb

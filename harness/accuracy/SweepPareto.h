@@ -1,0 +1,34 @@
+// The Pareto front of `cloudbench sweep` and `merge` over measured rows, with
+// ties within the timing noise (docs/accuracy.md, "Sweeps: which rows, the
+// Pareto front and ties").
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "harness/accuracy/Measurement.h"
+
+namespace cb {
+
+// The error metrics a sweep's front may use: max, mean and p99 of |error| (lower is better) and psnr (the
+// renderers' images only; higher is better).
+bool IsSweepMetric(std::string_view metric);
+// Whether `metric` is defined for a row of `stage` (psnr: renderers only).
+bool MetricApplies(std::string_view metric, Stage stage);
+
+// An ok row's error on `metric` as a loss, lower is better: the statistic over all elements, or -PSNR in dB
+// (-infinity for an image equal to the reference, whose PSNR is infinite).
+double MetricLoss(const Row& row, std::string_view metric);
+
+// Whether ok row `a` beats ok row `b` on the front: a's loss is at most b's and b is not clearly faster,
+// and a is clearly faster or its loss is smaller. Clearly faster: its time's q3 is below the other's q1
+// (the q1-q3 intervals do not overlap).
+bool ParetoBeats(const Row& a, const Row& b, std::string_view metric);
+
+// Marks the front per stage (the renderers share one: they make the same image): a row is on it (pareto)
+// when it is ok, its metric applies, and no other such row beats it; a front row whose loss equals another
+// front row's and whose q1-q3 time interval overlaps that row's is a tie (paretoTie) for both.
+void MarkPareto(std::vector<Row>& rows, const std::string& metric);
+
+}  // namespace cb
