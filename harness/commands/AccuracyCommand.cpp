@@ -33,7 +33,8 @@ over the voxels in cloud (q > 0) or ground cells under cloud (G_ref < 1), the
 reference's own speed in rays per second, and writes DIR/accuracy.json and
 DIR/accuracy.md.
 
-With render_march and/or render_splat in the scene it also renders the exact
+With a renderer in the scene (render_splat, render_march, render_layers; a
+tiled volume is not rendered by the reference yet) it also renders the exact
 reference image (render_march's kernel with exact light toward the sun and the
 point light, a fine step, no early termination, no jitter) and measures each
 renderer on each backend against it: the scene's settings, then for
@@ -49,7 +50,7 @@ Options:
   --switches         also cross the principal axis's 45-degree switches: error on
                      each side (1e-6 rad, 1e-3 rad, 1 degree) and the jump in T
   --reference-step X the exact reference render's step in voxel edges (default
-                     0.125), for scenes with render_march or render_splat
+                     0.125), for scenes with a renderer
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/accuracy)
   --set PATH=VALUE   override a scene field (see cloudbench help run)

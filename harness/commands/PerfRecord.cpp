@@ -114,7 +114,7 @@ int Record(const std::vector<std::string>& args, const CommonOptions& options) {
             const std::string out = temporary.path + "/" + std::to_string(suiteJson.size()) + "-" + std::to_string(r);
             const auto runStart = std::chrono::steady_clock::now();
             if (!a.Has("--quiet"))
-                std::fprintf(stderr, "perf record: %s (%d of %d)\n", entry.scene.c_str(), r + 1, int(repeat));
+                std::fprintf(stderr, "perf record: %s, run %d of %d\n", entry.scene.c_str(), r + 1, int(repeat));
             bool compared = false;
             if (auto code = RunInto(self, entry.scene, runArgs, out, temporary.path + "/runs.log", side, failed, -1,
                                     nullptr, &compared))
