@@ -7,8 +7,10 @@ usage: check_path_policy.py CLOUDBENCH WORKDIR [TARGET_REGEX]
 Each target is one file a command reads or writes: a scene, a results folder's
 results.json and the frames it lists, a report's history, a kept interleave's
 manifest and runs, a perf history, a suite, a conform baseline, a sweep shard,
-a saved state's manifest and arrays; report -o, perf history --json, perf
-record --history, a kept interleave's runs.log and run --out's results.json.
+a saved state's manifest and arrays, a perf compare verdict (a --json file,
+or a kept folder's compare.json); report -o, perf history --json, perf record
+--history, a kept interleave's runs.log and compare.json, and run --out's
+results.json.
 Its file is replaced in turn by
 
   link-out   a symbolic link to a valid file of the same kind outside the folder
@@ -101,6 +103,8 @@ class Fixtures:
         (kept / "interleave.json").write_text(json.dumps(
             {"format": "cloudbench-interleave/1", "base": CLI, "head": CLI, "scenes": ["ci-small"], "rounds": 1,
              "order": "ABBA", "run_options": [], "runs": runs}))
+        # Its verdict, as --keep writes it when the comparison ends (report DIR reads it).
+        must("perf", "compare", kept, "--json", kept / "compare.json")
 
 
 def copy_tree(source, target):
@@ -211,6 +215,15 @@ def targets(fx, work):
         copy_tree(f / "kept", d / "kept")
         return ["perf", "compare", d / "kept"], d / "kept" / "base" / "r01-ci-small" / "results.json", results_bytes
 
+    def kept_verdict(d):
+        copy_tree(f / "kept", d / "kept")
+        return (["report", d / "kept", "-o", d / "page.html"], d / "kept" / "compare.json",
+                (f / "kept" / "compare.json").read_bytes())
+
+    def compare_file(d):
+        return (["report", d / "compare.json", "-o", d / "page.html"], d / "compare.json",
+                (f / "kept" / "compare.json").read_bytes())
+
     def history(d):
         return ["perf", "history", d / "h.jsonl"], d / "h.jsonl", (f / "history.jsonl").read_bytes()
 
@@ -252,6 +265,12 @@ def targets(fx, work):
         return (["perf", "compare", "--interleave", CLI, CLI, "ci-small", "--rounds", "1", "--steps", "2",
                  "--set", "warmup_steps=0", "--backend", "cpu", "--quiet", "--keep", d / "kept"], d / "kept" / "runs.log", b"")
 
+    def kept_verdict_out(d):
+        (d / "kept").mkdir()
+        return (["perf", "compare", "--interleave", CLI, CLI, "ci-small", "--rounds", "1", "--steps", "2",
+                 "--set", "warmup_steps=0", "--backend", "cpu", "--quiet", "--keep", d / "kept"],
+                d / "kept" / "compare.json", b"{}")
+
     def run_out(d):
         (d / "out").mkdir()
         return ["run", "ci-small", "--steps", "1", *QUICK, "--out", d / "out"], d / "out" / "results.json", b"{}"
@@ -265,6 +284,11 @@ def targets(fx, work):
         Target("report --history FILE", "named", "history", report_history, empty=None),
         Target("perf compare DIR: interleave.json", "beneath", "document", kept_manifest, empty=empty_json),
         Target("perf compare DIR: a run's results.json", "beneath", "document", kept_run, empty=empty_json),
+        Target("report DIR: a kept interleave's compare.json", "beneath", "document", kept_verdict,
+               empty=empty_json),
+        # report takes a folder as well as a file: an empty folder in the file's place holds none it reads.
+        Target("report FILE: a perf compare --json file", "named", "document", compare_file, empty=empty_json,
+               overrides={"folder": r"no results.json, conform.json, accuracy.json, sweep.json or compare.json"}),
         # An empty history is a history of no record yet: "0 change points ... over 0 records".
         Target("perf history FILE", "named", "history", history, overrides={"empty": None}),
         Target("perf record --suite FILE", "named", "document", suite, empty=empty_json),
@@ -277,6 +301,7 @@ def targets(fx, work):
         Target("perf history --json FILE", "writer", None, history_json, refused_codes=(1,)),
         Target("perf record --history FILE", "writer", None, record_history, refused_codes=(1,)),
         Target("perf compare --keep DIR: runs.log", "writer", None, kept_log, refused_codes=(1,)),
+        Target("perf compare --keep DIR: compare.json", "writer", None, kept_verdict_out, refused_codes=(1,)),
         Target("run --out DIR: results.json", "writer", None, run_out, refused_codes=(1,)),
     ]
 
