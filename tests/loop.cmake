@@ -93,3 +93,11 @@ print("sliced loop checked")
 PY]=])
 add_test(NAME Cli.LoopTimeSlicedRun COMMAND /bin/sh -c "${cli_loop_sliced_script}" ${cli} ${cli_out}/loop-sliced)
 set_tests_properties(Cli.LoopTimeSlicedRun PROPERTIES TIMEOUT 300 PASS_REGULAR_EXPRESSION "sliced loop checked")
+
+# No state survives a call that should not: the sun sets below the horizon at step 3 and rises again by step 6, every
+# step rendered, and every backend's every step must equal the CPU's. A backend that kept "no sun" set after sunset
+# (gl's shadow program setting its noSun uniform only to 1) draws no shadow after sunrise: shadow fails at step 5.
+add_test(NAME Cli.ConformSunsetSunrise COMMAND ${cli} conform ${CMAKE_CURRENT_SOURCE_DIR}/scenes/sunset-sunrise.json
+         --out ${cli_out}/conform-sunset-sunrise)
+set_tests_properties(Cli.ConformSunsetSunrise PROPERTIES TIMEOUT 120
+                     PASS_REGULAR_EXPRESSION "; exit 0, every compared row conforms")
