@@ -49,3 +49,20 @@ add_test(NAME Cli.ConformLargeSplats
                  --out ${cli_out}/conform-large-splats)
 set_tests_properties(Cli.ConformLargeSplats PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
                      TIMEOUT 300)
+# NaN, +Inf and -Inf planted in the first non-CPU backend's T through the test-only
+# CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE switch: conform exits 5 and its table names the voxel and the value.
+if(DEFINED conform_features_backend)
+  foreach(value IN ITEMS nan inf -inf)
+    add_test(NAME Cli.ConformNonFinite.${value} COMMAND /bin/sh -c [=[
+      mkdir -p "$(dirname "$2")"
+      "$0" conform ci-small --steps 1 --backend "$1" --out "$2" > "$2.log" 2>&1; rc=$?
+      cat "$2.log"
+      [ "$rc" = 5 ] && grep -q "step 0 at (0, 0, 0): not finite: cpu [0-9.e+-]*, $1 $3" "$2.log" &&
+        echo "conform non-finite: ok"
+    ]=] ${cli} ${conform_features_backend} ${cli_out}/conform-nonfinite-${value} ${value})
+    set_tests_properties(Cli.ConformNonFinite.${value} PROPERTIES PASS_REGULAR_EXPRESSION "conform non-finite: ok"
+                         ENVIRONMENT
+                         "CLOUDBENCH_TEST_CONFORM_MISMATCH=${conform_features_backend}:shade;CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE=${value}"
+                         TIMEOUT 300)
+  endforeach()
+endif()

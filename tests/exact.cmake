@@ -6,7 +6,9 @@
 # cloudbench target in ${CMAKE_BINARY_DIR}/exact-tests with the exact preset's
 # settings, CPU backend only (the counts are the CPU's), and the count tests run
 # that binary. Without valgrind the counting tests are not registered; the
-# refusals below still are.
+# refusals below still are. The counting tests (and the build) carry the
+# label `slow`, which tools/mutate.py's CTest oracle leaves out; the refusals,
+# a second each, do not.
 
 # A native binary refuses to count, naming the exact preset (exit 4).
 if(CLOUDBENCH_NATIVE)
@@ -31,6 +33,9 @@ if(NOT VALGRIND_EXECUTABLE OR NOT CALLGRIND_INCLUDE_DIR)
   message(STATUS "exact mode tests: valgrind or valgrind/callgrind.h not found; counting tests not registered")
   return()
 endif()
+
+# Every test registered below this line, labelled `slow` at the end of the file.
+get_directory_property(exact_tests_before TESTS)
 
 if(CLOUDBENCH_NATIVE)
   set(exact_dir ${CMAKE_BINARY_DIR}/exact-tests)
@@ -101,3 +106,7 @@ add_test(NAME Exact.CountOutputDiskSaysWhy COMMAND /usr/bin/python3 ${CMAKE_CURR
 set_tests_properties(Exact.CountOutputLinkRefused Exact.CountOutputDiskSaysWhy PROPERTIES FIXTURES_REQUIRED exact_build
                      TIMEOUT 300 FAIL_REGULAR_EXPRESSION "FAIL: ")
 set_tests_properties(Exact.CountOutputDiskSaysWhy PROPERTIES SKIP_RETURN_CODE 77)
+
+get_directory_property(exact_tests_after TESTS)
+list(REMOVE_ITEM exact_tests_after ${exact_tests_before})
+set_tests_properties(${exact_tests_after} PROPERTIES LABELS "exact;slow")

@@ -4,7 +4,8 @@
 #   Sanitized.*  the sanitized CLI (clang, ASan + UBSan with float-cast-overflow, every check fatal) on bad
 #                command lines, bad and extreme scenes, and short CPU runs: each must exit with its expected code
 #                and print no sanitizer report (label `sanitized`).
-# Leave both out locally with `ctest -LE 'fuzz|sanitized'`.
+# Both also carry the label `slow` (minutes, on a second build), which tools/mutate.py's CTest oracle leaves out.
+# Leave both out locally with `ctest -LE 'fuzz|sanitized'` (or `-LE slow`).
 if(NOT CLOUDBENCH_SANITIZED)
   return()
 endif()
@@ -17,7 +18,7 @@ set(sanitized_env "UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1"
 set(fuzz_dir ${CMAKE_CURRENT_BINARY_DIR}/fuzz)
 add_test(NAME Fuzz.SeedCorpus COMMAND /usr/bin/python3 ${CLOUDBENCH_ROOT}/fuzz/make_corpus.py ${CLOUDBENCH_ROOT}
                                       ${fuzz_dir}/seeds)
-set_tests_properties(Fuzz.SeedCorpus PROPERTIES FIXTURES_SETUP fuzz_seeds LABELS fuzz
+set_tests_properties(Fuzz.SeedCorpus PROPERTIES FIXTURES_SETUP fuzz_seeds LABELS "fuzz;slow"
                      PASS_REGULAR_EXPRESSION "make_corpus: [0-9]+ seeds")
 # New inputs go to fuzz/corpus (kept between local runs), crash files to fuzz/artifacts. libFuzzer exits non-zero on
 # a crash, a sanitizer report, a leak, an input slower than -timeout or memory above -rss_limit_mb (no
@@ -25,7 +26,7 @@ set_tests_properties(Fuzz.SeedCorpus PROPERTIES FIXTURES_SETUP fuzz_seeds LABELS
 add_test(NAME Fuzz.SceneParser60s
          COMMAND /bin/sh -c "mkdir -p \"$1/corpus\" \"$1/artifacts\" && exec \"$0\" -max_total_time=60 -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 -dict=\"$2\" -artifact_prefix=\"$1/artifacts/\" \"$1/corpus\" \"$1/seeds\""
                  ${CLOUDBENCH_SCENE_FUZZER} ${fuzz_dir} ${CLOUDBENCH_ROOT}/fuzz/scene.dict)
-set_tests_properties(Fuzz.SceneParser60s PROPERTIES FIXTURES_REQUIRED fuzz_seeds LABELS fuzz TIMEOUT 300
+set_tests_properties(Fuzz.SceneParser60s PROPERTIES FIXTURES_REQUIRED fuzz_seeds LABELS "fuzz;slow" TIMEOUT 300
                      ENVIRONMENT "${sanitized_env}"
                      FAIL_REGULAR_EXPRESSION "runtime error:|ERROR: AddressSanitizer|ERROR: LeakSanitizer|ERROR: libFuzzer|invariant broken")
 
@@ -39,7 +40,7 @@ set(sanitized_names)
 function(sanitized_case name codes)
   add_test(NAME Sanitized.${name} COMMAND ${CMAKE_COMMAND} -DCMD=${CLOUDBENCH_SANITIZED_CLI} "-DARGS=${ARGN}"
            "-DEXPECT=${codes}" -P ${CLOUDBENCH_ROOT}/cmake/ExpectCleanExit.cmake)
-  set_tests_properties(Sanitized.${name} PROPERTIES LABELS sanitized TIMEOUT 300 ENVIRONMENT "${sanitized_env}")
+  set_tests_properties(Sanitized.${name} PROPERTIES LABELS "sanitized;slow" TIMEOUT 300 ENVIRONMENT "${sanitized_env}")
 endfunction()
 
 # sanitized_scene(NAME "EXIT CODES" TEXT): TEXT written as NAME.json, run for one step on the CPU.
@@ -106,4 +107,4 @@ sanitized_scene(DeepNesting 3 "{\"grid\": {\"size\": [8, 4, 4]}, \"description\"
 add_test(NAME Sanitized.BadInputs
          COMMAND /usr/bin/python3 ${CLOUDBENCH_ROOT}/tests/check_bad_inputs.py --cli ${CLOUDBENCH_SANITIZED_CLI}
                  --jobs 2 --skip-rlimit)
-set_tests_properties(Sanitized.BadInputs PROPERTIES LABELS sanitized TIMEOUT 1200 ENVIRONMENT "${sanitized_env}")
+set_tests_properties(Sanitized.BadInputs PROPERTIES LABELS "sanitized;slow" TIMEOUT 1200 ENVIRONMENT "${sanitized_env}")

@@ -12,7 +12,8 @@ incrementally) with its own build folder.
 
 Oracles, cheapest first (a mutant stops at the first that catches it unless --all-oracles):
   conform   `cloudbench conform ci-small` on every built backend
-  ctest     the CTest suite less --ctest-exclude, with --stop-on-failure
+  ctest     the CTest suite less the tests labelled --ctest-exclude-label (default `slow`: the sanitized build, the
+            fuzzer, exact mode's counts, the benchmarks) and less --ctest-exclude's names, with --stop-on-failure
   medium    `cloudbench conform thesis-medium`
 A run past an oracle's timeout counts as caught (a hang), and is marked so. A mutant whose build fails is
 "build-broken": a bad mutant, reported and never counted as caught.
@@ -213,9 +214,11 @@ def oracle_conform(scene, tree, build, out, logs, mid, timeout, env):
     return result
 
 
-def ctest_cmd(build, exclude, jobs, junit, timeout_each, stop):
+def ctest_cmd(build, exclude, jobs, junit, timeout_each, stop, label_exclude=""):
     cmd = ["ctest", "--test-dir", build, "-j", str(jobs), "--output-on-failure", "--output-junit", junit,
            "--timeout", str(timeout_each), "-E", exclude]
+    if label_exclude:
+        cmd += ["-LE", label_exclude]
     if stop:
         cmd.append("--stop-on-failure")
     return cmd
@@ -240,7 +243,8 @@ def oracle_ctest(args, build, logs, mid, exclude, env):
     junit = os.path.join(logs, f"{mid}.ctest.xml")
     if os.path.exists(junit):
         os.remove(junit)
-    cmd = ctest_cmd(build, exclude, args.jobs, junit, args.test_timeout, not args.all_oracles)
+    cmd = ctest_cmd(build, exclude, args.jobs, junit, args.test_timeout, not args.all_oracles,
+                    args.ctest_exclude_label)
     # Without cost data CTest runs the tests in their declared order, unit tests before the long CLI runs, so a
     # stop at the first failure comes sooner; the data of the last run would put the longest tests first.
     cost = os.path.join(build, "Testing", "Temporary", "CTestCostData.txt")
@@ -400,8 +404,11 @@ def main():
     p.add_argument("--all-oracles", action="store_true", help="run every oracle on every mutant")
     p.add_argument("--oracles", default=",".join(ORACLES), help="which oracles, in order (default all three)")
     p.add_argument("-j", "--jobs", type=int, default=2, help="build and ctest parallelism (default 2)")
-    p.add_argument("--ctest-exclude", default=r"^(Exact|Fuzz|Perf|Sanitized|Bench)\.",
-                   help="tests CTest leaves out, a regex (Tools.MutantsApply is always left out)")
+    p.add_argument("--ctest-exclude-label", default="slow",
+                   help="CTest leaves out the tests with a label matching this regex (ctest -LE; default slow: "
+                        "the sanitized build, the fuzzer, exact mode's counts, the benchmarks; '' for none)")
+    p.add_argument("--ctest-exclude", default="",
+                   help="tests CTest also leaves out by name, a regex (Tools.MutantsApply is always left out)")
     p.add_argument("--conform-timeout", type=float, default=300, help="seconds for conform ci-small")
     p.add_argument("--ctest-timeout", type=float, default=2400, help="seconds for the whole CTest oracle")
     p.add_argument("--test-timeout", type=int, default=300, help="seconds for one CTest test")
@@ -457,7 +464,8 @@ def main():
     commit = git(tree, "rev-parse", "HEAD").stdout.strip()
     results = {"format": "cloudbench-mutate/1", "commit": commit, "tree": tree, "build": build_dir,
                "started": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-               "oracles": args.oracles, "ctest_exclude": args.ctest_exclude, "mutants": {}}
+               "oracles": args.oracles, "ctest_exclude": args.ctest_exclude,
+               "ctest_exclude_label": args.ctest_exclude_label, "mutants": {}}
     if args.resume and os.path.exists(results_path):
         with open(results_path, encoding="utf-8") as f:
             old = json.load(f)

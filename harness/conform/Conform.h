@@ -42,7 +42,10 @@ using ConformProgress = std::function<void(uint32_t step, const std::vector<Conf
 // which perturbs that backend's output of that row (its first element: a float by 1, down from 0.5 up, so that a code
 // stored clamped to [0, 1] changes too; a byte by flipping its top bit; the cover by 1) before it is compared, on
 // attempts below <attempts> (default: every attempt), in the case named after '@' (default: every case). With
-// CLOUDBENCH_TEST_CONFORM_MISMATCH_EVERY=1 a byte row has every element one code off instead.
+// CLOUDBENCH_TEST_CONFORM_MISMATCH_EVERY=1 a byte row has every element one code off instead; with
+// CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE=nan, inf or -inf a float row's first element is set to that value.
+// A NaN or Inf in a float output, the backend's or the CPU's, fails its row whatever the rule: worst = inf and
+// the detail names the step, the voxel (or camera, pixel and channel) and both values.
 Result<std::vector<ConformRow>> RunConformance(const Scene& scene, Backend& cpu, std::span<const OpenedBackend> others,
                                                const ConformProgress& afterStep = {},
                                                const std::string& differenceDir = "", uint32_t attempt = 0,

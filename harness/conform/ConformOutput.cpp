@@ -15,6 +15,7 @@
 #include "core/scene/SceneNames.h"
 #include "harness/conform/Conform.h"
 #include "harness/platform/Command.h"
+#include "harness/platform/TransferJson.h"
 
 namespace cb {
 namespace {
@@ -57,8 +58,8 @@ nlohmann::json ConformJson(const Scene& scene, const std::vector<ConformRow>& ro
                         {"backend", r.backend},
                         {"status", r.status},
                         {"rule", r.rule},
-                        {"worst", r.worst},
-                        {"tolerance", r.tolerance},
+                        {"worst", transfer::D(r.worst)},
+                        {"tolerance", transfer::D(r.tolerance)},
                         {"detail", r.detail},
                         {"difference_image", r.differenceImage}});
     for (size_t i = 0; i < rows.size(); ++i)
