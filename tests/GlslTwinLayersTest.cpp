@@ -25,7 +25,8 @@ using test::W;
 using test::WF;
 using test::Words;
 
-constexpr uint32_t kLayersRayFn = 60, kLayersTapsFn = 61, kLayerFragmentFn = 62, kLayersPixelFn = 63;
+constexpr uint32_t kLayersRayFn = 60, kLayersTapsFn = 61, kLayerFragmentFn = 62, kLayersPixelFn = 63,
+                   kLayersFadeFn = 64;
 
 // A random layered call: a grid up to 40 x 40 x 24, a camera below, inside or above it, tiled or not, a layer
 // count from a quarter to four per voxel, an extent that cuts some rays, every phase, beer or wang opacity (the
@@ -69,6 +70,8 @@ LayersParams RandomLayersParams(Pcg32& r, std::vector<float>& map) {
     map.resize(size_t(e.nx) * e.ny);
     for (uint32_t i = 0; i < map.size(); ++i) map[i] = test::TwinLayersMap(i);
     s.map = map.data();
+    const float fade = Uniform(r, 0.05f, 1);  // one call in three without the falloff
+    s.fadeInv2 = r.Below(3) == 0 ? 0.0f : 1.0f / (s.outer2 * fade * (2.0f - fade));
     return p;
 }
 
@@ -146,6 +149,13 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
                         s, MakeLayersWalks(s), MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]), TwinFetch);
                     out = W({Bits(r.color[0]), Bits(r.color[1]), Bits(r.color[2]), r.fragments, r.drawn});
                     fragments += r.fragments;
+                });
+        // LayersFade across its inner radius, the band, the extent and beyond.
+        std::vector<Words> fadeIn;
+        for (int n = 0; n < 200; ++n) fadeIn.push_back(WF({Uniform(rng, 0, 1.5f * s.outer2), s.outer2, s.fadeInv2}));
+        Compare("LayersFade", {Kind::F}, ulps, fadeIn, Run(kLayersFadeFn, fadeIn, {}, {}, g),
+                [&](const Words& in, Words& out) {
+                    out = W({Bits(LayersFade(Float(in[0]), Float(in[1]), Float(in[2])))});
                 });
     }
     // Both outcomes are well represented: fragments drawn, and pixels whose rays cross layers.

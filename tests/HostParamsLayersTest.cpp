@@ -238,6 +238,8 @@ TEST(HostParamsLayers, GeometryFromTheGridAndTheCamera) {
     EXPECT_EQ(s.count, 4u);           // default N = nz
     EXPECT_EQ(s.spacing, 1.0f);       // nz / N = 4 / 4
     EXPECT_EQ(s.outer2, 400.0f);      // extent = far 1000 m = 20 voxel edges, squared
+    // Default fade 0.5: inner radius 10, 1 / (400 - 100) = 1 / 300.
+    EXPECT_FLOAT_EQ(s.fadeInv2, 1.0f / 300.0f);
     EXPECT_EQ(s.maxLength, 4.0f);     // l_max default nz
     EXPECT_EQ(s.sigmaH, 6.25f);       // 0.125 * 50
     EXPECT_FALSE(s.tiling);
@@ -278,6 +280,11 @@ TEST(HostParamsLayers, GeometryFromTheGridAndTheCamera) {
     EXPECT_NEAR(LayerHeight(p.setup, 2), 3.3333333f, 1e-6f);
     EXPECT_EQ(p.setup.outer2, 25.0f);
     EXPECT_EQ(p.setup.maxLength, 2.5f);
+    // Fade 0.2: inner radius 4, 1 / (25 - 16) = 1 / 9; fade 0 is no falloff.
+    sc.layers.fade = 0.2;
+    EXPECT_FLOAT_EQ(HplParams(sc, 0).setup.fadeInv2, 1.0f / 9.0f);
+    sc.layers.fade = 0;
+    EXPECT_EQ(HplParams(sc, 0).setup.fadeInv2, 0.0f);
     // Eight layers (two per voxel): spacing 0.5, and l_max's default is still nz = 4 (not N). The largest extent,
     // 1e30 m: (1e30 / 50)^2 = 4e56 is capped at 1e36.
     sc.layers.count = 8;
@@ -367,6 +374,8 @@ TEST(HostParamsLayers, GpuBlockCarriesTheHostValues) {
     EXPECT_EQ(g.drift, (std::array<float, 4>{1.0f, 5.5f, 0.75f, 3.0f}));
     EXPECT_NEAR(g.light[0], 0.70710678f, 1e-6f);  // cos 45
     EXPECT_EQ(g.light[0], p.setup.lightScale);
+    EXPECT_EQ(g.light[1], p.setup.fadeInv2);  // y: the falloff, 1 / 300 (default fade 0.5 of 20 voxel edges)
+    EXPECT_FLOAT_EQ(g.light[1], 1.0f / 300.0f);
     // Step 3 (135 degrees from s0): the block carries the clamped 0.
     EXPECT_EQ(MakeLayersGpu(HplParams(sc, 3)).light[0], 0.0f);
     // Without tiling or wang no flag bit.

@@ -171,6 +171,75 @@ TEST_P(RenderLayersAll, HomogeneousLayerIsTheSlabsClosedForm) {
         }
 }
 
+// Test LayersFade by hand: extent 100 (outer2 10^4) and fade 0.2, so the inner radius is 80 and fadeInv2 =
+// 1 / (10^4 - 6400) = 1 / 3600. w = (10^4 - r^2) / 3600, the fade w^2 (3 - 2 w): 1 at r <= 80; at r^2 = 8200,
+// w = 1/2 and 1/4 * 2 = 1/2; at r = 90, w = 19/36 and (361/1296)(70/36) = 25270/46656; 0 at r = 100 and beyond.
+TEST(LayersFade, SmoothFalloffFromTheInnerRadiusToTheExtent) {
+    const float outer2 = 10000.0f, inv = 1.0f / 3600.0f;
+    EXPECT_EQ(LayersFade(0.0f, outer2, inv), 1.0f);
+    EXPECT_EQ(LayersFade(6400.0f, outer2, inv), 1.0f);  // the fade's start
+    EXPECT_NEAR(LayersFade(8200.0f, outer2, inv), 0.5f, 1e-6f);
+    EXPECT_NEAR(LayersFade(8100.0f, outer2, inv), 25270.0f / 46656.0f, 1e-6f);
+    EXPECT_EQ(LayersFade(10000.0f, outer2, inv), 0.0f);  // the extent
+    EXPECT_EQ(LayersFade(12100.0f, outer2, inv), 0.0f);  // beyond
+    // Its slope vanishes at both ends (no kink): a step of 1 in r^2 changes it by O(1 / 3600^2).
+    EXPECT_GT(LayersFade(6401.0f, outer2, inv), 1.0f - 1e-6f);
+    EXPECT_LT(LayersFade(9999.0f, outer2, inv), 1e-6f);
+    // Monotone across the band.
+    float last = 1.0f;
+    for (float r2 = 6400.0f; r2 <= 10000.0f; r2 += 7.0f) {
+        const float f = LayersFade(r2, outer2, inv);
+        EXPECT_LE(f, last) << r2;
+        last = f;
+    }
+    // fadeInv2 0: no falloff, a hard cut left to the caller's extent test.
+    EXPECT_EQ(LayersFade(9999.0f, outer2, 0.0f), 1.0f);
+    EXPECT_EQ(LayersFade(20000.0f, outer2, 0.0f), 1.0f);
+}
+
+// Test the falloff in the image on every backend: one homogeneous tiled layer (q = 1, T = 1) at z = 3 seen from
+// below, extent 60 and fade 0.5 (inner radius 30). A pixel whose ray meets the plane at horizontal distance r has
+// alpha = (1 - exp(-sigma h 6 / |d_z|)) s(w), s(w) = w^2 (3 - 2 w), w = clamp((60^2 - r^2) / (60^2 - 30^2), 0, 1),
+// worked in double; beyond 60 the pixel is the background bit for bit.
+TEST_P(RenderLayersAll, OpacityFadesOutTowardTheExtent) {
+    const Extent3 e{8, 8, 6};
+    LayersCase c = UniformLayers(e, 1.0f);
+    c.params = CameraLayers(e, {4, 4, -20}, {4, 50, 3}, 48, 36, 1, true);
+    LayersSetup& s = c.params.setup;
+    s.maxLength = 1e30f;
+    s.outer2 = 3600.0f;
+    s.fadeInv2 = float(1.0 / (3600.0 - 900.0));
+    const LayersImage im = RenderLayersOn(*mBackend, c);
+    ASSERT_TRUE(im.ok);
+    double worst = 0;
+    uint32_t inBand = 0, beyond = 0;
+    for (uint32_t y = 0; y < 36; ++y)
+        for (uint32_t x = 0; x < 48; ++x) {
+            const LayersRay ray = MakeLayersRay(c.params.camera, 1.0f, x, y);
+            const double dz = ray.dir[2], t = (3.0 - s.eye[2]) / dz;
+            const double r = std::hypot(ray.dir[0] * t, ray.dir[1] * t);
+            if (!(dz > 0) || r > 60.001) {
+                ++beyond;
+                for (int ch = 0; ch < 3; ++ch)
+                    ASSERT_EQ(im.rgb[3 * (x + 48 * y) + ch], s.background[ch]) << x << ", " << y;
+                continue;
+            }
+            if (r > 59.999) continue;  // the float test at the extent may fall either way
+            const double w = std::clamp((3600.0 - r * r) / 2700.0, 0.0, 1.0);
+            inBand += w > 0.05 && w < 0.95 ? 1 : 0;
+            const double alpha = (1 - std::exp(-double(s.sigmaH) * 6.0 / dz)) * w * w * (3 - 2 * w);
+            const double phase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+            for (int ch = 0; ch < 3; ++ch) {
+                const double lit = double(s.sunRadiance[ch]) * phase + s.ambient[ch];
+                const double want = lit * alpha + s.background[ch] * (1 - alpha);
+                worst = std::max(worst, std::fabs(im.rgb[3 * (x + 48 * y) + ch] - want) / std::max(1.0, want));
+            }
+        }
+    EXPECT_LT(worst, 1e-5);
+    EXPECT_GT(inBand, 100u);  // the band is well sampled
+    EXPECT_GT(beyond, 50u);   // and so is the sky beyond it
+}
+
 // Test the wang opacity (Wang, Ji and Zhang's eq. 16) on every backend, by hand: q = 0.8 and T = 1 everywhere, untiled,
 // coverage 0.7 and density 1.5, and a map that is 0 on the columns x < 6 and 1 on the others. A layer crossed over
 // the first columns has alpha = min(1.5 max(0.8 - (0 + 1 - 0.7), 0), 1) = 1 - 1/4 (= 0.75 within float), over the
@@ -383,7 +452,7 @@ TEST(RenderLayersCpu, EqualsAMarchAtTheLayerPlanes) {
 
 // Test that each GPU backend's image matches the CPU's by SPEC 8's image rule (and lies within 1e-4 of it
 // everywhere, measured), with the same counters, over the eye below, inside and above, tiling, layer counts, l_max,
-// every phase function and q_prev != q_cur.
+// every phase function, q_prev != q_cur and the fade toward the extent.
 class RenderLayersGpu : public test::BackendTest {};
 
 TEST_P(RenderLayersGpu, MatchesTheCpu) {
@@ -403,6 +472,10 @@ TEST_P(RenderLayersGpu, MatchesTheCpu) {
                 c.params.setup.phase = phases[n++ % 4];
                 if (count == 4) c.params.setup.maxLength = 2.5f;
                 if (count == 15) c.params.setup.drift = {1.37f, -0.61f};
+                if (tiling) {  // an extent of 20 voxel edges, faded over its outer half: 1 / (400 - 100)
+                    c.params.setup.outer2 = 400.0f;
+                    c.params.setup.fadeInv2 = 1.0f / 300.0f;
+                }
                 // The wang opacity with a map that varies per column, in every third case.
                 std::vector<float> map(size_t(e.nx) * e.ny);
                 for (size_t i = 0; i < map.size(); ++i) map[i] = float((i * 2654435761u) % 997) / 2000.0f;

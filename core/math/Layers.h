@@ -26,6 +26,7 @@ struct LayersSetup {
     uint32_t count = 1;     // N layers
     float spacing = 1;      // nz / N, voxel edges between layers
     float outer2 = 0;       // extent^2, voxel edges^2: a fragment's horizontal distance from the eye is within
+    float fadeInv2 = 0;     // 1 / (extent^2 - inner^2), voxel edges^-2, inner = (1 - fade) extent; 0: no falloff
     float maxLength = 1;    // l_max, voxel edges: the most path one fragment stands for
     float sigmaH = 1;       // sigma h (MarchOpticalDepthPerVoxel)
     bool tiling = false;    // the volume repeats in x and y; else a fragment outside the box is empty
@@ -112,6 +113,16 @@ inline float LayersMapAt(const LayersSetup& s, float x, float y) {
     return Lerp(Lerp(m[i0 + nx * j0], m[i1 + nx * j0], wu), Lerp(m[i0 + nx * j1], m[i1 + nx * j1], wu), wv);
 }
 
+// The opacity's falloff toward the extent at squared horizontal distance r2:
+// w^2 (3 - 2 w), w = clamp((outer2 - r2) fadeInv2, 0, 1): 1 within the inner
+// radius, 0 at the extent and beyond, smooth between (w linear in r^2).
+// fadeInv2 0: 1 everywhere (a hard cut at the extent).
+inline float LayersFade(float r2, float outer2, float fadeInv2) {
+    if (!(fadeInv2 > 0.0f)) return 1.0f;
+    const float w = std::min(std::max((outer2 - r2) * fadeInv2, 0.0f), 1.0f);
+    return (w * w) * (3.0f - 2.0f * w);
+}
+
 // One pixel's ray as the layers see it: its direction (PixelRayDirection) and
 // the distances of the near and far planes along it (voxel edges).
 struct LayersRay {
@@ -128,7 +139,7 @@ inline LayersRay MakeLayersRay(const CameraFrame& c, float voxelSize, uint32_t x
 // distance t between the near and far planes, within the extent horizontally
 // and (without tiling) inside the box, where q > 0. Its opacity is beer's,
 // alpha = 1 - exp(-sigma h q l), l = min(spacing / |d_z|, l_max), or wang's
-// (eq. 16 of q and the map, without a path length); its colour
+// (eq. 16 of q and the map, without a path length), times LayersFade; its colour
 // c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
 struct LayerFragmentResult {
     bool crossed = false;  // the plane is met in range (a counted fragment)
@@ -147,7 +158,8 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     const float t = (z - s.eye[2]) * invDz;
     if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
     const float hx = ray.dir[0] * t, hy = ray.dir[1] * t;
-    if (!(hx * hx + hy * hy <= s.outer2)) return f;
+    const float r2 = hx * hx + hy * hy;
+    if (!(r2 <= s.outer2)) return f;
     float x = (s.eye[0] + hx) - s.drift[0], y = (s.eye[1] + hy) - s.drift[1];
     if (s.tiling) {
         x = LayersWrap(x, s.size[0], s.invSize[0]);
@@ -165,6 +177,7 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
         const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
         f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
     }
+    f.alpha = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     const float gain = (qt[1] * s.lightScale) * sunPhase;
     f.color = {s.sunRadiance[0] * gain + s.ambient[0], s.sunRadiance[1] * gain + s.ambient[1],
                s.sunRadiance[2] * gain + s.ambient[2]};

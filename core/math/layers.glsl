@@ -27,7 +27,7 @@ struct LayersGpu {
     uvec4 image;       // width, height, N, flags
     uvec4 phase;       // kind, Mie count, px, px * py
     vec4 drift;        // xy the wind's drift (voxel units); z coverage C, w density D_w (wang)
-    vec4 light;        // x T's factor (relighting); yzw unused
+    vec4 light;        // x T's factor (relighting); y fadeInv2; zw unused
 };
 
 const uint kLayersTiling = 1u;
@@ -43,6 +43,15 @@ float LayerHeight(LayersGpu s, uint i) {
 float LayersWrap(float x, float n, float invN) {
     precise float w = x - n * floor(x * invN);
     return w;
+}
+
+// core/math/Layers.h LayersFade, written out (no smoothstep).
+float LayersFade(float r2, float outer2, float fadeInv2) {
+    if (!(fadeInv2 > 0.0)) return 1.0;
+    precise float d = (outer2 - r2) * fadeInv2;
+    const float w = min(max(d, 0.0), 1.0);
+    precise float f = (w * w) * (3.0 - 2.0 * w);
+    return f;
 }
 
 struct LayersRay {
@@ -122,6 +131,8 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
         precise float alpha = 1.0 - SegmentTransmittance(s.size.w, qt.x, length);
         f.alpha = alpha;
     }
+    precise float faded = f.alpha * LayersFade(r2, s.sunRadiance.w, s.light.y);
+    f.alpha = faded;
     precise float gain = (qt.y * s.light.x) * sunPhase;
     precise vec3 c = vec3(s.sunRadiance.x * gain + s.ambient.x, s.sunRadiance.y * gain + s.ambient.y,
                           s.sunRadiance.z * gain + s.ambient.z);

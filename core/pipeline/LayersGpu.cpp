@@ -25,7 +25,7 @@ LayersGpu MakeLayersGpu(const LayersParams& params) {
     const uint32_t px = uint32_t(s.size[0]) + 2u, py = uint32_t(s.size[1]) + 2u;
     g.phase = {uint32_t(s.phase.kind), kMieCloudTable.count, px, px * py};
     g.drift = {s.drift[0], s.drift[1], s.coverage, s.density};
-    g.light = {s.lightScale, 0.0f, 0.0f, 0.0f};
+    g.light = {s.lightScale, s.fadeInv2, 0.0f, 0.0f};
     return g;
 }
 

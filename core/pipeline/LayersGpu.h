@@ -32,7 +32,7 @@ struct LayersGpu {
     std::array<uint32_t, 4> image;     // width, height, N, LayersGpuFlag bits
     std::array<uint32_t, 4> phase;     // PhaseKind, the Mie table's count, padded strides px, px * py
     std::array<float, 4> drift;        // xy: the wind's drift (voxel units); z: coverage C; w: density D_w
-    std::array<float, 4> light;        // x: T's factor (LayersSetup::lightScale); yzw: unused
+    std::array<float, 4> light;        // x: T's factor (LayersSetup::lightScale); y: fadeInv2; zw: unused
 };
 static_assert(sizeof(LayersGpu) == 14 * 16, "LayersGpu is fourteen 16-byte rows");
 

@@ -277,6 +277,9 @@ void main() {
             PutU(4u, p.drawn);
             break;
         }
+        case 64u:
+            PutF(0u, LayersFade(F(0u), F(1u), F(2u)));
+            break;
         case 27u: {
             Splat s;
             const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), s);

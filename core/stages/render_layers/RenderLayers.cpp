@@ -12,8 +12,8 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLayersKeys[] = {"count", "extent",  "max_length", "wind",
-                                            "wang",  "relight", "exposure",   "tone_map"};
+constexpr std::string_view kLayersKeys[] = {"count", "extent",  "fade",     "max_length", "wind",
+                                            "wang",  "relight", "exposure", "tone_map"};
 constexpr std::array<NamedValue<LayersRelight>, 2> kLayersRelightNames{{
     {"shade", LayersRelight::Shade},
     {"vector", LayersRelight::Vector},
@@ -35,6 +35,9 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
     }
     if (const Json* v = find("extent")) {
         if (auto d = check.Number(*v, "layers.extent", kSinglePositive)) layers.extent = *d;
+    }
+    if (const Json* v = find("fade")) {
+        if (auto d = check.Number(*v, "layers.fade", Range{.lo = 0, .hi = 1})) layers.fade = *d;
     }
     if (const Json* v = find("max_length")) {
         if (auto d = check.Number(*v, "layers.max_length", kSinglePositive)) layers.maxLength = *d;
@@ -84,6 +87,9 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     s.spacing = float(double(e.nz) / double(s.count));
     const double extent = (sc.layers.extent > 0 ? sc.layers.extent : camera.farPlane) / sc.grid.voxelSize;
     s.outer2 = float(std::min(extent * extent, 1e36));
+    // extent^2 - ((1 - fade) extent)^2 = extent^2 fade (2 - fade).
+    const double band = extent * extent * sc.layers.fade * (2.0 - sc.layers.fade);
+    s.fadeInv2 = band > 0 && extent * extent <= 1e36 ? float(1.0 / band) : 0.0f;
     s.maxLength = float(sc.layers.maxLength > 0 ? sc.layers.maxLength : double(e.nz));
     s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
     s.tiling = sc.grid.tiling;

@@ -24,6 +24,7 @@ enum class LayersRelight : uint8_t { Shade, Vector };
 struct LayersSettings {
     uint32_t count = 0;     // N; 0: the grid's nz (one layer on each voxel-centre plane)
     double extent = 0;      // metres, the layers' horizontal radius around the eye; 0: each camera's far plane
+    double fade = 0.5;      // the fraction of the extent over which the opacity falls to 0 (LayersFade); 0: a hard cut
     double maxLength = 0;   // l_max, voxel edges; 0: the grid's nz (a fragment stands for at most the slab seen
                             // straight through)
     // The wind (Wang, Ji and Zhang, eq. 18): the clouds drift by this many metres per step in x and y, at the
