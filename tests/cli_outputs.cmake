@@ -113,3 +113,10 @@ plot_sweep.py: [^\n]*/none/p.png: cannot write: No such file or directory\n$")
 add_test(NAME Cli.PathPolicy COMMAND /usr/bin/python3 ${outputs_py}/check_path_policy.py ${cli} ${cli_out}/path-policy)
 set_tests_properties(Cli.PathPolicy PROPERTIES TIMEOUT 400 FAIL_REGULAR_EXPRESSION "FAIL: "
                      PASS_REGULAR_EXPRESSION "every reader and writer follows the path policy")
+
+# Test that a planted failed write, rename and remove (CLOUDBENCH_TEST_FAIL_FS) of a frame and of results.json
+# exits 1 naming the file, never lists a file not placed (results.json, the journal), and frees the lock.
+add_test(NAME Cli.FailedWritesKeepBookkeeping
+         COMMAND /usr/bin/python3 ${outputs_py}/check_output_faults.py ${cli} ${cli_out}/faults)
+set_tests_properties(Cli.FailedWritesKeepBookkeeping PROPERTIES TIMEOUT 120 PASS_REGULAR_EXPRESSION
+                     "every planted failure left the bookkeeping true")

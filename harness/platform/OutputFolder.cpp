@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -286,6 +287,7 @@ Status RemoveFileAt(const OpenFolder& folder, const std::string& name, std::stri
         return errno == ENOENT ? Status{} : cannot(std::strerror(errno));
     if (S_ISLNK(info.st_mode)) return std::unexpected(LinkRefused(shown));
     if (S_ISDIR(info.st_mode)) return cannot("it is a folder");
+    if (PlantedFsFailure("remove", name)) return cannot(std::strerror(EIO));
     // A name swapped for a link since the check is removed as a name: unlinkat never follows it.
     if (unlinkat(folder.Fd(), name.c_str(), 0) != 0 && errno != ENOENT) return cannot(std::strerror(errno));
     return {};
@@ -326,6 +328,15 @@ Status RemoveTreeAt(const OpenFolder& folder, const std::string& name) {
     }
     if (unlinkat(folder.Fd(), name.c_str(), AT_REMOVEDIR) != 0 && errno != ENOENT) return cannot(errno);
     return {};
+}
+
+bool PlantedFsFailure(std::string_view op, std::string_view name) {
+    static const std::string planted = [] {
+        const char* value = std::getenv("CLOUDBENCH_TEST_FAIL_FS");
+        return std::string(value ? value : "");
+    }();
+    return !planted.empty() && planted.size() == op.size() + 1 + name.size() && planted.starts_with(op) &&
+           planted[op.size()] == ':' && planted.ends_with(name);
 }
 
 std::string TemporaryNameOf(const std::string& path) {

@@ -60,6 +60,10 @@ Status RecordOutput(const std::string& path, OutputEvent event);
 // `except`. Empty when `dir` is not claimed.
 std::vector<std::string> WrittenOutputs(const std::string& dir, std::string_view except = {});
 
+// The test-only switch CLOUDBENCH_TEST_FAIL_FS=<op>:<NAME>, read once (docs/cli.md): whether `op` ("write",
+// "rename" or "remove") on a file whose own name is NAME (no folder) is to fail as with EIO. Never set otherwise.
+bool PlantedFsFailure(std::string_view op, std::string_view name);
+
 // The temporary name a file is written under before it is renamed into place:
 // ".<stem>.partial<ext>" in the same folder.
 std::string TemporaryNameOf(const std::string& path);

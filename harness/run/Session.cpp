@@ -211,7 +211,8 @@ Status Session::WriteAtomically(const std::string& path, const std::function<Sta
     temp.fd = *created;
     temp.path = "/proc/self/fd/" + std::to_string(temp.fd);
     errno = 0;
-    Status written = write(temp);
+    Status written =
+        PlantedFsFailure("write", name) ? MakeError(path + ": cannot write: " + std::strerror(EIO)) : write(temp);
     const int writeErrno = errno;  // what the failed system call said, when the writer does not say it
     if (written) written = CheckFinished(temp, path);
     // The temporary name must still be the file created above: what took its place since (a link) is never
@@ -225,7 +226,9 @@ Status Session::WriteAtomically(const std::string& path, const std::function<Sta
                             " was replaced while it was written");
     if (close(temp.fd) != 0 && written) written = MakeError(path + ": cannot write: " + std::strerror(errno));
     if (written) written = RecordOutput(path, OutputEvent::Placing);
-    if (written && renameat(folder->Fd(), tempName.c_str(), folder->Fd(), name.c_str()) != 0) {
+    const bool plantedRename = written && PlantedFsFailure("rename", name);
+    if (plantedRename) errno = EIO;
+    if (written && (plantedRename || renameat(folder->Fd(), tempName.c_str(), folder->Fd(), name.c_str()) != 0)) {
         const int error = errno;
         (void)RecordOutput(path, OutputEvent::NotPlaced);
         written = MakeError(path + ": cannot move the finished file into place: " + std::strerror(error));
