@@ -18,7 +18,7 @@ at p <= ALPHA / m (Bonferroni over the m = 7 series); a clean step between k
 and k records reaches p = 2 / C(2k, k) at best, 7.4e-7 for k = 12, well under
 0.001 / 7 = 1.4e-4, which leaves room for a record or two out of place (with
 k = 9, 4.1e-5, two slow plain records, one as slow as the slowed ones, which a loaded
-machine gives now and then, was enough to miss the step). A record's time is the median of its 3 runs': on this
+machine gives now and then, were enough to miss the step). A record's time is the median of its 3 runs': on this
 loaded 2-core machine one run in ten or so has CPU times near half the
 others' (the backend's second thread found no core to spin on), and three
 runs outvote it where two would not. The compare pools 12 x 3 = 36 runs a
