@@ -43,6 +43,9 @@ in step order (the plain ones first, each side in the order it ran): a change
 of the machine's speed over the minute the records take then falls on both
 sides alike, and the test checks the tools' rules on real records rather than
 the machine's steadiness. `perf history` reads a history in file order.
+Interleaving balances the two sides but cannot separate them when the
+machine's speed moves by 2x, more than the step: CTest runs this test alone
+(RUN_SERIAL, tests/perf.cmake).
 
 usage: check_perf_history_step.py CLOUDBENCH WORKDIR
 """

@@ -11,11 +11,14 @@ add_test(NAME Perf.Record
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_record.py ${cli} ${cli_out}/perf-record)
 set_tests_properties(Perf.Record PROPERTIES PASS_REGULAR_EXPRESSION "perf record: ok" TIMEOUT 600)
 # CI tracking from a history: records before and after a planted 1.5x step; perf history finds it in that
-# stage alone and perf compare of the records flags it alone (one at a time with the gate: each loads the other).
+# stage alone and perf compare of the records flags it alone. It runs alone (RUN_SERIAL): records are taken at
+# different times, so unlike the interleaved gate's pairs they cannot cancel a machine whose speed moves by 2x
+# between them (beside another test, region's unslowed records had a median of 0.085 ms, against 0.045 ms alone,
+# and the step was found three records late), and the test is of the tools' rules, not of the machine.
 add_test(NAME Perf.HistoryStep
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_history_step.py ${cli} ${cli_out}/perf-history-step)
 set_tests_properties(Perf.HistoryStep PROPERTIES PASS_REGULAR_EXPRESSION "perf history step: ok" TIMEOUT 300
-                     RESOURCE_LOCK perf_gate)
+                     RUN_SERIAL TRUE)
 # kept: the verdict from a kept folder is the live one (a failed run fails both; a kept folder with no run is refused).
 foreach(case identical slowdown kept)
   add_test(NAME Perf.Gate.${case}
