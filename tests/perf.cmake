@@ -14,10 +14,11 @@ set_tests_properties(Perf.Record PROPERTIES PASS_REGULAR_EXPRESSION "perf record
 # stage alone and perf compare of the records flags it alone. It runs alone (RUN_SERIAL): records are taken at
 # different times, so unlike the interleaved gate's pairs they cannot cancel a machine whose speed moves by 2x
 # between them (beside another test, region's unslowed records had a median of 0.085 ms, against 0.045 ms alone,
-# and the step was found three records late), and the test is of the tools' rules, not of the machine.
+# and the step was found three records late), and the test is of the tools' rules, not of the machine. When the
+# machine's speed still moved between one side's records by more than the step (1.5x), it skips, saying so.
 add_test(NAME Perf.HistoryStep
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_perf_history_step.py ${cli} ${cli_out}/perf-history-step)
-set_tests_properties(Perf.HistoryStep PROPERTIES PASS_REGULAR_EXPRESSION "perf history step: ok" TIMEOUT 300
+set_tests_properties(Perf.HistoryStep PROPERTIES PASS_REGULAR_EXPRESSION "perf history step: ok" TIMEOUT 300 SKIP_RETURN_CODE 77
                      RUN_SERIAL TRUE)
 # kept: the verdict from a kept folder is the live one (a failed run fails both; a kept folder with no run is refused).
 foreach(case identical slowdown kept)
