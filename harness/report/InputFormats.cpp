@@ -19,14 +19,6 @@ using nlohmann::json;
 constexpr double kMaxCount = 9007199254740992.0;  // 2^53: the largest count a JSON reader holds exactly
 constexpr double kMaxSteps = 4294967295.0;        // steps are uint32
 
-const std::vector<std::string>& StageNames() {
-    static const std::vector<std::string> names = [] {
-        std::vector<std::string> all;
-        for (Stage stage : kAllStages) all.emplace_back(StageName(stage));
-        return all;
-    }();
-    return names;
-}
 
 Node Count() { return Integer(0, kMaxCount); }
 Node Step() { return Integer(0, kMaxSteps); }
@@ -182,7 +174,7 @@ Node ResultsSchema() {
                                {"warmup_steps", Step()},
                                {"frames_per_step", Count()},
                                {"sun_moves", Boolean()},
-                               {"stages", ArrayOf(TextOf(StageNames()))}});
+                               {"stages", ArrayOf(TextOf(detail::SchemaStageNames()))}});
     return Object({{"format", TextOf({"cloudbench-results/1"}), true},
                    {"scene", scene, true},
                    {"backends", MapOf(KeyRule::Backend, ResultsBackend()), true},
@@ -255,7 +247,7 @@ Node ErrorStats() {
 Node MeasuredRow() {
     return Object({{"settings", MapOf(KeyRule::Any, Text()), true},
                    {"backend", Text(), true},
-                   {"stage", TextOf(StageNames()), true},
+                   {"stage", TextOf(detail::SchemaStageNames()), true},
                    {"status", Text(), true},
                    {"detail", Text()},
                    {"time", Object(SummaryFields(false))},
@@ -277,7 +269,7 @@ Node ShardRow() {
                                  {"max", Statistic(), true}});
     return Object({{"settings", ArrayOf(ArrayOf(Text(), 2, 2)), true},
                    {"backend", Text(), true},
-                   {"stage", TextOf(StageNames()), true},
+                   {"stage", TextOf(detail::SchemaStageNames()), true},
                    {"status", Text(), true},
                    {"detail", Text(), true},
                    {"time", summary, true},
@@ -420,6 +412,15 @@ std::string Nouns(std::span<const Format> formats) {
 }  // namespace
 
 schema::Node detail::ProvenanceSchema() { return Provenance(); }
+
+const std::vector<std::string>& detail::SchemaStageNames() {
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> all;
+        for (Stage stage : kAllStages) all.emplace_back(StageName(stage));
+        return all;
+    }();
+    return names;
+}
 schema::Node detail::ReportBlockSchema() { return ReportBlock(); }
 
 std::string_view FormatName(Format format) { return Lookup(format).name; }

@@ -4,26 +4,15 @@
 #include <string>
 #include <vector>
 
-#include "core/scene/Stage.h"
-
 namespace cb::input::detail {
 
 using namespace schema;
 
 namespace {
 
-const std::vector<std::string>& PerfSchemaStageNames() {
-    static const std::vector<std::string> names = [] {
-        std::vector<std::string> all;
-        for (Stage stage : kAllStages) all.emplace_back(StageName(stage));
-        return all;
-    }();
-    return names;
-}
-
 // --plant STAGE:FACTOR: HEAD ran with the slowdown, BASE with factor 1 (harness/perf/Compare.h PlantedSlowdown).
 Node PerfSchemaPlant() {
-    return Object({{"stage", TextOf(PerfSchemaStageNames()), true}, {"factor", Number(1, 1000), true}});
+    return Object({{"stage", TextOf(SchemaStageNames()), true}, {"factor", Number(1, 1000), true}});
 }
 
 }  // namespace
@@ -57,7 +46,7 @@ Node PerfCompareSchema() {
     const Node probability = Nullable(Number(0, 1));
     const Node comparison = Object({{"scene", Text(), true},
                                     {"backend", Text(), true},
-                                    {"stage", TextOf(PerfSchemaStageNames()), true},
+                                    {"stage", TextOf(SchemaStageNames()), true},
                                     {"metric", TextOf({"time", "instructions"}), true},
                                     {"test", TextOf({"", "rounds", "runs", "steps"})},
                                     {"base_runs", count},
