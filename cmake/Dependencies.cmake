@@ -1,4 +1,5 @@
-# Every dependency is a Debian 12 package (tools/debian-packages.txt). A missing
+# Every dependency is a Debian 12 package (tools/debian-packages-run.txt, and tools/debian-packages.txt for the
+# tests, benchmarks and the sanitized build). A missing
 # one stops configure with the package to install.
 
 function(cloudbench_require found name package)

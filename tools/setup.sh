@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages listed in tools/debian-packages.txt.
+# Installs Debian 12 packages with apt-get.
+#   tools/setup.sh        everything: tools/debian-packages-run.txt and tools/debian-packages.txt
+#   tools/setup.sh run    only what building the CLI and `cloudbench run` need (debian-packages-run.txt)
 # Safe to run again: when every package is already installed it does nothing
 # (and needs neither root nor the network). As a non-root user it uses sudo if
 # there is one; otherwise it prints the apt-get line to run as root and fails.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-mapfile -t packages < <(grep -v '^\s*#' "$here/debian-packages.txt" | grep -v '^\s*$')
+lists=("$here/debian-packages-run.txt")
+case "${1:-all}" in
+  run) ;;
+  all) lists+=("$here/debian-packages.txt") ;;
+  *) echo "setup: unknown argument '$1'; use 'run' (what cloudbench run needs) or nothing (everything)" >&2; exit 2 ;;
+esac
+mapfile -t packages < <(cat "${lists[@]}" | grep -v '^\s*#' | grep -v '^\s*$')
 
 missing=()
 for p in "${packages[@]}"; do

@@ -75,7 +75,7 @@ class TempFolder {
 
 std::optional<std::string> WhyCannotCount(const std::string& buildFlags) {
     if (!CallgrindRequestsBuiltIn())
-        return "this binary was built without <valgrind/callgrind.h>: install valgrind (tools/debian-packages.txt) "
+        return "this binary was built without <valgrind/callgrind.h>: install valgrind (tools/setup.sh) "
                "and rebuild with the exact preset";
     if (buildFlags.find("-march=native") != std::string::npos)
         return "this binary was built with -march=native, which valgrind cannot run (no AVX-512): build with the "
@@ -84,7 +84,7 @@ std::optional<std::string> WhyCannotCount(const std::string& buildFlags) {
         return "this binary was built with AddressSanitizer, which cannot run under valgrind: build with the exact "
                "preset";
     if (FindOnPath("valgrind").empty())
-        return "valgrind is not on PATH: install the valgrind package (tools/debian-packages.txt)";
+        return "valgrind is not on PATH: install the valgrind package (tools/setup.sh)";
     return std::nullopt;
 }
 
