@@ -253,7 +253,7 @@ Result<std::vector<double>> BackendGL::EndBatch() {
                 stats.fragments = QueryResult(d.fragments);
                 f.DeleteQueries(1, &d.fragments);
             }
-            result.splat = stats;
+            result.frameCounters = ToFrameCounters(stats, kSplatCounters);
         }
         f.DeleteBuffers(1, &d.counters);
         mDeferredResults.push_back(result);

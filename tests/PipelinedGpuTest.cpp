@@ -202,24 +202,22 @@ TEST_P(PipelinedGpu, ABatchGivesTheBytesAndHostValuesOfTheCallsOneByOne) {
     EXPECT_TRUE(mBackend->TakeDeferredResults().empty()) << "each result once";
     ASSERT_LE(deferred.size(), 2u);
     std::optional<uint32_t> batchedCover = cover[1];
-    std::optional<SplatStats> batchedStats = stats[1];
+    std::optional<FrameCounters> batchedStats = ToFrameCounters(stats[1], kSplatCounters);
     for (const DeferredHostResult& d : deferred) {
-        EXPECT_NE(d.coveredColumns.has_value(), d.splat.has_value()) << "one value per deferred result";
+        EXPECT_NE(d.coveredColumns.has_value(), d.frameCounters.has_value()) << "one value per deferred result";
         if (d.coveredColumns) {
             EXPECT_EQ(d.mark, 4u);
             EXPECT_EQ(cover[1], 0u) << "the cover came from the call and again deferred";
             batchedCover = d.coveredColumns;
         }
-        if (d.splat) {
+        if (d.frameCounters) {
             EXPECT_EQ(d.mark, 6u);
             EXPECT_EQ(stats[1].splats, 0u) << "the stats came from the call and again deferred";
-            batchedStats = d.splat;
+            batchedStats = d.frameCounters;
         }
     }
     EXPECT_EQ(batchedCover, std::optional<uint32_t>(cover[0]));
-    EXPECT_EQ(batchedStats->splats, stats[0].splats);
-    EXPECT_EQ(batchedStats->voxelsVisited, stats[0].voxelsVisited);
-    EXPECT_EQ(batchedStats->fragments, stats[0].fragments);
+    EXPECT_EQ(*batchedStats, ToFrameCounters(stats[0], kSplatCounters)) << "splats, voxels visited, fragments";
 }
 
 TEST_P(PipelinedGpu, OneSubmissionAndOneWaitPerBatchAndOneMorePerDownload) {

@@ -90,7 +90,7 @@ struct SavedRunView {
     uint32_t frames = 0;
     // Every frame's splat counters: the frames before the step's last (alpha < 1) show Previous; the observer
     // sees only the last frame's image.
-    std::vector<std::array<uint64_t, 3>> frameStats;
+    std::vector<FrameCounters> frameStats;
 };
 
 // Steps `sim` until `to` (exclusive), keeping each step's view.
@@ -116,7 +116,7 @@ std::vector<SavedRunView> StepAndKeep(Simulation& sim, Backend& backend, uint32_
         view.skipped = record.skippedUnchanged;
         view.frames = record.framesRendered;
         for (const FrameRecord& f : record.frames)
-            view.frameStats.push_back({f.stats.splats, f.stats.voxelsVisited, f.stats.fragments});
+            view.frameStats.push_back(f.counters);
         views.push_back(std::move(view));
     }
     return views;

@@ -154,8 +154,9 @@ TEST(SweepFields, SweepStagesAreThoseTheFieldsReach) {
     EXPECT_EQ(StagesOf({"shadow.form"}), (S{Stage::Shadow}));
     EXPECT_EQ(StagesOf({"shade.sigma"}), (S{Stage::Shade, Stage::Shadow}));
     EXPECT_EQ(StagesOf({"sun.elevation_deg"}), (S{Stage::Shade, Stage::Shadow}));
+    // The renderers in stage order (kAllStages), as their descriptors are walked.
     EXPECT_EQ(StagesOf({"phase.function"}),
-              (S{Stage::Shade, Stage::RenderMarch, Stage::RenderSplat, Stage::RenderLayers}));
+              (S{Stage::Shade, Stage::RenderSplat, Stage::RenderMarch, Stage::RenderLayers}));
     EXPECT_EQ(StagesOf({"description"}), S{});
 }
 

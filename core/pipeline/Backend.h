@@ -164,7 +164,7 @@ struct DeferredHostResult {
     // after the first mark.
     uint32_t mark = 0;
     std::optional<uint32_t> coveredColumns;  // Density: DensityOutputs::coveredColumns
-    std::optional<SplatStats> splat;         // RenderSplat: *stats
+    std::optional<FrameCounters> frameCounters;  // a renderer: its *stats, as ToFrameCounters lists them
 };
 
 // One limit of a backend's device that bounds the scenes it can run, as the

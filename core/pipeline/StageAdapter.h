@@ -61,9 +61,7 @@ struct FrameRecord {
     double ms = 0;
     bool pipelined = false;          // drawn in a batch (pipelined timing)
     std::optional<double> deviceMs;  // its device time, where the backend measures it
-    SplatStats stats;
-    MarchStats march;    // render_march's counters
-    LayersStats layers;  // render_layers' counters
+    FrameCounters counters{};  // its renderer's counters (RendererDescriptor::counters names them)
 };
 
 // What one call measured and returned besides its buffers.

@@ -7,6 +7,7 @@
 // whoever writes q (smooth, or a noise producer).
 #pragma once
 
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -101,6 +102,57 @@ std::vector<std::string> TableNames() {
 inline std::vector<std::string> BooleanValues() { return {"false", "true"}; }
 inline std::string BooleanText(bool value) { return value ? "true" : "false"; }
 
+// How a run writes an HDR frame as PNG: each channel ReinhardToneMap(C, exposure) (core/math/March.h), or
+// min(exposure C, 1) without the tone map, before the sRGB encoding. The EXR stays linear.
+struct FrameToneMap {
+    bool reinhard = true;
+    float exposure = 1;
+};
+
+// What a renderer's accuracy measurement (harness/accuracy) hands it: the volume, the image to draw, the camera
+// and step, and `shadedT`, which shades T on the same backend when the renderer reads it (untimed).
+struct AccuracyRenderInputs {
+    const Buffer* q = nullptr;
+    Buffer* image = nullptr;
+    const CameraSettings* camera = nullptr;
+    uint32_t step = 0;
+    std::function<Result<const Buffer*>()> shadedT;
+};
+// The renderer's call, made ready: `call` draws the image once (the measurement times it, repeatedly);
+// `prepMs` is the untimed work the renderer's inputs took (shading T, the density stage's occupancy).
+struct AccuracyRender {
+    std::function<Status()> call;
+    double prepMs = 0;
+};
+
+// What the harness knows of a renderer, as data: how its output is named and shown, and what it can do.
+// results.json, the reports, `run`, `dump`, the accuracy evaluator, the sweep and the scene checks walk these.
+struct RendererDescriptor {
+    std::string_view fileStem;    // its frames: frame-<fileStem>-<camera>[-<backend>].exr and .png
+    std::string_view rowLabel;    // the text report's rows of a camera's frames: "<rowLabel> <camera>"
+    std::string_view resultsKey;  // results.json's per-camera frames of a backend
+    std::string_view recordKey;   // a saved step's frame keeps the counters under it ("": in the frame itself)
+    std::span<const FrameCounterField> counters;  // FrameRecord::counters, in order
+    // The PNG's tone map in this scene; nullptr: the image is LDR, written as it is.
+    FrameToneMap (*toneMap)(const Scene& scene) = nullptr;
+    // Reads q periodically, so it runs with grid.tiling (clouds to the horizon).
+    bool honoursTiling = false;
+    // Lights with T shaded once, for the first step's sun (relighting), in this scene: shade then runs once.
+    // nullptr: it reads T shaded at each step's sun, and cannot run beside a renderer that relights.
+    bool (*relights)(const Scene& scene) = nullptr;
+    // The scene fields that decide `relights` (a sweep's shade rows depend on them).
+    std::span<const std::string_view> relightFields;
+    // The scene fields whose variation a sweep measures its image for (images cost a reference render each).
+    std::span<const std::string_view> imageFields;
+    // Its fields that the exact reference render does not read (a change leaves the reference as it is).
+    std::span<const std::string_view> referenceIgnores;
+    // Its call for one image on `backend`, for the accuracy measurement.
+    Result<AccuracyRender> (*accuracyRender)(Backend& backend, const Scene& scene,
+                                             const AccuracyRenderInputs& in) = nullptr;
+    // The settings the accuracy measurement tries besides the scene's own, each a list of overrides.
+    std::vector<std::vector<SceneOverride>> (*accuracyVariants)(const Scene& scene) = nullptr;
+};
+
 struct StageDescriptor {
     Stage stage;
     std::string_view section;     // the scene section of its settings ("" for none)
@@ -129,8 +181,8 @@ struct StageDescriptor {
     // Time-slicing (SPEC 13): how many shares its work at `step` splits into
     // (core/pipeline/Backend.h SliceRange); nullptr: it runs whole, as one share.
     uint32_t (*shareCount)(const Scene& scene, uint32_t step) = nullptr;
-    // A renderer: writes one image per camera.
-    bool renderer = false;
+    // A renderer (writes one image per camera): what the harness knows of it; nullptr for other stages.
+    const RendererDescriptor* renderer = nullptr;
     std::string_view symbol;  // the compared quantity in rule texts ("R", "T", ...)
     // The comparison for this scene (shade's tolerance depends on its storage format).
     CompareRule (*rule)(const Scene& scene) = nullptr;

@@ -136,21 +136,30 @@ void CheckTiling(const Scene& scene, Validator& check) {
                                       ") must divide grid.size's nx and ny (" + std::to_string(scene.grid.size.nx) +
                                       ", " + std::to_string(scene.grid.size.ny) +
                                       ") for the detail volume to repeat with the grid");
-    for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch})
-        if (scene.stages.Has(renderer))
-            check.Fail("grid.tiling", Quote(StageName(renderer)) +
-                                          " does not repeat the volume yet; only render_layers honours tiling");
+    std::string honouring;  // the renderers that honour tiling, for the message
+    for (Stage stage : kAllStages)
+        if (const RendererDescriptor* r = Describe(stage).renderer; r && r->honoursTiling)
+            honouring += (honouring.empty() ? "" : ", ") + std::string(StageName(stage));
+    for (Stage stage : kAllStages)
+        if (const RendererDescriptor* r = Describe(stage).renderer; r && !r->honoursTiling && scene.stages.Has(stage))
+            check.Fail("grid.tiling", Quote(StageName(stage)) + " does not repeat the volume yet; only " + honouring +
+                                          " honours tiling");
 }
 
-// Relighting shades once, for the first step's sun: a renderer other than render_layers would read that T as if
-// it were shaded at its own step's sun.
+// Relighting shades once, for the first step's sun: a renderer that does not relight would read that T as if it
+// were shaded at its own step's sun.
 void CheckRelight(const Scene& scene, Validator& check) {
-    if (scene.layers.relight != LayersRelight::Vector) return;
-    for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch})
-        if (scene.stages.Has(renderer))
-            check.Fail("layers.relight", "\"vector\" shades once, for the first step's sun, and " +
-                                             Quote(StageName(renderer)) +
-                                             " would light with that T at every step; run it without relighting");
+    for (Stage relighting : kAllStages) {
+        const RendererDescriptor* r = Describe(relighting).renderer;
+        if (!r || !r->relights || !scene.stages.Has(relighting) || !r->relights(scene)) continue;
+        const std::string field = r->relightFields.empty() ? std::string(StageName(relighting))
+                                                           : std::string(r->relightFields.front());
+        for (Stage other : kAllStages)
+            if (const RendererDescriptor* o = Describe(other).renderer; o && !o->relights && scene.stages.Has(other))
+                check.Fail(field, Quote(StageName(relighting)) + " relights: it shades once, for the first step's sun, "
+                                  "and " + Quote(StageName(other)) +
+                                  " would light with that T at every step; run it without relighting");
+    }
 }
 
 void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& sections, Validator& check) {

@@ -22,14 +22,14 @@ bool LightingOnly(const std::string& path) {
 }  // namespace
 
 bool ReferenceRenderIgnores(std::string_view p) {
-    for (const char* exact :
-         {"march.step", "march.adaptive.enabled", "march.adaptive.kappa", "march.adaptive.start", "march.jitter",
-          "march.light", "march.light_steps", "march.epsilon", "march.skipping.enabled", "march.skipping.brick",
-          "march.exposure", "march.tone_map", "render.q_min", "render.splat_scale", "render.opacity", "render.culling",
-          "render.skipping", "repeats", "warmup_steps"})
-        if (p == exact) return true;
+    // A renderer's own settings the reference does not read: the field itself, or one inside it.
+    auto within = [&](std::string_view field) { return p == field || (p.starts_with(field) && p[field.size()] == '.'); };
+    for (Stage stage : kAllStages)
+        if (const RendererDescriptor* r = Describe(stage).renderer)
+            if (std::ranges::any_of(r->referenceIgnores, within)) return true;
+    if (p == "repeats" || p == "warmup_steps") return true;
     if (p == "shade.sigma") return false;
-    for (const char* prefix : {"shade.", "shadow.", "density.", "layers."})
+    for (const char* prefix : {"shade.", "shadow.", "density."})
         if (p.starts_with(prefix)) return true;
     return false;
 }

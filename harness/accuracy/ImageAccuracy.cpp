@@ -8,10 +8,6 @@
 #include <numbers>
 
 #include "core/scene/SceneNames.h"
-#include "core/stages/density/Density.h"
-#include "core/stages/render_layers/RenderLayers.h"
-#include "core/stages/render_march/RenderMarch.h"
-#include "core/stages/render_splat/RenderSplat.h"
 #include "core/stages/shade/Shade.h"
 #include "harness/platform/Isolation.h"
 
@@ -118,13 +114,13 @@ std::optional<std::string> ReferenceRenderUnsupported(const Scene& scene) {
 
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats) {
-    if (!Describe(renderer).renderer) return RenderNotMeasured("failed", "not a renderer");
+    const RendererDescriptor* descriptor = Describe(renderer).renderer;
+    if (!descriptor || !descriptor->accuracyRender) return RenderNotMeasured("failed", "not a renderer");
     if (auto why = ReferenceRenderUnsupported(scene)) return RenderNotMeasured("unsupported", *why);
     if (!backend.Supports(renderer))
         return RenderNotMeasured("unsupported",
                                  backend.Name() + " does not implement " + std::string(StageName(renderer)) + " yet");
     if (scene.render.cameras.empty()) return RenderNotMeasured("failed", "the scene has no camera");
-    const CameraSettings& camera = scene.render.cameras[0];
     auto fail = [](const std::string& what, const Error& e) { return RenderNotMeasured("failed", what + e.message); };
     auto q = backend.CreateBuffer(BufferFormat::F32, in.grid);
     if (!q) return fail("", q.error());
@@ -132,55 +128,29 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     auto image = backend.CreateBuffer(BufferFormat::F32, {3, scene.render.width, scene.render.height});
     if (!image) return fail("", image.error());
     RenderAccuracy a;
-    // T from shade on this backend, untimed in the render's time.
+    // T from shade on this backend when the renderer reads it, untimed in the render's time.
     std::unique_ptr<Buffer> T;
-    const bool needsT = renderer != Stage::RenderMarch || scene.march.light == MarchLightSource::Shade;
-    if (needsT) {
-        if (!backend.Supports(Stage::Shade))
-            return RenderNotMeasured("unsupported", backend.Name() + " does not implement shade, which feeds T");
+    std::optional<std::string> unsupported;
+    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr};
+    inputs.shadedT = [&]() -> Result<const Buffer*> {
+        if (!backend.Supports(Stage::Shade)) {
+            unsupported = backend.Name() + " does not implement shade, which feeds T";
+            return MakeError(*unsupported);
+        }
         auto t = backend.CreateBuffer(BufferFormat::F32, in.grid);
-        if (!t) return fail("", t.error());
+        if (!t) return std::unexpected(t.error());
         T = std::move(*t);
         const auto start = std::chrono::steady_clock::now();
-        if (Status s = backend.Shade(MakeShadeParams(scene), **q, *T); !s) return fail("shade: ", s.error());
+        if (Status s = backend.Shade(MakeShadeParams(scene), **q, *T); !s) return MakeError("shade: " + s.error().message);
         a.prepMs += MillisecondsSince(start);
-    }
+        return T.get();
+    };
+    auto render = descriptor->accuracyRender(backend, scene, inputs);
+    if (!render) return RenderNotMeasured(unsupported ? "unsupported" : "failed", render.error().message);
+    a.prepMs += render->prepMs;
     MarkPhase(StageName(renderer), in.step);
     InjectTestFault(backend.Name(), StageName(renderer));
-    Result<Summary> time;
-    if (renderer == Stage::RenderMarch) {
-        const MarchParams p = MakeMarchParams(scene, camera, in.step);
-        const MarchInputs inputs{q->get(), q->get(), T.get()};
-        time = TimeRepeated(repeats, [&] { return backend.RenderMarch(p, inputs, **image, nullptr); });
-    } else if (renderer == Stage::RenderLayers) {
-        LayersParams p = MakeLayersParams(scene, camera, in.step);
-        const std::vector<float> map = MakeLayersMap(scene, in.step);  // before the timed calls, as in a run
-        p.setup.map = map.empty() ? nullptr : map.data();
-        const LayersInputs inputs{q->get(), q->get(), T.get()};
-        time = TimeRepeated(repeats, [&] { return backend.RenderLayers(p, inputs, **image, nullptr); });
-    } else {
-        SplatParams p = MakeSplatParams(scene, camera);
-        const SplatOrder order = MakeSplatOrder(p.camera, scene.grid.size, scene.grid.origin, scene.grid.voxelSize);
-        p.order = &order;
-        // The density stage's occupancy (read when skipping), untimed in the render's time.
-        const DensityParams dp = MakeDensityParams(scene);
-        const Extent3 e = in.grid;
-        auto D = backend.CreateBuffer(BufferFormat::F32, {e.nx, e.ny, 1});
-        auto tiles = backend.CreateBuffer(BufferFormat::U8, {CeilDiv(e.nx, dp.tile), CeilDiv(e.ny, dp.tile), 1});
-        auto bands = backend.CreateBuffer(BufferFormat::U8,
-                                          {CeilDiv(e.nx, dp.tile), CeilDiv(e.ny, dp.tile), CeilDiv(e.nz, dp.band)});
-        if (!D || !tiles || !bands) return RenderNotMeasured("failed", "cannot create the density buffers");
-        if (backend.Supports(Stage::Density)) {
-            DensityOutputs outs{D->get(), tiles->get(), bands->get(), 0};
-            const auto start = std::chrono::steady_clock::now();
-            if (Status s = backend.Density(dp, **q, nullptr, outs); !s) return fail("density: ", s.error());
-            a.prepMs += MillisecondsSince(start);
-        } else {
-            p.skipping = false;
-        }
-        const SplatInputs inputs{q->get(), q->get(), T.get(), tiles->get(), tiles->get(), bands->get(), bands->get()};
-        time = TimeRepeated(repeats, [&] { return backend.RenderSplat(p, inputs, **image, nullptr); });
-    }
+    const Result<Summary> time = TimeRepeated(repeats, render->call);
     if (!time) return fail(std::string(StageName(renderer)) + ": ", time.error());
     a.timeMs = *time;
     std::vector<float> out(size_t(3) * scene.render.width * scene.render.height);
@@ -191,51 +161,6 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
                                                " channel values are not finite");
     a.error = ImageErrors(out, reference);
     return a;
-}
-
-std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& sc) {
-    std::vector<std::vector<SceneOverride>> out;
-    for (double f : {0.5, 2.0, 4.0}) out.push_back({{"march.step", Fmt("%.9g", sc.march.step * f)}});
-    if (!sc.march.adaptive) out.push_back({{"march.adaptive.enabled", "true"}});
-    if (sc.march.light == MarchLightSource::Shade) {
-        for (int n : {2, 4, 8, 16}) out.push_back({{"march.light", "march"}, {"march.light_steps", std::to_string(n)}});
-        if (sc.shade.resolution != 2) out.push_back({{std::string(ShadeResolutionSetting().path), "2"}});
-    } else {
-        for (uint32_t n : {2u, 4u, 8u, 16u})
-            if (n != sc.march.lightSteps) out.push_back({{"march.light_steps", std::to_string(n)}});
-        if (sc.stages.Has(Stage::Shade)) out.push_back({{"march.light", "shade"}});
-    }
-    out.push_back({{"march.jitter", sc.march.jitter ? "false" : "true"}});
-    out.push_back({{"march.skipping.enabled", sc.march.skipping ? "false" : "true"}});
-    if (sc.march.epsilon != 0) out.push_back({{"march.epsilon", "0"}});
-    // Every phase function against the Mie reference, the scene's own included
-    // (its row is the cost of approximating Mie); for a Mie scene that row is the scene's.
-    for (const auto& [name, kind] : kPhaseKindNames)
-        if (kind != PhaseKind::Mie || sc.phase.kind != PhaseKind::Mie)
-            out.push_back({{"phase.function", std::string(name)}});
-    return out;
-}
-
-std::vector<std::vector<SceneOverride>> LayersImageVariants(const Scene& sc) {
-    // SPEC 15's layers per voxel of height: 1/2, 1, 2 and 4 (N = nz/2 ... 4 nz), the scene's count left out.
-    std::vector<std::vector<SceneOverride>> out;
-    const uint32_t nz = sc.grid.size.nz, count = sc.layers.count > 0 ? sc.layers.count : nz;
-    for (uint32_t n : {nz / 2, nz, 2 * nz, 4 * nz})
-        if (n >= 1 && n != count) out.push_back({{"layers.count", std::to_string(n)}});
-    // Grazing views, where the paper's layers show gaps: one camera at the slab's mid-height, a quarter of the grid
-    // outside it in x, looking along +x raised by 1, 5 and 20 degrees.
-    const double h = sc.grid.voxelSize, nx = sc.grid.size.nx;
-    const std::array<double, 3> eye = {sc.grid.origin[0] - 0.25 * nx * h, sc.grid.origin[1] + 0.5 * sc.grid.size.ny * h,
-                                       sc.grid.origin[2] + 0.5 * nz * h};
-    for (double degrees : {1.0, 5.0, 20.0}) {
-        const double e = degrees * std::numbers::pi / 180, reach = nx * h;
-        const std::array<double, 3> target = {eye[0] + reach * std::cos(e), eye[1], eye[2] + reach * std::sin(e)};
-        out.push_back({{"render.cameras", "[{\"name\": \"elevation-" + Fmt("%.0f", degrees) + "\", \"eye\": [" +
-                                              Fmt("%.6g", eye[0]) + ", " + Fmt("%.6g", eye[1]) + ", " +
-                                              Fmt("%.6g", eye[2]) + "], \"target\": [" + Fmt("%.6g", target[0]) + ", " +
-                                              Fmt("%.6g", target[1]) + ", " + Fmt("%.6g", target[2]) + "]}]"}});
-    }
-    return out;
 }
 
 Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<SceneOverride>& setting, Stage renderer,
@@ -262,21 +187,14 @@ Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<co
     ImageReferences& refs = eval.Images();
     const int repeats = eval.Measurement().repeats;
     json rows = json::array();
-    if (scene.stages.Has(Stage::RenderMarch)) {
-        const Stage march[] = {Stage::RenderMarch};
-        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, march, rows));
-        for (const auto& v : MarchImageVariants(scene))
-            CB_TRY(MeasureImageRows(refs, session, repeats, v, backends, march, rows));
-    }
-    if (scene.stages.Has(Stage::RenderSplat)) {
-        const Stage splat[] = {Stage::RenderSplat};
-        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, splat, rows));
-    }
-    if (scene.stages.Has(Stage::RenderLayers)) {
-        const Stage layers[] = {Stage::RenderLayers};
-        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, layers, rows));
-        for (const auto& v : LayersImageVariants(scene))
-            CB_TRY(MeasureImageRows(refs, session, repeats, v, backends, layers, rows));
+    for (Stage stage : kAllStages) {
+        const RendererDescriptor* renderer = Describe(stage).renderer;
+        if (!renderer || !scene.stages.Has(stage)) continue;
+        const Stage one[] = {stage};
+        CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, one, rows));
+        if (renderer->accuracyVariants)
+            for (const auto& v : renderer->accuracyVariants(scene))
+                CB_TRY(MeasureImageRows(refs, session, repeats, v, backends, one, rows));
     }
     return json{{"rows", rows}, {"references", refs.Records()}};
 }

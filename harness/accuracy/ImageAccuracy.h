@@ -50,18 +50,10 @@ std::optional<std::string> ReferenceRenderUnsupported(const Scene& scene);
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats);
 
-// The render_march settings accuracy measures, one at a time from the scene's
-// (docs/accuracy.md lists them); each is a list of overrides.
-std::vector<std::vector<SceneOverride>> MarchImageVariants(const Scene& scene);
-// The render_layers settings: the layer count at 1/2, 1, 2 and 4 layers per voxel of height, and a camera
-// looking into the slab from its side at elevations of 1, 5 and 20 degrees (grazing views).
-std::vector<std::vector<SceneOverride>> LayersImageVariants(const Scene& scene);
-
 // Every image row of the session's scene on `backends` (one process's slot),
-// as JSON: {"rows": [...], "references": [...]} (docs/results.md). Rows:
-// render_march with the scene's settings and each MarchImageVariants, then
-// render_splat with the scene's settings, then render_layers with the scene's and
-// each LayersImageVariants; only the renderers the scene runs.
+// as JSON: {"rows": [...], "references": [...]} (docs/results.md). Rows: each
+// renderer the scene runs, in stage order, with the scene's settings and then
+// each of its descriptor's accuracyVariants.
 Result<nlohmann::json> MeasureImages(Evaluator& eval, const Session& session, std::span<const OpenedBackend> backends);
 // One renderer of one setting on one backend as a Row's result (sweep): the
 // per-pixel errors in `all`, PSNR in psnrDb; the reference is the setting's

@@ -54,12 +54,15 @@ std::vector<SceneOverride> SettingsRead(Stage stage, std::span<const SceneOverri
 std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
     // The renderers' reference render costs most: images are measured only when an image section varies.
     const bool images = std::ranges::any_of(axes, [](const SweepAxis& a) {
-        return std::ranges::any_of(
-            std::initializer_list<std::string_view>{"march", "render", "lightning", "phase", "layers"},
-            [&](std::string_view section) { return FieldsOverlap(a.path, section); });
+        return std::ranges::any_of(kAllStages, [&](Stage stage) {
+            const RendererDescriptor* r = Describe(stage).renderer;
+            return r && SweepFieldsListed(r->imageFields, a.path);
+        });
     });
     std::vector<Stage> candidates = {Stage::Shade, Stage::Shadow};
-    if (images) candidates.insert(candidates.end(), {Stage::RenderMarch, Stage::RenderSplat, Stage::RenderLayers});
+    if (images)
+        for (Stage stage : kAllStages)
+            if (Describe(stage).renderer) candidates.push_back(stage);
     std::vector<Stage> stages;
     for (Stage stage : candidates)
         if (std::ranges::any_of(axes, [&](const SweepAxis& a) { return RowDependsOn(stage, a.path); }))

@@ -7,8 +7,8 @@
 namespace cb {
 namespace {
 
-// The renderers share one front.
-Stage SweepParetoGroup(Stage s) { return Describe(s).renderer ? Stage::RenderMarch : s; }
+// Rows on one front: a stage's own, and every renderer's together (their images answer to one reference).
+bool SameParetoFront(Stage a, Stage b) { return a == b || (Describe(a).renderer && Describe(b).renderer); }
 
 bool SweepClearlyFaster(const Row& a, const Row& b) { return a.result.timeMs.q3 < b.result.timeMs.q1; }
 
@@ -45,7 +45,7 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
         if (!SweepOnFront(r, metric)) continue;
         r.pareto = true;
         for (const Row& o : rows)
-            if (&o != &r && SweepOnFront(o, metric) && SweepParetoGroup(o.stage) == SweepParetoGroup(r.stage) &&
+            if (&o != &r && SweepOnFront(o, metric) && SameParetoFront(o.stage, r.stage) &&
                 ParetoBeats(o, r, metric)) {
                 r.pareto = false;
                 break;
@@ -54,7 +54,7 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
     for (Row& r : rows) {
         if (!r.pareto) continue;
         for (const Row& o : rows)
-            if (&o != &r && o.pareto && SweepParetoGroup(o.stage) == SweepParetoGroup(r.stage) &&
+            if (&o != &r && o.pareto && SameParetoFront(o.stage, r.stage) &&
                 MetricLoss(o, metric) == MetricLoss(r, metric) && !SweepClearlyFaster(o, r) &&
                 !SweepClearlyFaster(r, o)) {
                 r.paretoTie = true;

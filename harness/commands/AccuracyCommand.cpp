@@ -391,8 +391,8 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
                 if (imageRefs.empty()) imageRefs = part.extra["images"]["references"];
                 continue;
             }
-            for (Stage r : {Stage::RenderMarch, Stage::RenderSplat})
-                if (scene.stages.Has(r))
+            for (Stage r : kAllStages)
+                if (Describe(r).renderer && scene.stages.Has(r))
                     imageRows.push_back({{"renderer", StageName(r)},
                                          {"backend", part.name},
                                          {"settings", json::object()},

@@ -168,12 +168,9 @@ bool RunBackend(const Session& session, const RunOptions& own, Backend& backend,
                 continue;
             }
             const std::string stem = outDir + "/" + FrameFileStem(renderer, scene.render.cameras[n].name, run.name);
-            // The ray marcher's and the layers' frames are HDR: their PNG is tone-mapped with the scene's exposure.
+            // An HDR renderer's PNG is tone-mapped as its descriptor says for the scene.
             std::optional<FrameToneMap> toneMap;
-            if (renderer == Stage::RenderMarch)
-                toneMap = FrameToneMap{scene.march.toneMap, float(scene.march.exposure)};
-            if (renderer == Stage::RenderLayers)
-                toneMap = FrameToneMap{scene.layers.toneMap, float(scene.layers.exposure)};
+            if (const auto map = Describe(renderer).renderer->toneMap) toneMap = map(scene);
             auto paths = WriteFrame(stem, *rgb, scene.render.width, scene.render.height, true, toneMap);
             if (paths)
                 written.insert(written.end(), paths->begin(), paths->end());

@@ -8,6 +8,7 @@
 #include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
 #include "core/scene/Stage.h"
+#include "core/plan/StageGraph.h"
 #include "harness/report/PerfSchemas.h"
 
 namespace cb::input {
@@ -96,13 +97,12 @@ Node ReportBlock() {
     return Object({{"title", Text(), true}, {"sections", ArrayOf(section), true}});
 }
 
-template <typename Stats, size_t N>
-Node FrameCamera(const Counter<Stats> (&counters)[N]) {
+Node FrameCamera(std::span<const FrameCounterField> counters) {
     std::vector<Field> fields = SummaryFields(true);
     fields.push_back({"steps", ArrayOf(Step()), true});
     fields.push_back({"alphas", ArrayOf(Fraction()), true});
     fields.push_back({"fps_median", Number(0, 1e12), true});
-    for (const Counter<Stats>& c : counters)
+    for (const FrameCounterField& c : counters)
         if (c.shown != CounterShown::ReadBack) fields.push_back({std::string(c.name), ArrayOf(Count()), true});
     return Object(std::move(fields));
 }
@@ -140,7 +140,7 @@ Node ResultsBackend() {
                                  {"stage", Text()},
                                  {"step", Nullable(Step())},
                                  {"message", Text()}});
-    return Object({
+    std::vector<Field> fields{
         {"status", TextOf(BackendStatuses()), true},
         {"error", Text()},
         {"failure", failure},
@@ -152,9 +152,6 @@ Node ResultsBackend() {
         {"transfers", MapOf(KeyRule::Any, Summary())},
         {"stage_runs", MapOf(KeyRule::Stage, stageRuns)},
         {"loop", loop},
-        {"frames", MapOf(KeyRule::PathName, FrameCamera(kSplatCounters))},
-        {"march_frames", MapOf(KeyRule::PathName, FrameCamera(kMarchCounters))},
-        {"layers_frames", MapOf(KeyRule::PathName, FrameCamera(kLayersCounters))},
         {"cover", ArrayOf(Fraction())},
         {"cover_summary", Object({{"mean", Fraction(), true},
                                   {"median", Fraction(), true},
@@ -163,7 +160,12 @@ Node ResultsBackend() {
         {"timing", Object({{"mode", TextOf({"synchronized", "pipelined", "both"}), true},
                            {"synchronized", TimingMode("wall")},
                            {"pipelined", TimingMode("host")}})},
-    });
+    };
+    // Each renderer's frames, per camera (harness/report/ResultsJson.cpp).
+    for (Stage stage : kAllStages)
+        if (const RendererDescriptor* renderer = Describe(stage).renderer)
+            fields.push_back({std::string(renderer->resultsKey), MapOf(KeyRule::PathName, FrameCamera(renderer->counters))});
+    return Object(std::move(fields));
 }
 
 Node ResultsSchema() {

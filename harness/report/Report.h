@@ -112,13 +112,7 @@ std::string FrameFileStem(Stage renderer, const std::string& camera, const std::
 // Writes a linear RGB float image (3 floats a pixel, row 0 at the top) as
 // `stem`.exr (float, linear) and, with png = true, `stem`.png (8-bit sRGB),
 // through the image module. Returns the paths written.
-// The PNG of an HDR frame (the ray marcher's): each channel becomes
-// ReinhardToneMap(C, exposure) (core/math/March.h), or min(exposure C, 1) without
-// the tone map, before the sRGB encoding. The EXR stays linear.
-struct FrameToneMap {
-    bool reinhard = true;
-    float exposure = 1;
-};
+// The PNG of an HDR frame is tone-mapped (FrameToneMap, core/pipeline/StageDescriptor.h); the EXR stays linear.
 
 Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
                                             uint32_t height, bool png = true,

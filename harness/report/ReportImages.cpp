@@ -15,16 +15,8 @@
 namespace cb {
 
 std::string_view RendererFileName(Stage renderer) {
-    switch (renderer) {
-        case Stage::RenderSplat:
-            return "splat";
-        case Stage::RenderMarch:
-            return "march";
-        case Stage::RenderLayers:
-            return "layers";
-        default:
-            return StageName(renderer);
-    }
+    const RendererDescriptor* d = Describe(renderer).renderer;
+    return d ? d->fileStem : StageName(renderer);
 }
 
 std::string FrameFileStem(Stage renderer, const std::string& camera, const std::string& backend) {

@@ -1,7 +1,6 @@
 // results.json (harness/report/Report.h ResultsJson and TimingJson; the format is in
 // docs/results.md): per backend, each stage's timing summary and how often it
 // ran, the loop, the frames, the cover, and the timing of each mode.
-#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,17 +10,11 @@
 namespace cb {
 namespace {
 
-// A counter of a frame as results.json lists it: its name and its value in a frame.
-using FrameCounter = std::pair<std::string, std::function<uint64_t(const FrameRecord&)>>;
-
-// The counters of `list` that results.json shows, read from the frame's statistics `stats`.
-template <typename Stats, size_t N>
-std::vector<FrameCounter> ResultsCounters(const Counter<Stats> (&list)[N], Stats FrameRecord::*stats) {
-    std::vector<FrameCounter> out;
-    for (const Counter<Stats>& c : list)
-        if (c.shown != CounterShown::ReadBack)
-            out.push_back(
-                {std::string(c.name), [stats, member = c.member](const FrameRecord& f) { return (f.*stats).*member; }});
+// The counters of a renderer that results.json shows: each one's name and its index in FrameRecord::counters.
+std::vector<std::pair<std::string, size_t>> ResultsCounters(const RendererDescriptor& renderer) {
+    std::vector<std::pair<std::string, size_t>> out;
+    for (size_t i = 0; i < renderer.counters.size(); ++i)
+        if (renderer.counters[i].shown != CounterShown::ReadBack) out.push_back({std::string(renderer.counters[i].name), i});
     return out;
 }
 
@@ -65,8 +58,8 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
             stages[std::string(StageName(stage))] = entry;
         }
         nlohmann::json frames = nlohmann::json::object();
-        for (Stage renderer : {Stage::RenderSplat, Stage::RenderMarch, Stage::RenderLayers}) {
-            if (!scene.stages.Has(renderer)) continue;
+        for (Stage renderer : kAllStages) {
+            if (!Describe(renderer).renderer || !scene.stages.Has(renderer)) continue;
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> wall, device;
                 ForEachFrame(run, renderer, camera.name, [&](const StepRecord& r, const FrameRecord& f) {
@@ -155,7 +148,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
         // Per camera of a renderer: every frame's time (not a pipelined frame's: its call
         // time is host time), step and alpha, the renderer's counters shown in results.json
         // (`counters`: a field name and a value of a frame each), and their summary.
-        auto framesJson = [&](Stage renderer, const std::vector<FrameCounter>& counters) {
+        auto framesJson = [&](Stage renderer, const std::vector<std::pair<std::string, size_t>>& counters) {
             nlohmann::json cameras = nlohmann::json::object();
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> ms;
@@ -166,7 +159,7 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
                     if (!f.pipelined) ms.push_back(f.ms);
                     steps.push_back(r.step);
                     alphas.push_back(f.alpha);
-                    for (const auto& counter : counters) c[counter.first].push_back(counter.second(f));
+                    for (const auto& counter : counters) c[counter.first].push_back(f.counters[counter.second]);
                 });
                 c.update(SummaryJson(ms));
                 c["steps"] = steps;
@@ -176,13 +169,9 @@ nlohmann::json ResultsJson(const Scene& scene, const std::vector<BackendRun>& ru
             }
             return cameras;
         };
-        if (scene.stages.Has(Stage::RenderSplat))
-            b["frames"] = framesJson(Stage::RenderSplat, ResultsCounters(kSplatCounters, &FrameRecord::stats));
-        if (scene.stages.Has(Stage::RenderMarch))
-            b["march_frames"] = framesJson(Stage::RenderMarch, ResultsCounters(kMarchCounters, &FrameRecord::march));
-        if (scene.stages.Has(Stage::RenderLayers))
-            b["layers_frames"] =
-                framesJson(Stage::RenderLayers, ResultsCounters(kLayersCounters, &FrameRecord::layers));
+        for (Stage stage : kAllStages)
+            if (const RendererDescriptor* renderer = Describe(stage).renderer; renderer && scene.stages.Has(stage))
+                b[std::string(renderer->resultsKey)] = framesJson(stage, ResultsCounters(*renderer));
         if (scene.stages.Has(Stage::Density)) {
             nlohmann::json cover = nlohmann::json::array();
             std::vector<double> after;

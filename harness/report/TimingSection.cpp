@@ -52,32 +52,27 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
         table.rows.push_back(TimingRow(std::string(StageName(stage)), StageSamples(scene, run, stage),
                                        StageSamples(scene, run, stage, StageClock::Device)));
     }
-    // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's count of `what`.
-    auto frameRows = [&](Stage renderer, const std::string& label, std::string_view what, auto count) {
-        if (!scene.stages.Has(renderer)) return;
+    // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's reported counter.
+    for (Stage renderer : kAllStages) {
+        const RendererDescriptor* d = Describe(renderer).renderer;
+        if (!d || !scene.stages.Has(renderer)) continue;
+        const size_t reported = ReportedCounterIndex(d->counters);
+        const std::string_view what = reported < d->counters.size() ? d->counters[reported].name : "";
         for (const CameraSettings& camera : scene.render.cameras) {
             std::vector<double> ms;
             uint64_t last = 0;
             ForEachFrame(run, renderer, camera.name, [&](const StepRecord&, const FrameRecord& f) {
                 ms.push_back(f.ms);
-                last = count(f);
+                last = reported < f.counters.size() ? f.counters[reported] : 0;
             });
             const Summary s = Summarize(ms);
             std::snprintf(line, sizeof line, "%zu frames, %.1f fps, %llu %.*s", s.count,
                           s.median > 0 ? 1000.0 / s.median : 0.0, static_cast<unsigned long long>(last),
                           int(what.size()), what.data());
-            table.rows.push_back(TimingRow(("  " + label + " " + camera.name).substr(0, 18), ms, {}, line));
+            table.rows.push_back(
+                TimingRow(("  " + std::string(d->rowLabel) + " " + camera.name).substr(0, 18), ms, {}, line));
         }
-    };
-    const auto& splatCount = ReportedCounter(kSplatCounters);
-    const auto& marchCount = ReportedCounter(kMarchCounters);
-    frameRows(Stage::RenderSplat, "frame", splatCount.name,
-              [&](const FrameRecord& f) { return f.stats.*splatCount.member; });
-    frameRows(Stage::RenderMarch, "march", marchCount.name,
-              [&](const FrameRecord& f) { return f.march.*marchCount.member; });
-    const auto& layersCount = ReportedCounter(kLayersCounters);
-    frameRows(Stage::RenderLayers, "layers", layersCount.name,
-              [&](const FrameRecord& f) { return f.layers.*layersCount.member; });
+    }
     if (scene.stages.Has(Stage::Region)) {
         std::vector<double> host;
         for (const StepRecord& r : run.steps)

@@ -1,5 +1,8 @@
 #include "harness/run/RunTransfer.h"
 
+#include <optional>
+#include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include "harness/platform/TransferJson.h"
@@ -7,16 +10,19 @@
 namespace cb::transfer {
 namespace {
 
-template <typename Stats, size_t N>
-json CountersJson(const Stats& stats, const Counter<Stats> (&counters)[N]) {
+// A frame's counters, named by its renderer's list.
+json CountersJson(const FrameRecord& f) {
     json out = json::object();
-    for (const Counter<Stats>& c : counters) out[std::string(c.name)] = stats.*c.member;
+    const std::span<const FrameCounterField> fields = Describe(f.renderer).renderer->counters;
+    for (size_t i = 0; i < fields.size(); ++i) out[std::string(fields[i].name)] = f.counters[i];
     return out;
 }
-template <typename Stats, size_t N>
-void CountersFromJson(const json& j, const Counter<Stats> (&counters)[N], Stats& stats) {
-    for (const Counter<Stats>& c : counters) stats.*c.member = j.at(std::string(c.name)).get<uint64_t>();
+void CountersFromJson(const json& j, FrameRecord& f) {
+    const std::span<const FrameCounterField> fields = Describe(f.renderer).renderer->counters;
+    for (size_t i = 0; i < fields.size(); ++i) f.counters[i] = j.at(std::string(fields[i].name)).get<uint64_t>();
 }
+// Where a frame keeps its counters: in itself, or under its renderer's key.
+std::string_view RecordKey(const FrameRecord& f) { return Describe(f.renderer).renderer->recordKey; }
 
 }  // namespace
 
@@ -37,10 +43,11 @@ json ToJson(const StepRecord& r) {
                           {"alpha", D(f.alpha)},
                           {"ms", D(f.ms)},
                           {"pipelined", f.pipelined},
-                          {"device_ms", Optional(f.deviceMs)},
-                          {"march", CountersJson(f.march, kMarchCounters)},
-                          {"layers", CountersJson(f.layers, kLayersCounters)}});
-        frames.back().update(CountersJson(f.stats, kSplatCounters));
+                          {"device_ms", Optional(f.deviceMs)}});
+        if (RecordKey(f).empty())
+            frames.back().update(CountersJson(f));
+        else
+            frames.back()[std::string(RecordKey(f))] = CountersJson(f);
     }
     json frameMs = json::array();
     for (double ms : r.frameMs) frameMs.push_back(D(ms));
@@ -85,16 +92,17 @@ StepRecord StepFromJson(const json& j) {
     r.frameWork = j.at("frame_work").get<std::vector<std::string>>();
     for (const json& f : j.at("frames")) {
         FrameRecord frame;
-        frame.renderer = ParseStage(f.at("renderer").get<std::string>()).value_or(Stage::RenderSplat);
+        const std::string renderer = f.at("renderer").get<std::string>();
+        const std::optional<Stage> stage = ParseStage(renderer);
+        if (!stage || !Describe(*stage).renderer) throw std::runtime_error("a frame of \"" + renderer + "\", not a renderer");
+        frame.renderer = *stage;
         frame.camera = f.at("camera").get<std::string>();
         frame.frame = f.at("frame").get<uint32_t>();
         frame.alpha = float(FromD(f.at("alpha")));
         frame.ms = FromD(f.at("ms"));
         frame.pipelined = f.at("pipelined").get<bool>();
         frame.deviceMs = OptionalFrom<double>(f.at("device_ms"));
-        CountersFromJson(f, kSplatCounters, frame.stats);
-        if (const auto m = f.find("march"); m != f.end()) CountersFromJson(*m, kMarchCounters, frame.march);
-        if (const auto m = f.find("layers"); m != f.end()) CountersFromJson(*m, kLayersCounters, frame.layers);
+        CountersFromJson(RecordKey(frame).empty() ? f : f.at(std::string(RecordKey(frame))), frame);
         r.frames.push_back(std::move(frame));
     }
     return r;

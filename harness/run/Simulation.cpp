@@ -19,7 +19,7 @@ Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutpu
 
 bool Simulation::IsOutputStep(uint32_t step) const {
     bool renders = false;
-    for (Stage stage : mSchedule) renders |= Describe(stage).renderer;
+    for (Stage stage : mSchedule) renders |= Describe(stage).renderer != nullptr;
     if (mEveryStepOutputs || !renders) return true;
     if (step + 1 == mScene.steps) return true;
     const uint32_t every = mScene.render.everySteps;
@@ -195,8 +195,8 @@ class Simulation::BatchScope {
                 cover = cover.value_or(0) + *result.coveredColumns;
                 if (owner.record != &mSim.mAhead) mSim.mLastCoveredColumns = cover;
             }
-            if (result.splat && owner.frame && *owner.frame < owner.record->frames.size())
-                owner.record->frames[*owner.frame].stats = *result.splat;
+            if (result.frameCounters && owner.frame && *owner.frame < owner.record->frames.size())
+                owner.record->frames[*owner.frame].counters = *result.frameCounters;
         }
         return {};
     }
@@ -283,7 +283,7 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     auto beforeObserver = [&]() -> Status {
         CB_TRY(RunStepStages(record, outputStep));
         bool renders = false;
-        for (Stage stage : mSchedule) renders |= Describe(stage).renderer;
+        for (Stage stage : mSchedule) renders |= Describe(stage).renderer != nullptr;
         if (renders && outputStep) CB_TRY(RenderFrames(record, std::max(mScene.render.framesPerStep, 1u), {}));
         return {};
     };

@@ -1,7 +1,11 @@
 #include "core/stages/render_layers/RenderLayers.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
 #include <string>
 #include <string_view>
 
@@ -131,6 +135,76 @@ std::vector<float> MakeLayersMap(const Scene& sc, uint32_t step) {
     return map;
 }
 
+namespace {
+
+constexpr auto kLayersCounterFields = FrameCounterFields(kLayersCounters);
+
+FrameToneMap LayersToneMap(const Scene& scene) { return {scene.layers.toneMap, float(scene.layers.exposure)}; }
+bool LayersRelights(const Scene& scene) { return scene.layers.relight == LayersRelight::Vector; }
+constexpr std::string_view kLayersRelightFields[] = {"layers.relight"};
+
+// One image for the accuracy measurement; the wang map is made before the timed calls, as in a run.
+Result<AccuracyRender> LayersAccuracyRender(Backend& backend, const Scene& scene, const AccuracyRenderInputs& in) {
+    auto T = in.shadedT();
+    if (!T) return std::unexpected(T.error());
+    auto map = std::make_shared<const std::vector<float>>(MakeLayersMap(scene, in.step));
+    auto p = std::make_shared<LayersParams>(MakeLayersParams(scene, *in.camera, in.step));
+    p->setup.map = map->empty() ? nullptr : map->data();
+    const LayersInputs inputs{in.q, in.q, *T};
+    return AccuracyRender{[&backend, p, map, inputs, image = in.image] {
+        return backend.RenderLayers(*p, inputs, *image, nullptr);
+    }};
+}
+
+// SPEC 15's layers per voxel of height, 1/2, 1, 2 and 4 (the scene's count left out), and grazing views.
+std::vector<std::vector<SceneOverride>> LayersAccuracyVariants(const Scene& sc) {
+    auto number = [](const char* format, double v) {
+        char text[48];
+        std::snprintf(text, sizeof text, format, v);
+        return std::string(text);
+    };
+    std::vector<std::vector<SceneOverride>> out;
+    const uint32_t nz = sc.grid.size.nz, count = sc.layers.count > 0 ? sc.layers.count : nz;
+    for (uint32_t n : {nz / 2, nz, 2 * nz, 4 * nz})
+        if (n >= 1 && n != count) out.push_back({{"layers.count", std::to_string(n)}});
+    // Grazing views, where the paper's layers show gaps: one camera at the slab's mid-height, a quarter of the grid
+    // outside it in x, looking along +x raised by 1, 5 and 20 degrees.
+    const double h = sc.grid.voxelSize, nx = sc.grid.size.nx;
+    const std::array<double, 3> eye = {sc.grid.origin[0] - 0.25 * nx * h, sc.grid.origin[1] + 0.5 * sc.grid.size.ny * h,
+                                       sc.grid.origin[2] + 0.5 * nz * h};
+    for (double degrees : {1.0, 5.0, 20.0}) {
+        const double e = degrees * std::numbers::pi / 180, reach = nx * h;
+        const std::array<double, 3> target = {eye[0] + reach * std::cos(e), eye[1], eye[2] + reach * std::sin(e)};
+        out.push_back({{"render.cameras", "[{\"name\": \"elevation-" + number("%.0f", degrees) + "\", \"eye\": [" +
+                                              number("%.6g", eye[0]) + ", " + number("%.6g", eye[1]) + ", " +
+                                              number("%.6g", eye[2]) + "], \"target\": [" + number("%.6g", target[0]) +
+                                              ", " + number("%.6g", target[1]) + ", " + number("%.6g", target[2]) +
+                                              "]}]"}});
+    }
+    return out;
+}
+
+constexpr std::string_view kLayersImageFields[] = {"layers", "render", "phase"};
+constexpr std::string_view kLayersReferenceIgnores[] = {"layers"};
+
+const RendererDescriptor kLayersRenderer{
+    .fileStem = "layers",
+    .rowLabel = "layers",
+    .resultsKey = "layers_frames",
+    .recordKey = "layers",
+    .counters = kLayersCounterFields,
+    .toneMap = LayersToneMap,
+    .honoursTiling = true,
+    .relights = LayersRelights,
+    .relightFields = kLayersRelightFields,
+    .imageFields = kLayersImageFields,
+    .referenceIgnores = kLayersReferenceIgnores,
+    .accuracyRender = LayersAccuracyRender,
+    .accuracyVariants = LayersAccuracyVariants,
+};
+
+}  // namespace
+
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kRenderLayersSceneFields[] = {"layers",
                                                          "noise",
@@ -157,7 +231,7 @@ const StageDescriptor& DescribeRenderLayers() {
         .readsPrevious = LayersPrevious,
         .writes = {Resource::LayersImage},
         .outputStepsOnly = true,
-        .renderer = true,
+        .renderer = &kLayersRenderer,
         .symbol = "image",
         .rule = LayersImageRule,
         .sceneFields = kRenderLayersSceneFields,
@@ -175,8 +249,11 @@ Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs
             LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
             p.setup.map = map.empty() ? nullptr : map.data();
             const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
-            return timed(
-                [&] { return backend.RenderLayers(p, in, *io.Current(Resource::LayersImage, n), &frame.layers); });
+            LayersStats stats;
+            Status drawn =
+                timed([&] { return backend.RenderLayers(p, in, *io.Current(Resource::LayersImage, n), &stats); });
+            frame.counters = ToFrameCounters(stats, kLayersCounters);
+            return drawn;
         });
 }
 

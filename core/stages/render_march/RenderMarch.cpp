@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <limits>
+#include <memory>
 #include <string_view>
 
 #include "core/base/NamedValues.h"
+#include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
+#include "core/stages/shade/Shade.h"
 
 namespace cb::scene_io {
 namespace {
@@ -198,6 +202,80 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
+namespace {
+
+constexpr auto kMarchCounterFields = FrameCounterFields(kMarchCounters);
+
+FrameToneMap MarchToneMap(const Scene& scene) { return {scene.march.toneMap, float(scene.march.exposure)}; }
+
+// One image for the accuracy measurement; T only with the light source "shade".
+Result<AccuracyRender> MarchAccuracyRender(Backend& backend, const Scene& scene, const AccuracyRenderInputs& in) {
+    const Buffer* T = nullptr;
+    if (scene.march.light == MarchLightSource::Shade) {
+        auto shaded = in.shadedT();
+        if (!shaded) return std::unexpected(shaded.error());
+        T = *shaded;
+    }
+    auto p = std::make_shared<const MarchParams>(MakeMarchParams(scene, *in.camera, in.step));
+    const MarchInputs inputs{in.q, in.q, T};
+    return AccuracyRender{[&backend, p, inputs, image = in.image] {
+        return backend.RenderMarch(*p, inputs, *image, nullptr);
+    }};
+}
+
+// The step halved and doubled and quadrupled, adaptive steps, the other light source and its step counts, shade at
+// half resolution, jitter, skipping and epsilon toggled, and every phase function against the Mie reference.
+std::vector<std::vector<SceneOverride>> MarchAccuracyVariants(const Scene& sc) {
+    auto number = [](double v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.9g", v);
+        return std::string(text);
+    };
+    std::vector<std::vector<SceneOverride>> out;
+    for (double f : {0.5, 2.0, 4.0}) out.push_back({{"march.step", number(sc.march.step * f)}});
+    if (!sc.march.adaptive) out.push_back({{"march.adaptive.enabled", "true"}});
+    if (sc.march.light == MarchLightSource::Shade) {
+        for (int n : {2, 4, 8, 16}) out.push_back({{"march.light", "march"}, {"march.light_steps", std::to_string(n)}});
+        if (sc.shade.resolution != 2) out.push_back({{std::string(ShadeResolutionSetting().path), "2"}});
+    } else {
+        for (uint32_t n : {2u, 4u, 8u, 16u})
+            if (n != sc.march.lightSteps) out.push_back({{"march.light_steps", std::to_string(n)}});
+        if (sc.stages.Has(Stage::Shade)) out.push_back({{"march.light", "shade"}});
+    }
+    out.push_back({{"march.jitter", sc.march.jitter ? "false" : "true"}});
+    out.push_back({{"march.skipping.enabled", sc.march.skipping ? "false" : "true"}});
+    if (sc.march.epsilon != 0) out.push_back({{"march.epsilon", "0"}});
+    // Every phase function against the Mie reference, the scene's own included
+    // (its row is the cost of approximating Mie); for a Mie scene that row is the scene's.
+    for (const auto& [name, kind] : kPhaseKindNames)
+        if (kind != PhaseKind::Mie || sc.phase.kind != PhaseKind::Mie)
+            out.push_back({{"phase.function", std::string(name)}});
+    return out;
+}
+
+constexpr std::string_view kMarchImageFields[] = {"march", "render", "lightning", "phase"};
+// The reference integrates the light exactly (SPEC 11): the march's steps, its light source and its tone map are
+// what it measures, not what it reads.
+constexpr std::string_view kMarchReferenceIgnores[] = {
+    "march.step",           "march.adaptive.enabled", "march.adaptive.kappa",   "march.adaptive.start",
+    "march.jitter",         "march.light",            "march.light_steps",      "march.epsilon",
+    "march.skipping.enabled", "march.skipping.brick", "march.exposure",         "march.tone_map"};
+
+const RendererDescriptor kMarchRenderer{
+    .fileStem = "march",
+    .rowLabel = "march",
+    .resultsKey = "march_frames",
+    .recordKey = "march",
+    .counters = kMarchCounterFields,
+    .toneMap = MarchToneMap,
+    .imageFields = kMarchImageFields,
+    .referenceIgnores = kMarchReferenceIgnores,
+    .accuracyRender = MarchAccuracyRender,
+    .accuracyVariants = MarchAccuracyVariants,
+};
+
+}  // namespace
+
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kRenderMarchSceneFields[] = {"march",         "lightning",
                                                         "sun",           "lighting",
@@ -220,7 +298,7 @@ const StageDescriptor& DescribeRenderMarch() {
         .readsPrevious = MarchPrevious,
         .writes = {Resource::MarchImage},
         .outputStepsOnly = true,
-        .renderer = true,
+        .renderer = &kMarchRenderer,
         .symbol = "image",
         .rule = MarchImageRule,
         .sceneFields = kRenderMarchSceneFields,
@@ -237,8 +315,11 @@ Status CallRenderMarch(Backend& backend, const Scene& sc, const StageHostInputs&
             // T only where shade runs (the light source "shade").
             MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
             in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
-            return timed(
-                [&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &frame.march); });
+            MarchStats stats;
+            Status drawn =
+                timed([&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &stats); });
+            frame.counters = ToFrameCounters(stats, kMarchCounters);
+            return drawn;
         });
 }
 

@@ -1,6 +1,10 @@
 #include "core/stages/render_splat/RenderSplat.h"
 
+#include <chrono>
+#include <memory>
+
 #include "core/scene/SceneReaders.h"
+#include "core/stages/density/Density.h"
 
 namespace cb {
 namespace {
@@ -79,6 +83,60 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     return p;
 }
 
+namespace {
+
+constexpr auto kSplatCounterFields = FrameCounterFields(kSplatCounters);
+
+// One image for the accuracy measurement; the density stage's occupancy (read when skipping) first, untimed.
+Result<AccuracyRender> SplatAccuracyRender(Backend& backend, const Scene& scene, const AccuracyRenderInputs& in) {
+    auto T = in.shadedT();
+    if (!T) return std::unexpected(T.error());
+    auto p = std::make_shared<SplatParams>(MakeSplatParams(scene, *in.camera));
+    auto order = std::make_shared<const SplatOrder>(
+        MakeSplatOrder(p->camera, scene.grid.size, scene.grid.origin, scene.grid.voxelSize));
+    p->order = order.get();
+    const DensityParams dp = MakeDensityParams(scene);
+    const Extent3 e = scene.grid.size;
+    auto D = backend.CreateBuffer(BufferFormat::F32, {e.nx, e.ny, 1});
+    auto tiles = backend.CreateBuffer(BufferFormat::U8, {CeilDiv(e.nx, dp.tile), CeilDiv(e.ny, dp.tile), 1});
+    auto bands =
+        backend.CreateBuffer(BufferFormat::U8, {CeilDiv(e.nx, dp.tile), CeilDiv(e.ny, dp.tile), CeilDiv(e.nz, dp.band)});
+    if (!D || !tiles || !bands) return MakeError("cannot create the density buffers");
+    AccuracyRender out;
+    if (backend.Supports(Stage::Density)) {
+        DensityOutputs outs{D->get(), tiles->get(), bands->get(), 0};
+        const auto start = std::chrono::steady_clock::now();
+        if (Status s = backend.Density(dp, *in.q, nullptr, outs); !s) return MakeError("density: " + s.error().message);
+        out.prepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    } else {
+        p->skipping = false;
+    }
+    std::shared_ptr<Buffer> occupancy[] = {std::move(*D), std::move(*tiles), std::move(*bands)};
+    const SplatInputs inputs{in.q, in.q, *T, occupancy[1].get(), occupancy[1].get(), occupancy[2].get(),
+                             occupancy[2].get()};
+    out.call = [&backend, p, order, occupancy, inputs, image = in.image] {
+        return backend.RenderSplat(*p, inputs, *image, nullptr);
+    };
+    return out;
+}
+
+constexpr std::string_view kSplatImageFields[] = {"render", "phase"};
+constexpr std::string_view kSplatReferenceIgnores[] = {"render.q_min", "render.splat_scale", "render.opacity",
+                                                       "render.culling", "render.skipping"};
+
+const RendererDescriptor kSplatRenderer{
+    .fileStem = "splat",
+    .rowLabel = "frame",
+    .resultsKey = "frames",
+    .recordKey = "",
+    .counters = kSplatCounterFields,
+    .imageFields = kSplatImageFields,
+    .referenceIgnores = kSplatReferenceIgnores,
+    .accuracyRender = SplatAccuracyRender,
+};
+
+}  // namespace
+
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kRenderSplatSceneFields[] = {
     "render", "sun", "lighting", "phase", "grid.voxel_size", "grid.origin", "density.tile", "density.band"};
@@ -94,7 +152,7 @@ const StageDescriptor& DescribeRenderSplat() {
         .readsPrevious = SplatPrevious,
         .writes = {Resource::SplatImage},
         .outputStepsOnly = true,
-        .renderer = true,
+        .renderer = &kSplatRenderer,
         .symbol = "image",
         .rule = SplatImageRule,
         .choices = kSplatChoices,
@@ -117,8 +175,11 @@ Status CallRenderSplat(Backend& backend, const Scene& sc, const StageHostInputs&
                 io.Previous(Resource::Tiles),       io.Current(Resource::Tiles), io.Previous(Resource::Bands),
                 io.Current(Resource::Bands)};
             in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
-            return timed(
-                [&] { return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &frame.stats); });
+            SplatStats stats;
+            Status drawn =
+                timed([&] { return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &stats); });
+            frame.counters = ToFrameCounters(stats, kSplatCounters);
+            return drawn;
         });
 }
 

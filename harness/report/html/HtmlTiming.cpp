@@ -68,10 +68,9 @@ std::vector<std::string> SeedFiguresFor(const std::string& stage, const std::str
 
 // A renderer's block of per-camera frames in results.json (as ResultsJson.cpp names them); "" for another stage.
 std::string FramesKey(const std::string& stage) {
-    return stage == "render_splat"    ? "frames"
-           : stage == "render_march"  ? "march_frames"
-           : stage == "render_layers" ? "layers_frames"
-                                      : "";
+    const std::optional<Stage> parsed = ParseStage(stage);
+    const RendererDescriptor* renderer = parsed ? Describe(*parsed).renderer : nullptr;
+    return renderer ? std::string(renderer->resultsKey) : "";
 }
 
 // A stage's per-step summary in one backend: from its samples (the median and quartiles as Summarize takes them),
