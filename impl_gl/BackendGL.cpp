@@ -54,10 +54,10 @@ std::vector<DeviceLimit> DescribeGLLimits(const GLLimits& limits) {
 namespace {
 
 // The sun's principal axes (0 x, 1 y, 2 z) at the steps shade runs, as ShadeSunAt picks the sun
-// (core/stages/shade/Shade.cpp): the first step's only when the sun stands still or the layers relight by vector.
+// (core/stages/shade/Shade.cpp): the first step's only when the sun stands still or a renderer relights.
 std::array<bool, 3> ShadeAxes(const Scene& scene) {
     std::array<bool, 3> axes{};
-    const bool fixed = !scene.sun.Moves() || scene.layers.relight == LayersRelight::Vector;
+    const bool fixed = !scene.sun.Moves() || scene.needs.shadeOnce;
     const uint32_t steps = fixed ? 1 : std::max<uint32_t>(scene.steps, 1);
     for (uint32_t step = 0; step < steps; ++step) axes[size_t(PrincipalAxis(scene.sun.DirectionAt(step)))] = true;
     return axes;

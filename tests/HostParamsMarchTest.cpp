@@ -340,9 +340,9 @@ TEST(HostParamsMarch, SplatFrameCarriesTheHostValues) {
 TEST(HostParamsMarch, ShadeSunAndPlanBelowTheHorizon) {
     Scene sc = HpmScene();
     HpmNear3(MakeShadeParams(sc, 2).sun, {0.64278761f, 0.0f, -0.76604444f}, "shade at step 2: el -50");
-    sc.layers.relight = LayersRelight::Vector;
+    sc.needs.shadeOnce = true;  // as the plan decides when a renderer relights (layers.relight "vector")
     HpmNear3(MakeShadeParams(sc, 2).sun, {0.93969262f, 0.0f, 0.34202014f}, "relit: s0 (el 20) at step 2");
-    sc.layers.relight = LayersRelight::Shade;
+    sc.needs.shadeOnce = false;
     ShadeParams sp = MakeShadeParams(sc, 2);
     sp.resolution = 2;
     // el -50: |s_z| = 0.766 >= |s_x| = 0.643: w = z, below: slices from k = 0 up. Cells ceil((10, 8, 5) / 2).

@@ -115,6 +115,7 @@ TEST(SweepFields, FieldsOverlapOnWholeNames) {
 TEST(SweepFields, RowsDependOnWhatTheStagesRead) {
     EXPECT_TRUE(RowDependsOn(Stage::Shade, "shade.resolution"));
     EXPECT_TRUE(RowDependsOn(Stage::Shade, "layers.relight"));
+    EXPECT_FALSE(RowDependsOn(Stage::Shadow, "layers.relight"));  // shadow reads D, not T
     EXPECT_FALSE(RowDependsOn(Stage::Shade, "layers.count"));
     EXPECT_FALSE(RowDependsOn(Stage::Shade, "march.step"));
     EXPECT_TRUE(RowDependsOn(Stage::Shade, "ca.p_ext"));

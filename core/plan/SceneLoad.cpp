@@ -162,6 +162,15 @@ void CheckRelight(const Scene& scene, Validator& check) {
     }
 }
 
+// What the enabled renderers ask of the stages upstream (Scene::needs).
+Scene::RendererNeeds PlanRendererNeeds(const Scene& scene) {
+    Scene::RendererNeeds needs;
+    for (Stage stage : kAllStages)
+        if (const RendererDescriptor* r = Describe(stage).renderer; r && r->relights && scene.stages.Has(stage))
+            needs.shadeOnce = needs.shadeOnce || r->relights(scene);
+    return needs;
+}
+
 void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& sections, Validator& check) {
     if (sections.stageList) CheckStageInputs(scene.stages, check);
     // Every renderer draws one image per camera.
@@ -228,6 +237,7 @@ Result<Scene> ParseSceneChecked(const std::string& text, const std::string& labe
     CheckAcrossSections(scene, sections, check);
     if (check.ErrorCount() > 0) return MakeError(check.Message());
 
+    scene.needs = PlanRendererNeeds(scene);
     // One pair means "the same shift for every slice"; expanded only now that nz is known to be sane.
     if (scene.ca.windShift.size() == 1 && scene.grid.size.nz > 1)
         scene.ca.windShift.assign(scene.grid.size.nz, scene.ca.windShift[0]);

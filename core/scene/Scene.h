@@ -143,6 +143,11 @@ struct Scene {
     LightningSettings lightning;  // the point light of render_march (section `lightning`)
     NoiseSettings noise;          // stage `noise` (SPEC 10a)
     LayersSettings layers;        // stage render_layers (section `layers`)
+    // What the enabled renderers ask of the stages upstream, decided when the scene is loaded (core/plan/SceneLoad.cpp,
+    // from the renderers' descriptors), not read from the file: shade reads this, not a renderer's section.
+    struct RendererNeeds {
+        bool shadeOnce = false;  // T shaded once, for step 0's sun, and relit per frame (a renderer relights)
+    } needs;
 };
 
 // One --set PATH=VALUE override, applied to the JSON before validation.

@@ -20,6 +20,12 @@ bool SweepFieldsReach(Stage stage, std::string_view path, std::set<Stage>& seen)
     if (!seen.insert(stage).second) return false;
     const StageDescriptor& d = Describe(stage);
     if (SweepFieldsListed(d.sceneFields, path)) return true;
+    // Shade's sun is fixed at step 0's when a renderer relights (Scene::needs.shadeOnce, from the descriptors).
+    if (stage == Stage::Shade && std::ranges::any_of(kAllStages, [&](Stage s) {
+            const RendererDescriptor* r = Describe(s).renderer;
+            return r && SweepFieldsListed(r->relightFields, path);
+        }))
+        return true;
     std::vector<Resource> inputs = d.reads;
     inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
     for (Stage writer : kAllStages) {

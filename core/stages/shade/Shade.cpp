@@ -107,7 +107,7 @@ const ChoiceSetting& ShadeResolutionSetting() { return kShadeResolution; }
 const ChoiceSetting& ShadeScatteringSetting() { return kShadeScattering; }
 
 Vec3 ShadeSunAt(const Scene& sc, uint32_t step) {
-    return sc.layers.relight == LayersRelight::Vector ? sc.sun.DirectionAt(0) : sc.sun.DirectionAt(step);
+    return sc.needs.shadeOnce ? sc.sun.DirectionAt(0) : sc.sun.DirectionAt(step);
 }
 
 ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
@@ -128,7 +128,8 @@ ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
 }
 
 // What its parameters read from the scene (StageDescriptor::sceneFields).
-constexpr std::string_view kShadeSceneFields[] = {"shade", "sun", "phase", "grid.voxel_size", "layers.relight"};
+// (A renderer that relights fixes the sun it receives, Scene::needs: its RendererDescriptor::relightFields.)
+constexpr std::string_view kShadeSceneFields[] = {"shade", "sun", "phase", "grid.voxel_size"};
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"

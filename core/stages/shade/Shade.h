@@ -18,7 +18,7 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
 }  // namespace scene_io
 
 // The sun shade lights toward at `step`: the scene's (SunSettings::DirectionAt; step 0 is the fixed sun's), or
-// with layers.relight "vector" the first step's at every step (Wang, Ji and Zhang's relighting: shade once).
+// when a renderer relights (Scene::needs.shadeOnce) the first step's at every step (Wang, Ji and Zhang: shade once).
 Vec3 ShadeSunAt(const Scene& scene, uint32_t step);
 ShadeParams MakeShadeParams(const Scene& scene, uint32_t step = 0);
 
