@@ -175,7 +175,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     if (slicesKept.size() < outerIdx.size()) slicesKept.resize(outerIdx.size());
     std::vector<uint64_t> visitedPerSlice(outerIdx.size(), 0);
     const SplatFrame frame = MakeSplatFrame(p, e, FlattenSplatOrder(order), W, H);
-    const float qMin = frame.ambient[3], alpha = p.alpha;
+    const float qMin = frame.qMin, alpha = p.alpha;
     const uint8_t* const visible = boxVisible.data();
     const uint32_t *const boxMiddle = boxPart[middle].data(), *const boxInner = boxPart[inner].data();
     const size_t strideMiddle = voxelStride[middle], strideInner = voxelStride[inner];

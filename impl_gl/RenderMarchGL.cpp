@@ -49,10 +49,11 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const Functions& f = mContext->F();
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "gl: render_march"));
     const MarchGpu block = MakeMarchGpu(params, e);
-    // The program specialised for this call's option bits and phase kind (render_march.frag).
-    auto marchProgram = mContext->Program("render_march", "#define MARCH_FLAGS " + std::to_string(block.flags[0]) +
-                                                              "u\n#define MARCH_PHASE " +
-                                                              std::to_string(block.flags[1]) + "u\n");
+    // The program specialised for this call's option bits, phase kind and point light (render_march.frag).
+    auto marchProgram =
+        mContext->Program("render_march", "#define MARCH_FLAGS " + std::to_string(block.flags) +
+                                              "u\n#define MARCH_PHASE " + std::to_string(block.light.phaseKind) +
+                                              "u\n#define MARCH_POINT " + std::to_string(block.light.pointOn) + "u\n");
     if (!marchProgram) return std::unexpected(marchProgram.error());
     Result<GLuint> bricksProgram = GLuint(0);
     if (params.skipping) {
@@ -62,7 +63,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     const GLsizei px = GLsizei(e.nx + 2), py = GLsizei(e.ny + 2), pz = GLsizei(e.nz + 2);
     CB_TRY(CheckPaddedVolumeFits(e, "render_march"));
-    const uint32_t B = block.flags[3];
+    const uint32_t B = block.brick;
     const auto brickCounts = MarchBrickCounts(e, B);
 
     Timing timer(*this);

@@ -98,7 +98,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.NamedBufferSubData(orderBuffer, 0, GLsizeiptr(flat.indices.size() * 4), flat.indices.data());
     // The shared frame; this backend's lane: the largest point size.
     SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
-    frame.misc[2] = pointRange[1];
+    frame.maxPointSize = pointRange[1];
     const GLuint frameBuffer = ScratchBuffer(state.frame, sizeof frame);
     f.NamedBufferSubData(frameBuffer, 0, sizeof frame, &frame);
     const GLuint counters = CounterBuffer(state.counters, 16);

@@ -14,7 +14,7 @@ namespace cb::vk {
 // One member or entry per line, as in the GLSL blocks.
 // clang-format off
 
-using PushVec4 = std::array<float, 4>;    // GLSL vec4
+using PushVec3 = std::array<float, 3>;    // GLSL vec3 (a scalar after it takes its fourth lane)
 using PushFloat8 = std::array<float, 8>;  // GLSL float[8]
 
 // Each block: its C++ name and its members (below).
@@ -200,7 +200,7 @@ using PushFloat8 = std::array<float, 8>;  // GLSL float[8]
     X(uint32_t, height) \
     X(uint32_t, tilesX) \
     X(uint32_t, tileSize) \
-    X(PushVec4, background) \
+    X(PushVec3, background) \
     X(uint32_t, ground)
 #define CB_VK_SCAN_PUSH(X) \
     X(uint32_t, n) \

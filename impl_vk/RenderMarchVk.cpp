@@ -57,7 +57,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "vk: render_march"));
     const MarchGpu frame = MakeMarchGpu(params, e);
     const uint32_t px = e.nx + 2, py = e.ny + 2, pz = e.nz + 2;
-    const uint32_t B = frame.flags[3];
+    const uint32_t B = frame.brick;
     const uint32_t brickCount = frame.bricks[0] * frame.bricks[1] * frame.bricks[2];
     const bool mie = params.setup.phase.kind == PhaseKind::Mie;
 

@@ -26,8 +26,8 @@ struct RankPart {
 // x / tile + tilesAcross (y / tile + tilesDown z / band) (SplatFrame.boxes).
 std::vector<RankPart> MakeRankParts(const SplatFrame& F, const FlatSplatOrder& flat) {
     const uint32_t voxelStride[3] = {1, F.grid[0], F.grid[0] * F.grid[1]};
-    const uint32_t boxSize[3] = {F.boxes[0], F.boxes[0], F.boxes[1]};
-    const uint32_t boxStride[3] = {1, F.boxes[2], F.boxes[2] * F.boxes[3]};
+    const uint32_t boxSize[3] = {F.boxTile, F.boxTile, F.boxBand};
+    const uint32_t boxStride[3] = {1, F.boxTilesX, F.boxTilesX * F.boxTilesY};
     std::vector<RankPart> parts(flat.indices.size());
     for (uint32_t level = 0; level < 3; ++level) {
         const uint32_t axis = F.axes[level];
@@ -78,9 +78,9 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const uint32_t tilesX = CeilDiv(W, kTileSize), tilesY = CeilDiv(H, kTileSize), screenTiles = tilesX * tilesY;
     // The shared frame; this backend's lanes: ranks per chunk, screen tiles.
     SplatFrame frame = MakeSplatFrame(p, e, flat, W, H);
-    frame.grid[3] = ranksPerChunk;
-    frame.image[2] = tilesX;
-    frame.image[3] = tilesY;
+    frame.ranksPerChunk = ranksPerChunk;
+    frame.tilesX = tilesX;
+    frame.tilesY = tilesY;
     const uint32_t chunks = CeilDiv(voxels, ranksPerChunk);
     const std::vector<RankPart> rankParts = MakeRankParts(frame, flat);
     // This stage's scratch buffers, one per slot of RenderSplatVkState (what each holds is said there).
@@ -205,8 +205,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     constexpr uint32_t kRowGroups = 32768;
     const uint32_t splatGroups = std::max(1u, CeilDiv(splatCount, 64u));
     SplatRangesPush rangePush{pairCount, screenTiles};
-    SplatCompositePush composite{
-        W, H, tilesX, kTileSize, {p.background[0], p.background[1], p.background[2], 0}, p.ground.on ? 1u : 0u};
+    SplatCompositePush composite{W, H, tilesX, kTileSize, p.background, p.ground.on ? 1u : 0u};
     // The ground's block and G; without the ground, a buffer that exists (a binding needs one), unread.
     const DeviceBuffer* groundBlock = scratch.frame;
     const DeviceBuffer* groundG = scratch.frame;

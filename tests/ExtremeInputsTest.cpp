@@ -61,21 +61,22 @@ SplatFrame FrameWithFocal(float focalPx) {
     const CameraFrame f = MakeCameraFrame(camera, 64, 48);
     SplatFrame F{};
     F.grid[0] = F.grid[1] = F.grid[2] = 8;
-    F.image[0] = 64, F.image[1] = 48;
+    F.width = 64, F.height = 48;
     for (int a = 0; a < 3; ++a) {
         F.eye[a] = f.eye[a];
         F.forward[a] = f.forward[a];
         F.right[a] = f.right[a];
         F.up[a] = f.upVector[a];
     }
-    F.eye[3] = f.nearPlane;
-    F.forward[3] = focalPx;
+    F.nearPlane = f.nearPlane;
+    F.focalPx = focalPx;
     F.sun[2] = 1;
-    F.sunRadiance[0] = F.sunRadiance[1] = F.sunRadiance[2] = 1;
-    F.ambient[3] = 0.3f;
-    F.background[3] = 0.6f;
-    F.origin[3] = 0.25f;
-    F.misc[0] = 0.4f;
+    F.light.sunRadiance = {1, 1, 1};
+    F.light.phaseKind = uint32_t(PhaseKind::None);
+    F.qMin = 0.3f;
+    F.opacity = 0.6f;
+    F.voxelSize = 0.25f;
+    F.splatDiameter = 0.4f;
     return F;
 }
 

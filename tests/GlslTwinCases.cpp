@@ -38,13 +38,13 @@ std::vector<TwinCase> Cases() {
 
     // ---- random.glsl ----
     c.push_back({"LowBias32",
-                 0,
+                 kTwinLowBias32,
                  {Kind::U},
                  [](Pcg32& r, Words& in) { in[0] = r.NextU32(); },
                  {W({0}), W({1}), W({0xffffffffu}), W({0x80000000u})},
                  [](const Words& in, Words& out) { out[0] = LowBias32(in[0]); }});
     c.push_back({"StreamKey",
-                 1,
+                 kTwinStreamKey,
                  {Kind::U},
                  [](Pcg32& r, Words& in) {
                      in = W({r.NextU32(), r.NextU32(), r.Below(4)});
@@ -52,7 +52,7 @@ std::vector<TwinCase> Cases() {
                  {W({0, 0, 0}), W({0, kInitialStateStep, 1}), W({0xffffffffu, kInitialStateStep, 3})},
                  [](const Words& in, Words& out) { out[0] = StreamKey(in[0], in[1], in[2]); }});
     c.push_back({"Rand24FromKey",
-                 2,
+                 kTwinRand24FromKey,
                  {Kind::U},
                  [](Pcg32& r, Words& in) {
                      in = W({r.NextU32(), r.NextU32()});
@@ -68,7 +68,7 @@ std::vector<TwinCase> Cases() {
             in = W({uint32_t(std::clamp<int64_t>(rand, 0, kQ1 - 1)), region, q});
         };
         c.push_back({"RegionEventFires",
-                     3,
+                     kTwinRegionEventFires,
                      {Kind::U},
                      random,
                      {W({0, 0, 0}), W({0, 255, kQ1}), W({kQ1 - 1, 255, kQ1}), W({kQ1 - 1, 254, kQ1}), W({0, 1, 1}),
@@ -93,7 +93,7 @@ std::vector<TwinCase> Cases() {
             out[0] = Bits(EllipsoidWeight(e, Float(in[8]), Float(in[9]), Float(in[10])));
         };
         c.push_back({"EllipsoidWeight",
-                     4,
+                     kTwinEllipsoidWeight,
                      {Kind::F},
                      random,
                      {WF({10.5f, 10.5f, 4.5f, 3, 3, 2, 1, 0, 10.5f, 10.5f, 4.5f}),   // at the centre: w = 1
@@ -109,7 +109,7 @@ std::vector<TwinCase> Cases() {
             for (float w : AndNeighbours((float(k) + 0.5f) / 255.0f)) edges.push_back(WF({w}));
         for (float w : unormTies) edges.push_back(WF({w}));  // 255 w = k + 0.5 exactly
         c.push_back({"QuantizeRegion",
-                     5,
+                     kTwinQuantizeRegion,
                      {Kind::U},
                      [](Pcg32& r, Words& in) { in = WF({Uniform(r, 0, 1)}); },
                      edges,
@@ -120,7 +120,7 @@ std::vector<TwinCase> Cases() {
         for (int radius = 0; radius <= 2; ++radius)
             for (int d = -3; d <= 3; ++d) edges.push_back(W({uint32_t(radius), uint32_t(d)}));
         c.push_back({"SmoothWeight",
-                     6,
+                     kTwinSmoothWeight,
                      {Kind::I},
                      [](Pcg32& r, Words& in) {
                          in = W({r.Below(3), uint32_t(int(r.Below(7)) - 3)});
@@ -138,7 +138,7 @@ std::vector<TwinCase> Cases() {
         for (int k = 1; k < 126; k += 17)  // where the range reduction's k changes
             for (float x : AndNeighbours(-(float(k) + 0.5f) * std::numbers::ln2_v<float>)) edges.push_back(WF({x}));
         c.push_back({"ExpNonPositive",
-                     7,
+                     kTwinExpNonPositive,
                      {Kind::F},
                      [](Pcg32& r, Words& in) { in = WF({Uniform(r, -90, 0)}); },
                      edges,
@@ -170,7 +170,7 @@ std::vector<TwinCase> Cases() {
         halfTies.push_back(WF({-m}));
     }
     c.push_back({"RoundToHalf",
-                 8,
+                 kTwinRoundToHalf,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      // Any float of magnitude < 2^18 (random sign, exponent and mantissa), or one in [0, 1].
@@ -189,7 +189,7 @@ std::vector<TwinCase> Cases() {
         for (float v : AndNeighbours((float(k) + 0.5f) / 255.0f)) unormEdges.push_back(WF({v}));
     for (float v : unormTies) unormEdges.push_back(WF({v}));  // every k: 255 v = k + 0.5 exactly
     c.push_back({"RoundToUnorm8",
-                 9,
+                 kTwinRoundToUnorm8,
                  {Kind::F},
                  [](Pcg32& r, Words& in) { in = WF({Uniform(r, -0.1, 1.1)}); },
                  unormEdges,
@@ -203,7 +203,7 @@ std::vector<TwinCase> Cases() {
         for (const Words& e : halfTies) edges.push_back(W({uint32_t(StorageFormat::Fp16), e[0]}));
         c.push_back(
             {"RoundToStorage",
-             10,
+             kTwinRoundToStorage,
              {Kind::F},
              [](Pcg32& r, Words& in) {
                  in = W({r.Below(3), Bits(Uniform(r, 0, 1))});
@@ -212,7 +212,7 @@ std::vector<TwinCase> Cases() {
              [](const Words& in, Words& out) { out[0] = Bits(RoundToStorage(StorageFormat(in[0]), Float(in[1]))); }});
     }
     c.push_back({"Lerp",
-                 11,
+                 kTwinLerp,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = WF({Uniform(r, -2, 2), Uniform(r, -2, 2), Uniform(r, 0, 1)});
@@ -220,7 +220,7 @@ std::vector<TwinCase> Cases() {
                  {WF({0.25f, 0.75f, 0}), WF({0.25f, 0.75f, 1}), WF({1, 1, 0.5f})},
                  [](const Words& in, Words& out) { out[0] = Bits(Lerp(Float(in[0]), Float(in[1]), Float(in[2]))); }});
     c.push_back({"Bilinear",
-                 12,
+                 kTwinBilinear,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = WF({Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1),
@@ -232,7 +232,7 @@ std::vector<TwinCase> Cases() {
                          Bilinear(Float(in[0]), Float(in[1]), Float(in[2]), Float(in[3]), Float(in[4]), Float(in[5])));
                  }});
     c.push_back({"PhaseValue",
-                 13,
+                 kTwinPhaseValue,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = W({r.Below(3), Bits(Uniform(r, -0.95, 0.95)), Bits(Uniform(r, -1, 1))});
@@ -244,7 +244,7 @@ std::vector<TwinCase> Cases() {
                  },
                  /*otherDeviceUlps=*/4});
     c.push_back({"SplatKernel",
-                 14,
+                 kTwinSplatKernel,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = WF({Uniform(r, -0.2, 1.2), Uniform(r, -0.2, 1.2)});
@@ -252,7 +252,7 @@ std::vector<TwinCase> Cases() {
                  {WF({0.5f, 0.5f}), WF({0, 0}), WF({1, 0.5f}), WF({0.5f, 0})},
                  [](const Words& in, Words& out) { out[0] = Bits(SplatKernel(Float(in[0]), Float(in[1]))); }});
     c.push_back({"SliceFactor",
-                 15,
+                 kTwinSliceFactor,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = W({r.Below(2), Bits(Uniform(r, 0, 5)), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 0.5)),
@@ -266,7 +266,7 @@ std::vector<TwinCase> Cases() {
                      out[0] = Bits(SliceFactor(in[0] != 0, Float(in[1]), Float(in[2]), Float(in[3]), Float(in[4])));
                  }});
     c.push_back({"StoreTransmittance",
-                 16,
+                 kTwinStoreTransmittance,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = W({r.Below(3), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1))});
@@ -278,7 +278,7 @@ std::vector<TwinCase> Cases() {
                      out[0] = Bits(StoreTransmittance(StorageFormat(in[0]), Float(in[1]), Float(in[2])));
                  }});
     c.push_back({"GroundShadow",
-                 17,
+                 kTwinGroundShadow,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = W({r.Below(2), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 0.1)), Bits(Uniform(r, 0, 100))});
@@ -289,7 +289,7 @@ std::vector<TwinCase> Cases() {
                      out[0] = Bits(GroundShadow(in[0] != 0, Float(in[1]), Float(in[2]), Float(in[3])));
                  }});
     c.push_back({"WangShadow",
-                 45,
+                 kTwinWangShadow,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = W({Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)),
@@ -308,7 +308,7 @@ std::vector<TwinCase> Cases() {
             for (uint32_t cells : {1u, 2u, 3u, 16u})
                 for (uint32_t i : {0u, f * cells - 1, f * cells / 2}) edges.push_back(W({i, f, cells}));
         c.push_back({"UpsampleTap",
-                     18,
+                     kTwinUpsampleTap,
                      {Kind::I, Kind::I, Kind::F},
                      [](Pcg32& r, Words& in) {
                          const uint32_t f = 1u << r.Below(3), cells = 1 + r.Below(40);
@@ -323,7 +323,7 @@ std::vector<TwinCase> Cases() {
 
     // ---- automaton.glsl ----
     c.push_back({"CaRowNeighbours",
-                 19,
+                 kTwinCaRowNeighbours,
                  {Kind::U},
                  [](Pcg32& r, Words& in) {
                      in = W({r.NextU32(), r.NextU32(), r.NextU32()});
@@ -331,7 +331,7 @@ std::vector<TwinCase> Cases() {
                  {W({0, 0, 0}), W({1, 0, 0}), W({0x80000000u, 0, 0}), W({0, 0xc0000000u, 3})},
                  [](const Words& in, Words& out) { out[0] = CaRowNeighbours<uint32_t>(in[0], in[1], in[2]); }});
     c.push_back({"CaGrowth",
-                 20,
+                 kTwinCaGrowth,
                  {Kind::U, Kind::U, Kind::U},
                  [](Pcg32& r, Words& in) {
                      in = W({r.NextU32(), r.NextU32(), r.NextU32(), r.NextU32()});
@@ -355,7 +355,7 @@ std::vector<TwinCase> Cases() {
                 for (uint32_t qq : {0u, kQ1})
                     edges.push_back(W({g & 1, g >> 1 & 1, g >> 2, r, 12345, 1, 2, 3, qq, qq, qq}));
         c.push_back({"CaVoxelEvents",
-                     21,
+                     kTwinCaVoxelEvents,
                      {Kind::U, Kind::U, Kind::U},
                      [q](Pcg32& r, Words& in) {
                          const uint32_t kind = r.Below(3);
@@ -370,7 +370,7 @@ std::vector<TwinCase> Cases() {
                          out = W({s.hum, s.act, s.cld});
                      }});
         c.push_back({"CaInitialVoxel",
-                     22,
+                     kTwinCaInitialVoxel,
                      {Kind::U, Kind::U, Kind::U},
                      [q](Pcg32& r, Words& in) {
                          in = W({r.NextU32(), r.NextU32(), q(r), q(r), r.NextU32()});
@@ -381,7 +381,7 @@ std::vector<TwinCase> Cases() {
                          out = W({s.hum, s.act, s.cld});
                      }});
         c.push_back({"MakeCaEvents",
-                     23,
+                     kTwinMakeCaEvents,
                      std::vector<Kind>(6, Kind::U),
                      [q](Pcg32& r, Words& in) {
                          in = W({r.NextU32(), r.NextU32(), q(r), q(r), q(r)});
@@ -395,7 +395,7 @@ std::vector<TwinCase> Cases() {
 
     // ---- splat.glsl (MakeSplat needs a frame: see SplatFrames) ----
     c.push_back({"SplatQ",
-                 24,
+                 kTwinSplatQ,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = WF({Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1)});
@@ -404,7 +404,7 @@ std::vector<TwinCase> Cases() {
                  [](const Words& in, Words& out) { out[0] = Bits(SplatQ(Float(in[0]), Float(in[1]), Float(in[2]))); }});
     c.push_back(
         {"SplatCoord",
-         25,
+         kTwinSplatCoord,
          {Kind::F},
          [](Pcg32& r, Words& in) {
              in = WF({float(r.Below(1024)) + 0.5f, Uniform(r, -100, 1100), Uniform(r, 1, 255)});
@@ -414,7 +414,7 @@ std::vector<TwinCase> Cases() {
          /*otherDeviceUlps=*/3});
     c.push_back(
         {"SplatAlpha",
-         26,
+         kTwinSplatAlpha,
          {Kind::F},
          [](Pcg32& r, Words& in) {
              in = WF({Uniform(r, 0, 1.5), Uniform(r, -0.2, 1.2), Uniform(r, -0.2, 1.2)});
@@ -471,7 +471,7 @@ std::vector<TwinCase> Cases() {
         };
         auto period = [](const Words& in) { return noise::Period{Int(in[3]), Int(in[4]), Int(in[5])}; };
         c.push_back({"NoisePerlin",
-                     28,
+                     kTwinNoisePerlin,
                      {Kind::F},
                      [point](Pcg32& r, Words& in) { point(r, in, 1); },
                      edgesFor(1),
@@ -480,7 +480,7 @@ std::vector<TwinCase> Cases() {
                              noise::Perlin(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
                      }});
         c.push_back({"NoiseSimplex",
-                     29,
+                     kTwinNoiseSimplex,
                      {Kind::F},
                      [point](Pcg32& r, Words& in) { point(r, in, 3); },
                      edgesFor(3),
@@ -489,7 +489,7 @@ std::vector<TwinCase> Cases() {
                              noise::Simplex(kTwinPerm.data(), Float(in[0]), Float(in[1]), Float(in[2]), period(in)));
                      }});
         c.push_back({"NoiseWorley",
-                     30,
+                     kTwinNoiseWorley,
                      {Kind::F},
                      [point](Pcg32& r, Words& in) {
                          point(r, in, 1);
@@ -501,7 +501,7 @@ std::vector<TwinCase> Cases() {
                      },
                      /*otherDeviceUlps=*/4});
         c.push_back({"NoiseFbm",
-                     31,
+                     kTwinNoiseFbm,
                      {Kind::F, Kind::F},
                      [point](Pcg32& r, Words& in) {
                          const uint32_t basis = r.Below(3);
@@ -521,7 +521,7 @@ std::vector<TwinCase> Cases() {
                      },
                      /*otherDeviceUlps=*/8});
         c.push_back({"NoiseForming",
-                     32,
+                     kTwinNoiseForming,
                      {Kind::F, Kind::F, Kind::F, Kind::I, Kind::F},
                      [](Pcg32& r, Words& in) {
                          const float half = float(int(r.Below(41)) - 20) + 0.5f;  // round's ties half the time
@@ -550,7 +550,7 @@ std::vector<TwinCase> Cases() {
                      /*otherDeviceUlps=*/3});
         TwinCase exps{
             "NoiseHeightAndTower",
-            33,
+            kTwinNoiseHeightAndTower,
             {Kind::F, Kind::F},
             [](Pcg32& r, Words& in) {
                 // A voxel centre within 4 sigma of the tower per axis (the result stays a normal

@@ -50,7 +50,7 @@ void Compare(const char* name, const std::vector<Kind>& kinds, uint32_t ulps, co
 
 #if CLOUDBENCH_HAVE_VK
 
-std::vector<Words> GlslTwin::Run(uint32_t fn, const std::vector<Words>& inputs, const SplatFrame& frame,
+std::vector<Words> GlslTwin::Run(TwinFn fn, const std::vector<Words>& inputs, const SplatFrame& frame,
                                  const MarchGpu& march, const LayersGpu& layers) {
     vk::VulkanContext& ctx = *sContext;
     const VkDeviceSize bytes = inputs.size() * sizeof(Words);
@@ -71,7 +71,7 @@ std::vector<Words> GlslTwin::Run(uint32_t fn, const std::vector<Words>& inputs, 
     EXPECT_TRUE(ctx.Upload(*marchBuffer, std::as_bytes(std::span(&march, 1))));
     EXPECT_TRUE(ctx.Upload(*layersBuffer, std::as_bytes(std::span(&layers, 1))));
     EXPECT_TRUE(ctx.Upload(*table, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
-    const struct { uint32_t fn, count; } push{fn, uint32_t(inputs.size())};
+    const struct { uint32_t fn, count; } push{uint32_t(fn), uint32_t(inputs.size())};
     const vk::DeviceBuffer* buffers[] = {&*in, &*out, &*frameBuffer, &*marchBuffer, &*table, &*layersBuffer};
     auto ran = ctx.Run("twin", [&](vk::VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, push.count);

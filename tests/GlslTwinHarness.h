@@ -37,9 +37,17 @@ inline int32_t Int(uint32_t u) { return int32_t(u); }
 
 enum class Kind : uint8_t { U, I, F };  // how an output word compares
 
+// The functions of twin.comp by name (kTwinLowBias32, ...): the list tests/twin/twin_fns.h, which twin.comp
+// reads too for its switch labels.
+enum TwinFn : uint32_t {
+#define CB_TWIN_FN(name, number) kTwin##name = number,
+#include "twin/twin_fns.h"
+#undef CB_TWIN_FN
+};
+
 struct TwinCase {
     const char* name;
-    uint32_t fn;  // the `fn` of twin.comp
+    TwinFn fn;  // the `fn` of twin.comp
     std::vector<Kind> outputs;
     std::function<void(Pcg32&, Words&)> random;
     std::vector<Words> edges;
@@ -110,7 +118,7 @@ class GlslTwin : public ::testing::Test {
     }
 
     // Runs twin.comp's function `fn` on `inputs` with `frame`, `march`, kMieCloudTable and `layers` bound.
-    static std::vector<Words> Run(uint32_t fn, const std::vector<Words>& inputs, const SplatFrame& frame,
+    static std::vector<Words> Run(TwinFn fn, const std::vector<Words>& inputs, const SplatFrame& frame,
                                   const MarchGpu& march = MarchGpu{}, const LayersGpu& layers = LayersGpu{});
 
     static inline std::unique_ptr<vk::VulkanContext> sContext;

@@ -25,9 +25,6 @@ using test::W;
 using test::WF;
 using test::Words;
 
-constexpr uint32_t kLayersRayFn = 60, kLayersTapsFn = 61, kLayerFragmentFn = 62, kLayersPixelFn = 63,
-                   kLayersFadeFn = 64;
-
 // A random layered call: a grid up to 40 x 40 x 24, a camera below, inside or above it, tiled or not, a layer
 // count from a quarter to four per voxel, an extent that cuts some rays, every phase, beer or wang opacity (the
 // map TwinLayersMap, held in `map`).
@@ -103,7 +100,7 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         const std::vector<Words> pixels = PixelInputs(rng, p.camera, s.count);
         std::vector<Kind> rayKinds(5, Kind::F);
         rayKinds.insert(rayKinds.end(), {Kind::I, Kind::I, Kind::U});
-        Compare("MakeLayersRay", rayKinds, ulps, pixels, Run(kLayersRayFn, pixels, {}, {}, g),
+        Compare("MakeLayersRay", rayKinds, ulps, pixels, Run(test::kTwinMakeLayersRay, pixels, {}, {}, g),
                 [&](const Words& in, Words& out) {
                     const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
                     const LayersWalk w = LayersWalkOf(s, r.dir[2]);
@@ -119,7 +116,7 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
             points.back()[6] = rng.Below(s.count);
         }
         std::vector<Kind> tapKinds = {Kind::U, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F};
-        Compare("LayersTaps", tapKinds, ulps, points, Run(kLayersTapsFn, points, {}, {}, g),
+        Compare("LayersTaps", tapKinds, ulps, points, Run(test::kTwinLayersTaps, points, {}, {}, g),
                 [&](const Words& in, Words& out) {
                     const LayersTaps t = LayersTapsAt(s.size, {Float(in[0]), Float(in[1]), Float(in[2])});
                     const auto qt = LayersBlend(s.size, t, TwinFetch);
@@ -132,8 +129,8 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         }
         std::vector<Kind> fragmentKinds = {Kind::U, Kind::U};
         fragmentKinds.insert(fragmentKinds.end(), 8, Kind::F);
-        Compare("LayerFragment", fragmentKinds, ulps, fragmentsIn, Run(kLayerFragmentFn, fragmentsIn, {}, {}, g),
-                [&](const Words& in, Words& out) {
+        Compare("LayerFragment", fragmentKinds, ulps, fragmentsIn,
+                Run(test::kTwinLayerFragment, fragmentsIn, {}, {}, g), [&](const Words& in, Words& out) {
                     const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
                     const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, r.dir));
                     const LayerFragmentResult f = LayerFragment(s, r, sunPhase, in[2], TwinFetch);
@@ -143,7 +140,7 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
                     drawn += f.drawn ? 1 : 0;
                 });
         const std::vector<Kind> pixelKinds = {Kind::F, Kind::F, Kind::F, Kind::U, Kind::U};
-        Compare("LayersPixel", pixelKinds, ulps, pixels, Run(kLayersPixelFn, pixels, {}, {}, g),
+        Compare("LayersPixel", pixelKinds, ulps, pixels, Run(test::kTwinLayersPixel, pixels, {}, {}, g),
                 [&](const Words& in, Words& out) {
                     const LayersPixelResult r = LayersPixel(
                         s, MakeLayersWalks(s), MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]), TwinFetch);
@@ -153,7 +150,7 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         // LayersFade across its inner radius, the band, the extent and beyond.
         std::vector<Words> fadeIn;
         for (int n = 0; n < 200; ++n) fadeIn.push_back(WF({Uniform(rng, 0, 1.5f * s.outer2), s.outer2, s.fadeInv2}));
-        Compare("LayersFade", {Kind::F}, ulps, fadeIn, Run(kLayersFadeFn, fadeIn, {}, {}, g),
+        Compare("LayersFade", {Kind::F}, ulps, fadeIn, Run(test::kTwinLayersFade, fadeIn, {}, {}, g),
                 [&](const Words& in, Words& out) {
                     out = W({Bits(LayersFade(Float(in[0]), Float(in[1]), Float(in[2])))});
                 });

@@ -21,7 +21,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                 if (std::fabs(y) <= 1.0f) edges.push_back(WF({y}));
         edges.push_back(WF({-0.0f}));
         c.push_back({"ArcCos",
-                     34,
+                     kTwinArcCos,
                      {Kind::F},
                      [](Pcg32& r, Words& in) { in = WF({Uniform(r, -1, 1)}); },
                      edges,
@@ -39,7 +39,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                 edges.push_back(W({Bits(perRadian), count, Bits(std::clamp(x, -1.0f, 1.0f))}));
         for (float x : {1.5f, -1.5f, 1.0f, -1.0f}) edges.push_back(W({Bits(perRadian), count, Bits(x)}));
         c.push_back({"SamplePhaseTable",
-                     35,
+                     kTwinSamplePhaseTable,
                      {Kind::F},
                      [perRadian, count](Pcg32& r, Words& in) {
                          in = W({Bits(perRadian), count, Bits(Uniform(r, -1, 1))});
@@ -49,7 +49,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      /*otherDeviceUlps=*/64});
         // PhaseValue of every kind through march.glsl's MarchPhase (Mie: the table; the others: shading.glsl).
         c.push_back({"MarchPhase",
-                     36,
+                     kTwinMarchPhase,
                      {Kind::F},
                      [perRadian, count](Pcg32& r, Words& in) {
                          in = W({r.Below(4), Bits(Uniform(r, -0.95, 0.95)), Bits(Uniform(r, -1, 1)), Bits(perRadian),
@@ -78,7 +78,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
             WF({5, 5, 5, -0.0f, 0, 1, 10, 10, 10, 0, 1e30f}), WF({5, 5, 5, 1e-20f, 0, 1, 10, 10, 10, 0, 3}),
             WF({5, 5, 5, 0, 0, 0, 10, 10, 10, 0, 1e30f})};
         c.push_back({"ClipRayToBox",
-                     37,
+                     kTwinClipRayToBox,
                      {Kind::F, Kind::F},
                      [component](Pcg32& r, Words& in) {
                          const float n[3] = {float(1 + r.Below(300)), float(1 + r.Below(300)), float(1 + r.Below(300))};
@@ -96,7 +96,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      },
                      /*otherDeviceUlps=*/3});
         c.push_back({"RayExitFromBox",
-                     40,
+                     kTwinRayExitFromBox,
                      {Kind::F, Kind::F, Kind::F, Kind::F},
                      [component](Pcg32& r, Words& in) {
                          const float B = float(1 + r.Below(16));
@@ -119,7 +119,7 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      /*otherDeviceUlps=*/3});
     }
     c.push_back({"MarchStepAt",
-                 38,
+                 kTwinMarchStepAt,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = W({Bits(Uniform(r, 0.01, 4)), Bits(Uniform(r, 0, 0.5)), Bits(Uniform(r, 0, 200)), r.Below(2),
@@ -135,18 +135,18 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      out[0] = Bits(MarchStepAt(s, Float(in[4])));
                  }});
     c.push_back({"MarchJitter",
-                 39,
+                 kTwinMarchJitter,
                  {Kind::F},
                  [](Pcg32& r, Words& in) { in = W({r.NextU32(), r.Below(1000), r.Below(1u << 22)}); },
                  {W({0, 0, 0}), W({1, 0, 0}), W({0xffffffffu, 0xffffffffu, 0xffffffffu})},
                  [](const Words& in, Words& out) { out[0] = Bits(MarchJitter(in[0], in[1], in[2])); }});
-    // PowderTerm (fn 41) calls pow: GlslTwinTest.cpp compares it with an absolute bound.
+    // PowderTerm (kTwinPowderTerm) calls pow: GlslTwinTest.cpp compares it with an absolute bound.
     {
         std::vector<Words> edges = {WF({1, 0.5f, 2, 4, 1, 0}), WF({0, 1, 1, 0, 1, -0.0f}),
                                     WF({3.4e38f, 1, 1, 1e-30f, 1e-30f, -1}), WF({0.07f, 0, 1e6f, 2500, 2500, 1e30f}),
                                     WF({1, 1, 0, 1, 2, Float(0x7f7ffffeu)})};
         c.push_back({"MarchKernelFormulas",
-                     42,
+                     kTwinMarchKernelFormulas,
                      {Kind::F, Kind::F, Kind::F},
                      [](Pcg32& r, Words& in) {
                          in = WF({Uniform(r, 0, 5), Uniform(r, 0, 1), Uniform(r, 0, 4), Uniform(r, 0, 1e6),
@@ -168,7 +168,7 @@ float TwinGroundG(uint32_t i, uint32_t j) { return float(LowBias32(i + 4096u * j
 void AddGroundCases(std::vector<TwinCase>& c) {
     // Eyes above and below the plane, directions down, level and up, near / far intervals that cut the hit.
     c.push_back({"GroundHit",
-                 46,
+                 kTwinGroundHit,
                  {Kind::U, Kind::F, Kind::F},
                  [](Pcg32& r, Words& in) {
                      const float near = Uniform(r, 0, 5);
@@ -194,7 +194,7 @@ void AddGroundCases(std::vector<TwinCase>& c) {
         for (float x : {0.0f, 0.25f, 0.5f, 1.0f, float(n) - 0.5f, float(n), float(n) + 0.01f, -0.01f})
             edges.push_back(W({Bits(x), Bits(0.75f), n, n + 1}));
     c.push_back({"GroundShadowAt",
-                 47,
+                 kTwinGroundShadowAt,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      const uint32_t nx = 1 + r.Below(40), ny = 1 + r.Below(40);
@@ -205,7 +205,7 @@ void AddGroundCases(std::vector<TwinCase>& c) {
                      out[0] = Bits(GroundShadowAt(Float(in[0]), Float(in[1]), in[2], in[3], TwinGroundG));
                  }});
     c.push_back({"GroundChannel",
-                 48,
+                 kTwinGroundChannel,
                  {Kind::F},
                  [](Pcg32& r, Words& in) {
                      in = WF({Uniform(r, 0, 1), Uniform(r, 0, 20), Uniform(r, -1, 1), Uniform(r, 0, 2), Uniform(r, 0, 1)});

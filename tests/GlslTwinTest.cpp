@@ -39,6 +39,7 @@
 #include "GlslTwinHarness.h"
 #include "core/math/Automaton.h"
 #include "core/math/Camera.h"
+#include "core/math/Light.h"
 #include "core/math/March.h"
 #include "core/math/Random.h"
 #include "core/math/Rules.h"
@@ -64,7 +65,6 @@ using test::Words;
 
 // The MakeSplat case: a frame (a random camera around a 64 x 64 x 16 grid) and
 // voxels of it, some behind the eye or below q_min.
-constexpr uint32_t kMakeSplatFn = 27;
 const std::vector<Kind> kSplatOutputs = {Kind::U, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F,
                                          Kind::F, Kind::F, Kind::I, Kind::I, Kind::I, Kind::I};
 
@@ -78,27 +78,28 @@ SplatFrame RandomSplatFrame(Pcg32& r) {
     const Vec3 sun = SunDirection(r.Uniform(0.1, 1.5), r.Uniform(0, 6.28));
     SplatFrame F{};
     F.grid[0] = 64, F.grid[1] = 64, F.grid[2] = 16;
-    F.image[0] = width, F.image[1] = height;
+    F.width = width, F.height = height;
     for (int a = 0; a < 3; ++a) {
         F.eye[a] = f.eye[a];
         F.forward[a] = f.forward[a];
         F.right[a] = f.right[a];
         F.up[a] = f.upVector[a];
         F.sun[a] = sun[a];
-        F.sunRadiance[a] = Uniform(r, 0, 2);
-        F.ambient[a] = Uniform(r, 0, 0.3);
+        F.light.sunRadiance[a] = Uniform(r, 0, 2);
+        F.light.ambient[a] = Uniform(r, 0, 0.3);
         F.origin[a] = 0;
     }
-    F.eye[3] = f.nearPlane;
-    F.forward[3] = f.focalPx;
-    F.sun[3] = Uniform(r, -0.9, 0.9);
-    F.sunRadiance[3] = float(r.Below(4));  // every PhaseKind, Mie (3) with the table its frame names
-    F.right[3] = kMieCloudTable.indexPerRadian;
-    F.up[3] = float(kMieCloudTable.count);
-    F.ambient[3] = 0.3f;
-    F.background[3] = 0.6f;
-    F.origin[3] = 50;
-    F.misc[0] = 75, F.misc[1] = 0.5f;
+    F.nearPlane = f.nearPlane;
+    F.focalPx = f.focalPx;
+    F.light.phaseG = Uniform(r, -0.9, 0.9);
+    F.light.phaseKind = r.Below(4);  // every PhaseKind, Mie (3) with the table its frame names
+    F.light.mieIndexPerRadian = kMieCloudTable.indexPerRadian;
+    F.light.mieCount = kMieCloudTable.count;
+    F.light.voxelSize = 50;
+    F.qMin = 0.3f;
+    F.opacity = 0.6f;
+    F.voxelSize = 50;
+    F.splatDiameter = 75, F.alpha = 0.5f;
     return F;
 }
 
@@ -144,7 +145,7 @@ TEST_F(GlslTwin, MakeSplatEqualsItsCppTwin) {
         const SplatFrame frame = RandomSplatFrame(rng);
         std::vector<Words> inputs;
         for (uint32_t n = 0; n < 1024; ++n) inputs.push_back(RandomVoxel(rng));
-        Compare("MakeSplat", kSplatOutputs, sExact ? 0 : 4, inputs, Run(kMakeSplatFn, inputs, frame),
+        Compare("MakeSplat", kSplatOutputs, sExact ? 0 : 4, inputs, Run(test::kTwinMakeSplat, inputs, frame),
                 [&](const Words& in, Words& out) {
                     MakeSplatCpp(frame, in, out);
                     made += out[0];
@@ -157,8 +158,6 @@ TEST_F(GlslTwin, MakeSplatEqualsItsCppTwin) {
 }
 
 // ---- march.glsl with a MarchGpu block ----
-
-constexpr uint32_t kPixelRayFn = 43, kPaddedSamplerFn = 44, kMieLookupFn = 35, kPowderFn = 41;
 
 using test::TwinPaddedQT;
 
@@ -225,8 +224,8 @@ TEST_F(GlslTwin, MakePixelRayEqualsItsCppTwin) {
         const uint32_t width = p.camera.width, height = p.camera.height;
         std::vector<Words> inputs = {W({0, 0}), W({width - 1, 0}), W({0, height - 1}), W({width - 1, height - 1})};
         for (int n = 0; n < 1000; ++n) inputs.push_back(W({rng.Below(width), rng.Below(height)}));
-        Compare("MakePixelRay", std::vector<Kind>(8, Kind::F), sExact ? 0 : 4, inputs, Run(kPixelRayFn, inputs, {}, m),
-                [&](const Words& in, Words& out) {
+        Compare("MakePixelRay", std::vector<Kind>(8, Kind::F), sExact ? 0 : 4, inputs,
+                Run(test::kTwinMakePixelRay, inputs, {}, m), [&](const Words& in, Words& out) {
                     const MarchRayGeometry r =
                         MakePixelRay(p.camera, p.origin, p.setup.voxelSize, p.setup.size, in[0], in[1]);
                     out = W({Bits(r.origin[0]), Bits(r.origin[1]), Bits(r.origin[2]), Bits(r.dir[0]), Bits(r.dir[1]),
@@ -257,13 +256,48 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
             inputs.push_back(WF({Uniform(rng, -2, n[0] + 2), Uniform(rng, -2, n[1] + 2), Uniform(rng, -2, n[2] + 2)}));
         auto q = [&](const Vec3& x) { return sampler.Blend(sampler.TapsAt(x), 0); };
         std::vector<Kind> kinds = {Kind::U, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F};
-        Compare("MarchPaddedSampler", kinds, sExact ? 0 : 4, inputs, Run(kPaddedSamplerFn, inputs, {}, m),
+        Compare("MarchPaddedSampler", kinds, sExact ? 0 : 4, inputs, Run(test::kTwinMarchPaddedSampler, inputs, {}, m),
                 [&](const Words& in, Words& out) {
                     const Vec3 x{Float(in[0]), Float(in[1]), Float(in[2])};
                     const TwinPaddedSampler::Taps t = sampler.TapsAt(x);
                     out = W({t.base, Bits(t.wx), Bits(t.wy), Bits(t.wz), Bits(sampler.Blend(t, 0)),
                              Bits(sampler.Blend(t, 1)), Bits(q(x)), Bits(SunLightMarch(p.setup, x, p.lightSteps, q)),
                              Bits(PointLightMarch(p.setup, x, p.lightSteps, q))});
+                });
+    }
+}
+
+// Test that light.glsl's InScattered, with the light MakeMarchGpu nests (MakeLightGpu), equals
+// core/math/Light.h's on random samples: every phase, the point light on and off, samples at
+// and near the point light (d = 0: cos 1; within r0: the capped falloff).
+TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
+    Pcg32 rng(0x11947);
+    const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
+    for (int call = 0; call < 16; ++call) {
+        Extent3 e;
+        MarchParams p = RandomMarchParams(rng, e);
+        p.setup.sunRadiance = {Uniform(rng, 0, 3), Uniform(rng, 0, 3), Uniform(rng, 0, 3)};
+        p.setup.ambient = {Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5)};
+        p.setup.phase = {kinds[call % 4], Uniform(rng, -0.9, 0.9)};
+        p.setup.point.on = call % 8 < 6;
+        p.setup.point.radiance = {Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4)};
+        p.setup.point.minDistance2 = Uniform(rng, 1, 1e4);
+        const MarchGpu m = MakeMarchGpu(p, e);
+        const LightTerms terms = MarchLightTerms(p.setup);
+        const Vec3& at = p.setup.point.position;
+        std::vector<Words> inputs = {WF({0.5f, 1, at[0], at[1], at[2], 0, 0, 1}),
+                                     WF({0, 0, at[0] + 0.01f, at[1], at[2], 1, 0, 0})};
+        for (int k = 0; k < 2000; ++k) {
+            const Vec3 d = SunDirection(rng.Uniform(-1.5, 1.5), rng.Uniform(0, 6.28));
+            inputs.push_back(WF({Uniform(rng, 0, 2), Uniform(rng, 0, 1), Uniform(rng, -10, 60), Uniform(rng, -10, 60),
+                                 Uniform(rng, -10, 60), d[0], d[1], d[2]}));
+        }
+        Compare("InScattered", {Kind::F, Kind::F, Kind::F}, sExact ? 0 : 4, inputs,
+                Run(test::kTwinInScattered, inputs, {}, m), [&](const Words& in, Words& out) {
+                    const LightSample s{Float(in[0]), Float(in[1]), Vec3{Float(in[2]), Float(in[3]), Float(in[4])},
+                                        Vec3{Float(in[5]), Float(in[6]), Float(in[7])}};
+                    const Vec3 c = InScattered(terms, s);
+                    out = WF({c[0], c[1], c[2]});
                 });
     }
 }
@@ -278,7 +312,7 @@ TEST_F(GlslTwin, MieTableLookupEqualsTheCpus) {
     for (uint32_t n = 0; n <= steps; ++n)
         inputs.push_back(W({Bits(kMieCloudTable.indexPerRadian), kMieCloudTable.count,
                             Bits(float(-1.0 + 2.0 * n / steps))}));
-    const std::vector<Words> glsl = Run(kMieLookupFn, inputs, {});
+    const std::vector<Words> glsl = Run(test::kTwinSamplePhaseTable, inputs, {});
     uint64_t worst = 0;
     for (size_t n = 0; n < inputs.size(); ++n) {
         const float want = SamplePhaseTable(kMieCloudTable, Float(inputs[n][2]));
@@ -304,7 +338,7 @@ TEST_F(GlslTwin, PowderTermWithinAFewUlpsOfOne) {
     std::vector<Words> inputs = {WF({2, 1}), WF({2, 0}), WF({0, 0.5f}), WF({2, -0.0f}), WF({2.5f, 0.25f}),
                                  WF({1, 0.3f})};
     for (int n = 0; n < 8192; ++n) inputs.push_back(WF({Uniform(rng, 0, 10), Uniform(rng, 0, 1)}));
-    const std::vector<Words> glsl = Run(kPowderFn, inputs, {});
+    const std::vector<Words> glsl = Run(test::kTwinPowderTerm, inputs, {});
     double worst = 0;
     for (size_t n = 0; n < inputs.size(); ++n) {
         const float want = PowderTerm(Float(inputs[n][0]), Float(inputs[n][1]));

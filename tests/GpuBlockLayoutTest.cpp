@@ -25,7 +25,9 @@
 #include <vector>
 
 #include "core/math/Ground.h"
+#include "core/math/Light.h"
 #include "core/math/Splat.h"
+#include "core/pipeline/LayersGpu.h"
 #include "core/pipeline/MarchGpu.h"
 #include "impl_vk/PushBlocks.h"
 
@@ -33,19 +35,29 @@ namespace cb::gpu_block_layout {
 namespace {
 
 // GL type enums as glslang's reflection prints them.
-constexpr int kGlFloat = 0x1406, kGlInt = 0x1404, kGlVec4 = 0x8b52, kGlUvec4 = 0x8dc8;
+constexpr int kGlFloat = 0x1406, kGlInt = 0x1404, kGlUint = 0x1405, kGlVec2 = 0x8b50, kGlVec3 = 0x8b51,
+              kGlVec4 = 0x8b52, kGlUvec3 = 0x8dc7, kGlUvec4 = 0x8dc8;
 
 template <typename T>
 constexpr int GlTypeOf() {
     if constexpr (std::is_same_v<T, float>) return kGlFloat;
     if constexpr (std::is_same_v<T, int32_t>) return kGlInt;
+    if constexpr (std::is_same_v<T, uint32_t>) return kGlUint;
+    if constexpr (std::is_same_v<T, std::array<float, 2>> || std::is_same_v<T, float[2]>) return kGlVec2;
+    if constexpr (std::is_same_v<T, std::array<float, 3>> || std::is_same_v<T, float[3]>) return kGlVec3;
     if constexpr (std::is_same_v<T, std::array<float, 4>> || std::is_same_v<T, float[4]>) return kGlVec4;
+    if constexpr (std::is_same_v<T, std::array<uint32_t, 3>> || std::is_same_v<T, uint32_t[3]>) return kGlUvec3;
     if constexpr (std::is_same_v<T, std::array<uint32_t, 4>> || std::is_same_v<T, uint32_t[4]>) return kGlUvec4;
     return 0;  // a type this test does not know: the comparison fails and names it
 }
 
+// Bytes of a member of GL type t.
+constexpr size_t GlBytes(int t) {
+    return t == kGlVec4 || t == kGlUvec4 ? 16 : t == kGlVec3 || t == kGlUvec3 ? 12 : t == kGlVec2 ? 8 : 4;
+}
+
 struct Member {
-    std::string name;  // the GLSL member's name
+    std::string name;  // the GLSL member's name (nested: "light.sunRadiance")
     size_t offset;     // where the C++ struct has it
     int glType;        // what the C++ member's type is in GLSL
 };
@@ -53,43 +65,107 @@ struct Member {
 #define CB_MEMBER(Struct, member) \
     Member { #member, offsetof(Struct, member), GlTypeOf < std::remove_cvref_t < decltype(Struct::member)>>() }
 
+// The members of LightGpu (core/math/Light.h), as a block's member `prefix` at byte `at`.
+std::vector<Member> LightMembers(const std::string& prefix, size_t at) {
+    std::vector<Member> light = {CB_MEMBER(LightGpu, sunRadiance),   CB_MEMBER(LightGpu, phaseKind),
+                                 CB_MEMBER(LightGpu, ambient),       CB_MEMBER(LightGpu, phaseG),
+                                 CB_MEMBER(LightGpu, pointPosition), CB_MEMBER(LightGpu, pointMinDistance2),
+                                 CB_MEMBER(LightGpu, pointRadiance), CB_MEMBER(LightGpu, pointOn),
+                                 CB_MEMBER(LightGpu, voxelSize),     CB_MEMBER(LightGpu, mieIndexPerRadian),
+                                 CB_MEMBER(LightGpu, mieCount),      CB_MEMBER(LightGpu, unused)};
+    for (Member& m : light) m.name = prefix + m.name, m.offset += at;
+    return light;
+}
+
+template <typename... Lists>
+std::vector<Member> Concat(std::vector<Member> first, const Lists&... rest) {
+    (first.insert(first.end(), rest.begin(), rest.end()), ...);
+    return first;
+}
+
 struct Block {
     std::string glslName;  // the struct's name in GLSL (and in C++)
     std::string file;      // under core/math/
     size_t bytes;          // sizeof the C++ struct
     bool std140;           // the header promises std140 as well as std430
     std::vector<Member> members;
+    bool nestsLight = false;  // has a LightGpu member (light.glsl's struct goes before it)
 };
 
 std::vector<Block> Blocks() {
     // Splat's colour[3] is GLSL's r, g, b.
     const size_t colour = offsetof(Splat, colour);
     return {
-        {"MarchGpu",
-         "march.glsl",
-         sizeof(MarchGpu),
-         true,
-         {CB_MEMBER(MarchGpu, eye), CB_MEMBER(MarchGpu, forward), CB_MEMBER(MarchGpu, right), CB_MEMBER(MarchGpu, up),
-          CB_MEMBER(MarchGpu, size), CB_MEMBER(MarchGpu, stepping), CB_MEMBER(MarchGpu, sun),
-          CB_MEMBER(MarchGpu, sunRadiance), CB_MEMBER(MarchGpu, ambient), CB_MEMBER(MarchGpu, background),
-          CB_MEMBER(MarchGpu, pointPosition), CB_MEMBER(MarchGpu, pointRadiance), CB_MEMBER(MarchGpu, image),
-          CB_MEMBER(MarchGpu, flags), CB_MEMBER(MarchGpu, strides), CB_MEMBER(MarchGpu, bricks)}},
+        {"MarchGpu", "march.glsl", sizeof(MarchGpu), true,
+         Concat({CB_MEMBER(MarchGpu, eye),
+                 CB_MEMBER(MarchGpu, focalPx),
+                 CB_MEMBER(MarchGpu, forward),
+                 CB_MEMBER(MarchGpu, nearPlane),
+                 CB_MEMBER(MarchGpu, right),
+                 CB_MEMBER(MarchGpu, farPlane),
+                 CB_MEMBER(MarchGpu, up),
+                 CB_MEMBER(MarchGpu, voxelSize),
+                 CB_MEMBER(MarchGpu, size),
+                 CB_MEMBER(MarchGpu, sigmaH),
+                 CB_MEMBER(MarchGpu, baseStep),
+                 CB_MEMBER(MarchGpu, kappa),
+                 CB_MEMBER(MarchGpu, adaptiveStart),
+                 CB_MEMBER(MarchGpu, epsilon),
+                 CB_MEMBER(MarchGpu, sun),
+                 CB_MEMBER(MarchGpu, powderC),
+                 CB_MEMBER(MarchGpu, background),
+                 CB_MEMBER(MarchGpu, flags),
+                 CB_MEMBER(MarchGpu, width),
+                 CB_MEMBER(MarchGpu, height),
+                 CB_MEMBER(MarchGpu, seed),
+                 CB_MEMBER(MarchGpu, frame),
+                 CB_MEMBER(MarchGpu, lightSteps),
+                 CB_MEMBER(MarchGpu, brick),
+                 CB_MEMBER(MarchGpu, strideY),
+                 CB_MEMBER(MarchGpu, strideZ),
+                 CB_MEMBER(MarchGpu, bricks),
+                 CB_MEMBER(MarchGpu, unused)},
+                LightMembers("light.", offsetof(MarchGpu, light))),
+         true},
+        {"LayersGpu", "layers.glsl", sizeof(LayersGpu), true,
+         Concat({CB_MEMBER(LayersGpu, eye),       CB_MEMBER(LayersGpu, focalPx),    CB_MEMBER(LayersGpu, forward),
+                 CB_MEMBER(LayersGpu, nearPlane), CB_MEMBER(LayersGpu, right),      CB_MEMBER(LayersGpu, farPlane),
+                 CB_MEMBER(LayersGpu, up),        CB_MEMBER(LayersGpu, voxelSize),  CB_MEMBER(LayersGpu, size),
+                 CB_MEMBER(LayersGpu, sigmaH),    CB_MEMBER(LayersGpu, invSize),    CB_MEMBER(LayersGpu, spacing),
+                 CB_MEMBER(LayersGpu, sun),       CB_MEMBER(LayersGpu, outer2),     CB_MEMBER(LayersGpu, background),
+                 CB_MEMBER(LayersGpu, maxLength), CB_MEMBER(LayersGpu, width),      CB_MEMBER(LayersGpu, height),
+                 CB_MEMBER(LayersGpu, count),     CB_MEMBER(LayersGpu, flags),      CB_MEMBER(LayersGpu, strideY),
+                 CB_MEMBER(LayersGpu, strideZ),   CB_MEMBER(LayersGpu, lightScale), CB_MEMBER(LayersGpu, fadeInv2),
+                 CB_MEMBER(LayersGpu, drift),     CB_MEMBER(LayersGpu, coverage),   CB_MEMBER(LayersGpu, density)},
+                LightMembers("light.", offsetof(LayersGpu, light))),
+         true},
+        {"LightGpu", "light.glsl", sizeof(LightGpu), true, LightMembers("", 0)},
         {"GroundGpu",
          "ground.glsl",
          sizeof(GroundGpu),
          true,
-         {CB_MEMBER(GroundGpu, eye), CB_MEMBER(GroundGpu, forward), CB_MEMBER(GroundGpu, right),
-          CB_MEMBER(GroundGpu, up), CB_MEMBER(GroundGpu, albedo), CB_MEMBER(GroundGpu, sunRadiance),
-          CB_MEMBER(GroundGpu, ambient), CB_MEMBER(GroundGpu, background), CB_MEMBER(GroundGpu, grid)}},
-        {"SplatFrame",
-         "splat.glsl",
-         sizeof(SplatFrame),
-         false,
-         {CB_MEMBER(SplatFrame, grid), CB_MEMBER(SplatFrame, axes), CB_MEMBER(SplatFrame, orderBase),
-          CB_MEMBER(SplatFrame, boxes), CB_MEMBER(SplatFrame, image), CB_MEMBER(SplatFrame, eye),
-          CB_MEMBER(SplatFrame, forward), CB_MEMBER(SplatFrame, right), CB_MEMBER(SplatFrame, up),
-          CB_MEMBER(SplatFrame, sun), CB_MEMBER(SplatFrame, sunRadiance), CB_MEMBER(SplatFrame, ambient),
-          CB_MEMBER(SplatFrame, background), CB_MEMBER(SplatFrame, origin), CB_MEMBER(SplatFrame, misc)}},
+         {CB_MEMBER(GroundGpu, eye),       CB_MEMBER(GroundGpu, focalPx),     CB_MEMBER(GroundGpu, forward),
+          CB_MEMBER(GroundGpu, nearPlane), CB_MEMBER(GroundGpu, right),       CB_MEMBER(GroundGpu, farPlane),
+          CB_MEMBER(GroundGpu, up),        CB_MEMBER(GroundGpu, voxelSize),   CB_MEMBER(GroundGpu, albedo),
+          CB_MEMBER(GroundGpu, sunZ),      CB_MEMBER(GroundGpu, sunRadiance), CB_MEMBER(GroundGpu, unused0),
+          CB_MEMBER(GroundGpu, ambient),   CB_MEMBER(GroundGpu, unused1),     CB_MEMBER(GroundGpu, background),
+          CB_MEMBER(GroundGpu, unused2),   CB_MEMBER(GroundGpu, gridX),       CB_MEMBER(GroundGpu, gridY),
+          CB_MEMBER(GroundGpu, width),     CB_MEMBER(GroundGpu, height)}},
+        {"SplatFrame", "splat.glsl", sizeof(SplatFrame), false,
+         Concat(
+             {CB_MEMBER(SplatFrame, grid),       CB_MEMBER(SplatFrame, ranksPerChunk), CB_MEMBER(SplatFrame, axes),
+              CB_MEMBER(SplatFrame, voxelCount), CB_MEMBER(SplatFrame, orderBase),     CB_MEMBER(SplatFrame, unused0),
+              CB_MEMBER(SplatFrame, boxTile),    CB_MEMBER(SplatFrame, boxBand),       CB_MEMBER(SplatFrame, boxTilesX),
+              CB_MEMBER(SplatFrame, boxTilesY),  CB_MEMBER(SplatFrame, width),         CB_MEMBER(SplatFrame, height),
+              CB_MEMBER(SplatFrame, tilesX),     CB_MEMBER(SplatFrame, tilesY),        CB_MEMBER(SplatFrame, eye),
+              CB_MEMBER(SplatFrame, nearPlane),  CB_MEMBER(SplatFrame, forward),       CB_MEMBER(SplatFrame, focalPx),
+              CB_MEMBER(SplatFrame, right),      CB_MEMBER(SplatFrame, qMin),          CB_MEMBER(SplatFrame, up),
+              CB_MEMBER(SplatFrame, opacity),    CB_MEMBER(SplatFrame, sun),           CB_MEMBER(SplatFrame, voxelSize),
+              CB_MEMBER(SplatFrame, background), CB_MEMBER(SplatFrame, splatDiameter), CB_MEMBER(SplatFrame, origin),
+              CB_MEMBER(SplatFrame, alpha),      CB_MEMBER(SplatFrame, maxPointSize),  CB_MEMBER(SplatFrame, unused1),
+              CB_MEMBER(SplatFrame, unused2),    CB_MEMBER(SplatFrame, unused3)},
+             LightMembers("light.", offsetof(SplatFrame, light))),
+         true},
         {"Splat",
          "splat.glsl",
          sizeof(Splat),
@@ -102,14 +178,22 @@ std::vector<Block> Blocks() {
 }
 
 // The declaration `struct NAME { ... };` as it stands in core/math/FILE.
-std::string GlslStruct(const Block& block) {
-    std::ifstream in(std::filesystem::path(CLOUDBENCH_SOURCE_DIR) / "core" / "math" / block.file);
+std::string GlslStruct(const std::string& name, const std::string& file) {
+    std::ifstream in(std::filesystem::path(CLOUDBENCH_SOURCE_DIR) / "core" / "math" / file);
     std::stringstream text;
     text << in.rdbuf();
     const std::string source = text.str();
     std::smatch found;
-    const std::regex declaration("struct " + block.glslName + " \\{[^}]*\\};");
+    const std::regex declaration("struct " + name + " \\{[^}]*\\};");
     return std::regex_search(source, found, declaration) ? found.str() : "";
+}
+
+// The block's declaration, after light.glsl's LightGpu where it nests one.
+std::string GlslStruct(const Block& block) {
+    const std::string own = GlslStruct(block.glslName, block.file);
+    if (own.empty() || !block.nestsLight) return own;
+    const std::string light = GlslStruct("LightGpu", "light.glsl");
+    return light.empty() ? "" : light + "\n" + own;
 }
 
 struct Reflected {
@@ -130,7 +214,7 @@ std::map<std::string, Reflected> Reflect(const std::string& shader, const std::s
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return members;
     char line[512];
-    const std::regex entry("^" + instance + "\\.([A-Za-z0-9_]+): offset (\\d+), type ([0-9a-f]+),");
+    const std::regex entry("^" + instance + "\\.([A-Za-z0-9_.]+): offset (\\d+), type ([0-9a-f]+),");
     while (std::fgets(line, sizeof line, pipe)) {
         log += line;
         std::cmatch m;
@@ -148,7 +232,8 @@ std::map<std::string, Reflected> Reflect(const std::string& shader, const std::s
 // is live.
 std::string BlockShader(const std::string& declaration, const Block& block, const std::string& layout) {
     const Member& first = block.members.front();
-    const std::string lane = first.name + (first.glType == kGlVec4 || first.glType == kGlUvec4 ? ".x" : "");
+    const bool isVector = first.glType != kGlFloat && first.glType != kGlInt && first.glType != kGlUint;
+    const std::string lane = first.name + (isVector ? ".x" : "");
     const std::string qualifier = layout == "std430" ? "layout(std430, binding = 0) readonly buffer Block"
                                                      : "layout(std140, binding = 0) uniform Block";
     return "#version 450\nlayout(local_size_x = 1) in;\n" + declaration + "\n" + qualifier + " { " + block.glslName +
@@ -173,7 +258,7 @@ void ExpectSameLayout(const Block& block, const std::string& layout) {
         EXPECT_EQ(it->second.glType, member.glType)
             << block.glslName << "." << member.name << " (" << layout << "): GL type 0x" << std::hex
             << it->second.glType << " in GLSL, 0x" << member.glType << " from the C++ type";
-        end = std::max(end, member.offset + (member.glType == kGlVec4 || member.glType == kGlUvec4 ? 16 : 4));
+        end = std::max(end, member.offset + GlBytes(member.glType));
     }
     EXPECT_EQ(end, block.bytes) << block.glslName << ": the C++ struct has bytes no member accounts for";
 }
@@ -193,11 +278,11 @@ TEST(GpuBlockLayout, SwappedMembersAreCaught) {
     std::string log;
     std::string declaration = GlslStruct(march);
     ASSERT_FALSE(declaration.empty());
-    const size_t forward = declaration.find("vec4 forward;"), right = declaration.find("vec4 right;");
+    const size_t forward = declaration.find("vec3 forward;"), right = declaration.find("vec3 right;");
     ASSERT_NE(forward, std::string::npos);
     ASSERT_NE(right, std::string::npos);
-    declaration.replace(right, 11, "vec4 forward;");
-    declaration.replace(forward, 13, "vec4 right;");
+    declaration.replace(right, 11, "vec3 forward;");
+    declaration.replace(forward, 13, "vec3 right;");
     const auto reflected = Reflect(BlockShader(declaration, march, "std430"), "m", log);
     ASSERT_EQ(reflected.count("forward"), 1u) << log;
     EXPECT_NE(reflected.at("forward").offset, offsetof(MarchGpu, forward));
@@ -206,13 +291,11 @@ TEST(GpuBlockLayout, SwappedMembersAreCaught) {
 
 // ---- The Vulkan push-constant blocks (impl_vk/PushBlocks.h) against the shaders' `Params` ----
 
-constexpr int kGlUint = 0x1405;
 using vk::PushFloat8;  // the member types CB_VK_PUSH_BLOCKS names unqualified
-using vk::PushVec4;
+using vk::PushVec3;
 
 template <typename T>
 constexpr int PushGlType() {
-    if constexpr (std::is_same_v<T, uint32_t>) return kGlUint;
     if constexpr (std::is_same_v<T, PushFloat8>) return kGlFloat;  // float[8]: reflected as float, size 8
     return GlTypeOf<T>();
 }

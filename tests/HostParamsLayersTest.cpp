@@ -335,7 +335,7 @@ TEST(HostParamsLayers, WrapOnAndBeyondTheTileEdge) {
     EXPECT_EQ(LayersPaddedSource(8, 8, false), 7);
 }
 
-// Test the GPU block (core/pipeline/LayersGpu.h): each row holds the host's values in the lanes its comment names,
+// Test the GPU block (core/pipeline/LayersGpu.h): each member holds the host's value,
 // with every field distinct, so a swapped or dropped lane fails. Tiled, wang, relit at step 1 (sun at az 45).
 TEST(HostParamsLayers, GpuBlockCarriesTheHostValues) {
     Scene sc = HplScene();
@@ -350,38 +350,53 @@ TEST(HostParamsLayers, GpuBlockCarriesTheHostValues) {
     const LayersGpu g = MakeLayersGpu(p);
     const float c45 = p.setup.sun[0];
     EXPECT_NEAR(c45, 0.70710678f, 1e-6f);
-    EXPECT_EQ(g.eye[0], 4.0f);
-    EXPECT_EQ(g.eye[1], 3.0f);
-    EXPECT_EQ(g.eye[2], 2.0f);
-    EXPECT_NEAR(g.eye[3], 10.5f, 1e-5f);                                      // w: focalPx
-    EXPECT_EQ(g.forward, (std::array<float, 4>{0.0f, 1.0f, 0.0f, 25.0f}));    // w: near (m)
-    EXPECT_EQ(g.right, (std::array<float, 4>{1.0f, 0.0f, 0.0f, 1000.0f}));    // w: far (m)
-    EXPECT_EQ(g.up, (std::array<float, 4>{0.0f, 0.0f, 1.0f, 50.0f}));         // w: h
-    EXPECT_EQ(g.size, (std::array<float, 4>{8.0f, 6.0f, 4.0f, 6.25f}));       // w: sigma h
-    EXPECT_EQ(g.invSize, (std::array<float, 4>{0.125f, 1.0f / 6.0f, 0.25f, 1.0f}));  // w: spacing
+    using F3 = std::array<float, 3>;
+    EXPECT_EQ(g.eye, (F3{4.0f, 3.0f, 2.0f}));
+    EXPECT_NEAR(g.focalPx, 10.5f, 1e-5f);
+    EXPECT_EQ(g.forward, (F3{0.0f, 1.0f, 0.0f}));
+    EXPECT_EQ(g.nearPlane, 25.0f);  // m
+    EXPECT_EQ(g.right, (F3{1.0f, 0.0f, 0.0f}));
+    EXPECT_EQ(g.farPlane, 1000.0f);  // m
+    EXPECT_EQ(g.up, (F3{0.0f, 0.0f, 1.0f}));
+    EXPECT_EQ(g.voxelSize, 50.0f);
+    EXPECT_EQ(g.size, (F3{8.0f, 6.0f, 4.0f}));
+    EXPECT_EQ(g.sigmaH, 6.25f);
+    EXPECT_EQ(g.invSize, (F3{0.125f, 1.0f / 6.0f, 0.25f}));
+    EXPECT_EQ(g.spacing, 1.0f);
     EXPECT_NEAR(g.sun[0], 0.70710678f, 1e-6f);
     EXPECT_NEAR(g.sun[1], 0.70710678f, 1e-6f);
     EXPECT_NEAR(g.sun[2], 0.0f, 1e-7f);
-    EXPECT_EQ(g.sun[3], 0.25f);                                               // w: g
-    EXPECT_EQ(g.sunRadiance, (std::array<float, 4>{4.0f, 2.0f, 1.0f, 400.0f}));  // w: extent^2
-    EXPECT_EQ(g.ambient[3], kMieCloudTable.indexPerRadian);
-    EXPECT_EQ(g.ambient[2], 0.75f);
-    EXPECT_EQ(g.background, (std::array<float, 4>{0.125f, 0.375f, 0.625f, 2.5f}));  // w: l_max
-    EXPECT_EQ(g.image, (std::array<uint32_t, 4>{33, 21, 4, kLayersGpuTiling | kLayersGpuWang}));
+    EXPECT_EQ(g.light.phaseG, 0.25f);
+    EXPECT_EQ(g.light.sunRadiance, (F3{4.0f, 2.0f, 1.0f}));
+    EXPECT_EQ(g.outer2, 400.0f);  // extent^2
+    EXPECT_EQ(g.light.mieIndexPerRadian, kMieCloudTable.indexPerRadian);
+    EXPECT_EQ(g.light.ambient[2], 0.75f);
+    EXPECT_EQ(g.light.pointOn, 0u);
+    EXPECT_EQ(g.background, (F3{0.125f, 0.375f, 0.625f}));
+    EXPECT_EQ(g.maxLength, 2.5f);  // l_max
+    EXPECT_EQ(g.width, 33u);
+    EXPECT_EQ(g.height, 21u);
+    EXPECT_EQ(g.count, 4u);
+    EXPECT_EQ(g.flags, uint32_t(kLayersGpuTiling | kLayersGpuWang));
+    EXPECT_EQ(g.light.phaseKind, uint32_t(PhaseKind::HenyeyGreenstein));
+    EXPECT_EQ(g.light.mieCount, kMieCloudTable.count);
     // Padded strides: px = 8 + 2 = 10, px py = 10 * (6 + 2) = 80.
-    EXPECT_EQ(g.phase, (std::array<uint32_t, 4>{uint32_t(PhaseKind::HenyeyGreenstein), kMieCloudTable.count, 10, 80}));
+    EXPECT_EQ(g.strideY, 10u);
+    EXPECT_EQ(g.strideZ, 80u);
     // Step 1, alpha 0.5: t = 0.5, raw drift (1, -0.5), tiled (1, 5.5); then C, D_w.
-    EXPECT_EQ(g.drift, (std::array<float, 4>{1.0f, 5.5f, 0.75f, 3.0f}));
-    EXPECT_NEAR(g.light[0], 0.70710678f, 1e-6f);  // cos 45
-    EXPECT_EQ(g.light[0], p.setup.lightScale);
-    EXPECT_EQ(g.light[1], p.setup.fadeInv2);  // y: the falloff, 1 / 300 (default fade 0.5 of 20 voxel edges)
-    EXPECT_FLOAT_EQ(g.light[1], 1.0f / 300.0f);
+    EXPECT_EQ(g.drift, (std::array<float, 2>{1.0f, 5.5f}));
+    EXPECT_EQ(g.coverage, 0.75f);
+    EXPECT_EQ(g.density, 3.0f);
+    EXPECT_NEAR(g.lightScale, 0.70710678f, 1e-6f);  // cos 45
+    EXPECT_EQ(g.lightScale, p.setup.lightScale);
+    EXPECT_EQ(g.fadeInv2, p.setup.fadeInv2);  // the falloff, 1 / 300 (default fade 0.5 of 20 voxel edges)
+    EXPECT_FLOAT_EQ(g.fadeInv2, 1.0f / 300.0f);
     // Step 3 (135 degrees from s0): the block carries the clamped 0.
-    EXPECT_EQ(MakeLayersGpu(HplParams(sc, 3)).light[0], 0.0f);
+    EXPECT_EQ(MakeLayersGpu(HplParams(sc, 3)).lightScale, 0.0f);
     // Without tiling or wang no flag bit.
     sc.grid.tiling = false;
     sc.layers.wang.enabled = false;
-    EXPECT_EQ(MakeLayersGpu(HplParams(sc, 1)).image[3], 0u);
+    EXPECT_EQ(MakeLayersGpu(HplParams(sc, 1)).flags, 0u);
 }
 
 // Test the OpenGL draw order (SPEC 15: decreasing |z_i - z_eye|, ties by lower index) on four layers at

@@ -231,50 +231,70 @@ TEST(HostParamsMarch, CentrePixelRayClippedToNearAndBox) {
     EXPECT_EQ(r.tMax, 2.5f);
 }
 
-// Test the march's GPU block (core/pipeline/MarchGpu.h): each lane its comment names holds the host's value.
+// Test the march's GPU block (core/pipeline/MarchGpu.h): each member holds the host's value.
 TEST(HostParamsMarch, GpuBlockCarriesTheHostValues) {
     const Scene sc = HpmScene();
     const Extent3 e = sc.grid.size;
     const MarchParams p = HpmMarch(sc, 3);
     const MarchGpu g = MakeMarchGpu(p, e);
-    EXPECT_EQ(g.eye[0], 5.0f);
-    EXPECT_EQ(g.eye[1], 4.0f);
-    EXPECT_EQ(g.eye[2], 2.5f);
-    EXPECT_NEAR(g.eye[3], 12.5f, 1e-5f);                                        // w: focalPx
-    EXPECT_EQ(g.forward, (std::array<float, 4>{0.0f, 0.0f, -1.0f, 10.0f}));     // w: near
-    EXPECT_EQ(g.right, (std::array<float, 4>{1.0f, 0.0f, 0.0f, 2000.0f}));      // w: far
-    EXPECT_EQ(g.up, (std::array<float, 4>{0.0f, 1.0f, 0.0f, 20.0f}));           // w: h
-    EXPECT_EQ(g.size, (std::array<float, 4>{10.0f, 8.0f, 5.0f, 0.625f}));       // w: sigma h
-    EXPECT_EQ(g.stepping, (std::array<float, 4>{0.75f, 0.125f, 16.0f, 0.0625f}));  // Delta_0, kappa, t_a, epsilon
-    // Step 3: el 20 - 105 = -85: (cos 85, 0, -sin 85) = (0.08715574, 0, -0.99619470); w: g.
+    using F3 = std::array<float, 3>;
+    EXPECT_EQ(g.eye, (F3{5.0f, 4.0f, 2.5f}));
+    EXPECT_NEAR(g.focalPx, 12.5f, 1e-5f);
+    EXPECT_EQ(g.forward, (F3{0.0f, 0.0f, -1.0f}));
+    EXPECT_EQ(g.nearPlane, 10.0f);
+    EXPECT_EQ(g.right, (F3{1.0f, 0.0f, 0.0f}));
+    EXPECT_EQ(g.farPlane, 2000.0f);
+    EXPECT_EQ(g.up, (F3{0.0f, 1.0f, 0.0f}));
+    EXPECT_EQ(g.voxelSize, 20.0f);
+    EXPECT_EQ(g.size, (F3{10.0f, 8.0f, 5.0f}));
+    EXPECT_EQ(g.sigmaH, 0.625f);
+    EXPECT_EQ(g.baseStep, 0.75f);
+    EXPECT_EQ(g.kappa, 0.125f);
+    EXPECT_EQ(g.adaptiveStart, 16.0f);
+    EXPECT_EQ(g.epsilon, 0.0625f);
+    // Step 3: el 20 - 105 = -85: (cos 85, 0, -sin 85) = (0.08715574, 0, -0.99619470).
     EXPECT_NEAR(g.sun[0], 0.08715574f, 1e-6f);
     EXPECT_EQ(g.sun[1], 0.0f);
     EXPECT_NEAR(g.sun[2], -0.99619470f, 1e-6f);
-    EXPECT_EQ(g.sun[3], 0.375f);
-    EXPECT_EQ(g.sunRadiance, (std::array<float, 4>{1.0f, 2.0f, 0.5f, 3.0f}));   // w: powder c
-    EXPECT_EQ(g.ambient, (std::array<float, 4>{0.25f, 0.5f, 0.75f, kMieCloudTable.indexPerRadian}));
-    EXPECT_EQ(g.background, (std::array<float, 4>{0.125f, 0.375f, 0.625f, 0.0f}));
-    EXPECT_EQ(g.pointPosition, (std::array<float, 4>{8.0f, -2.0f, 5.0f, 25.0f}));  // w: r0^2
-    EXPECT_EQ(g.pointRadiance, (std::array<float, 4>{4.0f, 2.0f, 8.0f, 0.0f}));
-    EXPECT_EQ(g.image, (std::array<uint32_t, 4>{31, 25, 777, 3}));  // width, height, seed, frame = the step
-    const uint32_t all = kMarchGpuAdaptive | kMarchGpuJitter | kMarchGpuPowder | kMarchGpuPointLight |
-                         kMarchGpuSkipping | kMarchGpuLightMarch | kMarchGpuGround;
-    EXPECT_EQ(g.flags, (std::array<uint32_t, 4>{all, uint32_t(PhaseKind::CornetteShanks), 6, 4}));
+    EXPECT_EQ(g.light.phaseG, 0.375f);
+    EXPECT_EQ(g.light.phaseKind, uint32_t(PhaseKind::CornetteShanks));
+    EXPECT_EQ(g.light.sunRadiance, (F3{1.0f, 2.0f, 0.5f}));
+    EXPECT_EQ(g.powderC, 3.0f);
+    EXPECT_EQ(g.light.ambient, (F3{0.25f, 0.5f, 0.75f}));
+    EXPECT_EQ(g.light.mieIndexPerRadian, kMieCloudTable.indexPerRadian);
+    EXPECT_EQ(g.light.mieCount, kMieCloudTable.count);
+    EXPECT_EQ(g.light.voxelSize, 20.0f);
+    EXPECT_EQ(g.background, (F3{0.125f, 0.375f, 0.625f}));
+    EXPECT_EQ(g.light.pointPosition, (F3{8.0f, -2.0f, 5.0f}));
+    EXPECT_EQ(g.light.pointMinDistance2, 25.0f);  // r0^2
+    EXPECT_EQ(g.light.pointRadiance, (F3{4.0f, 2.0f, 8.0f}));
+    EXPECT_EQ(g.light.pointOn, 1u);
+    EXPECT_EQ(g.width, 31u);
+    EXPECT_EQ(g.height, 25u);
+    EXPECT_EQ(g.seed, 777u);
+    EXPECT_EQ(g.frame, 3u);  // the step
+    const uint32_t all = kMarchGpuAdaptive | kMarchGpuJitter | kMarchGpuPowder | kMarchGpuSkipping |
+                         kMarchGpuLightMarch | kMarchGpuGround;
+    EXPECT_EQ(g.flags, all);
+    EXPECT_EQ(g.lightSteps, 6u);
+    EXPECT_EQ(g.brick, 4u);
     // px = 10 + 2 = 12, px (8 + 2) = 120.
-    EXPECT_EQ(g.strides, (std::array<uint32_t, 4>{12, 120, kMieCloudTable.count, 0}));
+    EXPECT_EQ(g.strideY, 12u);
+    EXPECT_EQ(g.strideZ, 120u);
     // Bricks of 4: ceil(10 / 4) = 3 (a partial brick beyond x 8), ceil(8 / 4) = 2 (on the edge), ceil(5 / 4) = 2.
-    EXPECT_EQ(g.bricks, (std::array<uint32_t, 4>{3, 2, 2, 0}));
-    // Step 5: the flash is over, the point light's bit alone clears.
-    EXPECT_EQ(MakeMarchGpu(HpmMarch(sc, 5), e).flags[0], all & ~uint32_t(kMarchGpuPointLight));
+    EXPECT_EQ(g.bricks, (std::array<uint32_t, 3>{3, 2, 2}));
+    // Step 5: the flash is over, the point light alone goes off.
+    EXPECT_EQ(MakeMarchGpu(HpmMarch(sc, 5), e).flags, all);
+    EXPECT_EQ(MakeMarchGpu(HpmMarch(sc, 5), e).light.pointOn, 0u);
     // Brick 0 counts as 1: one brick per voxel.
     MarchParams q = p;
     q.brick = 0;
-    EXPECT_EQ(MakeMarchGpu(q, e).bricks, (std::array<uint32_t, 4>{10, 8, 5, 0}));
-    EXPECT_EQ(MakeMarchGpu(q, e).flags[3], 1u);
+    EXPECT_EQ(MakeMarchGpu(q, e).bricks, (std::array<uint32_t, 3>{10, 8, 5}));
+    EXPECT_EQ(MakeMarchGpu(q, e).brick, 1u);
     EXPECT_EQ(MarchBrickCounts({9, 8, 1}, 8), (std::array<uint32_t, 3>{2, 1, 1}));  // 9 = one past the edge
 }
 
-// Test the splat renderer's parameters and its GPU frame (SPEC 8; core/math/Splat.h's SplatFrame rows): the splat
+// Test the splat renderer's parameters and its GPU frame (SPEC 8; core/math/Splat.h's SplatFrame): the splat
 // diameter splat_scale h, alpha, the tiles ceil(n / tile), and the world (not voxel) eye.
 TEST(HostParamsMarch, SplatFrameCarriesTheHostValues) {
     Scene sc = HpmScene();
@@ -298,41 +318,40 @@ TEST(HostParamsMarch, SplatFrameCarriesTheHostValues) {
     EXPECT_EQ(f.axes[0], 2u);
     EXPECT_EQ(f.axes[1], 0u);
     EXPECT_EQ(f.axes[2], 1u);
-    EXPECT_EQ(f.axes[3], 400u);
+    EXPECT_EQ(f.voxelCount, 400u);
     EXPECT_EQ(f.orderBase[0], 0u);
     EXPECT_EQ(f.orderBase[1], 5u);   // after z's 5
     EXPECT_EQ(f.orderBase[2], 15u);  // after x's 10
     // Tiles of 4: ceil(10 / 4) = 3 across (a partial tile), ceil(8 / 4) = 2 down (on the edge).
-    EXPECT_EQ(f.boxes[0], 4u);
-    EXPECT_EQ(f.boxes[1], 2u);
-    EXPECT_EQ(f.boxes[2], 3u);
-    EXPECT_EQ(f.boxes[3], 2u);
-    EXPECT_EQ(f.image[0], 31u);
-    EXPECT_EQ(f.image[1], 25u);
+    EXPECT_EQ(f.boxTile, 4u);
+    EXPECT_EQ(f.boxBand, 2u);
+    EXPECT_EQ(f.boxTilesX, 3u);
+    EXPECT_EQ(f.boxTilesY, 2u);
+    EXPECT_EQ(f.width, 31u);
+    EXPECT_EQ(f.height, 25u);
     EXPECT_EQ(f.eye[0], 0.0f);
     EXPECT_EQ(f.eye[1], 120.0f);
     EXPECT_EQ(f.eye[2], 50.0f);
-    EXPECT_EQ(f.eye[3], 10.0f);  // near
+    EXPECT_EQ(f.nearPlane, 10.0f);
     EXPECT_EQ(f.forward[2], -1.0f);
-    EXPECT_NEAR(f.forward[3], 12.5f, 1e-5f);  // focalPx
+    EXPECT_NEAR(f.focalPx, 12.5f, 1e-5f);
     EXPECT_EQ(f.right[0], 1.0f);
-    EXPECT_EQ(f.right[3], kMieCloudTable.indexPerRadian);
+    EXPECT_EQ(f.light.mieIndexPerRadian, kMieCloudTable.indexPerRadian);
     EXPECT_EQ(f.up[1], 1.0f);
-    EXPECT_EQ(f.up[3], float(kMieCloudTable.count));
+    EXPECT_EQ(f.light.mieCount, kMieCloudTable.count);
     EXPECT_NEAR(f.sun[2], -0.76604444f, 1e-6f);
-    EXPECT_EQ(f.sun[3], 0.375f);  // g
-    EXPECT_EQ(f.sunRadiance[0], 1.0f);
-    EXPECT_EQ(f.sunRadiance[1], 2.0f);
-    EXPECT_EQ(f.sunRadiance[2], 0.5f);
-    EXPECT_EQ(f.sunRadiance[3], float(PhaseKind::CornetteShanks));
-    EXPECT_EQ(f.ambient[3], 0.125f);     // q_min
-    EXPECT_EQ(f.background[3], 0.625f);  // opacity
+    EXPECT_EQ(f.light.phaseG, 0.375f);
+    EXPECT_EQ(f.light.sunRadiance, (std::array<float, 3>{1.0f, 2.0f, 0.5f}));
+    EXPECT_EQ(f.light.phaseKind, uint32_t(PhaseKind::CornetteShanks));
+    EXPECT_EQ(f.light.pointOn, 0u);
+    EXPECT_EQ(f.qMin, 0.125f);
+    EXPECT_EQ(f.opacity, 0.625f);
     EXPECT_EQ(f.origin[0], -100.0f);
     EXPECT_EQ(f.origin[1], 40.0f);
     EXPECT_EQ(f.origin[2], 0.0f);
-    EXPECT_EQ(f.origin[3], 20.0f);  // h
-    EXPECT_EQ(f.misc[0], 30.0f);    // splat diameter
-    EXPECT_EQ(f.misc[1], 1.0f);     // alpha
+    EXPECT_EQ(f.voxelSize, 20.0f);  // h
+    EXPECT_EQ(f.splatDiameter, 30.0f);
+    EXPECT_EQ(f.alpha, 1.0f);
 }
 
 // Test shade's sun and plan (SPEC 6): the step's sun, or with relighting the first step's at every step; the shaded

@@ -87,34 +87,53 @@ inline Vec3 GroundEyeVoxel(const CameraFrame& c, const std::array<float, 3>& ori
     return {(c.eye[0] - origin[0]) / voxelSize, (c.eye[1] - origin[1]) / voxelSize, (c.eye[2] - origin[2]) / voxelSize};
 }
 
-// The constants of GroundBackground on the GPU backends, as 16-byte rows that
-// std140 and std430 lay out alike; core/math/ground.glsl's GroundGpu twins it.
-struct GroundGpu {
-    std::array<float, 4> eye;          // xyz: the eye in voxel units; w: focalPx
-    std::array<float, 4> forward;      // xyz; w: near plane (metres)
-    std::array<float, 4> right;        // xyz; w: far plane (metres)
-    std::array<float, 4> up;           // xyz; w: voxel size h (metres)
-    std::array<float, 4> albedo;       // rgb; w: s_z
-    std::array<float, 4> sunRadiance;  // rgb; w: unused
-    std::array<float, 4> ambient;      // rgb; w: unused
-    std::array<float, 4> background;   // rgb: the flat background; w: unused
-    std::array<uint32_t, 4> grid;      // nx, ny of G; width, height of the image
+// The constants of GroundBackground on the GPU backends, one block that
+// std140 and std430 lay out alike (a scalar after a vec3 takes its fourth
+// lane); core/math/ground.glsl's GroundGpu twins it member for member.
+struct alignas(16) GroundGpu {
+    std::array<float, 3> eye;  // the eye in voxel units
+    float focalPx;
+    std::array<float, 3> forward;
+    float nearPlane;  // metres
+    std::array<float, 3> right;
+    float farPlane;  // metres
+    std::array<float, 3> up;
+    float voxelSize;              // h, metres
+    std::array<float, 3> albedo;  // rgb
+    float sunZ;                   // s_z
+    std::array<float, 3> sunRadiance;
+    float unused0;
+    std::array<float, 3> ambient;
+    float unused1;
+    std::array<float, 3> background;  // the flat background
+    float unused2;
+    uint32_t gridX;  // nx of G
+    uint32_t gridY;  // ny of G
+    uint32_t width;  // the image
+    uint32_t height;
 };
 static_assert(sizeof(GroundGpu) == 9 * 16, "GroundGpu is nine 16-byte rows");
 
 inline GroundGpu MakeGroundGpu(const CameraFrame& c, const std::array<float, 3>& origin, float voxelSize,
                                const GroundLight& light, uint32_t nx, uint32_t ny) {
-    const Vec3 eye = GroundEyeVoxel(c, origin, voxelSize);
     GroundGpu g{};
-    g.eye = {eye[0], eye[1], eye[2], c.focalPx};
-    g.forward = {c.forward[0], c.forward[1], c.forward[2], c.nearPlane};
-    g.right = {c.right[0], c.right[1], c.right[2], c.farPlane};
-    g.up = {c.upVector[0], c.upVector[1], c.upVector[2], voxelSize};
-    g.albedo = {light.albedo[0], light.albedo[1], light.albedo[2], light.sunZ};
-    g.sunRadiance = {light.sunRadiance[0], light.sunRadiance[1], light.sunRadiance[2], 0};
-    g.ambient = {light.ambient[0], light.ambient[1], light.ambient[2], 0};
-    g.background = {light.background[0], light.background[1], light.background[2], 0};
-    g.grid = {nx, ny, c.width, c.height};
+    g.eye = GroundEyeVoxel(c, origin, voxelSize);
+    g.focalPx = c.focalPx;
+    g.forward = c.forward;
+    g.nearPlane = c.nearPlane;
+    g.right = c.right;
+    g.farPlane = c.farPlane;
+    g.up = c.upVector;
+    g.voxelSize = voxelSize;
+    g.albedo = light.albedo;
+    g.sunZ = light.sunZ;
+    g.sunRadiance = light.sunRadiance;
+    g.ambient = light.ambient;
+    g.background = light.background;
+    g.gridX = nx;
+    g.gridY = ny;
+    g.width = c.width;
+    g.height = c.height;
     return g;
 }
 

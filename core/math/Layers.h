@@ -53,6 +53,16 @@ inline int64_t LayersPaddedSource(uint32_t i, uint32_t n, bool wrap) {
     return i == 0 ? int64_t(n) - 1 : 0;
 }
 
+// The setup's light terms (core/math/Light.h): the sun and the ambient light, no point light.
+inline LightTerms LayersLightTerms(const LayersSetup& s) {
+    LightTerms L;
+    L.sunRadiance = s.sunRadiance;
+    L.ambient = s.ambient;
+    L.phase = s.phase;
+    L.voxelSize = s.voxelSize;
+    return L;
+}
+
 // Layer i's plane: z_i = (i + 1/2) nz / N (voxel units, above the grid's base).
 inline float LayerHeight(const LayersSetup& s, uint32_t i) { return (float(i) + 0.5f) * s.spacing; }
 
@@ -179,8 +189,9 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     }
     f.alpha = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     const float gain = (qt[1] * s.lightScale) * sunPhase;
-    f.color = {s.sunRadiance[0] * gain + s.ambient[0], s.sunRadiance[1] * gain + s.ambient[1],
-               s.sunRadiance[2] * gain + s.ambient[2]};
+    // The sample at the crossing (voxel units, before the drift and the wrap).
+    const Vec3 at{s.eye[0] + hx, s.eye[1] + hy, z};
+    f.color = InScattered(LayersLightTerms(s), LightSample{gain, 1.0f, at, ray.dir});
     return f;
 }
 

@@ -19,6 +19,7 @@
 
 #include "core/math/Camera.h"
 #include "core/math/Grid.h"
+#include "core/math/Light.h"
 #include "core/math/Random.h"
 #include "core/math/Shading.h"
 
@@ -172,8 +173,19 @@ inline float ReinhardToneMap(float c, float exposure) {
     return std::isinf(x) ? 1.0f : x / (1.0f + x);
 }
 
-// The point light's radiance factor at distance^2 d2 (metres^2): 1 / max(d2, r0^2).
-inline float PointLightFalloff(float distance2, float minDistance2) { return 1.0f / std::max(distance2, minDistance2); }
+// The setup's light terms (core/math/Light.h), as MarchRay and MakeMarchGpu gather them.
+inline LightTerms MarchLightTerms(const MarchSetup& s) {
+    LightTerms L;
+    L.sunRadiance = s.sunRadiance;
+    L.ambient = s.ambient;
+    L.phase = s.phase;
+    L.voxelSize = s.voxelSize;
+    L.pointOn = s.point.on;
+    L.pointPosition = s.point.position;
+    L.pointRadiance = s.point.radiance;
+    L.pointMinDistance2 = s.point.minDistance2;
+    return L;
+}
 
 // ---- Brick skip structure (SPEC 10) ----------------------------------------------
 
@@ -264,6 +276,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
     MarchRayResult r;
     float L0 = 0, L1 = 0, L2 = 0, T = 1;
     if (!ray.Empty()) {
+        const LightTerms terms = MarchLightTerms(s);
         // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
         const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
         const float B = bricks ? float(bricks->brick) : 1.0f, invB = 1.0f / B;
@@ -336,26 +349,11 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                 const MarchLightSample l = light(p);
                 float sunGain = l.sun * sunPhase;
                 if (s.powder) sunGain *= PowderTerm(s.powderC, l.sun);
-                float in0 = s.sunRadiance[0] * sunGain + s.ambient[0];
-                float in1 = s.sunRadiance[1] * sunGain + s.ambient[1];
-                float in2 = s.sunRadiance[2] * sunGain + s.ambient[2];
-                if (s.point.on) {
-                    const Vec3 toLight{s.point.position[0] - p[0], s.point.position[1] - p[1],
-                                       s.point.position[2] - p[2]};
-                    const float d2v = MarchDot(toLight, toLight);
-                    const float d2 = d2v * s.voxelSize * s.voxelSize;
-                    // cos theta = u . d with u the unit vector from p toward the light: 1 when the
-                    // light shines straight at the eye through p, as s . d for the sun.
-                    const float cosL = d2v > 0.0f ? MarchDot(toLight, ray.dir) / std::sqrt(d2v) : 1.0f;
-                    const float g = l.point * PointLightFalloff(d2, s.point.minDistance2) * PhaseValue(s.phase, cosL);
-                    in0 += s.point.radiance[0] * g;
-                    in1 += s.point.radiance[1] * g;
-                    in2 += s.point.radiance[2] * g;
-                }
+                const Vec3 in = InScattered(terms, LightSample{sunGain, l.point, p, ray.dir});
                 const float w = T * (1.0f - tau);
-                L0 += w * in0;
-                L1 += w * in1;
-                L2 += w * in2;
+                L0 += w * in[0];
+                L1 += w * in[1];
+                L2 += w * in[2];
                 T *= tau;
                 if (T < s.epsilon || T == 0.0f) break;
             }

@@ -9,41 +9,19 @@
 #include <vector>
 
 #include "core/math/Noise.h"
+#include "core/math/noise_words.glsl"
 
 namespace cb::noise {
 
-// The header's word indices; noise.glsl's kNoise* constants must match.
+// The header's word indices, kGpu<Name>: core/math/noise_words.glsl's list, from which noise.glsl makes its
+// kNoise<Name> constants too; then the header's length.
 enum GpuWord : uint32_t {
-    kGpuNx = 0,
-    kGpuNy = 1,
-    kGpuNz = 2,
-    kGpuBasis = 3,
-    kGpuOctaves = 4,
-    kGpuGain = 5,
-    kGpuLacunarity = 6,
-    kGpuTurbulence = 7,
-    kGpuScale = 8,
-    kGpuPeriod = 11,
-    kGpuDetailOn = 14,
-    kGpuDetailSize = 15,
-    kGpuStrength = 16,
-    kGpuCoverageOn = 17,
-    kGpuCoverage = 18,
-    kGpuDensity = 19,
-    kGpuThreshold = 20,
-    kGpuMapOctaves = 21,
-    kGpuMapGain = 22,
-    kGpuMapPeriod = 23,
-    kGpuMapScale = 25,
-    kGpuTowerCount = 27,
-    kGpuSeed = 28,
-    kGpuBasePerm = 29,
-    kGpuMapPerm = 30,
-    kGpuHeights = 31,
-    kGpuTowers = 32,
-    kGpuDetail = 33,
+#define CB_NOISE_GPU_WORD(name, index) kGpu##name = index,
+    CB_NOISE_WORDS(CB_NOISE_GPU_WORD)
+#undef CB_NOISE_GPU_WORD
     kGpuHeaderWords = 64
 };
+static_assert(kGpuDetail < kGpuHeaderWords, "the header's words fit in the header");
 
 // Header (64 words), then: the base permutation (256 words, one entry each),
 // the weather map's permutation (256), HD per slice (nz floats, the CPU's own

@@ -5,33 +5,54 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
+#include "core/math/Light.h"
 #include "core/math/Shading.h"
 
 namespace cb {
 
-// The std430 block `SplatFrame` of core/math/splat.glsl, field for field.
-// Lanes marked (backend) are left 0 by MakeSplatFrame
-// (core/pipeline/SplatFrame.h) for a backend's own use.
+// The std430 block `SplatFrame` of core/math/splat.glsl, member for member (a
+// scalar after a 3-vector takes its fourth lane). Members marked (backend) are
+// left 0 by MakeSplatFrame (core/pipeline/SplatFrame.h) for a backend's own use.
 struct alignas(16) SplatFrame {
-    uint32_t grid[4];       // nx, ny, nz, (backend)
-    uint32_t axes[4];       // outer, middle, inner axis, voxel count
-    uint32_t orderBase[4];  // where each axis's order starts in the flat order (outer, middle, inner), 0
-    uint32_t boxes[4];      // tile, band, tiles across, tiles down (of the occupancy boxes)
-    uint32_t image[4];      // width, height, (backend), (backend)
-    float eye[4];           // xyz, near plane
-    float forward[4];       // xyz, focal length in pixels
-    float right[4];         // xyz, kMieCloudTable's index per radian (read with phase Mie)
-    float up[4];            // xyz, kMieCloudTable's count (likewise)
-    float sun[4];           // xyz toward the sun, phase g
-    float sunRadiance[4];   // rgb, phase kind
-    float ambient[4];       // rgb, q_min
-    float background[4];    // rgb, opacity
-    float origin[4];        // xyz, voxel size
-    float misc[4];          // splat diameter, alpha, (backend), (backend)
+    uint32_t grid[3];        // nx, ny, nz
+    uint32_t ranksPerChunk;  // (backend: Vulkan's ranks per chunk)
+    uint32_t axes[3];        // outer, middle, inner axis
+    uint32_t voxelCount;
+    uint32_t orderBase[3];  // where each axis's order starts in the flat order (outer, middle, inner)
+    uint32_t unused0;
+    uint32_t boxTile;    // the occupancy boxes: tile edge,
+    uint32_t boxBand;    // band depth,
+    uint32_t boxTilesX;  // tiles across,
+    uint32_t boxTilesY;  // tiles down
+    uint32_t width;      // the image
+    uint32_t height;
+    uint32_t tilesX;  // (backend: Vulkan's screen tiles across)
+    uint32_t tilesY;  // (backend: and down)
+    float eye[3];
+    float nearPlane;
+    float forward[3];
+    float focalPx;
+    float right[3];
+    float qMin;
+    float up[3];
+    float opacity;
+    float sun[3];     // toward the sun
+    float voxelSize;  // h
+    float background[3];
+    float splatDiameter;
+    float origin[3];
+    float alpha;         // the frame's time between the two steps
+    float maxPointSize;  // (backend: OpenGL's largest point size)
+    float unused1;
+    float unused2;
+    float unused3;
+    LightGpu light;  // the sun, the ambient light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(SplatFrame) == 240);
+static_assert(sizeof(SplatFrame) == 288);
+static_assert(offsetof(SplatFrame, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 // One splat, as the std430 struct `Splat` of core/math/splat.glsl (48 bytes).
 struct Splat {
@@ -53,32 +74,36 @@ inline float SplatQ(float qPrev, float qCur, float alpha) { return qPrev + alpha
 // far outside the image gets an empty range (x0 > x1 or y0 > y1), never a wrap.
 inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, float qa, float t, Splat& s) {
     s = Splat{0, 0, 0, 0, {0, 0, 0}, 0, 0, -1, 0, -1};
-    if (!(qa > F.ambient[3])) return false;
-    const float h = F.origin[3];
+    if (!(qa > F.qMin)) return false;
+    const float h = F.voxelSize;
     const float cx = F.origin[0] + (float(i) + 0.5f) * h, cy = F.origin[1] + (float(j) + 0.5f) * h,
                 cz = F.origin[2] + (float(k) + 0.5f) * h;
     const float dx = cx - F.eye[0], dy = cy - F.eye[1], dz = cz - F.eye[2];
     const float x = dx * F.right[0] + dy * F.right[1] + dz * F.right[2];
     const float y = dx * F.up[0] + dy * F.up[1] + dz * F.up[2];
     const float depth = dx * F.forward[0] + dy * F.forward[1] + dz * F.forward[2];
-    if (!(depth > F.eye[3])) return false;
-    const float focal = F.forward[3];
-    const float px = 0.5f * float(F.image[0]) + x * focal / depth;
-    const float py = 0.5f * float(F.image[1]) - y * focal / depth;
-    const float size = std::clamp(F.misc[0] * focal / depth, 1.0f, 255.0f);
+    if (!(depth > F.nearPlane)) return false;
+    const float focal = F.focalPx;
+    const float px = 0.5f * float(F.width) + x * focal / depth;
+    const float py = 0.5f * float(F.height) - y * focal / depth;
+    const float size = std::clamp(F.splatDiameter * focal / depth, 1.0f, 255.0f);
     if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(size)) return false;
     s.px = px;
     s.py = py;
     s.size = size;
     const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float cosTheta = (F.sun[0] * dx + F.sun[1] * dy + F.sun[2] * dz) / len;
-    const PhaseParams phase{PhaseKind(uint8_t(F.sunRadiance[3])), F.sun[3]};
-    const float light = t * PhaseValue(phase, cosTheta);
-    s.alphaScale = qa * F.background[3];
-    for (int c = 0; c < 3; ++c) s.colour[c] = F.sunRadiance[c] * light + F.ambient[c];
+    const LightTerms terms = LightTermsOf(F.light);
+    const float light = t * PhaseValue(terms.phase, cosTheta);
+    s.alphaScale = qa * F.opacity;
+    // The sample: the voxel centre in voxel units, seen along the unit direction from the eye.
+    const Vec3 at{float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f};
+    const Vec3 dir{dx / len, dy / len, dz / len};
+    const Vec3 colour = InScattered(terms, LightSample{light, 1.0f, at, dir});
+    for (int c = 0; c < 3; ++c) s.colour[c] = colour[c];
     // Covered pixels: px - s/2 <= x + 0.5 < px + s/2.
     // Clamped to [0, image] and [-1, image - 1] in float, so the ints cannot overflow.
-    const float half = 0.5f * s.size, imageW = float(F.image[0]), imageH = float(F.image[1]);
+    const float half = 0.5f * s.size, imageW = float(F.width), imageH = float(F.height);
     s.x0 = int32_t(std::min(std::max(0.0f, std::ceil(s.px - half - 0.5f)), imageW));
     s.x1 = int32_t(std::max(std::min(imageW - 1.0f, std::ceil(s.px + half - 0.5f) - 1.0f), -1.0f));
     s.y0 = int32_t(std::min(std::max(0.0f, std::ceil(s.py - half - 0.5f)), imageH));

@@ -8,17 +8,28 @@
 #ifndef CLOUDBENCH_GROUND_GLSL
 #define CLOUDBENCH_GROUND_GLSL
 
-// core/math/Ground.h GroundGpu, row for row.
+// core/math/Ground.h GroundGpu, member for member.
 struct GroundGpu {
-    vec4 eye;          // xyz voxel units; w focalPx
-    vec4 forward;      // w near (metres)
-    vec4 right;        // w far (metres)
-    vec4 up;           // w voxel size h (metres)
-    vec4 albedo;       // rgb; w s_z
-    vec4 sunRadiance;  // rgb
-    vec4 ambient;      // rgb
-    vec4 background;   // rgb: the flat background
-    uvec4 grid;        // nx, ny of G; width, height
+    vec3 eye;  // voxel units
+    float focalPx;
+    vec3 forward;
+    float nearPlane;  // metres
+    vec3 right;
+    float farPlane;  // metres
+    vec3 up;
+    float voxelSize;  // h, metres
+    vec3 albedo;
+    float sunZ;
+    vec3 sunRadiance;
+    float unused0;
+    vec3 ambient;
+    float unused1;
+    vec3 background;  // the flat background
+    float unused2;
+    uint gridX;  // nx of G
+    uint gridY;  // ny of G
+    uint width;
+    uint height;
 };
 
 float GroundFetchG(uint i, uint j);
@@ -55,23 +66,23 @@ float GroundChannel(float albedo, float sunRadiance, float sunZ, float ambient, 
 
 // core/math/Ground.h GroundBackground of pixel (x, y); the ray as march.glsl's MakePixelRay builds it.
 vec3 GroundBackground(GroundGpu g, uint x, uint y) {
-    const float focal = g.eye.w;
-    precise float u = (float(x) + 0.5 - 0.5 * float(g.grid.z)) / focal;
-    precise float v = (0.5 * float(g.grid.w) - (float(y) + 0.5)) / focal;
+    const float focal = g.focalPx;
+    precise float u = (float(x) + 0.5 - 0.5 * float(g.width)) / focal;
+    precise float v = (0.5 * float(g.height) - (float(y) + 0.5)) / focal;
     precise vec3 d;
     for (int i = 0; i < 3; ++i) d[i] = g.forward[i] + u * g.right[i] + v * g.up[i];
     precise float dd = d.x * d.x + d.y * d.y + d.z * d.z;
     precise float inv = 1.0 / sqrt(dd);
     precise vec3 dir = vec3(d.x * inv, d.y * inv, d.z * inv);
-    precise float perDepth = 1.0 / (g.up.w * inv);
-    precise float tNear = g.forward.w * perDepth;
-    precise float tFar = g.right.w * perDepth;
+    precise float perDepth = 1.0 / (g.voxelSize * inv);
+    precise float tNear = g.nearPlane * perDepth;
+    precise float tFar = g.farPlane * perDepth;
     vec2 p;
-    if (!GroundHit(g.eye.xyz, dir, tNear, tFar, p)) return g.background.rgb;
-    const float s = GroundShadowAt(p.x, p.y, g.grid.x, g.grid.y);
-    return vec3(GroundChannel(g.albedo.x, g.sunRadiance.x, g.albedo.w, g.ambient.x, s),
-                GroundChannel(g.albedo.y, g.sunRadiance.y, g.albedo.w, g.ambient.y, s),
-                GroundChannel(g.albedo.z, g.sunRadiance.z, g.albedo.w, g.ambient.z, s));
+    if (!GroundHit(g.eye, dir, tNear, tFar, p)) return g.background;
+    const float s = GroundShadowAt(p.x, p.y, g.gridX, g.gridY);
+    return vec3(GroundChannel(g.albedo.x, g.sunRadiance.x, g.sunZ, g.ambient.x, s),
+                GroundChannel(g.albedo.y, g.sunRadiance.y, g.sunZ, g.ambient.y, s),
+                GroundChannel(g.albedo.z, g.sunRadiance.z, g.sunZ, g.ambient.z, s));
 }
 
 #endif

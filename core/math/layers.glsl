@@ -3,7 +3,7 @@
 // the per-pixel loop. The same operations in the same order, `precise` where
 // the CPU (built with -ffp-contract=off) rounds each product.
 //
-// Include after random.glsl, shading.glsl, phase_table.glsl and march.glsl,
+// Include after random.glsl, shading.glsl, phase_table.glsl, light.glsl and march.glsl,
 // whose pixel ray, padded sampler (PaddedTapsAt, PaddedBlend), SegmentTransmittance
 // and phase it uses. The including shader defines march.glsl's MarchFetchQT as the
 // layers' padded (q_alpha, T) volume, (nx+2) x (ny+2) x (nz+2) with voxel
@@ -12,22 +12,36 @@
 #ifndef CLOUDBENCH_LAYERS_GLSL
 #define CLOUDBENCH_LAYERS_GLSL
 
-// core/pipeline/LayersGpu.h, row for row.
+// core/pipeline/LayersGpu.h, member for member.
 struct LayersGpu {
-    vec4 eye;          // xyz voxel units; w focalPx
-    vec4 forward;      // w near (metres)
-    vec4 right;        // w far (metres)
-    vec4 up;           // w voxel size h (metres)
-    vec4 size;         // xyz grid; w sigma h
-    vec4 invSize;      // xyz 1 / size; w spacing nz / N
-    vec4 sun;          // xyz toward the sun; w phase g
-    vec4 sunRadiance;  // rgb; w extent^2
-    vec4 ambient;      // rgb; w Mie index per radian
-    vec4 background;   // rgb; w l_max
-    uvec4 image;       // width, height, N, flags
-    uvec4 phase;       // kind, Mie count, px, px * py
-    vec4 drift;        // xy the wind's drift (voxel units); z coverage C, w density D_w (wang)
-    vec4 light;        // x T's factor (relighting); y fadeInv2; zw unused
+    vec3 eye;  // voxel units
+    float focalPx;
+    vec3 forward;
+    float nearPlane;  // metres
+    vec3 right;
+    float farPlane;  // metres
+    vec3 up;
+    float voxelSize;  // h, metres
+    vec3 size;        // the grid
+    float sigmaH;
+    vec3 invSize;  // 1 / size
+    float spacing;  // nz / N
+    vec3 sun;       // toward the sun
+    float outer2;   // extent^2
+    vec3 background;
+    float maxLength;  // l_max
+    uint width;
+    uint height;
+    uint count;  // N
+    uint flags;  // kLayers* bits
+    uint strideY;  // px
+    uint strideZ;  // px * py
+    float lightScale;  // T's factor (relighting)
+    float fadeInv2;
+    vec2 drift;  // the wind's drift (voxel units)
+    float coverage;  // C (wang)
+    float density;   // D_w (wang)
+    LightGpu light;  // light.glsl
 };
 
 const uint kLayersTiling = 1u;
@@ -36,7 +50,7 @@ const uint kLayersWang = 2u;
 float LayersMapValue(uint i);
 
 float LayerHeight(LayersGpu s, uint i) {
-    precise float z = (float(i) + 0.5) * s.invSize.w;
+    precise float z = (float(i) + 0.5) * s.spacing;
     return z;
 }
 
@@ -63,15 +77,15 @@ struct LayersRay {
 LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
     float inv;
     LayersRay r;
-    r.dir = PixelRayDirection(s.forward.xyz, s.right.xyz, s.up.xyz, s.eye.w, s.image.xy, x, y, inv);
-    precise float perDepth = 1.0 / (s.up.w * inv);
-    r.tNear = s.forward.w * perDepth;
-    r.tFar = s.right.w * perDepth;
+    r.dir = PixelRayDirection(s.forward, s.right, s.up, s.focalPx, uvec2(s.width, s.height), x, y, inv);
+    precise float perDepth = 1.0 / (s.voxelSize * inv);
+    r.tNear = s.nearPlane * perDepth;
+    r.tFar = s.farPlane * perDepth;
     return r;
 }
 
 // P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
-float LayersPhase(LayersGpu s, float cosTheta) { return PhaseOf(s.phase.x, s.sun.w, s.ambient.w, s.phase.y, cosTheta); }
+float LayersPhase(LayersGpu s, float cosTheta) { return LightPhase(s.light, cosTheta); }
 
 // core/math/Layers.h LayersMapAt.
 float LayersMapAt(LayersGpu s, float x, float y) {
@@ -80,7 +94,7 @@ float LayersMapAt(LayersGpu s, float x, float y) {
     const float fu = floor(u), fv = floor(v);
     precise float wu = u - fu, wv = v - fv;
     int i0 = int(fu), i1 = i0 + 1, j0 = int(fv), j1 = j0 + 1;
-    if ((s.image.w & kLayersTiling) != 0u) {
+    if ((s.flags & kLayersTiling) != 0u) {
         i0 = i0 < 0 ? i0 + nx : i0;
         i1 = i1 >= nx ? i1 - nx : i1;
         j0 = j0 < 0 ? j0 + ny : j0;
@@ -112,31 +126,31 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0)) return f;
     precise float hx = ray.dir.x * t, hy = ray.dir.y * t;
     precise float r2 = hx * hx + hy * hy;
-    if (!(r2 <= s.sunRadiance.w)) return f;
+    if (!(r2 <= s.outer2)) return f;
     precise float x = (s.eye.x + hx) - s.drift.x, y = (s.eye.y + hy) - s.drift.y;
-    if ((s.image.w & kLayersTiling) != 0u) {
+    if ((s.flags & kLayersTiling) != 0u) {
         x = LayersWrap(x, s.size.x, s.invSize.x);
         y = LayersWrap(y, s.size.y, s.invSize.y);
     } else if (!(x >= 0.0 && x <= s.size.x && y >= 0.0 && y <= s.size.y)) {
         return f;
     }
     f.crossed = true;
-    const vec2 qt = PaddedBlend(s.phase.z, s.phase.w, PaddedTapsAt(s.size.xyz, s.phase.z, s.phase.w, vec3(x, y, z)));
+    const vec2 qt = PaddedBlend(s.strideY, s.strideZ, PaddedTapsAt(s.size, s.strideY, s.strideZ, vec3(x, y, z)));
     if (!(qt.x > 0.0)) return f;
     f.drawn = true;
-    if ((s.image.w & kLayersWang) != 0u) {
-        f.alpha = CoverageModulate(qt.x, LayersMapAt(s, x, y), s.drift.z, s.drift.w);
+    if ((s.flags & kLayersWang) != 0u) {
+        f.alpha = CoverageModulate(qt.x, LayersMapAt(s, x, y), s.coverage, s.density);
     } else {
-        precise float length = min(s.invSize.w * abs(invDz), s.background.w);
-        precise float alpha = 1.0 - SegmentTransmittance(s.size.w, qt.x, length);
+        precise float length = min(s.spacing * abs(invDz), s.maxLength);
+        precise float alpha = 1.0 - SegmentTransmittance(s.sigmaH, qt.x, length);
         f.alpha = alpha;
     }
-    precise float faded = f.alpha * LayersFade(r2, s.sunRadiance.w, s.light.y);
+    precise float faded = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     f.alpha = faded;
-    precise float gain = (qt.y * s.light.x) * sunPhase;
-    precise vec3 c = vec3(s.sunRadiance.x * gain + s.ambient.x, s.sunRadiance.y * gain + s.ambient.y,
-                          s.sunRadiance.z * gain + s.ambient.z);
-    f.color = c;
+    precise float gain = (qt.y * s.lightScale) * sunPhase;
+    // The sample at the crossing (voxel units, before the drift and the wrap).
+    precise vec3 at = vec3(s.eye.x + hx, s.eye.y + hy, z);
+    f.color = InScattered(s.light, LightSample(gain, 1.0, at, ray.dir));
     return f;
 }
 
@@ -153,7 +167,7 @@ struct LayersWalk {
 
 LayersWalk LayersWalkOf(LayersGpu s, float dz) {
     LayersWalk w = LayersWalk(0, 0, 0u);
-    const uint n = s.image.z;
+    const uint n = s.count;
     if (dz > 0.0) {
         uint lowest = n;
         while (lowest > 0u && LayerHeight(s, lowest - 1u) > s.eye.z) --lowest;
@@ -173,9 +187,9 @@ struct LayersPixelResult {
 
 // core/math/Layers.h LayersPixel: the background, then the layers the ray crosses, back to front.
 LayersPixelResult LayersPixel(LayersGpu s, uint x, uint y) {
-    LayersPixelResult r = LayersPixelResult(s.background.xyz, 0u, 0u);
+    LayersPixelResult r = LayersPixelResult(s.background, 0u, 0u);
     const LayersRay ray = MakeLayersRay(s, x, y);
-    const float sunPhase = LayersPhase(s, MarchDot(s.sun.xyz, ray.dir));
+    const float sunPhase = LayersPhase(s, MarchDot(s.sun, ray.dir));
     const LayersWalk w = LayersWalkOf(s, ray.dir.z);
     for (uint n = 0u; n < w.count; ++n) {
         const uint i = uint(w.first + w.step * int(n));

@@ -4,7 +4,7 @@
 // step with the C++; the same operations in the same order, `precise` where
 // the CPU (built with -ffp-contract=off) rounds each product.
 //
-// Include after random.glsl, shading.glsl and phase_table.glsl. The including shader declares
+// Include after random.glsl, shading.glsl, phase_table.glsl and light.glsl. The including shader declares
 // the block that holds a MarchGpu (core/pipeline/MarchGpu.h) and DEFINES:
 //   vec2  MarchFetchQT(uint paddedIndex);  // (q_alpha, T) of the padded volume:
 //         (nx+2) x (ny+2) x (nz+2), voxel (i, j, k) at padded (i+1, j+1, k+1),
@@ -14,30 +14,42 @@
 #ifndef CLOUDBENCH_MARCH_GLSL
 #define CLOUDBENCH_MARCH_GLSL
 
-// core/pipeline/MarchGpu.h, row for row.
+// core/pipeline/MarchGpu.h, member for member.
 struct MarchGpu {
-    vec4 eye;            // xyz voxel units; w focalPx
-    vec4 forward;        // w near (metres)
-    vec4 right;          // w far (metres)
-    vec4 up;             // w voxel size h (metres)
-    vec4 size;           // xyz box; w sigma h
-    vec4 stepping;       // step, kappa, adaptive start, epsilon
-    vec4 sun;            // xyz toward the sun; w phase g
-    vec4 sunRadiance;    // rgb; w powder c
-    vec4 ambient;        // rgb; w Mie index per radian
-    vec4 background;     // rgb
-    vec4 pointPosition;  // xyz voxel units; w r0^2 (metres^2)
-    vec4 pointRadiance;  // rgb
-    uvec4 image;         // width, height, seed, frame
-    uvec4 flags;         // flag bits, phase kind, light steps n_l, brick edge B
-    uvec4 strides;       // px, px * py, Mie table count
-    uvec4 bricks;        // bricks along x, y, z
+    vec3 eye;  // voxel units
+    float focalPx;
+    vec3 forward;
+    float nearPlane;  // metres
+    vec3 right;
+    float farPlane;  // metres
+    vec3 up;
+    float voxelSize;  // h, metres
+    vec3 size;        // the box
+    float sigmaH;
+    float baseStep;
+    float kappa;
+    float adaptiveStart;
+    float epsilon;
+    vec3 sun;  // toward the sun
+    float powderC;
+    vec3 background;
+    uint flags;  // kMarch* bits
+    uint width;
+    uint height;
+    uint seed;
+    uint frame;
+    uint lightSteps;
+    uint brick;
+    uint strideY;  // px
+    uint strideZ;  // px * py
+    uvec3 bricks;  // bricks along x, y, z
+    uint unused;
+    LightGpu light;  // light.glsl
 };
 
 const uint kMarchAdaptive = 1u;
 const uint kMarchJitter = 2u;
 const uint kMarchPowder = 4u;
-const uint kMarchPointLight = 8u;
 const uint kMarchSkipping = 16u;
 const uint kMarchLightMarch = 32u;
 const uint kMarchGround = 64u;  // the background is the ground (core/math/ground.glsl), per pixel
@@ -113,12 +125,12 @@ vec3 PixelRayDirection(vec3 forward, vec3 right, vec3 up, float focal, uvec2 ima
 MarchRayGeometry MakePixelRay(MarchGpu m, uint x, uint y) {
     float inv;
     MarchRayGeometry r;
-    r.origin = m.eye.xyz;
-    r.dir = PixelRayDirection(m.forward.xyz, m.right.xyz, m.up.xyz, m.eye.w, m.image.xy, x, y, inv);
-    precise float perDepth = 1.0 / (m.up.w * inv);
-    r.tMin = m.forward.w * perDepth;
-    r.tMax = m.right.w * perDepth;
-    ClipRayToBox(r.origin, r.dir, m.size.xyz, r.tMin, r.tMax);
+    r.origin = m.eye;
+    r.dir = PixelRayDirection(m.forward, m.right, m.up, m.focalPx, uvec2(m.width, m.height), x, y, inv);
+    precise float perDepth = 1.0 / (m.voxelSize * inv);
+    r.tMin = m.nearPlane * perDepth;
+    r.tMax = m.farPlane * perDepth;
+    ClipRayToBox(r.origin, r.dir, m.size, r.tMin, r.tMax);
     return r;
 }
 
@@ -143,7 +155,7 @@ MarchTaps PaddedTapsAt(vec3 size, uint px, uint pxy, vec3 p) {
     return t;
 }
 
-MarchTaps MarchTapsAt(MarchGpu m, vec3 p) { return PaddedTapsAt(m.size.xyz, m.strides.x, m.strides.y, p); }
+MarchTaps MarchTapsAt(MarchGpu m, vec3 p) { return PaddedTapsAt(m.size, m.strideY, m.strideZ, p); }
 
 // Lerp per component, unfused (core/math/Shading.h Lerp).
 vec2 MarchLerp2(vec2 a, vec2 b, float t) { return vec2(Lerp(a.x, b.x, t), Lerp(a.y, b.y, t)); }
@@ -158,7 +170,7 @@ vec2 PaddedBlend(uint px, uint pxy, MarchTaps t) {
     return MarchLerp2(MarchLerp2(c00, c10, t.w.y), MarchLerp2(c01, c11, t.w.y), t.w.z);
 }
 
-vec2 MarchBlend(MarchGpu m, MarchTaps t) { return PaddedBlend(m.strides.x, m.strides.y, t); }
+vec2 MarchBlend(MarchGpu m, MarchTaps t) { return PaddedBlend(m.strideY, m.strideZ, t); }
 
 float MarchSampleQ(MarchGpu m, vec3 p) { return MarchBlend(m, MarchTapsAt(m, p)).x; }
 
@@ -170,8 +182,8 @@ float SegmentTransmittance(float sigmaH, float q, float len) {
 }
 
 float MarchStepAt(MarchGpu m, float t) {
-    precise float adaptive = m.stepping.x + m.stepping.y * max(0.0, t - m.stepping.z);
-    return (m.flags.x & kMarchAdaptive) != 0u ? adaptive : m.stepping.x;
+    precise float adaptive = m.baseStep + m.kappa * max(0.0, t - m.adaptiveStart);
+    return (m.flags & kMarchAdaptive) != 0u ? adaptive : m.baseStep;
 }
 
 float MarchJitter(uint seed, uint frame, uint pixel) {
@@ -180,10 +192,8 @@ float MarchJitter(uint seed, uint frame, uint pixel) {
 
 float PowderTerm(float c, float lightT) { return 1.0 - pow(max(lightT, 0.0), c); }
 
-float PointLightFalloff(float distance2, float minDistance2) { return 1.0 / max(distance2, minDistance2); }
-
 // P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
-float MarchPhase(MarchGpu m, float cosTheta) { return PhaseOf(m.flags.y, m.sun.w, m.ambient.w, m.strides.z, cosTheta); }
+float MarchPhase(MarchGpu m, float cosTheta) { return LightPhase(m.light, cosTheta); }
 
 // 1/d per component; FLT_MAX where d is (nearly) zero.
 vec3 InverseDirection(vec3 d) {
@@ -210,25 +220,26 @@ float MarchTransmittance(MarchGpu m, vec3 p, vec3 u, float len, uint n) {
         precise float t = (float(j) + 0.5) * dl;
         depth += MarchSampleQ(m, MarchAlong(p, u, t));
     }
-    precise float x = -(m.size.w * depth) * dl;
+    precise float x = -(m.sigmaH * depth) * dl;
     return ExpNonPositive(x);
 }
 
 float SunLightMarch(MarchGpu m, vec3 p) {
     float t0 = 0.0, t1 = kMarchFloatMax;
-    ClipRayToBox(p, m.sun.xyz, m.size.xyz, t0, t1);
-    return t1 > t0 ? MarchTransmittance(m, p, m.sun.xyz, t1, m.flags.z) : 1.0;
+    ClipRayToBox(p, m.sun, m.size, t0, t1);
+    return t1 > t0 ? MarchTransmittance(m, p, m.sun, t1, m.lightSteps) : 1.0;
 }
 
 float PointLightMarch(MarchGpu m, vec3 p) {
-    precise vec3 toLight = vec3(m.pointPosition.x - p.x, m.pointPosition.y - p.y, m.pointPosition.z - p.z);
+    precise vec3 toLight =
+        vec3(m.light.pointPosition.x - p.x, m.light.pointPosition.y - p.y, m.light.pointPosition.z - p.z);
     const float dist = sqrt(MarchDot(toLight, toLight));
     if (!(dist > 0.0)) return 1.0;
     precise float inv = 1.0 / dist;
     const vec3 u = vec3(toLight.x * inv, toLight.y * inv, toLight.z * inv);
     float t0 = 0.0, t1 = dist;
-    ClipRayToBox(p, u, m.size.xyz, t0, t1);
-    return t1 > t0 ? MarchTransmittance(m, p, u, t1, m.flags.z) : 1.0;
+    ClipRayToBox(p, u, m.size, t0, t1);
+    return t1 > t0 ? MarchTransmittance(m, p, u, t1, m.lightSteps) : 1.0;
 }
 
 bool MarchBrickInside(MarchGpu m, ivec3 b) {
@@ -258,14 +269,14 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
     r.lightCalls = 0u;
     r.bricksSkipped = 0u;
     precise float L0 = 0.0, L1 = 0.0, L2 = 0.0, T = 1.0;
-    const bool adaptive = (m.flags.x & kMarchAdaptive) != 0u;
-    const bool skipping = (m.flags.x & kMarchSkipping) != 0u;
-    const bool lightMarch = (m.flags.x & kMarchLightMarch) != 0u;
-    const bool pointOn = (m.flags.x & kMarchPointLight) != 0u;
-    const bool powder = (m.flags.x & kMarchPowder) != 0u;
+    const bool adaptive = (m.flags & kMarchAdaptive) != 0u;
+    const bool skipping = (m.flags & kMarchSkipping) != 0u;
+    const bool lightMarch = (m.flags & kMarchLightMarch) != 0u;
+    const bool pointOn = m.light.pointOn != 0u;
+    const bool powder = (m.flags & kMarchPowder) != 0u;
     if (ray.tMin < ray.tMax) {
-        const float sunPhase = MarchPhase(m, MarchDot(m.sun.xyz, ray.dir));
-        const float B = skipping ? float(m.flags.w) : 1.0;
+        const float sunPhase = MarchPhase(m, MarchDot(m.sun, ray.dir));
+        const float B = skipping ? float(m.brick) : 1.0;
         precise float invB = 1.0 / B;
         const vec3 invDir = InverseDirection(ray.dir);
         float tn = ray.tMin;
@@ -318,31 +329,18 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
             const float qa = qt.x;
             if (qa > 0.0) {
                 ++r.lightCalls;
-                const float tau = SegmentTransmittance(m.size.w, qa, len);
+                const float tau = SegmentTransmittance(m.sigmaH, qa, len);
                 const float lightSun = lightMarch ? SunLightMarch(m, p) : qt.y;
                 precise float sunGain = lightSun * sunPhase;
-                if (powder) sunGain *= PowderTerm(m.sunRadiance.w, lightSun);
-                precise float in0 = m.sunRadiance.x * sunGain + m.ambient.x;
-                precise float in1 = m.sunRadiance.y * sunGain + m.ambient.y;
-                precise float in2 = m.sunRadiance.z * sunGain + m.ambient.z;
-                if (pointOn) {
-                    const float lightPoint = PointLightMarch(m, p);
-                    precise vec3 toLight =
-                        vec3(m.pointPosition.x - p.x, m.pointPosition.y - p.y, m.pointPosition.z - p.z);
-                    const float d2v = MarchDot(toLight, toLight);
-                    precise float d2 = d2v * m.up.w * m.up.w;
-                    precise float cosL = d2v > 0.0 ? MarchDot(toLight, ray.dir) / sqrt(d2v) : 1.0;
-                    precise float g = lightPoint * PointLightFalloff(d2, m.pointPosition.w) * MarchPhase(m, cosL);
-                    in0 += m.pointRadiance.x * g;
-                    in1 += m.pointRadiance.y * g;
-                    in2 += m.pointRadiance.z * g;
-                }
+                if (powder) sunGain *= PowderTerm(m.powderC, lightSun);
+                const float lightPoint = pointOn ? PointLightMarch(m, p) : 1.0;
+                const vec3 inLight = InScattered(m.light, LightSample(sunGain, lightPoint, p, ray.dir));
                 precise float w = T * (1.0 - tau);
-                L0 += w * in0;
-                L1 += w * in1;
-                L2 += w * in2;
+                L0 += w * inLight.x;
+                L1 += w * inLight.y;
+                L2 += w * inLight.z;
                 T *= tau;
-                if (T < m.stepping.w || T == 0.0) break;
+                if (T < m.epsilon || T == 0.0) break;
             }
             ++n;
             tn = tNext;
@@ -358,7 +356,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
 // The whole pixel: its ray, its jitter and the march.
 MarchRayResult MarchPixel(MarchGpu m, uint x, uint y) {
     const MarchRayGeometry ray = MakePixelRay(m, x, y);
-    const float xi = (m.flags.x & kMarchJitter) != 0u ? MarchJitter(m.image.z, m.image.w, x + m.image.x * y) : 0.5;
+    const float xi = (m.flags & kMarchJitter) != 0u ? MarchJitter(m.seed, m.frame, x + m.width * y) : 0.5;
     return MarchRay(m, ray, xi);
 }
 

@@ -1,6 +1,7 @@
 // GLSL twin of core/math/Noise.h (SPEC 10a): Perlin, simplex and Worley noise, fBm,
 // and the forming of q (height distribution, towers, detail erosion, threshold
-// or coverage). Needs random.glsl and shading.glsl (CoverageModulate). Line by line the same operations as the C++
+// or coverage). Needs random.glsl, shading.glsl (CoverageModulate) and noise_words.glsl
+// (the header's words). Line by line the same operations as the C++
 // (built with -ffp-contract=off), written `precise` so nothing is fused.
 //
 // The shader that includes this defines NoiseWord(index): word `index` of the
@@ -229,12 +230,10 @@ float NoiseTower(vec3 c, vec3 is, float amplitude, float x, float y, float z, fl
 }
 
 // ---- The stage: q at voxel (i, j, k), NoiseForm::Q's operations (core/math/NoiseGpu.h lays out the words). ----
-const uint kNoiseNx = 0u, kNoiseNy = 1u, kNoiseNz = 2u, kNoiseBasisWord = 3u, kNoiseOctaves = 4u, kNoiseGain = 5u,
-           kNoiseLacunarity = 6u, kNoiseTurbulence = 7u, kNoiseScale = 8u, kNoisePeriod = 11u, kNoiseDetailOn = 14u,
-           kNoiseDetailSize = 15u, kNoiseStrength = 16u, kNoiseCoverageOn = 17u, kNoiseCoverage = 18u,
-           kNoiseDensity = 19u, kNoiseThresholdWord = 20u, kNoiseMapOctaves = 21u, kNoiseMapGain = 22u,
-           kNoiseMapPeriod = 23u, kNoiseMapScale = 25u, kNoiseTowerCount = 27u, kNoiseSeed = 28u,
-           kNoiseBasePerm = 29u, kNoiseMapPerm = 30u, kNoiseHeights = 31u, kNoiseTowers = 32u, kNoiseDetail = 33u;
+// The header's words kNoise<Name> (noise_words.glsl, included before this file; the C++ reads the same list).
+#define CB_NOISE_WORD_CONST(name, index) const uint kNoise##name = index;
+CB_NOISE_WORDS(CB_NOISE_WORD_CONST)
+#undef CB_NOISE_WORD_CONST
 
 // offsets: base[3], detail[3], map[2] of the step (core/math/Noise.h StepOffsets).
 float NoiseDetailAt(float offsets[8], uint i, uint j, uint k) {
@@ -288,7 +287,7 @@ float NoiseQ(float offsets[8], uint i, uint j, uint k) {
     precise float px = (float(i) + 0.5) * NoiseFloat(kNoiseScale) + offsets[0];
     precise float py = (float(j) + 0.5) * NoiseFloat(kNoiseScale + 1u) + offsets[1];
     precise float pz = (float(k) + 0.5) * NoiseFloat(kNoiseScale + 2u) + offsets[2];
-    const uint basis = NoiseWord(kNoiseBasisWord), octaves = NoiseWord(kNoiseOctaves);
+    const uint basis = NoiseWord(kNoiseBasis), octaves = NoiseWord(kNoiseOctaves);
     const float gain = NoiseFloat(kNoiseGain);
     const bool turbulence = NoiseWord(kNoiseTurbulence) != 0u;
     const ivec3 period = ivec3(int(NoiseWord(kNoisePeriod)), int(NoiseWord(kNoisePeriod + 1u)), int(NoiseWord(kNoisePeriod + 2u)));
@@ -299,7 +298,7 @@ float NoiseQ(float offsets[8], uint i, uint j, uint k) {
     if (NoiseWord(kNoiseDetailOn) != 0u) v = NoiseErode(v, NoiseDetailAt(offsets, i, j, k), NoiseFloat(kNoiseStrength));
     if (NoiseWord(kNoiseCoverageOn) != 0u)
         return CoverageModulate(v, NoiseMapAt(offsets, i, j), NoiseFloat(kNoiseCoverage), NoiseFloat(kNoiseDensity));
-    return NoiseThreshold(v, NoiseFloat(kNoiseThresholdWord));
+    return NoiseThreshold(v, NoiseFloat(kNoiseThreshold));
 }
 
 #endif

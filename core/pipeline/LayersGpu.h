@@ -1,40 +1,58 @@
 // The constants of stage `render_layers` on the GPU backends, as one block of
-// 16-byte rows that std140 (GL uniform block) and std430 (Vulkan storage
+// named members that std140 (GL uniform block) and std430 (Vulkan storage
 // buffer) lay out the same way. core/math/layers.glsl declares the twin struct
-// `LayersGpu`; the field order and the flag bits below must match. The floats
+// `LayersGpu`; the member order and the flag bits below must match. The floats
 // are the CPU's (MakeLayersParams), so every backend starts from the same ones.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
+#include "core/math/Light.h"
 #include "core/pipeline/Backend.h"
 
 namespace cb {
 
-// LayersGpu.image.w bits.
+// LayersGpu.flags bits.
 enum LayersGpuFlag : uint32_t {
     kLayersGpuTiling = 1u << 0,  // the volume repeats in x and y
     kLayersGpuWang = 1u << 1,    // wang opacity (eq. 16 with the modulation map)
 };
 
-struct LayersGpu {
-    std::array<float, 4> eye;          // xyz: the eye in voxel units; w: focalPx
-    std::array<float, 4> forward;      // xyz; w: near plane (metres)
-    std::array<float, 4> right;        // xyz; w: far plane (metres)
-    std::array<float, 4> up;           // xyz; w: h, the voxel size (metres)
-    std::array<float, 4> size;         // xyz: (nx, ny, nz); w: sigma h
-    std::array<float, 4> invSize;      // xyz: 1 / size; w: the spacing nz / N
-    std::array<float, 4> sun;          // xyz: unit, toward the sun; w: the phase's g
-    std::array<float, 4> sunRadiance;  // rgb; w: extent^2 (voxel edges^2)
-    std::array<float, 4> ambient;      // rgb; w: the Mie table's index per radian
-    std::array<float, 4> background;   // rgb; w: l_max (voxel edges)
-    std::array<uint32_t, 4> image;     // width, height, N, LayersGpuFlag bits
-    std::array<uint32_t, 4> phase;     // PhaseKind, the Mie table's count, padded strides px, px * py
-    std::array<float, 4> drift;        // xy: the wind's drift (voxel units); z: coverage C; w: density D_w
-    std::array<float, 4> light;        // x: T's factor (LayersSetup::lightScale); y: fadeInv2; zw: unused
+// Member for member layers.glsl's LayersGpu (a scalar after a vec3 takes its fourth lane in std140 and std430).
+struct alignas(16) LayersGpu {
+    std::array<float, 3> eye;  // the eye in voxel units
+    float focalPx;
+    std::array<float, 3> forward;
+    float nearPlane;  // metres
+    std::array<float, 3> right;
+    float farPlane;  // metres
+    std::array<float, 3> up;
+    float voxelSize;            // h, metres
+    std::array<float, 3> size;  // (nx, ny, nz)
+    float sigmaH;
+    std::array<float, 3> invSize;     // 1 / size
+    float spacing;                    // nz / N
+    std::array<float, 3> sun;         // unit, toward the sun
+    float outer2;                     // extent^2 (voxel edges^2)
+    std::array<float, 3> background;  // rgb
+    float maxLength;                  // l_max (voxel edges)
+    uint32_t width;
+    uint32_t height;
+    uint32_t count;    // N layers
+    uint32_t flags;    // LayersGpuFlag bits
+    uint32_t strideY;  // padded strides: px = nx + 2
+    uint32_t strideZ;  // px * (ny + 2)
+    float lightScale;  // T's factor (LayersSetup::lightScale)
+    float fadeInv2;
+    std::array<float, 2> drift;  // the wind's drift (voxel units)
+    float coverage;              // C (wang)
+    float density;               // D_w (wang)
+    LightGpu light;              // the sun, the ambient light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(LayersGpu) == 14 * 16, "LayersGpu is fourteen 16-byte rows");
+static_assert(sizeof(LayersGpu) == 16 * 16, "LayersGpu is sixteen 16-byte rows");
+static_assert(offsetof(LayersGpu, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 LayersGpu MakeLayersGpu(const LayersParams& params);
 

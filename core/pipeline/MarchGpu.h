@@ -1,7 +1,8 @@
 // The constants of stage `render_march` on the GPU backends, as one block of
-// 16-byte rows that both std140 (GL uniform block) and std430 (Vulkan storage
+// named members that both std140 (GL uniform block) and std430 (Vulkan storage
 // or uniform buffer) lay out the same way. core/math/march.glsl declares the
-// twin struct `MarchGpu`; the field order and the flag bits below must match.
+// twin struct `MarchGpu`; the member order and the flag bits below must match
+// (tests/GpuBlockLayoutTest.cpp checks every member against glslang's layout).
 //
 // Everything the CPU computes once per call (the eye in voxel units, sigma h,
 // the point light in voxel units) is computed here by the same code
@@ -10,42 +11,58 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
+#include "core/math/Light.h"
 #include "core/pipeline/Backend.h"
 
 namespace cb {
 
-// MarchGpu.flags.x bits.
+// MarchGpu.flags bits (the point light's switch is light.pointOn).
 enum MarchGpuFlag : uint32_t {
     kMarchGpuAdaptive = 1u << 0,
     kMarchGpuJitter = 1u << 1,
     kMarchGpuPowder = 1u << 2,
-    kMarchGpuPointLight = 1u << 3,
     kMarchGpuSkipping = 1u << 4,
     kMarchGpuLightMarch = 1u << 5,  // the sun's light from a light march; else shade's T
     kMarchGpuGround = 1u << 6,      // the ground plane (core/math/Ground.h) is the background, per pixel
 };
 
-struct MarchGpu {
-    std::array<float, 4> eye;            // xyz: the eye in voxel units ((eye - origin) / h); w: focalPx
-    std::array<float, 4> forward;        // xyz; w: near plane (metres)
-    std::array<float, 4> right;          // xyz; w: far plane (metres)
-    std::array<float, 4> up;             // xyz; w: h, the voxel size (metres)
-    std::array<float, 4> size;           // xyz: the box (nx, ny, nz); w: sigma h
-    std::array<float, 4> stepping;       // step Delta_0, kappa, adaptive start t_a, epsilon
-    std::array<float, 4> sun;            // xyz: unit, toward the sun; w: the phase's g
-    std::array<float, 4> sunRadiance;    // rgb; w: the powder's c
-    std::array<float, 4> ambient;        // rgb; w: the Mie table's index per radian
-    std::array<float, 4> background;     // rgb; w: unused
-    std::array<float, 4> pointPosition;  // xyz: voxel units; w: r0^2 (metres^2)
-    std::array<float, 4> pointRadiance;  // rgb: colour * intensity; w: unused
-    std::array<uint32_t, 4> image;       // width, height, seed, frame
-    std::array<uint32_t, 4> flags;       // MarchGpuFlag bits, PhaseKind, light steps n_l, brick edge B
-    std::array<uint32_t, 4> strides;     // padded strides px = nx + 2, px * (ny + 2); Mie table count; unused
-    std::array<uint32_t, 4> bricks;      // bricks along x, y, z (ceil(n / B)); unused
+// Member for member march.glsl's MarchGpu (a scalar after a vec3 takes its fourth lane in std140 and std430).
+struct alignas(16) MarchGpu {
+    std::array<float, 3> eye;  // the eye in voxel units ((eye - origin) / h)
+    float focalPx;
+    std::array<float, 3> forward;
+    float nearPlane;  // metres
+    std::array<float, 3> right;
+    float farPlane;  // metres
+    std::array<float, 3> up;
+    float voxelSize;            // h, metres
+    std::array<float, 3> size;  // the box (nx, ny, nz)
+    float sigmaH;
+    float baseStep;  // Delta_0
+    float kappa;
+    float adaptiveStart;  // t_a
+    float epsilon;
+    std::array<float, 3> sun;  // unit, toward the sun
+    float powderC;
+    std::array<float, 3> background;  // rgb
+    uint32_t flags;                   // MarchGpuFlag bits
+    uint32_t width;
+    uint32_t height;
+    uint32_t seed;
+    uint32_t frame;
+    uint32_t lightSteps;             // n_l
+    uint32_t brick;                  // the brick edge B
+    uint32_t strideY;                // padded strides: px = nx + 2
+    uint32_t strideZ;                // px * (ny + 2)
+    std::array<uint32_t, 3> bricks;  // bricks along x, y, z (ceil(n / B))
+    uint32_t unused;
+    LightGpu light;  // the sun, the ambient light, the point light and the phase (core/math/Light.h)
 };
 static_assert(sizeof(MarchGpu) == 16 * 16, "MarchGpu is sixteen 16-byte rows");
+static_assert(offsetof(MarchGpu, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 // The block for one call on a grid of extent e. The Mie table's values are
 // bound separately (kMieCloudTable, read by the index of march.glsl).

@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/pipeline/Backend.h"
 #include "core/scene/Scene.h"
 #include "core/scene/Stage.h"
@@ -149,6 +151,11 @@ struct RendererDescriptor {
     // Its call for one image on `backend`, for the accuracy measurement.
     Result<AccuracyRender> (*accuracyRender)(Backend& backend, const Scene& scene,
                                              const AccuracyRenderInputs& in) = nullptr;
+    // The exact reference render (SPEC 11, reference/) is a ray march with this renderer's parameters; nullptr for
+    // every renderer but the one whose parameters it takes.
+    MarchParams (*referenceParams)(const Scene& scene, const CameraSettings& camera, uint32_t step) = nullptr;
+    // Its settings as conform.json's coverage records them for this scene; nullptr: none.
+    nlohmann::json (*conformOptions)(const Scene& scene) = nullptr;
     // The settings the accuracy measurement tries besides the scene's own, each a list of overrides.
     std::vector<std::vector<SceneOverride>> (*accuracyVariants)(const Scene& scene) = nullptr;
 };

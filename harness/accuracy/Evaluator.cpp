@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <stdexcept>
 
 #include "core/scene/SceneNames.h"
-#include "core/stages/render_march/RenderMarch.h"
 
 namespace cb {
 using nlohmann::json;
@@ -34,6 +34,12 @@ bool ReferenceRenderIgnores(std::string_view p) {
     return false;
 }
 
+Stage ReferenceRenderer() {
+    for (Stage stage : kAllStages)
+        if (const RendererDescriptor* r = Describe(stage).renderer; r && r->referenceParams) return stage;
+    throw std::logic_error("no renderer gives the reference render's parameters");
+}
+
 std::string Fmt(const char* format, double value) {
     char buffer[64];
     std::snprintf(buffer, sizeof buffer, format, value);
@@ -43,7 +49,7 @@ std::string Fmt(const char* format, double value) {
 Result<ImageReference> ComputeImageReference(const Scene& scene, const LightingInputs& in, float stepVoxels,
                                              int threads) {
     if (scene.render.cameras.empty()) return MakeError(scene.path + ": render: the reference render needs a camera");
-    const MarchParams p = MakeMarchParams(scene, scene.render.cameras[0], in.step);
+    const MarchParams p = Describe(ReferenceRenderer()).renderer->referenceParams(scene, scene.render.cameras[0], in.step);
     ref::MarchReferenceOptions options;
     options.stepVoxels = stepVoxels;
     options.threads = threads;

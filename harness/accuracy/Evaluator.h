@@ -120,6 +120,8 @@ class ImageReferences {
 // render computes (the reference fixes its own step, light, epsilon, jitter and skipping, and reads no
 // shade (but shade.sigma), shadow, density or layers setting): the reference is cached across it.
 bool ReferenceRenderIgnores(std::string_view path);
+// The renderer whose parameters the exact reference render takes (RendererDescriptor::referenceParams).
+Stage ReferenceRenderer();
 
 // Whether a setting changes the physical model (the phase function): its
 // rows are measured against the reference with the Mie phase.

@@ -47,7 +47,7 @@ bool StageOutputReads(Stage stage, std::string_view path) {
 
 bool RowDependsOn(Stage stage, std::string_view path) {
     if (StageOutputReads(stage, path)) return true;
-    return Describe(stage).renderer && StageOutputReads(Stage::RenderMarch, path) && !ReferenceRenderIgnores(path);
+    return Describe(stage).renderer && StageOutputReads(ReferenceRenderer(), path) && !ReferenceRenderIgnores(path);
 }
 
 std::vector<SceneOverride> SettingsRead(Stage stage, std::span<const SceneOverride> setting) {

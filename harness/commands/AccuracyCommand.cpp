@@ -251,10 +251,12 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
     const Scene& scene = (*session)->GetScene();
     const bool images = RunsARenderer(scene.stages);
     if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow) && !images) {
-        std::fprintf(stderr,
-                     "%s: stages: accuracy needs \"shade\", \"shadow\" or a renderer (\"render_splat\", "
-                     "\"render_march\", \"render_layers\")\n",
-                     scene.path.c_str());
+        std::string renderers;
+        for (Stage stage : kAllStages)
+            if (Describe(stage).renderer)
+                renderers += (renderers.empty() ? "\"" : ", \"") + std::string(StageName(stage)) + "\"";
+        std::fprintf(stderr, "%s: stages: accuracy needs \"shade\", \"shadow\" or a renderer (%s)\n",
+                     scene.path.c_str(), renderers.c_str());
         return kExitBadScene;
     }
     if (!(*session)->MakeOutDir()) return kExitFailed;

@@ -85,13 +85,9 @@ nlohmann::json ConformStageOptions(const Scene& scene, const std::string& stage)
                     {"scattering", scene.shade.scattering},
                     {"phase", scene.shade.scattering ? PhaseKindName(scene.phase.kind) : "none"}};
         if (stage == "shadow") return {{"form", ShadowFormName(scene.shadow.form)}};
-        if (stage == "render_splat")
-            return {{"phase", PhaseKindName(scene.phase.kind)},
-                    {"culling", scene.splat.culling},
-                    {"skipping", scene.splat.skipping},
-                    {"storage", StorageFormatName(scene.shade.storage)},
-                    {"cameras", scene.render.cameras.size()},
-                    {"frames_per_step", std::max(scene.render.framesPerStep, 1u)}};
+        if (const std::optional<Stage> parsed = ParseStage(stage))
+            if (const RendererDescriptor* renderer = Describe(*parsed).renderer; renderer && renderer->conformOptions)
+                return renderer->conformOptions(scene);
         return nlohmann::json::object();
     }
 }

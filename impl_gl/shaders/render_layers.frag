@@ -25,7 +25,7 @@ void LayersCount(uint n) {
 void main() {
     const uint x = uint(gl_FragCoord.x), y = uint(gl_FragCoord.y);
     const LayersRay ray = MakeLayersRay(layers, x, y);
-    const float sunPhase = LayersPhase(layers, MarchDot(layers.sun.xyz, ray.dir));
+    const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, ray.dir));
     const LayerFragmentResult f = LayerFragment(layers, ray, sunPhase, layerIndex);
     if (f.crossed) LayersCount(0u);
     if (!f.drawn) discard;

@@ -26,7 +26,7 @@ void main() {
     const vec2 ndc = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
     // Window row y is the image's row y from the top (render_march.frag), so the corner's pixel coordinates are
     // ((ndc + 1) / 2) (W, H), and its ray (MakeLayersRay, unnormalised) forward + u right + v up.
-    const float W = float(layers.image.x), H = float(layers.image.y), focal = layers.eye.w;
+    const float W = float(layers.width), H = float(layers.height), focal = layers.focalPx;
     const float u = ((ndc.x + 1.0) * 0.5 * W - 0.5 * W) / focal;
     const float v = (0.5 * H - (ndc.y + 1.0) * 0.5 * H) / focal;
     const float dz = layers.forward.z + u * layers.right.z + v * layers.up.z;

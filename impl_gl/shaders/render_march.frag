@@ -29,17 +29,18 @@ void MarchCount(uint n, uint v) {
 
 void main() {
     const uint x = uint(gl_FragCoord.x), y = uint(gl_FragCoord.y);
-    // The option bits and the phase kind are compile-time constants where the
+    // The option bits, the phase kind and the point light are compile-time constants where the
     // host defines them (impl_gl/RenderMarchGL.cpp links a program per
     // combination): the compiler then drops the code of the options that are
     // off, which halves the time on llvmpipe.
     MarchGpu m = march;
 #ifdef MARCH_FLAGS
-    m.flags.x = MARCH_FLAGS;
-    m.flags.y = MARCH_PHASE;
+    m.flags = MARCH_FLAGS;
+    m.light.phaseKind = MARCH_PHASE;
+    m.light.pointOn = MARCH_POINT;
 #endif
     const MarchRayResult r = MarchPixel(m, x, y);
-    if ((m.flags.x & kMarchGround) != 0u) {
+    if ((m.flags & kMarchGround) != 0u) {
         // C = L + T_view background with the pixel's own background (impl_cpu/RenderMarchCpu.cpp).
         const vec3 bg = GroundBackground(ground, x, y);
         precise vec3 c = vec3(r.light.x + r.transmittance * bg.x, r.light.y + r.transmittance * bg.y,

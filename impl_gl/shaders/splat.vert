@@ -11,7 +11,7 @@ layout(binding = 4) uniform usampler2DArray bandsPrevMap;
 layout(binding = 5) uniform usampler2DArray bandsCurMap;
 uniform int deviceSkip;
 uniform ivec2 tileBand;
-layout(std430, binding = 2) readonly buffer Frame { SplatFrame F; };  // misc.z: the largest point size
+layout(std430, binding = 2) readonly buffer Frame { SplatFrame F; };  // maxPointSize: the largest point size
 layout(std430, binding = 3) readonly buffer PhaseTable { float phaseTable[]; };  // read with phase Mie only
 float PhaseTableValue(uint i) { return phaseTable[i]; }
 layout(binding = 0) uniform sampler2DArray qPrev;
@@ -41,7 +41,7 @@ void main() {
         }
         atomicAdd(visitedCount, 1u);
     }
-    const float qa = SplatQ(texelFetch(qPrev, idx, 0).r, texelFetch(qCur, idx, 0).r, F.misc.y);
+    const float qa = SplatQ(texelFetch(qPrev, idx, 0).r, texelFetch(qCur, idx, 0).r, F.alpha);
     Splat s;
     if (!MakeSplat(F, uvec3(idx), qa, texelFetch(transmittance, idx, 0).r, s)) {
         Reject();
@@ -54,7 +54,7 @@ void main() {
     // drawn two pixels wider than the splat and the fragment shader keeps
     // exactly SPEC 8's coverage; the viewport's guard band keeps points whose
     // centre is just off the image from being clipped whole.
-    const vec2 viewport = vec2(F.image.xy) + 2.0 * guard;
+    const vec2 viewport = vec2(F.width, F.height) + 2.0 * guard;
     gl_Position = vec4((vec2(s.px, s.py) + guard) / viewport * 2.0 - 1.0, 0.0, 1.0);
-    gl_PointSize = min(s.size + 2.0, F.misc.z);
+    gl_PointSize = min(s.size + 2.0, F.maxPointSize);
 }

@@ -5,6 +5,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "random.glsl"
 #include "shading.glsl"
+#include "noise_words.glsl"
 #include "noise.glsl"
 
 layout(local_size_x = 64) in;

@@ -9,6 +9,7 @@
 #include "random.glsl"
 #include "shading.glsl"
 #include "phase_table.glsl"
+#include "light.glsl"
 #include "march.glsl"
 #include "layers.glsl"
 
@@ -40,9 +41,9 @@ void main() {
     barrier();
     const LayersGpu s = frame;
     const uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
-    if (x < s.image.x && y < s.image.y) {
+    if (x < s.width && y < s.height) {
         const LayersPixelResult r = LayersPixel(s, x, y);
-        const uint pixel = x + s.image.x * y;
+        const uint pixel = x + s.width * y;
         image[3u * pixel] = r.color.x;
         image[3u * pixel + 1u] = r.color.y;
         image[3u * pixel + 2u] = r.color.z;

@@ -4,6 +4,7 @@
 #include "random.glsl"
 #include "shading.glsl"
 #include "phase_table.glsl"
+#include "light.glsl"
 #include "march.glsl"
 #include "ground.glsl"
 
@@ -30,7 +31,7 @@ vec2 MarchFetchQT(uint paddedIndex) { return vec2(volume[paddedIndex], 1.0); }
 #endif
 bool MarchBrickEmpty(uint brick) { return brickEmpty[brick] != 0u; }
 float PhaseTableValue(uint i) { return mieTable[i]; }
-float GroundFetchG(uint i, uint j) { return groundG[i + ground.grid.x * j]; }
+float GroundFetchG(uint i, uint j) { return groundG[i + ground.gridX * j]; }
 
 shared uint gCounts[4];
 
@@ -47,11 +48,11 @@ void main() {
     barrier();
     const MarchGpu m = frame;
     const uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
-    if (x < m.image.x && y < m.image.y) {
+    if (x < m.width && y < m.height) {
         const MarchRayResult r = MarchPixel(m, x, y);
-        const uint pixel = x + m.image.x * y;
+        const uint pixel = x + m.width * y;
         vec3 c = r.color;
-        if ((m.flags.x & kMarchGround) != 0u) {
+        if ((m.flags & kMarchGround) != 0u) {
             // C = L + T_view background with the pixel's own background (impl_cpu/RenderMarchCpu.cpp).
             const vec3 bg = GroundBackground(ground, x, y);
             precise vec3 lit = vec3(r.light.x + r.transmittance * bg.x, r.light.y + r.transmittance * bg.y,

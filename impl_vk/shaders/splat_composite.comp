@@ -8,6 +8,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
 #include "phase_table.glsl"
+#include "light.glsl"
 #include "splat.glsl"
 #include "ground.glsl"
 layout(local_size_x = 64) in;
@@ -17,9 +18,9 @@ layout(std430, binding = 2) readonly buffer List { uint list[]; };
 layout(std430, binding = 3) writeonly buffer Image { float image[]; };
 layout(std430, binding = 4) readonly buffer Ground { GroundGpu ground; };  // read only with pc.ground
 layout(std430, binding = 5) readonly buffer GroundG { float groundG[]; };  // G, (nx, ny); likewise
-layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec4 background; uint ground; } pc;
+layout(push_constant) uniform Params { uint width, height, tilesX, tileSize; vec3 background; uint ground; } pc;
 
-float GroundFetchG(uint i, uint j) { return groundG[i + ground.grid.x * j]; }
+float GroundFetchG(uint i, uint j) { return groundG[i + ground.gridX * j]; }
 
 void main() {
     const uint tile = gl_WorkGroupID.x + pc.tilesX * gl_WorkGroupID.y, lane = gl_LocalInvocationID.x;
@@ -27,7 +28,7 @@ void main() {
     const int y = int(pc.tileSize * gl_WorkGroupID.y + lane / pc.tileSize);
     if (uint(x) >= pc.width || uint(y) >= pc.height) return;
     const uint id = uint(x) + pc.width * uint(y);
-    vec3 c = pc.ground != 0u ? GroundBackground(ground, uint(x), uint(y)) : pc.background.rgb;
+    vec3 c = pc.ground != 0u ? GroundBackground(ground, uint(x), uint(y)) : pc.background;
     for (uint n = bases[tile]; n < bases[tile + 1u]; ++n) {
         const Splat s = splats[list[n]];
         if (x < s.x0 || x > s.x1 || y < s.y0 || y > s.y1) continue;

@@ -1,5 +1,5 @@
 #version 450
-// Splat pass 1: per chunk of ranks (F.grid.w, a multiple of 32), how many
+// Splat pass 1: per chunk of ranks (F.ranksPerChunk, a multiple of 32), how many
 // splats it makes, how many (screen tile, splat) pairs they make, and which
 // ranks make one: a bit per rank, 32 to a word (splat_write.comp walks them).
 // Also SplatStats' voxels visited (ranks whose box is visible) and fragments
@@ -19,7 +19,7 @@ layout(push_constant) uniform Params { uint chunks, tileSize; } pc;
 void main() {
     const uint c = gl_GlobalInvocationID.x;
     if (c >= pc.chunks) return;
-    const uint first = c * F.grid.w, last = min(F.axes.w, first + F.grid.w);
+    const uint first = c * F.ranksPerChunk, last = min(F.voxelCount, first + F.ranksPerChunk);
     const uint nMid = AxisSize(F.axes.y), nIn = AxisSize(F.axes.z);
     uint splats = 0u, pairs = 0u, word = 0u, visited = 0u, fragments = 0u;  // a chunk's fragments: < 2^32
     // Run by run along the inner axis: the outer and middle entries hold for a run.

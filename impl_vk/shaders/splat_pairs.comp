@@ -5,6 +5,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
 #include "phase_table.glsl"
+#include "light.glsl"
 #include "splat.glsl"
 #include "splat_tiles.glsl"
 layout(local_size_x = 64) in;

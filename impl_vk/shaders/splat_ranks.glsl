@@ -7,6 +7,7 @@
 #extension GL_EXT_shader_8bit_storage : require
 #include "shading.glsl"
 #include "phase_table.glsl"
+#include "light.glsl"
 #include "splat.glsl"
 
 layout(std430, binding = 0) readonly buffer QPrev { float qPrev[]; };
@@ -20,7 +21,7 @@ layout(std430, binding = 3) readonly buffer RankParts { uvec4 rankPart[]; };
 layout(std430, binding = 4) readonly buffer Boxes { uint8_t boxVisible[]; };
 // grid.w: voxels per chunk of ranks; image.zw: screen tiles across and down.
 layout(std430, binding = 5) readonly buffer Frame { SplatFrame F; };
-// Read with phase Mie only: kMieCloudTable's values (F.right.w index per radian, F.up.w count).
+// Read with phase Mie only: kMieCloudTable's values (F.light.mieIndexPerRadian, F.light.mieCount).
 layout(std430, binding = 10) readonly buffer PhaseTable { float phaseTable[]; };
 float PhaseTableValue(uint i) { return phaseTable[i]; }
 
@@ -47,7 +48,7 @@ bool MakePartsSplat(uvec4 outer, uvec4 mid, uvec4 inner, out Splat s) {
     idx[F.axes.x] = outer.x;
     idx[F.axes.y] = mid.x;
     idx[F.axes.z] = inner.x;
-    return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.misc.y), transmittance[v], s);
+    return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.alpha), transmittance[v], s);
 }
 
 // The splat of the voxel at cursor c (RankCursor), whose box is visible.

@@ -15,7 +15,7 @@ layout(push_constant) uniform Params { uint chunks, tileSize; } pc;
 void main() {
     const uint c = gl_GlobalInvocationID.x;
     if (c >= pc.chunks) return;
-    const uint first = c * F.grid.w, last = min(F.axes.w, first + F.grid.w);
+    const uint first = c * F.ranksPerChunk, last = min(F.voxelCount, first + F.ranksPerChunk);
     uint slot = chunkOffset[c];
     for (uint w = first / 32u; w < (last + 31u) / 32u; ++w)
         for (uint word = candidates[w]; word != 0u; word &= word - 1u) {

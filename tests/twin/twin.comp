@@ -7,12 +7,19 @@
 #include "rules.glsl"
 #include "shading.glsl"
 #include "phase_table.glsl"
+#include "light.glsl"
 #include "automaton.glsl"
 #include "splat.glsl"
+#include "noise_words.glsl"
 #include "noise.glsl"
 #include "march.glsl"
 #include "ground.glsl"
 #include "layers.glsl"
+
+// The functions' numbers by name (kTwinLowBias32, ...), from the list the C++ reads too.
+#define CB_TWIN_FN(name, number) const uint kTwin##name = number;
+#include "twin_fns.h"
+#undef CB_TWIN_FN
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In { uint inWords[]; };
@@ -36,9 +43,13 @@ float PhaseTableValue(uint i) { return mieTable[i]; }
 // layers.glsl's modulation map: a hash of the column index (tests/GlslTwinHarness.h TwinLayersMap).
 float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1.0 / 16777216.0); }
 
+LightGpu ZeroLight() {
+    return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u);
+}
+
 MarchGpu ZeroMarch() {
-    return MarchGpu(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0),
-                    vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), uvec4(0u), uvec4(0u), uvec4(0u), uvec4(0u));
+    return MarchGpu(vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, 0.0, 0.0, 0.0, 0.0,
+                    vec3(0.0), 0.0, vec3(0.0), 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, uvec3(0u), 0u, ZeroLight());
 }
 
 // noise.glsl's tables: one permutation, i -> (167 i + 13) mod 256 (tests/GlslTwinCases.cpp kTwinPerm).
@@ -57,27 +68,27 @@ void main() {
     if (n >= pc.count) return;
     base = 16u * n;
     switch (pc.fn) {
-        case 0u: PutU(0u, LowBias32(U(0u))); break;
-        case 1u: PutU(0u, StreamKey(U(0u), U(1u), U(2u))); break;
-        case 2u: PutU(0u, Rand24FromKey(U(0u), U(1u))); break;
-        case 3u: PutU(0u, RegionEventFires(U(0u), U(1u), U(2u)) ? 1u : 0u); break;
-        case 4u: PutF(0u, EllipsoidWeight(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), F(6u), F(7u),
+        case kTwinLowBias32: PutU(0u, LowBias32(U(0u))); break;
+        case kTwinStreamKey: PutU(0u, StreamKey(U(0u), U(1u), U(2u))); break;
+        case kTwinRand24FromKey: PutU(0u, Rand24FromKey(U(0u), U(1u))); break;
+        case kTwinRegionEventFires: PutU(0u, RegionEventFires(U(0u), U(1u), U(2u)) ? 1u : 0u); break;
+        case kTwinEllipsoidWeight: PutF(0u, EllipsoidWeight(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), F(6u), F(7u),
                                           vec3(F(8u), F(9u), F(10u)))); break;
-        case 5u: PutU(0u, QuantizeRegion(F(0u))); break;
-        case 6u: PutI(0u, SmoothWeight(I(0u), I(1u))); break;
-        case 7u: PutF(0u, ExpNonPositive(F(0u))); break;
-        case 8u: PutF(0u, RoundToHalf(F(0u))); break;
-        case 9u: PutF(0u, RoundToUnorm8(F(0u))); break;
-        case 10u: PutF(0u, RoundToStorage(U(0u), F(1u))); break;
-        case 11u: PutF(0u, Lerp(F(0u), F(1u), F(2u))); break;
-        case 12u: PutF(0u, Bilinear(F(0u), F(1u), F(2u), F(3u), F(4u), F(5u))); break;
-        case 13u: PutF(0u, PhaseValue(U(0u), F(1u), F(2u))); break;
-        case 14u: PutF(0u, SplatKernel(F(0u), F(1u))); break;
-        case 15u: PutF(0u, SliceFactor(U(0u), F(1u), F(2u), F(3u), F(4u))); break;
-        case 16u: PutF(0u, StoreTransmittance(U(0u), F(1u), F(2u))); break;
-        case 17u: PutF(0u, GroundShadow(U(0u), F(1u), F(2u), F(3u))); break;
-        case 45u: PutF(0u, WangShadow(F(0u), F(1u), F(2u), F(3u))); break;
-        case 46u: {
+        case kTwinQuantizeRegion: PutU(0u, QuantizeRegion(F(0u))); break;
+        case kTwinSmoothWeight: PutI(0u, SmoothWeight(I(0u), I(1u))); break;
+        case kTwinExpNonPositive: PutF(0u, ExpNonPositive(F(0u))); break;
+        case kTwinRoundToHalf: PutF(0u, RoundToHalf(F(0u))); break;
+        case kTwinRoundToUnorm8: PutF(0u, RoundToUnorm8(F(0u))); break;
+        case kTwinRoundToStorage: PutF(0u, RoundToStorage(U(0u), F(1u))); break;
+        case kTwinLerp: PutF(0u, Lerp(F(0u), F(1u), F(2u))); break;
+        case kTwinBilinear: PutF(0u, Bilinear(F(0u), F(1u), F(2u), F(3u), F(4u), F(5u))); break;
+        case kTwinPhaseValue: PutF(0u, PhaseValue(U(0u), F(1u), F(2u))); break;
+        case kTwinSplatKernel: PutF(0u, SplatKernel(F(0u), F(1u))); break;
+        case kTwinSliceFactor: PutF(0u, SliceFactor(U(0u), F(1u), F(2u), F(3u), F(4u))); break;
+        case kTwinStoreTransmittance: PutF(0u, StoreTransmittance(U(0u), F(1u), F(2u))); break;
+        case kTwinGroundShadow: PutF(0u, GroundShadow(U(0u), F(1u), F(2u), F(3u))); break;
+        case kTwinWangShadow: PutF(0u, WangShadow(F(0u), F(1u), F(2u), F(3u))); break;
+        case kTwinGroundHit: {
             vec2 p;
             const bool hit = GroundHit(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), F(6u), F(7u), p);
             PutU(0u, hit ? 1u : 0u);
@@ -85,9 +96,9 @@ void main() {
             PutF(2u, hit ? p.y : 0.0);
             break;
         }
-        case 47u: PutF(0u, GroundShadowAt(F(0u), F(1u), U(2u), U(3u))); break;
-        case 48u: PutF(0u, GroundChannel(F(0u), F(1u), F(2u), F(3u), F(4u))); break;
-        case 18u: {
+        case kTwinGroundShadowAt: PutF(0u, GroundShadowAt(F(0u), F(1u), U(2u), U(3u))); break;
+        case kTwinGroundChannel: PutF(0u, GroundChannel(F(0u), F(1u), F(2u), F(3u), F(4u))); break;
+        case kTwinUpsampleTap: {
             int i0, i1;
             float w;
             UpsampleTap(I(0u), I(1u), I(2u), i0, i1, w);
@@ -96,15 +107,15 @@ void main() {
             PutF(2u, w);
             break;
         }
-        case 19u: PutU(0u, CaRowNeighbours(U(0u), U(1u), U(2u))); break;
-        case 20u: {
+        case kTwinCaRowNeighbours: PutU(0u, CaRowNeighbours(U(0u), U(1u), U(2u))); break;
+        case kTwinCaGrowth: {
             const uvec3 s = CaGrowth(uvec3(U(0u), U(1u), U(2u)), U(3u));
             PutU(0u, s.x);
             PutU(1u, s.y);
             PutU(2u, s.z);
             break;
         }
-        case 21u: {
+        case kTwinCaVoxelEvents: {
             const CaEvents e = CaEvents(U(5u), U(6u), U(7u), U(8u), U(9u), U(10u));
             const uvec3 s = CaVoxelEvents(uvec3(U(0u), U(1u), U(2u)), U(3u), U(4u), e);
             PutU(0u, s.x);
@@ -112,14 +123,14 @@ void main() {
             PutU(2u, s.z);
             break;
         }
-        case 22u: {
+        case kTwinCaInitialVoxel: {
             const uvec3 s = CaInitialVoxel(U(0u), U(1u), U(2u), U(3u), U(4u));
             PutU(0u, s.x);
             PutU(1u, s.y);
             PutU(2u, s.z);
             break;
         }
-        case 23u: {
+        case kTwinMakeCaEvents: {
             const CaEvents e = MakeCaEvents(U(0u), U(1u), U(2u), U(3u), U(4u));
             PutU(0u, e.keyExt);
             PutU(1u, e.keyHum);
@@ -129,59 +140,61 @@ void main() {
             PutU(5u, e.qAct);
             break;
         }
-        case 24u: PutF(0u, SplatQ(F(0u), F(1u), F(2u))); break;
-        case 25u: PutF(0u, SplatCoord(F(0u), F(1u), F(2u))); break;
-        case 26u: PutF(0u, SplatAlpha(F(0u), F(1u), F(2u))); break;
-        case 28u: PutF(0u, NoisePerlin(0u, F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
-        case 29u: PutF(0u, NoiseSimplex(0u, F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
-        case 30u: PutF(0u, NoiseWorley(U(6u), F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
-        case 31u: {
+        case kTwinSplatQ: PutF(0u, SplatQ(F(0u), F(1u), F(2u))); break;
+        case kTwinSplatCoord: PutF(0u, SplatCoord(F(0u), F(1u), F(2u))); break;
+        case kTwinSplatAlpha: PutF(0u, SplatAlpha(F(0u), F(1u), F(2u))); break;
+        case kTwinNoisePerlin: PutF(0u, NoisePerlin(0u, F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
+        case kTwinNoiseSimplex: PutF(0u, NoiseSimplex(0u, F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
+        case kTwinNoiseWorley: PutF(0u, NoiseWorley(U(6u), F(0u), F(1u), F(2u), ivec3(I(3u), I(4u), I(5u)))); break;
+        case kTwinNoiseFbm: {
             const float sum = NoiseFbm(U(6u), 0u, U(7u), U(8u), F(9u), U(10u), U(11u) != 0u, F(0u), F(1u), F(2u),
                                        ivec3(I(3u), I(4u), I(5u)));
             PutF(0u, sum);
             PutF(1u, NoiseFbm01FromSum(U(6u), U(8u), F(9u), U(11u) != 0u, sum));
             break;
         }
-        case 32u:
+        case kTwinNoiseForming:
             PutF(0u, NoiseThreshold(F(0u), F(1u)));
             PutF(1u, CoverageModulate(F(0u), F(2u), F(3u), F(4u)));
             PutF(2u, NoiseErode(F(0u), F(5u), F(6u)));
             PutI(3u, NoiseWrapIndex(I(7u), I(8u)));
             PutF(4u, NoiseRound(F(9u)));
             break;
-        case 33u:
+        case kTwinNoiseHeightAndTower:
             PutF(0u, NoiseHeightDistribution(F(0u), F(1u), F(2u)));
             PutF(1u, NoiseTower(vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), F(9u), F(10u), F(11u), F(12u),
                                 F(13u), F(14u)));
             break;
         // ---- march.glsl ----
-        case 34u: PutF(0u, ArcCos(F(0u))); break;
-        case 35u: PutF(0u, SamplePhaseTable(F(0u), U(1u), F(2u))); break;
-        case 36u: {
+        case kTwinArcCos: PutF(0u, ArcCos(F(0u))); break;
+        case kTwinSamplePhaseTable: PutF(0u, SamplePhaseTable(F(0u), U(1u), F(2u))); break;
+        case kTwinMarchPhase: {
             MarchGpu m = ZeroMarch();
-            m.flags.y = U(0u);
-            m.sun.w = F(1u);
-            m.ambient.w = F(3u);
-            m.strides.z = U(4u);
+            m.light.phaseKind = U(0u);
+            m.light.phaseG = F(1u);
+            m.light.mieIndexPerRadian = F(3u);
+            m.light.mieCount = U(4u);
             PutF(0u, MarchPhase(m, F(2u)));
             break;
         }
-        case 37u: {
+        case kTwinClipRayToBox: {
             float tMin = F(9u), tMax = F(10u);
             ClipRayToBox(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), tMin, tMax);
             PutF(0u, tMin);
             PutF(1u, tMax);
             break;
         }
-        case 38u: {
+        case kTwinMarchStepAt: {
             MarchGpu m = ZeroMarch();
-            m.stepping = vec4(F(0u), F(1u), F(2u), 0.0);
-            m.flags.x = U(3u) != 0u ? kMarchAdaptive : 0u;
+            m.baseStep = F(0u);
+            m.kappa = F(1u);
+            m.adaptiveStart = F(2u);
+            m.flags = U(3u) != 0u ? kMarchAdaptive : 0u;
             PutF(0u, MarchStepAt(m, F(4u)));
             break;
         }
-        case 39u: PutF(0u, MarchJitter(U(0u), U(1u), U(2u))); break;
-        case 40u: {
+        case kTwinMarchJitter: PutF(0u, MarchJitter(U(0u), U(1u), U(2u))); break;
+        case kTwinRayExitFromBox: {
             const vec3 inv = InverseDirection(vec3(F(3u), F(4u), F(5u)));
             PutF(0u, RayExitFromBox(vec3(F(0u), F(1u), F(2u)), inv, vec3(F(6u), F(7u), F(8u)),
                                     vec3(F(9u), F(10u), F(11u)), F(12u)));
@@ -190,14 +203,14 @@ void main() {
             PutF(3u, inv.z);
             break;
         }
-        case 41u: PutF(0u, PowderTerm(F(0u), F(1u))); break;
-        case 42u:
+        case kTwinPowderTerm: PutF(0u, PowderTerm(F(0u), F(1u))); break;
+        case kTwinMarchKernelFormulas:
             PutF(0u, SegmentTransmittance(F(0u), F(1u), F(2u)));
             PutF(1u, PointLightFalloff(F(3u), F(4u)));
             PutF(2u, MarchNextUp(F(5u)));
             break;
         // With the bound MarchGpu (tests/GlslTwinTest.cpp MarchFrameTwin).
-        case 43u: {
+        case kTwinMakePixelRay: {
             const MarchRayGeometry r = MakePixelRay(march, U(0u), U(1u));
             PutF(0u, r.origin.x);
             PutF(1u, r.origin.y);
@@ -209,7 +222,7 @@ void main() {
             PutF(7u, r.tMax);
             break;
         }
-        case 44u: {
+        case kTwinMarchPaddedSampler: {
             const vec3 p = vec3(F(0u), F(1u), F(2u));
             const MarchTaps t = MarchTapsAt(march, p);
             const vec2 qt = MarchBlend(march, t);
@@ -225,7 +238,7 @@ void main() {
             break;
         }
         // With the bound LayersGpu (tests/GlslTwinLayersTest.cpp).
-        case 60u: {
+        case kTwinMakeLayersRay: {
             const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
             PutF(0u, r.dir.x);
             PutF(1u, r.dir.y);
@@ -238,9 +251,9 @@ void main() {
             PutU(7u, w.count);
             break;
         }
-        case 61u: {
-            const MarchTaps t = PaddedTapsAt(layers.size.xyz, layers.phase.z, layers.phase.w, vec3(F(0u), F(1u), F(2u)));
-            const vec2 qt = PaddedBlend(layers.phase.z, layers.phase.w, t);
+        case kTwinLayersTaps: {
+            const MarchTaps t = PaddedTapsAt(layers.size, layers.strideY, layers.strideZ, vec3(F(0u), F(1u), F(2u)));
+            const vec2 qt = PaddedBlend(layers.strideY, layers.strideZ, t);
             PutU(0u, t.base);
             PutF(1u, t.w.x);
             PutF(2u, t.w.y);
@@ -251,9 +264,9 @@ void main() {
             PutF(7u, LayerHeight(layers, U(6u)));
             break;
         }
-        case 62u: {
+        case kTwinLayerFragment: {
             const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
-            const float sunPhase = LayersPhase(layers, MarchDot(layers.sun.xyz, r.dir));
+            const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, r.dir));
             const LayerFragmentResult f = LayerFragment(layers, r, sunPhase, U(2u));
             PutU(0u, f.crossed ? 1u : 0u);
             PutU(1u, f.drawn ? 1u : 0u);
@@ -268,7 +281,7 @@ void main() {
             PutF(9u, over.z);
             break;
         }
-        case 63u: {
+        case kTwinLayersPixel: {
             const LayersPixelResult p = LayersPixel(layers, U(0u), U(1u));
             PutF(0u, p.color.x);
             PutF(1u, p.color.y);
@@ -277,10 +290,19 @@ void main() {
             PutU(4u, p.drawn);
             break;
         }
-        case 64u:
+        case kTwinLayersFade:
             PutF(0u, LayersFade(F(0u), F(1u), F(2u)));
             break;
-        case 27u: {
+        // With the bound MarchGpu's light (tests/GlslTwinTest.cpp InScatteredMatchesTheCpp).
+        case kTwinInScattered: {
+            const LightSample s = LightSample(F(0u), F(1u), vec3(F(2u), F(3u), F(4u)), vec3(F(5u), F(6u), F(7u)));
+            const vec3 c = InScattered(march.light, s);
+            PutF(0u, c.x);
+            PutF(1u, c.y);
+            PutF(2u, c.z);
+            break;
+        }
+        case kTwinMakeSplat: {
             Splat s;
             const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), s);
             PutU(0u, made ? 1u : 0u);

@@ -271,6 +271,9 @@ const RendererDescriptor kMarchRenderer{
     .imageFields = kMarchImageFields,
     .referenceIgnores = kMarchReferenceIgnores,
     .accuracyRender = MarchAccuracyRender,
+    .referenceParams = [](const Scene& scene, const CameraSettings& camera, uint32_t step) {
+        return MakeMarchParams(scene, camera, step);
+    },
     .accuracyVariants = MarchAccuracyVariants,
 };
 

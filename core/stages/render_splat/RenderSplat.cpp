@@ -1,8 +1,10 @@
 #include "core/stages/render_splat/RenderSplat.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
+#include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
 #include "core/stages/density/Density.h"
 
@@ -124,6 +126,15 @@ constexpr std::string_view kSplatImageFields[] = {"render", "phase"};
 constexpr std::string_view kSplatReferenceIgnores[] = {"render.q_min", "render.splat_scale", "render.opacity",
                                                        "render.culling", "render.skipping"};
 
+nlohmann::json SplatConformOptions(const Scene& scene) {
+    return {{"phase", PhaseKindName(scene.phase.kind)},
+            {"culling", scene.splat.culling},
+            {"skipping", scene.splat.skipping},
+            {"storage", StorageFormatName(scene.shade.storage)},
+            {"cameras", scene.render.cameras.size()},
+            {"frames_per_step", std::max(scene.render.framesPerStep, 1u)}};
+}
+
 const RendererDescriptor kSplatRenderer{
     .fileStem = "splat",
     .rowLabel = "frame",
@@ -133,6 +144,7 @@ const RendererDescriptor kSplatRenderer{
     .imageFields = kSplatImageFields,
     .referenceIgnores = kSplatReferenceIgnores,
     .accuracyRender = SplatAccuracyRender,
+    .conformOptions = SplatConformOptions,
 };
 
 }  // namespace

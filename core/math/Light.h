@@ -1,0 +1,121 @@
+// The light a sample scatters toward the eye, ONE function for every renderer
+// (ray march, layers, splats) on every backend: the scene's enabled light terms
+// (the sun, the ambient light, the lightning's point light) gathered at a
+// sample. GLSL twin: core/math/light.glsl (InScattered, LightGpu), which the
+// GPU blocks of the renderers (MarchGpu, LayersGpu, SplatFrame) nest as their
+// member `light`, made by MakeLightGpu below.
+//
+// Adding a light term (sky light, eye scattering, city glow): a member of
+// LightTerms (and, if it varies per sample, of LightSample), its lines in
+// InScattered here and in light.glsl, its member of LightGpu in both languages
+// and its line in MakeLightGpu / LightTermsOf, and where the scene sets it
+// (the renderers' Make*Params). The renderers themselves do not change.
+//
+// The operations, in this order (bit-identical on every backend, built with
+// -ffp-contract=off): per channel c = sunRadiance_c * sunGain + ambient_c,
+// then with the point light on c += pointRadiance_c * g, g = T_point / max(d^2, r0^2) P^(cos theta_point).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "core/math/Shading.h"
+
+namespace cb {
+
+// The point light's radiance factor at distance^2 d2 (metres^2): 1 / max(d2, r0^2).
+inline float PointLightFalloff(float distance2, float minDistance2) { return 1.0f / std::max(distance2, minDistance2); }
+
+// The scene's light terms as a renderer sees them (voxel units as in core/math/March.h).
+struct LightTerms {
+    Vec3 sunRadiance{1, 1, 1};  // colour * intensity
+    Vec3 ambient{0, 0, 0};
+    PhaseParams phase;            // the phase function, of the sun's and the point light's angle alike
+    float voxelSize = 1;          // h (metres): a voxel-unit distance^2 d times h h is metres^2
+    bool pointOn = false;         // the lightning's point light (Wang, Ji and Zhang, eq. 21)
+    Vec3 pointPosition{};         // voxel units
+    Vec3 pointRadiance{};         // colour * intensity (radiance * m^2)
+    float pointMinDistance2 = 1;  // r0^2 in metres^2: the 1/D^2 law is capped at 1/r0^2
+};
+
+// What varies per sample: the sun's gain (its transmittance times the phase,
+// times the powder where the renderer has it), the point light's
+// transmittance, the sample's position (voxel units) and the ray's unit direction.
+struct LightSample {
+    float sunGain = 0;
+    float pointT = 1;
+    Vec3 position{};
+    Vec3 dir{};
+};
+
+// The light scattered toward the eye at the sample, per channel.
+inline Vec3 InScattered(const LightTerms& L, const LightSample& s) {
+    Vec3 c{L.sunRadiance[0] * s.sunGain + L.ambient[0], L.sunRadiance[1] * s.sunGain + L.ambient[1],
+           L.sunRadiance[2] * s.sunGain + L.ambient[2]};
+    if (L.pointOn) {
+        const Vec3 toLight{L.pointPosition[0] - s.position[0], L.pointPosition[1] - s.position[1],
+                           L.pointPosition[2] - s.position[2]};
+        const float d2v = toLight[0] * toLight[0] + toLight[1] * toLight[1] + toLight[2] * toLight[2];
+        const float d2 = d2v * L.voxelSize * L.voxelSize;
+        // cos theta = u . d with u the unit vector from the sample toward the light: 1 when the
+        // light shines straight at the eye through the sample, as s . d for the sun.
+        const float cosL =
+            d2v > 0.0f ? (toLight[0] * s.dir[0] + toLight[1] * s.dir[1] + toLight[2] * s.dir[2]) / std::sqrt(d2v)
+                       : 1.0f;
+        const float g = s.pointT * PointLightFalloff(d2, L.pointMinDistance2) * PhaseValue(L.phase, cosL);
+        for (int i = 0; i < 3; ++i) c[i] += L.pointRadiance[i] * g;
+    }
+    return c;
+}
+
+// LightTerms as the GPU blocks nest it: core/math/light.glsl's `LightGpu`,
+// member for member (std140 and std430 alike: a scalar after a vec3 takes its fourth lane).
+struct alignas(16) LightGpu {
+    std::array<float, 3> sunRadiance;
+    uint32_t phaseKind;  // PhaseKind
+    std::array<float, 3> ambient;
+    float phaseG;
+    std::array<float, 3> pointPosition;
+    float pointMinDistance2;
+    std::array<float, 3> pointRadiance;
+    uint32_t pointOn;  // 1: the point light shines
+    float voxelSize;
+    float mieIndexPerRadian;  // kMieCloudTable's, read with phase Mie
+    uint32_t mieCount;        // likewise
+    uint32_t unused;
+};
+static_assert(sizeof(LightGpu) == 5 * 16, "LightGpu is five 16-byte rows");
+
+inline LightGpu MakeLightGpu(const LightTerms& L) {
+    LightGpu g{};
+    g.sunRadiance = L.sunRadiance;
+    g.phaseKind = uint32_t(L.phase.kind);
+    g.ambient = L.ambient;
+    g.phaseG = L.phase.g;
+    g.pointPosition = L.pointPosition;
+    g.pointMinDistance2 = L.pointMinDistance2;
+    g.pointRadiance = L.pointRadiance;
+    g.pointOn = L.pointOn ? 1u : 0u;
+    g.voxelSize = L.voxelSize;
+    g.mieIndexPerRadian = kMieCloudTable.indexPerRadian;
+    g.mieCount = kMieCloudTable.count;
+    return g;
+}
+
+// The terms back from a block (the splats' C++ reads its GPU frame).
+inline LightTerms LightTermsOf(const LightGpu& g) {
+    LightTerms L;
+    L.sunRadiance = g.sunRadiance;
+    L.ambient = g.ambient;
+    L.phase = PhaseParams{PhaseKind(uint8_t(g.phaseKind)), g.phaseG};
+    L.voxelSize = g.voxelSize;
+    L.pointOn = g.pointOn != 0u;
+    L.pointPosition = g.pointPosition;
+    L.pointRadiance = g.pointRadiance;
+    L.pointMinDistance2 = g.pointMinDistance2;
+    return L;
+}
+
+}  // namespace cb

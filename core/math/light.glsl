@@ -1,0 +1,62 @@
+// GLSL twin of core/math/Light.h: the light a sample scatters toward the eye,
+// one function (InScattered) for every renderer, and the block LightGpu that
+// MarchGpu, LayersGpu and SplatFrame nest as their member `light`. The same
+// operations in the same order as the C++, `precise` where the CPU (built
+// with -ffp-contract=off) rounds each product. Include after shading.glsl and
+// phase_table.glsl (PhaseOf).
+#ifndef CLOUDBENCH_LIGHT_GLSL
+#define CLOUDBENCH_LIGHT_GLSL
+
+// core/math/Light.h LightGpu, member for member.
+struct LightGpu {
+    vec3 sunRadiance;
+    uint phaseKind;
+    vec3 ambient;
+    float phaseG;
+    vec3 pointPosition;
+    float pointMinDistance2;
+    vec3 pointRadiance;
+    uint pointOn;
+    float voxelSize;
+    float mieIndexPerRadian;
+    uint mieCount;
+    uint unused;
+};
+
+// core/math/Light.h LightSample.
+struct LightSample {
+    float sunGain;
+    float pointT;
+    vec3 position;
+    vec3 dir;
+};
+
+// P^(cos theta) of the scene's phase function (core/math/Shading.h PhaseValue).
+float LightPhase(LightGpu L, float cosTheta) {
+    return PhaseOf(L.phaseKind, L.phaseG, L.mieIndexPerRadian, L.mieCount, cosTheta);
+}
+
+// 1 / max(d2, r0^2) (core/math/Light.h PointLightFalloff).
+float PointLightFalloff(float distance2, float minDistance2) { return 1.0 / max(distance2, minDistance2); }
+
+// core/math/Light.h InScattered.
+vec3 InScattered(LightGpu L, LightSample s) {
+    precise float c0 = L.sunRadiance.x * s.sunGain + L.ambient.x;
+    precise float c1 = L.sunRadiance.y * s.sunGain + L.ambient.y;
+    precise float c2 = L.sunRadiance.z * s.sunGain + L.ambient.z;
+    if (L.pointOn != 0u) {
+        precise vec3 toLight = vec3(L.pointPosition.x - s.position.x, L.pointPosition.y - s.position.y,
+                                    L.pointPosition.z - s.position.z);
+        precise float d2v = toLight.x * toLight.x + toLight.y * toLight.y + toLight.z * toLight.z;
+        precise float d2 = d2v * L.voxelSize * L.voxelSize;
+        precise float dotDir = toLight.x * s.dir.x + toLight.y * s.dir.y + toLight.z * s.dir.z;
+        precise float cosL = d2v > 0.0 ? dotDir / sqrt(d2v) : 1.0;
+        precise float g = s.pointT * PointLightFalloff(d2, L.pointMinDistance2) * LightPhase(L, cosL);
+        c0 += L.pointRadiance.x * g;
+        c1 += L.pointRadiance.y * g;
+        c2 += L.pointRadiance.z * g;
+    }
+    return vec3(c0, c1, c2);
+}
+
+#endif
