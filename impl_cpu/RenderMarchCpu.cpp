@@ -195,7 +195,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
                 return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = density.LastT();
-                    if (s.point.on) l.point = PointLightMarch(s, p, nl, plainQ);
+                    if (s.light.pointOn) l.point = PointLightMarch(s, p, nl, plainQ);
                     return l;
                 };
             });
@@ -204,7 +204,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
                 return [&s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = SunLightMarch(s, p, nl, plainQ);
-                    if (s.point.on) l.point = PointLightMarch(s, p, nl, plainQ);
+                    if (s.light.pointOn) l.point = PointLightMarch(s, p, nl, plainQ);
                     return l;
                 };
             });

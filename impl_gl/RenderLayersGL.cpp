@@ -53,7 +53,8 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
 
     // 2. The layers, instanced, back to front over the background.
     GLuint phaseTable = *volumeCopy;  // bound to the unused binding unless the phase is Mie
-    if (params.setup.phase.kind == PhaseKind::Mie) phaseTable = MiePhaseTable(state.phaseTable, state.mieUploaded);
+    if (params.setup.light.phase.kind == PhaseKind::Mie)
+        phaseTable = MiePhaseTable(state.phaseTable, state.mieUploaded);
     const GLuint blockBuffer = ScratchBuffer(state.block, sizeof block);
     f.NamedBufferSubData(blockBuffer, 0, sizeof block, &block);
     const GLuint orderBuffer = ScratchBuffer(state.order, order.size() * 4);

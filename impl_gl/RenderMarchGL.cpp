@@ -100,7 +100,8 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     // 3. The rays.
     GLuint phaseTable = volumeCopy;  // bound to the unused binding unless the phase is Mie
-    if (params.setup.phase.kind == PhaseKind::Mie) phaseTable = MiePhaseTable(state.phaseTable, state.mieUploaded);
+    if (params.setup.light.phase.kind == PhaseKind::Mie)
+        phaseTable = MiePhaseTable(state.phaseTable, state.mieUploaded);
     const GLuint blockBuffer = ScratchBuffer(state.block, sizeof block);
     f.NamedBufferSubData(blockBuffer, 0, sizeof block, &block);
     const GLuint target = Scratch(state.target, GL_TEXTURE_2D, GL_RGBA32F, GLsizei(W), GLsizei(H));

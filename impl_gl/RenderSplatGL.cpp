@@ -127,7 +127,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, frameBuffer);
     // splat.vert's phase table: kMieCloudTable with phase Mie; else the frame stands in, unread.
     const GLuint phaseTable =
-        p.phase.kind == PhaseKind::Mie ? MiePhaseTable(state.phaseTable, state.mieUploaded) : frameBuffer;
+        p.light.phase.kind == PhaseKind::Mie ? MiePhaseTable(state.phaseTable, state.mieUploaded) : frameBuffer;
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, phaseTable);
     f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());

@@ -50,7 +50,7 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
     auto statsBuffer = Scratch(state.stats, kLayersStatWords * 4);
     if (!statsBuffer) return std::unexpected(statsBuffer.error());
     const DeviceBuffer* table = *frameBuffer;  // unread without phase Mie; a binding needs a buffer
-    if (params.setup.phase.kind == PhaseKind::Mie) {
+    if (params.setup.light.phase.kind == PhaseKind::Mie) {
         auto t = MiePhaseTable(state.mieTable);
         if (!t) return std::unexpected(t.error());
         table = *t;

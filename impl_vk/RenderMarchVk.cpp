@@ -59,7 +59,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const uint32_t px = e.nx + 2, py = e.ny + 2, pz = e.nz + 2;
     const uint32_t B = frame.brick;
     const uint32_t brickCount = frame.bricks[0] * frame.bricks[1] * frame.bricks[2];
-    const bool mie = params.setup.phase.kind == PhaseKind::Mie;
+    const bool mie = params.setup.light.phase.kind == PhaseKind::Mie;
 
     Pipeline* pipes[3] = {};
     const char* names[3] = {"march_volume", "march_bricks", shadeLight ? "render_march" : "render_march_q"};

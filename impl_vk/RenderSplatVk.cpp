@@ -128,7 +128,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
                                      scratch.rankParts, scratch.boxes, scratch.frame};
     // splat_ranks.glsl's phase table: kMieCloudTable with phase Mie; else the frame stands in, unread.
     const DeviceBuffer* phaseTable = scratch.frame;
-    if (p.phase.kind == PhaseKind::Mie) {
+    if (p.light.phase.kind == PhaseKind::Mie) {
         auto t = MiePhaseTable(state.mieTable);
         if (!t) return std::unexpected(t.error());
         phaseTable = *t;

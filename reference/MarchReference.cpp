@@ -34,7 +34,7 @@ Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, con
     s.epsilon = 0.0f;
     const double sigmaH = s.sigmaH;
     const Point3d sun{s.sun[0], s.sun[1], s.sun[2]};
-    const Point3d light{s.point.position[0], s.point.position[1], s.point.position[2]};
+    const Point3d light{s.light.pointPosition[0], s.light.pointPosition[1], s.light.pointPosition[2]};
     const CameraFrame& cam = params.camera;
     const uint32_t W = cam.width, H = cam.height;
 
@@ -55,7 +55,7 @@ Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, con
                     l.sun = float(
                         std::exp(-sigmaH * exact.Integrate(at, sun, 0.0, std::numeric_limits<double>::infinity())));
                     ++nLight;
-                    if (s.point.on) {
+                    if (s.light.pointOn) {
                         l.point = float(std::exp(-sigmaH * exact.IntegrateSegment(at, light)));
                         ++nLight;
                     }

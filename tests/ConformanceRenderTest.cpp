@@ -159,9 +159,9 @@ TEST_P(Conformance, RenderSplat) {
             p.voxelSize = h;
             p.splatDiameter = 1.5f * h;
             p.sun = SunDirection(0.5, 0.8);
-            p.phase = phases[c];
-            p.sunRadiance = {1.5f, 1.4f, 1.3f};
-            p.ambient = {0.2f, 0.25f, 0.3f};
+            p.light.phase = phases[c];
+            p.light.sunRadiance = {1.5f, 1.4f, 1.3f};
+            p.light.ambient = {0.2f, 0.25f, 0.3f};
             p.background = {0.4f, 0.5f, 0.8f};
             p.tile = 8;
             p.band = 4;

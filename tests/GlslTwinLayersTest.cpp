@@ -56,11 +56,11 @@ LayersParams RandomLayersParams(Pcg32& r, std::vector<float>& map) {
     s.tiling = r.Below(2) == 1;
     s.drift = {Uniform(r, -2, 2) * s.size[0], Uniform(r, -2, 2) * s.size[1]};
     s.sun = SunDirection(r.Uniform(-0.2, 1.55), r.Uniform(0, 6.28));
-    s.sunRadiance = {Uniform(r, 0, 3), Uniform(r, 0, 3), Uniform(r, 0, 3)};
-    s.ambient = {Uniform(r, 0, 0.4), Uniform(r, 0, 0.4), Uniform(r, 0, 0.4)};
+    s.light.sunRadiance = {Uniform(r, 0, 3), Uniform(r, 0, 3), Uniform(r, 0, 3)};
+    s.light.ambient = {Uniform(r, 0, 0.4), Uniform(r, 0, 0.4), Uniform(r, 0, 0.4)};
     s.background = {Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1)};
     const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
-    s.phase = {kinds[r.Below(4)], Uniform(r, -0.9, 0.9)};
+    s.light.phase = {kinds[r.Below(4)], Uniform(r, -0.9, 0.9)};
     s.wang = r.Below(2) == 1;
     s.coverage = Uniform(r, 0, 1);
     s.density = Uniform(r, 0.5, 8);
@@ -132,7 +132,7 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         Compare("LayerFragment", fragmentKinds, ulps, fragmentsIn,
                 Run(test::kTwinLayerFragment, fragmentsIn, {}, {}, g), [&](const Words& in, Words& out) {
                     const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
-                    const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, r.dir));
+                    const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, r.dir));
                     const LayerFragmentResult f = LayerFragment(s, r, sunPhase, in[2], TwinFetch);
                     const Vec3 over = LayersOver({Float(in[3]), Float(in[4]), Float(in[5])}, f.alpha, f.color);
                     out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]), Bits(f.color[1]),

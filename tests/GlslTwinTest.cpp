@@ -203,10 +203,13 @@ MarchParams RandomMarchParams(Pcg32& r, Extent3& e) {
     camera.farPlane = r.Below(2) ? 1e6 : r.Uniform(10 * h, 60 * h);
     p.camera = MakeCameraFrame(camera, 1 + r.Below(300), 1 + r.Below(200));
     p.setup.size = {float(e.nx), float(e.ny), float(e.nz)};
-    p.setup.voxelSize = h;
+    p.setup.voxelSize = p.setup.light.voxelSize = h;
     p.setup.sigmaH = Uniform(r, 0, 2);
     p.setup.sun = SunDirection(r.Uniform(0.05, 1.55), r.Uniform(0, 6.28));
-    p.setup.point = {true, {Uniform(r, -10, 60), Uniform(r, -10, 60), Uniform(r, -10, 60)}, {1, 1, 1}, 1};
+    p.setup.light.pointOn = true;
+    p.setup.light.pointPosition = {Uniform(r, -10, 60), Uniform(r, -10, 60), Uniform(r, -10, 60)};
+    p.setup.light.pointRadiance = {1, 1, 1};
+    p.setup.light.pointMinDistance2 = 1;
     p.lightSteps = 1 + r.Below(12);
     return p;
 }
@@ -276,15 +279,15 @@ TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
     for (int call = 0; call < 16; ++call) {
         Extent3 e;
         MarchParams p = RandomMarchParams(rng, e);
-        p.setup.sunRadiance = {Uniform(rng, 0, 3), Uniform(rng, 0, 3), Uniform(rng, 0, 3)};
-        p.setup.ambient = {Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5)};
-        p.setup.phase = {kinds[call % 4], Uniform(rng, -0.9, 0.9)};
-        p.setup.point.on = call % 8 < 6;
-        p.setup.point.radiance = {Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4)};
-        p.setup.point.minDistance2 = Uniform(rng, 1, 1e4);
+        p.setup.light.sunRadiance = {Uniform(rng, 0, 3), Uniform(rng, 0, 3), Uniform(rng, 0, 3)};
+        p.setup.light.ambient = {Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5)};
+        p.setup.light.phase = {kinds[call % 4], Uniform(rng, -0.9, 0.9)};
+        p.setup.light.pointOn = call % 8 < 6;
+        p.setup.light.pointRadiance = {Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4)};
+        p.setup.light.pointMinDistance2 = Uniform(rng, 1, 1e4);
         const MarchGpu m = MakeMarchGpu(p, e);
-        const LightTerms terms = MarchLightTerms(p.setup);
-        const Vec3& at = p.setup.point.position;
+        const LightTerms& terms = p.setup.light;
+        const Vec3& at = p.setup.light.pointPosition;
         std::vector<Words> inputs = {WF({0.5f, 1, at[0], at[1], at[2], 0, 0, 1}),
                                      WF({0, 0, at[0] + 0.01f, at[1], at[2], 1, 0, 0})};
         for (int k = 0; k < 2000; ++k) {

@@ -89,8 +89,8 @@ void ExtSplat(Backend& cpu, Backend& gpu, const ExtentCase& c) {
     p.order = &order;
     p.voxelSize = 1, p.splatDiameter = 1.5f;
     p.sun = SunDirection(0.5, 0.8);
-    p.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
-    p.sunRadiance = {1.5f, 1.4f, 1.3f}, p.ambient = {0.2f, 0.25f, 0.3f}, p.background = {0.4f, 0.5f, 0.8f};
+    p.light.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+    p.light.sunRadiance = {1.5f, 1.4f, 1.3f}, p.light.ambient = {0.2f, 0.25f, 0.3f}, p.background = {0.4f, 0.5f, 0.8f};
     p.alpha = 0.4f;
     p.skipping = skipping, p.tile = 2, p.band = 1;
     Backend* backends[2] = {&cpu, &gpu};

@@ -126,10 +126,10 @@ class GroundRender : public ::testing::TestWithParam<GroundParam> {
             const SplatOrder order = MakeSplatOrder(p.camera, e, {0, 0, 0}, 1.0);
             p.order = &order;
             p.sun = sunDir;
-            p.sunRadiance = kSun;
-            p.ambient = kAmbient;
+            p.light.sunRadiance = kSun;
+            p.light.ambient = kAmbient;
             p.background = kFlat;
-            p.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
+            p.light.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
             p.splatDiameter = 1.5f;
             p.voxelSize = 1;
             p.skipping = false;  // no occupancy maps here
@@ -142,13 +142,13 @@ class GroundRender : public ::testing::TestWithParam<GroundParam> {
             MarchParams p;
             p.camera = MakeCameraFrame(camera, W, H);
             p.setup.size = {float(e.nx), float(e.ny), float(e.nz)};
-            p.setup.voxelSize = 1;
+            p.setup.voxelSize = p.setup.light.voxelSize = 1;
             p.setup.sigmaH = 0.5f;
             p.setup.sun = sunDir;
-            p.setup.sunRadiance = kSun;
-            p.setup.ambient = kAmbient;
+            p.setup.light.sunRadiance = kSun;
+            p.setup.light.ambient = kAmbient;
             p.setup.background = kFlat;
-            p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
+            p.setup.light.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
             p.ground = ground;
             MarchInputs in{qb.get(), qb.get(), tb.get()};
             in.G = gb.get();

@@ -243,11 +243,11 @@ TEST(HostParamsLayers, GeometryFromTheGridAndTheCamera) {
     EXPECT_EQ(s.maxLength, 4.0f);     // l_max default nz
     EXPECT_EQ(s.sigmaH, 6.25f);       // 0.125 * 50
     EXPECT_FALSE(s.tiling);
-    EXPECT_EQ(s.sunRadiance, (Vec3{4.0f, 2.0f, 1.0f}));  // (1, 0.5, 0.25) * 4
-    EXPECT_EQ(s.ambient, (Vec3{0.25f, 0.5f, 0.75f}));
+    EXPECT_EQ(s.light.sunRadiance, (Vec3{4.0f, 2.0f, 1.0f}));  // (1, 0.5, 0.25) * 4
+    EXPECT_EQ(s.light.ambient, (Vec3{0.25f, 0.5f, 0.75f}));
     EXPECT_EQ(s.background, (Vec3{0.125f, 0.375f, 0.625f}));
-    EXPECT_EQ(s.phase.kind, PhaseKind::HenyeyGreenstein);
-    EXPECT_EQ(s.phase.g, 0.25f);
+    EXPECT_EQ(s.light.phase.kind, PhaseKind::HenyeyGreenstein);
+    EXPECT_EQ(s.light.phase.g, 0.25f);
     EXPECT_FALSE(s.wang);
     EXPECT_EQ(s.lightScale, 1.0f);
     // Layer heights z_i = (i + 0.5) nz / N: with N = 4, 0.5 and 3.5.

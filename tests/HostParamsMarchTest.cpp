@@ -129,11 +129,11 @@ TEST(HostParamsMarch, SetupFromTheScene) {
     EXPECT_EQ(s.adaptiveStart, 16.0f);
     EXPECT_EQ(s.sigmaH, 0.625f);  // 0.03125 * 20
     EXPECT_EQ(s.epsilon, 0.0625f);
-    EXPECT_EQ(s.sunRadiance, (Vec3{1.0f, 2.0f, 0.5f}));  // (0.5, 1, 0.25) * 2
-    EXPECT_EQ(s.ambient, (Vec3{0.25f, 0.5f, 0.75f}));
+    EXPECT_EQ(s.light.sunRadiance, (Vec3{1.0f, 2.0f, 0.5f}));  // (0.5, 1, 0.25) * 2
+    EXPECT_EQ(s.light.ambient, (Vec3{0.25f, 0.5f, 0.75f}));
     EXPECT_EQ(s.background, (Vec3{0.125f, 0.375f, 0.625f}));
-    EXPECT_EQ(s.phase.kind, PhaseKind::CornetteShanks);
-    EXPECT_EQ(s.phase.g, 0.375f);
+    EXPECT_EQ(s.light.phase.kind, PhaseKind::CornetteShanks);
+    EXPECT_EQ(s.light.phase.g, 0.375f);
     EXPECT_TRUE(s.powder);
     EXPECT_EQ(s.powderC, 3.0f);
     EXPECT_EQ(p.light, MarchLightSource::March);
@@ -195,28 +195,28 @@ TEST(HostParamsMarch, AlphaAndTheJittersFrameKey) {
 // (x - origin) / h, radiance colour * intensity, r0^2, and the flash window [start, start + steps) at its edges.
 TEST(HostParamsMarch, PointLightAndItsFlashWindow) {
     Scene sc = HpmScene();
-    const MarchPointLight& l = HpmMarch(sc, 3).setup.point;
+    const LightTerms l = HpmMarch(sc, 3).setup.light;
     // ((60 + 100) / 20, (0 - 40) / 20, (100 - 0) / 20) = (8, -2, 5).
-    EXPECT_EQ(l.position, (Vec3{8.0f, -2.0f, 5.0f}));
-    EXPECT_EQ(l.radiance, (Vec3{4.0f, 2.0f, 8.0f}));  // (0.5, 0.25, 1) * 8
-    EXPECT_EQ(l.minDistance2, 25.0f);                 // 5 m squared, metres^2
-    EXPECT_FALSE(HpmMarch(sc, 2).setup.point.on);     // before the window
-    EXPECT_TRUE(HpmMarch(sc, 3).setup.point.on);      // its first step
-    EXPECT_TRUE(HpmMarch(sc, 4).setup.point.on);      // its last step: 3 + 2 - 1
-    EXPECT_FALSE(HpmMarch(sc, 5).setup.point.on);     // 3 + 2: past it
+    EXPECT_EQ(l.pointPosition, (Vec3{8.0f, -2.0f, 5.0f}));
+    EXPECT_EQ(l.pointRadiance, (Vec3{4.0f, 2.0f, 8.0f}));  // (0.5, 0.25, 1) * 8
+    EXPECT_EQ(l.pointMinDistance2, 25.0f);                 // 5 m squared, metres^2
+    EXPECT_FALSE(HpmMarch(sc, 2).setup.light.pointOn);     // before the window
+    EXPECT_TRUE(HpmMarch(sc, 3).setup.light.pointOn);      // its first step
+    EXPECT_TRUE(HpmMarch(sc, 4).setup.light.pointOn);      // its last step: 3 + 2 - 1
+    EXPECT_FALSE(HpmMarch(sc, 5).setup.light.pointOn);     // 3 + 2: past it
     // A flash at step 0 of one step: on at the first step only.
     sc.lightning.flashStart = 0;
     sc.lightning.flashSteps = 1;
-    EXPECT_TRUE(HpmMarch(sc, 0).setup.point.on);
-    EXPECT_FALSE(HpmMarch(sc, 1).setup.point.on);
+    EXPECT_TRUE(HpmMarch(sc, 0).setup.light.pointOn);
+    EXPECT_FALSE(HpmMarch(sc, 1).setup.light.pointOn);
     // The window's end past 2^32 - 1 does not wrap: start 4294967295, 2 steps: on at 4294967295.
     sc.lightning.flashStart = 4294967295u;
     sc.lightning.flashSteps = 2;
-    EXPECT_TRUE(HpmMarch(sc, 4294967295u).setup.point.on);
-    EXPECT_FALSE(HpmMarch(sc, 0).setup.point.on);
+    EXPECT_TRUE(HpmMarch(sc, 4294967295u).setup.light.pointOn);
+    EXPECT_FALSE(HpmMarch(sc, 0).setup.light.pointOn);
     sc.lightning.enabled = false;
     sc.lightning.flashStart = 3;
-    EXPECT_FALSE(HpmMarch(sc, 3).setup.point.on);
+    EXPECT_FALSE(HpmMarch(sc, 3).setup.light.pointOn);
 }
 
 // Test the centre pixel's ray (docs/pipeline.md "Rays"): dir = forward, depth = t h, so near 10 m is t = 0.5 and the

@@ -46,10 +46,10 @@ struct MarchVariant {
 // the point light) together.
 std::vector<MarchVariant> MarchVariants(const Extent3& e) {
     auto point = [e](MarchParams& p) {
-        p.setup.point.on = true;
-        p.setup.point.position = {0.6f * float(e.nx), 0.4f * float(e.ny), 0.5f * float(e.nz)};
-        p.setup.point.radiance = {40.0f, 42.0f, 50.0f};
-        p.setup.point.minDistance2 = 4.0f;  // r0 = 2 m (h = 1 m): the cap bites next to the light
+        p.setup.light.pointOn = true;
+        p.setup.light.pointPosition = {0.6f * float(e.nx), 0.4f * float(e.ny), 0.5f * float(e.nz)};
+        p.setup.light.pointRadiance = {40.0f, 42.0f, 50.0f};
+        p.setup.light.pointMinDistance2 = 4.0f;  // r0 = 2 m (h = 1 m): the cap bites next to the light
     };
     return {
         {"baseline: shade light, skipping, HG", [](MarchParams&) {}},
@@ -68,18 +68,18 @@ std::vector<MarchVariant> MarchVariants(const Extent3& e) {
         {"light march, powder c 2",
          [](MarchParams& p) { p.light = MarchLightSource::March, p.lightSteps = 4, p.setup.powder = true; }},
         {"shade light, powder c 3.5", [](MarchParams& p) { p.setup.powder = true, p.setup.powderC = 3.5f; }},
-        {"phase none", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::None; }},
+        {"phase none", [](MarchParams& p) { p.setup.light.phase.kind = PhaseKind::None; }},
         {"phase Cornette-Shanks g 0.75",
          [](MarchParams& p) {
-             p.setup.phase = {PhaseKind::CornetteShanks, 0.75f};
+             p.setup.light.phase = {PhaseKind::CornetteShanks, 0.75f};
          }},
-        {"phase Mie", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::Mie; }},
+        {"phase Mie", [](MarchParams& p) { p.setup.light.phase.kind = PhaseKind::Mie; }},
         {"point light, shade light", point},
         {"point light, light march, Mie, jitter, adaptive",
          [point](MarchParams& p) {
              point(p);
              p.light = MarchLightSource::March, p.lightSteps = 3;
-             p.setup.phase.kind = PhaseKind::Mie;
+             p.setup.light.phase.kind = PhaseKind::Mie;
              p.jitter = true;
              p.setup.adaptive = true, p.setup.kappa = 0.05f, p.setup.adaptiveStart = 6;
          }},
@@ -195,15 +195,15 @@ TEST_P(MarchConformance, OptionMatrix) {
             MarchParams p;
             p.camera = MakeCameraFrame(camera, W, H);
             p.setup.size = {float(e.nx), float(e.ny), float(e.nz)};
-            p.setup.voxelSize = 1;
+            p.setup.voxelSize = p.setup.light.voxelSize = 1;
             p.setup.step = 0.5f;
             p.setup.sigmaH = 0.25f;
             p.setup.epsilon = 0.01f;
             p.setup.sun = sun;
-            p.setup.sunRadiance = {1.5f, 1.4f, 1.25f};
-            p.setup.ambient = {0.2f, 0.24f, 0.3f};
+            p.setup.light.sunRadiance = {1.5f, 1.4f, 1.25f};
+            p.setup.light.ambient = {0.2f, 0.24f, 0.3f};
             p.setup.background = {0.4f, 0.55f, 0.85f};
-            p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+            p.setup.light.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
             p.origin = {0, 0, 0};
             p.alpha = 0.4f;
             p.seed = 7;

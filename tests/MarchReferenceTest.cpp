@@ -32,13 +32,13 @@ MarchParams RefCamera(const Extent3& e, std::array<double, 3> eye, std::array<do
     p.camera = MakeCameraFrame(cam, w, h);
     MarchSetup& s = p.setup;
     s.size = {float(e.nx), float(e.ny), float(e.nz)};
-    s.voxelSize = 1;
+    s.voxelSize = s.light.voxelSize = 1;
     s.sigmaH = 0.1f;
     s.epsilon = 0.01f;  // the reference must ignore it
-    s.sunRadiance = {1.0f, 0.8f, 0.6f};
-    s.ambient = {0.05f, 0.1f, 0.2f};
+    s.light.sunRadiance = {1.0f, 0.8f, 0.6f};
+    s.light.ambient = {0.05f, 0.1f, 0.2f};
     s.background = {0.3f, 0.5f, 0.9f};
-    s.phase.kind = PhaseKind::None;
+    s.light.phase.kind = PhaseKind::None;
     p.origin = {0, 0, 0};
     p.alpha = 0.5f;
     return p;
@@ -56,9 +56,9 @@ std::vector<float> RenderRef(const MarchParams& p, const Extent3& e, const std::
 TEST(MarchReference, EmptyVolumeIsTheBackgroundExactly) {
     const Extent3 e{12, 10, 8};
     MarchParams p = RefCamera(e, {-5, -4, 12}, {6, 5, 4}, {0, 0, 1}, 1e4, 16, 12);
-    p.setup.point.on = true;
-    p.setup.point.position = {6, 5, 4};
-    p.setup.point.radiance = {5, 5, 5};
+    p.setup.light.pointOn = true;
+    p.setup.light.pointPosition = {6, 5, 4};
+    p.setup.light.pointRadiance = {5, 5, 5};
     const std::vector<float> image = RenderRef(p, e, std::vector<float>(e.Count(), 0.0f));
     ASSERT_EQ(image.size(), 3u * 16 * 12);
     for (size_t v = 0; v < image.size(); v += 3) {
@@ -112,9 +112,10 @@ TEST(MarchReference, HomogeneousSlabMatchesTheClosedForm) {
                                         : std::exp(-a * k.c) * (1 - std::exp(-a * k.D));
         const double x = a * step;
         for (int ch = 0; ch < 3; ++ch) {
-            const double expected = p.setup.sunRadiance[ch] * sunTerm + p.setup.ambient[ch] * (1 - std::exp(-a * k.D)) +
+            const double expected = p.setup.light.sunRadiance[ch] * sunTerm +
+                                    p.setup.light.ambient[ch] * (1 - std::exp(-a * k.D)) +
                                     p.setup.background[ch] * std::exp(-a * k.D);
-            const double tol = p.setup.sunRadiance[ch] * sunTerm * (k.linear ? x * x / 8 : 0) + 2e-5;
+            const double tol = p.setup.light.sunRadiance[ch] * sunTerm * (k.linear ? x * x / 8 : 0) + 2e-5;
             EXPECT_NEAR(image[ch], expected, tol) << k.name << " channel " << ch;
         }
     }
@@ -139,11 +140,11 @@ TEST(MarchReference, FastMarchConvergesToTheReference) {
     MarchParams p = RefCamera(e, {-20, -14, 30}, {12, 12, 8}, {0, 0, 1}, 1e4, 24, 18);
     p.setup.sigmaH = 0.6f;
     p.setup.sun = SunDirection(0.6, 0.5);
-    p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
+    p.setup.light.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
     p.setup.powder = true;
-    p.setup.point.on = true;
-    p.setup.point.position = {12, 12, 3};
-    p.setup.point.radiance = {20, 15, 10};
+    p.setup.light.pointOn = true;
+    p.setup.light.pointPosition = {12, 12, 3};
+    p.setup.light.pointRadiance = {20, 15, 10};
     p.setup.epsilon = 0;
     const std::vector<float> reference = RenderRef(p, e, q);
 

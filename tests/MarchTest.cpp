@@ -97,7 +97,7 @@ TEST(March, HomogeneousSlabMatchesAnalyticInScattering) {
             const double T = std::exp(-double(sigmaH) * q0 * depth);
             for (int c = 0; c < 3; ++c) {
                 const double expected =
-                    (double(s.sunRadiance[c]) + s.ambient[c]) * (1 - T) + T * double(s.background[c]);
+                    (double(s.light.sunRadiance[c]) + s.light.ambient[c]) * (1 - T) + T * double(s.background[c]);
                 EXPECT_NEAR(r.color[c], expected, 1e-5 * expected) << "adaptive " << adaptive << " xi " << xi;
             }
             EXPECT_NEAR(r.transmittance, T, 1e-5 * T);
@@ -127,8 +127,8 @@ struct SmoothRay {
     float March(float step, float xi) const {
         MarchSetup s = PlainSetup({32, 32, 32}, float(sigma));
         s.step = step;
-        s.sunRadiance = {1, 1, 1};
-        s.ambient = {0, 0, 0};
+        s.light.sunRadiance = {1, 1, 1};
+        s.light.ambient = {0, 0, 0};
         s.background = {0, 0, 0};
         auto density = [&](const Vec3& p) { return float(q(p[2])); };
         auto light = [&](const Vec3& p) { return MarchLightSample{float(S(p[2])), 1.0f}; };
@@ -198,26 +198,26 @@ TEST(March, PointLightFallsOffAsInverseSquareWithTheR0Guard) {
     const float w = 0.05f, z0 = 20, q0 = 1, sigmaH = 0.5f, r0 = 4;
     MarchSetup s = PlainSetup({64, 64, 64}, sigmaH);
     s.step = 0.01f;
-    s.sunRadiance = {0, 0, 0};
-    s.ambient = {0, 0, 0};
+    s.light.sunRadiance = {0, 0, 0};
+    s.light.ambient = {0, 0, 0};
     s.background = {0, 0, 0};
-    s.point.on = true;
-    s.point.radiance = {1000, 500, 250};
-    s.point.minDistance2 = r0 * r0;
+    s.light.pointOn = true;
+    s.light.pointRadiance = {1000, 500, 250};
+    s.light.pointMinDistance2 = r0 * r0;
     const double slab = 1 - std::exp(-2.0 * sigmaH * q0 * w);
     auto q = [&](const Vec3&) { return q0; };
     for (float d : {0.5f, 2.0f, 4.0f, 8.0f, 16.0f, 30.0f}) {
-        s.point.position = {10 + d, 10, z0};
+        s.light.pointPosition = {10 + d, 10, z0};
         const MarchRayResult r = MarchRay(s, RayAlongZ(10, 10, z0 - w, z0 + w), 0.5f, nullptr, q, UnitLight);
         const double falloff = 1.0 / std::max(double(d) * d, double(r0) * r0);
         for (int c = 0; c < 3; ++c) {
-            const double expected = s.point.radiance[c] * falloff * slab;
+            const double expected = s.light.pointRadiance[c] * falloff * slab;
             EXPECT_NEAR(r.color[c], expected, 2e-3 * expected) << "d = " << d;
         }
     }
     // Metres: the falloff uses D h; with h = 10 and the light 8 voxels away, D = 80 m.
-    s.voxelSize = 10;
-    s.point.position = {18, 10, z0};
+    s.voxelSize = s.light.voxelSize = 10;
+    s.light.pointPosition = {18, 10, z0};
     const MarchRayResult r = MarchRay(s, RayAlongZ(10, 10, z0 - w, z0 + w), 0.5f, nullptr, q, UnitLight);
     EXPECT_NEAR(r.color[0], 1000.0 / (80.0 * 80.0) * slab, 2e-3 * 1000.0 / 6400.0 * slab);
 }
@@ -226,17 +226,17 @@ TEST(March, PointLightFallsOffAsInverseSquareWithTheR0Guard) {
 // sample) gives P(1), light behind the eye P(-1).
 TEST(March, PointLightPhaseUsesTheAngleBetweenViewAndLight) {
     MarchSetup s = PlainSetup({64, 64, 64}, 0.5f);
-    s.sunRadiance = {0, 0, 0};
-    s.ambient = {0, 0, 0};
+    s.light.sunRadiance = {0, 0, 0};
+    s.light.ambient = {0, 0, 0};
     s.background = {0, 0, 0};
-    s.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
-    s.point.on = true;
-    s.point.radiance = {1, 1, 1};
-    s.point.minDistance2 = 1e-6f;
+    s.light.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+    s.light.pointOn = true;
+    s.light.pointRadiance = {1, 1, 1};
+    s.light.pointMinDistance2 = 1e-6f;
     auto q = [&](const Vec3&) { return 1.0f; };
-    s.point.position = {10, 10, 40};  // ahead
+    s.light.pointPosition = {10, 10, 40};  // ahead
     const float ahead = MarchRay(s, RayAlongZ(10, 10, 19.99f, 20.01f), 0.5f, nullptr, q, UnitLight).color[0];
-    s.point.position = {10, 10, 0};  // behind
+    s.light.pointPosition = {10, 10, 0};  // behind
     const float behind = MarchRay(s, RayAlongZ(10, 10, 19.99f, 20.01f), 0.5f, nullptr, q, UnitLight).color[0];
     // Same distance (20), so the ratio is the phase ratio P(1) / P(-1) = ((1 + g) / (1 - g))^3 for HG.
     const double g = 0.6, ratio = std::pow((1 + g) / (1 - g), 3);
@@ -248,9 +248,9 @@ TEST(March, PointLightPhaseUsesTheAngleBetweenViewAndLight) {
 TEST(March, PointLightMarchStopsAtTheLightOrTheBox) {
     MarchSetup s = PlainSetup({10, 10, 10}, 0.2f);
     auto q = [](const Vec3&) { return 0.5f; };
-    s.point.position = {5, 5, 8};
+    s.light.pointPosition = {5, 5, 8};
     EXPECT_NEAR(PointLightMarch(s, {5, 5, 2}, 4, q), std::exp(-0.2 * 0.5 * 6), 1e-6);
-    s.point.position = {5, 5, 100};
+    s.light.pointPosition = {5, 5, 100};
     EXPECT_NEAR(PointLightMarch(s, {5, 5, 2}, 4, q), std::exp(-0.2 * 0.5 * 8), 1e-6);
 }
 
@@ -353,14 +353,15 @@ TEST(MarchCpu, FullVolumeSeenHeadOnMatchesTheTrilinearOpticalDepth) {
     c.grid = {8, 8, 12};
     c.q.assign(c.grid.Count(), 1.0f);
     c.params = CameraParams(c.grid, {4, 4, 40}, {4, 4, 0}, 1, 1, 0.07f);
-    c.params.setup.phase.kind = PhaseKind::None;
+    c.params.setup.light.phase.kind = PhaseKind::None;
     c.params.setup.epsilon = 0;
     c.params.setup.step = 0.5f;
     const MarchImage im = RenderCpu(c);
     const double T = std::exp(-0.07 * (12 - 0.25));
     for (int ch = 0; ch < 3; ++ch) {
         const MarchSetup& s = c.params.setup;
-        const double expected = (double(s.sunRadiance[ch]) + s.ambient[ch]) * (1 - T) + T * s.background[ch];
+        const double expected =
+            (double(s.light.sunRadiance[ch]) + s.light.ambient[ch]) * (1 - T) + T * s.background[ch];
         EXPECT_NEAR(im.rgb[ch], expected, 1e-5 * expected);
     }
     EXPECT_EQ(im.stats.rays, 1u);
@@ -380,10 +381,10 @@ TEST(MarchCpu, MatchesTheKernelWithCanonicalSamplers) {
     for (MarchLightSource source : {MarchLightSource::Shade, MarchLightSource::March}) {
         c.params.light = source;
         c.params.lightSteps = 6;
-        c.params.setup.point.on = true;
-        c.params.setup.point.position = {12, 20, 14};
-        c.params.setup.point.radiance = {30, 30, 40};
-        c.params.setup.point.minDistance2 = 1;
+        c.params.setup.light.pointOn = true;
+        c.params.setup.light.pointPosition = {12, 20, 14};
+        c.params.setup.light.pointRadiance = {30, 30, 40};
+        c.params.setup.light.pointMinDistance2 = 1;
         const MarchImage im = RenderCpu(c);
         auto q = [&](const Vec3& p) { return TrilinearSample(c.q.data(), c.grid, 0.0f, p); };
         auto light = [&](const Vec3& p) {
@@ -456,10 +457,10 @@ TEST(MarchCpu, NoNanOrInfAtTheExtremes) {
                     c.params.setup.sigmaH = MarchOpticalDepthPerVoxel(sigma, 1.0f);
                     c.params.light = source;
                     c.params.setup.powder = true;
-                    c.params.setup.point.on = true;
-                    c.params.setup.point.position = {6, 5, 4.5f};  // at the eye, inside the cloud
-                    c.params.setup.point.radiance = {1e3f, 1e3f, 1e3f};
-                    c.params.setup.point.minDistance2 = 0.25f;
+                    c.params.setup.light.pointOn = true;
+                    c.params.setup.light.pointPosition = {6, 5, 4.5f};  // at the eye, inside the cloud
+                    c.params.setup.light.pointRadiance = {1e3f, 1e3f, 1e3f};
+                    c.params.setup.light.pointMinDistance2 = 0.25f;
                     const MarchImage im = RenderCpu(c, 1);
                     ASSERT_TRUE(AllFinite(im.rgb)) << "sigma " << sigma;
                     for (float v : im.rgb) ASSERT_GE(v, 0.0f);
@@ -525,15 +526,15 @@ TEST(MarchBench, DISABLED_Cumulus128At720p) {
         MarchParams p;
         p.camera = MakeCameraFrame(cam, 1280, 720);
         p.setup.size = {128, 128, 128};
-        p.setup.voxelSize = 50;
+        p.setup.voxelSize = p.setup.light.voxelSize = 50;
         p.setup.step = 0.5f;
         p.setup.sigmaH = MarchOpticalDepthPerVoxel(0.02f, 50);
         p.setup.epsilon = 0.01f;
         p.setup.sun = sp.sun;
-        p.setup.sunRadiance = {1.6f, 1.44f, 1.2f};
-        p.setup.ambient = {0.22f, 0.26f, 0.34f};
+        p.setup.light.sunRadiance = {1.6f, 1.44f, 1.2f};
+        p.setup.light.ambient = {0.22f, 0.26f, 0.34f};
         p.setup.background = {0.42f, 0.58f, 0.85f};
-        p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+        p.setup.light.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
         p.alpha = 0.5f;
         return p;
     };
@@ -547,7 +548,7 @@ TEST(MarchBench, DISABLED_Cumulus128At720p) {
         {"adaptive (kappa 0.02, t_a 64)",
          [](MarchParams& p) { p.setup.adaptive = true, p.setup.kappa = 0.02f, p.setup.adaptiveStart = 64; }},
         {"light march n_l 6", [](MarchParams& p) { p.light = MarchLightSource::March, p.lightSteps = 6; }},
-        {"phase none", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::None; }},
+        {"phase none", [](MarchParams& p) { p.setup.light.phase.kind = PhaseKind::None; }},
         {"jitter", [](MarchParams& p) { p.jitter = true; }},
         {"step 1.0", [](MarchParams& p) { p.setup.step = 1.0f; }},
         {"brick 4", [](MarchParams& p) { p.brick = 4; }},

@@ -15,15 +15,15 @@ namespace cb::test {
 inline MarchSetup PlainSetup(Vec3 size, float sigmaH) {
     MarchSetup s;
     s.size = size;
-    s.voxelSize = 1;
+    s.voxelSize = s.light.voxelSize = 1;
     s.step = 0.5f;
     s.sigmaH = sigmaH;
     s.epsilon = 0;
     s.sun = {0, 0, 1};
-    s.sunRadiance = {1.0f, 0.9f, 0.8f};
-    s.ambient = {0.2f, 0.25f, 0.3f};
+    s.light.sunRadiance = {1.0f, 0.9f, 0.8f};
+    s.light.ambient = {0.2f, 0.25f, 0.3f};
     s.background = {0.4f, 0.6f, 0.9f};
-    s.phase.kind = PhaseKind::None;
+    s.light.phase.kind = PhaseKind::None;
     return s;
 }
 
@@ -40,7 +40,7 @@ inline MarchParams CameraParams(const Extent3& e, std::array<double, 3> eye, std
     MarchParams p;
     p.camera = MakeCameraFrame(cam, w, h);
     p.setup = PlainSetup({float(e.nx), float(e.ny), float(e.nz)}, sigma);
-    p.setup.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+    p.setup.light.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
     p.setup.sun = SunDirection(0.7, 0.4);
     p.origin = {0, 0, 0};
     p.alpha = 0.5f;
@@ -66,10 +66,10 @@ inline LayersParams LayersFromCamera(const MarchParams& m, const Extent3& e, uin
     s.sigmaH = 0.3f;
     s.tiling = tiling;
     s.sun = m.setup.sun;
-    s.sunRadiance = m.setup.sunRadiance;
-    s.ambient = m.setup.ambient;
+    s.light.sunRadiance = m.setup.light.sunRadiance;
+    s.light.ambient = m.setup.light.ambient;
     s.background = m.setup.background;
-    s.phase = m.setup.phase;
+    s.light.phase = m.setup.light.phase;
     return p;
 }
 

@@ -158,9 +158,9 @@ TEST_P(RenderLayersAll, HomogeneousLayerIsTheSlabsClosedForm) {
                     }
                     const double transmittance =
                         std::exp(-double(s.sigmaH) * depth * double(s.spacing) / std::fabs(dz));
-                    const double phase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+                    const double phase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
                     for (int ch = 0; ch < 3; ++ch) {
-                        const double lit = double(s.sunRadiance[ch]) * phase + s.ambient[ch];
+                        const double lit = double(s.light.sunRadiance[ch]) * phase + s.light.ambient[ch];
                         const double want = lit * (1 - transmittance) + s.background[ch] * transmittance;
                         const double got = im.rgb[3 * (x + 40 * y) + ch];
                         worst = std::max(worst, std::fabs(got - want) / std::max(1.0, want));
@@ -228,9 +228,9 @@ TEST_P(RenderLayersAll, OpacityFadesOutTowardTheExtent) {
             const double w = std::clamp((3600.0 - r * r) / 2700.0, 0.0, 1.0);
             inBand += w > 0.05 && w < 0.95 ? 1 : 0;
             const double alpha = (1 - std::exp(-double(s.sigmaH) * 6.0 / dz)) * w * w * (3 - 2 * w);
-            const double phase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+            const double phase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
             for (int ch = 0; ch < 3; ++ch) {
-                const double lit = double(s.sunRadiance[ch]) * phase + s.ambient[ch];
+                const double lit = double(s.light.sunRadiance[ch]) * phase + s.light.ambient[ch];
                 const double want = lit * alpha + s.background[ch] * (1 - alpha);
                 worst = std::max(worst, std::fabs(im.rgb[3 * (x + 48 * y) + ch] - want) / std::max(1.0, want));
             }
@@ -289,10 +289,10 @@ TEST_P(RenderLayersAll, WangOpacityIsEq16OfQAndTheMap) {
                             ASSERT_EQ(std::bit_cast<uint32_t>(got[ch]), std::bit_cast<uint32_t>(s.background[ch]));
                     } else if (k > 0 && hi < 5.5 && !rim) {
                         ++lit;
-                        const double phase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+                        const double phase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
                         for (int ch = 0; ch < 3; ++ch) {
-                            const double want =
-                                (s.sunRadiance[ch] * phase + s.ambient[ch]) * (1 - keep) + s.background[ch] * keep;
+                            const double want = (s.light.sunRadiance[ch] * phase + s.light.ambient[ch]) * (1 - keep) +
+                                                s.background[ch] * keep;
                             worst = std::max(worst, std::fabs(got[ch] - want) / std::max(1.0, want));
                         }
                     }
@@ -396,7 +396,7 @@ Vec3 LayerPlaneMarch(const LayersCase& c, uint32_t x, uint32_t y) {
                 qBig[dst] = s.tiling || home ? qa[src] : 0.0f;
                 tBig[dst] = s.tiling || home ? c.T[src] : 1.0f;
             }
-    const double phase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+    const double phase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
     std::vector<std::pair<double, uint32_t>> crossings;
     for (uint32_t i = 0; i < s.count; ++i) {
         const double z = (i + 0.5) * double(e.nz) / s.count;
@@ -418,7 +418,8 @@ Vec3 LayerPlaneMarch(const LayersCase& c, uint32_t x, uint32_t y) {
         const double T = TrilinearSample(tBig.data(), big, 1.0f, p);
         const double len = std::min(double(s.spacing) / std::fabs(ray.dir[2]), double(s.maxLength));
         const double tau = std::exp(-double(s.sigmaH) * q * len);
-        for (int ch = 0; ch < 3; ++ch) L[ch] += Tv * (1 - tau) * (s.sunRadiance[ch] * T * phase + s.ambient[ch]);
+        for (int ch = 0; ch < 3; ++ch)
+            L[ch] += Tv * (1 - tau) * (s.light.sunRadiance[ch] * T * phase + s.light.ambient[ch]);
         Tv *= tau;
     }
     return {float(L[0] + Tv * s.background[0]), float(L[1] + Tv * s.background[1]), float(L[2] + Tv * s.background[2])};
@@ -469,7 +470,7 @@ TEST_P(RenderLayersGpu, MatchesTheCpu) {
             for (const auto& eye : Eyes(e)) {
                 LayersCase c = BlobLayers(e);
                 c.params = CameraLayers(e, eye, {0.5 * e.nx, 0.6 * e.ny, 0.5 * e.nz}, 37, 29, count, tiling);
-                c.params.setup.phase = phases[n++ % 4];
+                c.params.setup.light.phase = phases[n++ % 4];
                 if (count == 4) c.params.setup.maxLength = 2.5f;
                 if (count == 15) c.params.setup.drift = {1.37f, -0.61f};
                 if (tiling) {  // an extent of 20 voxel edges, faded over its outer half: 1 / (400 - 100)

@@ -118,10 +118,10 @@ TEST_P(RenderMarchGpu, MatchesTheCpuOnEveryOptionOnOddSizes) {
     };
     const auto pointLight = [](GpuMarchCase& c) {
         MarchSetup& s = c.params.setup;
-        s.point.on = true;
-        s.point.position = {0.5f * s.size[0], 0.45f * s.size[1], 0.3f * s.size[2]};
-        s.point.radiance = {30, 28, 40};
-        s.point.minDistance2 = 1;
+        s.light.pointOn = true;
+        s.light.pointPosition = {0.5f * s.size[0], 0.45f * s.size[1], 0.3f * s.size[2]};
+        s.light.pointRadiance = {30, 28, 40};
+        s.light.pointMinDistance2 = 1;
     };
     const std::vector<Option> options = {
         {"shade, skipping, HG", [](GpuMarchCase&) {}},
@@ -148,27 +148,28 @@ TEST_P(RenderMarchGpu, MatchesTheCpuOnEveryOptionOnOddSizes) {
              c.params.light = MarchLightSource::March, c.T.clear(), c.params.lightSteps = 3, c.params.jitter = true;
          }},
         {"powder", [](GpuMarchCase& c) { c.params.setup.powder = true, c.params.setup.powderC = 2.5f; }},
-        {"phase none", [](GpuMarchCase& c) { c.params.setup.phase.kind = PhaseKind::None; }},
+        {"phase none", [](GpuMarchCase& c) { c.params.setup.light.phase.kind = PhaseKind::None; }},
         {"phase cornette-shanks",
          [](GpuMarchCase& c) {
-             c.params.setup.phase = {PhaseKind::CornetteShanks, 0.7f};
+             c.params.setup.light.phase = {PhaseKind::CornetteShanks, 0.7f};
          }},
         {"phase cornette-shanks, back",
          [](GpuMarchCase& c) {
-             c.params.setup.phase = {PhaseKind::CornetteShanks, -0.3f};
+             c.params.setup.light.phase = {PhaseKind::CornetteShanks, -0.3f};
          }},
-        {"phase mie", [](GpuMarchCase& c) { c.params.setup.phase.kind = PhaseKind::Mie; }},
+        {"phase mie", [](GpuMarchCase& c) { c.params.setup.light.phase.kind = PhaseKind::Mie; }},
         {"point light", pointLight},
         {"point light, mie, light march, powder",
          [&](GpuMarchCase& c) {
              pointLight(c);
-             c.params.setup.phase.kind = PhaseKind::Mie;
+             c.params.setup.light.phase.kind = PhaseKind::Mie;
              c.params.light = MarchLightSource::March, c.T.clear();
              c.params.setup.powder = true;
          }},
         {"point light outside, step 0.21, epsilon 0",
          [](GpuMarchCase& c) {
-             c.params.setup.point = {true, {-3, 14, 20}, {300, 200, 100}, 4};
+             c.params.setup.light.pointOn = true, c.params.setup.light.pointPosition = {-3, 14, 20};
+             c.params.setup.light.pointRadiance = {300, 200, 100}, c.params.setup.light.pointMinDistance2 = 4;
              c.params.setup.step = 0.21f, c.params.setup.epsilon = 0;
          }},
         {"epsilon 0, step 0.37", [](GpuMarchCase& c) { c.params.setup.epsilon = 0, c.params.setup.step = 0.37f; }},
@@ -238,14 +239,15 @@ TEST_P(RenderMarchGpu, FullVolumeSeenHeadOnMatchesTheTrilinearOpticalDepth) {
     c.qCur = c.qPrev;
     c.T.assign(c.grid.Count(), 1.0f);
     c.params = GpuCameraParams(c.grid, {4, 4, 40}, {4, 4, 0}, 1, 1, 0.07f);
-    c.params.setup.phase.kind = PhaseKind::None;
+    c.params.setup.light.phase.kind = PhaseKind::None;
     c.params.setup.epsilon = 0;
     const GpuMarchImage im = RenderMarchOn(*mBackend, c);
     ASSERT_TRUE(im.ok);
     const double T = std::exp(-0.07 * (12 - 0.25));
     const MarchSetup& s = c.params.setup;
     for (int ch = 0; ch < 3; ++ch) {
-        const double expected = (double(s.sunRadiance[ch]) + s.ambient[ch]) * (1 - T) + T * s.background[ch];
+        const double expected =
+            (double(s.light.sunRadiance[ch]) + s.light.ambient[ch]) * (1 - T) + T * s.background[ch];
         EXPECT_NEAR(im.rgb[ch], expected, 1e-5 * expected) << ch;
     }
     EXPECT_EQ(im.stats.rays, 1u);
@@ -311,7 +313,7 @@ TEST_P(RenderMarchGpu, RowZeroIsTheTopOfTheImage) {
     cam.farPlane = 1e5;
     c.params = GpuCameraParams(c.grid, cam.eye, cam.target, 16, 12, 1.0f);
     c.params.camera = MakeCameraFrame(cam, 16, 12);
-    c.params.setup.phase.kind = PhaseKind::None;
+    c.params.setup.light.phase.kind = PhaseKind::None;
     const GpuMarchImage im = RenderMarchOn(*mBackend, c);
     ASSERT_TRUE(im.ok);
     const float bg = c.params.setup.background[2];
@@ -349,10 +351,10 @@ TEST_P(RenderMarchGpu, MieLookupsEqualTheCpus) {
         c.params.camera = MakeCameraFrame(cam, 48, 36);
         MarchSetup& s = c.params.setup;
         s.sun = sun;
-        s.sunRadiance = {1, 1, 1};
-        s.ambient = {0, 0, 0};
+        s.light.sunRadiance = {1, 1, 1};
+        s.light.ambient = {0, 0, 0};
         s.background = {0, 0, 0};
-        s.phase.kind = PhaseKind::Mie;
+        s.light.phase.kind = PhaseKind::Mie;
         const GpuMarchImage im = RenderMarchOn(*mBackend, c);
         ASSERT_TRUE(im.ok);
         const PhaseTable& table = kMieCloudTable;
@@ -399,7 +401,9 @@ TEST_P(RenderMarchGpu, NoNanOrInfAtTheExtremesAndTheCpusImage) {
                     c.params.light = source;
                     c.params.brick = 4;
                     c.params.setup.powder = true;
-                    c.params.setup.point = {true, {6, 5, 4.5f}, {1e3f, 1e3f, 1e3f}, 0.25f};
+                    c.params.setup.light.pointOn = true, c.params.setup.light.pointPosition = {6, 5, 4.5f};
+                    c.params.setup.light.pointRadiance = {1e3f, 1e3f, 1e3f};
+                    c.params.setup.light.pointMinDistance2 = 0.25f;
                     const GpuMarchImage got = RenderMarchOn(*mBackend, c);
                     const GpuMarchImage want = RenderMarchOn(cpu, c);
                     ASSERT_TRUE(got.ok && want.ok);
@@ -504,7 +508,7 @@ TEST(RenderMarchGLBench, DISABLED_NoiseLayerAgainstTheCpu) {
         {"shade, skip, HG (scene)", [](MarchParams&) {}},
         {"skipping off", [](MarchParams& p) { p.skipping = false; }},
         {"light march n_l 8", [](MarchParams& p) { p.light = MarchLightSource::March, p.lightSteps = 8; }},
-        {"phase mie", [](MarchParams& p) { p.setup.phase.kind = PhaseKind::Mie; }},
+        {"phase mie", [](MarchParams& p) { p.setup.light.phase.kind = PhaseKind::Mie; }},
     };
     const auto cpuNow = [] {
         timespec ts{};

@@ -85,9 +85,9 @@ TEST(RenderSplat, SingleSplatHandWorked) {
     p.opacity = 0.5f;
     p.qMin = 0.3f;
     p.sun = {0, 0, 1};
-    p.sunRadiance = {2, 2, 2};
-    p.phase = {PhaseKind::None, 0};
-    p.ambient = {0.1f, 0.1f, 0.1f};
+    p.light.sunRadiance = {2, 2, 2};
+    p.light.phase = {PhaseKind::None, 0};
+    p.light.ambient = {0.1f, 0.1f, 0.1f};
     p.background = {0, 0, 1};
     p.tile = 4;
     p.band = 4;
@@ -132,10 +132,10 @@ RenderCase RandomCloud(uint32_t seed) {
     p.origin = {0, 0, 0};
     p.splatDiameter = 75;
     p.sun = SunDirection(0.6, 0.4);
-    p.sunRadiance = {1.5f, 1.4f, 1.3f};
-    p.ambient = {0.2f, 0.25f, 0.3f};
+    p.light.sunRadiance = {1.5f, 1.4f, 1.3f};
+    p.light.ambient = {0.2f, 0.25f, 0.3f};
     p.background = {0.4f, 0.5f, 0.8f};
-    p.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
+    p.light.phase = {PhaseKind::HenyeyGreenstein, 0.6f};
     p.tile = 8;
     p.band = 4;
     p.alpha = 0.3f;

@@ -91,7 +91,7 @@ MarchParams LeakOtherMarch() {
     p.brick = 1;
     p.light = MarchLightSource::March;
     p.jitter = true, p.seed = 5, p.frame = 3;
-    p.setup.phase = {PhaseKind::Mie, 0};
+    p.setup.light.phase = {PhaseKind::Mie, 0};
     p.setup.adaptive = true, p.setup.kappa = 0.1f;
     p.alpha = 0.8f;
     return p;
@@ -103,7 +103,7 @@ LayersParams LeakOtherLayers(const std::vector<float>& map) {
     LayersSetup& s = p.setup;
     s.wang = true, s.coverage = 0.9f, s.density = 3.0f, s.map = map.data();
     s.drift = {1.37f, -0.61f};
-    s.phase = {PhaseKind::Mie, 0};
+    s.light.phase = {PhaseKind::Mie, 0};
     s.count = 2 * kLeakGrid.nz, s.spacing = 0.5f, s.maxLength = 2.5f;
     p.alpha = 0.9f;
     return p;

@@ -38,10 +38,12 @@ struct LayersSetup {
     bool wang = false;
     float coverage = 1, density = 1;
     const float* map = nullptr;
-    Vec3 sun{0, 0, 1};      // unit, toward the sun
-    float lightScale = 1;   // T's factor: 1, or with relighting max(0, s0 . s) (SPEC 15)
-    Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
-    PhaseParams phase;
+    Vec3 sun{0, 0, 1};     // unit, toward the sun
+    float lightScale = 1;  // T's factor: 1, or with relighting max(0, s0 . s) (SPEC 15)
+    Vec3 background{0, 0, 0};
+    // The light terms (core/math/Light.h; made by MakeLightTerms): the sun and the ambient light; the point
+    // light stays off (no transmittance toward it here).
+    LightTerms light;
 };
 
 // The voxel that padded index i stands for along an axis of n voxels: voxel
@@ -51,16 +53,6 @@ inline int64_t LayersPaddedSource(uint32_t i, uint32_t n, bool wrap) {
     if (i >= 1 && i <= n) return int64_t(i) - 1;
     if (!wrap) return -1;
     return i == 0 ? int64_t(n) - 1 : 0;
-}
-
-// The setup's light terms (core/math/Light.h): the sun and the ambient light, no point light.
-inline LightTerms LayersLightTerms(const LayersSetup& s) {
-    LightTerms L;
-    L.sunRadiance = s.sunRadiance;
-    L.ambient = s.ambient;
-    L.phase = s.phase;
-    L.voxelSize = s.voxelSize;
-    return L;
 }
 
 // Layer i's plane: z_i = (i + 1/2) nz / N (voxel units, above the grid's base).
@@ -191,7 +183,7 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     const float gain = (qt[1] * s.lightScale) * sunPhase;
     // The sample at the crossing (voxel units, before the drift and the wrap).
     const Vec3 at{s.eye[0] + hx, s.eye[1] + hy, z};
-    f.color = InScattered(LayersLightTerms(s), LightSample{gain, 1.0f, at, ray.dir});
+    f.color = InScattered(s.light, LightSample{gain, 1.0f, at, ray.dir});
     return f;
 }
 
@@ -245,7 +237,7 @@ inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersWalks& wa
                                      Fetch&& fetch) {
     LayersPixelResult r;
     r.color = s.background;
-    const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+    const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
     const float dz = ray.dir[2];
     const LayersWalk w = dz > 0.0f ? walks.up : dz < 0.0f ? walks.down : LayersWalk{};
     for (uint32_t n = 0; n < w.count; ++n) {

@@ -5,11 +5,15 @@
 // GPU blocks of the renderers (MarchGpu, LayersGpu, SplatFrame) nest as their
 // member `light`, made by MakeLightGpu below.
 //
+// Every renderer's setup carries the terms once, as its member `light`
+// (MarchSetup, LayersSetup, SplatParams), made by MakeLightTerms
+// (core/pipeline/LightTerms.h) in each renderer's Make*Params.
+//
 // Adding a light term (sky light, eye scattering, city glow): a member of
-// LightTerms (and, if it varies per sample, of LightSample), its lines in
-// InScattered here and in light.glsl, its member of LightGpu in both languages
-// and its line in MakeLightGpu / LightTermsOf, and where the scene sets it
-// (the renderers' Make*Params). The renderers themselves do not change.
+// LightTerms (and, if it varies per sample, of LightSample) and its lines in
+// InScattered, here and in light.glsl; its member of LightGpu in both languages
+// and its line in MakeLightGpu / LightTermsOf; its line in MakeLightTerms and
+// the scene section it reads; and the exact reference. The renderers do not change.
 //
 // The operations, in this order (bit-identical on every backend, built with
 // -ffp-contract=off): per channel c = sunRadiance_c * sunGain + ambient_c,

@@ -119,14 +119,6 @@ inline float TrilinearSample(const float* v, const Extent3& e, float outside, co
 
 // ---- Kernel constants ------------------------------------------------------------
 
-// The point light (Wang, Ji and Zhang, eq. 21) as the kernel sees it.
-struct MarchPointLight {
-    bool on = false;
-    Vec3 position{};         // voxel units
-    Vec3 radiance{};         // colour * intensity (radiance * m^2)
-    float minDistance2 = 1;  // r0^2 in metres^2: the 1/D^2 law is capped at 1/r0^2
-};
-
 struct MarchSetup {
     Vec3 size{1, 1, 1};   // the box [0, size], voxel units (nx, ny, nz)
     float voxelSize = 1;  // h, metres
@@ -136,11 +128,12 @@ struct MarchSetup {
     float sigmaH = 1;                    // sigma h: optical depth per voxel edge at q = 1 (finite)
     float epsilon = 0.01f;
     Vec3 sun{0, 0, 1};  // unit, toward the sun
-    Vec3 sunRadiance{1, 1, 1}, ambient{0, 0, 0}, background{0, 0, 0};
-    PhaseParams phase;
+    Vec3 background{0, 0, 0};
     bool powder = false;
     float powderC = 2;
-    MarchPointLight point;
+    // The light terms (core/math/Light.h; made by core/pipeline/LightTerms.h's MakeLightTerms): the sun's
+    // radiance, the ambient light, the phase function, the lightning's point light; light.voxelSize is h.
+    LightTerms light;
 };
 
 // sigma h, capped so that sigma h q l stays free of inf * 0 (as in MakeSliceAttenuation).
@@ -171,20 +164,6 @@ inline float PowderTerm(float c, float lightT) { return 1.0f - std::pow(std::max
 inline float ReinhardToneMap(float c, float exposure) {
     const float x = std::max(c * exposure, 0.0f);
     return std::isinf(x) ? 1.0f : x / (1.0f + x);
-}
-
-// The setup's light terms (core/math/Light.h), as MarchRay and MakeMarchGpu gather them.
-inline LightTerms MarchLightTerms(const MarchSetup& s) {
-    LightTerms L;
-    L.sunRadiance = s.sunRadiance;
-    L.ambient = s.ambient;
-    L.phase = s.phase;
-    L.voxelSize = s.voxelSize;
-    L.pointOn = s.point.on;
-    L.pointPosition = s.point.position;
-    L.pointRadiance = s.point.radiance;
-    L.pointMinDistance2 = s.point.minDistance2;
-    return L;
 }
 
 // ---- Brick skip structure (SPEC 10) ----------------------------------------------
@@ -245,7 +224,8 @@ float SunLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& q)
 // or at the box exit, whichever comes first.
 template <class Density>
 float PointLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& q) {
-    const Vec3 toLight{s.point.position[0] - p[0], s.point.position[1] - p[1], s.point.position[2] - p[2]};
+    const Vec3 toLight{s.light.pointPosition[0] - p[0], s.light.pointPosition[1] - p[1],
+                       s.light.pointPosition[2] - p[2]};
     const float dist = std::sqrt(MarchDot(toLight, toLight));
     if (!(dist > 0.0f)) return 1.0f;
     const Vec3 u = MarchScale(toLight, 1.0f / dist);
@@ -276,9 +256,8 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
     MarchRayResult r;
     float L0 = 0, L1 = 0, L2 = 0, T = 1;
     if (!ray.Empty()) {
-        const LightTerms terms = MarchLightTerms(s);
         // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
-        const float sunPhase = PhaseValue(s.phase, MarchDot(s.sun, ray.dir));
+        const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
         const float B = bricks ? float(bricks->brick) : 1.0f, invB = 1.0f / B;
         const Vec3 invDir = InverseDirection(ray.dir);
         float tn = ray.tMin;
@@ -349,7 +328,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                 const MarchLightSample l = light(p);
                 float sunGain = l.sun * sunPhase;
                 if (s.powder) sunGain *= PowderTerm(s.powderC, l.sun);
-                const Vec3 in = InScattered(terms, LightSample{sunGain, l.point, p, ray.dir});
+                const Vec3 in = InScattered(s.light, LightSample{sunGain, l.point, p, ray.dir});
                 const float w = T * (1.0f - tau);
                 L0 += w * in[0];
                 L1 += w * in[1];

@@ -51,7 +51,7 @@ struct alignas(16) SplatFrame {
     float unused3;
     LightGpu light;  // the sun, the ambient light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(SplatFrame) == 288);
+static_assert(sizeof(SplatFrame) == 13 * 16 + sizeof(LightGpu), "SplatFrame is thirteen 16-byte rows and its light");
 static_assert(offsetof(SplatFrame, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 // One splat, as the std430 struct `Splat` of core/math/splat.glsl (48 bytes).

@@ -60,11 +60,11 @@ Result<std::vector<uint8_t>> DownloadSplatBoxVisibility(Backend& backend, const 
 }
 
 GroundLight MakeGroundLight(const SplatParams& p) {
-    return {p.ground.albedo, p.sunRadiance, p.ambient, p.background, p.sun[2]};
+    return {p.ground.albedo, p.light.sunRadiance, p.light.ambient, p.background, p.sun[2]};
 }
 
 GroundLight MakeGroundLight(const MarchParams& p) {
-    return {p.ground.albedo, p.setup.sunRadiance, p.setup.ambient, p.setup.background, p.setup.sun[2]};
+    return {p.ground.albedo, p.setup.light.sunRadiance, p.setup.light.ambient, p.setup.background, p.setup.sun[2]};
 }
 
 Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Extent3& grid, std::string_view where) {

@@ -38,7 +38,7 @@ LayersGpu MakeLayersGpu(const LayersParams& params) {
     g.drift = s.drift;
     g.coverage = s.coverage;
     g.density = s.density;
-    g.light = MakeLightGpu(LayersLightTerms(s));
+    g.light = MakeLightGpu(s.light);
     return g;
 }
 

@@ -51,7 +51,7 @@ struct alignas(16) LayersGpu {
     float density;               // D_w (wang)
     LightGpu light;              // the sun, the ambient light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(LayersGpu) == 16 * 16, "LayersGpu is sixteen 16-byte rows");
+static_assert(sizeof(LayersGpu) == 11 * 16 + sizeof(LightGpu), "LayersGpu is eleven 16-byte rows and its light");
 static_assert(offsetof(LayersGpu, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 LayersGpu MakeLayersGpu(const LayersParams& params);

@@ -50,7 +50,7 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     g.strideZ = (e.nx + 2) * (e.ny + 2);
     const auto counts = MarchBrickCounts(e, brick);
     g.bricks = {counts[0], counts[1], counts[2]};
-    g.light = MakeLightGpu(MarchLightTerms(s));
+    g.light = MakeLightGpu(s.light);
     return g;
 }
 

@@ -6,8 +6,8 @@
 //
 // Everything the CPU computes once per call (the eye in voxel units, sigma h,
 // the point light in voxel units) is computed here by the same code
-// (core/math/March.h, MakeMarchParams in core/stages/render_march/), so the GPU
-// starts from the CPU's floats.
+// (core/math/March.h, MakeMarchParams in core/stages/render_march/ and its
+// MakeLightTerms, core/pipeline/LightTerms.h), so the GPU starts from the CPU's floats.
 #pragma once
 
 #include <array>
@@ -61,7 +61,7 @@ struct alignas(16) MarchGpu {
     uint32_t unused;
     LightGpu light;  // the sun, the ambient light, the point light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(MarchGpu) == 16 * 16, "MarchGpu is sixteen 16-byte rows");
+static_assert(sizeof(MarchGpu) == 11 * 16 + sizeof(LightGpu), "MarchGpu is eleven 16-byte rows and its light");
 static_assert(offsetof(MarchGpu, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 // The block for one call on a grid of extent e. The Mie table's values are

@@ -2,15 +2,6 @@
 
 namespace cb {
 
-LightTerms SplatLightTerms(const SplatParams& p) {
-    LightTerms L;
-    L.sunRadiance = p.sunRadiance;
-    L.ambient = p.ambient;
-    L.phase = p.phase;
-    L.voxelSize = p.voxelSize;
-    return L;
-}
-
 SplatFrame MakeSplatFrame(const SplatParams& p, const Extent3& e, const FlatSplatOrder& flat, uint32_t width,
                           uint32_t height) {
     const CameraFrame& cam = p.camera;
@@ -43,7 +34,7 @@ SplatFrame MakeSplatFrame(const SplatParams& p, const Extent3& e, const FlatSpla
     F.voxelSize = p.voxelSize;
     F.splatDiameter = p.splatDiameter;
     F.alpha = p.alpha;
-    F.light = MakeLightGpu(SplatLightTerms(p));
+    F.light = MakeLightGpu(p.light);
     return F;
 }
 

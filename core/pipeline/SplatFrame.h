@@ -9,9 +9,6 @@
 
 namespace cb {
 
-// The renderer's light terms (core/math/Light.h): the sun and the ambient light, no point light.
-LightTerms SplatLightTerms(const SplatParams& params);
-
 // The frame of one image of `grid` in `width` x `height` pixels.
 SplatFrame MakeSplatFrame(const SplatParams& params, const Extent3& grid, const FlatSplatOrder& order, uint32_t width,
                           uint32_t height);

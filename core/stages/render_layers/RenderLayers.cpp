@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "core/math/Noise.h"
+#include "core/pipeline/LightTerms.h"
 #include "core/scene/SceneReaders.h"
 #include "core/stages/noise/Noise.h"
 
@@ -110,10 +111,9 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     // Relighting: shade's T is the first step's (ShadeSunAt); n . s = T (s0 . s) with n = T s0.
     if (sc.layers.relight == LayersRelight::Vector)
         s.lightScale = std::max(0.0f, MarchDot(sc.sun.DirectionAt(0), s.sun));
-    s.sunRadiance = sc.sun.Radiance();
-    s.ambient = sc.lighting.Ambient();
     s.background = sc.lighting.Background();
-    s.phase = sc.phase;
+    s.light = MakeLightTerms(sc, step);
+    s.light.pointOn = false;  // no transmittance toward the point light in the layers: it stays off
     s.wang = sc.layers.wang.enabled;
     s.coverage = float(sc.layers.wang.coverage);
     s.density = float(sc.layers.wang.density);

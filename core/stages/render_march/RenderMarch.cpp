@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "core/base/NamedValues.h"
+#include "core/pipeline/LightTerms.h"
 #include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
 #include "core/stages/shade/Shade.h"
@@ -177,19 +178,10 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     s.sigmaH = MarchOpticalDepthPerVoxel(float(sc.shade.sigma), h);
     s.epsilon = float(sc.march.epsilon);
     s.sun = sc.sun.DirectionAt(step);
-    s.sunRadiance = sc.sun.Radiance();
-    s.ambient = sc.lighting.Ambient();
     s.background = sc.lighting.Background();
-    s.phase = sc.phase;
     s.powder = sc.march.powder;
     s.powderC = float(sc.march.powderC);
-    const LightningSettings& l = sc.lightning;
-    s.point.on = l.OnAt(step);
-    for (int c = 0; c < 3; ++c) {
-        s.point.position[c] = float((l.position[c] - sc.grid.origin[c]) / sc.grid.voxelSize);
-        s.point.radiance[c] = float(l.color[c] * l.intensity);
-    }
-    s.point.minDistance2 = float(l.radius * l.radius);
+    s.light = MakeLightTerms(sc, step);
     p.alpha = sc.render.FrameAlpha(frame, frames);
     p.light = sc.march.light;
     p.lightSteps = sc.march.lightSteps;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <memory>
 
+#include "core/pipeline/LightTerms.h"
 #include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
 #include "core/stages/density/Density.h"
@@ -67,10 +68,9 @@ SplatParams MakeSplatParams(const Scene& sc, const CameraSettings& camera, uint3
     SplatParams p;
     p.camera = MakeCameraFrame(camera, sc.render.width, sc.render.height);
     p.sun = sc.sun.DirectionAt(step);
-    p.sunRadiance = sc.sun.Radiance();
-    p.ambient = sc.lighting.Ambient();
     p.background = sc.lighting.Background();
-    p.phase = sc.phase;
+    p.light = MakeLightTerms(sc, step);
+    p.light.pointOn = false;  // no transmittance toward the point light in the splats: it stays off
     p.qMin = float(sc.splat.qMin);
     p.splatDiameter = float(sc.splat.splatScale * sc.grid.voxelSize);
     p.opacity = float(sc.splat.opacity);

@@ -11,6 +11,7 @@
 #include "core/base/Counter.h"
 #include "core/math/Camera.h"
 #include "core/math/Ground.h"
+#include "core/math/Light.h"
 #include "core/math/Shading.h"
 
 namespace cb {
@@ -32,10 +33,11 @@ struct SplatSettings {
 struct SplatParams {
     CameraFrame camera;
     const SplatOrder* order = nullptr;
-    Vec3 sun{0, 0, 1};          // toward the sun
-    Vec3 sunRadiance{1, 1, 1};  // colour * intensity
-    Vec3 ambient{0, 0, 0}, background{0, 0, 0};
-    PhaseParams phase;
+    Vec3 sun{0, 0, 1};  // toward the sun
+    Vec3 background{0, 0, 0};
+    // The light terms (core/math/Light.h; made by MakeLightTerms): the sun and the ambient light; the point
+    // light stays off (no transmittance toward it here).
+    LightTerms light;
     float qMin = 0.3f, splatDiameter = 75, opacity = 0.6f, alpha = 0.5f;
     std::array<float, 3> origin{0, 0, 0};
     float voxelSize = 50;
