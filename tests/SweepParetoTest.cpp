@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "harness/accuracy/Measurement.h"
+#include "harness/accuracy/Evaluator.h"
 #include "harness/accuracy/SweepFields.h"
 #include "harness/accuracy/SweepPareto.h"
 
@@ -193,6 +194,25 @@ TEST(SweepPareto, InfinitePsnrIsInfAndNull) {
     EXPECT_EQ(cells.back().text, "inf");
     r.result.psnrDb = 42.5;
     EXPECT_EQ(RowJson(r)["error"]["psnr_db"].get<double>(), 42.5);
+}
+
+}  // namespace
+}  // namespace cb
+
+namespace cb {
+namespace {
+
+// The lighting inputs (q and D) are simulated once across the fields that only the stages after them read:
+// from the descriptors, the sections the evaluator once listed by hand (shade, shadow, sun, phase, render,
+// lighting, march, lightning, layers, and description, which nothing reads) and none of those that shape the
+// volume.
+TEST(SweepFields, LightingOnlyFieldsLeaveTheVolume) {
+    for (const char* path : {"shade.sigma", "shadow.form", "sun.elevation_deg", "phase.function", "render.width",
+                             "lighting.ambient", "march.step", "lightning.intensity", "layers.count", "description"})
+        EXPECT_TRUE(LightingOnly(path)) << path;
+    for (const char* path : {"ca.seed", "ca.p_hum", "ellipsoids", "smooth.radius", "noise.seed", "density.tile",
+                             "grid.size", "steps", "stages"})
+        EXPECT_FALSE(LightingOnly(path)) << path;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <iterator>
+#include <set>
 
 #include "core/stages/ca/Ca.h"
 #include "core/stages/density/Density.h"
@@ -168,6 +169,42 @@ std::vector<PlannedBuffer> PlanBuffers(const Scene& scene) {
         if (plan.pending[i]) buffers.push_back({r, BufferRole::Pending, 0, format, extent});
     }
     return buffers;
+}
+
+bool FieldsListed(std::span<const std::string_view> fields, std::string_view path) {
+    return std::ranges::any_of(fields, [&](std::string_view f) { return FieldsOverlap(path, f); });
+}
+
+namespace {
+
+// Depth-first over the writers of the stage's inputs; `seen` stops at a stage that reads its own outputs.
+bool FieldsReach(Stage stage, std::string_view path, std::set<Stage>& seen) {
+    if (!seen.insert(stage).second) return false;
+    const StageDescriptor& d = Describe(stage);
+    if (FieldsListed(d.sceneFields, path)) return true;
+    // Shade's sun is fixed at step 0's when a renderer relights (Scene::needs.shadeOnce, from the descriptors).
+    if (stage == Stage::Shade && std::ranges::any_of(kAllStages, [&](Stage s) {
+            const RendererDescriptor* r = Describe(s).renderer;
+            return r && FieldsListed(r->relightFields, path);
+        }))
+        return true;
+    std::vector<Resource> inputs = d.reads;
+    inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
+    for (Stage writer : kAllStages) {
+        const std::vector<Resource>& writes = Describe(writer).writes;
+        const bool feeds =
+            std::ranges::any_of(inputs, [&](Resource r) { return std::ranges::find(writes, r) != writes.end(); });
+        if (feeds && FieldsReach(writer, path, seen)) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+bool StageOutputReads(Stage stage, std::string_view path) {
+    if (FieldsListed(kFieldsEveryStageReads, path)) return true;
+    std::set<Stage> seen;
+    return FieldsReach(stage, path, seen);
 }
 
 }  // namespace cb

@@ -6,6 +6,8 @@
 
 #include <array>
 #include <optional>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "core/pipeline/StageAdapter.h"
@@ -19,6 +21,12 @@ namespace cb {
 const StageDescriptor& Describe(Stage stage);
 // Whether any of `enabled` is a renderer (its descriptor's `renderer`).
 bool RunsARenderer(const StageSet& enabled);
+// Whether `path` (a dotted scene field) overlaps one of `fields` (FieldsOverlap).
+bool FieldsListed(std::span<const std::string_view> fields, std::string_view path);
+// Whether `path` can change what `stage` writes: it overlaps a field of kFieldsEveryStageReads or of the
+// stage's sceneFields, or one that a stage writing a resource it reads (reads and optionalReads) depends on,
+// transitively; shade's output also follows the fields that make a renderer relight (Scene::needs).
+bool StageOutputReads(Stage stage, std::string_view path);
 // The stage's call adapter, from its module (core/pipeline/StageAdapter.h).
 StageAdapter AdapterOf(Stage stage);
 

@@ -9,17 +9,14 @@
 namespace cb {
 using nlohmann::json;
 
-namespace {
-
-// Paths whose value changes only the lighting stages, not q or D.
-bool LightingOnly(const std::string& path) {
-    for (const char* prefix :
-         {"shade", "shadow", "sun", "phase", "render", "lighting", "description", "march", "lightning", "layers"})
-        if (path == prefix || path.starts_with(std::string(prefix) + ".")) return true;
-    return false;
+bool LightingOnly(std::string_view path) {
+    for (Stage stage : kAllStages) {
+        const std::vector<Resource>& writes = Describe(stage).writes;
+        const bool volume = std::ranges::any_of(writes, [](Resource r) { return r == Resource::Q || r == Resource::ColumnSum; });
+        if (volume && StageOutputReads(stage, path)) return false;
+    }
+    return true;
 }
-
-}  // namespace
 
 bool ReferenceRenderIgnores(std::string_view p) {
     // A renderer's own settings the reference does not read: the field itself, or one inside it.

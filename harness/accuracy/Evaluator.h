@@ -120,6 +120,9 @@ class ImageReferences {
 // render computes (the reference fixes its own step, light, epsilon, jitter and skipping, and reads no
 // shade (but shade.sigma), shadow, density or layers setting): the reference is cached across it.
 bool ReferenceRenderIgnores(std::string_view path);
+// Whether a change of `path` leaves q and D as they are (no stage writing them reads it, StageOutputReads):
+// the lighting inputs are then simulated once for every value.
+bool LightingOnly(std::string_view path);
 // The renderer whose parameters the exact reference render takes (RendererDescriptor::referenceParams).
 Stage ReferenceRenderer();
 

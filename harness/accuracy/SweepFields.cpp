@@ -9,42 +9,6 @@
 #include "harness/accuracy/Evaluator.h"
 
 namespace cb {
-namespace {
-
-bool SweepFieldsListed(std::span<const std::string_view> fields, std::string_view path) {
-    return std::ranges::any_of(fields, [&](std::string_view f) { return FieldsOverlap(path, f); });
-}
-
-// Depth-first over the writers of the stage's inputs; `seen` stops at a stage that reads its own outputs.
-bool SweepFieldsReach(Stage stage, std::string_view path, std::set<Stage>& seen) {
-    if (!seen.insert(stage).second) return false;
-    const StageDescriptor& d = Describe(stage);
-    if (SweepFieldsListed(d.sceneFields, path)) return true;
-    // Shade's sun is fixed at step 0's when a renderer relights (Scene::needs.shadeOnce, from the descriptors).
-    if (stage == Stage::Shade && std::ranges::any_of(kAllStages, [&](Stage s) {
-            const RendererDescriptor* r = Describe(s).renderer;
-            return r && SweepFieldsListed(r->relightFields, path);
-        }))
-        return true;
-    std::vector<Resource> inputs = d.reads;
-    inputs.insert(inputs.end(), d.optionalReads.begin(), d.optionalReads.end());
-    for (Stage writer : kAllStages) {
-        const std::vector<Resource>& writes = Describe(writer).writes;
-        const bool feeds =
-            std::ranges::any_of(inputs, [&](Resource r) { return std::ranges::find(writes, r) != writes.end(); });
-        if (feeds && SweepFieldsReach(writer, path, seen)) return true;
-    }
-    return false;
-}
-
-}  // namespace
-
-bool StageOutputReads(Stage stage, std::string_view path) {
-    if (SweepFieldsListed(kFieldsEveryStageReads, path)) return true;
-    std::set<Stage> seen;
-    return SweepFieldsReach(stage, path, seen);
-}
-
 bool RowDependsOn(Stage stage, std::string_view path) {
     if (StageOutputReads(stage, path)) return true;
     return Describe(stage).renderer && StageOutputReads(ReferenceRenderer(), path) && !ReferenceRenderIgnores(path);
@@ -62,7 +26,7 @@ std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
     const bool images = std::ranges::any_of(axes, [](const SweepAxis& a) {
         return std::ranges::any_of(kAllStages, [&](Stage stage) {
             const RendererDescriptor* r = Describe(stage).renderer;
-            return r && SweepFieldsListed(r->imageFields, a.path);
+            return r && FieldsListed(r->imageFields, a.path);
         });
     });
     std::vector<Stage> candidates = {Stage::Shade, Stage::Shadow};

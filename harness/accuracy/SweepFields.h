@@ -8,16 +8,12 @@
 #include <string_view>
 #include <vector>
 
+#include "core/plan/StageGraph.h"
 #include "core/scene/Scene.h"
 #include "core/scene/Stage.h"
 #include "harness/run/VaryAxes.h"
 
 namespace cb {
-
-// Whether `path` can change what `stage` writes: it overlaps a field of kFieldsEveryStageReads or of the
-// stage's sceneFields, or one that a stage writing a resource it reads (reads and optionalReads) depends on,
-// transitively.
-bool StageOutputReads(Stage stage, std::string_view path);
 
 // Whether `path` can change a row of `stage` as sweep measures it: its output (StageOutputReads), or for a
 // renderer the exact reference render it is compared with (the fields render_march's output reads that the
