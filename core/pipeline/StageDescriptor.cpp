@@ -115,6 +115,7 @@ std::string CompareRule::Text(std::string_view symbol) const {
 }
 
 CompareRule BitExactRule(const Scene&) { return {CompareRule::Kind::BitExact}; }
+CompareRule ImageRuleSpec8(const Scene&) { return {CompareRule::Kind::Image, 2.0 / 255.0, 0.001, 8.0 / 255.0}; }
 
 uint32_t SharesOfSlicesK(const Scene& scene, uint32_t) { return scene.grid.size.nz; }
 

@@ -216,6 +216,8 @@ constexpr bool FieldsOverlap(std::string_view path, std::string_view listed) {
 
 // Helpers the stages' descriptors share.
 CompareRule BitExactRule(const Scene& scene);
+// SPEC 8's image rule: per channel 2/255 on 99.9 % of pixels, 8/255 everywhere (the LDR renderers' rule).
+CompareRule ImageRuleSpec8(const Scene& scene = {});
 // The share count of a stage whose shares are the slices k (time-slicing; SliceRange): nz.
 uint32_t SharesOfSlicesK(const Scene& scene, uint32_t step);
 

@@ -99,7 +99,7 @@ struct ImageComparison {
 };
 Result<ImageComparison> CompareImages(const std::vector<float>& reference, const std::vector<float>& candidate,
                                       uint32_t width, uint32_t height,
-                                      const CompareRule& rule = Describe(Stage::RenderSplat).rule(Scene{}));
+                                      const CompareRule& rule = ImageRuleSpec8());
 // Writes |reference - candidate| as an EXR (for a failed comparison).
 Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
                             const std::vector<float>& candidate, uint32_t width, uint32_t height);

@@ -67,9 +67,6 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
 namespace cb {
 namespace {
 
-// SPEC 15: SPEC 8's image rule.
-CompareRule LayersImageRule(const Scene&) { return {CompareRule::Kind::Image, 2.0 / 255.0, 0.001, 8.0 / 255.0}; }
-
 // Like the other renderers, the layers interpolate q between the last two steps.
 std::vector<Resource> LayersPrevious(const Scene&) { return {Resource::Q}; }
 
@@ -233,7 +230,7 @@ const StageDescriptor& DescribeRenderLayers() {
         .outputStepsOnly = true,
         .renderer = &kLayersRenderer,
         .symbol = "image",
-        .rule = LayersImageRule,
+        .rule = ImageRuleSpec8,  // SPEC 15 takes SPEC 8's rule
         .sceneFields = kRenderLayersSceneFields,
     };
     return descriptor;

@@ -51,9 +51,6 @@ void ReadSplat(const Json& root, Validator& check, SplatSettings& splat) {
 namespace cb {
 namespace {
 
-// SPEC 8: per channel 2/255 on 99.9 % of pixels, 8/255 everywhere.
-CompareRule SplatImageRule(const Scene&) { return {CompareRule::Kind::Image, 2.0 / 255.0, 0.001, 8.0 / 255.0}; }
-
 // The splat renderer interpolates q between the last two steps, and skips
 // boxes empty in both steps' occupancy.
 std::vector<Resource> SplatPrevious(const Scene& scene) {
@@ -166,7 +163,7 @@ const StageDescriptor& DescribeRenderSplat() {
         .outputStepsOnly = true,
         .renderer = &kSplatRenderer,
         .symbol = "image",
-        .rule = SplatImageRule,
+        .rule = ImageRuleSpec8,
         .choices = kSplatChoices,
         .sceneFields = kRenderSplatSceneFields,
     };
