@@ -51,6 +51,16 @@ const StageDescriptor& Describe(Stage stage) {
     return d;
 }
 
+const std::vector<Stage>& RendererStages() {
+    static const std::vector<Stage> renderers = [] {
+        std::vector<Stage> out;
+        for (Stage s : kAllStages)
+            if (Describe(s).renderer) out.push_back(s);
+        return out;
+    }();
+    return renderers;
+}
+
 bool RunsARenderer(const StageSet& enabled) {
     return std::ranges::any_of(kAllStages, [&](Stage s) { return Describe(s).renderer && enabled.Has(s); });
 }

@@ -27,6 +27,8 @@ bool FieldsListed(std::span<const std::string_view> fields, std::string_view pat
 // stage's sceneFields, or one that a stage writing a resource it reads (reads and optionalReads) depends on,
 // transitively; shade's output also follows the fields that make a renderer relight (Scene::needs).
 bool StageOutputReads(Stage stage, std::string_view path);
+// The renderers (stages with a RendererDescriptor), in stage order.
+const std::vector<Stage>& RendererStages();
 // The stage's call adapter, from its module (core/pipeline/StageAdapter.h).
 StageAdapter AdapterOf(Stage stage);
 

@@ -187,9 +187,9 @@ Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<co
     ImageReferences& refs = eval.Images();
     const int repeats = eval.Measurement().repeats;
     json rows = json::array();
-    for (Stage stage : kAllStages) {
+    for (Stage stage : RendererStages()) {
         const RendererDescriptor* renderer = Describe(stage).renderer;
-        if (!renderer || !scene.stages.Has(stage)) continue;
+        if (!scene.stages.Has(stage)) continue;
         const Stage one[] = {stage};
         CB_TRY(MeasureImageRows(refs, session, repeats, {}, backends, one, rows));
         if (renderer->accuracyVariants)

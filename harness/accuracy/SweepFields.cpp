@@ -31,8 +31,7 @@ std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
     });
     std::vector<Stage> candidates = {Stage::Shade, Stage::Shadow};
     if (images)
-        for (Stage stage : kAllStages)
-            if (Describe(stage).renderer) candidates.push_back(stage);
+        candidates.insert(candidates.end(), RendererStages().begin(), RendererStages().end());
     std::vector<Stage> stages;
     for (Stage stage : candidates)
         if (std::ranges::any_of(axes, [&](const SweepAxis& a) { return RowDependsOn(stage, a.path); }))

@@ -252,9 +252,8 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
     const bool images = RunsARenderer(scene.stages);
     if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow) && !images) {
         std::string renderers;
-        for (Stage stage : kAllStages)
-            if (Describe(stage).renderer)
-                renderers += (renderers.empty() ? "\"" : ", \"") + std::string(StageName(stage)) + "\"";
+        for (Stage stage : RendererStages())
+            renderers += (renderers.empty() ? "\"" : ", \"") + std::string(StageName(stage)) + "\"";
         std::fprintf(stderr, "%s: stages: accuracy needs \"shade\", \"shadow\" or a renderer (%s)\n",
                      scene.path.c_str(), renderers.c_str());
         return kExitBadScene;
@@ -393,8 +392,8 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
                 if (imageRefs.empty()) imageRefs = part.extra["images"]["references"];
                 continue;
             }
-            for (Stage r : kAllStages)
-                if (Describe(r).renderer && scene.stages.Has(r))
+            for (Stage r : RendererStages())
+                if (scene.stages.Has(r))
                     imageRows.push_back({{"renderer", StageName(r)},
                                          {"backend", part.name},
                                          {"settings", json::object()},

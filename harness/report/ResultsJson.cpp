@@ -58,8 +58,8 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run) {
             stages[std::string(StageName(stage))] = entry;
         }
         nlohmann::json frames = nlohmann::json::object();
-        for (Stage renderer : kAllStages) {
-            if (!Describe(renderer).renderer || !scene.stages.Has(renderer)) continue;
+        for (Stage renderer : RendererStages()) {
+            if (!scene.stages.Has(renderer)) continue;
             for (const CameraSettings& camera : scene.render.cameras) {
                 std::vector<double> wall, device;
                 ForEachFrame(run, renderer, camera.name, [&](const StepRecord& r, const FrameRecord& f) {

@@ -53,9 +53,9 @@ report::Section TimingSection(const Scene& scene, const BackendRun& run) {
                                        StageSamples(scene, run, stage, StageClock::Device)));
     }
     // One row per camera for each renderer the scene runs: its frames' ms, and the last frame's reported counter.
-    for (Stage renderer : kAllStages) {
+    for (Stage renderer : RendererStages()) {
         const RendererDescriptor* d = Describe(renderer).renderer;
-        if (!d || !scene.stages.Has(renderer)) continue;
+        if (!scene.stages.Has(renderer)) continue;
         const size_t reported = ReportedCounterIndex(d->counters);
         const std::string_view what = reported < d->counters.size() ? d->counters[reported].name : "";
         for (const CameraSettings& camera : scene.render.cameras) {

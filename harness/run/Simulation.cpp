@@ -18,9 +18,7 @@ Simulation::Simulation(const Scene& scene, Backend& backend, bool everyStepOutpu
       mEveryStepOutputs(everyStepOutputs) {}
 
 bool Simulation::IsOutputStep(uint32_t step) const {
-    bool renders = false;
-    for (Stage stage : mSchedule) renders |= Describe(stage).renderer != nullptr;
-    if (mEveryStepOutputs || !renders) return true;
+    if (mEveryStepOutputs || !RunsARenderer(mScene.stages)) return true;
     if (step + 1 == mScene.steps) return true;
     const uint32_t every = mScene.render.everySteps;
     return every > 0 && step >= mScene.warmupSteps && (step - mScene.warmupSteps) % every == 0;
@@ -282,9 +280,7 @@ Status Simulation::Step(StepRecord& record, const Observer& observe) {
     // section 6.3), one per alpha of render.frames_per_step.
     auto beforeObserver = [&]() -> Status {
         CB_TRY(RunStepStages(record, outputStep));
-        bool renders = false;
-        for (Stage stage : mSchedule) renders |= Describe(stage).renderer != nullptr;
-        if (renders && outputStep) CB_TRY(RenderFrames(record, std::max(mScene.render.framesPerStep, 1u), {}));
+        if (outputStep && RunsARenderer(mScene.stages)) CB_TRY(RenderFrames(record, std::max(mScene.render.framesPerStep, 1u), {}));
         return {};
     };
     // The state advances, and the host updates the ellipsoid list (inside the batch: it overlaps the device's work).
