@@ -1,16 +1,31 @@
 # Build step for one OpenGL shader (run with cmake -P):
-#   SOURCE     impl_gl/shaders/<name>.frag (no #version line)
-#   INCLUDES   ;-list of core/math files to prepend
-#   OUTPUT     the .inc file to write: the full source as a C++ raw string
-#   VALIDATOR  glslangValidator, which must accept the full source
+#   SOURCE       impl_gl/shaders/<name>.frag or .vert: no #version line; its first lines may be
+#                #include "<file>.glsl" lines, and only those (OpenGL has no #include of its own)
+#   INCLUDE_DIR  the folder of those files (core/math)
+#   OUTPUT       the .inc file to write: the full source as a C++ raw string
+#   VALIDATOR    glslangValidator, which must accept the full source
+# The full source is "#version 450 core", each included file in the order listed, then the rest of
+# the shader after a #line that keeps its line numbers in messages.
 get_filename_component(name ${SOURCE} NAME)
-set(full "#version 450 core\n")
-foreach(include ${INCLUDES})
-  file(READ ${include} text)
-  string(APPEND full "${text}\n")
-endforeach()
 file(READ ${SOURCE} body)
-string(APPEND full "#line 1\n${body}")
+string(REGEX MATCH "^(#include \"[A-Za-z0-9_]+\\.glsl\"\n)*" block "${body}")
+string(LENGTH "${block}" block_length)
+string(SUBSTRING "${body}" ${block_length} -1 body)
+if(body MATCHES "(^|\n)[ \t]*#[ \t]*include")
+  message(FATAL_ERROR "${SOURCE}: #include lines must be the shader's first lines, each #include \"<file>.glsl\"")
+endif()
+string(REGEX MATCHALL "[A-Za-z0-9_]+\\.glsl" includes "${block}")
+set(full "#version 450 core\n")
+set(line 1)
+foreach(include ${includes})
+  if(NOT EXISTS ${INCLUDE_DIR}/${include})
+    message(FATAL_ERROR "${SOURCE}: included file ${INCLUDE_DIR}/${include} does not exist")
+  endif()
+  file(READ ${INCLUDE_DIR}/${include} text)
+  string(APPEND full "${text}\n")
+  math(EXPR line "${line} + 1")
+endforeach()
+string(APPEND full "#line ${line}\n${body}")
 get_filename_component(dir ${OUTPUT} DIRECTORY)
 set(checked ${dir}/${name})
 file(WRITE ${checked} "${full}")

@@ -1,5 +1,11 @@
 #include "core/pipeline/LightTerms.h"
 
+#include <algorithm>
+#include <string_view>
+
+#include "core/scene/SceneNames.h"
+#include "core/scene/SceneReaders.h"
+
 namespace cb {
 
 LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
@@ -19,3 +25,79 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
 }
 
 }  // namespace cb
+
+namespace cb::scene_io {
+namespace {
+
+constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
+constexpr std::string_view kLightningKeys[] = {"enabled", "position", "color", "intensity", "radius", "flash"};
+constexpr std::string_view kFlashKeys[] = {"start", "steps"};
+
+}  // namespace
+
+void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting) {
+    const Json* section = check.Section(root, "", "lighting", kLightingKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "ambient")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.ambient", kSingleNonNegative)) lighting.ambient = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "background")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.background", kSingleNonNegative)) lighting.background = *a;
+    }
+}
+
+void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {
+    const Json* section = check.Section(root, "", "lightning", kLightningKeys);
+    if (!section) return;
+    lightning.enabled = true;  // the section switches it on unless "enabled": false
+    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
+    if (const Json* v = find("enabled")) {
+        if (auto b = check.Boolean(*v, "lightning.enabled")) lightning.enabled = *b;
+    }
+    if (const Json* v = find("position")) {
+        if (auto a = check.Numbers<3>(*v, "lightning.position", Range{.lo = -kMaxSingle, .hi = kMaxSingle}))
+            lightning.position = *a;
+    } else if (lightning.enabled) {
+        check.Fail("lightning.position", "required field is missing");
+    }
+    if (const Json* v = find("color")) {
+        if (auto a = check.Numbers<3>(*v, "lightning.color", kSingleNonNegative)) lightning.color = *a;
+    }
+    if (const Json* v = find("intensity")) {
+        if (auto d = check.Number(*v, "lightning.intensity", kSingleNonNegative)) lightning.intensity = *d;
+    }
+    if (const Json* v = find("radius")) {
+        // r0^2 must stay a normal float: 1e-15 m squared is still far above FLT_MIN.
+        if (auto d = check.Number(*v, "lightning.radius", Range{.lo = 1e-15, .hi = 1e15})) lightning.radius = *d;
+    }
+    // The light's radiance in float: colour * intensity (radiance * m^2, as the kernel holds it), and
+    // colour * intensity / r0^2, the most it reaches (at the guard radius: the falloff is 1 / max(D^2, r0^2)), each
+    // at most the sun's bound 1e30. The light then adds at most 1e30 * 2^19.5 per sample (every P^ is at most
+    // 2^19.5, core/math/Shading.h kMaxPhasePeak), as the sun does; the sum over a ray stays finite (the derivation is
+    // ReadSun's). Colour 1e30 times intensity 1e30 was inf in float and made pixels inf on every backend.
+    if (lightning.enabled) {
+        const double brightest =
+            std::max({lightning.color[0], lightning.color[1], lightning.color[2]}) * lightning.intensity;
+        const double atGuard = brightest / (lightning.radius * lightning.radius);
+        if (brightest > kMaxSingle)
+            check.Fail("lightning.intensity",
+                       "color * intensity (the light's radiance at 1 m) must be at most 1e+30 in "
+                       "each channel, got " +
+                           FormatNumber(brightest));
+        else if (atGuard > kMaxSingle)
+            check.Fail("lightning.radius",
+                       "color * intensity / radius^2 (the light's radiance at its guard radius, the "
+                       "most it reaches) must be at most 1e+30 in each channel, got " +
+                           FormatNumber(atGuard));
+    }
+    if (const Json* flash = check.Section(*section, "lightning", "flash", kFlashKeys)) {
+        if (const Json* v = Validator::Find(*flash, "start")) {
+            if (auto n = check.Integer(*v, "lightning.flash.start", 0, kU32Max)) lightning.flashStart = uint32_t(*n);
+        }
+        if (const Json* v = Validator::Find(*flash, "steps")) {
+            if (auto n = check.Integer(*v, "lightning.flash.steps", 1, kU32Max)) lightning.flashSteps = uint32_t(*n);
+        }
+    }
+}
+
+}  // namespace cb::scene_io

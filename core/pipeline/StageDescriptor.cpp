@@ -38,21 +38,13 @@ BufferFormat ResourceFormat(Resource resource) {
     return BufferFormat::F32;
 }
 
-bool IsPerCamera(Resource resource) {
-    return resource == Resource::SplatImage || resource == Resource::MarchImage || resource == Resource::LayersImage;
-}
+bool IsPerCamera(Resource resource) { return ResourceDumpStem(resource).empty(); }
 
 Extent3 ResourceExtent(Resource resource, const Scene& scene) {
+    if (IsPerCamera(resource)) return {3, scene.render.width, scene.render.height};
     const Extent3 grid = scene.grid.size;
     const uint32_t tile = scene.density.tile, band = scene.density.band;
     switch (resource) {
-        case Resource::Region:
-        case Resource::Hum:
-        case Resource::Act:
-        case Resource::Cld:
-        case Resource::Q:
-        case Resource::T:
-            return grid;
         case Resource::ColumnSum:
         case Resource::Shadow:
             return {grid.nx, grid.ny, 1};
@@ -60,12 +52,9 @@ Extent3 ResourceExtent(Resource resource, const Scene& scene) {
             return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), 1};
         case Resource::Bands:
             return {CeilDiv(grid.nx, tile), CeilDiv(grid.ny, tile), CeilDiv(grid.nz, band)};
-        case Resource::SplatImage:
-        case Resource::MarchImage:
-        case Resource::LayersImage:
-            return {3, scene.render.width, scene.render.height};
+        default:  // the volumes: region, the automaton's fields, q and T
+            return grid;
     }
-    return grid;
 }
 
 namespace {

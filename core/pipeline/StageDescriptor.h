@@ -17,12 +17,15 @@
 
 #include "core/pipeline/Backend.h"
 #include "core/scene/Scene.h"
+#include "core/scene/SectionReader.h"
 #include "core/scene/Stage.h"
 
 namespace cb {
 
 // X(Enum, "name", format, "dump file stem"): the buffers that pass between
-// stages (SPEC 0). Images have no dump array; they are written as frames.
+// stages (SPEC 0). An image has the stem "": it is one (3, width, height) buffer
+// per camera, written as frames, not dumped. Any other resource is one buffer
+// of the grid's extent unless ResourceExtent says otherwise.
 #define CB_RESOURCES(X)                                                             \
     X(Region, "region", U8, "region") /* R: region weights, grid */                 \
     X(Hum, "hum", Bits, "hum")        /* automaton fields, grid */                  \
@@ -58,7 +61,7 @@ std::string_view ResourceDumpStem(Resource resource);
 BufferFormat ResourceFormat(Resource resource);
 // The extent of one buffer of the resource in this scene.
 Extent3 ResourceExtent(Resource resource, const Scene& scene);
-// Images: one buffer per camera; every other resource: one.
+// Images (dump stem ""): one buffer per camera; every other resource: one.
 bool IsPerCamera(Resource resource);
 
 // How two implementations of a stage are compared, as data (SPEC's rule for
@@ -162,7 +165,14 @@ struct RendererDescriptor {
 
 struct StageDescriptor {
     Stage stage;
-    std::string_view section;     // the scene section of its settings ("" for none)
+    std::string_view section;  // the scene section of its settings ("" for none)
+    // The scene file's top-level keys its reader owns ({} where it reads fields of a shared section only, as
+    // render_splat does of `render`), and the reader: it reads them into `scene` after the shared sections (grid,
+    // steps, stages, sun, lighting, lightning, phase, render) and the readers of the stages before it in CB_STAGES.
+    // `grid` is the grid's size, nullptr where that was not read. nullptr: the stage has no settings.
+    std::span<const std::string_view> sceneKeys;
+    void (*readSettings)(const scene_io::Json& root, scene_io::Validator& check, const Extent3* grid,
+                         Scene& scene) = nullptr;
     std::vector<Resource> reads;  // this step's values (a stage that advances the state reads its own)
     // Read when some enabled stage writes them, and not needed otherwise
     // (density's cover comes from cld with an automaton, from q without).

@@ -1,34 +1,33 @@
 #include "core/plan/SceneSections.h"
 
 #include <filesystem>
-#include <optional>
 #include <string_view>
+#include <vector>
 
+#include "core/pipeline/LightTerms.h"
+#include "core/plan/StageGraph.h"
 #include "core/scene/SceneNames.h"
 #include "core/scene/SceneReaders.h"
-#include "core/stages/ca/Ca.h"
-#include "core/stages/density/Density.h"
-#include "core/stages/noise/Noise.h"
-#include "core/stages/region/Region.h"
-#include "core/stages/render_layers/RenderLayers.h"
-#include "core/stages/render_march/RenderMarch.h"
-#include "core/stages/render_splat/RenderSplat.h"
-#include "core/stages/shade/Shade.h"
-#include "core/stages/shadow/Shadow.h"
-#include "core/stages/smooth/Smooth.h"
 
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kTopKeys[] = {
-    "name", "description", "grid",  "steps", "warmup_steps", "stages", "ca",    "ellipsoids", "smooth", "density",
-    "sun",  "lighting",    "phase", "shade", "shadow",       "render", "march", "lightning",  "noise",  "layers"};
+// The top-level keys of the sections every stage shares; each stage's descriptor adds its own (sceneKeys).
+constexpr std::string_view kSharedKeys[] = {"name", "description", "grid",      "steps", "warmup_steps", "stages",
+                                            "sun",  "lighting",    "lightning", "phase", "render"};
+
+std::vector<std::string_view> TopKeys() {
+    std::vector<std::string_view> keys(std::begin(kSharedKeys), std::end(kSharedKeys));
+    for (Stage stage : kAllStages)
+        for (std::string_view key : Describe(stage).sceneKeys) keys.push_back(key);
+    return keys;
+}
 
 }  // namespace
 
 SectionsRead ReadSceneSections(const Json& root, const std::string& label, Validator& check, Scene& scene) {
     SectionsRead sections;
-    check.CheckKeys(root, "", kTopKeys);
+    check.CheckKeys(root, "", TopKeys());
 
     // The name becomes the folder out/<name>: it follows kPathNameRule, and so must the file stem it defaults to.
     if (const Json* v = Validator::Find(root, "name")) {
@@ -61,26 +60,20 @@ SectionsRead ReadSceneSections(const Json& root, const std::string& label, Valid
     }
 
     sections.stageList = ReadStages(root, check, scene.stages);
-    ReadCa(root, check, sizeOk ? std::optional(scene.grid.size.nz) : std::nullopt, scene.ca);
-
-    // The ellipsoid seed follows ca.seed unless given.
-    scene.ellipsoids.seed = scene.ca.seed;
-    ReadEllipsoids(root, check, scene.ellipsoids);
-
-    ReadSmooth(root, check, scene.smooth);
-    ReadDensity(root, check, scene.density, sizeOk ? &scene.grid.size : nullptr);
-
     ReadSun(root, check, scene.sun);
     ReadLighting(root, check, scene.lighting);
-    ReadPhase(root, check, scene.phase);
-    ReadShade(root, check, scene.shade);
-    ReadShadow(root, check, scene.shadow);
-    sections.cameras = ReadRender(root, check, scene.render);
-    ReadSplat(root, check, scene.splat);
-    ReadMarch(root, check, scene.stages, scene.march);
     ReadLightning(root, check, scene.lightning);
-    ReadNoise(root, check, scene.noise);
-    ReadLayers(root, check, sizeOk ? std::optional(scene.grid.size.nz) : std::nullopt, scene.layers);
+    ReadPhase(root, check, scene.phase);
+    sections.cameras = ReadRender(root, check, scene.render);
+
+    // Each stage's own sections, by its descriptor's reader, in CB_STAGES order (also for stages not enabled).
+    for (Stage stage : kAllStages)
+        if (auto read = Describe(stage).readSettings) read(root, check, sizeOk ? &scene.grid.size : nullptr, scene);
+
+    // The ellipsoids' seed follows ca.seed unless the file gives one.
+    const Json* ellipsoids = Validator::Find(root, "ellipsoids");
+    if (!(ellipsoids && ellipsoids->is_object() && Validator::Find(*ellipsoids, "seed")))
+        scene.ellipsoids.seed = scene.ca.seed;
     return sections;
 }
 

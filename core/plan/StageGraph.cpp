@@ -5,22 +5,20 @@
 #include <iterator>
 #include <set>
 
-#include "core/stages/ca/Ca.h"
-#include "core/stages/density/Density.h"
-#include "core/stages/noise/Noise.h"
-#include "core/stages/region/Region.h"
-#include "core/stages/render_layers/RenderLayers.h"
-#include "core/stages/render_march/RenderMarch.h"
-#include "core/stages/render_splat/RenderSplat.h"
-#include "core/stages/shade/Shade.h"
-#include "core/stages/shadow/Shadow.h"
-#include "core/stages/smooth/Smooth.h"
-
 namespace cb {
-namespace {
 
 // Each stage's module names its descriptor Describe<Stage> and its adapter
-// Call<Stage>; these tables expand CB_STAGES, so a stage without them does not compile.
+// Call<Stage> (its header declares them alike); the declarations and tables here
+// expand CB_STAGES, so a stage without them does not link.
+#define CB_STAGE_DECLARE(name, text, spec, splat)                                                                \
+    const StageDescriptor& Describe##name();                                                                     \
+    Status Call##name(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io, \
+                      StageCallRecord& record);
+CB_STAGES(CB_STAGE_DECLARE)
+#undef CB_STAGE_DECLARE
+
+namespace {
+
 // Describe<Stage> returns a function-local static, made on first use: commands
 // describe stages in their help text during static initialisation. The fields
 // it leaves out take their defaults (each module silences GCC's warning about that).

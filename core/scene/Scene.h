@@ -87,6 +87,21 @@ struct LightingSettings {
     Vec3 Background() const { return {float(background[0]), float(background[1]), float(background[2])}; }
 };
 
+// A point light (Wang, Ji and Zhang, eq. 21) that flashes over a window of steps (section `lightning`);
+// every renderer takes it through its light terms (core/pipeline/LightTerms.h).
+struct LightningSettings {
+    bool enabled = false;
+    std::array<double, 3> position{0, 0, 0};  // world, metres
+    std::array<double, 3> color{0.8, 0.85, 1.0};
+    double intensity = 1e6;                   // radiance * metres^2
+    double radius = 50;                       // r0, metres: the 1/D^2 law is capped at 1/r0^2
+    uint32_t flashStart = 0, flashSteps = 1;  // on for steps [start, start + steps)
+
+    bool OnAt(uint32_t step) const {
+        return enabled && step >= flashStart && uint64_t(step) < uint64_t(flashStart) + flashSteps;
+    }
+};
+
 // Stage `shade` (SPEC 6).
 
 // What every renderer shares (section `render`): the image, the cameras,
@@ -140,7 +155,7 @@ struct Scene {
     RenderSettings render;
     SplatSettings splat;
     MarchSettings march;          // stage render_march (section `march`)
-    LightningSettings lightning;  // the point light of render_march (section `lightning`)
+    LightningSettings lightning;  // the point light (section `lightning`)
     NoiseSettings noise;          // stage `noise` (SPEC 10a)
     LayersSettings layers;        // stage render_layers (section `layers`)
     // What the enabled renderers ask of the stages upstream, decided when the scene is loaded (core/plan/SceneLoad.cpp,

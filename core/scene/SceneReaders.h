@@ -1,5 +1,6 @@
-// The readers of the sections every stage shares (grid, stages, sun, lighting,
-// phase, render; docs/scenes.md); each stage's module reads its own. Each reads its
+// The readers of the sections every stage shares (grid, stages, sun, phase,
+// render; docs/scenes.md); each stage's module reads its own, and the light
+// terms' sections are read beside MakeLightTerms (core/pipeline/LightTerms.h). Each reads its
 // section from the document root into its settings, which hold the defaults on
 // entry; a field that is wrong is reported into `check` and leaves its default.
 // Internal to core (see core/base/JsonDom.h).
@@ -24,13 +25,12 @@ bool ReadGrid(const Json& root, Validator& check, GridSettings& grid);
 // The default stage list when absent. False when an entry is unknown, duplicate or not a string.
 bool ReadStages(const Json& root, Validator& check, StageSet& stages);
 
-// Sun, lighting, phase and render (core/scene/SceneRenderReaders.cpp).
+// Sun, phase and render (core/scene/SceneRenderReaders.cpp).
 
 void ReadSun(const Json& root, Validator& check, SunSettings& sun);
 // True when the sun may take azimuth `degrees` (at most 1e9 in magnitude); otherwise fails `field` with the bound
 // and the value, `where` appended (e.g. " at the last step (29)").
 bool CheckAzimuth(double degrees, const std::string& field, std::string_view where, Validator& check);
-void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting);
 void ReadPhase(const Json& root, Validator& check, PhaseParams& phase);
 // Returns false when render.cameras was given but is wrong (so "needs a camera" is not piled on).
 bool ReadRender(const Json& root, Validator& check, RenderSettings& render);

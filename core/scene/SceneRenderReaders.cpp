@@ -15,7 +15,6 @@ namespace {
 constexpr std::string_view kSunKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity", "path", "speed"};
 constexpr std::string_view kSunKeyframeKeys[] = {"step", "elevation_deg", "azimuth_deg"};
 constexpr std::string_view kSunSpeedKeys[] = {"elevation_deg", "azimuth_deg"};
-constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
 constexpr std::string_view kPhaseKeys[] = {"function", "g"};
 constexpr std::string_view kRenderKeys[] = {
     "width",    "height",      "q_min",           "splat_scale",      "opacity", "alpha", "culling",
@@ -213,8 +212,8 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
         }
     }
     // The radiance color * intensity is what the renderers use, in single precision. With it, the lightning's
-    // (ReadLightning), ambient and background each at most 1e30 and every P^ at most 2^19.5 (ReadPhase), every
-    // output stays finite (float's largest is 3.4e38):
+    // (ReadLightning, core/pipeline/LightTerms.cpp), ambient and background each at most 1e30 and every P^ at most
+    // 2^19.5 (ReadPhase), every output stays finite (float's largest is 3.4e38):
     //   a sample's light  sun T P^ powder + ambient + lightning T P^ / max(D^2, r0^2)
     //                     <= 1e30 * 2^19.5 + 1e30 + 1e30 * 2^19.5 < 1.5e36 (T, powder <= 1);
     //   a march pixel     L + T_view background, L = sum of T_n (1 - tau_n) * light_n: the float weights sum to at
@@ -228,17 +227,6 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
         check.Fail("sun.intensity",
                    "color * intensity (the sun's radiance) must be at most 1e+30 in each channel, got " +
                        FormatNumber(brightest));
-}
-
-void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting) {
-    const Json* section = check.Section(root, "", "lighting", kLightingKeys);
-    if (!section) return;
-    if (const Json* v = Validator::Find(*section, "ambient")) {
-        if (auto a = check.Numbers<3>(*v, "lighting.ambient", kSingleNonNegative)) lighting.ambient = *a;
-    }
-    if (const Json* v = Validator::Find(*section, "background")) {
-        if (auto a = check.Numbers<3>(*v, "lighting.background", kSingleNonNegative)) lighting.background = *a;
-    }
 }
 
 void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca`, advection (SPEC 3 step 4), packed layout:
 // X'(i, j, k) = X(i - shift.x, j - shift.y, k), zero fill; one fragment per word.
 layout(binding = 0) uniform usampler2DArray in0;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca`, advection (SPEC 3 step 4), the thesis's layout:
 // X'(i, j, k) = X(i - shift.x, j - shift.y, k), zero fill; one fragment per voxel.
 layout(binding = 0) uniform usampler2DArray state;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca` (SPEC 3), packed layout (the thesis's section 9.2): one fragment
 // per 32-voxel word of slice `layer`; bitwise rules, random numbers drawn only
 // where an event can flip a bit. Reads the step-t textures, writes step t+1

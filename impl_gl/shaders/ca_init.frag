@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca`, initial state (SPEC 3), packed layout: one fragment per 32-voxel
 // word of slice `layer`, the three fields as three R32UI targets.
 uniform int layer;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca`, the thesis's layout (its Figure 4.1 texel): the three packed
 // R32UI fields into one RGBA8UI texel per voxel, R = hum, G = act, B = cld.
 layout(binding = 0) uniform usampler2DArray hum;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca` (SPEC 3), the thesis's layout: one fragment per voxel, one 8-bit
 // channel per bit (R = hum, G = act, B = cld), the rules evaluated per voxel
 // as the thesis's shader does; the same random draws as the packed layout.

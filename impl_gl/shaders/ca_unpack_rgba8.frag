@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `ca`, the thesis's layout: RGBA8UI voxels back to the three packed
 // R32UI fields the other stages read; one fragment per 32-voxel word. With
 // SHIFTED defined (a share of a step with wind), the advection is folded in:

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `density`, cover: one fragment per column; a column with any cloud
 // bit counts once in the atomic counter, or, in a scene without an automaton
 // (fromCld = 0, cld unused), a column with D > 0. The colour output is the

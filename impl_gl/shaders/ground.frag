@@ -1,3 +1,8 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "ground.glsl"
 // The ground pass of stage `render_splat` (core/math/ground.glsl): the full-screen
 // triangle writes each pixel's background, the lit ground where the pixel's ray
 // meets it, before the splats blend over it. The fragment at gl_FragCoord

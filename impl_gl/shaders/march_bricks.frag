@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `render_march`, step 2 (impl_cpu/RenderMarchCpu.cpp step 2): brick
 // (a, b) of layer c is empty (1) iff q_alpha = 0 over the brick grown by one
 // voxel, padded indices a B .. (a + 1) B + 1 (clamped to the padded volume).

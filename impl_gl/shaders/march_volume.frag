@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `render_march`, step 1 (impl_cpu/RenderMarchCpu.cpp step 1): layer k
 // of the padded (q_alpha, T) volume, one fragment per padded (i, j): voxel
 // (i - 1, j - 1, k - 1) inside the grid, else the border (0, 1), or with `wrap`

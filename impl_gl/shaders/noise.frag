@@ -1,3 +1,9 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "noise_words.glsl"
+#include "noise.glsl"
 // Stage `noise` (SPEC 10a): one fragment per voxel of slice `layer`, q =
 // NoiseForm::Q by core/math/noise.glsl (prepended), reading the scene's data
 // block (core/math/NoiseGpu.h) from a storage buffer and the step's offsets.

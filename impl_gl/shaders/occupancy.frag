@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `density`, occupancy by max-downsampling (thesis section 7.2.2): one
 // fragment per tile. mode 0: the tile's columns in band `layer` of q (bands);
 // mode 1: the tile's columns of D (tiles).

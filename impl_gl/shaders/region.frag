@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `region`: the quantised weight of one ellipsoid at the voxel centre,
 // written as r/255 into an R8 UNORM slice (exactly r again) where MAX
 // blending keeps the largest (quantising is monotone, so this is SPEC 2's

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `region` (SPEC 2), the thesis's way: every ellipsoid that reaches
 // slice `layer` is drawn as one quad (a 4-vertex strip, one instance per
 // ellipsoid) over its bounding square in that slice, plus a voxel; the

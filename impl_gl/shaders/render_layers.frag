@@ -1,3 +1,11 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "phase_table.glsl"
+#include "light.glsl"
+#include "march.glsl"
+#include "layers.glsl"
 // Stage `render_layers` (SPEC 15): one layer's fragment at pixel (x, y),
 // LayerFragment of core/math/layers.glsl on the pixel's own ray (the fragment
 // at gl_FragCoord (x + 0.5, y + 0.5) is the image's pixel (x, y), row 0 at the

@@ -1,3 +1,11 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "phase_table.glsl"
+#include "light.glsl"
+#include "march.glsl"
+#include "layers.glsl"
 // Stage `render_layers` (SPEC 15): one mesh, a screen quad (its corners from
 // gl_VertexID, a triangle strip), drawn instanced N times; instance n is layer
 // layerOrder[n], so the layers arrive back to front (core/pipeline/LayersGpu.h

@@ -1,3 +1,11 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "phase_table.glsl"
+#include "light.glsl"
+#include "march.glsl"
+#include "ground.glsl"
 // Stage `render_march` (SPEC 10): one fragment per pixel, as Olajos's
 // full-screen pass. The fragment at gl_FragCoord (x + 0.5, y + 0.5) is the
 // image's pixel (x, y): the target's row y = 0 is the first row read back, so

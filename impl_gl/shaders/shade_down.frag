@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `shade` at resolution f > 1: the mean of each f^3 block of q (partial
 // blocks: of the voxels present); one fragment per coarse cell of layer K.
 layout(binding = 0) uniform sampler2DArray q;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `shade` (SPEC 6): one slice m of the inverse shear-warp, one fragment
 // per (u, v). T_{m-1} comes from a 2-D texture and T_m goes to the other
 // (the thesis's ping-pong, its Figure 4.3) and to layer w of a w-major volume.

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `shade`: full-resolution T of slice `layer` from the w-major volume of
 // the shaded grid, read trilinearly at (i + 0.5)/f - 0.5 clamped to the cell
 // centres; at f = 1 each voxel's own value.

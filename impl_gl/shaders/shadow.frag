@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `shadow` (SPEC 7): one fragment per ground cell; D read bilinearly at
 // the cell plus the offset to mid-height along the sun (0 outside).
 layout(binding = 0) uniform sampler2DArray d;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `smooth` (SPEC 4), first of three separable passes (the binomial
 // weights are a product w(di) w(dj) w(dk), and integer sums are exact, so the
 // passes give the direct sum's result bit for bit): the weighted sum along x

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `smooth`, second pass: the weighted sum along y of the x sums.
 layout(binding = 0) uniform usampler2DArray sumX;
 uniform int layer;

@@ -1,3 +1,7 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
 // Stage `smooth`, third pass: the weighted sum along z of the xy sums, scaled
 // by 1/W (exact: W is a power of two).
 layout(binding = 0) uniform usampler2DArray sumXY;

@@ -1,3 +1,10 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "phase_table.glsl"
+#include "light.glsl"
+#include "splat.glsl"
 // Stage `render_splat`: one fragment of a point sprite. Keeps SPEC 8's
 // coverage (px - s/2 <= x + 0.5 < px + s/2, likewise y) and gives the
 // kernel-weighted alpha; blending (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) composites.

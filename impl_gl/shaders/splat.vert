@@ -1,3 +1,10 @@
+#include "random.glsl"
+#include "rules.glsl"
+#include "shading.glsl"
+#include "automaton.glsl"
+#include "phase_table.glsl"
+#include "light.glsl"
+#include "splat.glsl"
 // Stage `render_splat` (SPEC 8), the thesis's way (its chapter 6): one
 // GL_POINTS vertex per voxel, drawn in the shared back-to-front order (the
 // vertex id is the voxel's rank), so blending composites in that order. The

@@ -68,12 +68,19 @@ CaStepParams MakeCaStepParams(const Scene& sc, uint32_t step) {
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kCaSceneFields[] = {"ca"};
 
+constexpr std::string_view kCaSceneKeys[] = {"ca"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeCa() {
     static const StageDescriptor descriptor{
         .stage = Stage::Ca,
         .section = "ca",
+        .sceneKeys = kCaSceneKeys,
+        .readSettings =
+            [](const scene_io::Json& root, scene_io::Validator& check, const Extent3* grid, Scene& scene) {
+                scene_io::ReadCa(root, check, grid ? std::optional(grid->nz) : std::nullopt, scene.ca);
+            },
         .reads = {Resource::Region, Resource::Hum, Resource::Act, Resource::Cld},
         .writes = {Resource::Hum, Resource::Act, Resource::Cld},
         .advancesState = true,

@@ -54,12 +54,17 @@ DensityParams MakeDensityParams(const Scene& sc) {
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kDensitySceneFields[] = {"density"};
 
+constexpr std::string_view kDensitySceneKeys[] = {"density"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeDensity() {
     static const StageDescriptor descriptor{
         .stage = Stage::Density,
         .section = "density",
+        .sceneKeys = kDensitySceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3* grid,
+                           Scene& scene) { scene_io::ReadDensity(root, check, scene.density, grid); },
         .reads = {Resource::Q},
         .optionalReads = {Resource::Cld},
         .writes = {Resource::ColumnSum, Resource::Tiles, Resource::Bands},

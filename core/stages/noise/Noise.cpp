@@ -225,12 +225,17 @@ NoiseParams MakeNoiseParams(const Scene& sc, uint32_t step) { return {step, &sc.
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kNoiseSceneFields[] = {"noise"};
 
+constexpr std::string_view kNoiseSceneKeys[] = {"noise"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeNoise() {
     static const StageDescriptor descriptor{
         .stage = Stage::Noise,
         .section = "noise",
+        .sceneKeys = kNoiseSceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadNoise(root, check, scene.noise); },
         .writes = {Resource::Q},
         .skipsUnchangedInputs = true,
         .dependsOnStep = NoiseAnimated,

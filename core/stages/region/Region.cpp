@@ -150,12 +150,17 @@ CompareRule RegionRule(const Scene&) { return {CompareRule::Kind::Quantised, 1, 
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kRegionSceneFields[] = {"ellipsoids", "ca.seed"};
 
+constexpr std::string_view kRegionSceneKeys[] = {"ellipsoids"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRegion() {
     static const StageDescriptor descriptor{
         .stage = Stage::Region,
         .section = "ellipsoids",
+        .sceneKeys = kRegionSceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadEllipsoids(root, check, scene.ellipsoids); },
         .writes = {Resource::Region},
         .shareCount = SharesOfSlicesK,
         .symbol = "R",

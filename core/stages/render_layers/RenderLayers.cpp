@@ -218,12 +218,19 @@ constexpr std::string_view kRenderLayersSceneFields[] = {"layers",
                                                          "render.alpha",
                                                          "render.frames_per_step"};
 
+constexpr std::string_view kRenderLayersSceneKeys[] = {"layers"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderLayers() {
     static const StageDescriptor descriptor{
         .stage = Stage::RenderLayers,
         .section = "layers",
+        .sceneKeys = kRenderLayersSceneKeys,
+        .readSettings =
+            [](const scene_io::Json& root, scene_io::Validator& check, const Extent3* grid, Scene& scene) {
+                scene_io::ReadLayers(root, check, grid ? std::optional(grid->nz) : std::nullopt, scene.layers);
+            },
         .reads = {Resource::Q, Resource::T},
         .readsPrevious = LayersPrevious,
         .writes = {Resource::LayersImage},

@@ -21,8 +21,6 @@ constexpr std::string_view kMarchKeys[] = {"step",   "adaptive", "jitter",   "li
 constexpr std::string_view kAdaptiveKeys[] = {"enabled", "kappa", "start"};
 constexpr std::string_view kPowderKeys[] = {"enabled", "c"};
 constexpr std::string_view kSkippingKeys[] = {"enabled", "brick"};
-constexpr std::string_view kLightningKeys[] = {"enabled", "position", "color", "intensity", "radius", "flash"};
-constexpr std::string_view kFlashKeys[] = {"start", "steps"};
 
 constexpr std::array<NamedValue<MarchLightSource>, 2> kMarchLightNames{{
     {"shade", MarchLightSource::Shade},
@@ -91,60 +89,6 @@ void ReadMarch(const Json& root, Validator& check, const StageSet& stages, March
     if (stages.Has(Stage::RenderMarch) && march.light == MarchLightSource::Shade && !stages.Has(Stage::Shade))
         check.Fail("march.light",
                    "\"shade\" needs stage \"shade\" (add it to stages, or set march.light to \"march\")");
-}
-
-void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {
-    const Json* section = check.Section(root, "", "lightning", kLightningKeys);
-    if (!section) return;
-    lightning.enabled = true;  // the section switches it on unless "enabled": false
-    auto find = [&](std::string_view key) { return Validator::Find(*section, key); };
-    if (const Json* v = find("enabled")) {
-        if (auto b = check.Boolean(*v, "lightning.enabled")) lightning.enabled = *b;
-    }
-    if (const Json* v = find("position")) {
-        if (auto a = check.Numbers<3>(*v, "lightning.position", Range{.lo = -kMaxSingle, .hi = kMaxSingle}))
-            lightning.position = *a;
-    } else if (lightning.enabled) {
-        check.Fail("lightning.position", "required field is missing");
-    }
-    if (const Json* v = find("color")) {
-        if (auto a = check.Numbers<3>(*v, "lightning.color", kSingleNonNegative)) lightning.color = *a;
-    }
-    if (const Json* v = find("intensity")) {
-        if (auto d = check.Number(*v, "lightning.intensity", kSingleNonNegative)) lightning.intensity = *d;
-    }
-    if (const Json* v = find("radius")) {
-        // r0^2 must stay a normal float: 1e-15 m squared is still far above FLT_MIN.
-        if (auto d = check.Number(*v, "lightning.radius", Range{.lo = 1e-15, .hi = 1e15})) lightning.radius = *d;
-    }
-    // The light's radiance in float: colour * intensity (radiance * m^2, as the kernel holds it), and
-    // colour * intensity / r0^2, the most it reaches (at the guard radius: the falloff is 1 / max(D^2, r0^2)), each
-    // at most the sun's bound 1e30. The light then adds at most 1e30 * 2^19.5 per sample (every P^ is at most
-    // 2^19.5, core/math/Shading.h kMaxPhasePeak), as the sun does; the sum over a ray stays finite (the derivation is
-    // ReadSun's). Colour 1e30 times intensity 1e30 was inf in float and made pixels inf on every backend.
-    if (lightning.enabled) {
-        const double brightest =
-            std::max({lightning.color[0], lightning.color[1], lightning.color[2]}) * lightning.intensity;
-        const double atGuard = brightest / (lightning.radius * lightning.radius);
-        if (brightest > kMaxSingle)
-            check.Fail("lightning.intensity",
-                       "color * intensity (the light's radiance at 1 m) must be at most 1e+30 in "
-                       "each channel, got " +
-                           FormatNumber(brightest));
-        else if (atGuard > kMaxSingle)
-            check.Fail("lightning.radius",
-                       "color * intensity / radius^2 (the light's radiance at its guard radius, the "
-                       "most it reaches) must be at most 1e+30 in each channel, got " +
-                           FormatNumber(atGuard));
-    }
-    if (const Json* flash = check.Section(*section, "lightning", "flash", kFlashKeys)) {
-        if (const Json* v = Validator::Find(*flash, "start")) {
-            if (auto n = check.Integer(*v, "lightning.flash.start", 0, kU32Max)) lightning.flashStart = uint32_t(*n);
-        }
-        if (const Json* v = Validator::Find(*flash, "steps")) {
-            if (auto n = check.Integer(*v, "lightning.flash.steps", 1, kU32Max)) lightning.flashSteps = uint32_t(*n);
-        }
-    }
 }
 
 }  // namespace cb::scene_io
@@ -281,12 +225,17 @@ constexpr std::string_view kRenderMarchSceneFields[] = {"march",         "lightn
                                                         "render.alpha",  "render.frames_per_step",
                                                         "render.ground"};
 
+constexpr std::string_view kRenderMarchSceneKeys[] = {"march"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeRenderMarch() {
     static const StageDescriptor descriptor{
         .stage = Stage::RenderMarch,
         .section = "render",
+        .sceneKeys = kRenderMarchSceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadMarch(root, check, scene.stages, scene.march); },
         .reads = {Resource::Q},
         // march.light "shade" (the default) needs T, render.ground G: checked when the scene is loaded.
         .optionalReads = {Resource::T, Resource::Shadow},

@@ -16,7 +16,6 @@ namespace cb {
 namespace scene_io {
 // `stages` is the scene's list: the default light source "shade" needs the shade stage when render_march runs.
 void ReadMarch(const Json& root, Validator& check, const StageSet& stages, MarchSettings& march);
-void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning);
 }  // namespace scene_io
 
 // The ray marcher's parameters for one camera at `step` (the jitter's frame, the lightning's flash window and the

@@ -41,20 +41,6 @@ struct MarchSettings {
     bool toneMap = true;    // PNG only; false: clamp(exposure C)
 };
 
-// A point light (Wang, Ji and Zhang, eq. 21) that flashes over a window of steps.
-struct LightningSettings {
-    bool enabled = false;
-    std::array<double, 3> position{0, 0, 0};  // world, metres
-    std::array<double, 3> color{0.8, 0.85, 1.0};
-    double intensity = 1e6;                   // radiance * metres^2
-    double radius = 50;                       // r0, metres: the 1/D^2 law is capped at 1/r0^2
-    uint32_t flashStart = 0, flashSteps = 1;  // on for steps [start, start + steps)
-
-    bool OnAt(uint32_t step) const {
-        return enabled && step >= flashStart && uint64_t(step) < uint64_t(flashStart) + flashSteps;
-    }
-};
-
 // Inputs of the ray marcher (SPEC 10) besides its buffers: the kernel's
 // constants (core/math/March.h, voxel units) and how the backend feeds it.
 struct MarchParams {

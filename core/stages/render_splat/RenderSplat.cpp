@@ -156,6 +156,8 @@ const StageDescriptor& DescribeRenderSplat() {
     static const StageDescriptor descriptor{
         .stage = Stage::RenderSplat,
         .section = "render",
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadSplat(root, check, scene.splat); },
         .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
         .optionalReads = {Resource::Shadow},  // render.ground needs it: checked when the scene is loaded
         .readsPrevious = SplatPrevious,

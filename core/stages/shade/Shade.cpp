@@ -131,12 +131,17 @@ ShadeParams MakeShadeParams(const Scene& sc, uint32_t step) {
 // (A renderer that relights fixes the sun it receives, Scene::needs: its RendererDescriptor::relightFields.)
 constexpr std::string_view kShadeSceneFields[] = {"shade", "sun", "phase", "grid.voxel_size"};
 
+constexpr std::string_view kShadeSceneKeys[] = {"shade"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeShade() {
     static const StageDescriptor descriptor{
         .stage = Stage::Shade,
         .section = "shade",
+        .sceneKeys = kShadeSceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadShade(root, check, scene.shade); },
         .reads = {Resource::Q},
         .writes = {Resource::T},
         .outputStepsOnly = true,

@@ -62,12 +62,17 @@ ShadowParams MakeShadowParams(const Scene& sc, uint32_t step) {
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kShadowSceneFields[] = {"shadow", "shade.sigma", "sun", "grid.voxel_size"};
 
+constexpr std::string_view kShadowSceneKeys[] = {"shadow"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeShadow() {
     static const StageDescriptor descriptor{
         .stage = Stage::Shadow,
         .section = "shadow",
+        .sceneKeys = kShadowSceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadShadow(root, check, scene.shadow); },
         .reads = {Resource::ColumnSum},
         .writes = {Resource::Shadow},
         .outputStepsOnly = true,

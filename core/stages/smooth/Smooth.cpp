@@ -39,12 +39,17 @@ namespace cb {
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 constexpr std::string_view kSmoothSceneFields[] = {"smooth"};
 
+constexpr std::string_view kSmoothSceneKeys[] = {"smooth"};
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 const StageDescriptor& DescribeSmooth() {
     static const StageDescriptor descriptor{
         .stage = Stage::Smooth,
         .section = "smooth",
+        .sceneKeys = kSmoothSceneKeys,
+        .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
+                           Scene& scene) { scene_io::ReadSmooth(root, check, scene.smooth); },
         .reads = {Resource::Cld},
         .writes = {Resource::Q},
         .shareCount = SharesOfSlicesK,
