@@ -3,6 +3,9 @@
 // cannot see a mistake here: each is checked against hand-worked cases.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "core/plan/StageGraph.h"
 #include "impl_cpu/BackendCpu.h"
 
@@ -126,6 +129,42 @@ TEST(StagePlan, ResourceShapes) {
     EXPECT_EQ(ResourceDumpStem(Resource::SplatImage), "");
     EXPECT_TRUE(IsPerCamera(Resource::SplatImage));
     EXPECT_FALSE(IsPerCamera(Resource::T));
+    // Every image is per camera with the image's extent; the volumes have the grid's (SPEC 0's table).
+    for (Resource r : {Resource::MarchImage, Resource::LayersImage}) {
+        EXPECT_TRUE(IsPerCamera(r));
+        EXPECT_EQ(ResourceExtent(r, scene), (Extent3{3, 20, 10}));
+    }
+    for (Resource r : {Resource::Region, Resource::Hum, Resource::Act, Resource::Cld, Resource::T}) {
+        EXPECT_FALSE(IsPerCamera(r));
+        EXPECT_EQ(ResourceExtent(r, scene), (Extent3{70, 33, 17}));
+    }
+    EXPECT_EQ(ResourceExtent(Resource::Shadow, scene), (Extent3{70, 33, 1}));
+}
+
+// Test that the renderers are the stages that write an image, and that their names join for messages and help.
+TEST(StageList, RenderersAreTheImageWriters) {
+    std::vector<Stage> imageWriters;
+    for (Stage s : kAllStages)
+        if (std::ranges::any_of(Describe(s).writes, IsPerCamera)) imageWriters.push_back(s);
+    EXPECT_EQ(RendererStages(), imageWriters);
+    EXPECT_EQ(RendererStages(), (std::vector<Stage>{Stage::RenderSplat, Stage::RenderMarch, Stage::RenderLayers}));
+    EXPECT_EQ(RendererNames(" or "), "render_splat, render_march or render_layers");
+    EXPECT_EQ(RendererNames(", "), "render_splat, render_march, render_layers");
+}
+
+// Test that each stage's reader owns distinct top-level keys, none of them a shared section's.
+TEST(StageList, SceneKeysAreOwnedOnce) {
+    std::vector<std::string_view> keys = {"name", "description", "grid",      "steps", "warmup_steps", "stages",
+                                          "sun",  "lighting",    "lightning", "phase", "render"};
+    for (Stage s : kAllStages) {
+        const StageDescriptor& d = Describe(s);
+        EXPECT_TRUE(d.readSettings) << StageName(s);
+        for (std::string_view key : d.sceneKeys) {
+            EXPECT_EQ(std::ranges::count(keys, key), 0) << key;
+            keys.push_back(key);
+        }
+    }
+    EXPECT_EQ(keys.size(), 11u + 9u);  // every stage but render_splat owns one section
 }
 
 // Test the comparison rules as SPEC states them, and their texts.

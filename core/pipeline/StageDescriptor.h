@@ -159,8 +159,12 @@ struct RendererDescriptor {
     MarchParams (*referenceParams)(const Scene& scene, const CameraSettings& camera, uint32_t step) = nullptr;
     // Its settings as conform.json's coverage records them for this scene; nullptr: none.
     nlohmann::json (*conformOptions)(const Scene& scene) = nullptr;
-    // The settings the accuracy measurement tries besides the scene's own, each a list of overrides.
+    // conform's built-in matrix tries every phase function when it runs (as it does when shade runs).
+    bool conformVariesPhase = false;
+    // The settings the accuracy measurement tries besides the scene's own, each a list of overrides, and what they
+    // are, for `accuracy`'s help ("" for none).
     std::vector<std::vector<SceneOverride>> (*accuracyVariants)(const Scene& scene) = nullptr;
+    std::string_view accuracyVariantsHelp;
 };
 
 struct StageDescriptor {
@@ -210,6 +214,9 @@ struct StageDescriptor {
     // must be listed (sweep measures a stage once per distinct setting of these and of its inputs'
     // writers' fields); one listed that it does not read only repeats rows.
     std::span<const std::string_view> sceneFields;
+    // Reads Scene::needs, what the enabled renderers ask of it: its output then also depends on the fields that
+    // decide those (the renderers' relightFields).
+    bool readsRendererNeeds = false;
 };
 
 // The fields every stage's output depends on: the grid's extent, the number of steps (the last step is

@@ -148,14 +148,20 @@ void CheckTiling(const Scene& scene, Validator& check) {
 
 // Relighting shades once, for the first step's sun: a renderer that does not relight would read that T as if it
 // were shaded at its own step's sun.
+// True when `stage` is an enabled renderer that relights in this scene (shades once, for the first step's sun).
+bool RelightsHere(const Scene& scene, Stage stage) {
+    const RendererDescriptor* r = Describe(stage).renderer;
+    return r && r->relights && scene.stages.Has(stage) && r->relights(scene);
+}
+
 void CheckRelight(const Scene& scene, Validator& check) {
-    for (Stage relighting : kAllStages) {
-        const RendererDescriptor* r = Describe(relighting).renderer;
-        if (!r || !r->relights || !scene.stages.Has(relighting) || !r->relights(scene)) continue;
-        const std::string field = r->relightFields.empty() ? std::string(StageName(relighting))
-                                                           : std::string(r->relightFields.front());
-        for (Stage other : kAllStages)
-            if (const RendererDescriptor* o = Describe(other).renderer; o && !o->relights && scene.stages.Has(other))
+    for (Stage relighting : RendererStages()) {
+        if (!RelightsHere(scene, relighting)) continue;
+        const RendererDescriptor& r = *Describe(relighting).renderer;
+        const std::string field =
+            r.relightFields.empty() ? std::string(StageName(relighting)) : std::string(r.relightFields.front());
+        for (Stage other : RendererStages())
+            if (!Describe(other).renderer->relights && scene.stages.Has(other))
                 check.Fail(field, Quote(StageName(relighting)) + " relights: it shades once, for the first step's sun, "
                                   "and " + Quote(StageName(other)) +
                                   " would light with that T at every step; run it without relighting");
@@ -165,9 +171,7 @@ void CheckRelight(const Scene& scene, Validator& check) {
 // What the enabled renderers ask of the stages upstream (Scene::needs).
 Scene::RendererNeeds PlanRendererNeeds(const Scene& scene) {
     Scene::RendererNeeds needs;
-    for (Stage stage : kAllStages)
-        if (const RendererDescriptor* r = Describe(stage).renderer; r && r->relights && scene.stages.Has(stage))
-            needs.shadeOnce = needs.shadeOnce || r->relights(scene);
+    needs.shadeOnce = std::ranges::any_of(RendererStages(), [&](Stage s) { return RelightsHere(scene, s); });
     return needs;
 }
 
@@ -181,7 +185,8 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
     if (scene.render.slicesPerFrame > 0 && !RunsARenderer(scene.stages))
         check.Fail("render.slices_per_frame",
                    "time-slicing spreads a step over the frames drawn between steps, and "
-                   "no renderer is enabled; enable render_splat, render_march or render_layers, or remove it");
+                   "no renderer is enabled; enable " +
+                       RendererNames(" or ") + ", or remove it");
 
     // The ground is lit through G: the stage that computes it must run.
     if (scene.render.ground.on && !scene.stages.Has(Stage::Shadow))

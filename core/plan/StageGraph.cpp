@@ -59,6 +59,17 @@ const std::vector<Stage>& RendererStages() {
     return renderers;
 }
 
+std::string RendererNames(std::string_view last) {
+    const std::vector<Stage>& renderers = RendererStages();
+    std::string names;
+    for (size_t i = 0; i < renderers.size(); ++i)
+        names += std::string(i == 0                      ? ""
+                             : i + 1 == renderers.size() ? last
+                                                         : ", ") +
+                 std::string(StageName(renderers[i]));
+    return names;
+}
+
 bool RunsARenderer(const StageSet& enabled) {
     return std::ranges::any_of(kAllStages, [&](Stage s) { return Describe(s).renderer && enabled.Has(s); });
 }
@@ -190,10 +201,9 @@ bool FieldsReach(Stage stage, std::string_view path, std::set<Stage>& seen) {
     if (!seen.insert(stage).second) return false;
     const StageDescriptor& d = Describe(stage);
     if (FieldsListed(d.sceneFields, path)) return true;
-    // Shade's sun is fixed at step 0's when a renderer relights (Scene::needs.shadeOnce, from the descriptors).
-    if (stage == Stage::Shade && std::ranges::any_of(kAllStages, [&](Stage s) {
-            const RendererDescriptor* r = Describe(s).renderer;
-            return r && FieldsListed(r->relightFields, path);
+    // Scene::needs follows from the renderers' relightFields (shade's sun is fixed at step 0's when one relights).
+    if (d.readsRendererNeeds && std::ranges::any_of(RendererStages(), [&](Stage s) {
+            return FieldsListed(Describe(s).renderer->relightFields, path);
         }))
         return true;
     std::vector<Resource> inputs = d.reads;

@@ -7,6 +7,7 @@
 #include <array>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -29,6 +30,9 @@ bool FieldsListed(std::span<const std::string_view> fields, std::string_view pat
 bool StageOutputReads(Stage stage, std::string_view path);
 // The renderers (stages with a RendererDescriptor), in stage order.
 const std::vector<Stage>& RendererStages();
+// Their names for a message or a help text, joined by ", " and by `last` before the last one
+// ("render_splat, render_march or render_layers").
+std::string RendererNames(std::string_view last);
 // The stage's call adapter, from its module (core/pipeline/StageAdapter.h).
 StageAdapter AdapterOf(Stage stage);
 

@@ -1,7 +1,8 @@
 // The references one process computes and keeps for `accuracy` and `sweep`:
 // the lighting stages' inputs (the CPU simulation) per distinct setting, the
-// exact Embree references of T and G for them, and the reference renders of
-// render_march (docs/accuracy.md), each computed once and cached.
+// exact Embree references of T and G for them, and the reference renders (the
+// ray march with the parameters of the renderer whose descriptor has
+// referenceParams; docs/accuracy.md), each computed once and cached.
 #pragma once
 
 #include <map>

@@ -32,7 +32,7 @@ struct ImageErrorStats {
 };
 ImageErrorStats ImageErrors(std::span<const float> approx, std::span<const float> reference);
 
-// One renderer (render_march or render_splat) on one backend: the render call
+// One renderer on one backend (its descriptor's accuracyRender): the render call
 // alone timed over `repeats` calls after a warm-up; the inputs it reads
 // (T from shade, the density stage's occupancy for the splat renderer) are
 // computed first on the same backend, untimed there, and their time is

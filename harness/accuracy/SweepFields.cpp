@@ -24,10 +24,8 @@ std::vector<SceneOverride> SettingsRead(Stage stage, std::span<const SceneOverri
 std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
     // The renderers' reference render costs most: images are measured only when an image section varies.
     const bool images = std::ranges::any_of(axes, [](const SweepAxis& a) {
-        return std::ranges::any_of(kAllStages, [&](Stage stage) {
-            const RendererDescriptor* r = Describe(stage).renderer;
-            return r && FieldsListed(r->imageFields, a.path);
-        });
+        return std::ranges::any_of(
+            RendererStages(), [&](Stage stage) { return FieldsListed(Describe(stage).renderer->imageFields, a.path); });
     });
     std::vector<Stage> candidates = {Stage::Shade, Stage::Shadow};
     if (images)

@@ -16,8 +16,8 @@
 namespace cb {
 
 // Whether `path` can change a row of `stage` as sweep measures it: its output (StageOutputReads), or for a
-// renderer the exact reference render it is compared with (the fields render_march's output reads that the
-// reference does not ignore, ReferenceRenderIgnores).
+// renderer the exact reference render it is compared with (the fields the reference renderer's output reads
+// that the reference does not ignore, ReferenceRenderIgnores).
 bool RowDependsOn(Stage stage, std::string_view path);
 
 // The overrides of `setting` that a row of `stage` depends on, in their order.

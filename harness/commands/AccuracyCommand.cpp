@@ -20,7 +20,32 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* kHelpText = R"(usage: cloudbench accuracy [SCENE] [options]
+// Each renderer's own settings that `accuracy` tries, from its descriptor: "  <name>: <settings>;" wrapped at 80
+// columns, the last line ending with "; " and a newline.
+std::string AccuracyVariantsHelp() {
+    std::string text;
+    for (Stage stage : RendererStages()) {
+        const std::string_view help = Describe(stage).renderer->accuracyVariantsHelp;
+        if (help.empty()) continue;
+        std::string line = "  " + std::string(StageName(stage)) + ":";
+        size_t start = 0;
+        while (start <= help.size()) {
+            size_t end = help.find(' ', start);
+            if (end == std::string_view::npos) end = help.size();
+            const std::string word = std::string(help.substr(start, end - start)) + (end == help.size() ? ";" : "");
+            if (line.size() + 1 + word.size() > 80) {
+                text += line + "\n";
+                line = "   ";
+            }
+            line += " " + word;
+            start = end + 1;
+        }
+        text += line + "\n";
+    }
+    return text;
+}
+
+const std::string kHelpText = R"(usage: cloudbench accuracy [SCENE] [options]
 
 Simulates SCENE on the CPU to its last step, computes the exact references
 T_ref (every voxel, from the point where the ray toward the sun leaves the
@@ -33,14 +58,14 @@ over the voxels in cloud (q > 0) or ground cells under cloud (G_ref < 1), the
 reference's own speed in rays per second, and writes DIR/accuracy.json and
 DIR/accuracy.md.
 
-With a renderer in the scene (render_splat, render_march, render_layers; a
-tiled volume is not rendered by the reference yet) it also renders the exact
-reference image (render_march's kernel with exact light toward the sun and the
-point light, a fine step, no early termination, no jitter) and measures each
-renderer on each backend against it: the scene's settings, then for
-render_march each of step (x0.5, x2, x4), adaptive step, light source and n_l,
-jitter, skipping, epsilon 0 and phase function changed one at a time; per-pixel
-error = max over channels of |C - C_ref|, with max, mean, p99 and PSNR.
+With a renderer in the scene ()" + RendererNames(", ") + R"()
+it also renders the exact reference image (the ray march's kernel with exact
+light toward the sun and the point light, a fine step, no early termination,
+no jitter; a tiled volume is not rendered by the reference yet) and measures
+each renderer on each backend against it: the scene's settings, then each of
+its own settings changed one at a time:
+)" + AccuracyVariantsHelp() + R"(per-pixel error = max over channels of |C - C_ref|, with max, mean, p99 and
+PSNR.
 
 Options:
   --backend LIST     backends to measure (default: all built); unavailable ones

@@ -9,6 +9,7 @@
 #include <expected>
 
 #include "core/base/ShownText.h"
+#include "core/plan/StageGraph.h"
 #include "harness/accuracy/AccuracyTransfer.h"
 #include "harness/accuracy/IsolatedMeasurement.h"
 #include "harness/accuracy/Measurement.h"
@@ -22,7 +23,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* kHelpText = R"(usage: cloudbench sweep [SCENE] --vary PATH=V1,V2,... [--vary ...] [options]
+const std::string kHelpText = R"(usage: cloudbench sweep [SCENE] --vary PATH=V1,V2,... [--vary ...] [options]
 
 Runs the cartesian product of the --vary values (dotted scene paths, as for
 --set; a value may be JSON, e.g. --vary grid.size=[32,32,8],[64,64,16]). At
@@ -35,14 +36,15 @@ DIR/sweep.json, DIR/sweep.md and DIR/sweep.png (error against time, one
 series per backend; needs python3 with matplotlib, otherwise the plot is
 skipped with a message).
 
-When a varied field belongs to the march, render, phase, lightning or layers
-sections, the scene's renderers (render_march, render_splat, render_layers) are
-measured too, against the exact reference render (see cloudbench help
-accuracy): per-pixel error = max over channels of |C - C_ref|, and PSNR; the
-renderers share one Pareto front and one panel of the plot. A stage is measured
-only when a varied field can change its rows (the fields its descriptor reads,
-those of the stages that feed it, and for a renderer its reference), once per
-distinct setting of those fields; its rows list only them.
+When a varied field is one a renderer's image depends on (its descriptor's
+image fields), the scene's renderers
+()" + RendererNames(", ") + R"() are measured too, against the
+exact reference render (see cloudbench help accuracy): per-pixel error = max
+over channels of |C - C_ref|, and PSNR; the renderers share one Pareto front
+and one panel of the plot. A stage is measured only when a varied field can
+change its rows (the fields its descriptor reads, those of the stages that
+feed it, and for a renderer its reference), once per distinct setting of those
+fields; its rows list only them.
 
 Exit codes: 0 when a row was measured and none failed, 1 for a failed or
 crashed row, 4 when no row was measured (every row unsupported or

@@ -37,11 +37,13 @@ std::string ConformCaseName(const std::vector<SceneOverride>& overrides, std::op
 
 std::vector<ConformCase> ConformMatrixCases(const Scene& scene, gl::CaLayout sceneLayout, bool glCompared) {
     const StageSet& stages = scene.stages;
-    const bool shade = stages.Has(Stage::Shade), splat = stages.Has(Stage::RenderSplat);
+    const bool shade = stages.Has(Stage::Shade);
+    const bool rendererVariesPhase = std::ranges::any_of(
+        RendererStages(), [&](Stage s) { return stages.Has(s) && Describe(s).renderer->conformVariesPhase; });
     std::vector<Candidate> candidates;
     // The phase function: with scattering on when the scene shades, so that shade compares it too.
     auto eachPhase = [&] {
-        if (!shade && !splat) return;
+        if (!shade && !rendererVariesPhase) return;
         for (const auto& [name, kind] : kPhaseKindNames) {
             Candidate c{{{"phase.function", std::string(name)}}, {}, {}};
             if (shade) c.overrides.push_back({std::string(ShadeScatteringSetting().path), "true"});

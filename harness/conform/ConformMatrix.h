@@ -34,9 +34,9 @@ std::string ConformCaseName(const std::vector<SceneOverride>& overrides, std::op
 // the scene does not already use, for the stages the scene runs: each stage's
 // choice settings in CB_STAGES order (its descriptor's `choices`: smooth.radius;
 // shade.attenuation, filter, resolution, storage, scattering.enabled; shadow.form;
-// render.culling, render.skipping), with, after shade's, phase.function (with scattering on
-//   when the scene shades, so that shade and render_splat both see it; "mie"
-//   without render_splat, which gl and vk refuse for it); the sun on each principal axis (a fixed
+// render.culling, render.skipping), with, after shade's, phase.function when shade runs or a
+//   renderer whose descriptor asks for it (conformVariesPhase; with scattering on when the scene
+//   shades, so that shade and the renderer both see it); the sun on each principal axis (a fixed
 //   sun only); ca.wind_shift (on when the scene has none, off otherwise); and,
 //   when `glCompared`, gl's other automaton layout (a case for gl only).
 // A case whose overrides all equal the scene's values is dropped (the case

@@ -104,7 +104,7 @@ Result<ImageComparison> CompareImages(const std::vector<float>& reference, const
 Status WriteDifferenceImage(const std::string& path, const std::vector<float>& reference,
                             const std::vector<float>& candidate, uint32_t width, uint32_t height);
 
-// The short name of a renderer stage in file names: "splat" for render_splat.
+// The short name of a renderer stage in file names (its descriptor's fileStem).
 std::string_view RendererFileName(Stage renderer);
 // "frame-<renderer>-<camera>", with "-<backend>" when `backend` is not empty.
 std::string FrameFileStem(Stage renderer, const std::string& camera, const std::string& backend = "");

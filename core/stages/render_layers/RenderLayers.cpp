@@ -198,6 +198,9 @@ const RendererDescriptor kLayersRenderer{
     .referenceIgnores = kLayersReferenceIgnores,
     .accuracyRender = LayersAccuracyRender,
     .accuracyVariants = LayersAccuracyVariants,
+    .accuracyVariantsHelp =
+        "layers.count (nz/2, nz, 2 nz, 4 nz) and three grazing views (one camera at the slab's "
+        "mid-height looking up 1, 5 and 20 degrees)",
 };
 
 }  // namespace

@@ -207,10 +207,12 @@ const RendererDescriptor kMarchRenderer{
     .imageFields = kMarchImageFields,
     .referenceIgnores = kMarchReferenceIgnores,
     .accuracyRender = MarchAccuracyRender,
-    .referenceParams = [](const Scene& scene, const CameraSettings& camera, uint32_t step) {
-        return MakeMarchParams(scene, camera, step);
-    },
+    .referenceParams = [](const Scene& scene, const CameraSettings& camera,
+                          uint32_t step) { return MakeMarchParams(scene, camera, step); },
     .accuracyVariants = MarchAccuracyVariants,
+    .accuracyVariantsHelp =
+        "step (x0.5, x2, x4), adaptive step, light source and n_l, jitter, skipping, epsilon 0 "
+        "and phase function",
 };
 
 }  // namespace

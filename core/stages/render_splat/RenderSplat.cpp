@@ -142,6 +142,7 @@ const RendererDescriptor kSplatRenderer{
     .referenceIgnores = kSplatReferenceIgnores,
     .accuracyRender = SplatAccuracyRender,
     .conformOptions = SplatConformOptions,
+    .conformVariesPhase = true,
 };
 
 }  // namespace

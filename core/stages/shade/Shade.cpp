@@ -153,6 +153,7 @@ const StageDescriptor& DescribeShade() {
         .ruleNote = "one storage quantum with fp16 or unorm8 storage",
         .choices = kShadeChoices,
         .sceneFields = kShadeSceneFields,
+        .readsRendererNeeds = true,  // shadeOnce
     };
     return descriptor;
 }

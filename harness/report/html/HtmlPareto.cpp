@@ -1,8 +1,8 @@
 // The accuracy part of `cloudbench report` (ParetoBlocks,
 // harness/report/html/ReportSections.h): error against time per stage, with the
-// Pareto front. The renderers (render_splat, render_march, render_layers) make
-// the same image, so they share one plot and one front, a series per renderer
-// and backend, as sweep.json's marks and tools/plot_sweep.py do.
+// Pareto front. The renderers (RendererStages) make the same image, so they
+// share one plot and one front, a series per renderer and backend, as
+// sweep.json's marks and tools/plot_sweep.py do.
 #include <algorithm>
 
 #include "core/plan/StageGraph.h"
