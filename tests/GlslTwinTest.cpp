@@ -272,7 +272,7 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
 
 // Test that light.glsl's InScattered, with the light MakeMarchGpu nests (MakeLightGpu), equals
 // core/math/Light.h's on random samples: every phase, the point light on and off, samples at
-// and near the point light (d = 0: cos 1; within r0: the capped falloff).
+// and near the point light (d = 0: cos 1; within r0: the capped falloff), the city glow on and off.
 TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
     Pcg32 rng(0x11947);
     const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
@@ -285,6 +285,14 @@ TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
         p.setup.light.pointOn = call % 8 < 6;
         p.setup.light.pointRadiance = {Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4)};
         p.setup.light.pointMinDistance2 = Uniform(rng, 1, 1e4);
+        // The city glow in two calls of three, with one to four blobs (their centres among the samples).
+        p.setup.light.glowOn = call % 3 != 0;
+        p.setup.light.glowColor = {Uniform(rng, 0, 2), Uniform(rng, 0, 2), Uniform(rng, 0, 2)};
+        p.setup.light.glowFade = Uniform(rng, 0, 3);
+        p.setup.light.glowInvThickness = 1.0f / float(1 + call * 7);
+        p.setup.light.glowBlobCount = 1 + uint32_t(call) % kMaxGlowBlobs;
+        for (auto& blob : p.setup.light.glowBlobs)
+            blob = {Uniform(rng, -10, 60), Uniform(rng, -10, 60), Uniform(rng, 1e-4, 0.5), Uniform(rng, 0, 2)};
         const MarchGpu m = MakeMarchGpu(p, e);
         const LightTerms& terms = p.setup.light;
         const Vec3& at = p.setup.light.pointPosition;

@@ -21,6 +21,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -59,20 +60,40 @@ constexpr size_t GlBytes(int t) {
 struct Member {
     std::string name;  // the GLSL member's name (nested: "light.sunRadiance")
     size_t offset;     // where the C++ struct has it
-    int glType;        // what the C++ member's type is in GLSL
+    int glType;        // what the C++ member's type is in GLSL (an array's: its element's)
+    size_t count = 1;  // an array's elements (each 16 bytes apart: vec4 arrays only)
 };
 
 #define CB_MEMBER(Struct, member) \
     Member { #member, offsetof(Struct, member), GlTypeOf < std::remove_cvref_t < decltype(Struct::member)>>() }
+// A std::array of vec4 rows, GLSL's vec4 member[N].
+#define CB_VEC4_ARRAY_MEMBER(Struct, member)                                                            \
+    Member {                                                                                            \
+#member, offsetof(Struct, member), GlTypeOf < typename decltype(Struct::member)::value_type>(), \
+            std::tuple_size_v < decltype(Struct::member)>                                               \
+    }
 
 // The members of LightGpu (core/math/Light.h), as a block's member `prefix` at byte `at`.
 std::vector<Member> LightMembers(const std::string& prefix, size_t at) {
-    std::vector<Member> light = {CB_MEMBER(LightGpu, sunRadiance),   CB_MEMBER(LightGpu, phaseKind),
-                                 CB_MEMBER(LightGpu, ambient),       CB_MEMBER(LightGpu, phaseG),
-                                 CB_MEMBER(LightGpu, pointPosition), CB_MEMBER(LightGpu, pointMinDistance2),
-                                 CB_MEMBER(LightGpu, pointRadiance), CB_MEMBER(LightGpu, pointOn),
-                                 CB_MEMBER(LightGpu, voxelSize),     CB_MEMBER(LightGpu, mieIndexPerRadian),
-                                 CB_MEMBER(LightGpu, mieCount),      CB_MEMBER(LightGpu, unused)};
+    std::vector<Member> light = {CB_MEMBER(LightGpu, sunRadiance),
+                                 CB_MEMBER(LightGpu, phaseKind),
+                                 CB_MEMBER(LightGpu, ambient),
+                                 CB_MEMBER(LightGpu, phaseG),
+                                 CB_MEMBER(LightGpu, pointPosition),
+                                 CB_MEMBER(LightGpu, pointMinDistance2),
+                                 CB_MEMBER(LightGpu, pointRadiance),
+                                 CB_MEMBER(LightGpu, pointOn),
+                                 CB_MEMBER(LightGpu, voxelSize),
+                                 CB_MEMBER(LightGpu, mieIndexPerRadian),
+                                 CB_MEMBER(LightGpu, mieCount),
+                                 CB_MEMBER(LightGpu, unused),
+                                 CB_MEMBER(LightGpu, glowColor),
+                                 CB_MEMBER(LightGpu, glowOn),
+                                 CB_MEMBER(LightGpu, glowFade),
+                                 CB_MEMBER(LightGpu, glowInvThickness),
+                                 CB_MEMBER(LightGpu, glowBlobCount),
+                                 CB_MEMBER(LightGpu, glowUnused),
+                                 CB_VEC4_ARRAY_MEMBER(LightGpu, glowBlobs)};
     for (Member& m : light) m.name = prefix + m.name, m.offset += at;
     return light;
 }
@@ -199,6 +220,7 @@ std::string GlslStruct(const Block& block) {
 struct Reflected {
     size_t offset;
     int glType;
+    size_t size;  // array elements (1 for a plain member)
 };
 
 // glslangValidator's reflection of `instance`'s members (instance.member: offset N, type T, ...).
@@ -214,12 +236,13 @@ std::map<std::string, Reflected> Reflect(const std::string& shader, const std::s
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return members;
     char line[512];
-    const std::regex entry("^" + instance + "\\.([A-Za-z0-9_.]+): offset (\\d+), type ([0-9a-f]+),");
+    const std::regex entry("^" + instance + "\\.([A-Za-z0-9_.]+): offset (\\d+), type ([0-9a-f]+), size (\\d+),");
     while (std::fgets(line, sizeof line, pipe)) {
         log += line;
         std::cmatch m;
         if (std::regex_search(line, m, entry))
-            members[m[1].str()] = {std::stoul(m[2].str()), int(std::stoul(m[3].str(), nullptr, 16))};
+            members[m[1].str()] = {std::stoul(m[2].str()), int(std::stoul(m[3].str(), nullptr, 16)),
+                                   std::stoul(m[4].str())};
     }
     pclose(pipe);
     std::filesystem::remove(path);
@@ -258,7 +281,8 @@ void ExpectSameLayout(const Block& block, const std::string& layout) {
         EXPECT_EQ(it->second.glType, member.glType)
             << block.glslName << "." << member.name << " (" << layout << "): GL type 0x" << std::hex
             << it->second.glType << " in GLSL, 0x" << member.glType << " from the C++ type";
-        end = std::max(end, member.offset + GlBytes(member.glType));
+        EXPECT_EQ(it->second.size, member.count) << block.glslName << "." << member.name << " (" << layout << ")";
+        end = std::max(end, member.offset + (member.count - 1) * 16 + GlBytes(member.glType));
     }
     EXPECT_EQ(end, block.bytes) << block.glslName << ": the C++ struct has bytes no member accounts for";
 }

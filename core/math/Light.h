@@ -1,6 +1,6 @@
 // The light a sample scatters toward the eye, ONE function for every renderer
 // (ray march, layers, splats) on every backend: the scene's enabled light terms
-// (the sun, the ambient light, the lightning's point light) gathered at a
+// (the sun, the ambient light, the lightning's point light, the city glow) gathered at a
 // sample. GLSL twin: core/math/light.glsl (InScattered, LightGpu), which the
 // GPU blocks of the renderers (MarchGpu, LayersGpu, SplatFrame) nest as their
 // member `light`, made by MakeLightGpu below.
@@ -9,7 +9,7 @@
 // (MarchSetup, LayersSetup, SplatParams), made by MakeLightTerms
 // (core/pipeline/LightTerms.h) in each renderer's Make*Params.
 //
-// Adding a light term (sky light, eye scattering, city glow): a member of
+// Adding a light term (sky light, eye scattering): a member of
 // LightTerms (and, if it varies per sample, of LightSample) and its lines in
 // InScattered, here and in light.glsl; its member of LightGpu in both languages
 // and its line in MakeLightGpu / LightTermsOf; its line in MakeLightTerms and
@@ -17,7 +17,8 @@
 //
 // The operations, in this order (bit-identical on every backend, built with
 // -ffp-contract=off): per channel c = sunRadiance_c * sunGain + ambient_c,
-// then with the point light on c += pointRadiance_c * g, g = T_point / max(d^2, r0^2) P^(cos theta_point).
+// then with the point light on c += pointRadiance_c * g, g = T_point / max(d^2, r0^2) P^(cos theta_point),
+// then with the city glow on c += glowColor_c * GlowMap(x, y) (1 - clamp(glowFade (z glowInvThickness), 0, 1)).
 #pragma once
 
 #include <algorithm>
@@ -32,6 +33,19 @@ namespace cb {
 // The point light's radiance factor at distance^2 d2 (metres^2): 1 / max(d2, r0^2).
 inline float PointLightFalloff(float distance2, float minDistance2) { return 1.0f / std::max(distance2, minDistance2); }
 
+// The most blobs a city glow map has (LightGpu's rows).
+inline constexpr uint32_t kMaxGlowBlobs = 4;
+
+// City glow's map g at (x, y) (voxel units): the sum of the blobs' strength exp(-d^2 k), in blob order.
+inline float GlowMap(const std::array<std::array<float, 4>, kMaxGlowBlobs>& blobs, uint32_t count, float x, float y) {
+    float g = 0.0f;
+    for (uint32_t i = 0; i < count; ++i) {
+        const float dx = x - blobs[i][0], dy = y - blobs[i][1];
+        g += blobs[i][3] * ExpNonPositive(-((dx * dx + dy * dy) * blobs[i][2]));
+    }
+    return g;
+}
+
 // The scene's light terms as a renderer sees them (voxel units as in core/math/March.h).
 struct LightTerms {
     Vec3 sunRadiance{1, 1, 1};  // colour * intensity
@@ -42,6 +56,14 @@ struct LightTerms {
     Vec3 pointPosition{};         // voxel units
     Vec3 pointRadiance{};         // colour * intensity (radiance * m^2)
     float pointMinDistance2 = 1;  // r0^2 in metres^2: the 1/D^2 law is capped at 1/r0^2
+    // City glow (Wang, Ji and Zhang, eq. 20): glowColor g(x, y) (1 - clamp(glowFade z / nz, 0, 1)), with
+    // g = sum over the blobs of strength exp(-((x - cx)^2 + (y - cy)^2) k) at the sample (voxel units).
+    bool glowOn = false;
+    Vec3 glowColor{};
+    float glowFade = 1;          // f_c
+    float glowInvThickness = 1;  // 1 / nz: z / nz is dH / thickness (z from the grid's bottom, the cloud base)
+    uint32_t glowBlobCount = 0;  // at most kMaxGlowBlobs
+    std::array<std::array<float, 4>, kMaxGlowBlobs> glowBlobs{};  // (cx, cy, k = h^2 / (2 sigma^2), strength)
 };
 
 // What varies per sample: the sun's gain (its transmittance times the phase,
@@ -71,6 +93,11 @@ inline Vec3 InScattered(const LightTerms& L, const LightSample& s) {
         const float g = s.pointT * PointLightFalloff(d2, L.pointMinDistance2) * PhaseValue(L.phase, cosL);
         for (int i = 0; i < 3; ++i) c[i] += L.pointRadiance[i] * g;
     }
+    if (L.glowOn) {
+        const float height = std::clamp(L.glowFade * (s.position[2] * L.glowInvThickness), 0.0f, 1.0f);
+        const float glow = GlowMap(L.glowBlobs, L.glowBlobCount, s.position[0], s.position[1]) * (1.0f - height);
+        for (int i = 0; i < 3; ++i) c[i] += L.glowColor[i] * glow;
+    }
     return c;
 }
 
@@ -89,8 +116,15 @@ struct alignas(16) LightGpu {
     float mieIndexPerRadian;  // kMieCloudTable's, read with phase Mie
     uint32_t mieCount;        // likewise
     uint32_t unused;
+    std::array<float, 3> glowColor;
+    uint32_t glowOn;  // 1: the city glow shines
+    float glowFade;
+    float glowInvThickness;
+    uint32_t glowBlobCount;
+    uint32_t glowUnused;
+    std::array<std::array<float, 4>, kMaxGlowBlobs> glowBlobs;  // (cx, cy, k, strength)
 };
-static_assert(sizeof(LightGpu) == 5 * 16, "LightGpu is five 16-byte rows");
+static_assert(sizeof(LightGpu) == (7 + kMaxGlowBlobs) * 16, "LightGpu is seven 16-byte rows and one per glow blob");
 
 inline LightGpu MakeLightGpu(const LightTerms& L) {
     LightGpu g{};
@@ -105,6 +139,12 @@ inline LightGpu MakeLightGpu(const LightTerms& L) {
     g.voxelSize = L.voxelSize;
     g.mieIndexPerRadian = kMieCloudTable.indexPerRadian;
     g.mieCount = kMieCloudTable.count;
+    g.glowColor = L.glowColor;
+    g.glowOn = L.glowOn ? 1u : 0u;
+    g.glowFade = L.glowFade;
+    g.glowInvThickness = L.glowInvThickness;
+    g.glowBlobCount = L.glowBlobCount;
+    g.glowBlobs = L.glowBlobs;
     return g;
 }
 
@@ -119,6 +159,12 @@ inline LightTerms LightTermsOf(const LightGpu& g) {
     L.pointPosition = g.pointPosition;
     L.pointRadiance = g.pointRadiance;
     L.pointMinDistance2 = g.pointMinDistance2;
+    L.glowOn = g.glowOn != 0u;
+    L.glowColor = g.glowColor;
+    L.glowFade = g.glowFade;
+    L.glowInvThickness = g.glowInvThickness;
+    L.glowBlobCount = g.glowBlobCount;
+    L.glowBlobs = g.glowBlobs;
     return L;
 }
 

@@ -2,8 +2,8 @@
 // one function (InScattered) for every renderer, and the block LightGpu that
 // MarchGpu, LayersGpu and SplatFrame nest as their member `light`. The same
 // operations in the same order as the C++, `precise` where the CPU (built
-// with -ffp-contract=off) rounds each product. Include after shading.glsl and
-// phase_table.glsl (PhaseOf).
+// with -ffp-contract=off) rounds each product. Include after shading.glsl
+// (ExpNonPositive) and phase_table.glsl (PhaseOf).
 #ifndef CLOUDBENCH_LIGHT_GLSL
 #define CLOUDBENCH_LIGHT_GLSL
 
@@ -21,6 +21,13 @@ struct LightGpu {
     float mieIndexPerRadian;
     uint mieCount;
     uint unused;
+    vec3 glowColor;
+    uint glowOn;
+    float glowFade;
+    float glowInvThickness;
+    uint glowBlobCount;
+    uint glowUnused;
+    vec4 glowBlobs[4];  // kMaxGlowBlobs: (cx, cy, k, strength)
 };
 
 // core/math/Light.h LightSample.
@@ -39,6 +46,18 @@ float LightPhase(LightGpu L, float cosTheta) {
 // 1 / max(d2, r0^2) (core/math/Light.h PointLightFalloff).
 float PointLightFalloff(float distance2, float minDistance2) { return 1.0 / max(distance2, minDistance2); }
 
+// core/math/Light.h GlowMap.
+float GlowMap(LightGpu L, float x, float y) {
+    precise float g = 0.0;
+    for (uint i = 0u; i < L.glowBlobCount; ++i) {
+        precise float dx = x - L.glowBlobs[i].x;
+        precise float dy = y - L.glowBlobs[i].y;
+        precise float d2k = (dx * dx + dy * dy) * L.glowBlobs[i].z;
+        g += L.glowBlobs[i].w * ExpNonPositive(-d2k);
+    }
+    return g;
+}
+
 // core/math/Light.h InScattered.
 vec3 InScattered(LightGpu L, LightSample s) {
     precise float c0 = L.sunRadiance.x * s.sunGain + L.ambient.x;
@@ -55,6 +74,13 @@ vec3 InScattered(LightGpu L, LightSample s) {
         c0 += L.pointRadiance.x * g;
         c1 += L.pointRadiance.y * g;
         c2 += L.pointRadiance.z * g;
+    }
+    if (L.glowOn != 0u) {
+        precise float height = clamp(L.glowFade * (s.position.z * L.glowInvThickness), 0.0, 1.0);
+        precise float glow = GlowMap(L, s.position.x, s.position.y) * (1.0 - height);
+        c0 += L.glowColor.x * glow;
+        c1 += L.glowColor.y * glow;
+        c2 += L.glowColor.z * glow;
     }
     return vec3(c0, c1, c2);
 }

@@ -1,6 +1,7 @@
 #include "core/pipeline/LightTerms.h"
 
 #include <algorithm>
+#include <string>
 #include <string_view>
 
 #include "core/scene/SceneNames.h"
@@ -21,6 +22,24 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
         L.pointRadiance[c] = float(l.color[c] * l.intensity);
     }
     L.pointMinDistance2 = float(l.radius * l.radius);
+    // City glow in voxel units. The clamps keep every product of GlowMap finite or +inf, never NaN, whatever the
+    // voxel size: a centre at most 1e18 voxel edges out, k = h^2 / (2 sigma^2) at most 1e30 (0 * k is 0).
+    const CityGlowSettings& glow = sc.lighting.cityGlow;
+    L.glowOn = glow.on;
+    if (glow.on) {
+        const double h = sc.grid.voxelSize;
+        for (int c = 0; c < 3; ++c) L.glowColor[c] = float(glow.color[c]);
+        L.glowFade = float(glow.fade);
+        L.glowInvThickness = 1.0f / float(sc.grid.size.nz);
+        L.glowBlobCount = uint32_t(std::min<size_t>(glow.blobs.size(), kMaxGlowBlobs));
+        for (uint32_t i = 0; i < L.glowBlobCount; ++i) {
+            const CityGlowSettings::Blob& b = glow.blobs[i];
+            for (int c = 0; c < 2; ++c)
+                L.glowBlobs[i][c] = float(std::clamp((b.center[c] - sc.grid.origin[c]) / h, -1e18, 1e18));
+            L.glowBlobs[i][2] = float(std::min(h * h / (2 * b.radius * b.radius), 1e30));
+            L.glowBlobs[i][3] = float(b.strength);
+        }
+    }
     return L;
 }
 
@@ -29,7 +48,59 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLightingKeys[] = {"ambient", "background"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow"};
+constexpr std::string_view kCityGlowKeys[] = {"color", "fade", "blobs"};
+constexpr std::string_view kGlowBlobKeys[] = {"center", "radius", "strength"};
+// City glow's colour, strength and fade: bounded so that a sample's glow (at most kMaxGlowBlobs * 1e6 * 1e6)
+// stays far below the sun's bound (ReadSun); centres within float's reach; radii that a voxel size can resolve.
+constexpr Range kGlowValue{.lo = 0, .hi = 1e6};
+constexpr Range kGlowCenter{.lo = -1e15, .hi = 1e15};
+constexpr Range kGlowRadius{.lo = 1e-6, .hi = 1e15};
+
+void ReadCityGlow(const Json& lighting, Validator& check, CityGlowSettings& glow) {
+    const Json* section = check.Section(lighting, "lighting", "city_glow", kCityGlowKeys);
+    if (!section) return;
+    glow.on = true;
+    if (const Json* v = Validator::Find(*section, "color")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.city_glow.color", kGlowValue)) glow.color = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "fade")) {
+        if (auto d = check.Number(*v, "lighting.city_glow.fade", kGlowValue)) glow.fade = *d;
+    }
+    const std::string field = "lighting.city_glow.blobs";
+    const Json* list = Validator::Find(*section, "blobs");
+    if (!list) {
+        check.Fail(field, "required field is missing (1 to " + std::to_string(kMaxGlowBlobs) + " blobs)");
+        return;
+    }
+    if (!list->is_array() || list->empty() || list->size() > kMaxGlowBlobs) {
+        check.Fail(field, "expected an array of 1 to " + std::to_string(kMaxGlowBlobs) +
+                              " {\"center\", \"radius\", \"strength\"} objects, got " + Describe(*list));
+        return;
+    }
+    for (size_t n = 0; n < list->size(); ++n) {
+        const std::string bf = IndexField(field, n);
+        const Json& item = (*list)[n];
+        if (!item.is_object()) {
+            check.Fail(bf, "expected a blob object, got " + Describe(item));
+            continue;
+        }
+        check.CheckKeys(item, bf, kGlowBlobKeys);
+        CityGlowSettings::Blob blob;
+        if (const Json* v = Validator::Find(item, "center")) {
+            if (auto a = check.Numbers<2>(*v, JoinField(bf, "center"), kGlowCenter)) blob.center = *a;
+        } else {
+            check.Fail(JoinField(bf, "center"), "required field is missing");
+        }
+        if (const Json* v = Validator::Find(item, "radius")) {
+            if (auto d = check.Number(*v, JoinField(bf, "radius"), kGlowRadius)) blob.radius = *d;
+        }
+        if (const Json* v = Validator::Find(item, "strength")) {
+            if (auto d = check.Number(*v, JoinField(bf, "strength"), kGlowValue)) blob.strength = *d;
+        }
+        glow.blobs.push_back(blob);
+    }
+}
 constexpr std::string_view kLightningKeys[] = {"enabled", "position", "color", "intensity", "radius", "flash"};
 constexpr std::string_view kFlashKeys[] = {"start", "steps"};
 
@@ -44,6 +115,7 @@ void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting
     if (const Json* v = Validator::Find(*section, "background")) {
         if (auto a = check.Numbers<3>(*v, "lighting.background", kSingleNonNegative)) lighting.background = *a;
     }
+    ReadCityGlow(*section, check, lighting.cityGlow);
 }
 
 void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {

@@ -11,6 +11,7 @@
 #include "core/base/Error.h"
 #include "core/math/Camera.h"
 #include "core/math/Grid.h"
+#include "core/math/Light.h"
 #include "core/math/NoiseSettings.h"
 #include "core/math/Shading.h"
 #include "core/scene/Stage.h"
@@ -78,9 +79,26 @@ struct SunSettings {
     }
 };
 
+// City glow (Wang, Ji and Zhang, eq. 20): the light of a city below lighting the clouds from underneath,
+// glow = g(x, y) (1 - clamp(fade dH / thickness, 0, 1)) times `color`, with g a sum of Gaussian blobs
+// (section `lighting.city_glow`; docs/pipeline.md, "City glow").
+struct CityGlowSettings {
+    // One blob of g: strength exp(-|(x, y) - center|^2 / (2 radius^2)).
+    struct Blob {
+        std::array<double, 2> center{0, 0};  // world x, y, metres
+        double radius = 1000;                // sigma, metres
+        double strength = 1;
+    };
+    bool on = false;                           // the section is present
+    std::array<double, 3> color{1, 0.6, 0.3};  // linear RGB radiance where g = 1 at the cloud base
+    double fade = 1;                           // f_c: the glow is gone at dH = thickness / fade
+    std::vector<Blob> blobs;                   // 1 to kMaxGlowBlobs (core/math/Light.h)
+};
+
 struct LightingSettings {
     std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
     std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
+    CityGlowSettings cityGlow;
 
     // In single precision, as the renderers use them.
     Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }

@@ -44,7 +44,8 @@ float PhaseTableValue(uint i) { return mieTable[i]; }
 float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1.0 / 16777216.0); }
 
 LightGpu ZeroLight() {
-    return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u);
+    return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, vec3(0.0), 0u, 0.0,
+                    0.0, 0u, 0u, vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0)));
 }
 
 MarchGpu ZeroMarch() {
