@@ -272,7 +272,8 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
 
 // Test that light.glsl's InScattered, with the light MakeMarchGpu nests (MakeLightGpu), equals
 // core/math/Light.h's on random samples: every phase, the point light on and off, samples at
-// and near the point light (d = 0: cos 1; within r0: the capped falloff), the city glow on and off.
+// and near the point light (d = 0: cos 1; within r0: the capped falloff), the city glow and eye
+// scattering on and off (a sample looking straight at the sun among them).
 TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
     Pcg32 rng(0x11947);
     const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
@@ -289,24 +290,36 @@ TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
         p.setup.light.glowOn = call % 3 != 0;
         p.setup.light.glowColor = {Uniform(rng, 0, 2), Uniform(rng, 0, 2), Uniform(rng, 0, 2)};
         p.setup.light.glowFade = Uniform(rng, 0, 3);
-        p.setup.light.glowInvThickness = 1.0f / float(1 + call * 7);
+        p.setup.light.invThickness = 1.0f / float(1 + call * 7);
         p.setup.light.glowBlobCount = 1 + uint32_t(call) % kMaxGlowBlobs;
         for (auto& blob : p.setup.light.glowBlobs)
             blob = {Uniform(rng, -10, 60), Uniform(rng, -10, 60), Uniform(rng, 1e-4, 0.5), Uniform(rng, 0, 2)};
+        // Eye scattering in three calls of four, with a cone from 2 to 150 degrees around a random sun.
+        p.setup.light.eyeOn = call % 4 != 1;
+        p.setup.light.sunDirection = SunDirection(rng.Uniform(-1.5, 1.5), rng.Uniform(0, 6.28));
+        const double cone = rng.Uniform(2, 150) * std::numbers::pi / 180;
+        p.setup.light.eyeCosCone = float(std::cos(cone));
+        p.setup.light.eyeInvOneMinusCos = float(1 / (1 - std::cos(cone)));
+        p.setup.light.eyeIntensity = Uniform(rng, 0, 10);
+        p.setup.light.eyeHeightGain = Uniform(rng, 0, 5);
         const MarchGpu m = MakeMarchGpu(p, e);
         const LightTerms& terms = p.setup.light;
         const Vec3& at = p.setup.light.pointPosition;
-        std::vector<Words> inputs = {WF({0.5f, 1, at[0], at[1], at[2], 0, 0, 1}),
-                                     WF({0, 0, at[0] + 0.01f, at[1], at[2], 1, 0, 0})};
+        const Vec3& sun = p.setup.light.sunDirection;
+        // (sunGain, sunT, pointT, position, direction); the third looks straight at the sun.
+        std::vector<Words> inputs = {WF({0.5f, 0.5f, 1, at[0], at[1], at[2], 0, 0, 1}),
+                                     WF({0, 0, 0, at[0] + 0.01f, at[1], at[2], 1, 0, 0}),
+                                     WF({0.5f, 0.75f, 1, 20, 20, 3, sun[0], sun[1], sun[2]})};
         for (int k = 0; k < 2000; ++k) {
             const Vec3 d = SunDirection(rng.Uniform(-1.5, 1.5), rng.Uniform(0, 6.28));
-            inputs.push_back(WF({Uniform(rng, 0, 2), Uniform(rng, 0, 1), Uniform(rng, -10, 60), Uniform(rng, -10, 60),
-                                 Uniform(rng, -10, 60), d[0], d[1], d[2]}));
+            inputs.push_back(WF({Uniform(rng, 0, 2), Uniform(rng, 0, 1), Uniform(rng, 0, 1), Uniform(rng, -10, 60),
+                                 Uniform(rng, -10, 60), Uniform(rng, -10, 60), d[0], d[1], d[2]}));
         }
         Compare("InScattered", {Kind::F, Kind::F, Kind::F}, sExact ? 0 : 4, inputs,
                 Run(test::kTwinInScattered, inputs, {}, m), [&](const Words& in, Words& out) {
-                    const LightSample s{Float(in[0]), Float(in[1]), Vec3{Float(in[2]), Float(in[3]), Float(in[4])},
-                                        Vec3{Float(in[5]), Float(in[6]), Float(in[7])}};
+                    const LightSample s{Float(in[0]), Float(in[1]), Float(in[2]),
+                                        Vec3{Float(in[3]), Float(in[4]), Float(in[5])},
+                                        Vec3{Float(in[6]), Float(in[7]), Float(in[8])}};
                     const Vec3 c = InScattered(terms, s);
                     out = WF({c[0], c[1], c[2]});
                 });

@@ -90,10 +90,16 @@ std::vector<Member> LightMembers(const std::string& prefix, size_t at) {
                                  CB_MEMBER(LightGpu, glowColor),
                                  CB_MEMBER(LightGpu, glowOn),
                                  CB_MEMBER(LightGpu, glowFade),
-                                 CB_MEMBER(LightGpu, glowInvThickness),
+                                 CB_MEMBER(LightGpu, invThickness),
                                  CB_MEMBER(LightGpu, glowBlobCount),
                                  CB_MEMBER(LightGpu, glowUnused),
-                                 CB_VEC4_ARRAY_MEMBER(LightGpu, glowBlobs)};
+                                 CB_VEC4_ARRAY_MEMBER(LightGpu, glowBlobs),
+                                 CB_MEMBER(LightGpu, sunDirection),
+                                 CB_MEMBER(LightGpu, eyeOn),
+                                 CB_MEMBER(LightGpu, eyeIntensity),
+                                 CB_MEMBER(LightGpu, eyeCosCone),
+                                 CB_MEMBER(LightGpu, eyeInvOneMinusCos),
+                                 CB_MEMBER(LightGpu, eyeHeightGain)};
     for (Member& m : light) m.name = prefix + m.name, m.offset += at;
     return light;
 }

@@ -180,10 +180,11 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
         f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
     }
     f.alpha = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
-    const float gain = (qt[1] * s.lightScale) * sunPhase;
+    const float lit = qt[1] * s.lightScale;  // T, or relit
+    const float gain = lit * sunPhase;
     // The sample at the crossing (voxel units, before the drift and the wrap).
     const Vec3 at{s.eye[0] + hx, s.eye[1] + hy, z};
-    f.color = InScattered(s.light, LightSample{gain, 1.0f, at, ray.dir});
+    f.color = InScattered(s.light, LightSample{gain, lit, 1.0f, at, ray.dir});
     return f;
 }
 

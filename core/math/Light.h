@@ -1,6 +1,6 @@
 // The light a sample scatters toward the eye, ONE function for every renderer
 // (ray march, layers, splats) on every backend: the scene's enabled light terms
-// (the sun, the ambient light, the lightning's point light, the city glow) gathered at a
+// (the sun, the ambient light, the lightning's point light, the city glow, eye scattering) gathered at a
 // sample. GLSL twin: core/math/light.glsl (InScattered, LightGpu), which the
 // GPU blocks of the renderers (MarchGpu, LayersGpu, SplatFrame) nest as their
 // member `light`, made by MakeLightGpu below.
@@ -9,7 +9,7 @@
 // (MarchSetup, LayersSetup, SplatParams), made by MakeLightTerms
 // (core/pipeline/LightTerms.h) in each renderer's Make*Params.
 //
-// Adding a light term (sky light, eye scattering): a member of
+// Adding a light term (sky light): a member of
 // LightTerms (and, if it varies per sample, of LightSample) and its lines in
 // InScattered, here and in light.glsl; its member of LightGpu in both languages
 // and its line in MakeLightGpu / LightTermsOf; its line in MakeLightTerms and
@@ -18,7 +18,8 @@
 // The operations, in this order (bit-identical on every backend, built with
 // -ffp-contract=off): per channel c = sunRadiance_c * sunGain + ambient_c,
 // then with the point light on c += pointRadiance_c * g, g = T_point / max(d^2, r0^2) P^(cos theta_point),
-// then with the city glow on c += glowColor_c * GlowMap(x, y) (1 - clamp(glowFade (z glowInvThickness), 0, 1)).
+// then with the city glow on c += glowColor_c * GlowMap(x, y) (1 - clamp(glowFade (z invThickness), 0, 1)),
+// then with eye scattering on c += sunRadiance_c * (sunT ((eyeIntensity cone) rise)).
 #pragma once
 
 #include <algorithm>
@@ -58,19 +59,28 @@ struct LightTerms {
     float pointMinDistance2 = 1;  // r0^2 in metres^2: the 1/D^2 law is capped at 1/r0^2
     // City glow (Wang, Ji and Zhang, eq. 20): glowColor g(x, y) (1 - clamp(glowFade z / nz, 0, 1)), with
     // g = sum over the blobs of strength exp(-((x - cx)^2 + (y - cy)^2) k) at the sample (voxel units).
+    float invThickness = 1;  // 1 / nz: z / nz is dH / thickness (z from the grid's bottom, the cloud base)
     bool glowOn = false;
     Vec3 glowColor{};
     float glowFade = 1;          // f_c
-    float glowInvThickness = 1;  // 1 / nz: z / nz is dH / thickness (z from the grid's bottom, the cloud base)
     uint32_t glowBlobCount = 0;  // at most kMaxGlowBlobs
     std::array<std::array<float, 4>, kMaxGlowBlobs> glowBlobs{};  // (cx, cy, k = h^2 / (2 sigma^2), strength)
+    // Eye scattering (Wang, Ji and Zhang, eq. 17): sunRadiance T I_e, I_e = eyeIntensity max(0, (d . sun - cos phi)
+    // / (1 - cos phi)) (eyeHeightGain clamp(z / nz, 0, 1) + 1), d the ray's unit direction (eye to sample).
+    bool eyeOn = false;
+    Vec3 sunDirection{0, 0, 1};   // unit, toward the sun, at the step
+    float eyeIntensity = 1;       // I_e0
+    float eyeCosCone = 0;         // cos phi
+    float eyeInvOneMinusCos = 1;  // 1 / (1 - cos phi)
+    float eyeHeightGain = 0;      // f_e
 };
 
 // What varies per sample: the sun's gain (its transmittance times the phase,
-// times the powder where the renderer has it), the point light's
-// transmittance, the sample's position (voxel units) and the ray's unit direction.
+// times the powder where the renderer has it), the sun's transmittance alone, the
+// point light's transmittance, the sample's position (voxel units) and the ray's unit direction.
 struct LightSample {
     float sunGain = 0;
+    float sunT = 0;
     float pointT = 1;
     Vec3 position{};
     Vec3 dir{};
@@ -94,9 +104,16 @@ inline Vec3 InScattered(const LightTerms& L, const LightSample& s) {
         for (int i = 0; i < 3; ++i) c[i] += L.pointRadiance[i] * g;
     }
     if (L.glowOn) {
-        const float height = std::clamp(L.glowFade * (s.position[2] * L.glowInvThickness), 0.0f, 1.0f);
+        const float height = std::clamp(L.glowFade * (s.position[2] * L.invThickness), 0.0f, 1.0f);
         const float glow = GlowMap(L.glowBlobs, L.glowBlobCount, s.position[0], s.position[1]) * (1.0f - height);
         for (int i = 0; i < 3; ++i) c[i] += L.glowColor[i] * glow;
+    }
+    if (L.eyeOn) {
+        const float cosE = s.dir[0] * L.sunDirection[0] + s.dir[1] * L.sunDirection[1] + s.dir[2] * L.sunDirection[2];
+        const float cone = std::max(0.0f, (cosE - L.eyeCosCone) * L.eyeInvOneMinusCos);
+        const float rise = L.eyeHeightGain * std::clamp(s.position[2] * L.invThickness, 0.0f, 1.0f) + 1.0f;
+        const float eye = s.sunT * ((L.eyeIntensity * cone) * rise);
+        for (int i = 0; i < 3; ++i) c[i] += L.sunRadiance[i] * eye;
     }
     return c;
 }
@@ -119,12 +136,18 @@ struct alignas(16) LightGpu {
     std::array<float, 3> glowColor;
     uint32_t glowOn;  // 1: the city glow shines
     float glowFade;
-    float glowInvThickness;
+    float invThickness;
     uint32_t glowBlobCount;
     uint32_t glowUnused;
     std::array<std::array<float, 4>, kMaxGlowBlobs> glowBlobs;  // (cx, cy, k, strength)
+    std::array<float, 3> sunDirection;
+    uint32_t eyeOn;  // 1: eye scattering
+    float eyeIntensity;
+    float eyeCosCone;
+    float eyeInvOneMinusCos;
+    float eyeHeightGain;
 };
-static_assert(sizeof(LightGpu) == (7 + kMaxGlowBlobs) * 16, "LightGpu is seven 16-byte rows and one per glow blob");
+static_assert(sizeof(LightGpu) == (9 + kMaxGlowBlobs) * 16, "LightGpu is nine 16-byte rows and one per glow blob");
 
 inline LightGpu MakeLightGpu(const LightTerms& L) {
     LightGpu g{};
@@ -142,9 +165,15 @@ inline LightGpu MakeLightGpu(const LightTerms& L) {
     g.glowColor = L.glowColor;
     g.glowOn = L.glowOn ? 1u : 0u;
     g.glowFade = L.glowFade;
-    g.glowInvThickness = L.glowInvThickness;
+    g.invThickness = L.invThickness;
     g.glowBlobCount = L.glowBlobCount;
     g.glowBlobs = L.glowBlobs;
+    g.sunDirection = L.sunDirection;
+    g.eyeOn = L.eyeOn ? 1u : 0u;
+    g.eyeIntensity = L.eyeIntensity;
+    g.eyeCosCone = L.eyeCosCone;
+    g.eyeInvOneMinusCos = L.eyeInvOneMinusCos;
+    g.eyeHeightGain = L.eyeHeightGain;
     return g;
 }
 
@@ -162,9 +191,15 @@ inline LightTerms LightTermsOf(const LightGpu& g) {
     L.glowOn = g.glowOn != 0u;
     L.glowColor = g.glowColor;
     L.glowFade = g.glowFade;
-    L.glowInvThickness = g.glowInvThickness;
+    L.invThickness = g.invThickness;
     L.glowBlobCount = g.glowBlobCount;
     L.glowBlobs = g.glowBlobs;
+    L.eyeOn = g.eyeOn != 0u;
+    L.sunDirection = g.sunDirection;
+    L.eyeIntensity = g.eyeIntensity;
+    L.eyeCosCone = g.eyeCosCone;
+    L.eyeInvOneMinusCos = g.eyeInvOneMinusCos;
+    L.eyeHeightGain = g.eyeHeightGain;
     return L;
 }
 

@@ -99,7 +99,7 @@ inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, f
     // The sample: the voxel centre in voxel units, seen along the unit direction from the eye.
     const Vec3 at{float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f};
     const Vec3 dir{dx / len, dy / len, dz / len};
-    const Vec3 colour = InScattered(terms, LightSample{light, 1.0f, at, dir});
+    const Vec3 colour = InScattered(terms, LightSample{light, t, 1.0f, at, dir});
     for (int c = 0; c < 3; ++c) s.colour[c] = colour[c];
     // Covered pixels: px - s/2 <= x + 0.5 < px + s/2.
     // Clamped to [0, image] and [-1, image - 1] in float, so the ints cannot overflow.

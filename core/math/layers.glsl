@@ -147,10 +147,11 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     }
     precise float faded = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     f.alpha = faded;
-    precise float gain = (qt.y * s.lightScale) * sunPhase;
+    precise float lit = qt.y * s.lightScale;  // T, or relit
+    precise float gain = lit * sunPhase;
     // The sample at the crossing (voxel units, before the drift and the wrap).
     precise vec3 at = vec3(s.eye.x + hx, s.eye.y + hy, z);
-    f.color = InScattered(s.light, LightSample(gain, 1.0, at, ray.dir));
+    f.color = InScattered(s.light, LightSample(gain, lit, 1.0, at, ray.dir));
     return f;
 }
 

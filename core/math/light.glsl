@@ -24,15 +24,22 @@ struct LightGpu {
     vec3 glowColor;
     uint glowOn;
     float glowFade;
-    float glowInvThickness;
+    float invThickness;
     uint glowBlobCount;
     uint glowUnused;
     vec4 glowBlobs[4];  // kMaxGlowBlobs: (cx, cy, k, strength)
+    vec3 sunDirection;
+    uint eyeOn;
+    float eyeIntensity;
+    float eyeCosCone;
+    float eyeInvOneMinusCos;
+    float eyeHeightGain;
 };
 
 // core/math/Light.h LightSample.
 struct LightSample {
     float sunGain;
+    float sunT;
     float pointT;
     vec3 position;
     vec3 dir;
@@ -76,11 +83,20 @@ vec3 InScattered(LightGpu L, LightSample s) {
         c2 += L.pointRadiance.z * g;
     }
     if (L.glowOn != 0u) {
-        precise float height = clamp(L.glowFade * (s.position.z * L.glowInvThickness), 0.0, 1.0);
+        precise float height = clamp(L.glowFade * (s.position.z * L.invThickness), 0.0, 1.0);
         precise float glow = GlowMap(L, s.position.x, s.position.y) * (1.0 - height);
         c0 += L.glowColor.x * glow;
         c1 += L.glowColor.y * glow;
         c2 += L.glowColor.z * glow;
+    }
+    if (L.eyeOn != 0u) {
+        precise float cosE = s.dir.x * L.sunDirection.x + s.dir.y * L.sunDirection.y + s.dir.z * L.sunDirection.z;
+        precise float cone = max(0.0, (cosE - L.eyeCosCone) * L.eyeInvOneMinusCos);
+        precise float rise = L.eyeHeightGain * clamp(s.position.z * L.invThickness, 0.0, 1.0) + 1.0;
+        precise float eye = s.sunT * ((L.eyeIntensity * cone) * rise);
+        c0 += L.sunRadiance.x * eye;
+        c1 += L.sunRadiance.y * eye;
+        c2 += L.sunRadiance.z * eye;
     }
     return vec3(c0, c1, c2);
 }

@@ -334,7 +334,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
                 precise float sunGain = lightSun * sunPhase;
                 if (powder) sunGain *= PowderTerm(m.powderC, lightSun);
                 const float lightPoint = pointOn ? PointLightMarch(m, p) : 1.0;
-                const vec3 inLight = InScattered(m.light, LightSample(sunGain, lightPoint, p, ray.dir));
+                const vec3 inLight = InScattered(m.light, LightSample(sunGain, lightSun, lightPoint, p, ray.dir));
                 precise float w = T * (1.0 - tau);
                 L0 += w * inLight.x;
                 L1 += w * inLight.y;

@@ -84,7 +84,7 @@ bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
     // The sample: the voxel centre in voxel units, seen along the unit direction from the eye.
     const vec3 at = vec3(float(idx.x) + 0.5, float(idx.y) + 0.5, float(idx.z) + 0.5);
     precise vec3 dir = vec3(dx / len, dy / len, dz / len);
-    const vec3 colour = InScattered(F.light, LightSample(light, 1.0, at, dir));
+    const vec3 colour = InScattered(F.light, LightSample(light, t, 1.0, at, dir));
     s.r = colour.x;
     s.g = colour.y;
     s.b = colour.z;

@@ -1,6 +1,8 @@
 #include "core/pipeline/LightTerms.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 #include <string_view>
 
@@ -24,13 +26,13 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
     L.pointMinDistance2 = float(l.radius * l.radius);
     // City glow in voxel units. The clamps keep every product of GlowMap finite or +inf, never NaN, whatever the
     // voxel size: a centre at most 1e18 voxel edges out, k = h^2 / (2 sigma^2) at most 1e30 (0 * k is 0).
+    L.invThickness = 1.0f / float(std::max(sc.grid.size.nz, 1u));
     const CityGlowSettings& glow = sc.lighting.cityGlow;
     L.glowOn = glow.on;
     if (glow.on) {
         const double h = sc.grid.voxelSize;
         for (int c = 0; c < 3; ++c) L.glowColor[c] = float(glow.color[c]);
         L.glowFade = float(glow.fade);
-        L.glowInvThickness = 1.0f / float(sc.grid.size.nz);
         L.glowBlobCount = uint32_t(std::min<size_t>(glow.blobs.size(), kMaxGlowBlobs));
         for (uint32_t i = 0; i < L.glowBlobCount; ++i) {
             const CityGlowSettings::Blob& b = glow.blobs[i];
@@ -40,6 +42,16 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
             L.glowBlobs[i][3] = float(b.strength);
         }
     }
+    const EyeScatteringSettings& eye = sc.lighting.eyeScattering;
+    L.eyeOn = eye.on;
+    L.sunDirection = sc.sun.DirectionAt(step);
+    if (eye.on) {
+        const double cosCone = std::cos(eye.coneDeg * std::numbers::pi / 180);
+        L.eyeIntensity = float(eye.intensity);
+        L.eyeCosCone = float(cosCone);
+        L.eyeInvOneMinusCos = float(1 / (1 - cosCone));
+        L.eyeHeightGain = float(eye.heightGain);
+    }
     return L;
 }
 
@@ -48,7 +60,8 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering"};
+constexpr std::string_view kEyeScatteringKeys[] = {"intensity", "cone_deg", "height_gain"};
 constexpr std::string_view kCityGlowKeys[] = {"color", "fade", "blobs"};
 constexpr std::string_view kGlowBlobKeys[] = {"center", "radius", "strength"};
 // City glow's colour, strength and fade: bounded so that a sample's glow (at most kMaxGlowBlobs * 1e6 * 1e6)
@@ -56,6 +69,27 @@ constexpr std::string_view kGlowBlobKeys[] = {"center", "radius", "strength"};
 constexpr Range kGlowValue{.lo = 0, .hi = 1e6};
 constexpr Range kGlowCenter{.lo = -1e15, .hi = 1e15};
 constexpr Range kGlowRadius{.lo = 1e-6, .hi = 1e15};
+
+// I_e is at most intensity (height_gain + 1) <= 1e3 * 101, below every P^'s bound 2^19.5 (core/math/Shading.h
+// kMaxPhasePeak): the term adds no more than the sun's own, and ReadSun's bound on a sample's light holds.
+void ReadEyeScattering(const Json& lighting, Validator& check, EyeScatteringSettings& eye) {
+    const Json* section = check.Section(lighting, "lighting", "eye_scattering", kEyeScatteringKeys);
+    if (!section) return;
+    eye.on = true;
+    if (const Json* v = Validator::Find(*section, "intensity")) {
+        if (auto d = check.Number(*v, "lighting.eye_scattering.intensity", Range{.lo = 0, .hi = 1e3}))
+            eye.intensity = *d;
+    }
+    // At most 1e-3 degrees narrow, so that 1 - cos(cone) (about 1.5e-10) stays a normal number in double and float.
+    if (const Json* v = Validator::Find(*section, "cone_deg")) {
+        if (auto d = check.Number(*v, "lighting.eye_scattering.cone_deg", Range{.lo = 1e-3, .hi = 180}))
+            eye.coneDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "height_gain")) {
+        if (auto d = check.Number(*v, "lighting.eye_scattering.height_gain", Range{.lo = 0, .hi = 100}))
+            eye.heightGain = *d;
+    }
+}
 
 void ReadCityGlow(const Json& lighting, Validator& check, CityGlowSettings& glow) {
     const Json* section = check.Section(lighting, "lighting", "city_glow", kCityGlowKeys);
@@ -116,6 +150,7 @@ void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting
         if (auto a = check.Numbers<3>(*v, "lighting.background", kSingleNonNegative)) lighting.background = *a;
     }
     ReadCityGlow(*section, check, lighting.cityGlow);
+    ReadEyeScattering(*section, check, lighting.eyeScattering);
 }
 
 void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {

@@ -95,10 +95,22 @@ struct CityGlowSettings {
     std::vector<Blob> blobs;                   // 1 to kMaxGlowBlobs (core/math/Light.h)
 };
 
+// Eye scattering (Wang, Ji and Zhang, eq. 17): the sun's light scattered toward an eye that looks near the sun, a
+// fast stand-in for the phase function's forward peak, sun T I_e with
+// I_e = intensity max(0, (d . s - cos cone) / (1 - cos cone)) (height_gain clamp(dH / thickness, 0, 1) + 1)
+// (section `lighting.eye_scattering`; docs/pipeline.md, "Eye scattering").
+struct EyeScatteringSettings {
+    bool on = false;        // the section is present
+    double intensity = 1;   // I_e0
+    double coneDeg = 10;    // phi, degrees: no eye scattering farther than this from the sun
+    double heightGain = 0;  // f_e: how much it grows toward the cloud top
+};
+
 struct LightingSettings {
     std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
     std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
     CityGlowSettings cityGlow;
+    EyeScatteringSettings eyeScattering;
 
     // In single precision, as the renderers use them.
     Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }

@@ -45,7 +45,8 @@ float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1
 
 LightGpu ZeroLight() {
     return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, vec3(0.0), 0u, 0.0,
-                    0.0, 0u, 0u, vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0)));
+                    0.0, 0u, 0u, vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0)), vec3(0.0, 0.0, 1.0), 0u, 0.0,
+                    0.0, 0.0, 0.0);
 }
 
 MarchGpu ZeroMarch() {
@@ -296,7 +297,7 @@ void main() {
             break;
         // With the bound MarchGpu's light (tests/GlslTwinTest.cpp InScatteredMatchesTheCpp).
         case kTwinInScattered: {
-            const LightSample s = LightSample(F(0u), F(1u), vec3(F(2u), F(3u), F(4u)), vec3(F(5u), F(6u), F(7u)));
+            const LightSample s = LightSample(F(0u), F(1u), F(2u), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)));
             const vec3 c = InScattered(march.light, s);
             PutF(0u, c.x);
             PutF(1u, c.y);

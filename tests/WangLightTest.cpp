@@ -1,9 +1,11 @@
-// City glow (Wang, Ji and Zhang, eq. 20; lighting.city_glow): the term InScattered adds against its closed form
-// worked by hand, its terms in voxel units from a scene, every renderer taking it on the CPU, and its settings'
-// checks. The GLSL twin is GlslTwin.InScatteredMatchesTheCpp; the backends' agreement is Cli.ConformCityGlow.*.
+// Wang, Ji and Zhang's light terms: city glow (eq. 20; lighting.city_glow) and eye scattering (eq. 17;
+// lighting.eye_scattering). For each, the term InScattered adds against its closed form worked by hand, its terms
+// from a scene, every renderer taking it on the CPU, and its settings' checks. The GLSL twin is
+// GlslTwin.InScatteredMatchesTheCpp; the backends' agreement is Cli.ConformWangLight.*.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,14 +28,14 @@ LightTerms OneBlob() {
     L.glowOn = true;
     L.glowColor = {1.0f, 0.5f, 0.25f};
     L.glowFade = 2;
-    L.glowInvThickness = 1.0f / 16.0f;
+    L.invThickness = 1.0f / 16.0f;
     L.glowBlobCount = 1;
     L.glowBlobs[0] = {10, 20, 1.0f / 32.0f, 3};
     return L;
 }
 
 Vec3 At(const LightTerms& L, float x, float y, float z) {
-    return InScattered(L, LightSample{0, 1, {x, y, z}, {0, 0, 1}});
+    return InScattered(L, LightSample{0, 0, 1, {x, y, z}, {0, 0, 1}});
 }
 
 // Test the term against eq. 20 by hand: at the blob's centre and a quarter of the thickness up (fade 2: half gone)
@@ -80,7 +82,7 @@ TEST(CityGlow, TermsInVoxelUnits) {
     EXPECT_TRUE(L.glowOn);
     EXPECT_EQ(L.glowColor, (Vec3{2, 1, 0.5f}));
     EXPECT_EQ(L.glowFade, 3.0f);
-    EXPECT_EQ(L.glowInvThickness, 0.125f);
+    EXPECT_EQ(L.invThickness, 0.125f);
     ASSERT_EQ(L.glowBlobCount, 2u);
     EXPECT_EQ(L.glowBlobs[0], (std::array<float, 4>{30, 20, 0.125f, 4}));
     // The defaults: radius 1000 m (k = 50^2 / (2 1000^2) = 0.00125), strength 1.
@@ -147,6 +149,107 @@ TEST(CityGlow, SettingsAreChecked) {
     };
     for (const auto& [value, message] : cases) {
         auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json", {{"lighting.city_glow", value}});
+        ASSERT_FALSE(scene.has_value()) << value;
+        EXPECT_NE(scene.error().message.find(message), std::string::npos) << scene.error().message;
+    }
+}
+
+// Eye scattering, by hand: the sun (2, 1, 0.5) straight up, a 60-degree cone (cos 0.5), I_e0 = 3, f_e = 1, nz = 16,
+// the sun's transmittance 0.5 and no sun gain or ambient, so that c is the term alone.
+LightTerms EyeOnly() {
+    LightTerms L;
+    L.sunRadiance = {2, 1, 0.5f};
+    L.ambient = {0, 0, 0};
+    L.invThickness = 1.0f / 16.0f;
+    L.eyeOn = true;
+    L.sunDirection = {0, 0, 1};
+    L.eyeIntensity = 3;
+    L.eyeCosCone = 0.5f;
+    L.eyeInvOneMinusCos = 2;
+    L.eyeHeightGain = 1;
+    return L;
+}
+
+Vec3 Eye(const LightTerms& L, float sunT, float z, Vec3 dir) {
+    return InScattered(L, LightSample{0, sunT, 1, {5, 5, z}, dir});
+}
+
+// Test the term against eq. 17 by hand: looking at the sun, a quarter of the thickness up,
+// I_e = 3 * 1 * (1 * 0.25 + 1) = 3.75 and c = sun * 0.5 * 3.75; half the cone's cosine away ((1 - 0.5) / 2 = 0.25
+// of the way from its edge: cos 0.75) a quarter of it; at the cone's edge and beyond, none; at the top twice and
+// below the base once the intensity; with no sunlight reaching the sample (T = 0), none.
+TEST(EyeScattering, InScatteredIsEquationSeventeen) {
+    const LightTerms L = EyeOnly();
+    EXPECT_EQ(Eye(L, 0.5f, 4, {0, 0, 1}), (Vec3{3.75f, 1.875f, 0.9375f}));
+    const float s = std::sqrt(1.0f - 0.75f * 0.75f);
+    const Vec3 c = Eye(L, 0.5f, 4, {s, 0, 0.75f});  // cone (0.75 - 0.5) * 2 = 0.5
+    EXPECT_EQ(c, (Vec3{1.875f, 0.9375f, 0.46875f}));
+    EXPECT_EQ(Eye(L, 0.5f, 4, {std::sqrt(0.75f), 0, 0.5f}), (Vec3{0, 0, 0}));
+    EXPECT_EQ(Eye(L, 0.5f, 4, {1, 0, 0}), (Vec3{0, 0, 0}));
+    EXPECT_EQ(Eye(L, 0.5f, 4, {0, 0, -1}), (Vec3{0, 0, 0}));
+    EXPECT_EQ(Eye(L, 0.5f, 16, {0, 0, 1}), (Vec3{6, 3, 1.5f}));
+    EXPECT_EQ(Eye(L, 0.5f, 40, {0, 0, 1}), (Vec3{6, 3, 1.5f}));
+    EXPECT_EQ(Eye(L, 0.5f, -2, {0, 0, 1}), (Vec3{3, 1.5f, 0.75f}));
+    EXPECT_EQ(Eye(L, 0, 4, {0, 0, 1}), (Vec3{0, 0, 0}));
+    LightTerms off = L;
+    off.eyeOn = false;
+    EXPECT_EQ(Eye(off, 0.5f, 4, {0, 0, 1}), (Vec3{0, 0, 0}));
+}
+
+// Test the terms a scene gives: the sun's direction at the step, cos and 1 / (1 - cos) of the cone, I_e0 and f_e.
+TEST(EyeScattering, TermsFromTheScene) {
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json",
+                           {{"lighting.eye_scattering", R"({"intensity": 2, "cone_deg": 60, "height_gain": 0.5})"},
+                            {"sun.elevation_deg", "30"},
+                            {"sun.azimuth_deg", "90"}});
+    ASSERT_TRUE(scene.has_value()) << scene.error().message;
+    const LightTerms L = MakeLightTerms(*scene, 3);
+    EXPECT_TRUE(L.eyeOn);
+    EXPECT_EQ(L.sunDirection, scene->sun.DirectionAt(3));
+    EXPECT_NEAR(L.sunDirection[1], std::cos(std::numbers::pi / 6), 1e-6);  // azimuth 90: toward +y, elevation 30
+    EXPECT_NEAR(L.sunDirection[2], 0.5, 1e-6);
+    EXPECT_FLOAT_EQ(L.eyeCosCone, 0.5f);
+    EXPECT_FLOAT_EQ(L.eyeInvOneMinusCos, 2.0f);
+    EXPECT_EQ(L.eyeIntensity, 2.0f);
+    EXPECT_EQ(L.eyeHeightGain, 0.5f);
+    // The defaults: I_e0 1, a 10-degree cone, f_e 0.
+    auto plain = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json", {{"lighting.eye_scattering", "{}"}});
+    ASSERT_TRUE(plain.has_value()) << plain.error().message;
+    const LightTerms D = MakeLightTerms(*plain, 0);
+    EXPECT_EQ(D.eyeIntensity, 1.0f);
+    EXPECT_FLOAT_EQ(D.eyeCosCone, float(std::cos(10 * std::numbers::pi / 180)));
+    EXPECT_EQ(D.eyeHeightGain, 0.0f);
+}
+
+// Test that every renderer takes eye scattering through InScattered: with a cone of 180 degrees every lit sample
+// not facing straight away from the sun gains light, so each image brightens; with I_e0 = 0 the images are the
+// same bit for bit.
+TEST(EyeScattering, EveryRendererTakesIt) {
+    const std::pair<const char*, Resource> cases[] = {{"ci-small", Resource::SplatImage},
+                                                      {"noise-layer", Resource::MarchImage},
+                                                      {"layers-small", Resource::LayersImage}};
+    for (const auto& [scene, image] : cases) {
+        const double plain = ImageSum(scene, image, 6, {});
+        const double lit = ImageSum(scene, image, 6, {{"lighting.eye_scattering", R"({"cone_deg": 180})"}});
+        const double none = ImageSum(scene, image, 6, {{"lighting.eye_scattering", R"({"intensity": 0})"}});
+        EXPECT_GT(lit, plain * (1 + 1e-4)) << scene << ": without " << plain << ", with eye scattering " << lit;
+        EXPECT_EQ(none, plain) << scene;
+    }
+}
+
+// Test that each setting is checked, naming the field.
+TEST(EyeScattering, SettingsAreChecked) {
+    const std::pair<const char*, const char*> cases[] = {
+        {R"({"cone_deg": 0})", "lighting.eye_scattering.cone_deg"},
+        {R"({"cone_deg": 181})", "lighting.eye_scattering.cone_deg"},
+        {R"({"intensity": 2000})", "lighting.eye_scattering.intensity"},
+        {R"({"height_gain": -1})", "lighting.eye_scattering.height_gain"},
+        {R"({"phi": 5})", "lighting.eye_scattering.phi: unknown field"},
+        {"[]", "lighting.eye_scattering: expected an object"},
+    };
+    for (const auto& [value, message] : cases) {
+        auto scene =
+            LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json", {{"lighting.eye_scattering", value}});
         ASSERT_FALSE(scene.has_value()) << value;
         EXPECT_NE(scene.error().message.find(message), std::string::npos) << scene.error().message;
     }
