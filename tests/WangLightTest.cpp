@@ -13,6 +13,7 @@
 #include "core/math/Light.h"
 #include "core/pipeline/LightTerms.h"
 #include "core/plan/SceneLoad.h"
+#include "core/plan/StageGraph.h"
 #include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/TestUtil.h"
@@ -212,6 +213,7 @@ TEST(EyeScattering, TermsFromTheScene) {
     EXPECT_FLOAT_EQ(L.eyeInvOneMinusCos, 2.0f);
     EXPECT_EQ(L.eyeIntensity, 2.0f);
     EXPECT_EQ(L.eyeHeightGain, 0.5f);
+    EXPECT_EQ(L.phase.kind, scene->phase.kind);  // the scene's phase function: replaces_phase is off
     // The defaults: I_e0 1, a 10-degree cone, f_e 0.
     auto plain = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/ci-small.json", {{"lighting.eye_scattering", "{}"}});
     ASSERT_TRUE(plain.has_value()) << plain.error().message;
@@ -219,6 +221,24 @@ TEST(EyeScattering, TermsFromTheScene) {
     EXPECT_EQ(D.eyeIntensity, 1.0f);
     EXPECT_FLOAT_EQ(D.eyeCosCone, float(std::cos(10 * std::numbers::pi / 180)));
     EXPECT_EQ(D.eyeHeightGain, 0.0f);
+}
+
+// Test Wang's model: with replaces_phase the renderers' light has no phase function, while the exact reference keeps
+// the scene's (Cornette-Shanks here) and leaves eye scattering out, which is what its error measures.
+TEST(EyeScattering, ReplacesPhaseInTheRenderersNotTheReference) {
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/noise-layer.json",
+                           {{"phase.function", "cornette-shanks"},
+                            {"lighting.eye_scattering", R"({"cone_deg": 20, "replaces_phase": true})"}});
+    ASSERT_TRUE(scene.has_value()) << scene.error().message;
+    const LightTerms L = MakeLightTerms(*scene, 0);
+    EXPECT_TRUE(L.eyeOn);
+    EXPECT_EQ(L.phase.kind, PhaseKind::None);
+    const RendererDescriptor& march = *Describe(Stage::RenderMarch).renderer;
+    ASSERT_TRUE(march.referenceParams);
+    const MarchParams reference = march.referenceParams(*scene, scene->render.cameras[0], 0);
+    EXPECT_FALSE(reference.setup.light.eyeOn);
+    EXPECT_EQ(reference.setup.light.phase.kind, PhaseKind::CornetteShanks);
+    EXPECT_TRUE(FieldsListed(march.referenceIgnores, "lighting.eye_scattering.cone_deg"));
 }
 
 // Test that every renderer takes eye scattering through InScattered: with a cone of 180 degrees every lit sample

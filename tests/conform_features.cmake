@@ -66,13 +66,13 @@ if(DEFINED conform_features_backend)
                          TIMEOUT 300)
   endforeach()
 endif()
-# Wang, Ji and Zhang's light terms, city glow (one blob under the grid's middle) and eye scattering (a 90-degree
-# cone), on every built backend for each renderer: a splat (ci-small), a march (noise-layer) and a layers
-# (layers-small) scene; exit 4 (no backend besides the CPU could start) is a skip.
+# Wang, Ji and Zhang's light terms, city glow (one blob off the diagonal x = y, so that a swapped x and y shows) and
+# eye scattering (a 90-degree cone), on every built backend for each renderer: a splat (ci-small), a march
+# (noise-layer) and a layers (layers-small) scene; exit 4 (no backend besides the CPU could start) is a skip.
 foreach(scene IN ITEMS ci-small noise-layer layers-small)
   add_test(NAME Cli.ConformWangLight.${scene}
            COMMAND ${cli} conform ${scene} --steps 2 --set warmup_steps=0
-                   --set "lighting.city_glow={\"color\":[1,0.5,0.2],\"blobs\":[{\"center\":[1600,1600],\"radius\":1000,\"strength\":2}]}"
+                   --set "lighting.city_glow={\"color\":[1,0.5,0.2],\"blobs\":[{\"center\":[1600,900],\"radius\":1000,\"strength\":2}]}"
                    --set "lighting.eye_scattering={\"intensity\":2,\"cone_deg\":90,\"height_gain\":1}"
                    --out ${cli_out}/conform-wang-light-${scene})
   set_tests_properties(Cli.ConformWangLight.${scene} PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"

@@ -51,6 +51,7 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
         L.eyeCosCone = float(cosCone);
         L.eyeInvOneMinusCos = float(1 / (1 - cosCone));
         L.eyeHeightGain = float(eye.heightGain);
+        if (eye.replacesPhase) L.phase = PhaseParams{PhaseKind::None, 0.0f};
     }
     return L;
 }
@@ -61,7 +62,7 @@ namespace cb::scene_io {
 namespace {
 
 constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering"};
-constexpr std::string_view kEyeScatteringKeys[] = {"intensity", "cone_deg", "height_gain"};
+constexpr std::string_view kEyeScatteringKeys[] = {"intensity", "cone_deg", "height_gain", "replaces_phase"};
 constexpr std::string_view kCityGlowKeys[] = {"color", "fade", "blobs"};
 constexpr std::string_view kGlowBlobKeys[] = {"center", "radius", "strength"};
 // City glow's colour, strength and fade: bounded so that a sample's glow (at most kMaxGlowBlobs * 1e6 * 1e6)
@@ -88,6 +89,9 @@ void ReadEyeScattering(const Json& lighting, Validator& check, EyeScatteringSett
     if (const Json* v = Validator::Find(*section, "height_gain")) {
         if (auto d = check.Number(*v, "lighting.eye_scattering.height_gain", Range{.lo = 0, .hi = 100}))
             eye.heightGain = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "replaces_phase")) {
+        if (auto b = check.Boolean(*v, "lighting.eye_scattering.replaces_phase")) eye.replacesPhase = *b;
     }
 }
 

@@ -104,6 +104,9 @@ struct EyeScatteringSettings {
     double intensity = 1;   // I_e0
     double coneDeg = 10;    // phi, degrees: no eye scattering farther than this from the sun
     double heightGain = 0;  // f_e: how much it grows toward the cloud top
+    // Wang's model: the renderers light the sun's (and the point light's) term with no phase function and the eye
+    // scattering carries the forward peak; the exact reference keeps the scene's phase function.
+    bool replacesPhase = false;
 };
 
 struct LightingSettings {
