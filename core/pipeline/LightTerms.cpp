@@ -24,9 +24,9 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
         L.pointRadiance[c] = float(l.color[c] * l.intensity);
     }
     L.pointMinDistance2 = float(l.radius * l.radius);
+    L.invThickness = 1.0f / float(std::max(sc.grid.size.nz, 1u));
     // City glow in voxel units. The clamps keep every product of GlowMap finite or +inf, never NaN, whatever the
     // voxel size: a centre at most 1e18 voxel edges out, k = h^2 / (2 sigma^2) at most 1e30 (0 * k is 0).
-    L.invThickness = 1.0f / float(std::max(sc.grid.size.nz, 1u));
     const CityGlowSettings& glow = sc.lighting.cityGlow;
     L.glowOn = glow.on;
     if (glow.on) {

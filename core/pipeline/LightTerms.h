@@ -13,9 +13,11 @@
 
 namespace cb {
 
-// The sun's radiance, the ambient light, the phase function, the voxel size h
-// and the lightning's point light at `step` (its flash; position in voxel
-// units, radiance colour * intensity, r0^2 in metres^2).
+// The sun's radiance and direction, the ambient light, the phase function (none
+// where eye scattering replaces it), the voxel size h, 1 / nz, the lightning's
+// point light at `step` (its flash; position in voxel units, radiance colour *
+// intensity, r0^2 in metres^2), the city glow's blobs in voxel units and eye
+// scattering's cone.
 LightTerms MakeLightTerms(const Scene& scene, uint32_t step);
 
 namespace scene_io {
