@@ -147,7 +147,7 @@ std::vector<Stage> StagesOf(std::initializer_list<const char*> paths) {
 }
 
 // The stages a sweep measures: only those a varied field can change (the layers fields alone measure
-// render_layers alone, march.step render_march alone), renderers only when an image section varies.
+// render_layers alone, march.step render_march alone), renderers only when an image section or a light term varies.
 TEST(SweepFields, SweepStagesAreThoseTheFieldsReach) {
     using S = std::vector<Stage>;
     EXPECT_EQ(StagesOf({"layers.count"}), (S{Stage::RenderLayers}));
@@ -160,6 +160,12 @@ TEST(SweepFields, SweepStagesAreThoseTheFieldsReach) {
     EXPECT_EQ(StagesOf({"phase.function"}),
               (S{Stage::Shade, Stage::RenderSplat, Stage::RenderMarch, Stage::RenderLayers}));
     EXPECT_EQ(StagesOf({"description"}), S{});
+    // A light term reaches every renderer and nothing upstream of them.
+    const S renderers = {Stage::RenderSplat, Stage::RenderMarch, Stage::RenderLayers};
+    EXPECT_EQ(StagesOf({"lighting.eye_scattering.cone_deg"}), renderers);
+    EXPECT_EQ(StagesOf({"lighting.city_glow"}), renderers);
+    EXPECT_EQ(StagesOf({"lighting.ambient"}), renderers);
+    EXPECT_EQ(StagesOf({"lightning.intensity"}), renderers);
 }
 
 // march.step x shade.resolution (the last axis fastest): shade at each resolution once, shadow once,

@@ -20,6 +20,10 @@ namespace cb {
 // scattering's cone.
 LightTerms MakeLightTerms(const Scene& scene, uint32_t step);
 
+// The scene sections MakeLightTerms reads besides the sun and the grid: every renderer's image depends on them
+// (a sweep that varies one of them measures every renderer's image).
+inline constexpr std::string_view kLightTermFields[] = {"lighting", "lightning", "phase"};
+
 namespace scene_io {
 // Each reads its section from the document root into settings that hold the defaults on entry; a wrong field is
 // reported into `check` and leaves its default.

@@ -147,7 +147,8 @@ struct RendererDescriptor {
     bool (*relights)(const Scene& scene) = nullptr;
     // The scene fields that decide `relights` (a sweep's shade rows depend on them).
     std::span<const std::string_view> relightFields;
-    // The scene fields whose variation a sweep measures its image for (images cost a reference render each).
+    // The scene fields whose variation a sweep measures its image for (images cost a reference render each),
+    // besides the light terms' sections (core/pipeline/LightTerms.h kLightTermFields), which every renderer takes.
     std::span<const std::string_view> imageFields;
     // Its fields that the exact reference render does not read (a change leaves the reference as it is).
     std::span<const std::string_view> referenceIgnores;
@@ -209,7 +210,8 @@ struct StageDescriptor {
     CompareRule (*rule)(const Scene& scene) = nullptr;
     std::string_view ruleNote;  // how the rule depends on the scene, for the help ("" if it does not)
     std::span<const ChoiceSetting> choices;  // its settings with a few values each
-    // The scene fields its output depends on besides its input resources and kFieldsEveryStageReads, as
+    // The scene fields its output depends on besides its input resources and kFieldsEveryStageReads (and, for a
+    // renderer, the light terms' sections, kLightTermFields), as
     // dotted paths of the scene file; a section ("shade") stands for every field in it. A field it reads
     // must be listed (sweep measures a stage once per distinct setting of these and of its inputs'
     // writers' fields); one listed that it does not read only repeats rows.

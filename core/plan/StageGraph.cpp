@@ -5,6 +5,8 @@
 #include <iterator>
 #include <set>
 
+#include "core/pipeline/LightTerms.h"
+
 namespace cb {
 
 // Each stage's module names its descriptor Describe<Stage> and its adapter
@@ -201,6 +203,8 @@ bool FieldsReach(Stage stage, std::string_view path, std::set<Stage>& seen) {
     if (!seen.insert(stage).second) return false;
     const StageDescriptor& d = Describe(stage);
     if (FieldsListed(d.sceneFields, path)) return true;
+    // Every renderer takes the light terms (MakeLightTerms).
+    if (d.renderer && FieldsListed(kLightTermFields, path)) return true;
     // Scene::needs follows from the renderers' relightFields (shade's sun is fixed at step 0's when one relights).
     if (d.readsRendererNeeds && std::ranges::any_of(RendererStages(), [&](Stage s) {
             return FieldsListed(Describe(s).renderer->relightFields, path);

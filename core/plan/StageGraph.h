@@ -26,7 +26,8 @@ bool RunsARenderer(const StageSet& enabled);
 bool FieldsListed(std::span<const std::string_view> fields, std::string_view path);
 // Whether `path` can change what `stage` writes: it overlaps a field of kFieldsEveryStageReads or of the
 // stage's sceneFields, or one that a stage writing a resource it reads (reads and optionalReads) depends on,
-// transitively; shade's output also follows the fields that make a renderer relight (Scene::needs).
+// transitively; a renderer's also follows the light terms' sections (kLightTermFields), and shade's the fields
+// that make a renderer relight (Scene::needs).
 bool StageOutputReads(Stage stage, std::string_view path);
 // The renderers (stages with a RendererDescriptor), in stage order.
 const std::vector<Stage>& RendererStages();

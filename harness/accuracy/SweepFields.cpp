@@ -5,6 +5,7 @@
 #include <set>
 #include <string>
 
+#include "core/pipeline/LightTerms.h"
 #include "core/plan/StageGraph.h"
 #include "harness/accuracy/Evaluator.h"
 
@@ -22,10 +23,12 @@ std::vector<SceneOverride> SettingsRead(Stage stage, std::span<const SceneOverri
 }
 
 std::vector<Stage> SweepStages(const std::vector<SweepAxis>& axes) {
-    // The renderers' reference render costs most: images are measured only when an image section varies.
+    // The renderers' reference render costs most: images are measured only when a light term's section or a
+    // renderer's image field varies.
     const bool images = std::ranges::any_of(axes, [](const SweepAxis& a) {
-        return std::ranges::any_of(
-            RendererStages(), [&](Stage stage) { return FieldsListed(Describe(stage).renderer->imageFields, a.path); });
+        return FieldsListed(kLightTermFields, a.path) || std::ranges::any_of(RendererStages(), [&](Stage stage) {
+                   return FieldsListed(Describe(stage).renderer->imageFields, a.path);
+               });
     });
     std::vector<Stage> candidates = {Stage::Shade, Stage::Shadow};
     if (images)

@@ -181,7 +181,7 @@ std::vector<std::vector<SceneOverride>> LayersAccuracyVariants(const Scene& sc) 
     return out;
 }
 
-constexpr std::string_view kLayersImageFields[] = {"layers", "render", "phase"};
+constexpr std::string_view kLayersImageFields[] = {"layers", "render"};
 constexpr std::string_view kLayersReferenceIgnores[] = {"layers"};
 
 const RendererDescriptor kLayersRenderer{
@@ -206,20 +206,9 @@ const RendererDescriptor kLayersRenderer{
 }  // namespace
 
 // What its parameters read from the scene (StageDescriptor::sceneFields).
-constexpr std::string_view kRenderLayersSceneFields[] = {"layers",
-                                                         "noise",
-                                                         "sun",
-                                                         "lighting",
-                                                         "phase",
-                                                         "shade.sigma",
-                                                         "grid.voxel_size",
-                                                         "grid.origin",
-                                                         "grid.tiling",
-                                                         "render.width",
-                                                         "render.height",
-                                                         "render.cameras",
-                                                         "render.alpha",
-                                                         "render.frames_per_step"};
+constexpr std::string_view kRenderLayersSceneFields[] = {
+    "layers",      "noise",        "sun",           "shade.sigma",    "grid.voxel_size", "grid.origin",
+    "grid.tiling", "render.width", "render.height", "render.cameras", "render.alpha",    "render.frames_per_step"};
 
 constexpr std::string_view kRenderLayersSceneKeys[] = {"layers"};
 

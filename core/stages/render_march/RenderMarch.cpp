@@ -189,7 +189,7 @@ std::vector<std::vector<SceneOverride>> MarchAccuracyVariants(const Scene& sc) {
     return out;
 }
 
-constexpr std::string_view kMarchImageFields[] = {"march", "render", "lightning", "phase"};
+constexpr std::string_view kMarchImageFields[] = {"march", "render"};
 // The reference integrates the light exactly (SPEC 11): the march's steps, its light source and its tone map are
 // what it measures, not what it reads.
 constexpr std::string_view kMarchReferenceIgnores[] = {"march.step",
@@ -235,14 +235,10 @@ const RendererDescriptor kMarchRenderer{
 }  // namespace
 
 // What its parameters read from the scene (StageDescriptor::sceneFields).
-constexpr std::string_view kRenderMarchSceneFields[] = {"march",         "lightning",
-                                                        "sun",           "lighting",
-                                                        "phase",         "shade.sigma",
-                                                        "ca.seed",       "grid.voxel_size",
-                                                        "grid.origin",   "render.width",
-                                                        "render.height", "render.cameras",
-                                                        "render.alpha",  "render.frames_per_step",
-                                                        "render.ground"};
+// Besides the light terms' sections, which every renderer reads (core/pipeline/LightTerms.h kLightTermFields).
+constexpr std::string_view kRenderMarchSceneFields[] = {
+    "march",        "sun",           "shade.sigma",    "ca.seed",      "grid.voxel_size",        "grid.origin",
+    "render.width", "render.height", "render.cameras", "render.alpha", "render.frames_per_step", "render.ground"};
 
 constexpr std::string_view kRenderMarchSceneKeys[] = {"march"};
 

@@ -119,7 +119,7 @@ Result<AccuracyRender> SplatAccuracyRender(Backend& backend, const Scene& scene,
     return out;
 }
 
-constexpr std::string_view kSplatImageFields[] = {"render", "phase"};
+constexpr std::string_view kSplatImageFields[] = {"render"};
 constexpr std::string_view kSplatReferenceIgnores[] = {"render.q_min", "render.splat_scale", "render.opacity",
                                                        "render.culling", "render.skipping"};
 
@@ -148,8 +148,8 @@ const RendererDescriptor kSplatRenderer{
 }  // namespace
 
 // What its parameters read from the scene (StageDescriptor::sceneFields).
-constexpr std::string_view kRenderSplatSceneFields[] = {
-    "render", "sun", "lighting", "phase", "grid.voxel_size", "grid.origin", "density.tile", "density.band"};
+constexpr std::string_view kRenderSplatSceneFields[] = {"render",      "sun",          "grid.voxel_size",
+                                                        "grid.origin", "density.tile", "density.band"};
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
