@@ -86,6 +86,23 @@ struct LightSample {
     Vec3 dir{};
 };
 
+// The city glow, then eye scattering, each where it is on (InScattered's last terms). Out of line: a renderer's
+// loop without them keeps InScattered small.
+[[gnu::noinline]] inline void AddWangTerms(const LightTerms& L, const LightSample& s, Vec3& c) {
+    if (L.glowOn) {
+        const float height = std::clamp(L.glowFade * (s.position[2] * L.invThickness), 0.0f, 1.0f);
+        const float glow = GlowMap(L.glowBlobs, L.glowBlobCount, s.position[0], s.position[1]) * (1.0f - height);
+        for (int i = 0; i < 3; ++i) c[i] += L.glowColor[i] * glow;
+    }
+    if (L.eyeOn) {
+        const float cosE = s.dir[0] * L.sunDirection[0] + s.dir[1] * L.sunDirection[1] + s.dir[2] * L.sunDirection[2];
+        const float cone = std::max(0.0f, (cosE - L.eyeCosCone) * L.eyeInvOneMinusCos);
+        const float rise = L.eyeHeightGain * std::clamp(s.position[2] * L.invThickness, 0.0f, 1.0f) + 1.0f;
+        const float eye = s.sunT * ((L.eyeIntensity * cone) * rise);
+        for (int i = 0; i < 3; ++i) c[i] += L.sunRadiance[i] * eye;
+    }
+}
+
 // The light scattered toward the eye at the sample, per channel.
 inline Vec3 InScattered(const LightTerms& L, const LightSample& s) {
     Vec3 c{L.sunRadiance[0] * s.sunGain + L.ambient[0], L.sunRadiance[1] * s.sunGain + L.ambient[1],
@@ -103,18 +120,8 @@ inline Vec3 InScattered(const LightTerms& L, const LightSample& s) {
         const float g = s.pointT * PointLightFalloff(d2, L.pointMinDistance2) * PhaseValue(L.phase, cosL);
         for (int i = 0; i < 3; ++i) c[i] += L.pointRadiance[i] * g;
     }
-    if (L.glowOn) {
-        const float height = std::clamp(L.glowFade * (s.position[2] * L.invThickness), 0.0f, 1.0f);
-        const float glow = GlowMap(L.glowBlobs, L.glowBlobCount, s.position[0], s.position[1]) * (1.0f - height);
-        for (int i = 0; i < 3; ++i) c[i] += L.glowColor[i] * glow;
-    }
-    if (L.eyeOn) {
-        const float cosE = s.dir[0] * L.sunDirection[0] + s.dir[1] * L.sunDirection[1] + s.dir[2] * L.sunDirection[2];
-        const float cone = std::max(0.0f, (cosE - L.eyeCosCone) * L.eyeInvOneMinusCos);
-        const float rise = L.eyeHeightGain * std::clamp(s.position[2] * L.invThickness, 0.0f, 1.0f) + 1.0f;
-        const float eye = s.sunT * ((L.eyeIntensity * cone) * rise);
-        for (int i = 0; i < 3; ++i) c[i] += L.sunRadiance[i] * eye;
-    }
+    if (L.glowOn || L.eyeOn) [[unlikely]]
+        AddWangTerms(L, s, c);
     return c;
 }
 
