@@ -41,6 +41,22 @@ struct CameraFrame {
 
 CameraFrame MakeCameraFrame(const CameraSettings& camera, uint32_t width, uint32_t height);
 
+// The camera members every ray-casting GPU block has (GroundGpu, MarchGpu, LayersGpu): the eye (in the block's
+// units), the focal length, the frame's axes with the near and far planes, h, and the image's size.
+template <typename Block>
+void SetCameraMembers(Block& g, const CameraFrame& c, const std::array<float, 3>& eye, float voxelSize) {
+    g.eye = eye;
+    g.focalPx = c.focalPx;
+    g.forward = c.forward;
+    g.nearPlane = c.nearPlane;
+    g.right = c.right;
+    g.farPlane = c.farPlane;
+    g.up = c.upVector;
+    g.voxelSize = voxelSize;
+    g.width = c.width;
+    g.height = c.height;
+}
+
 // Where a world point lands: pixel position (row 0 at the top) and depth.
 // Follows SPEC 8: OpenGL-style perspective, px = (ndc_x + 1)/2 W,
 // py = (1 - ndc_y)/2 H. Only meaningful for depth > 0.

@@ -117,14 +117,7 @@ static_assert(sizeof(GroundGpu) == 9 * 16, "GroundGpu is nine 16-byte rows");
 inline GroundGpu MakeGroundGpu(const CameraFrame& c, const std::array<float, 3>& origin, float voxelSize,
                                const GroundLight& light, uint32_t nx, uint32_t ny) {
     GroundGpu g{};
-    g.eye = GroundEyeVoxel(c, origin, voxelSize);
-    g.focalPx = c.focalPx;
-    g.forward = c.forward;
-    g.nearPlane = c.nearPlane;
-    g.right = c.right;
-    g.farPlane = c.farPlane;
-    g.up = c.upVector;
-    g.voxelSize = voxelSize;
+    SetCameraMembers(g, c, GroundEyeVoxel(c, origin, voxelSize), voxelSize);
     g.albedo = light.albedo;
     g.sunZ = light.sunZ;
     g.sunRadiance = light.sunRadiance;
@@ -132,8 +125,6 @@ inline GroundGpu MakeGroundGpu(const CameraFrame& c, const std::array<float, 3>&
     g.background = light.background;
     g.gridX = nx;
     g.gridY = ny;
-    g.width = c.width;
-    g.height = c.height;
     return g;
 }
 

@@ -10,14 +10,7 @@ LayersGpu MakeLayersGpu(const LayersParams& params) {
     const CameraFrame& c = params.camera;
     const LayersSetup& s = params.setup;
     LayersGpu g{};
-    g.eye = s.eye;
-    g.focalPx = c.focalPx;
-    g.forward = c.forward;
-    g.nearPlane = c.nearPlane;
-    g.right = c.right;
-    g.farPlane = c.farPlane;
-    g.up = c.upVector;
-    g.voxelSize = s.voxelSize;
+    SetCameraMembers(g, c, s.eye, s.voxelSize);
     g.size = s.size;
     g.sigmaH = s.sigmaH;
     g.invSize = s.invSize;
@@ -26,8 +19,6 @@ LayersGpu MakeLayersGpu(const LayersParams& params) {
     g.outer2 = s.outer2;
     g.background = s.background;
     g.maxLength = s.maxLength;
-    g.width = c.width;
-    g.height = c.height;
     g.count = s.count;
     g.flags = (s.tiling ? uint32_t(kLayersGpuTiling) : 0u) | (s.wang ? uint32_t(kLayersGpuWang) : 0u);
     const uint32_t px = uint32_t(s.size[0]) + 2u, py = uint32_t(s.size[1]) + 2u;

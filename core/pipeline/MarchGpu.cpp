@@ -14,14 +14,9 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     const MarchSetup& s = params.setup;
     MarchGpu g{};
     // The eye as MakePixelRay forms it: (eye - origin) / h, per component.
-    for (int i = 0; i < 3; ++i) g.eye[i] = (c.eye[i] - params.origin[i]) / s.voxelSize;
-    g.focalPx = c.focalPx;
-    g.forward = c.forward;
-    g.nearPlane = c.nearPlane;
-    g.right = c.right;
-    g.farPlane = c.farPlane;
-    g.up = c.upVector;
-    g.voxelSize = s.voxelSize;
+    std::array<float, 3> eye;
+    for (int i = 0; i < 3; ++i) eye[i] = (c.eye[i] - params.origin[i]) / s.voxelSize;
+    SetCameraMembers(g, c, eye, s.voxelSize);
     g.size = s.size;
     g.sigmaH = s.sigmaH;
     g.baseStep = s.step;
@@ -39,8 +34,6 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     if (params.light == MarchLightSource::March) flags |= kMarchGpuLightMarch;
     if (params.ground.on) flags |= kMarchGpuGround;
     g.flags = flags;
-    g.width = c.width;
-    g.height = c.height;
     g.seed = params.seed;
     g.frame = params.frame;
     const uint32_t brick = std::max(params.brick, 1u);
