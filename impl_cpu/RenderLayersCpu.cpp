@@ -39,16 +39,16 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
     std::atomic<uint64_t> fragments{0}, drawn{0};
 
     mArena.execute([&] {
-        // 1. The padded volume: voxel (i, j, k) at (i + 1, j + 1, k + 1); LayersPaddedSource names each border's.
+        // 1. The padded volume: voxel (i, j, k) at (i + 1, j + 1, k + 1); PaddedSourceVoxel names each border's.
         state.volume.resize(px * py * pz);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, pz), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t k = r.begin(); k < r.end(); ++k)
                 for (size_t j = 0; j < py; ++j) {
                     std::array<float, 2>* row = state.volume.data() + px * (j + py * k);
-                    const int64_t vk = LayersPaddedSource(uint32_t(k), e.nz, false);
-                    const int64_t vj = LayersPaddedSource(uint32_t(j), e.ny, s.tiling);
+                    const int64_t vk = PaddedSourceVoxel(uint32_t(k), e.nz, false);
+                    const int64_t vj = PaddedSourceVoxel(uint32_t(j), e.ny, s.tiling);
                     for (size_t i = 0; i < px; ++i) {
-                        const int64_t vi = LayersPaddedSource(uint32_t(i), e.nx, s.tiling);
+                        const int64_t vi = PaddedSourceVoxel(uint32_t(i), e.nx, s.tiling);
                         if (vi < 0 || vj < 0 || vk < 0) {
                             row[i] = {0.0f, 1.0f};
                             continue;

@@ -1,6 +1,7 @@
 // The ray marcher on the CPU (SPEC 10): per call, q_alpha and T are formed
 // once into one padded volume of (q, T) pairs (a border voxel of q = 0, T = 1
-// stands for "outside the grid", so the trilinear taps need no bounds checks),
+// stands for "outside the grid", or with tiling holds the opposite edge's
+// voxel in x and y, so the trilinear taps need no bounds checks),
 // the brick skip structure is built from it, and then every pixel runs the
 // shared kernel MarchRay (core/math/March.h), TBB over 8 x 8 pixel tiles.
 #include <tbb/blocked_range.h>
@@ -19,18 +20,21 @@
 namespace cb::cpu {
 namespace {
 
-// Trilinear reads of the padded (q, T) volume; p in voxel units is clamped to
-// the box [0, n], where the padded taps (p + 0.5 floored, and +1) stay inside.
+// Trilinear reads of the padded (q, T) volume; p in voxel units (wrapped with
+// tiling, MarchWrapped) is clamped to the box [0, n], where the padded taps
+// (p + 0.5 floored, and +1) stay inside.
 struct MarchPaddedVolume {
     const MarchQT* v = nullptr;
     size_t px = 0, pxy = 0;  // padded row and slice strides
+    const MarchSetup* setup = nullptr;
     Vec3 size{};
 
     struct Taps {
         size_t base;
         float wx, wy, wz;
     };
-    Taps TapsAt(const Vec3& p) const {
+    Taps TapsAt(const Vec3& point) const {
+        const Vec3 p = MarchWrapped(*setup, point);
         const float cx = std::clamp(p[0], 0.0f, size[0]) + 0.5f;
         const float cy = std::clamp(p[1], 0.0f, size[1]) + 0.5f;
         const float cz = std::clamp(p[2], 0.0f, size[2]) + 0.5f;
@@ -77,8 +81,8 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
         auto light = makeLight(density);
         for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
             for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
-                const MarchRayGeometry ray =
-                    MakePixelRay(cam, params.origin, params.setup.voxelSize, params.setup.size, x, y);
+                const MarchRayGeometry ray = MakePixelRay(cam, params.origin, params.setup.voxelSize, params.setup.size,
+                                                          x, y, params.setup.tiling);
                 const uint32_t pixel = x + W * y;
                 const float xi = params.jitter ? MarchJitter(params.seed, params.frame, pixel) : 0.5f;
                 const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
@@ -143,15 +147,20 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
     MarchStats local;
 
     mArena.execute([&] {
-        // 1. q_alpha and T into the padded volume; the border reads q = 0, T = 1.
+        // 1. q_alpha and T into the padded volume: voxel (i, j, k) at (i + 1, j + 1, k + 1); the border reads
+        //    q = 0, T = 1, or with tiling the opposite edge's voxel in x and y (PaddedSourceVoxel).
+        const bool wrap = params.setup.tiling;
         state.volume.assign(px * py * pz, MarchQT{0.0f, 1.0f});
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.nz), [&](const tbb::blocked_range<uint32_t>& r) {
             for (uint32_t k = r.begin(); k < r.end(); ++k)
-                for (uint32_t j = 0; j < e.ny; ++j) {
-                    const size_t src = size_t(e.nx) * (j + size_t(e.ny) * k);
-                    MarchQT* dst = state.volume.data() + 1 + px * (j + 1) + px * py * (k + 1);
+                for (uint32_t pj = 0; pj < py; ++pj) {
+                    const int64_t j = PaddedSourceVoxel(pj, e.ny, wrap);
+                    if (j < 0) continue;
+                    const size_t src = size_t(e.nx) * (size_t(j) + size_t(e.ny) * k);
+                    MarchQT* dst = state.volume.data() + px * (pj + py * (k + 1));
                     for (uint32_t i = 0; i < e.nx; ++i)
-                        dst[i] = {Lerp(qPrev[src + i], qCur[src + i], alpha), T ? T[src + i] : 1.0f};
+                        dst[i + 1] = {Lerp(qPrev[src + i], qCur[src + i], alpha), T ? T[src + i] : 1.0f};
+                    if (wrap) dst[0] = dst[e.nx], dst[e.nx + 1] = dst[1];
                 }
         });
         // 2. Bricks: empty iff q_alpha = 0 over the brick grown by one voxel (padded indices b B .. (b+1) B + 1).
@@ -185,7 +194,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
             local.emptyBricks = uint64_t(std::count(state.bricks.begin(), state.bricks.end(), uint8_t(1)));
         }
         // 3. The rays.
-        const MarchPaddedVolume volume{state.volume.data(), px, px * py, params.setup.size};
+        const MarchPaddedVolume volume{state.volume.data(), px, px * py, &params.setup, params.setup.size};
         const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
         const MarchSetup& s = params.setup;
         const uint32_t nl = params.lightSteps;

@@ -75,7 +75,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     // 1. The padded (q_alpha, T) volume.
     auto formed = FormPaddedVolume(state.volume, state.volumeCopy, *in.qPrev, *in.qCur, shadeLight ? in.T : nullptr,
-                                   params.alpha, false);
+                                   params.alpha, params.setup.tiling);
     if (!formed) return std::unexpected(formed.error());
     const GLuint volume = state.volume.name.Get(), volumeCopy = *formed;
 

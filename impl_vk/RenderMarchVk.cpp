@@ -1,13 +1,13 @@
 // Stage `render_march` (SPEC 10) on Vulkan, one submit of three passes:
 //   1. march_volume.comp: the padded volume (impl_cpu/RenderMarchCpu.cpp step 1),
 //      (q_alpha, T) pairs with the light source "shade", q alone with "march";
-//      the border reads (0, 1);
+//      the border reads (0, 1), or with tiling the opposite edge's voxels;
 //   2. march_bricks.comp (skipping only): one word per brick, 1 iff q_alpha = 0
 //      over the brick grown by one voxel (step 2), and the count of empty ones;
 //   3. render_march.comp (light "shade") or render_march_q.comp ("march"), both
 //      shaders/render_march.glsl: one invocation per pixel in 8 x 8 workgroups,
 //      MarchPixel of core/math/march.glsl, and the MarchStats counters.
-// The constants are core/pipeline/MarchGpu.h's block in a storage buffer (256 bytes: more
+// The constants are core/pipeline/MarchGpu.h's block in a storage buffer (more
 // than the 128 bytes of push constants every device guarantees). The Mie table
 // (kMieCloudTable) is uploaded once, on the first call whose phase is Mie.
 #include <algorithm>
@@ -102,7 +102,8 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         groundG = &Dev(*in.G);
     }
 
-    const MarchVolumePush volumePush{e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha, 0u};
+    const MarchVolumePush volumePush{
+        e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha, params.setup.tiling ? 1u : 0u};
     const MarchBricksPush brickPush{
         px, py, pz, B, frame.bricks[0], frame.bricks[1], frame.bricks[2], shadeLight ? 2u : 1u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),

@@ -85,7 +85,7 @@ auto TwinFetch = [](uint32_t i) { return TwinPaddedQT(i); };
 
 using test::GlslTwin;
 
-// Test that MakeLayersRay and LayersWalkOf, the padded taps with LayersWrap and LayerHeight, LayerFragment with
+// Test that MakeLayersRay and LayersWalkOf, the padded taps with TileWrap and LayerHeight, LayerFragment with
 // LayersOver, and LayersPixel equal their C++ twins on random calls and pixels, corners included; and that the
 // cases reach both outcomes of a fragment (drawn and not).
 TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
@@ -121,7 +121,7 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
                     const LayersTaps t = LayersTapsAt(s.size, {Float(in[0]), Float(in[1]), Float(in[2])});
                     const auto qt = LayersBlend(s.size, t, TwinFetch);
                     out = W({t.base, Bits(t.wx), Bits(t.wy), Bits(t.wz), Bits(qt[0]), Bits(qt[1]),
-                             Bits(LayersWrap(Float(in[3]), Float(in[4]), Float(in[5]))), Bits(LayerHeight(s, in[6]))});
+                             Bits(TileWrap(Float(in[3]), Float(in[4]), Float(in[5]))), Bits(LayerHeight(s, in[6]))});
                 });
         std::vector<Words> fragmentsIn = pixels;
         for (Words& w : fragmentsIn) {

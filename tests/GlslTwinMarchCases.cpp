@@ -77,9 +77,10 @@ void AddMarchCases(std::vector<TwinCase>& c) {
             WF({0, 0, 0, 1, 1, 1, 10, 10, 10, 0, 1e30f}),  WF({10, 10, 10, -1, -1, -1, 10, 10, 10, 2, 5}),
             WF({5, 5, 5, -0.0f, 0, 1, 10, 10, 10, 0, 1e30f}), WF({5, 5, 5, 1e-20f, 0, 1, 10, 10, 10, 0, 3}),
             WF({5, 5, 5, 0, 0, 0, 10, 10, 10, 0, 1e30f})};
+        // ClipRayToBox, and ClipRayToVolume with tiling (the slab in z alone).
         c.push_back({"ClipRayToBox",
                      kTwinClipRayToBox,
-                     {Kind::F, Kind::F},
+                     {Kind::F, Kind::F, Kind::F, Kind::F},
                      [component](Pcg32& r, Words& in) {
                          const float n[3] = {float(1 + r.Below(300)), float(1 + r.Below(300)), float(1 + r.Below(300))};
                          in = WF({Uniform(r, -50, n[0] + 50), Uniform(r, -50, n[1] + 50), Uniform(r, -50, n[2] + 50),
@@ -89,10 +90,15 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      edges,
                      [](const Words& in, Words& out) {
                          float tMin = Float(in[9]), tMax = Float(in[10]);
-                         ClipRayToBox({Float(in[0]), Float(in[1]), Float(in[2])}, {Float(in[3]), Float(in[4]), Float(in[5])},
-                                      {Float(in[6]), Float(in[7]), Float(in[8])}, tMin, tMax);
+                         const Vec3 o{Float(in[0]), Float(in[1]), Float(in[2])},
+                             d{Float(in[3]), Float(in[4]), Float(in[5])}, n{Float(in[6]), Float(in[7]), Float(in[8])};
+                         ClipRayToBox(o, d, n, tMin, tMax);
                          out[0] = Bits(tMin);
                          out[1] = Bits(tMax);
+                         float zMin = Float(in[9]), zMax = Float(in[10]);
+                         ClipRayToVolume(o, d, n, true, zMin, zMax);
+                         out[2] = Bits(zMin);
+                         out[3] = Bits(zMax);
                      },
                      /*otherDeviceUlps=*/3});
         c.push_back({"RayExitFromBox",
@@ -117,6 +123,47 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                          out[3] = Bits(inv[2]);
                      },
                      /*otherDeviceUlps=*/3});
+    }
+    {
+        // Points inside and outside the grid's box and many periods away, bricks that the grid fills and a last
+        // one it does not (n not a multiple of B), with tiling and without.
+        auto brickInputs = [](float px, float py, float pz, float nx, float ny, float nz, float B, uint32_t tiling) {
+            const auto count = [B](float n) { return uint32_t(std::ceil(n / B)); };
+            return W({Bits(px), Bits(py), Bits(pz), Bits(nx), Bits(ny), Bits(nz), Bits(1.0f / nx), Bits(1.0f / ny),
+                      Bits(1.0f / nz), count(nx), count(ny), count(nz), Bits(B), Bits(1.0f / B), tiling});
+        };
+        std::vector<Words> edges;
+        for (uint32_t tiling : {0u, 1u})
+            for (float x : {0.0f, 7.999f, 8.0f, 12.0f, 12.5f, -0.001f, -12.0f, 100.25f, -1e4f})
+                edges.push_back(brickInputs(x, 3.5f, 2.0f, 12, 10, 8, 8, tiling));
+        c.push_back(
+            {"MarchBrickAt",
+             kTwinMarchBrickAt,
+             {Kind::U, Kind::U, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F},
+             [brickInputs](Pcg32& r, Words& in) {
+                 const float n[3] = {float(1 + r.Below(300)), float(1 + r.Below(300)), float(1 + r.Below(60))};
+                 const float B = float(1 + r.Below(16));
+                 const float reach = r.Below(2) ? 2.0f : 40.0f;  // near the box, or many periods away
+                 in = brickInputs(Uniform(r, -reach * n[0], (reach + 1) * n[0]),
+                                  Uniform(r, -reach * n[1], (reach + 1) * n[1]), Uniform(r, -2, n[2] + 2), n[0], n[1],
+                                  n[2], B, r.Below(2));
+             },
+             edges,
+             [](const Words& in, Words& out) {
+                 MarchSetup s;
+                 s.size = {Float(in[3]), Float(in[4]), Float(in[5])};
+                 s.invSize = {Float(in[6]), Float(in[7]), Float(in[8])};
+                 s.tiling = in[14] != 0;
+                 MarchBricks b;
+                 b.count[0] = in[9], b.count[1] = in[10], b.count[2] = in[11];
+                 const MarchBrickCell cell =
+                     MarchBrickAt(s, b, Float(in[12]), Float(in[13]), {Float(in[0]), Float(in[1]), Float(in[2])});
+                 out[0] = cell.inside ? 1u : 0u;
+                 out[1] = cell.inside ? cell.index : 0u;
+                 const Vec3 lo = cell.inside ? cell.lo : Vec3{0, 0, 0}, hi = cell.inside ? cell.hi : Vec3{0, 0, 0};
+                 for (int a = 0; a < 3; ++a) out[2 + a] = Bits(lo[a]), out[5 + a] = Bits(hi[a]);
+             },
+             /*otherDeviceUlps=*/3});
     }
     c.push_back({"MarchStepAt",
                  kTwinMarchStepAt,

@@ -309,30 +309,30 @@ TEST(HostParamsLayers, GeometryFromTheGridAndTheCamera) {
 }
 
 // Test the tiling's wrap of a point (docs/pipeline.md "Tiling": x - n floor(x (1/n))) on and beyond the tile's
-// edge, and the padded border's source voxel (LayersPaddedSource: the opposite edge with wrap, outside without).
+// edge, and the padded border's source voxel (PaddedSourceVoxel: the opposite edge with wrap, outside without).
 TEST(HostParamsLayers, WrapOnAndBeyondTheTileEdge) {
     const float inv8 = 0.125f, inv6 = 1.0f / 6.0f;
-    EXPECT_EQ(LayersWrap(0.0f, 8.0f, inv8), 0.0f);
-    EXPECT_EQ(LayersWrap(8.0f, 8.0f, inv8), 0.0f);      // on the edge: the next tile's start
-    EXPECT_EQ(LayersWrap(8.5f, 8.0f, inv8), 0.5f);      // beyond it
-    EXPECT_EQ(LayersWrap(-0.5f, 8.0f, inv8), 7.5f);     // before the start: the previous tile's end
-    EXPECT_EQ(LayersWrap(-8.0f, 8.0f, inv8), 0.0f);
-    EXPECT_EQ(LayersWrap(16.0f, 8.0f, inv8), 0.0f);
-    EXPECT_EQ(LayersWrap(23.25f, 8.0f, inv8), 7.25f);   // 23.25 - 16
-    EXPECT_EQ(LayersWrap(7.75f, 8.0f, inv8), 7.75f);
-    EXPECT_EQ(LayersWrap(-1e-7f, 8.0f, inv8), 8.0f);    // -1e-7 + 8 rounds to 8: the closed end of [0, n]
-    EXPECT_EQ(LayersWrap(6.0f, 6.0f, inv6), 0.0f);      // 6 * float(1/6) rounds to 1: floor 1
-    EXPECT_EQ(LayersWrap(12.0f, 6.0f, inv6), 0.0f);
-    EXPECT_EQ(LayersWrap(-6.0f, 6.0f, inv6), 0.0f);
-    EXPECT_EQ(LayersWrap(6.5f, 6.0f, inv6), 0.5f);
-    EXPECT_EQ(LayersWrap(-0.5f, 6.0f, inv6), 5.5f);
+    EXPECT_EQ(TileWrap(0.0f, 8.0f, inv8), 0.0f);
+    EXPECT_EQ(TileWrap(8.0f, 8.0f, inv8), 0.0f);   // on the edge: the next tile's start
+    EXPECT_EQ(TileWrap(8.5f, 8.0f, inv8), 0.5f);   // beyond it
+    EXPECT_EQ(TileWrap(-0.5f, 8.0f, inv8), 7.5f);  // before the start: the previous tile's end
+    EXPECT_EQ(TileWrap(-8.0f, 8.0f, inv8), 0.0f);
+    EXPECT_EQ(TileWrap(16.0f, 8.0f, inv8), 0.0f);
+    EXPECT_EQ(TileWrap(23.25f, 8.0f, inv8), 7.25f);  // 23.25 - 16
+    EXPECT_EQ(TileWrap(7.75f, 8.0f, inv8), 7.75f);
+    EXPECT_EQ(TileWrap(-1e-7f, 8.0f, inv8), 8.0f);  // -1e-7 + 8 rounds to 8: the closed end of [0, n]
+    EXPECT_EQ(TileWrap(6.0f, 6.0f, inv6), 0.0f);    // 6 * float(1/6) rounds to 1: floor 1
+    EXPECT_EQ(TileWrap(12.0f, 6.0f, inv6), 0.0f);
+    EXPECT_EQ(TileWrap(-6.0f, 6.0f, inv6), 0.0f);
+    EXPECT_EQ(TileWrap(6.5f, 6.0f, inv6), 0.5f);
+    EXPECT_EQ(TileWrap(-0.5f, 6.0f, inv6), 5.5f);
     // Padded index i stands for voxel i - 1 inside; the border 0 and n + 1 is voxel n - 1 and 0 with wrap.
-    EXPECT_EQ(LayersPaddedSource(0, 8, true), 7);
-    EXPECT_EQ(LayersPaddedSource(9, 8, true), 0);
-    EXPECT_EQ(LayersPaddedSource(0, 8, false), -1);
-    EXPECT_EQ(LayersPaddedSource(9, 8, false), -1);
-    EXPECT_EQ(LayersPaddedSource(1, 8, true), 0);
-    EXPECT_EQ(LayersPaddedSource(8, 8, false), 7);
+    EXPECT_EQ(PaddedSourceVoxel(0, 8, true), 7);
+    EXPECT_EQ(PaddedSourceVoxel(9, 8, true), 0);
+    EXPECT_EQ(PaddedSourceVoxel(0, 8, false), -1);
+    EXPECT_EQ(PaddedSourceVoxel(9, 8, false), -1);
+    EXPECT_EQ(PaddedSourceVoxel(1, 8, true), 0);
+    EXPECT_EQ(PaddedSourceVoxel(8, 8, false), 7);
 }
 
 // Test the GPU block (core/pipeline/LayersGpu.h): each member holds the host's value,

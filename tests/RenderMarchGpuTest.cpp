@@ -123,6 +123,15 @@ TEST_P(RenderMarchGpu, MatchesTheCpuOnEveryOptionOnOddSizes) {
         s.light.pointRadiance = {30, 28, 40};
         s.light.pointMinDistance2 = 1;
     };
+    // The volume repeated in x and y out to a far plane 120 voxel edges deep; bricks of 4 (the wrapped border
+    // leaves no brick of 8 empty on 24 x 20 x 18).
+    const auto tiling = [](GpuMarchCase& c) {
+        MarchSetup& s = c.params.setup;
+        s.tiling = true;
+        s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};
+        c.params.camera.farPlane = 120;
+        c.params.brick = 4;
+    };
     const std::vector<Option> options = {
         {"shade, skipping, HG", [](GpuMarchCase&) {}},
         {"skipping off", [](GpuMarchCase& c) { c.params.skipping = false; }},
@@ -174,6 +183,18 @@ TEST_P(RenderMarchGpu, MatchesTheCpuOnEveryOptionOnOddSizes) {
          }},
         {"epsilon 0, step 0.37", [](GpuMarchCase& c) { c.params.setup.epsilon = 0, c.params.setup.step = 0.37f; }},
         {"dense (early stop)", [](GpuMarchCase& c) { c.params.setup.sigmaH = 2.0f; }},
+        // Tiling: the rays to the far plane through the repeated layer, the wrapped taps and bricks (brick 5:
+        // the last brick along x is cut at the seam on 24 and 31 voxels), the light march through the copies.
+        {"tiling", tiling},
+        {"tiling, brick 5", [&](GpuMarchCase& c) { tiling(c), c.params.brick = 5; }},
+        {"tiling, light march",
+         [&](GpuMarchCase& c) { tiling(c), c.params.light = MarchLightSource::March, c.T.clear(); }},
+        {"tiling, adaptive, jitter, point light",
+         [&](GpuMarchCase& c) {
+             tiling(c), pointLight(c);
+             c.params.setup.adaptive = true, c.params.setup.kappa = 0.1f, c.params.setup.adaptiveStart = 8;
+             c.params.jitter = true, c.params.frame = 3;
+         }},
     };
     struct Size {
         Extent3 grid;
@@ -453,8 +474,8 @@ TEST_P(RenderMarchGpu, ScratchBytesByHand) {
         scene.march.brick = 4;
         scene.march.skipping = true;
         scene.march.light = MarchLightSource::Shade;
-        // MarchGpu: its own eleven 16-byte rows and LightGpu's thirteen (nine and four glow blobs).
-        const uint64_t block = 11u * 16u + 13u * 16u;
+        // MarchGpu: its own twelve 16-byte rows and LightGpu's thirteen (nine and four glow blobs).
+        const uint64_t block = 12u * 16u + 13u * 16u;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 8 + 36u * 4);
         scene.march.light = MarchLightSource::March;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4 + 36u * 4);

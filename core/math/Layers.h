@@ -46,21 +46,8 @@ struct LayersSetup {
     LightTerms light;
 };
 
-// The voxel that padded index i stands for along an axis of n voxels: voxel
-// i - 1 inside; the border (i = 0 and n + 1) is outside (-1), or with `wrap`
-// the opposite edge's voxel (n - 1 and 0).
-inline int64_t LayersPaddedSource(uint32_t i, uint32_t n, bool wrap) {
-    if (i >= 1 && i <= n) return int64_t(i) - 1;
-    if (!wrap) return -1;
-    return i == 0 ? int64_t(n) - 1 : 0;
-}
-
 // Layer i's plane: z_i = (i + 1/2) nz / N (voxel units, above the grid's base).
 inline float LayerHeight(const LayersSetup& s, uint32_t i) { return (float(i) + 0.5f) * s.spacing; }
-
-// x reduced into [0, n] (n x, n y periodic): x - n floor(x / n), with 1 / n
-// from the host so that every backend rounds the same product.
-inline float LayersWrap(float x, float n, float invN) { return x - n * std::floor(x * invN); }
 
 // The padded (q, T) volume's taps at voxel-unit point p, as core/math/March.h's
 // padded sampler (impl_cpu/RenderMarchCpu.cpp): p clamped to [0, n], plus
@@ -164,8 +151,8 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     if (!(r2 <= s.outer2)) return f;
     float x = (s.eye[0] + hx) - s.drift[0], y = (s.eye[1] + hy) - s.drift[1];
     if (s.tiling) {
-        x = LayersWrap(x, s.size[0], s.invSize[0]);
-        y = LayersWrap(y, s.size[1], s.invSize[1]);
+        x = TileWrap(x, s.size[0], s.invSize[0]);
+        y = TileWrap(y, s.size[1], s.invSize[1]);
     } else if (!(x >= 0.0f && x <= s.size[0] && y >= 0.0f && y <= s.size[1])) {
         return f;
     }

@@ -60,27 +60,52 @@ inline PixelDirection PixelRayDirection(const CameraFrame& c, uint32_t x, uint32
     return {MarchScale(d, inv), inv};
 }
 
-// Clips [tMin, tMax] of the ray o + t d to the box [0, size] (slab method). A
+// Clips [tMin, tMax] of the ray o + t d to the slab [0, size[a]] of axis a. A
 // direction component of (nearly) zero keeps the interval when o lies inside
 // that slab and empties it otherwise, so no 0 * inf is ever formed.
-inline void ClipRayToBox(const Vec3& o, const Vec3& d, const Vec3& size, float& tMin, float& tMax) {
-    for (int a = 0; a < 3; ++a) {
-        if (std::fabs(d[a]) < 1e-20f) {
-            if (o[a] < 0.0f || o[a] > size[a]) tMax = tMin = 0.0f;
-            continue;
-        }
-        const float inv = 1.0f / d[a];
-        float t0 = (0.0f - o[a]) * inv, t1 = (size[a] - o[a]) * inv;
-        if (t0 > t1) std::swap(t0, t1);
-        tMin = std::max(tMin, t0);
-        tMax = std::min(tMax, t1);
+inline void ClipRayToSlab(const Vec3& o, const Vec3& d, const Vec3& size, int a, float& tMin, float& tMax) {
+    if (std::fabs(d[a]) < 1e-20f) {
+        if (o[a] < 0.0f || o[a] > size[a]) tMax = tMin = 0.0f;
+        return;
     }
+    const float inv = 1.0f / d[a];
+    float t0 = (0.0f - o[a]) * inv, t1 = (size[a] - o[a]) * inv;
+    if (t0 > t1) std::swap(t0, t1);
+    tMin = std::max(tMin, t0);
+    tMax = std::min(tMax, t1);
 }
 
-// The camera ray of pixel (x, y) in voxel units, clipped to the box [0, n] and
-// to the near and far planes (view depth in [near, far], metres).
+// Clips [tMin, tMax] of the ray o + t d to the box [0, size] (slab method).
+inline void ClipRayToBox(const Vec3& o, const Vec3& d, const Vec3& size, float& tMin, float& tMax) {
+    for (int a = 0; a < 3; ++a) ClipRayToSlab(o, d, size, a, tMin, tMax);
+}
+
+// Clips to the volume the renderers see: the box, or with tiling (the volume
+// repeating in x and y, SPEC 15) the slab 0 <= z <= size[2] alone.
+inline void ClipRayToVolume(const Vec3& o, const Vec3& d, const Vec3& size, bool tiling, float& tMin, float& tMax) {
+    for (int a = tiling ? 2 : 0; a < 3; ++a) ClipRayToSlab(o, d, size, a, tMin, tMax);
+}
+
+// ---- Tiling (SPEC 15) --------------------------------------------------------------
+
+// x reduced into [0, n] (n x, n y periodic): x - n floor(x / n), with 1 / n
+// from the host so that every backend rounds the same product.
+inline float TileWrap(float x, float n, float invN) { return x - n * std::floor(x * invN); }
+
+// The voxel that padded index i stands for along an axis of n voxels: voxel
+// i - 1 inside; the border (i = 0 and n + 1) is outside (-1), or with `wrap`
+// the opposite edge's voxel (n - 1 and 0).
+inline int64_t PaddedSourceVoxel(uint32_t i, uint32_t n, bool wrap) {
+    if (i >= 1 && i <= n) return int64_t(i) - 1;
+    if (!wrap) return -1;
+    return i == 0 ? int64_t(n) - 1 : 0;
+}
+
+// The camera ray of pixel (x, y) in voxel units, clipped to the box [0, n] (with
+// tiling the slab of z in [0, nz]) and to the near and far planes (view depth
+// in [near, far], metres).
 inline MarchRayGeometry MakePixelRay(const CameraFrame& c, const Vec3& originWorld, float voxelSize, const Vec3& size,
-                                     uint32_t x, uint32_t y) {
+                                     uint32_t x, uint32_t y, bool tiling = false) {
     const PixelDirection p = PixelRayDirection(c, x, y);
     MarchRayGeometry r;
     for (int i = 0; i < 3; ++i) r.origin[i] = (c.eye[i] - originWorld[i]) / voxelSize;
@@ -89,25 +114,30 @@ inline MarchRayGeometry MakePixelRay(const CameraFrame& c, const Vec3& originWor
     const float perDepth = 1.0f / (voxelSize * p.cosForward);
     r.tMin = c.nearPlane * perDepth;
     r.tMax = c.farPlane * perDepth;
-    ClipRayToBox(r.origin, r.dir, size, r.tMin, r.tMax);
+    ClipRayToVolume(r.origin, r.dir, size, tiling, r.tMin, r.tMax);
     return r;
 }
 
 // ---- Sampling --------------------------------------------------------------------
 
 // Trilinear sample of a canonical volume between voxel centres at voxel-unit
-// point p; taps outside the grid read `outside` (q: 0, T: 1). The definition
+// point p; taps outside the grid read `outside` (q: 0, T: 1), or with `tiling`
+// wrap in x and y (the volume repeats with the grid's period). The definition
 // the faster samplers (a padded volume on the CPU, textures on GPUs) match.
-inline float TrilinearSample(const float* v, const Extent3& e, float outside, const Vec3& p) {
-    const float cx = p[0] - 0.5f, cy = p[1] - 0.5f, cz = p[2] - 0.5f;
+inline float TrilinearSample(const float* v, const Extent3& e, float outside, const Vec3& p, bool tiling = false) {
+    const float px = tiling ? TileWrap(p[0], float(e.nx), 1.0f / float(e.nx)) : p[0];
+    const float py = tiling ? TileWrap(p[1], float(e.ny), 1.0f / float(e.ny)) : p[1];
+    const float cx = px - 0.5f, cy = py - 0.5f, cz = p[2] - 0.5f;
     const float fx = std::floor(cx), fy = std::floor(cy), fz = std::floor(cz);
     const float wx = cx - fx, wy = cy - fy, wz = cz - fz;
     // Far outside: every tap is outside (also keeps the int conversion defined).
     const float lim = float(std::max({e.nx, e.ny, e.nz})) + 2.0f;
     if (!(std::fabs(fx) < lim && std::fabs(fy) < lim && std::fabs(fz) < lim)) return outside;
     const int64_t i0 = int64_t(fx), j0 = int64_t(fy), k0 = int64_t(fz);
+    const int64_t nx = int64_t(e.nx), ny = int64_t(e.ny);
     auto tap = [&](int64_t i, int64_t j, int64_t k) {
-        if (i < 0 || j < 0 || k < 0 || i >= int64_t(e.nx) || j >= int64_t(e.ny) || k >= int64_t(e.nz)) return outside;
+        if (tiling) i = (i % nx + nx) % nx, j = (j % ny + ny) % ny;
+        if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= int64_t(e.nz)) return outside;
         return v[size_t(i) + size_t(e.nx) * (size_t(j) + size_t(e.ny) * size_t(k))];
     };
     const float c00 = Lerp(tap(i0, j0, k0), tap(i0 + 1, j0, k0), wx);
@@ -131,10 +161,21 @@ struct MarchSetup {
     Vec3 background{0, 0, 0};
     bool powder = false;
     float powderC = 2;
+    // The volume repeats in x and y with the grid's period (SPEC 15): rays and light marches are clipped to the
+    // slab 0 <= z <= nz alone, samples and bricks read the wrapped point (TileWrap with invSize = 1 / size).
+    bool tiling = false;
+    Vec3 invSize{1, 1, 1};
     // The light terms (core/math/Light.h; made by core/pipeline/LightTerms.h's MakeLightTerms): the sun's
     // radiance, the ambient light, the phase function, the lightning's point light; light.voxelSize is h.
     LightTerms light;
 };
+
+// The point of the volume that voxel-unit point p reads: p itself, or with
+// tiling p wrapped into the first period in x and y.
+inline Vec3 MarchWrapped(const MarchSetup& s, const Vec3& p) {
+    if (!s.tiling) return p;
+    return {TileWrap(p[0], s.size[0], s.invSize[0]), TileWrap(p[1], s.size[1], s.invSize[1]), p[2]};
+}
 
 // sigma h, capped so that sigma h q l stays free of inf * 0 (as in MakeSliceAttenuation).
 inline float MarchOpticalDepthPerVoxel(float sigma, float voxelSize) {
@@ -193,6 +234,39 @@ inline float RayExitFromBox(const Vec3& o, const Vec3& invD, const Vec3& lo, con
     return std::max(exit, t);
 }
 
+// The brick that holds voxel-unit point p, and its box [lo, hi] (at p's own
+// position along the ray). With tiling the bricks cover the first period and
+// repeat: p's brick is that of its wrapped point, its box shifted by
+// n floor(p / n) in x and y back to p's period and cut at the period's end (a
+// last brick that n does not fill would reach into the next period's first).
+struct MarchBrickCell {
+    bool inside = false;  // p lies in a brick (else lo, hi and index are unset)
+    uint32_t index = 0;   // bx + count_x (by + count_y bz)
+    Vec3 lo{}, hi{};
+};
+inline MarchBrickCell MarchBrickAt(const MarchSetup& s, const MarchBricks& b, float B, float invB, const Vec3& p) {
+    float sx = 0.0f, sy = 0.0f;
+    if (s.tiling) {
+        sx = s.size[0] * std::floor(p[0] * s.invSize[0]);
+        sy = s.size[1] * std::floor(p[1] * s.invSize[1]);
+    }
+    // p * (1/B) may round across a brick face; the bricks' one-voxel margin covers that.
+    const int bx = int(std::floor((p[0] - sx) * invB)), by = int(std::floor((p[1] - sy) * invB)),
+              bz = int(std::floor(p[2] * invB));
+    MarchBrickCell c;
+    c.inside = bx >= 0 && by >= 0 && bz >= 0 && uint32_t(bx) < b.count[0] && uint32_t(by) < b.count[1] &&
+               uint32_t(bz) < b.count[2];
+    if (!c.inside) return c;
+    c.index = uint32_t(bx) + b.count[0] * (uint32_t(by) + b.count[1] * uint32_t(bz));
+    c.lo = {float(bx) * B + sx, float(by) * B + sy, float(bz) * B};
+    c.hi = {c.lo[0] + B, c.lo[1] + B, c.lo[2] + B};
+    if (s.tiling) {
+        c.hi[0] = std::min(float(bx) * B + B, s.size[0]) + sx;
+        c.hi[1] = std::min(float(by) * B + B, s.size[1]) + sy;
+    }
+    return c;
+}
+
 // ---- Light functor for the light march (Olajos) -----------------------------------
 
 // What a light functor returns at a sample: transmittance toward the sun and
@@ -216,7 +290,7 @@ float MarchTransmittance(const Vec3& p, const Vec3& u, float length, uint32_t n,
 template <class Density>
 float SunLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& q) {
     float t0 = 0, t1 = std::numeric_limits<float>::max();
-    ClipRayToBox(p, s.sun, s.size, t0, t1);
+    ClipRayToVolume(p, s.sun, s.size, s.tiling, t0, t1);
     return t1 > t0 ? MarchTransmittance(p, s.sun, t1, n, s.sigmaH, q) : 1.0f;
 }
 
@@ -230,7 +304,7 @@ float PointLightMarch(const MarchSetup& s, const Vec3& p, uint32_t n, Density&& 
     if (!(dist > 0.0f)) return 1.0f;
     const Vec3 u = MarchScale(toLight, 1.0f / dist);
     float t0 = 0, t1 = dist;
-    ClipRayToBox(p, u, s.size, t0, t1);
+    ClipRayToVolume(p, u, s.size, s.tiling, t0, t1);
     return t1 > t0 ? MarchTransmittance(p, u, t1, n, s.sigmaH, q) : 1.0f;
 }
 
@@ -248,7 +322,8 @@ struct MarchRayResult {
 // Marches one ray (SPEC 10). Segment n is [t_n, t_{n+1}] clipped to tMax,
 // t_0 = tMin, t_{n+1} = t_n + Delta(t_n) (fixed: t_n = tMin + n Delta); its
 // sample sits at t_n + xi l_n, l_n its clipped length. q(p) returns q_alpha at
-// voxel-unit point p; light(p) returns a MarchLightSample. Samples inside empty
+// voxel-unit point p (with tiling, at MarchWrapped(p)); light(p) returns a
+// MarchLightSample. Samples inside empty
 // bricks (bricks may be null) are skipped without moving any other sample.
 template <class Density, class Light>
 MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float xi, const MarchBricks* bricks,
@@ -271,33 +346,19 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
             const float ts = tn + xi * len;
             const Vec3 p = MarchAlong(ray.origin, ray.dir, ts);
             if (bricks) {
-                // p * (1/B) may round across a brick face; the bricks' one-voxel margin covers that.
-                const int bx = int(std::floor(p[0] * invB)), by = int(std::floor(p[1] * invB)),
-                          bz = int(std::floor(p[2] * invB));
-                const bool inside = bx >= 0 && by >= 0 && bz >= 0 && uint32_t(bx) < bricks->count[0] &&
-                                    uint32_t(by) < bricks->count[1] && uint32_t(bz) < bricks->count[2];
-                if (inside &&
-                    bricks->empty[uint32_t(bx) + bricks->count[0] * (uint32_t(by) + bricks->count[1] * uint32_t(bz))]) {
+                const MarchBrickCell cell = MarchBrickAt(s, *bricks, B, invB, p);
+                if (cell.inside && bricks->empty[cell.index]) {
                     // Jump to the first sample at or past the brick's exit; the samples in between read q = 0.
-                    const Vec3 lo{float(bx) * B, float(by) * B, float(bz) * B};
-                    const Vec3 hi{lo[0] + B, lo[1] + B, lo[2] + B};
-                    float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
+                    float tExit = RayExitFromBox(ray.origin, invDir, cell.lo, cell.hi, ts);
                     ++r.bricksSkipped;
                     // Walk on through the empty bricks that follow (probing a hundredth of a voxel past each
                     // exit face: the points in between lie within the next brick's one-voxel margin).
                     while (tExit < ray.tMax) {
                         const float tProbe = tExit + 0.01f;
-                        const Vec3 pe = MarchAlong(ray.origin, ray.dir, tProbe);
-                        const int ex = int(std::floor(pe[0] * invB)), ey = int(std::floor(pe[1] * invB)),
-                                  ez = int(std::floor(pe[2] * invB));
-                        if (!(ex >= 0 && ey >= 0 && ez >= 0 && uint32_t(ex) < bricks->count[0] &&
-                              uint32_t(ey) < bricks->count[1] && uint32_t(ez) < bricks->count[2]) ||
-                            !bricks->empty[uint32_t(ex) +
-                                           bricks->count[0] * (uint32_t(ey) + bricks->count[1] * uint32_t(ez))])
-                            break;
-                        const Vec3 elo{float(ex) * B, float(ey) * B, float(ez) * B};
-                        const Vec3 ehi{elo[0] + B, elo[1] + B, elo[2] + B};
-                        tExit = RayExitFromBox(ray.origin, invDir, elo, ehi, tProbe);
+                        const MarchBrickCell next =
+                            MarchBrickAt(s, *bricks, B, invB, MarchAlong(ray.origin, ray.dir, tProbe));
+                        if (!next.inside || !bricks->empty[next.index]) break;
+                        tExit = RayExitFromBox(ray.origin, invDir, next.lo, next.hi, tProbe);
                         ++r.bricksSkipped;
                     }
                     if (s.adaptive) {

@@ -54,11 +54,6 @@ float LayerHeight(LayersGpu s, uint i) {
     return z;
 }
 
-float LayersWrap(float x, float n, float invN) {
-    precise float w = x - n * floor(x * invN);
-    return w;
-}
-
 // core/math/Layers.h LayersFade, written out (no smoothstep).
 float LayersFade(float r2, float outer2, float fadeInv2) {
     if (!(fadeInv2 > 0.0)) return 1.0;
@@ -129,8 +124,8 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     if (!(r2 <= s.outer2)) return f;
     precise float x = (s.eye.x + hx) - s.drift.x, y = (s.eye.y + hy) - s.drift.y;
     if ((s.flags & kLayersTiling) != 0u) {
-        x = LayersWrap(x, s.size.x, s.invSize.x);
-        y = LayersWrap(y, s.size.y, s.invSize.y);
+        x = TileWrap(x, s.size.x, s.invSize.x);
+        y = TileWrap(y, s.size.y, s.invSize.y);
     } else if (!(x >= 0.0 && x <= s.size.x && y >= 0.0 && y <= s.size.y)) {
         return f;
     }

@@ -44,6 +44,8 @@ struct MarchGpu {
     uint strideZ;  // px * py
     uvec3 bricks;  // bricks along x, y, z
     uint unused;
+    vec3 invSize;  // 1 / size: the tiling's wrap
+    uint unused2;
     LightGpu light;  // light.glsl
 };
 
@@ -53,6 +55,7 @@ const uint kMarchPowder = 4u;
 const uint kMarchSkipping = 16u;
 const uint kMarchLightMarch = 32u;
 const uint kMarchGround = 64u;  // the background is the ground (core/math/ground.glsl), per pixel
+const uint kMarchTiling = 128u;  // the volume repeats in x and y
 const uint kMarchStreamOther = 3u;
 const float kMarchFloatMax = 3.402823466e+38;
 
@@ -83,27 +86,41 @@ float MarchDot(vec3 a, vec3 b) {
     return r;
 }
 
+// Clip of o + t d to the slab [0, size[a]] of axis a (core/math/March.h ClipRayToSlab).
+void ClipRayToSlab(vec3 o, vec3 d, vec3 size, int a, inout float tMin, inout float tMax) {
+    if (abs(d[a]) < 1e-20) {
+        if (o[a] < 0.0 || o[a] > size[a]) {
+            tMax = 0.0;
+            tMin = 0.0;
+        }
+        return;
+    }
+    precise float inv = 1.0 / d[a];
+    precise float t0 = (0.0 - o[a]) * inv;
+    precise float t1 = (size[a] - o[a]) * inv;
+    if (t0 > t1) {
+        const float swap = t0;
+        t0 = t1;
+        t1 = swap;
+    }
+    tMin = max(tMin, t0);
+    tMax = min(tMax, t1);
+}
+
 // Slab clip of o + t d to the box [0, size] (core/math/March.h ClipRayToBox).
 void ClipRayToBox(vec3 o, vec3 d, vec3 size, inout float tMin, inout float tMax) {
-    for (int a = 0; a < 3; ++a) {
-        if (abs(d[a]) < 1e-20) {
-            if (o[a] < 0.0 || o[a] > size[a]) {
-                tMax = 0.0;
-                tMin = 0.0;
-            }
-            continue;
-        }
-        precise float inv = 1.0 / d[a];
-        precise float t0 = (0.0 - o[a]) * inv;
-        precise float t1 = (size[a] - o[a]) * inv;
-        if (t0 > t1) {
-            const float swap = t0;
-            t0 = t1;
-            t1 = swap;
-        }
-        tMin = max(tMin, t0);
-        tMax = min(tMax, t1);
-    }
+    for (int a = 0; a < 3; ++a) ClipRayToSlab(o, d, size, a, tMin, tMax);
+}
+
+// The box, or with tiling the slab 0 <= z <= size.z (core/math/March.h ClipRayToVolume).
+void ClipRayToVolume(vec3 o, vec3 d, vec3 size, bool tiling, inout float tMin, inout float tMax) {
+    for (int a = tiling ? 2 : 0; a < 3; ++a) ClipRayToSlab(o, d, size, a, tMin, tMax);
+}
+
+// x reduced into [0, n] (core/math/March.h TileWrap).
+float TileWrap(float x, float n, float invN) {
+    precise float w = x - n * floor(x * invN);
+    return w;
 }
 
 // The unit direction of the ray through the centre of pixel (x, y), row 0 at
@@ -130,7 +147,7 @@ MarchRayGeometry MakePixelRay(MarchGpu m, uint x, uint y) {
     precise float perDepth = 1.0 / (m.voxelSize * inv);
     r.tMin = m.nearPlane * perDepth;
     r.tMax = m.farPlane * perDepth;
-    ClipRayToBox(r.origin, r.dir, m.size, r.tMin, r.tMax);
+    ClipRayToVolume(r.origin, r.dir, m.size, (m.flags & kMarchTiling) != 0u, r.tMin, r.tMax);
     return r;
 }
 
@@ -155,7 +172,13 @@ MarchTaps PaddedTapsAt(vec3 size, uint px, uint pxy, vec3 p) {
     return t;
 }
 
-MarchTaps MarchTapsAt(MarchGpu m, vec3 p) { return PaddedTapsAt(m.size, m.strideY, m.strideZ, p); }
+// p itself, or with tiling p wrapped into the first period (core/math/March.h MarchWrapped).
+vec3 MarchWrapped(MarchGpu m, vec3 p) {
+    if ((m.flags & kMarchTiling) == 0u) return p;
+    return vec3(TileWrap(p.x, m.size.x, m.invSize.x), TileWrap(p.y, m.size.y, m.invSize.y), p.z);
+}
+
+MarchTaps MarchTapsAt(MarchGpu m, vec3 p) { return PaddedTapsAt(m.size, m.strideY, m.strideZ, MarchWrapped(m, p)); }
 
 // Lerp per component, unfused (core/math/Shading.h Lerp).
 vec2 MarchLerp2(vec2 a, vec2 b, float t) { return vec2(Lerp(a.x, b.x, t), Lerp(a.y, b.y, t)); }
@@ -226,7 +249,7 @@ float MarchTransmittance(MarchGpu m, vec3 p, vec3 u, float len, uint n) {
 
 float SunLightMarch(MarchGpu m, vec3 p) {
     float t0 = 0.0, t1 = kMarchFloatMax;
-    ClipRayToBox(p, m.sun, m.size, t0, t1);
+    ClipRayToVolume(p, m.sun, m.size, (m.flags & kMarchTiling) != 0u, t0, t1);
     return t1 > t0 ? MarchTransmittance(m, p, m.sun, t1, m.lightSteps) : 1.0;
 }
 
@@ -238,20 +261,45 @@ float PointLightMarch(MarchGpu m, vec3 p) {
     precise float inv = 1.0 / dist;
     const vec3 u = vec3(toLight.x * inv, toLight.y * inv, toLight.z * inv);
     float t0 = 0.0, t1 = dist;
-    ClipRayToBox(p, u, m.size, t0, t1);
+    ClipRayToVolume(p, u, m.size, (m.flags & kMarchTiling) != 0u, t0, t1);
     return t1 > t0 ? MarchTransmittance(m, p, u, t1, m.lightSteps) : 1.0;
 }
 
-bool MarchBrickInside(MarchGpu m, ivec3 b) {
-    return b.x >= 0 && b.y >= 0 && b.z >= 0 && uint(b.x) < m.bricks.x && uint(b.y) < m.bricks.y &&
-           uint(b.z) < m.bricks.z;
-}
+// The brick that holds p and its box, shifted to p's period with tiling (core/math/March.h MarchBrickAt).
+struct MarchBrickCell {
+    bool inside;
+    uint index;
+    vec3 lo, hi;
+};
 
-uint MarchBrickIndex(MarchGpu m, ivec3 b) { return uint(b.x) + m.bricks.x * (uint(b.y) + m.bricks.y * uint(b.z)); }
-
-ivec3 MarchBrickOf(vec3 p, float invB) {
-    precise vec3 s = vec3(p.x * invB, p.y * invB, p.z * invB);
-    return ivec3(floor(s));
+MarchBrickCell MarchBrickAt(MarchGpu m, float B, float invB, vec3 p) {
+    const bool tiling = (m.flags & kMarchTiling) != 0u;
+    precise float sx = 0.0, sy = 0.0;
+    if (tiling) {
+        sx = m.size.x * floor(p.x * m.invSize.x);
+        sy = m.size.y * floor(p.y * m.invSize.y);
+    }
+    precise vec3 s = vec3((p.x - sx) * invB, (p.y - sy) * invB, p.z * invB);
+    const ivec3 b = ivec3(floor(s));
+    MarchBrickCell c;
+    c.inside = b.x >= 0 && b.y >= 0 && b.z >= 0 && uint(b.x) < m.bricks.x && uint(b.y) < m.bricks.y &&
+               uint(b.z) < m.bricks.z;
+    c.index = 0u;
+    c.lo = vec3(0.0);
+    c.hi = vec3(0.0);
+    if (!c.inside) return c;
+    c.index = uint(b.x) + m.bricks.x * (uint(b.y) + m.bricks.y * uint(b.z));
+    precise vec3 lo = vec3(float(b.x) * B + sx, float(b.y) * B + sy, float(b.z) * B);
+    precise vec3 hi = vec3(lo.x + B, lo.y + B, lo.z + B);
+    if (tiling) {
+        precise float ex = min(float(b.x) * B + B, m.size.x) + sx;
+        precise float ey = min(float(b.y) * B + B, m.size.y) + sy;
+        hi.x = ex;
+        hi.y = ey;
+    }
+    c.lo = lo;
+    c.hi = hi;
+    return c;
 }
 
 // ---- The per-ray kernel (core/math/March.h MarchRay) ----
@@ -291,17 +339,15 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
             precise float ts = tn + xi * len;
             const vec3 p = MarchAlong(ray.origin, ray.dir, ts);
             if (skipping) {
-                const ivec3 b = MarchBrickOf(p, invB);
-                if (MarchBrickInside(m, b) && MarchBrickEmpty(MarchBrickIndex(m, b))) {
-                    const vec3 lo = vec3(b) * B;
-                    float tExit = RayExitFromBox(ray.origin, invDir, lo, lo + vec3(B), ts);
+                const MarchBrickCell cell = MarchBrickAt(m, B, invB, p);
+                if (cell.inside && MarchBrickEmpty(cell.index)) {
+                    float tExit = RayExitFromBox(ray.origin, invDir, cell.lo, cell.hi, ts);
                     ++r.bricksSkipped;
                     while (tExit < ray.tMax) {
                         precise float tProbe = tExit + 0.01;
-                        const ivec3 e = MarchBrickOf(MarchAlong(ray.origin, ray.dir, tProbe), invB);
-                        if (!MarchBrickInside(m, e) || !MarchBrickEmpty(MarchBrickIndex(m, e))) break;
-                        const vec3 elo = vec3(e) * B;
-                        tExit = RayExitFromBox(ray.origin, invDir, elo, elo + vec3(B), tProbe);
+                        const MarchBrickCell next = MarchBrickAt(m, B, invB, MarchAlong(ray.origin, ray.dir, tProbe));
+                        if (!next.inside || !MarchBrickEmpty(next.index)) break;
+                        tExit = RayExitFromBox(ray.origin, invDir, next.lo, next.hi, tProbe);
                         ++r.bricksSkipped;
                     }
                     if (adaptive) {

@@ -33,6 +33,7 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     if (params.skipping) flags |= kMarchGpuSkipping;
     if (params.light == MarchLightSource::March) flags |= kMarchGpuLightMarch;
     if (params.ground.on) flags |= kMarchGpuGround;
+    if (s.tiling) flags |= kMarchGpuTiling;
     g.flags = flags;
     g.seed = params.seed;
     g.frame = params.frame;
@@ -43,6 +44,7 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     g.strideZ = (e.nx + 2) * (e.ny + 2);
     const auto counts = MarchBrickCounts(e, brick);
     g.bricks = {counts[0], counts[1], counts[2]};
+    g.invSize = s.invSize;
     g.light = MakeLightGpu(s.light);
     return g;
 }

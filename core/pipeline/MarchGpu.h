@@ -27,6 +27,7 @@ enum MarchGpuFlag : uint32_t {
     kMarchGpuSkipping = 1u << 4,
     kMarchGpuLightMarch = 1u << 5,  // the sun's light from a light march; else shade's T
     kMarchGpuGround = 1u << 6,      // the ground plane (core/math/Ground.h) is the background, per pixel
+    kMarchGpuTiling = 1u << 7,      // the volume repeats in x and y (MarchSetup::tiling)
 };
 
 // Member for member march.glsl's MarchGpu (a scalar after a vec3 takes its fourth lane in std140 and std430).
@@ -59,9 +60,11 @@ struct alignas(16) MarchGpu {
     uint32_t strideZ;                // px * (ny + 2)
     std::array<uint32_t, 3> bricks;  // bricks along x, y, z (ceil(n / B))
     uint32_t unused;
+    std::array<float, 3> invSize;  // 1 / size: the tiling's wrap
+    uint32_t unused2;
     LightGpu light;  // the sun, the ambient light, the point light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(MarchGpu) == 11 * 16 + sizeof(LightGpu), "MarchGpu is eleven 16-byte rows and its light");
+static_assert(sizeof(MarchGpu) == 12 * 16 + sizeof(LightGpu), "MarchGpu is twelve 16-byte rows and its light");
 static_assert(offsetof(MarchGpu, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
 // The block for one call on a grid of extent e. The Mie table's values are

@@ -104,19 +104,10 @@ Status MeasureImageRows(ImageReferences& refs, const Session& session, int repea
 
 }  // namespace
 
-std::optional<std::string> ReferenceRenderUnsupported(const Scene& scene) {
-    // The reference render clips its rays to the box: it would not be the same (infinite) clouds.
-    if (scene.grid.tiling)
-        return "the exact reference render does not repeat the volume (grid.tiling) yet; measure the untiled scene "
-               "with --set grid.tiling=false";
-    return std::nullopt;
-}
-
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats) {
     const RendererDescriptor* descriptor = Describe(renderer).renderer;
     if (!descriptor || !descriptor->accuracyRender) return RenderNotMeasured("failed", "not a renderer");
-    if (auto why = ReferenceRenderUnsupported(scene)) return RenderNotMeasured("unsupported", *why);
     if (!backend.Supports(renderer))
         return RenderNotMeasured("unsupported",
                                  backend.Name() + " does not implement " + std::string(StageName(renderer)) + " yet");
@@ -165,10 +156,6 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
 
 Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<SceneOverride>& setting, Stage renderer,
                                         Backend& backend) {
-    // Refused before the reference is rendered for nothing.
-    auto scene = eval.GetSession().LoadVariant(setting);
-    if (!scene) return std::unexpected(scene.error());
-    if (auto why = ReferenceRenderUnsupported(*scene)) return NotMeasured("unsupported", *why);
     auto loaded = eval.Images().Load(setting);
     if (!loaded) return std::unexpected(loaded.error());
     const RenderAccuracy a = MeasureRender(backend, renderer, loaded->scene, *loaded->in,

@@ -44,9 +44,6 @@ struct RenderAccuracy {
     double prepMs = 0;
     ImageErrorStats error;
 };
-// Why the exact reference render cannot stand for this scene's image (a tiled grid), with the way round;
-// nullopt when it can.
-std::optional<std::string> ReferenceRenderUnsupported(const Scene& scene);
 RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scene, const LightingInputs& in,
                              std::span<const float> reference, int repeats);
 

@@ -5,8 +5,8 @@
 // Stage `render_march`, step 1 (impl_cpu/RenderMarchCpu.cpp step 1): layer k
 // of the padded (q_alpha, T) volume, one fragment per padded (i, j): voxel
 // (i - 1, j - 1, k - 1) inside the grid, else the border (0, 1), or with `wrap`
-// (render_layers' tiling) the opposite edge's voxel in x and y (core/math/Layers.h
-// LayersPaddedSource).
+// (tiling) the opposite edge's voxel in x and y (core/math/March.h
+// PaddedSourceVoxel).
 layout(binding = 0) uniform sampler2DArray qPrev;
 layout(binding = 1) uniform sampler2DArray qCur;
 layout(binding = 2) uniform sampler2DArray transmittance;  // read only when hasT != 0

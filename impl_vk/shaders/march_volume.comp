@@ -3,8 +3,8 @@
 // padded volume, (nx+2) x (ny+2) x (nz+2), one invocation per padded voxel.
 // Voxel (i, j, k) sits at padded (i+1, j+1, k+1) and holds q_alpha =
 // Lerp(q_prev, q_cur, alpha) and, with the light source "shade", T; the border
-// holds (0, 1), or with `wrap` (render_layers' tiling) the opposite edge's voxels
-// in x and y (core/math/Layers.h LayersPaddedSource). With "shade" the volume is
+// holds (0, 1), or with `wrap` (tiling) the opposite edge's voxels
+// in x and y (core/math/March.h PaddedSourceVoxel). With "shade" the volume is
 // (q, T) pairs, else q alone.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"

@@ -51,7 +51,8 @@ LightGpu ZeroLight() {
 
 MarchGpu ZeroMarch() {
     return MarchGpu(vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, 0.0, 0.0, 0.0, 0.0,
-                    vec3(0.0), 0.0, vec3(0.0), 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, uvec3(0u), 0u, ZeroLight());
+                    vec3(0.0), 0.0, vec3(0.0), 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, uvec3(0u), 0u, vec3(0.0), 0u,
+                    ZeroLight());
 }
 
 // noise.glsl's tables: one permutation, i -> (167 i + 13) mod 256 (tests/GlslTwinCases.cpp kTwinPerm).
@@ -184,6 +185,28 @@ void main() {
             ClipRayToBox(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), tMin, tMax);
             PutF(0u, tMin);
             PutF(1u, tMax);
+            float zMin = F(9u), zMax = F(10u);
+            ClipRayToVolume(vec3(F(0u), F(1u), F(2u)), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), true, zMin,
+                            zMax);
+            PutF(2u, zMin);
+            PutF(3u, zMax);
+            break;
+        }
+        case kTwinMarchBrickAt: {
+            MarchGpu m = ZeroMarch();
+            m.size = vec3(F(3u), F(4u), F(5u));
+            m.invSize = vec3(F(6u), F(7u), F(8u));
+            m.bricks = uvec3(U(9u), U(10u), U(11u));
+            m.flags = U(14u) != 0u ? kMarchTiling : 0u;
+            const MarchBrickCell cell = MarchBrickAt(m, F(12u), F(13u), vec3(F(0u), F(1u), F(2u)));
+            PutU(0u, cell.inside ? 1u : 0u);
+            PutU(1u, cell.index);
+            PutF(2u, cell.lo.x);
+            PutF(3u, cell.lo.y);
+            PutF(4u, cell.lo.z);
+            PutF(5u, cell.hi.x);
+            PutF(6u, cell.hi.y);
+            PutF(7u, cell.hi.z);
             break;
         }
         case kTwinMarchStepAt: {
@@ -262,7 +285,7 @@ void main() {
             PutF(3u, t.w.z);
             PutF(4u, qt.x);
             PutF(5u, qt.y);
-            PutF(6u, LayersWrap(F(3u), F(4u), F(5u)));
+            PutF(6u, TileWrap(F(3u), F(4u), F(5u)));
             PutF(7u, LayerHeight(layers, U(6u)));
             break;
         }

@@ -53,6 +53,7 @@ CB_TWIN_FN(MarchJitter, 39u)
 CB_TWIN_FN(RayExitFromBox, 40u)
 CB_TWIN_FN(PowderTerm, 41u)
 CB_TWIN_FN(MarchKernelFormulas, 42u)
+CB_TWIN_FN(MarchBrickAt, 66u)
 // With the bound MarchGpu.
 CB_TWIN_FN(MakePixelRay, 43u)
 CB_TWIN_FN(MarchPaddedSampler, 44u)

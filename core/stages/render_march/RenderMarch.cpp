@@ -114,6 +114,8 @@ MarchParams MakeMarchParams(const Scene& sc, const CameraSettings& camera, uint3
     p.origin = {float(sc.grid.origin[0]), float(sc.grid.origin[1]), float(sc.grid.origin[2])};
     MarchSetup& s = p.setup;
     s.size = {float(sc.grid.size.nx), float(sc.grid.size.ny), float(sc.grid.size.nz)};
+    s.tiling = sc.grid.tiling;
+    s.invSize = {1.0f / s.size[0], 1.0f / s.size[1], 1.0f / s.size[2]};  // the wrap's factor on every backend
     s.voxelSize = h;
     s.step = float(sc.march.step);
     s.adaptive = sc.march.adaptive;
@@ -222,6 +224,7 @@ const RendererDescriptor kMarchRenderer{
     .recordKey = "march",
     .counters = kMarchCounterFields,
     .toneMap = MarchToneMap,
+    .honoursTiling = true,
     .imageFields = kMarchImageFields,
     .referenceIgnores = kMarchReferenceIgnores,
     .accuracyRender = MarchAccuracyRender,
@@ -237,8 +240,9 @@ const RendererDescriptor kMarchRenderer{
 // What its parameters read from the scene (StageDescriptor::sceneFields).
 // Besides the light terms' sections, which every renderer reads (core/pipeline/LightTerms.h kLightTermFields).
 constexpr std::string_view kRenderMarchSceneFields[] = {
-    "march",        "sun",           "shade.sigma",    "ca.seed",      "grid.voxel_size",        "grid.origin",
-    "render.width", "render.height", "render.cameras", "render.alpha", "render.frames_per_step", "render.ground"};
+    "march",        "sun",          "shade.sigma",   "ca.seed",        "grid.voxel_size", "grid.origin",
+    "grid.tiling",  "render.width", "render.height", "render.cameras", "render.alpha",    "render.frames_per_step",
+    "render.ground"};
 
 constexpr std::string_view kRenderMarchSceneKeys[] = {"march"};
 
