@@ -146,15 +146,24 @@ TEST(MarchTiling, CpuMarchEqualsTheUntiledMarchOfCopies) {
 
 // Test that skipping empty bricks moves no sample with tiling: bit for bit the
 // image without skipping, with bricks the period fills (5 of 25) and a last one
-// it does not (5 of 32: the box of the seventh brick along x is cut at the seam,
-// or the skip would jump over the next period's first voxels), fixed and adaptive steps.
+// it does not (5 of 32). The box of that seventh brick along x must be cut at
+// the seam: uncut, it reaches over the next period's first three voxels, and a
+// ray leaving it in +x would jump over the narrow blob there (at x = 3.5, below
+// the 1e-3 cut at x = 0.5, so the brick grown by its wrapped column stays
+// empty). The eye is inside the layer looking along +x, its rays crossing seven
+// seams; fixed and adaptive steps.
 TEST(MarchTiling, SkippingMovesNoSampleAcrossTheSeams) {
-    const TiledCopies c = MakeTiledCopies({32, 25, 10}, 1);
+    TiledCopies c = MakeTiledCopies({32, 25, 10}, 1);
+    const std::vector<float> narrow = test::GaussianBlobField(c.period, {{3.5, 12.5, 5, 0.8}});
+    for (size_t v = 0; v < c.q.size(); ++v) c.q[v] = std::min(c.q[v] + narrow[v], 1.0f);
     for (bool adaptive : {false, true}) {
-        MarchParams off = MakeTilingPair(c, MarchLightSource::Shade).tiled;
+        MarchParams off = test::CameraParams(c.period, {6, 11, 5}, {40, 13, 5}, 24, 18);
         off.camera.farPlane = 200;
+        off.skipping = false;
+        off.setup.tiling = true;
+        off.setup.invSize = {1.0f / 32, 1.0f / 25, 1.0f / 10};
         off.setup.adaptive = adaptive;
-        off.setup.kappa = 0.05f;
+        off.setup.kappa = 0.02f;
         off.setup.adaptiveStart = 10;
         MarchParams on = off;
         on.skipping = true;

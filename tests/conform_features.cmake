@@ -78,3 +78,13 @@ foreach(scene IN ITEMS ci-small noise-layer layers-small)
   set_tests_properties(Cli.ConformWangLight.${scene} PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
                        TIMEOUT 300)
 endforeach()
+# Tiling in the march: layers-small's tiled clouds out to its 20 km far plane, drawn by render_march beside
+# render_layers (shade's T, then the light march, whose light crosses the neighbouring tiles), on every built
+# backend; exit 4 (no backend besides the CPU could start) is a skip.
+foreach(light IN ITEMS shade march)
+  add_test(NAME Cli.ConformTiledMarch.${light}
+           COMMAND ${cli} conform layers-small --set "stages=[\"noise\",\"shade\",\"render_march\",\"render_layers\"]"
+                   --set "march.light=\"${light}\"" --out ${cli_out}/conform-tiled-march-${light})
+  set_tests_properties(Cli.ConformTiledMarch.${light} PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
+                       PASS_REGULAR_EXPRESSION "render_march +(gl|vk) +pass" TIMEOUT 300)
+endforeach()

@@ -136,14 +136,20 @@ void CheckTiling(const Scene& scene, Validator& check) {
                                       ") must divide grid.size's nx and ny (" + std::to_string(scene.grid.size.nx) +
                                       ", " + std::to_string(scene.grid.size.ny) +
                                       ") for the detail volume to repeat with the grid");
+    // G is the shadow of one tile, computed over the grid's box; the ground would show it clamped past the box.
+    if (scene.render.ground.on)
+        check.Fail("render.ground",
+                   "the ground shadow G covers one tile of grid.tiling and does not repeat; remove render.ground "
+                   "or set grid.tiling to false");
     std::string honouring;  // the renderers that honour tiling, for the message
     for (Stage stage : kAllStages)
         if (const RendererDescriptor* r = Describe(stage).renderer; r && r->honoursTiling)
             honouring += (honouring.empty() ? "" : ", ") + std::string(StageName(stage));
     for (Stage stage : kAllStages)
         if (const RendererDescriptor* r = Describe(stage).renderer; r && !r->honoursTiling && scene.stages.Has(stage))
-            check.Fail("grid.tiling", Quote(StageName(stage)) + " does not repeat the volume yet; only " + honouring +
-                                          " honours tiling");
+            check.Fail("grid.tiling",
+                       Quote(StageName(stage)) +
+                           " does not repeat the volume yet; the renderers that honour tiling: " + honouring);
 }
 
 // Relighting shades once, for the first step's sun: a renderer that does not relight would read that T as if it
