@@ -157,10 +157,11 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                  MarchBricks b;
                  b.count[0] = in[9], b.count[1] = in[10], b.count[2] = in[11];
                  const MarchBrickCell cell =
-                     MarchBrickAt(s, b, Float(in[12]), Float(in[13]), {Float(in[0]), Float(in[1]), Float(in[2])});
+                     MarchBrickAt(s, b, Float(in[13]), {Float(in[0]), Float(in[1]), Float(in[2])});
+                 Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+                 if (cell.inside) MarchBrickBox(s, cell, Float(in[12]), lo, hi);
                  out[0] = cell.inside ? 1u : 0u;
-                 out[1] = cell.inside ? cell.index : 0u;
-                 const Vec3 lo = cell.inside ? cell.lo : Vec3{0, 0, 0}, hi = cell.inside ? cell.hi : Vec3{0, 0, 0};
+                 out[1] = cell.index;
                  for (int a = 0; a < 3; ++a) out[2 + a] = Bits(lo[a]), out[5 + a] = Bits(hi[a]);
              },
              /*otherDeviceUlps=*/3});

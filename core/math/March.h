@@ -234,37 +234,41 @@ inline float RayExitFromBox(const Vec3& o, const Vec3& invD, const Vec3& lo, con
     return std::max(exit, t);
 }
 
-// The brick that holds voxel-unit point p, and its box [lo, hi] (at p's own
-// position along the ray). With tiling the bricks cover the first period and
-// repeat: p's brick is that of its wrapped point, its box shifted by
-// n floor(p / n) in x and y back to p's period and cut at the period's end (a
-// last brick that n does not fill would reach into the next period's first).
+// The brick that holds voxel-unit point p. With tiling the bricks cover the
+// first period and repeat: p's brick is that of its wrapped point, and
+// (sx, sy) = n floor(p / n) in x and y carries its box back to p's period.
 struct MarchBrickCell {
-    bool inside = false;  // p lies in a brick (else lo, hi and index are unset)
+    bool inside = false;  // p lies in a brick (else the rest is unset)
     uint32_t index = 0;   // bx + count_x (by + count_y bz)
-    Vec3 lo{}, hi{};
+    int b[3] = {0, 0, 0};
+    float sx = 0, sy = 0;
 };
-inline MarchBrickCell MarchBrickAt(const MarchSetup& s, const MarchBricks& b, float B, float invB, const Vec3& p) {
-    float sx = 0.0f, sy = 0.0f;
+inline MarchBrickCell MarchBrickAt(const MarchSetup& s, const MarchBricks& b, float invB, const Vec3& p) {
+    MarchBrickCell c;
     if (s.tiling) {
-        sx = s.size[0] * std::floor(p[0] * s.invSize[0]);
-        sy = s.size[1] * std::floor(p[1] * s.invSize[1]);
+        c.sx = s.size[0] * std::floor(p[0] * s.invSize[0]);
+        c.sy = s.size[1] * std::floor(p[1] * s.invSize[1]);
     }
     // p * (1/B) may round across a brick face; the bricks' one-voxel margin covers that.
-    const int bx = int(std::floor((p[0] - sx) * invB)), by = int(std::floor((p[1] - sy) * invB)),
-              bz = int(std::floor(p[2] * invB));
-    MarchBrickCell c;
-    c.inside = bx >= 0 && by >= 0 && bz >= 0 && uint32_t(bx) < b.count[0] && uint32_t(by) < b.count[1] &&
-               uint32_t(bz) < b.count[2];
-    if (!c.inside) return c;
-    c.index = uint32_t(bx) + b.count[0] * (uint32_t(by) + b.count[1] * uint32_t(bz));
-    c.lo = {float(bx) * B + sx, float(by) * B + sy, float(bz) * B};
-    c.hi = {c.lo[0] + B, c.lo[1] + B, c.lo[2] + B};
-    if (s.tiling) {
-        c.hi[0] = std::min(float(bx) * B + B, s.size[0]) + sx;
-        c.hi[1] = std::min(float(by) * B + B, s.size[1]) + sy;
-    }
+    c.b[0] = int(std::floor((p[0] - c.sx) * invB));
+    c.b[1] = int(std::floor((p[1] - c.sy) * invB));
+    c.b[2] = int(std::floor(p[2] * invB));
+    c.inside = c.b[0] >= 0 && c.b[1] >= 0 && c.b[2] >= 0 && uint32_t(c.b[0]) < b.count[0] &&
+               uint32_t(c.b[1]) < b.count[1] && uint32_t(c.b[2]) < b.count[2];
+    if (c.inside) c.index = uint32_t(c.b[0]) + b.count[0] * (uint32_t(c.b[1]) + b.count[1] * uint32_t(c.b[2]));
     return c;
+}
+
+// The box [lo, hi] of brick c (edge B) at its point's own position along the
+// ray; with tiling cut at the period's end in x and y, or a last brick that n
+// does not fill would reach into the next period's first.
+inline void MarchBrickBox(const MarchSetup& s, const MarchBrickCell& c, float B, Vec3& lo, Vec3& hi) {
+    lo = {float(c.b[0]) * B + c.sx, float(c.b[1]) * B + c.sy, float(c.b[2]) * B};
+    hi = {lo[0] + B, lo[1] + B, lo[2] + B};
+    if (s.tiling) {
+        hi[0] = std::min(float(c.b[0]) * B + B, s.size[0]) + c.sx;
+        hi[1] = std::min(float(c.b[1]) * B + B, s.size[1]) + c.sy;
+    }
 }
 
 // ---- Light functor for the light march (Olajos) -----------------------------------
@@ -346,19 +350,22 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
             const float ts = tn + xi * len;
             const Vec3 p = MarchAlong(ray.origin, ray.dir, ts);
             if (bricks) {
-                const MarchBrickCell cell = MarchBrickAt(s, *bricks, B, invB, p);
+                const MarchBrickCell cell = MarchBrickAt(s, *bricks, invB, p);
                 if (cell.inside && bricks->empty[cell.index]) {
                     // Jump to the first sample at or past the brick's exit; the samples in between read q = 0.
-                    float tExit = RayExitFromBox(ray.origin, invDir, cell.lo, cell.hi, ts);
+                    Vec3 lo, hi;
+                    MarchBrickBox(s, cell, B, lo, hi);
+                    float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
                     ++r.bricksSkipped;
                     // Walk on through the empty bricks that follow (probing a hundredth of a voxel past each
                     // exit face: the points in between lie within the next brick's one-voxel margin).
                     while (tExit < ray.tMax) {
                         const float tProbe = tExit + 0.01f;
                         const MarchBrickCell next =
-                            MarchBrickAt(s, *bricks, B, invB, MarchAlong(ray.origin, ray.dir, tProbe));
+                            MarchBrickAt(s, *bricks, invB, MarchAlong(ray.origin, ray.dir, tProbe));
                         if (!next.inside || !bricks->empty[next.index]) break;
-                        tExit = RayExitFromBox(ray.origin, invDir, next.lo, next.hi, tProbe);
+                        MarchBrickBox(s, next, B, lo, hi);
+                        tExit = RayExitFromBox(ray.origin, invDir, lo, hi, tProbe);
                         ++r.bricksSkipped;
                     }
                     if (s.adaptive) {

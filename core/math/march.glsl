@@ -265,41 +265,43 @@ float PointLightMarch(MarchGpu m, vec3 p) {
     return t1 > t0 ? MarchTransmittance(m, p, u, t1, m.lightSteps) : 1.0;
 }
 
-// The brick that holds p and its box, shifted to p's period with tiling (core/math/March.h MarchBrickAt).
+// The brick that holds p, and with tiling the shift to p's period (core/math/March.h MarchBrickAt).
 struct MarchBrickCell {
     bool inside;
     uint index;
-    vec3 lo, hi;
+    ivec3 b;
+    float sx, sy;
 };
 
-MarchBrickCell MarchBrickAt(MarchGpu m, float B, float invB, vec3 p) {
-    const bool tiling = (m.flags & kMarchTiling) != 0u;
+MarchBrickCell MarchBrickAt(MarchGpu m, float invB, vec3 p) {
+    MarchBrickCell c;
     precise float sx = 0.0, sy = 0.0;
-    if (tiling) {
+    if ((m.flags & kMarchTiling) != 0u) {
         sx = m.size.x * floor(p.x * m.invSize.x);
         sy = m.size.y * floor(p.y * m.invSize.y);
     }
+    c.sx = sx;
+    c.sy = sy;
     precise vec3 s = vec3((p.x - sx) * invB, (p.y - sy) * invB, p.z * invB);
-    const ivec3 b = ivec3(floor(s));
-    MarchBrickCell c;
-    c.inside = b.x >= 0 && b.y >= 0 && b.z >= 0 && uint(b.x) < m.bricks.x && uint(b.y) < m.bricks.y &&
-               uint(b.z) < m.bricks.z;
-    c.index = 0u;
-    c.lo = vec3(0.0);
-    c.hi = vec3(0.0);
-    if (!c.inside) return c;
-    c.index = uint(b.x) + m.bricks.x * (uint(b.y) + m.bricks.y * uint(b.z));
-    precise vec3 lo = vec3(float(b.x) * B + sx, float(b.y) * B + sy, float(b.z) * B);
-    precise vec3 hi = vec3(lo.x + B, lo.y + B, lo.z + B);
-    if (tiling) {
-        precise float ex = min(float(b.x) * B + B, m.size.x) + sx;
-        precise float ey = min(float(b.y) * B + B, m.size.y) + sy;
-        hi.x = ex;
-        hi.y = ey;
-    }
-    c.lo = lo;
-    c.hi = hi;
+    c.b = ivec3(floor(s));
+    c.inside = c.b.x >= 0 && c.b.y >= 0 && c.b.z >= 0 && uint(c.b.x) < m.bricks.x && uint(c.b.y) < m.bricks.y &&
+               uint(c.b.z) < m.bricks.z;
+    c.index = c.inside ? uint(c.b.x) + m.bricks.x * (uint(c.b.y) + m.bricks.y * uint(c.b.z)) : 0u;
     return c;
+}
+
+// The brick's box, cut at the period's end with tiling (core/math/March.h MarchBrickBox).
+void MarchBrickBox(MarchGpu m, MarchBrickCell c, float B, out vec3 lo, out vec3 hi) {
+    precise vec3 l = vec3(float(c.b.x) * B + c.sx, float(c.b.y) * B + c.sy, float(c.b.z) * B);
+    precise vec3 h = vec3(l.x + B, l.y + B, l.z + B);
+    if ((m.flags & kMarchTiling) != 0u) {
+        precise float ex = min(float(c.b.x) * B + B, m.size.x) + c.sx;
+        precise float ey = min(float(c.b.y) * B + B, m.size.y) + c.sy;
+        h.x = ex;
+        h.y = ey;
+    }
+    lo = l;
+    hi = h;
 }
 
 // ---- The per-ray kernel (core/math/March.h MarchRay) ----
@@ -339,15 +341,18 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
             precise float ts = tn + xi * len;
             const vec3 p = MarchAlong(ray.origin, ray.dir, ts);
             if (skipping) {
-                const MarchBrickCell cell = MarchBrickAt(m, B, invB, p);
+                const MarchBrickCell cell = MarchBrickAt(m, invB, p);
                 if (cell.inside && MarchBrickEmpty(cell.index)) {
-                    float tExit = RayExitFromBox(ray.origin, invDir, cell.lo, cell.hi, ts);
+                    vec3 lo, hi;
+                    MarchBrickBox(m, cell, B, lo, hi);
+                    float tExit = RayExitFromBox(ray.origin, invDir, lo, hi, ts);
                     ++r.bricksSkipped;
                     while (tExit < ray.tMax) {
                         precise float tProbe = tExit + 0.01;
-                        const MarchBrickCell next = MarchBrickAt(m, B, invB, MarchAlong(ray.origin, ray.dir, tProbe));
+                        const MarchBrickCell next = MarchBrickAt(m, invB, MarchAlong(ray.origin, ray.dir, tProbe));
                         if (!next.inside || !MarchBrickEmpty(next.index)) break;
-                        tExit = RayExitFromBox(ray.origin, invDir, next.lo, next.hi, tProbe);
+                        MarchBrickBox(m, next, B, lo, hi);
+                        tExit = RayExitFromBox(ray.origin, invDir, lo, hi, tProbe);
                         ++r.bricksSkipped;
                     }
                     if (adaptive) {

@@ -198,15 +198,17 @@ void main() {
             m.invSize = vec3(F(6u), F(7u), F(8u));
             m.bricks = uvec3(U(9u), U(10u), U(11u));
             m.flags = U(14u) != 0u ? kMarchTiling : 0u;
-            const MarchBrickCell cell = MarchBrickAt(m, F(12u), F(13u), vec3(F(0u), F(1u), F(2u)));
+            const MarchBrickCell cell = MarchBrickAt(m, F(13u), vec3(F(0u), F(1u), F(2u)));
+            vec3 lo = vec3(0.0), hi = vec3(0.0);
+            if (cell.inside) MarchBrickBox(m, cell, F(12u), lo, hi);
             PutU(0u, cell.inside ? 1u : 0u);
             PutU(1u, cell.index);
-            PutF(2u, cell.lo.x);
-            PutF(3u, cell.lo.y);
-            PutF(4u, cell.lo.z);
-            PutF(5u, cell.hi.x);
-            PutF(6u, cell.hi.y);
-            PutF(7u, cell.hi.z);
+            PutF(2u, lo.x);
+            PutF(3u, lo.y);
+            PutF(4u, lo.z);
+            PutF(5u, hi.x);
+            PutF(6u, hi.y);
+            PutF(7u, hi.z);
             break;
         }
         case kTwinMarchStepAt: {
