@@ -61,7 +61,7 @@ DIR/accuracy.md.
 With a renderer in the scene ()" + RendererNames(", ") + R"()
 it also renders the exact reference image (the ray march's kernel with exact
 light toward the sun and the point light, a fine step, no early termination,
-no jitter; a tiled volume is not rendered by the reference yet) and measures
+no jitter; with grid.tiling over the repeated volume) and measures
 each renderer on each backend against it: the scene's settings, then each of
 its own settings changed one at a time:
 )" + AccuracyVariantsHelp() + R"(per-pixel error = max over channels of |C - C_ref|, with max, mean, p99 and
