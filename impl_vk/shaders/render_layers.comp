@@ -1,7 +1,7 @@
 #version 450
 // Stage `render_layers` (SPEC 15), pass 2: one invocation per pixel in 8 x 8
 // workgroups, LayersPixel of core/math/layers.glsl (the CPU's loop over the
-// layers the pixel's ray crosses, back to front), over the padded (q_alpha, T)
+// layers the pixel's ray crosses, back to front, then LOD0's billboards), over the padded (q_alpha, T)
 // volume of pass 1 (march_volume.comp, wrapped with tiling). Writes linear RGB
 // and adds the LayersStats counters (a reduction in shared memory, then one
 // atomic per workgroup and counter).
@@ -21,10 +21,12 @@ layout(std430, binding = 3) writeonly buffer Image { float image[]; };
 // Words 2 n, 2 n + 1: counter n (low, high) of fragments, drawn.
 layout(std430, binding = 4) buffer Stats { uint stats[]; };
 layout(std430, binding = 5) readonly buffer Map { float layersMap[]; };  // read with wang opacity only
+layout(std430, binding = 6) readonly buffer Billboards { LayersBillboard billboards[]; };  // LOD0, back to front
 
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
 float PhaseTableValue(uint i) { return mieTable[i]; }
 float LayersMapValue(uint i) { return layersMap[i]; }
+LayersBillboard LayersBillboardAt(uint i) { return billboards[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here
 
 shared uint gCounts[2];

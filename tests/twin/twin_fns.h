@@ -66,5 +66,6 @@ CB_TWIN_FN(LayersTaps, 61u)
 CB_TWIN_FN(LayerFragment, 62u)
 CB_TWIN_FN(LayersPixel, 63u)
 CB_TWIN_FN(LayersFade, 64u)
+CB_TWIN_FN(BillboardFragment, 66u)
 // ---- light.glsl, with the bound MarchGpu's light ----
 CB_TWIN_FN(InScattered, 65u)

@@ -17,8 +17,9 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLayersKeys[] = {"count", "extent",  "fade",     "max_length", "wind",
-                                            "wang",  "relight", "exposure", "tone_map"};
+constexpr std::string_view kLayersKeys[] = {"count",   "extent",  "fade",        "max_length", "wind",
+                                            "wang",    "relight", "lod0_radius", "exposure",   "billboard_spacing",
+                                            "tone_map"};
 constexpr std::array<NamedValue<LayersRelight>, 2> kLayersRelightNames{{
     {"shade", LayersRelight::Shade},
     {"vector", LayersRelight::Vector},
@@ -53,6 +54,12 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
     ReadCoverage(*section, "layers", "wang", check, layers.wang);
     if (const Json* v = find("relight")) {
         if (auto kind = check.Choice(*v, "layers.relight", kLayersRelightNames)) layers.relight = *kind;
+    }
+    if (const Json* v = find("lod0_radius")) {
+        if (auto d = check.Number(*v, "layers.lod0_radius", kSingleNonNegative)) layers.lod0Radius = *d;
+    }
+    if (const Json* v = find("billboard_spacing")) {
+        if (auto d = check.Number(*v, "layers.billboard_spacing", kSinglePositive)) layers.billboardSpacing = *d;
     }
     if (const Json* v = find("exposure")) {
         if (auto d = check.Number(*v, "layers.exposure", kSinglePositive)) layers.exposure = *d;
@@ -112,9 +119,14 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     s.light = MakeLightTerms(sc, step);
     s.light.pointOn = false;  // no transmittance toward the point light in the layers: it stays off
     s.wang = sc.layers.wang.enabled;
+    SetLayersLod0(s, sc.layers.lod0Radius / sc.grid.voxelSize, LayersBillboardSpacing(sc) / sc.grid.voxelSize);
     s.coverage = float(sc.layers.wang.coverage);
     s.density = float(sc.layers.wang.density);
     return p;
+}
+
+double LayersBillboardSpacing(const Scene& sc) {
+    return sc.layers.billboardSpacing > 0 ? sc.layers.billboardSpacing : sc.grid.voxelSize;
 }
 
 std::vector<float> MakeLayersMap(const Scene& sc, uint32_t step) {

@@ -27,6 +27,9 @@ LayersParams MakeLayersParams(const Scene& scene, const CameraSettings& camera, 
 // centre (nx * ny values, x fastest); empty without.
 std::vector<float> MakeLayersMap(const Scene& scene, uint32_t step);
 
+// LOD0's grid spacing p_s in metres: layers.billboard_spacing, or the voxel size when it is 0.
+double LayersBillboardSpacing(const Scene& scene);
+
 const StageDescriptor& DescribeRenderLayers();
 Status CallRenderLayers(Backend& backend, const Scene& scene, const StageHostInputs& host, const StageBuffers& io,
                         StageCallRecord& record);
