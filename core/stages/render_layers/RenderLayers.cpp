@@ -69,6 +69,32 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
     }
 }
 
+void CheckLayersLod0(const Scene& sc, const Extent3* grid, Validator& check) {
+    const double r0 = sc.layers.lod0Radius;
+    if (!(r0 > 0)) return;
+    // LOD0 lies inside the layers' extent: beyond it the annulus would be empty and the billboards reach past it.
+    if (sc.layers.extent > 0) {
+        if (r0 > sc.layers.extent)
+            check.Fail("layers.lod0_radius", "must not exceed layers.extent (" + FormatNumber(sc.layers.extent) +
+                                                 "), got " + FormatNumber(r0));
+    } else {
+        for (const CameraSettings& camera : sc.render.cameras)
+            if (r0 > camera.farPlane) {
+                check.Fail("layers.lod0_radius", "must not exceed the layers' extent, camera \"" + camera.name +
+                                                     "\"'s far plane (" + FormatNumber(camera.farPlane) + "), got " +
+                                                     FormatNumber(r0));
+                break;
+            }
+    }
+    if (!grid) return;
+    const double bound = LayersBillboardBound(sc.layers, sc.grid.voxelSize, sc.grid.size.nz);
+    if (bound > kMaxLayersBillboards)
+        check.Fail("layers.lod0_radius", "LOD0 would hold up to " + FormatNumber(std::floor(bound)) +
+                                             " billboards ((2 r0 / p_s + 2)^2 on each layer), more than " +
+                                             FormatNumber(kMaxLayersBillboards) +
+                                             "; lower it or raise layers.billboard_spacing, got " + FormatNumber(r0));
+}
+
 }  // namespace cb::scene_io
 
 namespace cb {
@@ -234,6 +260,7 @@ const StageDescriptor& DescribeRenderLayers() {
         .readSettings =
             [](const scene_io::Json& root, scene_io::Validator& check, const Extent3* grid, Scene& scene) {
                 scene_io::ReadLayers(root, check, grid ? std::optional(grid->nz) : std::nullopt, scene.layers);
+                scene_io::CheckLayersLod0(scene, grid, check);
             },
         .reads = {Resource::Q, Resource::T},
         .readsPrevious = LayersPrevious,

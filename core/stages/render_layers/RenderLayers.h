@@ -16,6 +16,9 @@ namespace cb {
 namespace scene_io {
 // `nz` is the grid's, when its size was read: the layer count is checked against it.
 void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, LayersSettings& layers);
+// LOD0's radius against the layers' extent (layers.extent, or each camera's far plane) and the billboards' count
+// (LayersBillboardBound, with `grid` read), once the scene's other sections are read.
+void CheckLayersLod0(const Scene& scene, const Extent3* grid, Validator& check);
 }  // namespace scene_io
 
 // The layered renderer's parameters for one camera at `step` (the sun), frame `frame` of a step of `frames`
