@@ -7,7 +7,6 @@
 //      where rasterising every layer would shade and discard the others; then
 //      LOD0's billboards, a list made on the host per call, back to front.
 // The constants are core/pipeline/LayersGpu.h's block in a storage buffer.
-#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -69,15 +68,18 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
         map = *b;
     }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
-    // The billboards (LOD0): a binding needs a buffer, so one entry's bytes when there are none.
-    auto billboardBuffer = Scratch(state.billboards, std::max<size_t>(billboards.size(), 1) * sizeof(LayersBillboard));
-    if (!billboardBuffer) return std::unexpected(billboardBuffer.error());
-    if (!billboards.empty()) CB_TRY(mContext->Upload(**billboardBuffer, std::as_bytes(std::span(billboards))));
+    const DeviceBuffer* billboardBuffer = *frameBuffer;  // unread without billboards (LOD0); a binding needs a buffer
+    if (!billboards.empty()) {
+        auto b = Scratch(state.billboards, billboards.size() * sizeof(LayersBillboard));
+        if (!b) return std::unexpected(b.error());
+        CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(billboards))));
+        billboardBuffer = *b;
+    }
 
     const MarchVolumePush volumePush{e.nx, e.ny, e.nz, 1u, params.alpha, params.setup.tiling ? 1u : 0u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), *volume};
-    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table,           &Dev(image),
-                                          *statsBuffer, map,     *billboardBuffer};
+    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table,          &Dev(image),
+                                          *statsBuffer, map,     billboardBuffer};
     CB_TRY(Record("render_layers", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(**volumePipe, volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);

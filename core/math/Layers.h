@@ -263,6 +263,29 @@ inline LayerFragmentResult BillboardFragment(const LayersSetup& s, const LayersB
     return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length, fetch);
 }
 
+// The pixels a billboard's fragments can cover, conservatively: its quad projected (a rectangle, the quad being
+// parallel to the image plane) in pixel coordinates, x from the left and y (rows) from the top, [x0, x1] x [y0, y1],
+// grown by two pixels and by 1e-5 of the coordinates' magnitude (voxel edges) for the float rounding of
+// BillboardFragment's test; worked in double. OpenGL's vertex shader draws the same rectangle; the CPU culls a
+// tile's billboards with it.
+struct LayersPixelRect {
+    double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+inline LayersPixelRect LayersBillboardRect(const LayersSetup& s, const CameraFrame& c, const LayersBillboard& b) {
+    const double depth = b.depth, focal = c.focalPx;
+    double x = 0, y = 0, scale = 1;
+    for (int a = 0; a < 3; ++a) {
+        const double rel = double(b.centre[a]) - double(s.eye[a]);
+        x += rel * c.right[a];
+        y += rel * c.upVector[a];
+        scale = std::max({scale, std::fabs(double(b.centre[a])), std::fabs(double(s.eye[a]))});
+    }
+    const double margin = 2.0 * depth / focal + 1e-5 * scale;
+    const double hw = s.halfWidth + margin, hh = s.halfHeight + margin;
+    return {0.5 * c.width + focal * (x - hw) / depth, 0.5 * c.width + focal * (x + hw) / depth,
+            0.5 * c.height - focal * (y + hh) / depth, 0.5 * c.height - focal * (y - hh) / depth};
+}
+
 // The grid points of LOD0 (SPEC 15): on every layer's plane, the centres ((a + 1/2) p_s, (b + 1/2) p_s, z_i)
 // (voxel units: the cells of side p_s from the grid's origin, a billboard at each cell's centre) whose horizontal
 // distance from the eye is at most r0 (worked in double), in front of the eye (depth > 0: one behind it has no

@@ -36,7 +36,8 @@ float LayersMapValue(uint i) { return 0.0; }
 
 #ifdef LAYERS_BILLBOARDS
 // Billboard gl_InstanceID (LOD0; the list is in drawing order): its quad in the image plane, halfWidth along right
-// and halfHeight along up of its centre at its view depth D, grown by two pixels (2 D / focal) on every side; the
+// and halfHeight along up of its centre at its view depth D, grown by two pixels (2 D / focal) and 1e-5 of the
+// coordinates' magnitude on every side (core/math/Layers.h LayersBillboardRect); the
 // fragment shader then tests each pixel's ray exactly (BillboardFragment), so the rasteriser's rounding never
 // moves an edge. The quad is parallel to the image plane: its projection is a rectangle. A billboard nearer than
 // half the near plane (whose fragments all fail t >= tNear) is dropped.
@@ -51,8 +52,9 @@ void main() {
     }
     const vec2 corner = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0);
     const float W = float(layers.width), H = float(layers.height), focal = layers.focalPx;
-    const float margin = 2.0 * depth / focal;
     const vec3 rel = b.centre - layers.eye;
+    const vec3 magnitude = max(abs(b.centre), abs(layers.eye));
+    const float margin = 2.0 * depth / focal + 1e-5 * max(1.0, max(magnitude.x, max(magnitude.y, magnitude.z)));
     const float x = dot(rel, layers.right) + corner.x * (layers.halfWidth + margin);
     const float y = dot(rel, layers.up) + corner.y * (layers.halfHeight + margin);
     // Pixel coordinates (rows from the top, as render_layers.frag's gl_FragCoord), then NDC.
