@@ -5,7 +5,8 @@
 //      core/math/layers.glsl, the CPU's loop over the layers each ray crosses:
 //      a compute pass touches only the layers on the ray's side of the eye,
 //      where rasterising every layer would shade and discard the others; then
-//      LOD0's billboards, a list made on the host per call, back to front.
+//      LOD0's billboards, a list made on the host per call, back to front, of
+//      which each workgroup blends those that meet its 8 x 8 tile.
 // The constants are core/pipeline/LayersGpu.h's block in a storage buffer.
 #include <array>
 #include <vector>
