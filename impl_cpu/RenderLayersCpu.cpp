@@ -1,14 +1,15 @@
 // The layered renderer on the CPU (SPEC 15): per call, q_alpha and T are formed
 // once into a padded volume of (q, T) pairs (core/math/Layers.h's taps: the
 // border holds (0, 1), or with tiling the opposite edge's voxels), then every
-// pixel runs LayersPixel, the layers its ray crosses back to front, TBB over
-// 8 x 8 pixel tiles. A pixel's loop is the fastest form here: it touches only
-// the layers on its side of the eye, where OpenGL rasterises every layer.
+// pixel runs LayersPixel, the layers its ray crosses back to front and then
+// LOD0's billboards (a list made once per call, culled per tile), TBB over 8 x 8 pixel tiles. A pixel's loop is the
+// fastest form here: it touches only the layers on its side of the eye, where OpenGL rasterises every layer.
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
+#include <vector>
 
 #include "core/math/Layers.h"
 #include "impl_cpu/BackendCpu.h"
@@ -62,13 +63,27 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
         const std::array<float, 2>* volume = state.volume.data();
         auto fetch = [volume](uint32_t i) { return volume[i]; };
         const LayersWalks walks = MakeLayersWalks(s);
+        // LOD0's billboards, back to front (none without it).
+        const std::vector<LayersBillboard> list = MakeLayersBillboards(s, params.camera.forward);
+        // Each tile blends only the billboards whose rectangle (LayersBillboardRect) meets it, in the list's order:
+        // a billboard outside has no fragment there, so the pixels are the same as with the whole list.
+        std::vector<LayersPixelRect> rects(list.size());
+        for (size_t n = 0; n < list.size(); ++n) rects[n] = LayersBillboardRect(s, params.camera, list[n]);
         tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8),
                           [&](const tbb::blocked_range2d<uint32_t>& r) {
                               uint64_t nFragments = 0, nDrawn = 0;
+                              std::vector<LayersBillboard> near;
+                              const double x0 = r.cols().begin(), x1 = r.cols().end();
+                              const double y0 = r.rows().begin(), y1 = r.rows().end();
+                              for (size_t n = 0; n < list.size(); ++n)
+                                  if (rects[n].x1 >= x0 && rects[n].x0 <= x1 && rects[n].y1 >= y0 && rects[n].y0 <= y1)
+                                      near.push_back(list[n]);
+                              const LayersBillboards billboards{near.data(), uint32_t(near.size()), params.camera.right,
+                                                                params.camera.upVector};
                               for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
                                   for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
                                       const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
-                                      const LayersPixelResult p = LayersPixel(s, walks, ray, fetch);
+                                      const LayersPixelResult p = LayersPixel(s, walks, ray, fetch, billboards);
                                       float* o = out + 3 * (size_t(x) + size_t(W) * y);
                                       o[0] = p.color[0];
                                       o[1] = p.color[1];

@@ -5,9 +5,13 @@
 //      is the n-th layer back to front, cut by a clip distance to the side of
 //      the horizon the layer lies on), blended SRC_ALPHA, ONE_MINUS_SRC_ALPHA over
 //      the background; each fragment is LayerFragment of core/math/layers.glsl on
-//      its pixel's ray (render_layers.frag), the counters by storage-buffer atomics.
+//      its pixel's ray (render_layers.frag), the counters by storage-buffer atomics;
+//   3. with LOD0, the same program built with LAYERS_BILLBOARDS: one quad instanced per
+//      billboard, back to front, each fragment BillboardFragment on its pixel's ray.
 // The RGBA32F target's rows come back top row first and pass through a pixel
 // buffer into the (3, width, height) image, as render_march's.
+#include <vector>
+
 #include "core/pipeline/LayersGpu.h"
 #include "impl_gl/BackendGL.h"
 #include "impl_gl/RenderLayersGLState.h"
@@ -20,6 +24,8 @@ uint64_t RenderLayersGLState::ScratchBytes(const Scene& scene) const {
     bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
     if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
     if (scene.layers.wang.enabled) bytes += uint64_t(scene.grid.size.nx) * scene.grid.size.ny * 4;
+    bytes += uint64_t(LayersBillboardBound(scene.layers, scene.grid.voxelSize, scene.grid.size.nz)) *
+             sizeof(LayersBillboard);
     return bytes;
 }
 
@@ -36,7 +42,11 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
     auto layersProgram = mContext->Program("render_layers");
     if (!layersProgram) return std::unexpected(layersProgram.error());
     CB_TRY(CheckPaddedVolumeFits(e, "render_layers"));
-    const LayersGpu block = MakeLayersGpu(params);
+    const std::vector<LayersBillboard> billboards = MakeLayersBillboards(params.setup, params.camera.forward);
+    Result<GLuint> billboardProgram = GLuint(0);
+    if (!billboards.empty()) billboardProgram = mContext->Program("render_layers", "#define LAYERS_BILLBOARDS 1\n");
+    if (!billboardProgram) return std::unexpected(billboardProgram.error());
+    const LayersGpu block = MakeLayersGpu(params, uint32_t(billboards.size()));
     const std::vector<uint32_t> order = LayersDrawOrder(params.setup);
 
     Timing timer(*this);
@@ -84,6 +94,15 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
     f.Enable(GL_CLIP_DISTANCE0);
     Draw(GL_TRIANGLE_STRIP, 0, 4, GLsizei(s.count));
     f.Disable(GL_CLIP_DISTANCE0);
+    // 3. LOD0's billboards over the layers, back to front: one quad instanced per billboard.
+    if (!billboards.empty()) {
+        const size_t bytes = billboards.size() * sizeof(LayersBillboard);
+        const GLuint list = ScratchBuffer(state.billboards, bytes);
+        f.NamedBufferSubData(list, 0, GLsizeiptr(bytes), billboards.data());
+        f.UseProgram(*billboardProgram);
+        f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, list);
+        Draw(GL_TRIANGLE_STRIP, 0, 4, GLsizei(billboards.size()));
+    }
     f.Disable(GL_BLEND);
 
     CopyTargetToImage(target, W, H, state.imageCopy, image);

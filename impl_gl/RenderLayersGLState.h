@@ -19,8 +19,10 @@ struct RenderLayersGLState {
     BufferSlot counters;    // the shader's LayersStats counters
     BufferSlot imageCopy;   // the pixel buffer the image passes through
     BufferSlot map;         // wang opacity: the modulation map, nx * ny floats
+    BufferSlot billboards;  // LOD0's billboards (core/math/Layers.h LayersBillboard), in drawing order
     bool mieUploaded = false;
-    // volume and its copy, target and the RGB32F image copy; with phase mie the table; with wang the map.
+    // volume and its copy, target and the RGB32F image copy; with phase mie the table; with wang the map; the
+    // billboards (at most LayersBillboardBound of them).
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -4,9 +4,12 @@
 //   2. render_layers.comp: one invocation per pixel, LayersPixel of
 //      core/math/layers.glsl, the CPU's loop over the layers each ray crosses:
 //      a compute pass touches only the layers on the ray's side of the eye,
-//      where rasterising every layer would shade and discard the others.
+//      where rasterising every layer would shade and discard the others; then
+//      LOD0's billboards, a list made on the host per call, back to front, of
+//      which each workgroup blends those that meet its 8 x 8 tile.
 // The constants are core/pipeline/LayersGpu.h's block in a storage buffer.
 #include <array>
+#include <vector>
 
 #include "core/pipeline/LayersGpu.h"
 #include "impl_vk/BackendVk.h"
@@ -24,6 +27,8 @@ uint64_t RenderLayersVkState::ScratchBytes(const Scene& scene) const {
     uint64_t bytes = sizeof(LayersGpu) + MarchVolumeBytes(scene.grid.size, true) + kLayersStatWords * 4;
     if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
     if (scene.layers.wang.enabled) bytes += uint64_t(scene.grid.size.nx) * scene.grid.size.ny * 4;
+    bytes += uint64_t(LayersBillboardBound(scene.layers, scene.grid.voxelSize, scene.grid.size.nz)) *
+             sizeof(LayersBillboard);
     return bytes;
 }
 
@@ -37,11 +42,12 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
     if (image.Extent() != Extent3{3, W, H}) return MakeError("vk: render_layers: the image is not (3, width, height)");
     if (params.setup.wang && !params.setup.map) return MakeError("vk: render_layers: wang opacity needs its map");
 
-    const LayersGpu frame = MakeLayersGpu(params);
+    const std::vector<LayersBillboard> billboards = MakeLayersBillboards(params.setup, params.camera.forward);
+    const LayersGpu frame = MakeLayersGpu(params, uint32_t(billboards.size()));
     const uint32_t px = e.nx + 2, py = e.ny + 2, pz = e.nz + 2;
     auto volumePipe = mContext->GetPipeline("march_volume", 4);
     if (!volumePipe) return std::unexpected(volumePipe.error());
-    auto layersPipe = mContext->GetPipeline("render_layers", 6);
+    auto layersPipe = mContext->GetPipeline("render_layers", 7);
     if (!layersPipe) return std::unexpected(layersPipe.error());
     auto frameBuffer = Scratch(state.frame, sizeof frame);
     if (!frameBuffer) return std::unexpected(frameBuffer.error());
@@ -63,10 +69,18 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
         map = *b;
     }
     CB_TRY(mContext->Upload(**frameBuffer, std::as_bytes(std::span(&frame, 1))));
+    const DeviceBuffer* billboardBuffer = *frameBuffer;  // unread without billboards (LOD0); a binding needs a buffer
+    if (!billboards.empty()) {
+        auto b = Scratch(state.billboards, billboards.size() * sizeof(LayersBillboard));
+        if (!b) return std::unexpected(b.error());
+        CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(billboards))));
+        billboardBuffer = *b;
+    }
 
     const MarchVolumePush volumePush{e.nx, e.ny, e.nz, 1u, params.alpha, params.setup.tiling ? 1u : 0u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), *volume};
-    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table, &Dev(image), *statsBuffer, map};
+    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table,          &Dev(image),
+                                          *statsBuffer, map,     billboardBuffer};
     CB_TRY(Record("render_layers", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(**volumePipe, volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);

@@ -10,12 +10,14 @@ namespace cb::vk {
 
 struct RenderLayersVkState {
     static constexpr Stage kStage = Stage::RenderLayers;
-    BufferSlot frame;     // the constants (core/pipeline/LayersGpu.h), 224 bytes
+    BufferSlot frame;     // the constants (core/pipeline/LayersGpu.h), sizeof(LayersGpu)
     BufferSlot volume;    // the padded (q_alpha, T) volume, wrapped horizontally with tiling
     BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
     BufferSlot stats;     // the LayersStats counters, 64-bit as two words each
     BufferSlot map;       // wang opacity: the modulation map, nx * ny floats (uploaded when it changes)
-    // The constants, the padded volume, the Mie table with phase Mie, the counters, the map with wang.
+    BufferSlot billboards;  // LOD0's billboards (core/math/Layers.h LayersBillboard), in drawing order
+    // The constants, the padded volume, the Mie table with phase Mie, the counters, the map with wang, the
+    // billboards (at most LayersBillboardBound of them).
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -51,18 +51,20 @@ void Compare(const char* name, const std::vector<Kind>& kinds, uint32_t ulps, co
 #if CLOUDBENCH_HAVE_VK
 
 std::vector<Words> GlslTwin::Run(TwinFn fn, const std::vector<Words>& inputs, const SplatFrame& frame,
-                                 const MarchGpu& march, const LayersGpu& layers) {
+                                 const MarchGpu& march, const LayersGpu& layers,
+                                 std::span<const LayersBillboard> billboards) {
     vk::VulkanContext& ctx = *sContext;
     const VkDeviceSize bytes = inputs.size() * sizeof(Words);
-    auto pipeline = ctx.GetPipeline("twin", 6, kSpirv_twin);
+    auto pipeline = ctx.GetPipeline("twin", 7, kSpirv_twin);
     auto in = ctx.CreateBuffer(bytes);
     auto out = ctx.CreateBuffer(bytes);
     auto frameBuffer = ctx.CreateBuffer(sizeof frame);
     auto marchBuffer = ctx.CreateBuffer(sizeof march);
     auto table = ctx.CreateBuffer(kMieCloudTable.count * 4);
     auto layersBuffer = ctx.CreateBuffer(sizeof layers);
+    auto billboardBuffer = ctx.CreateBuffer(std::max<size_t>(billboards.size(), 1) * sizeof(LayersBillboard));
     std::vector<Words> result(inputs.size());
-    if (!pipeline || !in || !out || !frameBuffer || !marchBuffer || !table || !layersBuffer) {
+    if (!pipeline || !in || !out || !frameBuffer || !marchBuffer || !table || !layersBuffer || !billboardBuffer) {
         ADD_FAILURE() << "could not set up the twin pipeline";
         return result;
     }
@@ -70,9 +72,11 @@ std::vector<Words> GlslTwin::Run(TwinFn fn, const std::vector<Words>& inputs, co
     EXPECT_TRUE(ctx.Upload(*frameBuffer, std::as_bytes(std::span(&frame, 1))));
     EXPECT_TRUE(ctx.Upload(*marchBuffer, std::as_bytes(std::span(&march, 1))));
     EXPECT_TRUE(ctx.Upload(*layersBuffer, std::as_bytes(std::span(&layers, 1))));
+    if (!billboards.empty()) EXPECT_TRUE(ctx.Upload(*billboardBuffer, std::as_bytes(billboards)));
     EXPECT_TRUE(ctx.Upload(*table, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
     const struct { uint32_t fn, count; } push{uint32_t(fn), uint32_t(inputs.size())};
-    const vk::DeviceBuffer* buffers[] = {&*in, &*out, &*frameBuffer, &*marchBuffer, &*table, &*layersBuffer};
+    const vk::DeviceBuffer* buffers[] = {&*in,    &*out,          &*frameBuffer,    &*marchBuffer,
+                                         &*table, &*layersBuffer, &*billboardBuffer};
     auto ran = ctx.Run("twin", [&](vk::VulkanContext::Recorder& r) {
         r.Dispatch(**pipeline, buffers, &push, sizeof push, push.count);
     });
@@ -84,6 +88,7 @@ std::vector<Words> GlslTwin::Run(TwinFn fn, const std::vector<Words>& inputs, co
     ctx.DestroyBuffer(*marchBuffer);
     ctx.DestroyBuffer(*table);
     ctx.DestroyBuffer(*layersBuffer);
+    ctx.DestroyBuffer(*billboardBuffer);
     return result;
 }
 

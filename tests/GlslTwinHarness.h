@@ -117,9 +117,11 @@ class GlslTwin : public ::testing::Test {
         if (!sContext) GTEST_SKIP() << sSkipReason;
     }
 
-    // Runs twin.comp's function `fn` on `inputs` with `frame`, `march`, kMieCloudTable and `layers` bound.
+    // Runs twin.comp's function `fn` on `inputs` with `frame`, `march`, kMieCloudTable, `layers` and the
+    // billboard list `billboards` bound.
     static std::vector<Words> Run(TwinFn fn, const std::vector<Words>& inputs, const SplatFrame& frame,
-                                  const MarchGpu& march = MarchGpu{}, const LayersGpu& layers = LayersGpu{});
+                                  const MarchGpu& march = MarchGpu{}, const LayersGpu& layers = LayersGpu{},
+                                  std::span<const LayersBillboard> billboards = {});
 
     static inline std::unique_ptr<vk::VulkanContext> sContext;
     static inline std::string sSkipReason;

@@ -6,6 +6,8 @@
 // within 4 ulps on other devices, as GlslTwinTest.cpp's cases.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "core/math/Layers.h"
@@ -69,6 +71,11 @@ LayersParams RandomLayersParams(Pcg32& r, std::vector<float>& map) {
     s.map = map.data();
     const float fade = Uniform(r, 0.05f, 1);  // one call in three without the falloff
     s.fadeInv2 = r.Below(3) == 0 ? 0.0f : 1.0f / (s.outer2 * fade * (2.0f - fade));
+    // LOD0 in two calls of three: p_s from half a voxel to 3, r0 up to 5 p_s (and within the extent).
+    if (r.Below(3) != 0) {
+        const float ps = Uniform(r, 0.5, 3);
+        SetLayersLod0(s, std::min(Uniform(r, 0.3f, 5) * ps, extent), ps);
+    }
     return p;
 }
 
@@ -86,17 +93,19 @@ auto TwinFetch = [](uint32_t i) { return TwinPaddedQT(i); };
 using test::GlslTwin;
 
 // Test that MakeLayersRay and LayersWalkOf, the padded taps with TileWrap and LayerHeight, LayerFragment with
-// LayersOver, and LayersPixel equal their C++ twins on random calls and pixels, corners included; and that the
-// cases reach both outcomes of a fragment (drawn and not).
+// LayersOver, BillboardFragment, and LayersPixel with LOD0's billboards equal their C++ twins on random calls and
+// pixels, corners included; and that the cases reach both outcomes of a fragment (drawn and not).
 TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
     Pcg32 rng(0x1a7e);
     const uint32_t ulps = sExact ? 0 : 4;
-    uint32_t drawn = 0, fragments = 0;
+    uint32_t drawn = 0, fragments = 0, billboardDrawn = 0, billboardMissed = 0;
     for (int call = 0; call < 24; ++call) {
         std::vector<float> map;
         const LayersParams p = RandomLayersParams(rng, map);
         const LayersSetup& s = p.setup;
-        const LayersGpu g = MakeLayersGpu(p);
+        const std::vector<LayersBillboard> list = MakeLayersBillboards(s, p.camera.forward);
+        const LayersBillboards billboards{list.data(), uint32_t(list.size()), p.camera.right, p.camera.upVector};
+        const LayersGpu g = MakeLayersGpu(p, billboards.count);
         const std::vector<Words> pixels = PixelInputs(rng, p.camera, s.count);
         std::vector<Kind> rayKinds(5, Kind::F);
         rayKinds.insert(rayKinds.end(), {Kind::I, Kind::I, Kind::U});
@@ -140,13 +149,46 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
                     drawn += f.drawn ? 1 : 0;
                 });
         const std::vector<Kind> pixelKinds = {Kind::F, Kind::F, Kind::F, Kind::U, Kind::U};
-        Compare("LayersPixel", pixelKinds, ulps, pixels, Run(test::kTwinLayersPixel, pixels, {}, {}, g),
+        Compare("LayersPixel", pixelKinds, ulps, pixels, Run(test::kTwinLayersPixel, pixels, {}, {}, g, list),
                 [&](const Words& in, Words& out) {
-                    const LayersPixelResult r = LayersPixel(
-                        s, MakeLayersWalks(s), MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]), TwinFetch);
+                    const LayersPixelResult r =
+                        LayersPixel(s, MakeLayersWalks(s), MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]),
+                                    TwinFetch, billboards);
                     out = W({Bits(r.color[0]), Bits(r.color[1]), Bits(r.color[2]), r.fragments, r.drawn});
                     fragments += r.fragments;
                 });
+        // BillboardFragment on pixels near the projections of random billboards (so that both outcomes occur).
+        if (!list.empty()) {
+            std::vector<Words> billboardIn;
+            const CameraFrame& c = p.camera;
+            for (int n = 0; n < 400; ++n) {
+                const uint32_t k = rng.Below(uint32_t(list.size()));
+                const LayersBillboard& b = list[k];
+                const Vec3 rel{b.centre[0] - s.eye[0], b.centre[1] - s.eye[1], b.centre[2] - s.eye[2]};
+                const float reach = 1.5f * c.focalPx / b.depth;  // pixels per voxel edge at the billboard
+                const float px = 0.5f * c.width + c.focalPx * MarchDot(rel, c.right) / b.depth +
+                                 Uniform(rng, -1, 1) * reach * s.halfWidth;
+                const float py = 0.5f * c.height - c.focalPx * MarchDot(rel, c.upVector) / b.depth +
+                                 Uniform(rng, -1, 1) * reach * s.halfHeight;
+                const auto clampTo = [](float v, uint32_t n) {
+                    return uint32_t(std::clamp(std::isfinite(v) ? v : 0.0f, 0.0f, float(n - 1)));
+                };
+                billboardIn.push_back(W({clampTo(px, c.width), clampTo(py, c.height), k}));
+            }
+            std::vector<Kind> billboardKinds = {Kind::U, Kind::U};
+            billboardKinds.insert(billboardKinds.end(), 5, Kind::F);
+            Compare("BillboardFragment", billboardKinds, ulps, billboardIn,
+                    Run(test::kTwinBillboardFragment, billboardIn, {}, {}, g, list), [&](const Words& in, Words& out) {
+                        const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
+                        const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, r.dir));
+                        const LayerFragmentResult f =
+                            BillboardFragment(s, billboards, r, sunPhase, list[in[2]], TwinFetch);
+                        out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]),
+                                 Bits(f.color[1]), Bits(f.color[2]), Bits(r.cosForward)});
+                        billboardDrawn += f.drawn ? 1 : 0;
+                        billboardMissed += f.crossed ? 0 : 1;
+                    });
+        }
         // LayersFade across its inner radius, the band, the extent and beyond.
         std::vector<Words> fadeIn;
         for (int n = 0; n < 200; ++n) fadeIn.push_back(WF({Uniform(rng, 0, 1.5f * s.outer2), s.outer2, s.fadeInv2}));
@@ -158,6 +200,8 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
     // Both outcomes are well represented: fragments drawn, and pixels whose rays cross layers.
     EXPECT_GT(drawn, 500u);
     EXPECT_GT(fragments, 5000u);
+    EXPECT_GT(billboardDrawn, 150u);  // and billboard fragments drawn and missed
+    EXPECT_GT(billboardMissed, 300u);
 }
 
 #endif  // CLOUDBENCH_HAVE_VK

@@ -157,13 +157,15 @@ void ExtMarch(Backend& cpu, Backend& gpu, const ExtentCase& c) {
     EXPECT_EQ(stats[1].emptyBricks, stats[0].emptyBricks);
 }
 
-// render_layers, one layer per voxel of height; option 1: tiling. The eye is above the +x edge, looking down at it.
+// render_layers, one layer per voxel of height; option 1: tiling; 2: tiling and LOD0's billboards (r0 = 4, p_s = 1,
+// around the eye). The eye is above the +x edge, looking down at it.
 void ExtLayers(Backend& cpu, Backend& gpu, const ExtentCase& c) {
     const Extent3 e = c.grid;
     const ExtVolumes v = ExtDenseVolumes(e);
     const MarchParams m = test::CameraParams(e, {e.nx - 1.5, 0.4 * e.ny, e.nz + 4.0 + e.ny},
                                              {e.nx - 0.5, 0.5 * e.ny, 0.0}, c.width, c.height);
-    const LayersParams p = test::LayersFromCamera(m, e, e.nz, c.option == 1);
+    LayersParams p = test::LayersFromCamera(m, e, e.nz, c.option >= 1);
+    if (c.option == 2) SetLayersLod0(p.setup, 4.0, 1.0);
     Backend* backends[2] = {&cpu, &gpu};
     std::vector<float> rgb[2];
     LayersStats stats[2];

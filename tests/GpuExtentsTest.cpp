@@ -126,6 +126,7 @@ const std::vector<ExtentRow>& Table() {
         {"march_volume_render_layers_tiled", "vk", Stage::RenderLayers, 64, "nx + 2 (tiling)", {PaddedNx},
          PaddedColumns(1)},
         {"render_layers", "vk", Stage::RenderLayers, 8, "W, H", {Width, Height}, Images8(1)},
+        {"render_layers_lod0", "vk", Stage::RenderLayers, 8, "W, H (billboards)", {Width, Height}, Images8(2)},
         // OpenGL: fragment passes; the viewport's extent in each axis.
         {"noise", "gl", Stage::Noise, 64, "nx, ny", {Nx, Ny}, GlViewports(), true},
         {"region", "gl", Stage::Region, 64, "nx, ny", {Nx, Ny}, GlViewports(), true},
@@ -149,6 +150,7 @@ const std::vector<ExtentRow>& Table() {
         {"march_volume_render_layers", "gl", Stage::RenderLayers, 64, "nx + 2, ny + 2 (tiling)",
          {PaddedNx, PaddedNy}, GlPadded(1)},
         {"render_layers", "gl", Stage::RenderLayers, 64, "W, H", {Width, Height}, GlImages(0), true},
+        {"render_layers_lod0", "gl", Stage::RenderLayers, 64, "W, H (billboards)", {Width, Height}, GlImages(2), true},
     };
     return rows;
 }

@@ -55,7 +55,7 @@ TiledCopies MakeTiledCopies(const Extent3& e, uint32_t copies) {
     c.period = e;
     c.big = {e.nx * copies, e.ny * copies, e.nz};
     // A blob across the x = 0 seam and one across the y = 0 seam, so that the wrapped taps matter.
-    c.q = test::GaussianBlobField(e, {{0.5, 0.5 * e.ny, 0.4 * e.nz, 2.0}, {0.6 * e.nx, 0.2, 0.6 * e.nz, 1.8},
+    c.q = test::GaussianBlobField(e, {{0.5, 0.5 * e.ny, 0.4 * e.nz, 1.2}, {0.6 * e.nx, 0.2, 0.6 * e.nz, 1.8},
                                       {0.4 * e.nx, 0.6 * e.ny, 0.5 * e.nz, 1.5}});
     c.T.resize(e.Count());
     for (size_t i = 0; i < c.T.size(); ++i) c.T[i] = 0.3f + 0.7f * float((i * 2654435761u) % 1000) / 1000.0f;
@@ -148,13 +148,13 @@ TEST(MarchTiling, CpuMarchEqualsTheUntiledMarchOfCopies) {
 // image without skipping, with bricks the period fills (5 of 25) and a last one
 // it does not (5 of 32). The box of that seventh brick along x must be cut at
 // the seam: uncut, it reaches over the next period's first three voxels, and a
-// ray leaving it in +x would jump over the narrow blob there (at x = 3.5, below
-// the 1e-3 cut at x = 0.5, so the brick grown by its wrapped column stays
-// empty). The eye is inside the layer looking along +x, its rays crossing seven
-// seams; fixed and adaptive steps.
+// ray leaving it in +x would jump over the narrow blob there (at x = 3.5 and
+// y = 22.5, below the 1e-3 cut at x = 0.5 and clear of the seam blob, so the
+// bricks grown by their wrapped column stay empty). The eye is inside the layer
+// looking along +x, its rays crossing seven seams; fixed and adaptive steps.
 TEST(MarchTiling, SkippingMovesNoSampleAcrossTheSeams) {
     TiledCopies c = MakeTiledCopies({32, 25, 10}, 1);
-    const std::vector<float> narrow = test::GaussianBlobField(c.period, {{3.5, 12.5, 5, 0.8}});
+    const std::vector<float> narrow = test::GaussianBlobField(c.period, {{3.5, 22.5, 5, 0.8}});
     for (size_t v = 0; v < c.q.size(); ++v) c.q[v] = std::min(c.q[v] + narrow[v], 1.0f);
     for (bool adaptive : {false, true}) {
         MarchParams off = test::CameraParams(c.period, {6, 11, 5}, {40, 13, 5}, 24, 18);

@@ -14,7 +14,11 @@ set(layers_cases
     "WangOpacity|layers-small|--set|layers.wang={\"coverage\":0.8,\"density\":2.5,\"frequency\":[2,1]}"
     "WangOpacityUntiled|layers-small|--set|grid.tiling=false|--set|layers.wang={\"coverage\":0.9,\"octaves\":2}"
     # Relighting under a moving sun: T shaded once, scaled per step.
-    "RelightMovingSun|layers-small|--steps|3|--set|sun.speed={\"azimuth_deg\":12}|--set|layers.relight=\"vector\"")
+    "RelightMovingSun|layers-small|--steps|3|--set|sun.speed={\"azimuth_deg\":12}|--set|layers.relight=\"vector\""
+    # LOD0's billboards around each eye (below, inside and above the layer), at the voxel spacing, and untiled with
+    # wider spacing, the wang opacity and the wind.
+    "Lod0|layers-small|--set|layers.lod0_radius=1500"
+    "Lod0SpacingUntiledWang|layers-small|--steps|2|--set|grid.tiling=false|--set|layers.lod0_radius=2500|--set|layers.billboard_spacing=230|--set|layers.wind=[170,-45]|--set|layers.wang={\"coverage\":0.8,\"density\":2.5}")
 foreach(entry ${layers_cases})
   string(REPLACE "|" ";" fields "${entry}")
   list(POP_FRONT fields name scene)

@@ -1,9 +1,11 @@
 // The layered renderer's algorithm (SPEC 15; Wang, Ji and Zhang, sections 4 and 5):
 // N horizontal layers around the eye, each fragment the crossing of a pixel's
-// ray with one layer plane, composited back to front. One per-fragment
-// function, LayerFragment, which the CPU and Vulkan run in a per-pixel loop
-// (LayersPixel) and OpenGL's fragment shader runs once per rasterised layer,
-// and its GLSL twin core/math/layers.glsl. Decisions where SPEC is silent:
+// ray with one layer plane, composited back to front, and within LOD0's radius
+// camera-facing billboards (eq. 13). One per-fragment function for each,
+// LayerFragment and BillboardFragment (sharing LayersSampleAt), which the CPU
+// and Vulkan run in a per-pixel loop (LayersPixel) and OpenGL's fragment shader
+// runs once per rasterised layer or billboard, and its GLSL twin
+// core/math/layers.glsl. Decisions where SPEC is silent:
 // docs/pipeline.md, "Layered renderer".
 //
 // Voxel units throughout, as in core/math/March.h: a point p has world
@@ -13,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "core/math/March.h"
 
@@ -41,6 +44,14 @@ struct LayersSetup {
     Vec3 sun{0, 0, 1};     // unit, toward the sun
     float lightScale = 1;  // T's factor: 1, or with relighting max(0, s0 . s) (SPEC 15)
     Vec3 background{0, 0, 0};
+    // The billboards near the eye (LOD0, SPEC 15; SetLayersLod0): present when inner2 > 0. inner2 is r0^2, the
+    // radius of LOD0 squared (voxel edges^2): the layers' annulus starts there, and a billboard's fragment lies
+    // within it. A billboard is halfWidth x halfHeight either side of its centre in the camera's image plane, and
+    // its fragment stands for billboardLength / cos(ray, forward) of path (beer). docs/pipeline.md, "Layered
+    // renderer".
+    float inner2 = 0;
+    float billboardSpacing = 1;  // p_s, voxel edges: the grid's spacing
+    float halfWidth = 0.5f, halfHeight = 0.5f, billboardLength = 1;
     // The light terms (core/math/Light.h; made by MakeLightTerms): the sun and the ambient light; the point
     // light stays off (no transmittance toward it here).
     LightTerms light;
@@ -117,38 +128,31 @@ inline float LayersFade(float r2, float outer2, float fadeInv2) {
 struct LayersRay {
     Vec3 dir{};
     float tNear = 0, tFar = 0;
+    float cosForward = 1;  // dir . forward: a point at view depth D lies at t = D / cosForward
 };
 inline LayersRay MakeLayersRay(const CameraFrame& c, float voxelSize, uint32_t x, uint32_t y) {
     const PixelDirection p = PixelRayDirection(c, x, y);
     const float perDepth = 1.0f / (voxelSize * p.cosForward);
-    return {p.dir, c.nearPlane * perDepth, c.farPlane * perDepth};
+    return {p.dir, c.nearPlane * perDepth, c.farPlane * perDepth, p.cosForward};
 }
 
-// Layer i's fragment on a ray: drawn iff the ray crosses the plane at a
-// distance t between the near and far planes, within the extent horizontally
-// and (without tiling) inside the box, where q > 0. Its opacity is beer's,
-// alpha = 1 - exp(-sigma h q l), l = min(spacing / |d_z|, l_max), or wang's
-// (eq. 16 of q and the map, without a path length), times LayersFade; its colour
-// c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
+// The fragment result of a layer or a billboard.
 struct LayerFragmentResult {
     bool crossed = false;  // the plane is met in range (a counted fragment)
     bool drawn = false;    // and q > 0 there
     float alpha = 0;
     Vec3 color{};
 };
+
+// A fragment's sample, shared by a layer's and a billboard's: the point (eye x + hx, eye y + hy, z) (voxel units)
+// at squared horizontal distance r2 from the eye, standing for `length` of path. Moved by the drift and wrapped
+// (tiling), or outside the box [0, nx] x [0, ny] not a fragment; drawn where q > 0. Its opacity is beer's,
+// alpha = 1 - exp(-sigma h q length), or wang's (eq. 16 of q and the map, without a path length), times
+// LayersFade(r2); its colour c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
 template <class Fetch>
-inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& ray, float sunPhase, uint32_t i,
-                                         Fetch&& fetch) {
+inline LayerFragmentResult LayersSampleAt(const LayersSetup& s, const LayersRay& ray, float sunPhase, float hx,
+                                          float hy, float z, float r2, float length, Fetch&& fetch) {
     LayerFragmentResult f;
-    const float dz = ray.dir[2];
-    if (!(std::fabs(dz) >= 1e-20f)) return f;
-    const float z = LayerHeight(s, i);
-    const float invDz = 1.0f / dz;
-    const float t = (z - s.eye[2]) * invDz;
-    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
-    const float hx = ray.dir[0] * t, hy = ray.dir[1] * t;
-    const float r2 = hx * hx + hy * hy;
-    if (!(r2 <= s.outer2)) return f;
     float x = (s.eye[0] + hx) - s.drift[0], y = (s.eye[1] + hy) - s.drift[1];
     if (s.tiling) {
         x = TileWrap(x, s.size[0], s.invSize[0]);
@@ -163,16 +167,140 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     if (s.wang) {
         f.alpha = CoverageModulate(qt[0], LayersMapAt(s, x, y), s.coverage, s.density);
     } else {
-        const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
         f.alpha = 1.0f - SegmentTransmittance(s.sigmaH, qt[0], length);
     }
     f.alpha = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     const float lit = qt[1] * s.lightScale;  // T, or relit
     const float gain = lit * sunPhase;
-    // The sample at the crossing (voxel units, before the drift and the wrap).
+    // The sample (voxel units, before the drift and the wrap).
     const Vec3 at{s.eye[0] + hx, s.eye[1] + hy, z};
     f.color = InScattered(s.light, LightSample{gain, lit, 1.0f, at, ray.dir});
     return f;
+}
+
+// Layer i's fragment on a ray: drawn iff the ray crosses the plane at a
+// distance t between the near and far planes, within the annulus horizontally
+// (r0 <= r <= extent) and (without tiling) inside the box, where q > 0
+// (LayersSampleAt, with l = min(spacing / |d_z|, l_max)).
+template <class Fetch>
+inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& ray, float sunPhase, uint32_t i,
+                                         Fetch&& fetch) {
+    LayerFragmentResult f;
+    const float dz = ray.dir[2];
+    if (!(std::fabs(dz) >= 1e-20f)) return f;
+    const float z = LayerHeight(s, i);
+    const float invDz = 1.0f / dz;
+    const float t = (z - s.eye[2]) * invDz;
+    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
+    const float hx = ray.dir[0] * t, hy = ray.dir[1] * t;
+    const float r2 = hx * hx + hy * hy;
+    if (!(r2 <= s.outer2 && r2 >= s.inner2)) return f;
+    const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
+    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length, fetch);
+}
+
+// ---- Billboards (LOD0) ----
+
+// One billboard: its centre (voxel units, on a layer's plane) and its view depth (centre - eye) . forward, > 0.
+struct LayersBillboard {
+    Vec3 centre{};
+    float depth = 0;
+};
+
+// A call's billboards in drawing order, with the camera's right and up (the billboards' plane).
+struct LayersBillboards {
+    const LayersBillboard* items = nullptr;
+    uint32_t count = 0;
+    Vec3 right{1, 0, 0}, up{0, 0, 1};
+};
+
+// LOD0's constants from its radius r0 and the grid's spacing p_s (both voxel edges; r0 0: no billboards), with
+// Wang, Ji and Zhang's eq. 13 as docs/pipeline.md reads it: W_p = p_s, H_p = max(dz, p_s) with dz the layers'
+// spacing (eq. 12's Thickness / (N - 1)), and a fragment's path min(p_s, dz) / cos(ray, forward).
+inline void SetLayersLod0(LayersSetup& s, double radius, double spacing) {
+    s.inner2 = float(radius * radius);
+    s.billboardSpacing = float(spacing);
+    s.halfWidth = float(0.5 * spacing);
+    s.halfHeight = float(0.5 * std::max(double(s.spacing), spacing));
+    s.billboardLength = float(std::min(double(s.spacing), spacing));
+}
+
+// A billboard's fragment on a ray: the ray meets the billboard's plane (perpendicular to forward, through its
+// centre) at t = depth / cosForward, drawn iff t lies between the near and far planes, the point lies within
+// halfWidth along right and halfHeight along up of the centre, strictly within r0 of the eye horizontally
+// (r^2 < inner2) and within the grid's height [0, nz]; then as a layer's (LayersSampleAt, with
+// l = min(billboardLength / cosForward, l_max)).
+template <class Fetch>
+inline LayerFragmentResult BillboardFragment(const LayersSetup& s, const LayersBillboards& b, const LayersRay& ray,
+                                             float sunPhase, const LayersBillboard& bb, Fetch&& fetch) {
+    LayerFragmentResult f;
+    const float t = bb.depth / ray.cosForward;
+    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
+    const float hx = ray.dir[0] * t, hy = ray.dir[1] * t, hz = ray.dir[2] * t;
+    const float r2 = hx * hx + hy * hy;
+    if (!(r2 < s.inner2 && r2 <= s.outer2)) return f;
+    const float ox = (s.eye[0] + hx) - bb.centre[0], oy = (s.eye[1] + hy) - bb.centre[1];
+    const float z = s.eye[2] + hz;
+    const float oz = z - bb.centre[2];
+    const float u = ox * b.right[0] + oy * b.right[1] + oz * b.right[2];
+    const float v = ox * b.up[0] + oy * b.up[1] + oz * b.up[2];
+    if (!(std::fabs(u) <= s.halfWidth && std::fabs(v) <= s.halfHeight)) return f;
+    if (!(z >= 0.0f && z <= s.size[2])) return f;
+    const float length = std::min(s.billboardLength / ray.cosForward, s.maxLength);
+    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length, fetch);
+}
+
+// The pixels a billboard's fragments can cover, conservatively: its quad projected (a rectangle, the quad being
+// parallel to the image plane) in pixel coordinates, x from the left and y (rows) from the top, [x0, x1] x [y0, y1],
+// grown by two pixels and by 1e-5 of the coordinates' magnitude (voxel edges) for the float rounding of
+// BillboardFragment's test; worked in double. OpenGL's vertex shader draws the same rectangle; the CPU culls a
+// tile's billboards with it.
+struct LayersPixelRect {
+    double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+inline LayersPixelRect LayersBillboardRect(const LayersSetup& s, const CameraFrame& c, const LayersBillboard& b) {
+    const double depth = b.depth, focal = c.focalPx;
+    double x = 0, y = 0, scale = 1;
+    for (int a = 0; a < 3; ++a) {
+        const double rel = double(b.centre[a]) - double(s.eye[a]);
+        x += rel * c.right[a];
+        y += rel * c.upVector[a];
+        scale = std::max({scale, std::fabs(double(b.centre[a])), std::fabs(double(s.eye[a]))});
+    }
+    const double margin = 2.0 * depth / focal + 1e-5 * scale;
+    const double hw = s.halfWidth + margin, hh = s.halfHeight + margin;
+    return {0.5 * c.width + focal * (x - hw) / depth, 0.5 * c.width + focal * (x + hw) / depth,
+            0.5 * c.height - focal * (y + hh) / depth, 0.5 * c.height - focal * (y - hh) / depth};
+}
+
+// The grid points of LOD0 (SPEC 15): on every layer's plane, the centres ((a + 1/2) p_s, (b + 1/2) p_s, z_i)
+// (voxel units: the cells of side p_s from the grid's origin, a billboard at each cell's centre) whose horizontal
+// distance from the eye is at most r0 (worked in double), in front of the eye (depth > 0: one behind it has no
+// fragment); back to front: decreasing depth (the eye's distance to the billboard's plane, as the layers'
+// |z_i - z_eye|), ties in the order layer, b, a. Empty when r0 is 0.
+inline std::vector<LayersBillboard> MakeLayersBillboards(const LayersSetup& s, const Vec3& forward) {
+    std::vector<LayersBillboard> out;
+    if (!(s.inner2 > 0.0f)) return out;
+    const double ps = s.billboardSpacing, r0 = std::sqrt(double(s.inner2));
+    const double ex = s.eye[0], ey = s.eye[1];
+    const int64_t a0 = int64_t(std::floor((ex - r0) / ps - 0.5)), a1 = int64_t(std::ceil((ex + r0) / ps - 0.5));
+    const int64_t b0 = int64_t(std::floor((ey - r0) / ps - 0.5)), b1 = int64_t(std::ceil((ey + r0) / ps - 0.5));
+    for (uint32_t i = 0; i < s.count; ++i) {
+        const float z = LayerHeight(s, i);
+        for (int64_t b = b0; b <= b1; ++b)
+            for (int64_t a = a0; a <= a1; ++a) {
+                const float cx = float((double(a) + 0.5) * ps), cy = float((double(b) + 0.5) * ps);
+                const double dx = double(cx) - ex, dy = double(cy) - ey;
+                if (!(dx * dx + dy * dy <= double(s.inner2))) continue;
+                const float depth =
+                    (cx - s.eye[0]) * forward[0] + (cy - s.eye[1]) * forward[1] + (z - s.eye[2]) * forward[2];
+                if (!(depth > 0.0f)) continue;
+                out.push_back({{cx, cy, z}, depth});
+            }
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const LayersBillboard& x, const LayersBillboard& y) { return x.depth > y.depth; });
+    return out;
 }
 
 // C <- alpha c + (1 - alpha) C, per channel: the blend every backend uses
@@ -219,10 +347,11 @@ struct LayersPixelResult {
 };
 
 // One pixel: the background, then every layer the ray crosses, back to front
-// (walks: MakeLayersWalks(s)).
+// (walks: MakeLayersWalks(s)), then the billboards in their order: every billboard fragment lies within r0 of the
+// eye horizontally and every layer fragment at r0 or beyond, so on one ray all the billboards' are nearer.
 template <class Fetch>
 inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersWalks& walks, const LayersRay& ray,
-                                     Fetch&& fetch) {
+                                     Fetch&& fetch, const LayersBillboards& billboards = {}) {
     LayersPixelResult r;
     r.color = s.background;
     const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
@@ -231,6 +360,13 @@ inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersWalks& wa
     for (uint32_t n = 0; n < w.count; ++n) {
         const uint32_t i = uint32_t(w.first + w.step * int(n));
         const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i, fetch);
+        r.fragments += f.crossed ? 1u : 0u;
+        if (!f.drawn) continue;
+        ++r.drawn;
+        r.color = LayersOver(r.color, f.alpha, f.color);
+    }
+    for (uint32_t n = 0; n < billboards.count; ++n) {
+        const LayerFragmentResult f = BillboardFragment(s, billboards, ray, sunPhase, billboards.items[n], fetch);
         r.fragments += f.crossed ? 1u : 0u;
         if (!f.drawn) continue;
         ++r.drawn;

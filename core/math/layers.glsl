@@ -1,6 +1,6 @@
 // GLSL twin of core/math/Layers.h (SPEC 15): a pixel's ray, the padded (q, T)
-// taps with the tiling's wrap, one layer's fragment, the back-to-front walk and
-// the per-pixel loop. The same operations in the same order, `precise` where
+// taps with the tiling's wrap, one layer's or billboard's fragment, the
+// back-to-front walk and the per-pixel loop. The same operations in the same order, `precise` where
 // the CPU (built with -ffp-contract=off) rounds each product.
 //
 // Include after random.glsl, shading.glsl, phase_table.glsl, light.glsl and march.glsl,
@@ -9,6 +9,7 @@
 // layers' padded (q_alpha, T) volume, (nx+2) x (ny+2) x (nz+2) with voxel
 // (i, j, k) at (i+1, j+1, k+1), PhaseTableValue (phase Mie only) and
 //   float LayersMapValue(uint i);  // the modulation map, nx * ny, x fastest (wang opacity only)
+//   LayersBillboard LayersBillboardAt(uint i);  // the billboards in drawing order (billboardCount of them)
 #ifndef CLOUDBENCH_LAYERS_GLSL
 #define CLOUDBENCH_LAYERS_GLSL
 
@@ -41,6 +42,11 @@ struct LayersGpu {
     vec2 drift;  // the wind's drift (voxel units)
     float coverage;  // C (wang)
     float density;   // D_w (wang)
+    float inner2;    // r0^2: LOD0's radius squared (0: no billboards)
+    float halfWidth;   // W_p / 2 (billboards)
+    float halfHeight;  // H_p / 2
+    float billboardLength;  // a billboard fragment's path times cos(ray, forward) (beer)
+    uint billboardCount;
     LightGpu light;  // light.glsl
 };
 
@@ -48,6 +54,13 @@ const uint kLayersTiling = 1u;
 const uint kLayersWang = 2u;
 
 float LayersMapValue(uint i);
+
+// core/math/Layers.h LayersBillboard: its centre (voxel units) and view depth.
+struct LayersBillboard {
+    vec3 centre;
+    float depth;
+};
+LayersBillboard LayersBillboardAt(uint i);
 
 float LayerHeight(LayersGpu s, uint i) {
     precise float z = (float(i) + 0.5) * s.spacing;
@@ -66,6 +79,7 @@ float LayersFade(float r2, float outer2, float fadeInv2) {
 struct LayersRay {
     vec3 dir;
     float tNear, tFar;
+    float cosForward;
 };
 
 // core/math/Layers.h MakeLayersRay (PixelRayDirection, then the planes' distances).
@@ -76,6 +90,7 @@ LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
     precise float perDepth = 1.0 / (s.voxelSize * inv);
     r.tNear = s.nearPlane * perDepth;
     r.tFar = s.farPlane * perDepth;
+    r.cosForward = inv;
     return r;
 }
 
@@ -110,18 +125,10 @@ struct LayerFragmentResult {
     vec3 color;
 };
 
-// core/math/Layers.h LayerFragment.
-LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, uint i) {
+// core/math/Layers.h LayersSampleAt.
+LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, float sunPhase, float hx, float hy, float z, float r2,
+                                   float length) {
     LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
-    const float dz = ray.dir.z;
-    if (!(abs(dz) >= 1e-20)) return f;
-    const float z = LayerHeight(s, i);
-    precise float invDz = 1.0 / dz;
-    precise float t = (z - s.eye.z) * invDz;
-    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0)) return f;
-    precise float hx = ray.dir.x * t, hy = ray.dir.y * t;
-    precise float r2 = hx * hx + hy * hy;
-    if (!(r2 <= s.outer2)) return f;
     precise float x = (s.eye.x + hx) - s.drift.x, y = (s.eye.y + hy) - s.drift.y;
     if ((s.flags & kLayersTiling) != 0u) {
         x = TileWrap(x, s.size.x, s.invSize.x);
@@ -136,7 +143,6 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     if ((s.flags & kLayersWang) != 0u) {
         f.alpha = CoverageModulate(qt.x, LayersMapAt(s, x, y), s.coverage, s.density);
     } else {
-        precise float length = min(s.spacing * abs(invDz), s.maxLength);
         precise float alpha = 1.0 - SegmentTransmittance(s.sigmaH, qt.x, length);
         f.alpha = alpha;
     }
@@ -144,10 +150,45 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     f.alpha = faded;
     precise float lit = qt.y * s.lightScale;  // T, or relit
     precise float gain = lit * sunPhase;
-    // The sample at the crossing (voxel units, before the drift and the wrap).
+    // The sample (voxel units, before the drift and the wrap).
     precise vec3 at = vec3(s.eye.x + hx, s.eye.y + hy, z);
     f.color = InScattered(s.light, LightSample(gain, lit, 1.0, at, ray.dir));
     return f;
+}
+
+// core/math/Layers.h LayerFragment.
+LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, uint i) {
+    LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
+    const float dz = ray.dir.z;
+    if (!(abs(dz) >= 1e-20)) return f;
+    const float z = LayerHeight(s, i);
+    precise float invDz = 1.0 / dz;
+    precise float t = (z - s.eye.z) * invDz;
+    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0)) return f;
+    precise float hx = ray.dir.x * t, hy = ray.dir.y * t;
+    precise float r2 = hx * hx + hy * hy;
+    if (!(r2 <= s.outer2 && r2 >= s.inner2)) return f;
+    precise float length = min(s.spacing * abs(invDz), s.maxLength);
+    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length);
+}
+
+// core/math/Layers.h BillboardFragment (the billboards' plane: s.right, s.up).
+LayerFragmentResult BillboardFragment(LayersGpu s, LayersRay ray, float sunPhase, LayersBillboard bb) {
+    LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
+    precise float t = bb.depth / ray.cosForward;
+    if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0)) return f;
+    precise float hx = ray.dir.x * t, hy = ray.dir.y * t, hz = ray.dir.z * t;
+    precise float r2 = hx * hx + hy * hy;
+    if (!(r2 < s.inner2 && r2 <= s.outer2)) return f;
+    precise float ox = (s.eye.x + hx) - bb.centre.x, oy = (s.eye.y + hy) - bb.centre.y;
+    precise float z = s.eye.z + hz;
+    precise float oz = z - bb.centre.z;
+    precise float u = ox * s.right.x + oy * s.right.y + oz * s.right.z;
+    precise float v = ox * s.up.x + oy * s.up.y + oz * s.up.z;
+    if (!(abs(u) <= s.halfWidth && abs(v) <= s.halfHeight)) return f;
+    if (!(z >= 0.0 && z <= s.size.z)) return f;
+    precise float length = min(s.billboardLength / ray.cosForward, s.maxLength);
+    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length);
 }
 
 vec3 LayersOver(vec3 C, float alpha, vec3 c) {
@@ -181,7 +222,7 @@ struct LayersPixelResult {
     uint fragments, drawn;
 };
 
-// core/math/Layers.h LayersPixel: the background, then the layers the ray crosses, back to front.
+// core/math/Layers.h LayersPixel: the background, then the layers the ray crosses, back to front, then the billboards.
 LayersPixelResult LayersPixel(LayersGpu s, uint x, uint y) {
     LayersPixelResult r = LayersPixelResult(s.background, 0u, 0u);
     const LayersRay ray = MakeLayersRay(s, x, y);
@@ -190,6 +231,13 @@ LayersPixelResult LayersPixel(LayersGpu s, uint x, uint y) {
     for (uint n = 0u; n < w.count; ++n) {
         const uint i = uint(w.first + w.step * int(n));
         const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i);
+        r.fragments += f.crossed ? 1u : 0u;
+        if (!f.drawn) continue;
+        ++r.drawn;
+        r.color = LayersOver(r.color, f.alpha, f.color);
+    }
+    for (uint n = 0u; n < s.billboardCount; ++n) {
+        const LayerFragmentResult f = BillboardFragment(s, ray, sunPhase, LayersBillboardAt(n));
         r.fragments += f.crossed ? 1u : 0u;
         if (!f.drawn) continue;
         ++r.drawn;

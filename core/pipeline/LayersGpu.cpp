@@ -6,7 +6,7 @@
 
 namespace cb {
 
-LayersGpu MakeLayersGpu(const LayersParams& params) {
+LayersGpu MakeLayersGpu(const LayersParams& params, uint32_t billboardCount) {
     const CameraFrame& c = params.camera;
     const LayersSetup& s = params.setup;
     LayersGpu g{};
@@ -29,6 +29,11 @@ LayersGpu MakeLayersGpu(const LayersParams& params) {
     g.drift = s.drift;
     g.coverage = s.coverage;
     g.density = s.density;
+    g.inner2 = s.inner2;
+    g.halfWidth = s.halfWidth;
+    g.halfHeight = s.halfHeight;
+    g.billboardLength = s.billboardLength;
+    g.billboardCount = billboardCount;
     g.light = MakeLightGpu(s.light);
     return g;
 }

@@ -49,12 +49,19 @@ struct alignas(16) LayersGpu {
     std::array<float, 2> drift;  // the wind's drift (voxel units)
     float coverage;              // C (wang)
     float density;               // D_w (wang)
+    float inner2;                // r0^2 (voxel edges^2): LOD0's radius squared; 0: no billboards
+    float halfWidth;             // W_p / 2 (voxel edges)
+    float halfHeight;            // H_p / 2
+    float billboardLength;       // a billboard fragment's path times cos(ray, forward) (beer)
+    uint32_t billboardCount;     // the billboards' buffer (LayersBillboard, in drawing order)
     LightGpu light;              // the sun, the ambient light and the phase (core/math/Light.h)
 };
-static_assert(sizeof(LayersGpu) == 11 * 16 + sizeof(LightGpu), "LayersGpu is eleven 16-byte rows and its light");
+static_assert(sizeof(LayersGpu) == 13 * 16 + sizeof(LightGpu), "LayersGpu is thirteen 16-byte rows and its light");
 static_assert(offsetof(LayersGpu, light) % 16 == 0, "a nested struct starts a 16-byte row");
 
-LayersGpu MakeLayersGpu(const LayersParams& params);
+// billboardCount: the length of the call's billboard list (MakeLayersBillboards).
+LayersGpu MakeLayersGpu(const LayersParams& params, uint32_t billboardCount = 0);
+static_assert(sizeof(LayersBillboard) == 16, "a billboard is one vec4 in std430");
 
 // The layers in drawing order, back to front for every pixel: decreasing
 // |z_i - z_eye| (SPEC 15), ties by lower index. OpenGL's instance n draws layer order[n].

@@ -11,13 +11,20 @@
 // at gl_FragCoord (x + 0.5, y + 0.5) is the image's pixel (x, y), row 0 at the
 // top, as in render_march.frag). A fragment not drawn is discarded; a drawn one
 // blends (c, alpha) with SRC_ALPHA, ONE_MINUS_SRC_ALPHA over the layers behind.
+// Built with LAYERS_BILLBOARDS it draws LOD0's billboard layerIndex instead (BillboardFragment).
 layout(std140, binding = 0) uniform LayersBlock { LayersGpu layers; };
 layout(std430, binding = 2) readonly buffer LayersVolume { vec2 layersQT[]; };
 layout(std430, binding = 3) readonly buffer LayersPhaseTable { float layersPhaseTable[]; };
 // fragments, drawn: 64-bit sums as (low, high) word pairs.
 layout(std430, binding = 4) buffer LayersCounters { uint layersCounters[]; };
 layout(std430, binding = 5) readonly buffer LayersMap { float layersMap[]; };  // read with wang opacity only
-flat in uint layerIndex;
+#ifdef LAYERS_BILLBOARDS
+layout(std430, binding = 6) readonly buffer LayersBillboards { LayersBillboard layersBillboards[]; };
+LayersBillboard LayersBillboardAt(uint i) { return layersBillboards[i]; }
+#else
+LayersBillboard LayersBillboardAt(uint i) { return LayersBillboard(vec3(0.0), 0.0); }
+#endif
+flat in uint layerIndex;  // with LAYERS_BILLBOARDS, the billboard's index
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return layersQT[paddedIndex]; }
@@ -34,7 +41,11 @@ void main() {
     const uint x = uint(gl_FragCoord.x), y = uint(gl_FragCoord.y);
     const LayersRay ray = MakeLayersRay(layers, x, y);
     const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, ray.dir));
+#ifdef LAYERS_BILLBOARDS
+    const LayerFragmentResult f = BillboardFragment(layers, ray, sunPhase, LayersBillboardAt(layerIndex));
+#else
     const LayerFragmentResult f = LayerFragment(layers, ray, sunPhase, layerIndex);
+#endif
     if (f.crossed) LayersCount(0u);
     if (!f.drawn) discard;
     LayersCount(1u);

@@ -28,6 +28,7 @@ layout(std430, binding = 2) readonly buffer Frame { SplatFrame frame; };
 layout(std430, binding = 3) readonly buffer March { MarchGpu march; };
 layout(std430, binding = 4) readonly buffer MieTable { float mieTable[]; };  // kMieCloudTable
 layout(std430, binding = 5) readonly buffer Layers { LayersGpu layers; };
+layout(std430, binding = 6) readonly buffer Billboards { LayersBillboard twinBillboards[]; };  // LOD0's list
 layout(push_constant) uniform Params { uint fn, count; } pc;
 
 // march.glsl's volume: a hash of the padded index (tests/GlslTwinTest.cpp TwinPaddedQT);
@@ -42,6 +43,8 @@ float GroundFetchG(uint i, uint j) { return float(LowBias32(i + 4096u * j) >> 8u
 float PhaseTableValue(uint i) { return mieTable[i]; }
 // layers.glsl's modulation map: a hash of the column index (tests/GlslTwinHarness.h TwinLayersMap).
 float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1.0 / 16777216.0); }
+// layers.glsl's billboards: the bound list (GlslTwin::Run's `billboards`).
+LayersBillboard LayersBillboardAt(uint i) { return twinBillboards[i]; }
 
 LightGpu ZeroLight() {
     return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, vec3(0.0), 0u, 0.0,
@@ -320,6 +323,19 @@ void main() {
         case kTwinLayersFade:
             PutF(0u, LayersFade(F(0u), F(1u), F(2u)));
             break;
+        case kTwinBillboardFragment: {
+            const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
+            const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, r.dir));
+            const LayerFragmentResult f = BillboardFragment(layers, r, sunPhase, LayersBillboardAt(U(2u)));
+            PutU(0u, f.crossed ? 1u : 0u);
+            PutU(1u, f.drawn ? 1u : 0u);
+            PutF(2u, f.alpha);
+            PutF(3u, f.color.x);
+            PutF(4u, f.color.y);
+            PutF(5u, f.color.z);
+            PutF(6u, r.cosForward);
+            break;
+        }
         // With the bound MarchGpu's light (tests/GlslTwinTest.cpp InScatteredMatchesTheCpp).
         case kTwinInScattered: {
             const LightSample s = LightSample(F(0u), F(1u), F(2u), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)));

@@ -17,8 +17,9 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLayersKeys[] = {"count", "extent",  "fade",     "max_length", "wind",
-                                            "wang",  "relight", "exposure", "tone_map"};
+constexpr std::string_view kLayersKeys[] = {"count",   "extent",  "fade",        "max_length", "wind",
+                                            "wang",    "relight", "lod0_radius", "exposure",   "billboard_spacing",
+                                            "tone_map"};
 constexpr std::array<NamedValue<LayersRelight>, 2> kLayersRelightNames{{
     {"shade", LayersRelight::Shade},
     {"vector", LayersRelight::Vector},
@@ -54,12 +55,44 @@ void ReadLayers(const Json& root, Validator& check, std::optional<uint32_t> nz, 
     if (const Json* v = find("relight")) {
         if (auto kind = check.Choice(*v, "layers.relight", kLayersRelightNames)) layers.relight = *kind;
     }
+    if (const Json* v = find("lod0_radius")) {
+        if (auto d = check.Number(*v, "layers.lod0_radius", kSingleNonNegative)) layers.lod0Radius = *d;
+    }
+    if (const Json* v = find("billboard_spacing")) {
+        if (auto d = check.Number(*v, "layers.billboard_spacing", kSinglePositive)) layers.billboardSpacing = *d;
+    }
     if (const Json* v = find("exposure")) {
         if (auto d = check.Number(*v, "layers.exposure", kSinglePositive)) layers.exposure = *d;
     }
     if (const Json* v = find("tone_map")) {
         if (auto b = check.Boolean(*v, "layers.tone_map")) layers.toneMap = *b;
     }
+}
+
+void CheckLayersLod0(const Scene& sc, const Extent3* grid, Validator& check) {
+    const double r0 = sc.layers.lod0Radius;
+    if (!(r0 > 0)) return;
+    // LOD0 lies inside the layers' extent: beyond it the annulus would be empty and the billboards reach past it.
+    if (sc.layers.extent > 0) {
+        if (r0 > sc.layers.extent)
+            check.Fail("layers.lod0_radius", "must not exceed layers.extent (" + FormatNumber(sc.layers.extent) +
+                                                 "), got " + FormatNumber(r0));
+    } else {
+        for (const CameraSettings& camera : sc.render.cameras)
+            if (r0 > camera.farPlane) {
+                check.Fail("layers.lod0_radius", "must not exceed the layers' extent, camera \"" + camera.name +
+                                                     "\"'s far plane (" + FormatNumber(camera.farPlane) + "), got " +
+                                                     FormatNumber(r0));
+                break;
+            }
+    }
+    if (!grid) return;
+    const double bound = LayersBillboardBound(sc.layers, sc.grid.voxelSize, sc.grid.size.nz);
+    if (bound > kMaxLayersBillboards)
+        check.Fail("layers.lod0_radius", "LOD0 would hold up to " + FormatNumber(std::floor(bound)) +
+                                             " billboards ((2 r0 / p_s + 2)^2 on each layer), more than " +
+                                             FormatNumber(kMaxLayersBillboards) +
+                                             "; lower it or raise layers.billboard_spacing, got " + FormatNumber(r0));
 }
 
 }  // namespace cb::scene_io
@@ -112,9 +145,14 @@ LayersParams MakeLayersParams(const Scene& sc, const CameraSettings& camera, uin
     s.light = MakeLightTerms(sc, step);
     s.light.pointOn = false;  // no transmittance toward the point light in the layers: it stays off
     s.wang = sc.layers.wang.enabled;
+    SetLayersLod0(s, sc.layers.lod0Radius / sc.grid.voxelSize, LayersBillboardSpacing(sc) / sc.grid.voxelSize);
     s.coverage = float(sc.layers.wang.coverage);
     s.density = float(sc.layers.wang.density);
     return p;
+}
+
+double LayersBillboardSpacing(const Scene& sc) {
+    return sc.layers.billboardSpacing > 0 ? sc.layers.billboardSpacing : sc.grid.voxelSize;
 }
 
 std::vector<float> MakeLayersMap(const Scene& sc, uint32_t step) {
@@ -222,6 +260,7 @@ const StageDescriptor& DescribeRenderLayers() {
         .readSettings =
             [](const scene_io::Json& root, scene_io::Validator& check, const Extent3* grid, Scene& scene) {
                 scene_io::ReadLayers(root, check, grid ? std::optional(grid->nz) : std::nullopt, scene.layers);
+                scene_io::CheckLayersLod0(scene, grid, check);
             },
         .reads = {Resource::Q, Resource::T},
         .readsPrevious = LayersPrevious,

@@ -34,9 +34,24 @@ struct LayersSettings {
     // modulation map m of the noise stage's weather-map form (frequency, octaves, gain); else beer's.
     NoiseCoverage wang;
     LayersRelight relight = LayersRelight::Shade;
+    // The billboards near the eye (LOD0): r0, metres (0: none; the layers' annulus starts there), and the spacing
+    // p_s of their square grid, metres (0: the grid's voxel size).
+    double lod0Radius = 0;
+    double billboardSpacing = 0;
     double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
     bool toneMap = true;    // PNG only; false: clamp(exposure C)
 };
+
+// An upper bound on one call's billboards: (2 r0 / p_s + 2)^2 grid points on each of the N layers (nz: the grid's,
+// N's default), p_s the spacing or the voxel size h; 0 without LOD0.
+inline double LayersBillboardBound(const LayersSettings& layers, double voxelSize, uint32_t nz) {
+    if (!(layers.lod0Radius > 0)) return 0;
+    const double side = 2 * layers.lod0Radius / (layers.billboardSpacing > 0 ? layers.billboardSpacing : voxelSize) + 2;
+    return side * side * double(layers.count > 0 ? layers.count : nz);
+}
+// The most billboards a scene may ask for (LayersBillboardBound): each is 16 bytes, and every pixel of the CPU and
+// Vulkan tests each one.
+inline constexpr double kMaxLayersBillboards = double(1u << 20);
 
 // Inputs of the layered renderer besides its buffers: the kernel's constants
 // (core/math/Layers.h, voxel units) and what the backend needs to feed it.
