@@ -149,9 +149,12 @@ struct LayerFragmentResult {
 // (tiling), or outside the box [0, nx] x [0, ny] not a fragment; drawn where q > 0. Its opacity is beer's,
 // alpha = 1 - exp(-sigma h q length), or wang's (eq. 16 of q and the map, without a path length), times
 // LayersFade(r2); its colour c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
+// Always inlined: with two callers GCC keeps it out of line, and the call costs the CPU's layers a quarter of
+// their time on wang-20km (reports/perf/lod0-layers-cost.md).
 template <class Fetch>
-inline LayerFragmentResult LayersSampleAt(const LayersSetup& s, const LayersRay& ray, float sunPhase, float hx,
-                                          float hy, float z, float r2, float length, Fetch&& fetch) {
+[[gnu::always_inline]] inline LayerFragmentResult LayersSampleAt(const LayersSetup& s, const LayersRay& ray,
+                                                                 float sunPhase, float hx, float hy, float z, float r2,
+                                                                 float length, Fetch&& fetch) {
     LayerFragmentResult f;
     float x = (s.eye[0] + hx) - s.drift[0], y = (s.eye[1] + hy) - s.drift[1];
     if (s.tiling) {
