@@ -369,6 +369,12 @@ TEST(LayersLod0, GridPointsWithinR0OfTheEye) {
     EXPECT_EQ(ahead.back().depth, 1.0f);
     SetLayersLod0(s, 0.0, 1.0);
     EXPECT_TRUE(MakeLayersBillboards(s, {0, 0, 1}).empty());  // r0 = 0: none
+    // An eye 1e20 cells from the origin (past 2^52, where no float tells the cells apart): none, and no overflow.
+    SetLayersLod0(s, 3.0, 1.0);
+    s.eye = {1e20f, 0.5f, -2.0f};
+    EXPECT_TRUE(MakeLayersBillboards(s, {0, 0, 1}).empty());
+    s.eye = {0.5f, 0.5f, -2.0f};
+    EXPECT_EQ(MakeLayersBillboards(s, {0, 0, 1}).size(), 3u * 29u);  // and back at the origin, all of them
 }
 
 // Test that LOD0 cuts the layers to an annulus: a layer fragment whose crossing lies within r0 of the eye

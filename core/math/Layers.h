@@ -286,8 +286,13 @@ inline std::vector<LayersBillboard> MakeLayersBillboards(const LayersSetup& s, c
     if (!(s.inner2 > 0.0f)) return out;
     const double ps = s.billboardSpacing, r0 = std::sqrt(double(s.inner2));
     const double ex = s.eye[0], ey = s.eye[1];
-    const int64_t a0 = int64_t(std::floor((ex - r0) / ps - 0.5)), a1 = int64_t(std::ceil((ex + r0) / ps - 0.5));
-    const int64_t b0 = int64_t(std::floor((ey - r0) / ps - 0.5)), b1 = int64_t(std::ceil((ey + r0) / ps - 0.5));
+    const double fa0 = std::floor((ex - r0) / ps - 0.5), fa1 = std::ceil((ex + r0) / ps - 0.5);
+    const double fb0 = std::floor((ey - r0) / ps - 0.5), fb1 = std::ceil((ey + r0) / ps - 0.5);
+    // Beyond 2^52 cells of the grid's origin (or not finite) no float tells the cells apart: no billboards.
+    constexpr double kMostCells = 4503599627370496.0;
+    for (double f : {fa0, fa1, fb0, fb1})
+        if (!(std::fabs(f) <= kMostCells)) return out;
+    const int64_t a0 = int64_t(fa0), a1 = int64_t(fa1), b0 = int64_t(fb0), b1 = int64_t(fb1);
     for (uint32_t i = 0; i < s.count; ++i) {
         const float z = LayerHeight(s, i);
         for (int64_t b = b0; b <= b1; ++b)
