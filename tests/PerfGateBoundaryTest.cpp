@@ -442,6 +442,23 @@ TEST(PerfGateBoundary, FloorOnTheStepsTestOnly) {
     EXPECT_EQ(tiny.mark, '+') << tiny.note;
 }
 
+// Test that a stage with no sample in either build (one that ran in warm-up steps only) has no row and is no failure
+// of HEAD's, while one that lost its samples in HEAD alone is.
+TEST(PerfGateBoundary, AStageTimedInNeitherBuildIsNoRow) {
+    GateRounds g;
+    g.Add("region", GateSame(10, 0.0));
+    g.base.runs["s"]["cpu"]["noise"].push_back({0, {}});
+    g.head.runs["s"]["cpu"]["noise"].push_back({0, {}});
+    CompareOutcome out = Compare(g.base, g.head, GateInterleaved(0.01));
+    EXPECT_EQ(std::count_if(out.rows.begin(), out.rows.end(), [](const Comparison& c) { return c.stage == "noise"; }),
+              0);
+    EXPECT_FALSE(out.headFailed);
+    g.base.runs["s"]["cpu"]["noise"][0].ms = {1.0};
+    out = Compare(g.base, g.head, GateInterleaved(0.01));
+    EXPECT_EQ(GateRow(out, "noise").mark, 'x');
+    EXPECT_TRUE(out.headFailed);
+}
+
 // Test the marks a time row can have and what the outcome counts: + (regression), - (improvement), ~, ? (unjudged,
 // counted apart), x (HEAD failed or lacks the stage: headFailed) and ! (new in HEAD).
 TEST(PerfGateBoundary, EveryMark) {

@@ -430,6 +430,9 @@ CompareOutcome Compare(const Side& base, const Side& head, const CompareSettings
         if (b) c.baseCount = Pooled(*b).size();
         if (h) c.headCount = Pooled(*h).size();
         const std::string headFailure = Failure(head, scene, backend);
+        // A stage timed in neither build (it ran in warm-up steps only, as a static volume formed once) is no
+        // comparison, and no failure of HEAD's.
+        if (!c.baseCount && !c.headCount && headFailure.empty()) continue;
         if (!headFailure.empty() || !c.headCount) {
             c.mark = 'x';
             c.note = headFailure.empty() ? "no samples in HEAD" : "HEAD: " + headFailure;
