@@ -26,8 +26,7 @@ namespace {
 struct MarchPaddedVolume {
     const MarchQT* v = nullptr;
     size_t px = 0, pxy = 0;  // padded row and slice strides
-    const MarchSetup* setup = nullptr;
-    Vec3 size{};
+    const MarchSetup* setup = nullptr;  // the box (size) and the tiling's wrap
 
     struct Taps {
         size_t base;
@@ -35,6 +34,7 @@ struct MarchPaddedVolume {
     };
     Taps TapsAt(const Vec3& point) const {
         const Vec3 p = MarchWrapped(*setup, point);
+        const Vec3& size = setup->size;
         const float cx = std::clamp(p[0], 0.0f, size[0]) + 0.5f;
         const float cy = std::clamp(p[1], 0.0f, size[1]) + 0.5f;
         const float cz = std::clamp(p[2], 0.0f, size[2]) + 0.5f;
@@ -194,7 +194,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
             local.emptyBricks = uint64_t(std::count(state.bricks.begin(), state.bricks.end(), uint8_t(1)));
         }
         // 3. The rays.
-        const MarchPaddedVolume volume{state.volume.data(), px, px * py, &params.setup, params.setup.size};
+        const MarchPaddedVolume volume{state.volume.data(), px, px * py, &params.setup};
         const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
         const MarchSetup& s = params.setup;
         const uint32_t nl = params.lightSteps;
