@@ -110,7 +110,7 @@ Words RandomVoxel(Pcg32& r) {
 
 void MakeSplatCpp(const SplatFrame& F, const Words& in, Words& out) {
     Splat s;
-    const bool made = MakeSplat(F, in[0], in[1], in[2], Float(in[3]), Float(in[4]), s);
+    const bool made = MakeSplat(F, in[0], in[1], in[2], Float(in[3]), Float(in[4]), 1.0f, s);
     out = W({uint32_t(made), Bits(s.px), Bits(s.py), Bits(s.size), Bits(s.alphaScale), Bits(s.colour[0]),
              Bits(s.colour[1]), Bits(s.colour[2]), uint32_t(s.x0), uint32_t(s.x1), uint32_t(s.y0), uint32_t(s.y1)});
 }

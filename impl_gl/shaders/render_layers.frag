@@ -28,6 +28,7 @@ flat in uint layerIndex;  // with LAYERS_BILLBOARDS, the billboard's index
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return layersQT[paddedIndex]; }
+float MarchFetchSkyT(uint paddedIndex) { return 1.0; }  // TODO(sky): T_sky's padded volume
 float PhaseTableValue(uint i) { return layersPhaseTable[i]; }
 float LayersMapValue(uint i) { return layersMap[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here

@@ -30,6 +30,7 @@ out float gl_ClipDistance[1];
 
 // march.glsl's fetches: the vertex stage reads no volume.
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(0.0, 1.0); }
+float MarchFetchSkyT(uint paddedIndex) { return 1.0; }  // TODO(sky): T_sky's padded volume
 bool MarchBrickEmpty(uint brick) { return false; }
 float PhaseTableValue(uint i) { return 1.0; }
 float LayersMapValue(uint i) { return 0.0; }

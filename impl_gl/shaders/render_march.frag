@@ -24,6 +24,7 @@ layout(binding = 3) uniform sampler2DArray groundShadow;
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return marchQT[paddedIndex]; }
+float MarchFetchSkyT(uint paddedIndex) { return 1.0; }  // TODO(sky): T_sky's padded volume
 bool MarchBrickEmpty(uint brick) { return marchBrickEmpty[brick] != 0u; }
 float PhaseTableValue(uint i) { return marchPhaseTable[i]; }
 float GroundFetchG(uint i, uint j) { return texelFetch(groundShadow, ivec3(i, j, 0), 0).r; }

@@ -50,7 +50,7 @@ void main() {
     }
     const float qa = SplatQ(texelFetch(qPrev, idx, 0).r, texelFetch(qCur, idx, 0).r, F.alpha);
     Splat s;
-    if (!MakeSplat(F, uvec3(idx), qa, texelFetch(transmittance, idx, 0).r, s)) {
+    if (!MakeSplat(F, uvec3(idx), qa, texelFetch(transmittance, idx, 0).r, 1.0, s)) {
         Reject();
         return;
     }

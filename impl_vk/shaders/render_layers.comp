@@ -25,6 +25,7 @@ layout(std430, binding = 5) readonly buffer Map { float layersMap[]; };  // read
 layout(std430, binding = 6) readonly buffer Billboards { LayersBillboard billboards[]; };  // LOD0, back to front
 
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
+float MarchFetchSkyT(uint paddedIndex) { return 1.0; }  // TODO(sky): T_sky's padded volume
 float PhaseTableValue(uint i) { return mieTable[i]; }
 float LayersMapValue(uint i) { return layersMap[i]; }
 LayersBillboard LayersBillboardAt(uint i) { return billboards[i]; }

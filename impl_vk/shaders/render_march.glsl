@@ -29,6 +29,7 @@ vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
 #else
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(volume[paddedIndex], 1.0); }
 #endif
+float MarchFetchSkyT(uint paddedIndex) { return 1.0; }  // TODO(sky): T_sky's padded volume
 bool MarchBrickEmpty(uint brick) { return brickEmpty[brick] != 0u; }
 float PhaseTableValue(uint i) { return mieTable[i]; }
 float GroundFetchG(uint i, uint j) { return groundG[i + ground.gridX * j]; }

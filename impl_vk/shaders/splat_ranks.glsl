@@ -48,7 +48,7 @@ bool MakePartsSplat(uvec4 outer, uvec4 mid, uvec4 inner, out Splat s) {
     idx[F.axes.x] = outer.x;
     idx[F.axes.y] = mid.x;
     idx[F.axes.z] = inner.x;
-    return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.alpha), transmittance[v], s);
+    return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.alpha), transmittance[v], 1.0, s);  // TODO(sky): T_sky
 }
 
 // The splat of the voxel at cursor c (RankCursor), whose box is visible.
