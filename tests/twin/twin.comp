@@ -267,6 +267,7 @@ void main() {
             PutF(6u, MarchSampleQ(march, p));
             PutF(7u, SunLightMarch(march, p));
             PutF(8u, PointLightMarch(march, p));
+            PutF(9u, PaddedBlendSky(march.strideY, march.strideZ, t));
             break;
         }
         // With the bound LayersGpu (tests/GlslTwinLayersTest.cpp).
@@ -346,6 +347,7 @@ void main() {
             PutF(0u, c.x);
             PutF(1u, c.y);
             PutF(2u, c.z);
+            PutF(3u, SkyPhase(march.light, s.dir));
             break;
         }
         case kTwinMakeSplat: {
