@@ -1,5 +1,6 @@
 // The padded (q_alpha, T) volume that render_march and render_layers read by
-// index (march.glsl's MarchFetchQT), and the Mie table both look up.
+// index (march.glsl's MarchFetchQT), the sky light's padded T_sky volume (MarchFetchSkyT), and the Mie table
+// both look up.
 #include <string>
 
 #include "core/math/Shading.h"
@@ -8,7 +9,9 @@
 namespace cb::gl {
 namespace {
 
-size_t PaddedVolumeBytes(const Extent3& e) { return size_t(e.nx + 2) * size_t(e.ny + 2) * size_t(e.nz + 2) * 8; }
+size_t PaddedCells(const Extent3& e) { return size_t(e.nx + 2) * size_t(e.ny + 2) * size_t(e.nz + 2); }
+size_t PaddedVolumeBytes(const Extent3& e) { return PaddedCells(e) * 8; }     // (q_alpha, T) pairs
+size_t PaddedSkyVolumeBytes(const Extent3& e) { return PaddedCells(e) * 4; }  // T_sky
 
 }  // namespace
 
@@ -45,6 +48,28 @@ Result<GLuint> BackendGL::FormPaddedVolume(TextureSlot& volume, BufferSlot& copy
     f.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
     f.PixelStorei(GL_PACK_ALIGNMENT, 1);
     f.GetTextureImage(texture, 0, GL_RG, GL_FLOAT, GLsizei(bytes), nullptr);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    return buffer;
+}
+
+Result<GLuint> BackendGL::FormPaddedSkyVolume(TextureSlot& volume, BufferSlot& copy, const Buffer& TSky, bool wrap) {
+    const Functions& f = mContext->F();
+    auto program = PassProgram("march_sky_volume");
+    if (!program) return std::unexpected(program.error());
+    const Extent3 e = TSky.Extent();
+    const GLsizei px = GLsizei(e.nx + 2), py = GLsizei(e.ny + 2), pz = GLsizei(e.nz + 2);
+    const GLuint texture = Scratch(volume, GL_TEXTURE_2D_ARRAY, GL_R32F, px, py, pz);
+    f.UseProgram(*program);
+    f.BindTextureUnit(0, Tex(TSky).Texture());
+    f.Uniform3i(f.GetUniformLocation(*program, "grid"), GLint(e.nx), GLint(e.ny), GLint(e.nz));
+    f.Uniform1i(f.GetUniformLocation(*program, "wrap"), wrap ? 1 : 0);
+    f.Viewport(0, 0, px, py);
+    CB_TRY(DrawLayers(*program, uint32_t(pz), {texture}));
+    const size_t bytes = PaddedSkyVolumeBytes(e);
+    const GLuint buffer = ScratchBuffer(copy, bytes);
+    f.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.GetTextureImage(texture, 0, GL_RED, GL_FLOAT, GLsizei(bytes), nullptr);
     f.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     return buffer;
 }

@@ -469,6 +469,10 @@ TEST_P(RenderMarchGpu, ScratchBytesByHand) {
         EXPECT_EQ(mBackend->ScratchBytes(scene), volume + 2 * (3 * 2 * 1) * 4 + image);
         scene.phase.kind = PhaseKind::Mie;
         EXPECT_EQ(mBackend->ScratchBytes(scene), volume + 2 * (3 * 2 * 1) * 4 + image + 1801 * 4);
+        // The sky light: T_sky's padded volume, R32F layers and their copy.
+        scene.lighting.sky.on = true;
+        EXPECT_EQ(mBackend->ScratchBytes(scene),
+                  volume + 2 * (12 * 8 * 6) * 4 + 2 * (3 * 2 * 1) * 4 + image + 1801 * 4);
     } else if (GetParam() == "vk") {
         scene.grid.size = {10, 12, 14};
         scene.march.brick = 4;
