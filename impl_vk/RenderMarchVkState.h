@@ -19,8 +19,9 @@ struct RenderMarchVkState {
     BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
     BufferSlot stats;     // the MarchStats counters, 64-bit as two words each
     BufferSlot ground;    // with the ground: the GroundGpu block (core/math/Ground.h)
+    BufferSlot skyVolume;  // with the sky light: T_sky's padded volume (SkyVolumeVk.h)
     // The constants, the padded volume, a word per brick with skipping, the
-    // Mie table with phase Mie, the counters.
+    // Mie table with phase Mie, the counters, T_sky's padded volume with the sky light.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 
