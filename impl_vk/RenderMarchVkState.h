@@ -13,7 +13,7 @@ uint64_t MarchVolumeBytes(const Extent3& e, bool withT);
 
 struct RenderMarchVkState {
     static constexpr Stage kStage = Stage::RenderMarch;
-    BufferSlot frame;     // the constants (core/pipeline/MarchGpu.h), 256 bytes
+    BufferSlot frame;     // the constants (core/pipeline/MarchGpu.h), sizeof(MarchGpu)
     BufferSlot volume;    // the padded volume, (q_alpha, T) pairs with light "shade", else q_alpha
     BufferSlot bricks;    // one word per brick, 1 iff empty (only with skipping)
     BufferSlot mieTable;  // kMieCloudTable's values (MiePhaseTable; only with phase Mie)
