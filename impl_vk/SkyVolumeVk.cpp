@@ -1,9 +1,8 @@
-// The sky light's T_sky for the vk renderers (SkyVolumeVk.h): its padded volume and the check of its input.
+// The sky light's T_sky for the vk renderers (SkyVolumeVk.h): its padded volume's bytes and dispatch, and the check
+// of its input. The pass is made by the façade (BackendVk::PrepareSkyVolume, BackendVk.cpp), whose scratch it uses.
 #include "impl_vk/SkyVolumeVk.h"
 
 #include <string>
-
-#include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 
@@ -18,19 +17,6 @@ Status CheckSkyInput(const Buffer* TSky, const Extent3& e, const char* stage) {
 void SkyVolumePass::Record(VulkanContext::Recorder& r) const {
     const uint32_t px = push.nx + 2, py = push.ny + 2, pz = push.nz + 2;
     r.DispatchGroups(*pipeline, buffers, &push, sizeof push, CeilDiv(px, 64u), py, pz);
-}
-
-Result<SkyVolumePass> BackendVk::PrepareSkyVolume(BufferSlot& slot, const Buffer& TSky, bool tiling) {
-    const Extent3 e = TSky.Extent();
-    SkyVolumePass pass;
-    auto pipeline = mContext->GetPipeline("sky_volume", 2);
-    if (!pipeline) return std::unexpected(pipeline.error());
-    auto volume = Scratch(slot, SkyVolumeBytes(e));
-    if (!volume) return std::unexpected(volume.error());
-    pass.pipeline = *pipeline;
-    pass.buffers = {&Dev(TSky), *volume};
-    pass.push = {e.nx, e.ny, e.nz, tiling ? 1u : 0u};
-    return pass;
 }
 
 }  // namespace cb::vk
