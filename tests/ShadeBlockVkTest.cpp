@@ -232,14 +232,18 @@ TEST_F(ShadeBlockVk, SkyShadeBetweenSharesLeavesTheSunsSweepAsItWas) {
                 ASSERT_TRUE(mBackend->Upload(*skyT, std::as_bytes(std::span(minusOne))));
                 const uint32_t nw = MakeShadePlan(sun, grid).nw, split = nw / 2;
                 ASSERT_GT(split, 0u);
-                if (batched) ASSERT_TRUE(mBackend->BeginBatch().has_value());
+                if (batched) {
+                    ASSERT_TRUE(mBackend->BeginBatch().has_value());
+                }
                 ShadeParams first = sun, second = sun;
                 first.slices = {0, split};
                 second.slices = {split, nw};
                 ASSERT_TRUE(mBackend->Shade(first, *q, *T).has_value());
                 ASSERT_TRUE(mBackend->ShadeSky(sky, *q, *skyT).has_value());
                 ASSERT_TRUE(mBackend->Shade(second, *q, *T).has_value());
-                if (batched) ASSERT_TRUE(mBackend->EndBatch().has_value());
+                if (batched) {
+                    ASSERT_TRUE(mBackend->EndBatch().has_value());
+                }
                 expectBytes(test::Read<float>(*mBackend, *T), wholeT, what + ": the sun's T");
                 expectBytes(test::Read<float>(*mBackend, *skyT), aloneSkyT, what + ": T_sky");
             }
