@@ -214,6 +214,11 @@ class BackendGL final : public Backend {
     // edge's voxels in x and y; copied into `copy`, which it returns, a storage buffer of floats in the padded
     // index order (march.glsl's MarchFetchSkyT).
     Result<GLuint> FormPaddedSkyVolume(TextureSlot& volume, BufferSlot& copy, const Buffer& TSky, bool wrap);
+    // What both passes share: `program` (in use, its inputs bound) draws the padded volume of grid e, its
+    // `grid` and `wrap` uniforms set here, into `volume`'s layers of `internalFormat`, copied as `format` floats
+    // per cell (cellBytes) into `copy`, which it returns.
+    Result<GLuint> DrawPaddedVolume(GLuint program, const Extent3& e, bool wrap, GLenum internalFormat, GLenum format,
+                                    size_t cellBytes, TextureSlot& volume, BufferSlot& copy);
     // Shade's sweep (ShadeGL.cpp) writing T from q, on `state`'s textures: shade's with the sun, shade_sky's
     // with the sky light; errors name `stage`.
     Status ShadeSweep(ShadeGLState& state, const char* stage, const ShadeParams& params, const Buffer& q, Buffer& T);

@@ -128,8 +128,8 @@ Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, con
                     l.sun = float(std::exp(-sigmaH * depth.Along(at, sun, std::numeric_limits<double>::infinity())));
                     ++nLight;
                     if (s.light.skyOn) {
-                        l.sky = float(
-                            std::exp(-sigmaH * depth.Along(at, sky, std::numeric_limits<double>::infinity())));
+                        l.sky =
+                            float(std::exp(-sigmaH * depth.Along(at, sky, std::numeric_limits<double>::infinity())));
                         ++nLight;
                     }
                     if (s.light.pointOn) {

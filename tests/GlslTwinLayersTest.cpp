@@ -162,9 +162,9 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         Compare("LayersPixel", pixelKinds, ulps, pixels, Run(test::kTwinLayersPixel, pixels, {}, {}, g, list),
                 [&](const Words& in, Words& out) {
                     const LayersRay ray = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
-                    const LayersPixelResult r =
-                        s.light.skyOn ? LayersPixel(s, MakeLayersWalks(s), ray, TwinFetchSky, billboards)
-                                      : LayersPixel(s, MakeLayersWalks(s), ray, TwinFetch, billboards);
+                    const LayersPixelResult r = s.light.skyOn
+                                                    ? LayersPixel(s, MakeLayersWalks(s), ray, TwinFetchSky, billboards)
+                                                    : LayersPixel(s, MakeLayersWalks(s), ray, TwinFetch, billboards);
                     out = W({Bits(r.color[0]), Bits(r.color[1]), Bits(r.color[2]), r.fragments, r.drawn});
                     fragments += r.fragments;
                 });

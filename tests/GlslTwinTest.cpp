@@ -285,8 +285,8 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
 
 // Test that light.glsl's InScattered, with the light MakeMarchGpu nests (MakeLightGpu), equals
 // core/math/Light.h's on random samples: every phase, the point light on and off, samples at
-// and near the point light (d = 0: cos 1; within r0: the capped falloff), the sky light (and SkyPhase), the city glow and eye
-// scattering on and off (a sample looking straight at the sun among them).
+// and near the point light (d = 0: cos 1; within r0: the capped falloff), the sky light (and SkyPhase), the city glow
+// and eye scattering on and off (a sample looking straight at the sun among them).
 TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
     Pcg32 rng(0x11947);
     const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};

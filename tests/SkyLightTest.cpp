@@ -49,9 +49,9 @@ TEST(SkyLight, SkyPhaseIsThePhaseAtTheAngleToTheSkyLight) {
     L.skyDirection = {0.6f, 0.0f, 0.8f};
     L.phase = {PhaseKind::HenyeyGreenstein, 0.5f};
     auto hg = [](double c) { return 0.75 / std::pow(1.25 - c, 1.5); };
-    EXPECT_NEAR(SkyPhase(L, {0.6f, 0.0f, 0.8f}), hg(1), 1e-5 * hg(1));   // 0.75 / 0.125 = 6
-    EXPECT_NEAR(SkyPhase(L, {0.0f, 1.0f, 0.0f}), hg(0), 1e-6);           // 0.75 / 1.25^1.5
-    EXPECT_NEAR(SkyPhase(L, {-0.6f, 0.0f, -0.8f}), hg(-1), 1e-6);        // 0.75 / 2.25^1.5 = 2/9
+    EXPECT_NEAR(SkyPhase(L, {0.6f, 0.0f, 0.8f}), hg(1), 1e-5 * hg(1));  // 0.75 / 0.125 = 6
+    EXPECT_NEAR(SkyPhase(L, {0.0f, 1.0f, 0.0f}), hg(0), 1e-6);          // 0.75 / 1.25^1.5
+    EXPECT_NEAR(SkyPhase(L, {-0.6f, 0.0f, -0.8f}), hg(-1), 1e-6);       // 0.75 / 2.25^1.5 = 2/9
     L.phase = {PhaseKind::None, 0};
     EXPECT_EQ(SkyPhase(L, {0.0f, 1.0f, 0.0f}), 1.0f);
     L.skyOn = false;
@@ -77,8 +77,7 @@ TEST(SkyLight, TermsFromTheScene) {
     sun.elevationDeg = 12;
     sun.azimuthDeg = 250;
     EXPECT_EQ(L.skyDirection, sun.Direction());
-    auto defaults =
-        LoadCiScene("layers-small", {sky[0], {"lighting.sky", "{}"}});
+    auto defaults = LoadCiScene("layers-small", {sky[0], {"lighting.sky", "{}"}});
     ASSERT_TRUE(defaults.has_value()) << defaults.error().message;
     EXPECT_EQ(defaults->lighting.sky.elevationDeg, 20);
     EXPECT_EQ(defaults->lighting.sky.azimuthDeg, 0);
@@ -151,10 +150,9 @@ std::optional<SceneRun> RunScene(const std::string& backendName, const std::stri
 // sun where the sky light stands, at every resolution; and it differs from the sun's own T.
 TEST(SkyLight, ShadeSkyIsShadeTowardTheSkyLight) {
     for (const char* resolution : {"1", "2"}) {
-        const std::vector<SceneOverride> withSky = {
-            {"stages", R"(["noise", "shade", "shade_sky"])"},
-            {"shade.resolution", resolution},
-            {"lighting.sky", R"({"elevation_deg": 15, "azimuth_deg": 200})"}};
+        const std::vector<SceneOverride> withSky = {{"stages", R"(["noise", "shade", "shade_sky"])"},
+                                                    {"shade.resolution", resolution},
+                                                    {"lighting.sky", R"({"elevation_deg": 15, "azimuth_deg": 200})"}};
         auto lit = RunScene("cpu", "layers-small", withSky);
         auto moved = RunScene("cpu", "layers-small",
                               {{"stages", R"(["noise", "shade"])"},
@@ -184,11 +182,18 @@ struct RendererCase {
     std::vector<SceneOverride> base;
 };
 std::vector<RendererCase> RendererCases() {
-    return {{"render_splat", "ci-small", Resource::SplatImage,
-             {{"steps", "6"}, {"stages", R"(["region", "ca", "smooth", "density", "shade", "shade_sky", "render_splat"])"}}},
-            {"render_march", "layers-small", Resource::MarchImage,
+    return {{"render_splat",
+             "ci-small",
+             Resource::SplatImage,
+             {{"steps", "6"},
+              {"stages", R"(["region", "ca", "smooth", "density", "shade", "shade_sky", "render_splat"])"}}},
+            {"render_march",
+             "layers-small",
+             Resource::MarchImage,
              {{"stages", R"(["noise", "shade", "shade_sky", "render_march"])"}}},
-            {"render_layers", "layers-small", Resource::LayersImage,
+            {"render_layers",
+             "layers-small",
+             Resource::LayersImage,
              {{"stages", R"(["noise", "shade", "shade_sky", "render_layers"])"}}}};
 }
 
@@ -264,11 +269,10 @@ TEST(SkyLight, LightAddsUp) {
 // Test the exact reference render alike: its sky light where the sun stood, the sun dark, renders the sun's image
 // bit for bit (the exact depth toward either is the same integral).
 TEST(SkyLight, ReferenceSkyLightWhereTheSunStandsLightsAsTheSun) {
-    auto scene = LoadCiScene("layers-small",
-                             {{"stages", R"(["noise", "shade", "shade_sky", "render_march"])"},
-                              {"render.width", "32"},
-                              {"render.height", "24"},
-                              {"lighting.sky", "{}"}});
+    auto scene = LoadCiScene("layers-small", {{"stages", R"(["noise", "shade", "shade_sky", "render_march"])"},
+                                              {"render.width", "32"},
+                                              {"render.height", "24"},
+                                              {"lighting.sky", "{}"}});
     ASSERT_TRUE(scene.has_value()) << scene.error().message;
     const Extent3 e = scene->grid.size;
     std::vector<float> q(e.Count());

@@ -1,9 +1,10 @@
 // Finite outputs at the load-time bounds (SPEC 12's "no stage may return NaN or Inf for any valid input";
-// docs/pipeline.md, "Finite outputs"): the phase function's peak, the sun's, the sky light's and the lightning's radiance (at the
-// guard radius too), the lightning's distance in voxel edges, ambient and background, the sun's azimuth (fixed, on a
-// path, at a speed) and the optical depth with forward scattering. Each extreme runs just inside its bound on every
-// backend with every output on every step, and every array it writes (T, G, the images of every camera, ...) must
-// be finite and in range; just past each bound the scene is refused with file, field, bound and value.
+// docs/pipeline.md, "Finite outputs"): the phase function's peak, the sun's, the sky light's and the lightning's
+// radiance (at the guard radius too), the lightning's distance in voxel edges, ambient and background, the sun's
+// azimuth (fixed, on a path, at a speed) and the optical depth with forward scattering. Each extreme runs just inside
+// its bound on every backend with every output on every step, and every array it writes (T, G, the images of every
+// camera, ...) must be finite and in range; just past each bound the scene is refused with file, field, bound and
+// value.
 #include <gtest/gtest.h>
 
 #include <algorithm>

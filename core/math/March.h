@@ -397,7 +397,8 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                 const MarchLightSample l = light(p);
                 float sunGain = l.sun * sunPhase;
                 if (s.powder) sunGain *= PowderTerm(s.powderC, l.sun);
-                const Vec3 in = InScattered(s.light, LightSample{sunGain, l.sun, l.point, p, ray.dir, l.sky * skyPhase});
+                const Vec3 in =
+                    InScattered(s.light, LightSample{sunGain, l.sun, l.point, p, ray.dir, l.sky * skyPhase});
                 const float w = T * (1.0f - tau);
                 L0 += w * in[0];
                 L1 += w * in[1];

@@ -113,7 +113,8 @@ void ReadSky(const Json& lighting, Validator& check, SkyLightSettings& sky) {
         if (v->is_number() && v->get<double>() <= 0)
             check.Fail("lighting.sky.elevation_deg",
                        "the sky light shines from above the horizon (elevation in (0, 90] degrees; below is the "
-                       "ground), got " + FormatNumber(v->get<double>()));
+                       "ground), got " +
+                           FormatNumber(v->get<double>()));
         else if (auto d = check.Number(*v, "lighting.sky.elevation_deg", Range{.lo = 0, .loOpen = true, .hi = 90}))
             sky.elevationDeg = *d;
     }

@@ -36,7 +36,7 @@ namespace cb {
     X(Tiles, "tiles", U8, "tiles")        /* tile occupancy, (tx, ty, 1) */         \
     X(Bands, "bands", U8, "bands")        /* tile x band occupancy, (tx, ty, bz) */ \
     X(T, "T", F32, "T")                   /* transmittance toward the sun, grid */  \
-    X(TSky, "T_sky", F32, "T_sky")        /* toward the sky light, grid */         \
+    X(TSky, "T_sky", F32, "T_sky")        /* toward the sky light, grid */          \
     X(Shadow, "G", F32, "shadow")         /* ground shadow, (nx, ny, 1) */          \
     X(SplatImage, "image_splat", F32, "") /* (3, width, height) per camera */       \
     X(MarchImage, "image_march", F32, "")                                           \

@@ -206,8 +206,9 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
                    "needs the stage \"shade_sky\", which computes T_sky, the sky light's attenuation; enable it or "
                    "remove lighting.sky");
     if (!scene.lighting.sky.on && scene.stages.Has(Stage::ShadeSky))
-        check.Fail("stages", "\"shade_sky\" shades toward the sky light, and the scene has none (lighting.sky); add "
-                             "lighting.sky or remove the stage");
+        check.Fail("stages",
+                   "\"shade_sky\" shades toward the sky light, and the scene has none (lighting.sky); add "
+                   "lighting.sky or remove the stage");
 
     if (sections.steps) CheckSunSpeed(scene, check);
     CheckTiling(scene, check);

@@ -113,9 +113,9 @@ struct EyeScatteringSettings {
 // own attenuation T_sky (stage shade_sky, which runs iff the section is present): colour term
 // sky T_sky P^(s_sky . d) (section `lighting.sky`; docs/pipeline.md, "Skylight").
 struct SkyLightSettings {
-    bool on = false;            // the section is present
-    double elevationDeg = 20;   // above the horizon, degrees, in (0, 90]
-    double azimuthDeg = 0;      // from +x toward +y, degrees
+    bool on = false;                             // the section is present
+    double elevationDeg = 20;                    // above the horizon, degrees, in (0, 90]
+    double azimuthDeg = 0;                       // from +x toward +y, degrees
     std::array<double, 3> color{0.5, 0.6, 0.9};  // linear RGB
     double intensity = 1.0;                      // multiplies color
 

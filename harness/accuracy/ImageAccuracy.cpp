@@ -123,7 +123,7 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     // T from shade on this backend when the renderer reads it, untimed in the render's time.
     std::unique_ptr<Buffer> T;
     std::optional<std::string> unsupported;
-    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr};
+    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr, nullptr};
     inputs.shadedT = [&]() -> Result<const Buffer*> {
         if (!backend.Supports(Stage::Shade)) {
             unsupported = backend.Name() + " does not implement shade, which feeds T";

@@ -111,8 +111,7 @@ Result<AccuracyRender> SplatAccuracyRender(Backend& backend, const Scene& scene,
         p->skipping = false;
     }
     std::shared_ptr<Buffer> occupancy[] = {std::move(*D), std::move(*tiles), std::move(*bands)};
-    SplatInputs inputs{in.q, in.q, *T, occupancy[1].get(), occupancy[1].get(), occupancy[2].get(),
-                       occupancy[2].get()};
+    SplatInputs inputs{in.q, in.q, *T, occupancy[1].get(), occupancy[1].get(), occupancy[2].get(), occupancy[2].get()};
     if (scene.lighting.sky.on) {
         auto skyT = in.shadedSkyT();
         if (!skyT) return std::unexpected(skyT.error());
