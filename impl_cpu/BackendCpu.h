@@ -64,6 +64,7 @@ class BackendCpu : public Backend {
     std::optional<uint64_t> AvailableBytes() const override;
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_SKY_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
@@ -76,8 +77,8 @@ class BackendCpu : public Backend {
     // The stage objects (core/pipeline/StageObjects.h): what each stage keeps
     // between calls so that steady-state steps do not allocate, in its <Stage>CpuState.h.
     using StagesCpu = StageObjects<NothingKept<Stage::Region>, CaCpuState, SmoothCpuState, NothingKept<Stage::Density>,
-                                   ShadeCpuState, NothingKept<Stage::Shadow>, RenderSplatCpuState, NoiseCpuState,
-                                   RenderMarchCpuState, RenderLayersCpuState>;
+                                   ShadeCpuState, ShadeSkyCpuState, NothingKept<Stage::Shadow>, RenderSplatCpuState,
+                                   NoiseCpuState, RenderMarchCpuState, RenderLayersCpuState>;
 
     tbb::task_arena mArena;
     StagesCpu mStages;

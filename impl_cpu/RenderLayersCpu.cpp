@@ -1,6 +1,7 @@
 // The layered renderer on the CPU (SPEC 15): per call, q_alpha and T are formed
-// once into a padded volume of (q, T) pairs (core/math/Layers.h's taps: the
-// border holds (0, 1), or with tiling the opposite edge's voxels), then every
+// once into a padded volume of (q, T) pairs, or (q, T, T_sky) triples with the sky light (core/math/Layers.h's
+// taps: the border holds (0, 1) or (0, 1, 1), or with tiling the opposite edge's voxels;
+// impl_cpu/PaddedVolumeCpu.h), then every
 // pixel runs LayersPixel, the layers its ray crosses back to front and then
 // LOD0's billboards (a list made once per call, culled per tile), TBB over 8 x 8 pixel tiles. A pixel's loop is the
 // fastest form here: it touches only the layers on its side of the eye, where OpenGL rasterises every layer.
@@ -13,13 +14,58 @@
 
 #include "core/math/Layers.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/PaddedVolumeCpu.h"
 #include "impl_cpu/RenderLayersCpuState.h"
 
 namespace cb::cpu {
 
+namespace {
+
+// The pixels of one call, TBB over 8 x 8 pixel tiles, each reading the padded volume through fetch.
+template <class Fetch>
+void LayersPixels(const LayersParams& params, Fetch&& fetch, float* out, std::atomic<uint64_t>& fragments,
+                  std::atomic<uint64_t>& drawn) {
+    const LayersSetup& s = params.setup;
+    const uint32_t W = params.camera.width, H = params.camera.height;
+    const LayersWalks walks = MakeLayersWalks(s);
+    // LOD0's billboards, back to front (none without it).
+    const std::vector<LayersBillboard> list = MakeLayersBillboards(s, params.camera.forward);
+    // Each tile blends only the billboards whose rectangle (LayersBillboardRect) meets it, in the list's order:
+    // a billboard outside has no fragment there, so the pixels are the same as with the whole list.
+    std::vector<LayersPixelRect> rects(list.size());
+    for (size_t n = 0; n < list.size(); ++n) rects[n] = LayersBillboardRect(s, params.camera, list[n]);
+    tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) {
+        uint64_t nFragments = 0, nDrawn = 0;
+        std::vector<LayersBillboard> near;
+        const double x0 = r.cols().begin(), x1 = r.cols().end();
+        const double y0 = r.rows().begin(), y1 = r.rows().end();
+        for (size_t n = 0; n < list.size(); ++n)
+            if (rects[n].x1 >= x0 && rects[n].x0 <= x1 && rects[n].y1 >= y0 && rects[n].y0 <= y1)
+                near.push_back(list[n]);
+        const LayersBillboards billboards{near.data(), uint32_t(near.size()), params.camera.right,
+                                          params.camera.upVector};
+        for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
+            for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
+                const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
+                const LayersPixelResult p = LayersPixel(s, walks, ray, fetch, billboards);
+                float* o = out + 3 * (size_t(x) + size_t(W) * y);
+                o[0] = p.color[0];
+                o[1] = p.color[1];
+                o[2] = p.color[2];
+                nFragments += p.fragments;
+                nDrawn += p.drawn;
+            }
+        fragments += nFragments;
+        drawn += nDrawn;
+    });
+}
+
+}  // namespace
+
 uint64_t RenderLayersCpuState::ScratchBytes(const Scene& scene) const {
     const Extent3 e = scene.grid.size;
-    return SaturatingMul(uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull), 2 * sizeof(float));
+    const uint64_t fields = scene.lighting.sky.on ? 3 : 2;
+    return SaturatingMul(uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull), fields * sizeof(float));
 }
 
 Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats) {
@@ -34,66 +80,30 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
     const float* qPrev = static_cast<const BufferCpu*>(in.qPrev)->F32();
     const float* qCur = static_cast<const BufferCpu*>(in.qCur)->F32();
     const float* T = static_cast<const BufferCpu*>(in.T)->F32();
+    const bool skyLight = params.setup.light.skyOn;
+    if (skyLight && (!in.TSky || in.TSky->Extent() != e))
+        return MakeError("cpu: render_layers: the sky light needs T_sky of q's size");
+    const float* skyT = skyLight ? static_cast<const BufferCpu*>(in.TSky)->F32() : nullptr;
     float* out = static_cast<BufferCpu&>(image).F32();
     const LayersSetup& s = params.setup;
-    const size_t px = size_t(e.nx) + 2, py = size_t(e.ny) + 2, pz = size_t(e.nz) + 2;
     std::atomic<uint64_t> fragments{0}, drawn{0};
 
     mArena.execute([&] {
-        // 1. The padded volume: voxel (i, j, k) at (i + 1, j + 1, k + 1); PaddedSourceVoxel names each border's.
-        state.volume.resize(px * py * pz);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, pz), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t k = r.begin(); k < r.end(); ++k)
-                for (size_t j = 0; j < py; ++j) {
-                    std::array<float, 2>* row = state.volume.data() + px * (j + py * k);
-                    const int64_t vk = PaddedSourceVoxel(uint32_t(k), e.nz, false);
-                    const int64_t vj = PaddedSourceVoxel(uint32_t(j), e.ny, s.tiling);
-                    for (size_t i = 0; i < px; ++i) {
-                        const int64_t vi = PaddedSourceVoxel(uint32_t(i), e.nx, s.tiling);
-                        if (vi < 0 || vj < 0 || vk < 0) {
-                            row[i] = {0.0f, 1.0f};
-                            continue;
-                        }
-                        const size_t v = size_t(vi) + size_t(e.nx) * (size_t(vj) + size_t(e.ny) * size_t(vk));
-                        row[i] = {Lerp(qPrev[v], qCur[v], params.alpha), T[v]};
-                    }
-                }
-        });
-        // 2. The pixels.
-        const std::array<float, 2>* volume = state.volume.data();
-        auto fetch = [volume](uint32_t i) { return volume[i]; };
-        const LayersWalks walks = MakeLayersWalks(s);
-        // LOD0's billboards, back to front (none without it).
-        const std::vector<LayersBillboard> list = MakeLayersBillboards(s, params.camera.forward);
-        // Each tile blends only the billboards whose rectangle (LayersBillboardRect) meets it, in the list's order:
-        // a billboard outside has no fragment there, so the pixels are the same as with the whole list.
-        std::vector<LayersPixelRect> rects(list.size());
-        for (size_t n = 0; n < list.size(); ++n) rects[n] = LayersBillboardRect(s, params.camera, list[n]);
-        tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8),
-                          [&](const tbb::blocked_range2d<uint32_t>& r) {
-                              uint64_t nFragments = 0, nDrawn = 0;
-                              std::vector<LayersBillboard> near;
-                              const double x0 = r.cols().begin(), x1 = r.cols().end();
-                              const double y0 = r.rows().begin(), y1 = r.rows().end();
-                              for (size_t n = 0; n < list.size(); ++n)
-                                  if (rects[n].x1 >= x0 && rects[n].x0 <= x1 && rects[n].y1 >= y0 && rects[n].y0 <= y1)
-                                      near.push_back(list[n]);
-                              const LayersBillboards billboards{near.data(), uint32_t(near.size()), params.camera.right,
-                                                                params.camera.upVector};
-                              for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
-                                  for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
-                                      const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
-                                      const LayersPixelResult p = LayersPixel(s, walks, ray, fetch, billboards);
-                                      float* o = out + 3 * (size_t(x) + size_t(W) * y);
-                                      o[0] = p.color[0];
-                                      o[1] = p.color[1];
-                                      o[2] = p.color[2];
-                                      nFragments += p.fragments;
-                                      nDrawn += p.drawn;
-                                  }
-                              fragments += nFragments;
-                              drawn += nDrawn;
-                          });
+        // 1. The padded volume, 2. the pixels; with the sky light the volume's cells carry T_sky as a third field.
+        const float alpha = params.alpha;
+        if (skyLight) {
+            FormPaddedVolume(state.volumeWithSky, e, s.tiling, std::array<float, 3>{0.0f, 1.0f, 1.0f}, [&](size_t v) {
+                return std::array<float, 3>{Lerp(qPrev[v], qCur[v], alpha), T[v], skyT[v]};
+            });
+            const std::array<float, 3>* volume = state.volumeWithSky.data();
+            LayersPixels(params, [volume](uint32_t i) { return volume[i]; }, out, fragments, drawn);
+        } else {
+            FormPaddedVolume(state.volume, e, s.tiling, std::array<float, 2>{0.0f, 1.0f}, [&](size_t v) {
+                return std::array<float, 2>{Lerp(qPrev[v], qCur[v], alpha), T[v]};
+            });
+            const std::array<float, 2>* volume = state.volume.data();
+            LayersPixels(params, [volume](uint32_t i) { return volume[i]; }, out, fragments, drawn);
+        }
     });
     if (stats) *stats = {fragments, drawn};
     return {};

@@ -12,7 +12,8 @@ namespace cb::cpu {
 struct RenderLayersCpuState {
     static constexpr Stage kStage = Stage::RenderLayers;
     std::vector<std::array<float, 2>> volume;  // the padded (q_alpha, T) volume, wrapped horizontally with tiling
-    // The padded volume.
+    std::vector<std::array<float, 3>> volumeWithSky;  // instead, with the sky light: (q_alpha, T, T_sky)
+    // The padded volume of pairs, or of triples with the sky light.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -1,7 +1,8 @@
 // The ray marcher on the CPU (SPEC 10): per call, q_alpha and T are formed
 // once into one padded volume of (q, T) pairs (a border voxel of q = 0, T = 1
 // stands for "outside the grid", or with tiling holds the opposite edge's
-// voxel in x and y, so the trilinear taps need no bounds checks),
+// voxel in x and y, so the trilinear taps need no bounds checks; impl_cpu/PaddedVolumeCpu.h), and with the sky
+// light T_sky into a second one,
 // the brick skip structure is built from it, and then every pixel runs the
 // shared kernel MarchRay (core/math/March.h), TBB over 8 x 8 pixel tiles.
 #include <tbb/blocked_range.h>
@@ -15,6 +16,7 @@
 
 #include "core/math/March.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/PaddedVolumeCpu.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
 namespace cb::cpu {
@@ -25,6 +27,7 @@ namespace {
 // (p + 0.5 floored, and +1) stay inside.
 struct MarchPaddedVolume {
     const MarchQT* v = nullptr;
+    const float* sky = nullptr;  // T_sky's padded volume (the sky light on)
     size_t px = 0, pxy = 0;  // padded row and slice strides
     const MarchSetup* setup = nullptr;  // the box (size) and the tiling's wrap
 
@@ -52,6 +55,16 @@ struct MarchPaddedVolume {
         return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
     }
     float Q(const Vec3& p) const { return Blend<&MarchQT::q>(TapsAt(p)); }
+    // T_sky at the taps, blended as Blend blends a field.
+    float SkyT(const Taps& t) const {
+        const float* a = sky + t.base;
+        const float* b = a + pxy;
+        const float c00 = Lerp(a[0], a[1], t.wx);
+        const float c10 = Lerp(a[px], a[px + 1], t.wx);
+        const float c01 = Lerp(b[0], b[1], t.wx);
+        const float c11 = Lerp(b[px], b[px + 1], t.wx);
+        return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
+    }
 };
 
 // The main march's density functor: keeps the taps of its last sample so that
@@ -64,6 +77,7 @@ struct MarchCachedDensity {
         return volume->Blend<&MarchQT::q>(last);
     }
     float LastT() const { return volume->Blend<&MarchQT::t>(last); }
+    float LastSkyT() const { return volume->SkyT(last); }
 };
 
 template <class Light>
@@ -120,7 +134,8 @@ uint64_t RenderMarchCpuState::ScratchBytes(const Scene& scene) const {
     const uint64_t padded = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
     const uint32_t b = std::max(scene.march.brick, 1u);
     const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
-    return SaturatingAdd(SaturatingMul(padded, sizeof(MarchQT)), bricks);
+    const uint64_t cell = sizeof(MarchQT) + (scene.lighting.sky.on ? sizeof(float) : 0);
+    return SaturatingAdd(SaturatingMul(padded, cell), bricks);
 }
 
 Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
@@ -131,38 +146,33 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
     const bool shadeLight = params.light == MarchLightSource::Shade;
     if (shadeLight && !in.T) return MakeError("cpu: render_march: light source \"shade\" needs T");
     if (shadeLight && in.T->Extent() != e) return MakeError("cpu: render_march: T and q differ in size");
+    const bool skyLight = params.setup.light.skyOn;
+    if (skyLight && (!in.TSky || in.TSky->Extent() != e))
+        return MakeError("cpu: render_march: the sky light needs T_sky of q's size");
     if (image.Extent() != Extent3{3, params.camera.width, params.camera.height})
         return MakeError("cpu: render_march: the image is not (3, width, height)");
 
     const float* qPrev = static_cast<const BufferCpu*>(in.qPrev)->F32();
     const float* qCur = static_cast<const BufferCpu*>(in.qCur)->F32();
     const float* T = shadeLight ? static_cast<const BufferCpu*>(in.T)->F32() : nullptr;
+    const float* skyT = skyLight ? static_cast<const BufferCpu*>(in.TSky)->F32() : nullptr;
     float* out = static_cast<BufferCpu&>(image).F32();
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "cpu: render_march"));
     const float* G = params.ground.on ? static_cast<const BufferCpu*>(in.G)->F32() : nullptr;
     const float alpha = params.alpha;
     const size_t px = size_t(e.nx) + 2, py = size_t(e.ny) + 2, pz = size_t(e.nz) + 2;
+    const bool wrap = params.setup.tiling;
     const uint32_t B = std::max(params.brick, 1u);
     const uint32_t bx = CeilDiv(e.nx, B), by = CeilDiv(e.ny, B), bz = CeilDiv(e.nz, B);
     MarchStats local;
 
     mArena.execute([&] {
-        // 1. q_alpha and T into the padded volume: voxel (i, j, k) at (i + 1, j + 1, k + 1); the border reads
-        //    q = 0, T = 1, or with tiling the opposite edge's voxel in x and y (PaddedSourceVoxel).
-        const bool wrap = params.setup.tiling;
-        state.volume.assign(px * py * pz, MarchQT{0.0f, 1.0f});
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.nz), [&](const tbb::blocked_range<uint32_t>& r) {
-            for (uint32_t k = r.begin(); k < r.end(); ++k)
-                for (uint32_t pj = 0; pj < py; ++pj) {
-                    const int64_t j = PaddedSourceVoxel(pj, e.ny, wrap);
-                    if (j < 0) continue;
-                    const size_t src = size_t(e.nx) * (size_t(j) + size_t(e.ny) * k);
-                    MarchQT* dst = state.volume.data() + px * (pj + py * (k + 1));
-                    for (uint32_t i = 0; i < e.nx; ++i)
-                        dst[i + 1] = {Lerp(qPrev[src + i], qCur[src + i], alpha), T ? T[src + i] : 1.0f};
-                    if (wrap) dst[0] = dst[e.nx], dst[e.nx + 1] = dst[1];
-                }
+        // 1. q_alpha and T into the padded volume, T_sky into its own with the sky light; the border reads
+        //    q = 0, T = 1, T_sky = 1, or with tiling the opposite edge's voxel in x and y.
+        FormPaddedVolume(state.volume, e, wrap, MarchQT{0.0f, 1.0f}, [&](size_t v) {
+            return MarchQT{Lerp(qPrev[v], qCur[v], alpha), T ? T[v] : 1.0f};
         });
+        if (skyLight) FormPaddedVolume(state.skyVolume, e, wrap, 1.0f, [&](size_t v) { return skyT[v]; });
         // 2. Bricks: empty iff q_alpha = 0 over the brick grown by one voxel (padded indices b B .. (b+1) B + 1).
         MarchBricks bricks;
         if (params.skipping) {
@@ -194,7 +204,8 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
             local.emptyBricks = uint64_t(std::count(state.bricks.begin(), state.bricks.end(), uint8_t(1)));
         }
         // 3. The rays.
-        const MarchPaddedVolume volume{state.volume.data(), px, px * py, &params.setup};
+        const MarchPaddedVolume volume{state.volume.data(), skyLight ? state.skyVolume.data() : nullptr, px, px * py,
+                                       &params.setup};
         const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
         const MarchSetup& s = params.setup;
         const uint32_t nl = params.lightSteps;
@@ -205,15 +216,17 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
                     MarchLightSample l;
                     l.sun = density.LastT();
                     if (s.light.pointOn) l.point = PointLightMarch(s, p, nl, plainQ);
+                    if (s.light.skyOn) l.sky = density.LastSkyT();
                     return l;
                 };
             });
         } else {
-            MarchPixels(params, volume, brickPtr, out, local, G, e, [&](MarchCachedDensity&) {
-                return [&s, nl, plainQ](const Vec3& p) {
+            MarchPixels(params, volume, brickPtr, out, local, G, e, [&](MarchCachedDensity& density) {
+                return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = SunLightMarch(s, p, nl, plainQ);
                     if (s.light.pointOn) l.point = PointLightMarch(s, p, nl, plainQ);
+                    if (s.light.skyOn) l.sky = density.LastSkyT();
                     return l;
                 };
             });

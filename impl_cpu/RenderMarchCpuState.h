@@ -17,8 +17,9 @@ struct MarchQT {
 struct RenderMarchCpuState {
     static constexpr Stage kStage = Stage::RenderMarch;
     std::vector<MarchQT> volume;  // the padded (q_alpha, T) volume
+    std::vector<float> skyVolume;  // the padded T_sky volume (the sky light on), border 1
     std::vector<uint8_t> bricks;  // skipping: 1 per empty brick
-    // The padded volume and one byte per brick.
+    // The padded volume (and T_sky's with the sky light) and one byte per brick.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -125,6 +125,10 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const float* qPrev = static_cast<const BufferCpu&>(*in.qPrev).F32();
     const float* qCur = static_cast<const BufferCpu&>(*in.qCur).F32();
     const float* T = static_cast<const BufferCpu&>(*in.T).F32();
+    const bool skyLight = p.light.skyOn;
+    if (skyLight && (!in.TSky || in.TSky->Extent() != e))
+        return MakeError("cpu: render_splat: the sky light needs T_sky of q's size");
+    const float* skyT = skyLight ? static_cast<const BufferCpu&>(*in.TSky).F32() : nullptr;
     float* image = static_cast<BufferCpu&>(imageBuffer).F32();
     // The ground (core/math/Ground.h): each pixel's background where its ray meets the plane.
     CB_TRY(CheckGroundInput(p.ground, in.G, e, "cpu: render_splat"));
@@ -243,7 +247,8 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                             idx[inner] = innerIdx[bit % nInner];
                             const size_t v = vOuter + strideMiddle * idx[middle] + strideInner * idx[inner];
                             Splat s;
-                            if (MakeSplat(frame, idx[0], idx[1], idx[2], SplatQ(qPrev[v], qCur[v], alpha), T[v], s))
+                            if (MakeSplat(frame, idx[0], idx[1], idx[2], SplatQ(qPrev[v], qCur[v], alpha), T[v],
+                                          skyT ? skyT[v] : 1.0f, s))
                                 out.push_back(s);
                         }
                     visitedPerSlice[n] = visited;
@@ -263,7 +268,8 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
                         if (!(qa > qMin)) continue;  // MakeSplat's first test
                         idx[inner] = iIndex;
                         Splat s;
-                        if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, T[v], s)) out.push_back(s);
+                        if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, T[v], skyT ? skyT[v] : 1.0f, s))
+                            out.push_back(s);
                     }
                 }
                 visitedPerSlice[n] = visited;

@@ -476,7 +476,11 @@ uint64_t ShadeCpuState::ScratchBytes(const Scene& scene) const {
     return SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4);
 }
 
-Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffer& TBuffer) {
+namespace {
+
+// Shade's sweep for the sun's T or the sky light's T_sky, each with its own state (its coarse grids).
+Status ShadeInto(ShadeCpuState& state, tbb::task_arena& arena, const ShadeParams& params, const Buffer& qBuffer,
+                 Buffer& TBuffer) {
     const int f = params.resolution;
     CB_TRY(CheckShadeResolution("cpu", f));
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
@@ -490,26 +494,35 @@ Status BackendCpu::Shade(const ShadeParams& params, const Buffer& qBuffer, Buffe
     const uint32_t m0 = params.slices.Begin(plan.nw), m1 = params.slices.End(plan.nw);
     if (m0 >= m1) return {};
     if (f == 1) {
-        ShadeGrid(plan, params.storage, q, T, mArena, m0, m1);
+        ShadeGrid(plan, params.storage, q, T, arena, m0, m1);
         return {};
     }
 
     const uint32_t* c = plan.cells;
     const size_t coarseSlice = size_t(c[0]) * c[1];
-    ShadeCpuState& state = mStages.Get<ShadeCpuState>();
     if (m0 > 0 && (state.coarseQ.size() != coarseSlice * c[2] || state.coarseT.size() != coarseSlice * c[2]))
         return MakeError("cpu: shade share [" + std::to_string(m0) + ", " + std::to_string(m1) +
                          ") without the share that starts the sweep");
     if (m0 == 0) {
         state.coarseQ.assign(coarseSlice * c[2], 0.0f);
         state.coarseT.assign(coarseSlice * c[2], 1.0f);
-        DownsampleShadeQ(plan, f, q, e, state.coarseQ.data(), mArena);
+        DownsampleShadeQ(plan, f, q, e, state.coarseQ.data(), arena);
     }
-    ShadeGrid(plan, params.storage, state.coarseQ.data(), state.coarseT.data(), mArena, m0, m1);
+    ShadeGrid(plan, params.storage, state.coarseQ.data(), state.coarseT.data(), arena, m0, m1);
     if (m1 < plan.nw) return {};
 
-    UpsampleShadeT(plan, f, state.coarseT.data(), e, T, mArena);
+    UpsampleShadeT(plan, f, state.coarseT.data(), e, T, arena);
     return {};
+}
+
+}  // namespace
+
+Status BackendCpu::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    return ShadeInto(mStages.Get<ShadeCpuState>(), mArena, params, q, T);
+}
+
+Status BackendCpu::ShadeSky(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    return ShadeInto(mStages.Get<ShadeSkyCpuState>(), mArena, params, q, T);
 }
 
 }  // namespace cb::cpu

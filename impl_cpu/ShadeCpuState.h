@@ -18,4 +18,9 @@ struct ShadeCpuState {
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 
+// The sky light's shade (stage shade_sky): the same sweep toward the sky light, with coarse grids of its own.
+struct ShadeSkyCpuState : ShadeCpuState {
+    static constexpr Stage kStage = Stage::ShadeSky;
+};
+
 }  // namespace cb::cpu

@@ -133,6 +133,7 @@ class BackendGL final : public Backend {
     }
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_SKY_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
@@ -140,9 +141,9 @@ class BackendGL final : public Backend {
   private:
     // The stage objects (core/pipeline/StageObjects.h): each stage's textures,
     // buffer objects and what it keeps between calls, in its <Stage>GLState.h.
-    using StagesGL =
-        StageObjects<RegionGLState, CaGLState, SmoothGLState, DensityGLState, ShadeGLState, NothingKept<Stage::Shadow>,
-                     RenderSplatGLState, NoiseGLState, RenderMarchGLState, RenderLayersGLState>;
+    using StagesGL = StageObjects<RegionGLState, CaGLState, SmoothGLState, DensityGLState, ShadeGLState,
+                                  ShadeSkyGLState, NothingKept<Stage::Shadow>, RenderSplatGLState, NoiseGLState,
+                                  RenderMarchGLState, RenderLayersGLState>;
 
     BackendGL(std::unique_ptr<GLContext> context, bool rgba8)
         : mContext(std::move(context)),
@@ -201,13 +202,26 @@ class BackendGL final : public Backend {
     // first, in RGB floats are exactly the canonical layout.
     void CopyTargetToImage(GLuint target, uint32_t W, uint32_t H, BufferSlot& copy, Buffer& image);
     // render_march's and render_layers' padded (q_alpha, T) volume (PaddedVolumeGL.cpp): whether its storage
-    // buffer fits this driver's storage blocks (an error names `stage`), and the pass that forms it.
+    // buffer fits this driver's storage blocks (an error names `stage`; T_sky's, half its size, then fits too),
+    // and the pass that forms it.
     Status CheckPaddedVolumeFits(const Extent3& grid, const char* stage);
     // march_volume.frag into `volume`'s RG32F layers: q_alpha = Lerp(qPrev, qCur, alpha) and T (null: 1), the
     // border (0, 1) or with `wrap` the opposite edge's voxels in x and y; copied into `copy`, which it returns,
     // a storage buffer of (q_alpha, T) pairs in the padded index order.
     Result<GLuint> FormPaddedVolume(TextureSlot& volume, BufferSlot& copy, const Buffer& qPrev, const Buffer& qCur,
                                     const Buffer* T, float alpha, bool wrap);
+    // The same pass for the sky light's T_sky into `volume`'s R32F layers: the border 1, or with `wrap` the opposite
+    // edge's voxels in x and y; copied into `copy`, which it returns, a storage buffer of floats in the padded
+    // index order (march.glsl's MarchFetchSkyT).
+    Result<GLuint> FormPaddedSkyVolume(TextureSlot& volume, BufferSlot& copy, const Buffer& TSky, bool wrap);
+    // What both passes share: `program` (in use, its inputs bound) draws the padded volume of grid e, its
+    // `grid` and `wrap` uniforms set here, into `volume`'s layers of `internalFormat`, copied as `format` floats
+    // per cell (cellBytes) into `copy`, which it returns.
+    Result<GLuint> DrawPaddedVolume(GLuint program, const Extent3& e, bool wrap, GLenum internalFormat, GLenum format,
+                                    size_t cellBytes, TextureSlot& volume, BufferSlot& copy);
+    // Shade's sweep (ShadeGL.cpp) writing T from q, on `state`'s textures: shade's with the sun, shade_sky's
+    // with the sky light; errors name `stage`.
+    Status ShadeSweep(ShadeGLState& state, const char* stage, const ShadeParams& params, const Buffer& q, Buffer& T);
     // kMieCloudTable's values in `table`, uploaded on the first call (`uploaded`).
     GLuint MiePhaseTable(BufferSlot& table, bool& uploaded);
     // Attaches layer `layer` of each texture (layer < 0: a 2-D texture) to the

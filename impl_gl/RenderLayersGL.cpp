@@ -1,6 +1,7 @@
 // Stage `render_layers` (SPEC 15) on OpenGL, Wang, Ji and Zhang's way:
 //   1. march_volume: the padded (q_alpha, T) volume (render_march's step 1 with
-//      `wrap` under tiling), copied on the device into a storage buffer;
+//      `wrap` under tiling), copied on the device into a storage buffer; with the
+//      sky light march_sky_volume likewise forms T_sky's into a storage buffer of its own;
 //   2. one screen quad drawn instanced N times (render_layers.vert: instance n
 //      is the n-th layer back to front, cut by a clip distance to the side of
 //      the horizon the layer lies on), blended SRC_ALPHA, ONE_MINUS_SRC_ALPHA over
@@ -20,7 +21,9 @@ namespace cb::gl {
 
 uint64_t RenderLayersGLState::ScratchBytes(const Scene& scene) const {
     const Extent3 e = scene.grid.size;
-    uint64_t bytes = 2 * uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2) * 8;
+    const uint64_t padded = uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2);
+    uint64_t bytes = 2 * padded * 8;
+    if (scene.lighting.sky.on) bytes += 2 * padded * 4;
     bytes += uint64_t(scene.render.width) * scene.render.height * (16 + 12);
     if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
     if (scene.layers.wang.enabled) bytes += uint64_t(scene.grid.size.nx) * scene.grid.size.ny * 4;
@@ -38,6 +41,9 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_layers: the image is not (3, width, height)");
     if (params.setup.wang && !params.setup.map) return MakeError("gl: render_layers: wang opacity needs its map");
+    const bool skyLight = params.setup.light.skyOn;
+    if (skyLight && (!in.TSky || in.TSky->Extent() != e))
+        return MakeError("gl: render_layers: the sky light needs T_sky of q's size");
     const Functions& f = mContext->F();
     auto layersProgram = mContext->Program("render_layers");
     if (!layersProgram) return std::unexpected(layersProgram.error());
@@ -59,6 +65,12 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
     auto volumeCopy =
         FormPaddedVolume(state.volume, state.volumeCopy, *in.qPrev, *in.qCur, in.T, params.alpha, params.setup.tiling);
     if (!volumeCopy) return std::unexpected(volumeCopy.error());
+    GLuint skyVolumeCopy = *volumeCopy;  // bound to the unused binding without the sky light
+    if (skyLight) {
+        auto skyFormed = FormPaddedSkyVolume(state.skyVolume, state.skyVolumeCopy, *in.TSky, params.setup.tiling);
+        if (!skyFormed) return std::unexpected(skyFormed.error());
+        skyVolumeCopy = *skyFormed;
+    }
     f.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
     // 2. The layers, instanced, back to front over the background.
@@ -87,6 +99,7 @@ Status BackendGL::RenderLayers(const LayersParams& params, const LayersInputs& i
         f.NamedBufferSubData(map, 0, GLsizeiptr(bytes), s.map);
     }
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, map);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, skyVolumeCopy);
     f.Enable(GL_BLEND);
     f.BlendEquation(GL_FUNC_ADD);
     f.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);

@@ -1,7 +1,9 @@
 // Stage `render_march` (SPEC 10) on OpenGL, the thesis's way: fragment passes.
 //   1. march_volume: the padded (q_alpha, T) volume, one pass per padded layer
 //      into the RG32F layers of `volume` (border (0, 1); T only with light
-//      "shade", else 1), copied on the device into a storage buffer.
+//      "shade", else 1), copied on the device into a storage buffer; with the
+//      sky light march_sky_volume likewise forms T_sky's (border 1) into
+//      `skyVolume`'s R32F layers and its own storage buffer.
 //   2. march_bricks (skipping only): the bricks' empty flags, one pass per
 //      brick layer into R32UI layers, copied likewise; counts the empty ones.
 //   3. render_march: the full-screen triangle over the image, one fragment per
@@ -27,6 +29,7 @@ uint64_t RenderMarchGLState::ScratchBytes(const Scene& scene) const {
     const Extent3 e = scene.grid.size;
     const uint64_t padded = uint64_t(e.nx + 2) * (e.ny + 2) * (e.nz + 2);
     uint64_t bytes = 2 * padded * 8;
+    if (scene.lighting.sky.on) bytes += 2 * padded * 4;
     if (scene.march.skipping) {
         const uint32_t b = std::max(scene.march.brick, 1u);
         bytes += 2 * uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b) * 4;
@@ -44,16 +47,21 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const bool shadeLight = params.light == MarchLightSource::Shade;
     if (shadeLight && !in.T) return MakeError("gl: render_march: light source \"shade\" needs T");
     if (shadeLight && in.T->Extent() != e) return MakeError("gl: render_march: T and q differ in size");
+    const bool skyLight = params.setup.light.skyOn;
+    if (skyLight && (!in.TSky || in.TSky->Extent() != e))
+        return MakeError("gl: render_march: the sky light needs T_sky of q's size");
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: render_march: the image is not (3, width, height)");
     const Functions& f = mContext->F();
     CB_TRY(CheckGroundInput(params.ground, in.G, e, "gl: render_march"));
     const MarchGpu block = MakeMarchGpu(params, e);
-    // The program specialised for this call's option bits, phase kind and point light (render_march.frag).
+    // The program specialised for this call's option bits, phase kind, point light and sky light
+    // (render_march.frag).
     auto marchProgram =
         mContext->Program("render_march", "#define MARCH_FLAGS " + std::to_string(block.flags) +
                                               "u\n#define MARCH_PHASE " + std::to_string(block.light.phaseKind) +
-                                              "u\n#define MARCH_POINT " + std::to_string(block.light.pointOn) + "u\n");
+                                              "u\n#define MARCH_POINT " + std::to_string(block.light.pointOn) +
+                                              "u\n#define MARCH_SKY " + std::to_string(block.light.skyOn) + "u\n");
     if (!marchProgram) return std::unexpected(marchProgram.error());
     Result<GLuint> bricksProgram = GLuint(0);
     if (params.skipping) {
@@ -78,6 +86,12 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
                                    params.alpha, params.setup.tiling);
     if (!formed) return std::unexpected(formed.error());
     const GLuint volume = state.volume.name.Get(), volumeCopy = *formed;
+    GLuint skyVolumeCopy = volumeCopy;  // bound to the unused binding without the sky light
+    if (skyLight) {
+        auto skyFormed = FormPaddedSkyVolume(state.skyVolume, state.skyVolumeCopy, *in.TSky, params.setup.tiling);
+        if (!skyFormed) return std::unexpected(skyFormed.error());
+        skyVolumeCopy = *skyFormed;
+    }
 
     // 2. The bricks: empty iff q_alpha = 0 over the brick grown by one voxel.
     GLuint bricksCopy = volumeCopy;  // bound to the unused binding without skipping
@@ -111,6 +125,7 @@ Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, volumeCopy);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bricksCopy);
     f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, phaseTable);
+    f.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, skyVolumeCopy);
     // The ground's block and G (flag kMarchGpuGround); without the ground, stand-ins the program never reads.
     GLuint groundBuffer = blockBuffer;
     if (params.ground.on) {

@@ -27,6 +27,9 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (!program) return std::unexpected(program.error());
     const Extent3 e = in.qCur->Extent();
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
+    const bool skyLight = p.light.skyOn;
+    if (skyLight && (!in.TSky || in.TSky->Extent() != e))
+        return MakeError("gl: render_splat: the sky light needs T_sky of q's size");
     CB_TRY(CheckGroundInput(p.ground, in.G, e, "gl: render_splat"));
     Result<GLuint> groundProgram = GLuint(0);
     if (p.ground.on) {
@@ -132,6 +135,7 @@ Status BackendGL::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     f.BindTextureUnit(0, Tex(*in.qPrev).Texture());
     f.BindTextureUnit(1, Tex(*in.qCur).Texture());
     f.BindTextureUnit(2, Tex(*in.T).Texture());
+    f.BindTextureUnit(6, Tex(skyLight ? *in.TSky : *in.T).Texture());  // T stands in, unread, without the sky light
     f.Uniform1f(f.GetUniformLocation(*program, "guard"), kGuard);
     f.Uniform1i(f.GetUniformLocation(*program, "deviceSkip"), deviceSkip ? 1 : 0);
     f.Uniform2i(f.GetUniformLocation(*program, "tileBand"), GLint(p.tile), GLint(p.band));

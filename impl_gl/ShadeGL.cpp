@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <string>
 #include <utility>
 
 #include "core/pipeline/ShadePlan.h"
@@ -24,8 +25,8 @@ uint64_t ShadeGLState::ScratchBytes(const Scene& scene) const {
 // sweep: the share with m = 0 down-samples, the slices m0 <= m < m1 run (the
 // slice before m0 is in the ping-pong texture of m0's parity, left by the
 // preceding share), and the share ending at nw writes T.
-Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
-    ShadeGLState& state = mStages.Get<ShadeGLState>();
+Status BackendGL::ShadeSweep(ShadeGLState& state, const char* stage, const ShadeParams& params, const Buffer& q,
+                             Buffer& T) {
     const int res = params.resolution;
     CB_TRY(CheckShadeResolution("gl", res));
     const Functions& f = mContext->F();
@@ -95,7 +96,7 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     }
     if (m1 < plan.nw) {
         timer.Stop();
-        return mContext->Check("shade, a share");
+        return mContext->Check((std::string(stage) + ", a share").c_str());
     }
     f.UseProgram(*up);
     f.BindTextureUnit(0, volume);
@@ -105,7 +106,15 @@ Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     f.Viewport(0, 0, GLsizei(e.nx), GLsizei(e.ny));
     CB_TRY(DrawLayers(*up, e.nz, {Tex(T).Texture()}));
     timer.Stop();
-    return mContext->Check("shade");
+    return mContext->Check(stage);
+}
+
+Status BackendGL::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    return ShadeSweep(mStages.Get<ShadeGLState>(), "shade", params, q, T);
+}
+
+Status BackendGL::ShadeSky(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    return ShadeSweep(mStages.Get<ShadeSkyGLState>(), "shade_sky", params, q, T);
 }
 
 }  // namespace cb::gl

@@ -1,4 +1,4 @@
-// Shade's state on gl (ShadeGL.cpp).
+// Shade's state on gl, and shade_sky's (ShadeGL.cpp).
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,12 @@ struct ShadeGLState {
     // R32F: coarseQ below full resolution and volume on the shaded grid; ping
     // and pong counted for the two longest axes.
     uint64_t ScratchBytes(const Scene& scene) const;
+};
+
+// The sky light's shade (stage shade_sky): the same sweep toward the sky light, with textures of its own, so that
+// a sky shade between two shares of the sun's sweep leaves the sun's slices as they were.
+struct ShadeSkyGLState : ShadeGLState {
+    static constexpr Stage kStage = Stage::ShadeSky;
 };
 
 }  // namespace cb::gl

@@ -1,5 +1,5 @@
 // The Vulkan backend's façade: the context, buffers and their transfers, and
-// the helpers every stage shares (Record and Dev in BackendVk.h, Scratch). Each
+// the helpers every stage shares (Record and Dev in BackendVk.h, Scratch, PrepareSkyVolume). Each
 // stage has its object in <Stage>VkState.h (what it keeps between calls and its
 // scratch bytes) and its entry in <Stage>Vk.cpp: RegionVk.cpp, CaVk.cpp, ...
 #include "impl_vk/BackendVk.h"
@@ -111,6 +111,19 @@ Result<DeviceBuffer*> BackendVk::ScratchHolding(BufferSlot& slot, std::span<cons
 
 Result<DeviceBuffer*> BackendVk::MiePhaseTable(BufferSlot& slot) {
     return ScratchHolding(slot, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count)), 0);
+}
+
+Result<SkyVolumePass> BackendVk::PrepareSkyVolume(BufferSlot& slot, const Buffer& TSky, bool tiling) {
+    const Extent3 e = TSky.Extent();
+    SkyVolumePass pass;
+    auto pipeline = mContext->GetPipeline("sky_volume", 2);
+    if (!pipeline) return std::unexpected(pipeline.error());
+    auto volume = Scratch(slot, SkyVolumeBytes(e));
+    if (!volume) return std::unexpected(volume.error());
+    pass.pipeline = *pipeline;
+    pass.buffers = {&Dev(TSky), *volume};
+    pass.push = {e.nx, e.ny, e.nz, tiling ? 1u : 0u};
+    return pass;
 }
 
 Result<std::unique_ptr<Buffer>> BackendVk::CreateBuffer(BufferFormat format, Extent3 extent) {

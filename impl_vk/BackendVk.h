@@ -21,6 +21,7 @@
 #include "impl_vk/RenderSplatVkState.h"
 #include "impl_vk/ScratchVk.h"
 #include "impl_vk/ShadeVkState.h"
+#include "impl_vk/SkyVolumeVk.h"
 #include "impl_vk/SmoothVkState.h"
 #include "impl_vk/VulkanContext.h"
 
@@ -73,6 +74,7 @@ class BackendVk final : public Backend {
     }
 
     CB_SPLAT_PIPELINE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    CB_SKY_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
@@ -112,9 +114,9 @@ class BackendVk final : public Backend {
   private:
     // The stage objects (core/pipeline/StageObjects.h): each stage's device
     // buffers and what it keeps between calls, in its <Stage>VkState.h.
-    using StagesVk =
-        StageObjects<RegionVkState, CaVkState, SmoothVkState, DensityVkState, ShadeVkState, NothingKept<Stage::Shadow>,
-                     RenderSplatVkState, NoiseVkState, RenderMarchVkState, RenderLayersVkState>;
+    using StagesVk = StageObjects<RegionVkState, CaVkState, SmoothVkState, DensityVkState, ShadeVkState,
+                                  ShadeSkyVkState, NothingKept<Stage::Shadow>, RenderSplatVkState, NoiseVkState,
+                                  RenderMarchVkState, RenderLayersVkState>;
 
     explicit BackendVk(std::unique_ptr<VulkanContext> context) : mContext(std::move(context)) {}
     // Records with `fn`, submits, waits and keeps the device time (defined below the class).
@@ -130,6 +132,11 @@ class BackendVk final : public Backend {
     // The slot's buffer holding kMieCloudTable's values (uploaded once, by ScratchHolding): the phase_table.glsl
     // table of the renderers with phase Mie.
     Result<DeviceBuffer*> MiePhaseTable(BufferSlot& slot);
+    // Shade's sweep (ShadeVk.cpp) from q into T with `state`'s coarse grids: the sun's T (Shade) or the sky
+    // light's T_sky (ShadeSky); `stage` names it in errors.
+    Status ShadeInto(ShadeVkState& state, const char* stage, const ShadeParams& params, const Buffer& q, Buffer& T);
+    // The pass that forms T_sky's padded volume in the slot's buffer (SkyVolumeVk.h), `tiling` wrapping it.
+    Result<SkyVolumePass> PrepareSkyVolume(BufferSlot& slot, const Buffer& TSky, bool tiling);
 
     std::unique_ptr<VulkanContext> mContext;
     StagesVk mStages;  // after mContext: their buffers are destroyed before it

@@ -38,7 +38,8 @@ using PushFloat8 = std::array<float, 8>;  // GLSL float[8]
     X(ScanPush, CB_VK_SCAN_PUSH) \
     X(RadixSortPush, CB_VK_RADIX_SORT_PUSH) \
     X(MarchVolumePush, CB_VK_MARCH_VOLUME_PUSH) \
-    X(MarchBricksPush, CB_VK_MARCH_BRICKS_PUSH)
+    X(MarchBricksPush, CB_VK_MARCH_BRICKS_PUSH) \
+    X(SkyVolumePush, CB_VK_SKY_VOLUME_PUSH)
 
 // Every shader with a push-constant block and the block it is pushed (its file stem in impl_vk/shaders/).
 #define CB_VK_PUSH_SHADERS(X) \
@@ -63,7 +64,8 @@ using PushFloat8 = std::array<float, 8>;  // GLSL float[8]
     X(ScanPush, "scan") \
     X(RadixSortPush, "radix_sort") \
     X(MarchVolumePush, "march_volume") \
-    X(MarchBricksPush, "march_bricks")
+    X(MarchBricksPush, "march_bricks") \
+    X(SkyVolumePush, "sky_volume")
 
 #define CB_VK_CA_INIT_PUSH(X) \
     X(uint32_t, nx) \
@@ -227,6 +229,12 @@ using PushFloat8 = std::array<float, 8>;  // GLSL float[8]
     X(uint32_t, by) \
     X(uint32_t, bz) \
     X(uint32_t, qStride)
+// The grid (nx, ny, nz) and wrap: 1 with tiling.
+#define CB_VK_SKY_VOLUME_PUSH(X) \
+    X(uint32_t, nx) \
+    X(uint32_t, ny) \
+    X(uint32_t, nz) \
+    X(uint32_t, wrap)
 
 // clang-format on
 

@@ -1,6 +1,7 @@
 // Stage `render_layers` (SPEC 15) on Vulkan, one submit of two passes:
 //   1. march_volume.comp: the padded (q_alpha, T) volume, its horizontal
-//      border wrapped with tiling (render_march's pass 1 with `wrap`);
+//      border wrapped with tiling (render_march's pass 1 with `wrap`), and with
+//      the sky light sky_volume.comp: T_sky's, wrapped alike (SkyVolumeVk.h);
 //   2. render_layers.comp: one invocation per pixel, LayersPixel of
 //      core/math/layers.glsl, the CPU's loop over the layers each ray crosses:
 //      a compute pass touches only the layers on the ray's side of the eye,
@@ -9,6 +10,7 @@
 //      which each workgroup blends those that meet its 8 x 8 tile.
 // The constants are core/pipeline/LayersGpu.h's block in a storage buffer.
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "core/pipeline/LayersGpu.h"
@@ -29,6 +31,7 @@ uint64_t RenderLayersVkState::ScratchBytes(const Scene& scene) const {
     if (scene.layers.wang.enabled) bytes += uint64_t(scene.grid.size.nx) * scene.grid.size.ny * 4;
     bytes += uint64_t(LayersBillboardBound(scene.layers, scene.grid.voxelSize, scene.grid.size.nz)) *
              sizeof(LayersBillboard);
+    if (scene.lighting.sky.on) bytes += SkyVolumeBytes(scene.grid.size);
     return bytes;
 }
 
@@ -38,6 +41,8 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e || in.T->Extent() != e)
         return MakeError("vk: render_layers: q_prev, q_cur and T differ in size");
+    const bool skyLight = params.setup.light.skyOn;
+    if (skyLight) CB_TRY(CheckSkyInput(in.TSky, e, "render_layers"));
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("vk: render_layers: the image is not (3, width, height)");
     if (params.setup.wang && !params.setup.map) return MakeError("vk: render_layers: wang opacity needs its map");
@@ -47,7 +52,7 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
     const uint32_t px = e.nx + 2, py = e.ny + 2, pz = e.nz + 2;
     auto volumePipe = mContext->GetPipeline("march_volume", 4);
     if (!volumePipe) return std::unexpected(volumePipe.error());
-    auto layersPipe = mContext->GetPipeline("render_layers", 7);
+    auto layersPipe = mContext->GetPipeline("render_layers", 8);
     if (!layersPipe) return std::unexpected(layersPipe.error());
     auto frameBuffer = Scratch(state.frame, sizeof frame);
     if (!frameBuffer) return std::unexpected(frameBuffer.error());
@@ -76,14 +81,24 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
         CB_TRY(mContext->Upload(**b, std::as_bytes(std::span(billboards))));
         billboardBuffer = *b;
     }
+    // T_sky's padded volume with the sky light; without it, the frame stands in, unread.
+    std::optional<SkyVolumePass> sky;
+    const DeviceBuffer* skyVolume = *frameBuffer;
+    if (skyLight) {
+        auto pass = PrepareSkyVolume(state.skyVolume, *in.TSky, params.setup.tiling);
+        if (!pass) return std::unexpected(pass.error());
+        sky = *pass;
+        skyVolume = &sky->Volume();
+    }
 
     const MarchVolumePush volumePush{e.nx, e.ny, e.nz, 1u, params.alpha, params.setup.tiling ? 1u : 0u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), *volume};
-    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table,          &Dev(image),
-                                          *statsBuffer, map,     billboardBuffer};
+    const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table,           &Dev(image),
+                                          *statsBuffer, map,     billboardBuffer, skyVolume};
     CB_TRY(Record("render_layers", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(**volumePipe, volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);
+        if (sky) sky->Record(r);
         r.Barrier();
         r.DispatchGroups(**layersPipe, layerBuffers, nullptr, 0, CeilDiv(W, 8), CeilDiv(H, 8), 1);
     }));

@@ -16,8 +16,9 @@ struct RenderLayersVkState {
     BufferSlot stats;     // the LayersStats counters, 64-bit as two words each
     BufferSlot map;       // wang opacity: the modulation map, nx * ny floats (uploaded when it changes)
     BufferSlot billboards;  // LOD0's billboards (core/math/Layers.h LayersBillboard), in drawing order
+    BufferSlot skyVolume;   // with the sky light: T_sky's padded volume, wrapped alike (SkyVolumeVk.h)
     // The constants, the padded volume, the Mie table with phase Mie, the counters, the map with wang, the
-    // billboards (at most LayersBillboardBound of them).
+    // billboards (at most LayersBillboardBound of them), T_sky's padded volume with the sky light.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -1,7 +1,8 @@
 // Stage `render_march` (SPEC 10) on Vulkan, one submit of three passes:
 //   1. march_volume.comp: the padded volume (impl_cpu/RenderMarchCpu.cpp step 1),
 //      (q_alpha, T) pairs with the light source "shade", q alone with "march";
-//      the border reads (0, 1), or with tiling the opposite edge's voxels;
+//      the border reads (0, 1), or with tiling the opposite edge's voxels; with
+//      the sky light, sky_volume.comp: T_sky's padded volume (SkyVolumeVk.h);
 //   2. march_bricks.comp (skipping only): one word per brick, 1 iff q_alpha = 0
 //      over the brick grown by one voxel (step 2), and the count of empty ones;
 //   3. render_march.comp (light "shade") or render_march_q.comp ("march"), both
@@ -12,6 +13,7 @@
 // (kMieCloudTable) is uploaded once, on the first call whose phase is Mie.
 #include <algorithm>
 #include <array>
+#include <optional>
 
 #include "core/pipeline/MarchGpu.h"
 #include "impl_vk/BackendVk.h"
@@ -40,6 +42,7 @@ uint64_t RenderMarchVkState::ScratchBytes(const Scene& scene) const {
         bytes += uint64_t(b[0]) * b[1] * b[2] * 4;
     }
     if (scene.phase.kind == PhaseKind::Mie) bytes += uint64_t(kMieCloudTable.count) * 4;
+    if (scene.lighting.sky.on) bytes += SkyVolumeBytes(e);
     return bytes;
 }
 
@@ -51,6 +54,8 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const bool shadeLight = params.light == MarchLightSource::Shade;
     if (shadeLight && !in.T) return MakeError("vk: render_march: light source \"shade\" needs T");
     if (shadeLight && in.T->Extent() != e) return MakeError("vk: render_march: T and q differ in size");
+    const bool skyLight = params.setup.light.skyOn;
+    if (skyLight) CB_TRY(CheckSkyInput(in.TSky, e, "render_march"));
     const uint32_t W = params.camera.width, H = params.camera.height;
     if (image.Extent() != Extent3{3, W, H}) return MakeError("vk: render_march: the image is not (3, width, height)");
 
@@ -63,7 +68,7 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
 
     Pipeline* pipes[3] = {};
     const char* names[3] = {"march_volume", "march_bricks", shadeLight ? "render_march" : "render_march_q"};
-    const uint32_t bindings[3] = {4, 3, 8};
+    const uint32_t bindings[3] = {4, 3, 9};
     for (int n = 0; n < 3; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -101,6 +106,15 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         groundBlock = *b;
         groundG = &Dev(*in.G);
     }
+    // T_sky's padded volume with the sky light; without it, the frame stands in, unread.
+    std::optional<SkyVolumePass> sky;
+    const DeviceBuffer* skyVolume = *frameBuffer;
+    if (skyLight) {
+        auto pass = PrepareSkyVolume(state.skyVolume, *in.TSky, params.setup.tiling);
+        if (!pass) return std::unexpected(pass.error());
+        sky = *pass;
+        skyVolume = &sky->Volume();
+    }
 
     const MarchVolumePush volumePush{
         e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha, params.setup.tiling ? 1u : 0u};
@@ -109,11 +123,12 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),
                                            *volume};
     const DeviceBuffer* brickBuffers[] = {*volume, bricks, *statsBuffer};
-    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,      bricks,      table,
-                                          &Dev(image),  *statsBuffer, groundBlock, groundG};
+    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,     bricks,  table,    &Dev(image),
+                                          *statsBuffer, groundBlock, groundG, skyVolume};
     CB_TRY(Record("render_march", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(*pipes[0], volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);
+        if (sky) sky->Record(r);
         r.Barrier();
         if (params.skipping) {
             r.DispatchGroups(*pipes[1], brickBuffers, &brickPush, sizeof brickPush, CeilDiv(frame.bricks[0], 64),

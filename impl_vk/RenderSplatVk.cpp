@@ -47,6 +47,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     if (!p.order || !in.qPrev || !in.qCur || !in.T)
         return MakeError("vk: render_splat needs q (both steps), T and an order");
     const Extent3 e = in.qCur->Extent();
+    const bool skyLight = p.light.skyOn;
+    if (skyLight) CB_TRY(CheckSkyInput(in.TSky, e, "render_splat"));
     if (image.Extent().nx != 3) return MakeError("vk: render_splat image must have extent (3, width, height)");
     const uint32_t W = image.Extent().ny, H = image.Extent().nz;
     CB_TRY(CheckGroundInput(p.ground, in.G, e, "vk: render_splat"));
@@ -118,7 +120,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     Pipeline* pipes[kPipes] = {};
     const char* names[kPipes] = {"splat_count",  "scan",           "splat_write",    "splat_pairs",
                                  "radix_sort",   "splat_ranges",   "splat_composite", "splat_boxes"};
-    const uint32_t bindings[kPipes] = {11, 3, 11, 4, 5, 2, 6, 3};
+    const uint32_t bindings[kPipes] = {12, 3, 12, 4, 5, 2, 6, 3};
     for (int n = 0; n < kPipes; ++n) {
         auto pipe = mContext->GetPipeline(names[n], bindings[n]);
         if (!pipe) return std::unexpected(pipe.error());
@@ -133,6 +135,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
         if (!t) return std::unexpected(t.error());
         phaseTable = *t;
     }
+    // splat_ranks.glsl's T_sky with the sky light; else T stands in, unread.
+    const DeviceBuffer* skyT = skyLight ? &Dev(*in.TSky) : &Dev(*in.T);
     double deviceMs = 0;
     auto run = [&](const char* what, auto&& record) -> Status {
         CB_TRY(Record(what, record));
@@ -147,7 +151,7 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     SplatChunksPush chunkPush{chunks, kTileSize};
     const DeviceBuffer* countBuffers[] = {common[0],          common[1],      common[2],           common[3],
                                           common[4],          common[5],      scratch.chunkSplats, scratch.chunkPairs,
-                                          scratch.candidates, scratch.totals, phaseTable};
+                                          scratch.candidates, scratch.totals, phaseTable,          skyT};
     const SplatBoxesPush boxPush{CeilDiv(uint32_t(boxes.size()), 4)};
     const DeviceBuffer* boxBuffers[] = {scratch.boxes, p.skipping ? &Dev(*in.bandsPrev) : scratch.boxes,
                                         p.skipping ? &Dev(*in.bandsCur) : scratch.boxes};
@@ -197,8 +201,8 @@ Status BackendVk::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffe
     const uint32_t longestScan = std::max({chunks, splatCount, sortPlan.CountEntries()});
     CB_TRY(need(scratch.scanSums, state.scanSums, VkDeviceSize(ScanSumsEntries(longestScan)) * 4));
     const DeviceBuffer* writeBuffers[] = {
-        common[0],      common[1],          common[2],          common[3], common[4], common[5], scratch.chunkOffsets,
-        scratch.splats, scratch.splatTiles, scratch.candidates, phaseTable};
+        common[0],      common[1],          common[2],          common[3],  common[4], common[5], scratch.chunkOffsets,
+        scratch.splats, scratch.splatTiles, scratch.candidates, phaseTable, skyT};
     SplatPairsPush pairPush{splatCount, tilesX, kTileSize};
     const DeviceBuffer* pairBuffers[] = {scratch.splats, scratch.pairOffsets, scratch.keys[0], scratch.values[0]};
     // One invocation per splat, in rows of kRowGroups workgroups (splat_tiles.glsl LinearInvocation).

@@ -6,6 +6,10 @@
 // m0 .. m1 - 1 in visiting order; at f > 1 the share with m = 0 also down-samples
 // q and the share ending at nw up-samples into T. The coarse q and T
 // (ShadeVkState's coarseQ and coarseT) carry the sweep from one share to the next.
+// Stage `shade_sky` runs the same sweep toward the sky light into T_sky, with coarse
+// grids of its own (ShadeSkyVkState), so that it may come between two shares of the
+// sun's sweep, in a batch too: each call is one segment of the batch's command buffer,
+// ordered after the one before by the segment's barrier.
 // The reference path, one shade_slice.comp dispatch per slice, is what a CPU
 // device (lavapipe) runs by default (BackendVk::ShadeSweep; the tests compare the
 // two byte for byte).
@@ -51,7 +55,15 @@ uint64_t ShadeVkState::ScratchBytes(const Scene& scene) const {
 }
 
 Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
-    ShadeVkState& state = mStages.Get<ShadeVkState>();
+    return ShadeInto(mStages.Get<ShadeVkState>(), "shade", params, q, T);
+}
+
+Status BackendVk::ShadeSky(const ShadeParams& params, const Buffer& q, Buffer& T) {
+    return ShadeInto(mStages.Get<ShadeSkyVkState>(), "shade_sky", params, q, T);
+}
+
+Status BackendVk::ShadeInto(ShadeVkState& state, const char* stage, const ShadeParams& params, const Buffer& q,
+                            Buffer& T) {
     const int f = params.resolution;
     CB_TRY(CheckShadeResolution("vk", f));
     const Extent3 e = q.Extent();
@@ -131,7 +143,7 @@ Status BackendVk::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
     const DeviceBuffer* sliceBuffers[] = {shadeQ, shadeT};
     const DeviceBuffer* downBuffers[] = {&Dev(q), shadeQ};
     const DeviceBuffer* upBuffers[] = {shadeT, &Dev(T)};
-    return Record("shade", [&](VulkanContext::Recorder& r) {
+    return Record(stage, [&](VulkanContext::Recorder& r) {
         if (down) {
             r.Dispatch(*down, downBuffers, &resample, sizeof resample, n[0] * n[1] * n[2]);
             r.Barrier();

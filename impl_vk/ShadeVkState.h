@@ -1,4 +1,4 @@
-// Shade's state on vk (ShadeVk.cpp).
+// Shade's state on vk, and shade_sky's (ShadeVk.cpp).
 #pragma once
 
 #include <cstdint>
@@ -14,6 +14,12 @@ struct ShadeVkState {
     BufferSlot coarseQ, coarseT;
     // Below full resolution, coarseQ and coarseT: ceil(n / f) cells per axis.
     uint64_t ScratchBytes(const Scene& scene) const;
+};
+
+// The sky light's shade (stage shade_sky): the same sweep toward the sky light, with coarse grids of its own, so
+// that a sky shade between two shares of the sun's sweep leaves the sun's as they were.
+struct ShadeSkyVkState : ShadeVkState {
+    static constexpr Stage kStage = Stage::ShadeSky;
 };
 
 }  // namespace cb::vk

@@ -106,6 +106,7 @@ Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, con
     const ExactDepth depth(exact, grid, s.tiling,
                            sigmaH > 0 ? 110.0 / sigmaH : std::numeric_limits<double>::infinity());
     const Point3d sun{s.sun[0], s.sun[1], s.sun[2]};
+    const Point3d sky{s.light.skyDirection[0], s.light.skyDirection[1], s.light.skyDirection[2]};
     const Point3d light{s.light.pointPosition[0], s.light.pointPosition[1], s.light.pointPosition[2]};
     const CameraFrame& cam = params.camera;
     const uint32_t W = cam.width, H = cam.height;
@@ -126,6 +127,11 @@ Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, con
                     MarchLightSample l;
                     l.sun = float(std::exp(-sigmaH * depth.Along(at, sun, std::numeric_limits<double>::infinity())));
                     ++nLight;
+                    if (s.light.skyOn) {
+                        l.sky =
+                            float(std::exp(-sigmaH * depth.Along(at, sky, std::numeric_limits<double>::infinity())));
+                        ++nLight;
+                    }
                     if (s.light.pointOn) {
                         const Point3d v{light[0] - at[0], light[1] - at[1], light[2] - at[2]};
                         const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);

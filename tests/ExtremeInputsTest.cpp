@@ -97,7 +97,7 @@ TEST(ExtremeInputs, MakeSplatCoversOnlyTheImageAtExtremeFocalLengths) {
             for (uint32_t j = 0; j < 8; ++j)
                 for (uint32_t i = 0; i < 8; ++i) {
                     Splat s;
-                    if (!MakeSplat(F, i, j, k, 0.9f, 1.0f, s)) continue;
+                    if (!MakeSplat(F, i, j, k, 0.9f, 1.0f, 1.0f, s)) continue;
                     ASSERT_TRUE(std::isfinite(s.px) && std::isfinite(s.py) && std::isfinite(s.size)) << i << j << k;
                     if (s.x0 <= s.x1) {
                         ASSERT_TRUE(s.x0 >= 0 && s.x1 < 64) << s.x0 << " " << s.x1;

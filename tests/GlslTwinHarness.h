@@ -74,6 +74,9 @@ inline std::array<float, 2> TwinPaddedQT(uint32_t i) {
             float(LowBias32(i ^ 0x9E3779B9u) >> 8) * (1.0f / 16777216.0f)};
 }
 
+// twin.comp's synthetic T_sky (march.glsl's MarchFetchSkyT): a third hash of the padded index.
+inline float TwinPaddedSkyT(uint32_t i) { return float(LowBias32(i ^ 0x2545F491u) >> 8) * (1.0f / 16777216.0f); }
+
 // twin.comp's synthetic modulation map (layers.glsl's LayersMapValue): m of column index i from a hash.
 inline float TwinLayersMap(uint32_t i) { return float(LowBias32(i ^ 0x51ED27u) >> 8) * (1.0f / 16777216.0f); }
 

@@ -76,6 +76,10 @@ LayersParams RandomLayersParams(Pcg32& r, std::vector<float>& map) {
         const float ps = Uniform(r, 0.5, 3);
         SetLayersLod0(s, std::min(Uniform(r, 0.3f, 5) * ps, extent), ps);
     }
+    // The sky light in half the calls (its T_sky TwinPaddedSkyT, read through TwinFetchSky).
+    s.light.skyOn = r.Below(2) == 1;
+    s.light.skyRadiance = {Uniform(r, 0, 2), Uniform(r, 0, 2), Uniform(r, 0, 2)};
+    s.light.skyDirection = SunDirection(r.Uniform(0.02, 1.55), r.Uniform(0, 6.28));
     return p;
 }
 
@@ -87,6 +91,11 @@ std::vector<Words> PixelInputs(Pcg32& r, const CameraFrame& c, uint32_t layers) 
 }
 
 auto TwinFetch = [](uint32_t i) { return TwinPaddedQT(i); };
+// With the sky light: (q, T, T_sky), as the CPU's layers read them (twin.comp's MarchFetchSkyT is the third).
+auto TwinFetchSky = [](uint32_t i) {
+    const std::array<float, 2> qt = TwinPaddedQT(i);
+    return std::array<float, 3>{qt[0], qt[1], test::TwinPaddedSkyT(i)};
+};
 
 #if CLOUDBENCH_HAVE_VK
 
@@ -142,7 +151,8 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
                 Run(test::kTwinLayerFragment, fragmentsIn, {}, {}, g), [&](const Words& in, Words& out) {
                     const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
                     const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, r.dir));
-                    const LayerFragmentResult f = LayerFragment(s, r, sunPhase, in[2], TwinFetch);
+                    const LayerFragmentResult f = s.light.skyOn ? LayerFragment(s, r, sunPhase, in[2], TwinFetchSky)
+                                                                : LayerFragment(s, r, sunPhase, in[2], TwinFetch);
                     const Vec3 over = LayersOver({Float(in[3]), Float(in[4]), Float(in[5])}, f.alpha, f.color);
                     out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]), Bits(f.color[1]),
                              Bits(f.color[2]), Bits(sunPhase), Bits(over[0]), Bits(over[1]), Bits(over[2])});
@@ -151,9 +161,10 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         const std::vector<Kind> pixelKinds = {Kind::F, Kind::F, Kind::F, Kind::U, Kind::U};
         Compare("LayersPixel", pixelKinds, ulps, pixels, Run(test::kTwinLayersPixel, pixels, {}, {}, g, list),
                 [&](const Words& in, Words& out) {
-                    const LayersPixelResult r =
-                        LayersPixel(s, MakeLayersWalks(s), MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]),
-                                    TwinFetch, billboards);
+                    const LayersRay ray = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
+                    const LayersPixelResult r = s.light.skyOn
+                                                    ? LayersPixel(s, MakeLayersWalks(s), ray, TwinFetchSky, billboards)
+                                                    : LayersPixel(s, MakeLayersWalks(s), ray, TwinFetch, billboards);
                     out = W({Bits(r.color[0]), Bits(r.color[1]), Bits(r.color[2]), r.fragments, r.drawn});
                     fragments += r.fragments;
                 });
@@ -182,7 +193,8 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
                         const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
                         const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, r.dir));
                         const LayerFragmentResult f =
-                            BillboardFragment(s, billboards, r, sunPhase, list[in[2]], TwinFetch);
+                            s.light.skyOn ? BillboardFragment(s, billboards, r, sunPhase, list[in[2]], TwinFetchSky)
+                                          : BillboardFragment(s, billboards, r, sunPhase, list[in[2]], TwinFetch);
                         out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]),
                                  Bits(f.color[1]), Bits(f.color[2]), Bits(r.cosForward)});
                         billboardDrawn += f.drawn ? 1 : 0;

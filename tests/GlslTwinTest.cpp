@@ -96,6 +96,10 @@ SplatFrame RandomSplatFrame(Pcg32& r) {
     F.light.mieIndexPerRadian = kMieCloudTable.indexPerRadian;
     F.light.mieCount = kMieCloudTable.count;
     F.light.voxelSize = 50;
+    // The sky light in half the frames.
+    F.light.skyOn = r.Below(2);
+    const Vec3 sky = SunDirection(r.Uniform(0.02, 1.55), r.Uniform(0, 6.28));
+    for (int a = 0; a < 3; ++a) F.light.skyRadiance[a] = Uniform(r, 0, 2), F.light.skyDirection[a] = sky[a];
     F.qMin = 0.3f;
     F.opacity = 0.6f;
     F.voxelSize = 50;
@@ -105,12 +109,12 @@ SplatFrame RandomSplatFrame(Pcg32& r) {
 
 Words RandomVoxel(Pcg32& r) {
     return W({r.Below(64), r.Below(64), r.Below(16), Bits(r.Below(4) == 0 ? 0.3f : Uniform(r, 0, 1)),
-              Bits(Uniform(r, 0, 1))});
+              Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1))});
 }
 
 void MakeSplatCpp(const SplatFrame& F, const Words& in, Words& out) {
     Splat s;
-    const bool made = MakeSplat(F, in[0], in[1], in[2], Float(in[3]), Float(in[4]), s);
+    const bool made = MakeSplat(F, in[0], in[1], in[2], Float(in[3]), Float(in[4]), Float(in[5]), s);
     out = W({uint32_t(made), Bits(s.px), Bits(s.py), Bits(s.size), Bits(s.alphaScale), Bits(s.colour[0]),
              Bits(s.colour[1]), Bits(s.colour[2]), uint32_t(s.x0), uint32_t(s.x1), uint32_t(s.y0), uint32_t(s.y1)});
 }
@@ -184,6 +188,14 @@ struct TwinPaddedSampler {
         const float c01 = Lerp(v(b), v(b + 1), t.wx), c11 = Lerp(v(b + px), v(b + px + 1), t.wx);
         return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
     }
+    // T_sky (TwinPaddedSkyT) at the taps, as impl_cpu's MarchPaddedVolume::SkyT.
+    float BlendSky(const Taps& t) const {
+        auto v = [](uint32_t i) { return test::TwinPaddedSkyT(i); };
+        const uint32_t a = t.base, b = t.base + pxy;
+        const float c00 = Lerp(v(a), v(a + 1), t.wx), c10 = Lerp(v(a + px), v(a + px + 1), t.wx);
+        const float c01 = Lerp(v(b), v(b + 1), t.wx), c11 = Lerp(v(b + px), v(b + px + 1), t.wx);
+        return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
+    }
 };
 
 // A random march call: a grid up to 48^3, a camera in or around it, the sun, a point light.
@@ -242,7 +254,7 @@ TEST_F(GlslTwin, MakePixelRayEqualsItsCppTwin) {
     EXPECT_LT(hits, total - total / 10);
 }
 
-// Test that the padded trilinear sampler (taps, weights, (q, T)) and the light
+// Test that the padded trilinear sampler (taps, weights, (q, T), T_sky) and the light
 // marches toward the sun and the point light through it equal the CPU's, at
 // points inside, on the faces and outside the box (clamped).
 TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
@@ -258,22 +270,23 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
         for (int k = 0; k < 1000; ++k)
             inputs.push_back(WF({Uniform(rng, -2, n[0] + 2), Uniform(rng, -2, n[1] + 2), Uniform(rng, -2, n[2] + 2)}));
         auto q = [&](const Vec3& x) { return sampler.Blend(sampler.TapsAt(x), 0); };
-        std::vector<Kind> kinds = {Kind::U, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F, Kind::F};
+        std::vector<Kind> kinds = {Kind::U, Kind::F, Kind::F, Kind::F, Kind::F,
+                                   Kind::F, Kind::F, Kind::F, Kind::F, Kind::F};
         Compare("MarchPaddedSampler", kinds, sExact ? 0 : 4, inputs, Run(test::kTwinMarchPaddedSampler, inputs, {}, m),
                 [&](const Words& in, Words& out) {
                     const Vec3 x{Float(in[0]), Float(in[1]), Float(in[2])};
                     const TwinPaddedSampler::Taps t = sampler.TapsAt(x);
                     out = W({t.base, Bits(t.wx), Bits(t.wy), Bits(t.wz), Bits(sampler.Blend(t, 0)),
                              Bits(sampler.Blend(t, 1)), Bits(q(x)), Bits(SunLightMarch(p.setup, x, p.lightSteps, q)),
-                             Bits(PointLightMarch(p.setup, x, p.lightSteps, q))});
+                             Bits(PointLightMarch(p.setup, x, p.lightSteps, q)), Bits(sampler.BlendSky(t))});
                 });
     }
 }
 
 // Test that light.glsl's InScattered, with the light MakeMarchGpu nests (MakeLightGpu), equals
 // core/math/Light.h's on random samples: every phase, the point light on and off, samples at
-// and near the point light (d = 0: cos 1; within r0: the capped falloff), the city glow and eye
-// scattering on and off (a sample looking straight at the sun among them).
+// and near the point light (d = 0: cos 1; within r0: the capped falloff), the sky light (and SkyPhase), the city glow
+// and eye scattering on and off (a sample looking straight at the sun among them).
 TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
     Pcg32 rng(0x11947);
     const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
@@ -302,26 +315,33 @@ TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
         p.setup.light.eyeInvOneMinusCos = float(1 / (1 - std::cos(cone)));
         p.setup.light.eyeIntensity = Uniform(rng, 0, 10);
         p.setup.light.eyeHeightGain = Uniform(rng, 0, 5);
+        // The sky light in one call of two.
+        p.setup.light.skyOn = call % 2 == 0;
+        p.setup.light.skyRadiance = {Uniform(rng, 0, 2), Uniform(rng, 0, 2), Uniform(rng, 0, 2)};
+        p.setup.light.skyDirection = SunDirection(rng.Uniform(0.02, 1.55), rng.Uniform(0, 6.28));
         const MarchGpu m = MakeMarchGpu(p, e);
         const LightTerms& terms = p.setup.light;
         const Vec3& at = p.setup.light.pointPosition;
         const Vec3& sun = p.setup.light.sunDirection;
-        // (sunGain, sunT, pointT, position, direction); the third looks straight at the sun.
-        std::vector<Words> inputs = {WF({0.5f, 0.5f, 1, at[0], at[1], at[2], 0, 0, 1}),
-                                     WF({0, 0, 0, at[0] + 0.01f, at[1], at[2], 1, 0, 0}),
-                                     WF({0.5f, 0.75f, 1, 20, 20, 3, sun[0], sun[1], sun[2]})};
+        // (sunGain, sunT, pointT, position, direction, skyGain); the third looks straight at the sun.
+        std::vector<Words> inputs = {WF({0.5f, 0.5f, 1, at[0], at[1], at[2], 0, 0, 1, 0.25f}),
+                                     WF({0, 0, 0, at[0] + 0.01f, at[1], at[2], 1, 0, 0, 0}),
+                                     WF({0.5f, 0.75f, 1, 20, 20, 3, sun[0], sun[1], sun[2], 3})};
         for (int k = 0; k < 2000; ++k) {
             const Vec3 d = SunDirection(rng.Uniform(-1.5, 1.5), rng.Uniform(0, 6.28));
             inputs.push_back(WF({Uniform(rng, 0, 2), Uniform(rng, 0, 1), Uniform(rng, 0, 1), Uniform(rng, -10, 60),
-                                 Uniform(rng, -10, 60), Uniform(rng, -10, 60), d[0], d[1], d[2]}));
+                                 Uniform(rng, -10, 60), Uniform(rng, -10, 60), d[0], d[1], d[2], Uniform(rng, 0, 5)}));
         }
-        Compare("InScattered", {Kind::F, Kind::F, Kind::F}, sExact ? 0 : 4, inputs,
+        Compare("InScattered", {Kind::F, Kind::F, Kind::F, Kind::F}, sExact ? 0 : 4, inputs,
                 Run(test::kTwinInScattered, inputs, {}, m), [&](const Words& in, Words& out) {
-                    const LightSample s{Float(in[0]), Float(in[1]), Float(in[2]),
+                    const LightSample s{Float(in[0]),
+                                        Float(in[1]),
+                                        Float(in[2]),
                                         Vec3{Float(in[3]), Float(in[4]), Float(in[5])},
-                                        Vec3{Float(in[6]), Float(in[7]), Float(in[8])}};
+                                        Vec3{Float(in[6]), Float(in[7]), Float(in[8])},
+                                        Float(in[9])};
                     const Vec3 c = InScattered(terms, s);
-                    out = WF({c[0], c[1], c[2]});
+                    out = WF({c[0], c[1], c[2], SkyPhase(terms, s.dir)});
                 });
     }
 }

@@ -99,7 +99,11 @@ std::vector<Member> LightMembers(const std::string& prefix, size_t at) {
                                  CB_MEMBER(LightGpu, eyeIntensity),
                                  CB_MEMBER(LightGpu, eyeCosCone),
                                  CB_MEMBER(LightGpu, eyeInvOneMinusCos),
-                                 CB_MEMBER(LightGpu, eyeHeightGain)};
+                                 CB_MEMBER(LightGpu, eyeHeightGain),
+                                 CB_MEMBER(LightGpu, skyRadiance),
+                                 CB_MEMBER(LightGpu, skyOn),
+                                 CB_MEMBER(LightGpu, skyDirection),
+                                 CB_MEMBER(LightGpu, skyUnused)};
     for (Member& m : light) m.name = prefix + m.name, m.offset += at;
     return light;
 }

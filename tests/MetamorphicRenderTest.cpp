@@ -100,7 +100,7 @@ TEST(MetamorphicRender, FrustumEdgeBoxesHandWorked) {
         p.order = &order;
         const SplatFrame F = MakeSplatFrame(p, s.grid, FlattenSplatOrder(order), 64, 64);
         Splat splat;
-        ASSERT_TRUE(MakeSplat(F, c.i, c.j, 0, 1.0f, 1.0f, splat)) << c.name;
+        ASSERT_TRUE(MakeSplat(F, c.i, c.j, 0, 1.0f, 1.0f, 1.0f, splat)) << c.name;
         EXPECT_EQ(splat.size, c.size) << c.name;
         EXPECT_EQ(splat.x0, c.x0) << c.name;
         EXPECT_EQ(splat.x1, c.x1) << c.name;
@@ -277,7 +277,7 @@ TEST(MetamorphicRender, CulledBoxesHoldNoVisibleSplat) {
                 for (uint32_t i = 0; i < e.nx; ++i) {
                     Splat splat;
                     const bool drawn =
-                        MakeSplat(F, i, j, k, 1.0f, 1.0f, splat) && splat.x0 <= splat.x1 && splat.y0 <= splat.y1;
+                        MakeSplat(F, i, j, k, 1.0f, 1.0f, 1.0f, splat) && splat.x0 <= splat.x1 && splat.y0 <= splat.y1;
                     const bool visible =
                         boxes[i / s.tile + size_t(tilesX) * (j / s.tile + size_t(tilesY) * (k / s.band))];
                     drawnVoxels += drawn;
@@ -287,7 +287,7 @@ TEST(MetamorphicRender, CulledBoxesHoldNoVisibleSplat) {
                                         << ") in a culled box covers pixels " << splat.x0 << ".." << splat.x1 << " x "
                                         << splat.y0 << ".." << splat.y1;
                     // A splat whose centre is off the image but in reach of it.
-                    nearMisses += MakeSplat(F, i, j, k, 1.0f, 1.0f, splat) &&
+                    nearMisses += MakeSplat(F, i, j, k, 1.0f, 1.0f, 1.0f, splat) &&
                                   (splat.px > -0.5f * splat.size - 2 && splat.px < W + 0.5f * splat.size + 2) &&
                                   (splat.py > -0.5f * splat.size - 2 && splat.py < H + 0.5f * splat.size + 2);
                 }

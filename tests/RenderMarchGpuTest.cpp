@@ -451,9 +451,10 @@ TEST_P(RenderMarchGpu, NoNanOrInfAtTheExtremesAndTheCpusImage) {
 //  flags and their copy; the RGBA32F target and the RGB32F image copy; with
 //  phase mie the 1801-float table.
 //  vk, on a 10 x 12 x 14 grid (12 x 14 x 16 = 2688 padded voxels, 3 x 3 x 4 =
-//  36 bricks of 4): the 256-byte constants and 40 bytes of counters; (q, T)
+//  36 bricks of 4): the constants (MarchGpu) and 40 bytes of counters; (q, T)
 //  pairs with light "shade", q alone with "march"; a word per brick only with
-//  skipping; the table only with Mie.
+//  skipping; the table only with Mie; T_sky's padded volume only with the sky
+//  light; and shade's and shade_sky's coarse grids at resolution 2.
 TEST_P(RenderMarchGpu, ScratchBytesByHand) {
     Scene scene;
     scene.stages = StageSet{Stage::RenderMarch};
@@ -469,13 +470,17 @@ TEST_P(RenderMarchGpu, ScratchBytesByHand) {
         EXPECT_EQ(mBackend->ScratchBytes(scene), volume + 2 * (3 * 2 * 1) * 4 + image);
         scene.phase.kind = PhaseKind::Mie;
         EXPECT_EQ(mBackend->ScratchBytes(scene), volume + 2 * (3 * 2 * 1) * 4 + image + 1801 * 4);
+        // The sky light: T_sky's padded volume, R32F layers and their copy.
+        scene.lighting.sky.on = true;
+        EXPECT_EQ(mBackend->ScratchBytes(scene),
+                  volume + 2 * (12 * 8 * 6) * 4 + 2 * (3 * 2 * 1) * 4 + image + 1801 * 4);
     } else if (GetParam() == "vk") {
         scene.grid.size = {10, 12, 14};
         scene.march.brick = 4;
         scene.march.skipping = true;
         scene.march.light = MarchLightSource::Shade;
-        // MarchGpu: its own twelve 16-byte rows and LightGpu's thirteen (nine and four glow blobs).
-        const uint64_t block = 12u * 16u + 13u * 16u;
+        // MarchGpu: its own twelve 16-byte rows and LightGpu's fifteen (eleven and four glow blobs).
+        const uint64_t block = 12u * 16u + 15u * 16u;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 8 + 36u * 4);
         scene.march.light = MarchLightSource::March;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4 + 36u * 4);
@@ -483,9 +488,17 @@ TEST_P(RenderMarchGpu, ScratchBytesByHand) {
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4);
         scene.phase.kind = PhaseKind::Mie;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4 + 1801u * 4);
+        scene.lighting.sky.on = true;  // T_sky's padded volume, a float per padded voxel
+        EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4 + 1801u * 4 + 2688u * 4);
+        scene.lighting.sky.on = false;
         scene.stages = StageSet{Stage::Shade};
         scene.shade.resolution = 1;
         EXPECT_EQ(mBackend->ScratchBytes(scene), 0u);  // no march, no march scratch
+        // At resolution 2 shade's coarse q and T, 5 x 6 x 7 floats each, and shade_sky's own.
+        scene.shade.resolution = 2;
+        EXPECT_EQ(mBackend->ScratchBytes(scene), 2u * 210u * 4u);
+        scene.stages = StageSet{Stage::Shade, Stage::ShadeSky};
+        EXPECT_EQ(mBackend->ScratchBytes(scene), 2u * 2u * 210u * 4u);
     } else {
         GTEST_SKIP() << "no scratch worked out by hand for " << GetParam();
     }

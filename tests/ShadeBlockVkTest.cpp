@@ -4,7 +4,8 @@
 // principal axis and sign, fractional and whole taps (45-degree ties: a tap
 // offset of +1 or -1 with weight 0), nearest taps, odd grids that are not
 // multiples of the 32-cell tile and sweeps longer than a 16-slice block,
-// every storage, both attenuations, resolutions 1, 2 and 4, and in shares.
+// every storage, both attenuations, resolutions 1, 2 and 4, and in shares; and
+// shade_sky, the same sweep with coarse grids of its own.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -195,6 +196,58 @@ TEST_F(ShadeBlockVk, SharesOfTheSweepSameAsPerSlice) {
             const std::vector<SliceRange> shares = {{0, 1}, {1, 5}, {5, 6}, {6, split}, {split, nw}};
             if (!ExpectSame(SunName(sun) + " f " + std::to_string(f) + " in shares", p, *q, *T, shares)) return;
         }
+}
+
+// shade_sky (BackendVk::ShadeSky) is shade's sweep with coarse grids of its own: between two shares of the sun's
+// sweep at f = 2 or 4, alone or with the three calls in one batch (one command buffer), on either path, the
+// sun's T is byte for byte its whole sweep's and T_sky the sky's sweep alone, which is shade's toward the sky.
+TEST_F(ShadeBlockVk, SkyShadeBetweenSharesLeavesTheSunsSweepAsItWas) {
+    const Extent3 grid{70, 45, 37};
+    auto q = test::MakeFilled(*mBackend, BufferFormat::F32, grid, ShadeBlockQ(grid, 8));
+    auto T = test::MakeBuffer(*mBackend, BufferFormat::F32, grid);
+    auto skyT = test::MakeBuffer(*mBackend, BufferFormat::F32, grid);
+    auto expectBytes = [](const std::vector<float>& got, const std::vector<float>& want, const std::string& what) {
+        ASSERT_EQ(got.size(), want.size()) << what;
+        EXPECT_EQ(std::memcmp(got.data(), want.data(), got.size() * 4), 0) << what;
+    };
+    for (int f : {2, 4})
+        for (bool perSlice : {false, true})
+            for (bool batched : {false, true}) {
+                Vk().SetShadeSweep(perSlice ? vk::BackendVk::ShadeSweep::PerSlice : vk::BackendVk::ShadeSweep::Blocks);
+                ShadeParams sun;
+                sun.sun = kShadeBlockSuns[2], sun.resolution = f, sun.storage = StorageFormat::Fp16, sun.sigma = 0.004f;
+                ShadeParams sky = sun;
+                sky.sun = kShadeBlockSuns[5];  // another sweep axis and direction
+                const std::string what =
+                    "f " + std::to_string(f) + (perSlice ? " per slice" : " blocks") + (batched ? " batched" : "");
+                ASSERT_TRUE(mBackend->Shade(sun, *q, *T).has_value());
+                const std::vector<float> wholeT = test::Read<float>(*mBackend, *T);
+                ASSERT_TRUE(mBackend->ShadeSky(sky, *q, *skyT).has_value());
+                const std::vector<float> aloneSkyT = test::Read<float>(*mBackend, *skyT);
+                ASSERT_TRUE(mBackend->Shade(sky, *q, *T).has_value());
+                expectBytes(test::Read<float>(*mBackend, *T), aloneSkyT, what + ": T_sky is shade's toward the sky");
+
+                const std::vector<float> minusOne(grid.Count(), -1.0f);  // a value shade never writes
+                ASSERT_TRUE(mBackend->Upload(*T, std::as_bytes(std::span(minusOne))));
+                ASSERT_TRUE(mBackend->Upload(*skyT, std::as_bytes(std::span(minusOne))));
+                const uint32_t nw = MakeShadePlan(sun, grid).nw, split = nw / 2;
+                ASSERT_GT(split, 0u);
+                if (batched) {
+                    ASSERT_TRUE(mBackend->BeginBatch().has_value());
+                }
+                ShadeParams first = sun, second = sun;
+                first.slices = {0, split};
+                second.slices = {split, nw};
+                ASSERT_TRUE(mBackend->Shade(first, *q, *T).has_value());
+                ASSERT_TRUE(mBackend->ShadeSky(sky, *q, *skyT).has_value());
+                ASSERT_TRUE(mBackend->Shade(second, *q, *T).has_value());
+                if (batched) {
+                    ASSERT_TRUE(mBackend->EndBatch().has_value());
+                }
+                expectBytes(test::Read<float>(*mBackend, *T), wholeT, what + ": the sun's T");
+                expectBytes(test::Read<float>(*mBackend, *skyT), aloneSkyT, what + ": T_sky");
+            }
+    Vk().SetShadeSweep(vk::BackendVk::ShadeSweep::Auto);
 }
 
 // Not a test: times both paths on thesis-medium's grid and sun (256 x 256 x 32,

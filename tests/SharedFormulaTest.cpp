@@ -300,7 +300,7 @@ TEST(SharedFormula, FrustumBoundGrowsBySplatRadius) {
     p.qMin = 0;
     const SplatFrame frame = MakeSplatFrame(p, c.grid, FlattenSplatOrder(order), 64, 64);
     Splat s;
-    ASSERT_TRUE(MakeSplat(frame, 16, 3, 0, 1.0f, 1.0f, s));
+    ASSERT_TRUE(MakeSplat(frame, 16, 3, 0, 1.0f, 1.0f, 1.0f, s));
     EXPECT_NEAR(s.px, 66.0f, 1e-4f);
     EXPECT_NEAR(s.size, 8.0f, 1e-4f);
     EXPECT_EQ(s.x0, 62);
@@ -340,7 +340,7 @@ TEST(SharedFormula, FrustumCullsNoSplatThatCoversAPixel) {
                 for (uint32_t i = 0; i < grid.nx; ++i) {
                     const size_t box = i / p.tile + tilesX * (j / p.tile + size_t(tilesY) * (k / p.band));
                     Splat s;
-                    const bool covers = MakeSplat(frame, i, j, k, 1.0f, 1.0f, s) && s.x0 <= s.x1 && s.y0 <= s.y1;
+                    const bool covers = MakeSplat(frame, i, j, k, 1.0f, 1.0f, 1.0f, s) && s.x0 <= s.x1 && s.y0 <= s.y1;
                     coveringVoxels += covers;
                     if (covers) {
                         ASSERT_TRUE(visible[box]) << "camera " << n << " voxel " << i << "," << j << "," << k;

@@ -1,9 +1,10 @@
 // Finite outputs at the load-time bounds (SPEC 12's "no stage may return NaN or Inf for any valid input";
-// docs/pipeline.md, "Finite outputs"): the phase function's peak, the sun's and the lightning's radiance (at the
-// guard radius too), the lightning's distance in voxel edges, ambient and background, the sun's azimuth (fixed, on a
-// path, at a speed) and the optical depth with forward scattering. Each extreme runs just inside its bound on every
-// backend with every output on every step, and every array it writes (T, G, the images of every camera, ...) must
-// be finite and in range; just past each bound the scene is refused with file, field, bound and value.
+// docs/pipeline.md, "Finite outputs"): the phase function's peak, the sun's, the sky light's and the lightning's
+// radiance (at the guard radius too), the lightning's distance in voxel edges, ambient and background, the sun's
+// azimuth (fixed, on a path, at a speed) and the optical depth with forward scattering. Each extreme runs just inside
+// its bound on every backend with every output on every step, and every array it writes (T, G, the images of every
+// camera, ...) must be finite and in range; just past each bound the scene is refused with file, field, bound and
+// value.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -128,6 +129,14 @@ std::vector<BoundItem> BoundItems() {
     const std::string farLight = R"({"position": [1e18, 1e18, -1e18], "color": [1, 1, 1], "intensity": 1e30,
                                      "radius": 1, "flash": {"start": 0, "steps": 10}})";
     items.push_back({"LightningFarAtEdgeBound", Plus(LitFullVolume(), Plus(peak, {{"lightning", farLight}})), 1e34});
+    // The sky light at its bound where the sun stands (its phase peak too), beside the sun and the lightning at theirs:
+    // a sample's light is then three terms of up to 1e30 * 2^19.5 each.
+    const std::vector<SceneOverride> sky = {
+        {"stages", R"(["region", "ca", "smooth", "density", "shade", "shade_sky", "shadow", "render_splat",
+                      "render_march"])"},
+        {"lighting.sky", R"({"elevation_deg": 25, "azimuth_deg": 60, "color": [1e30, 1e30, 1e30], "intensity": 1})"},
+        {"lightning", light}};
+    items.push_back({"SkyLightAtBound", Plus(LitFullVolume(), Plus(peak, sky)), 1e34});
     // A path from -1e9 to 1e9 degrees over 2^32 - 1 steps: 0.47 degrees a step.
     const std::string path = R"({"color": [1e30, 1e30, 1e30], "intensity": 1, "path": [
         {"step": 0, "elevation_deg": 25, "azimuth_deg": -1e9},

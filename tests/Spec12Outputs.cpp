@@ -44,8 +44,8 @@ double PhaseMax(const PhaseParams& phase) {
 // The documented range of element `index` of a resource. Images (SPEC 8, 10, 15):
 // each pixel is a convex combination (compositing with alpha in [0, 1], or
 // T_view weights summing to 1) of the background and of colours
-// sun*T*P^ + ambient with T in [0, 1], so each channel lies between
-// min(background, ambient) and max(background, sun*P^max + ambient).
+// sun*T*P^ + ambient (+ sky*T_sky*P^ with the sky light) with T, T_sky in [0, 1], so each channel lies between
+// min(background, ambient) and max(background, (sun + sky)*P^max + ambient).
 struct Bounds {
     double lo, hi;
     bool zeroOrOne = false;
@@ -61,12 +61,15 @@ Bounds DocumentedBounds(Resource r, const Scene& s, size_t index) {
         case Resource::Q: return {0, 1};                      // SPEC 4: a weighted mean of bits
         case Resource::ColumnSum: return {0, double(s.grid.size.nz)};  // SPEC 5: nz values of q
         case Resource::T:
+        case Resource::TSky:
         case Resource::Shadow: return {0, 1};                 // SPEC 6, 7
         case Resource::SplatImage:
         case Resource::MarchImage:
         case Resource::LayersImage: {  // SPEC 15: the same blend, from the background
             const size_t c = index % 3;
-            const double sun = double(s.sun.Radiance()[c]), ambient = s.lighting.ambient[c], bg = s.lighting.background[c];
+            const double sky = s.lighting.sky.on ? double(s.lighting.sky.Radiance()[c]) : 0.0;
+            const double sun = double(s.sun.Radiance()[c]) + sky, ambient = s.lighting.ambient[c],
+                         bg = s.lighting.background[c];
             const double lo = std::min(bg, ambient), hi = std::max(bg, sun * PhaseMax(s.phase) + ambient);
             return {lo * (1 - 1e-5), hi * (1 + 1e-5)};  // float rounding of the blends
         }

@@ -15,7 +15,7 @@ namespace {
 // Test that the list expands consistently: names round-trip, SPEC sections
 // are the documented ones, and each descriptor sits at its stage's index.
 TEST(StageList, NamesSectionsAndDescriptorsAgree) {
-    EXPECT_EQ(kStageCount, 10u);
+    EXPECT_EQ(kStageCount, 11u);
     for (Stage s : kAllStages) {
         EXPECT_EQ(ParseStage(StageName(s)), s);
         EXPECT_EQ(Describe(s).stage, s);
@@ -23,6 +23,8 @@ TEST(StageList, NamesSectionsAndDescriptorsAgree) {
     EXPECT_EQ(StageName(Stage::RenderSplat), "render_splat");
     EXPECT_EQ(StageSpecSection(Stage::Shade), "6");
     EXPECT_EQ(StageSpecSection(Stage::Noise), "10a");
+    EXPECT_EQ(StageName(Stage::ShadeSky), "shade_sky");
+    EXPECT_EQ(StageSpecSection(Stage::ShadeSky), "16");
     EXPECT_EQ(StageName(Stage::RenderLayers), "render_layers");
     EXPECT_EQ(StageSpecSection(Stage::RenderLayers), "15");
     EXPECT_FALSE(IsSplatPipelineStage(Stage::RenderLayers));
@@ -158,13 +160,14 @@ TEST(StageList, SceneKeysAreOwnedOnce) {
                                           "sun",  "lighting",    "lightning", "phase", "render"};
     for (Stage s : kAllStages) {
         const StageDescriptor& d = Describe(s);
-        EXPECT_TRUE(d.readSettings) << StageName(s);
+        // shade_sky alone has no settings of its own (it takes shade's and lighting.sky).
+        EXPECT_EQ(bool(d.readSettings), s != Stage::ShadeSky) << StageName(s);
         for (std::string_view key : d.sceneKeys) {
             EXPECT_EQ(std::ranges::count(keys, key), 0) << key;
             keys.push_back(key);
         }
     }
-    EXPECT_EQ(keys.size(), 11u + 9u);  // every stage but render_splat owns one section
+    EXPECT_EQ(keys.size(), 11u + 9u);  // every stage but render_splat and shade_sky owns one section
 }
 
 // Test the comparison rules as SPEC states them, and their texts.

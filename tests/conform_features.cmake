@@ -88,3 +88,26 @@ foreach(light IN ITEMS shade march)
   set_tests_properties(Cli.ConformTiledMarch.${light} PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
                        PASS_REGULAR_EXPRESSION "render_march +(gl|vk) +pass" TIMEOUT 300)
 endforeach()
+# The sky light, low and off the diagonal (so that a swapped x and y shows), with its own T_sky, on every built
+# backend for each renderer: the splats (ci-small, whose automaton runs two steps), the march (tiled layers-small,
+# shade's T and then the light march, which still reads T_sky) and the layers, at shade resolution 1 and 2 (the sky's
+# coarse sweep beside the sun's); exit 4 (no backend besides the CPU could start) is a skip.
+set(sky_light "lighting.sky={\"elevation_deg\":12,\"azimuth_deg\":200,\"color\":[1,0.5,0.3],\"intensity\":1.5}")
+foreach(resolution IN ITEMS 1 2)
+  add_test(NAME Cli.ConformSkyLight.splat-${resolution}
+           COMMAND ${cli} conform ci-small --steps 2 --set warmup_steps=0 --set "${sky_light}"
+                   --set "stages=[\"region\",\"ca\",\"smooth\",\"density\",\"shade\",\"shade_sky\",\"render_splat\"]"
+                   --set shade.resolution=${resolution} --out ${cli_out}/conform-sky-splat-${resolution})
+  set_tests_properties(Cli.ConformSkyLight.splat-${resolution} PROPERTIES SKIP_RETURN_CODE 4
+                       FAIL_REGULAR_EXPRESSION "fail" PASS_REGULAR_EXPRESSION "shade_sky +(gl|vk) +pass" TIMEOUT 300)
+  foreach(light IN ITEMS shade march)
+    add_test(NAME Cli.ConformSkyLight.${light}-${resolution}
+             COMMAND ${cli} conform layers-small --set "${sky_light}"
+                     --set "stages=[\"noise\",\"shade\",\"shade_sky\",\"render_march\",\"render_layers\"]"
+                     --set "march.light=\"${light}\"" --set shade.resolution=${resolution}
+                     --out ${cli_out}/conform-sky-${light}-${resolution})
+    set_tests_properties(Cli.ConformSkyLight.${light}-${resolution} PROPERTIES SKIP_RETURN_CODE 4
+                         FAIL_REGULAR_EXPRESSION "fail" PASS_REGULAR_EXPRESSION "render_layers +(gl|vk) +pass"
+                         TIMEOUT 300)
+  endforeach()
+endforeach()

@@ -77,15 +77,17 @@ inline LayersTaps LayersTapsAt(const Vec3& size, const Vec3& p) {
     return {i + px * (j + py * k), cx - float(i), cy - float(j), cz - float(k)};
 }
 
-// Trilinear (q, T) from the taps; fetch(paddedIndex) returns the pair.
+// Trilinear (q, T), or (q, T, T_sky) with the sky light, from the taps; fetch(paddedIndex) returns the pair
+// (the triple), each field blended alone.
 template <class Fetch>
-inline std::array<float, 2> LayersBlend(const Vec3& size, const LayersTaps& t, Fetch&& fetch) {
+inline auto LayersBlend(const Vec3& size, const LayersTaps& t, Fetch&& fetch) {
     const uint32_t px = uint32_t(size[0]) + 2u, pxy = px * (uint32_t(size[1]) + 2u);
-    std::array<float, 2> out{};
-    const std::array<float, 2> a0 = fetch(t.base), a1 = fetch(t.base + 1u), a2 = fetch(t.base + px),
-                               a3 = fetch(t.base + px + 1u), b0 = fetch(t.base + pxy), b1 = fetch(t.base + pxy + 1u),
-                               b2 = fetch(t.base + pxy + px), b3 = fetch(t.base + pxy + px + 1u);
-    for (int f = 0; f < 2; ++f) {
+    using Fields = std::remove_cvref_t<decltype(fetch(t.base))>;
+    Fields out{};
+    const Fields a0 = fetch(t.base), a1 = fetch(t.base + 1u), a2 = fetch(t.base + px), a3 = fetch(t.base + px + 1u),
+                 b0 = fetch(t.base + pxy), b1 = fetch(t.base + pxy + 1u), b2 = fetch(t.base + pxy + px),
+                 b3 = fetch(t.base + pxy + px + 1u);
+    for (size_t f = 0; f < out.size(); ++f) {
         const float c00 = Lerp(a0[f], a1[f], t.wx), c10 = Lerp(a2[f], a3[f], t.wx);
         const float c01 = Lerp(b0[f], b1[f], t.wx), c11 = Lerp(b2[f], b3[f], t.wx);
         out[f] = Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
@@ -148,7 +150,8 @@ struct LayerFragmentResult {
 // at squared horizontal distance r2 from the eye, standing for `length` of path. Moved by the drift and wrapped
 // (tiling), or outside the box [0, nx] x [0, ny] not a fragment; drawn where q > 0. Its opacity is beer's,
 // alpha = 1 - exp(-sigma h q length), or wang's (eq. 16 of q and the map, without a path length), times
-// LayersFade(r2); its colour c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's).
+// LayersFade(r2); its colour c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's), plus the
+// sky light's T_sky P^(s_sky . d) where fetch returns T_sky as a third field.
 // Always inlined: with two callers GCC keeps it out of line, and the call costs the CPU's layers a quarter of
 // their time on wang-20km (reports/perf/lod0-layers-cost.md).
 template <class Fetch>
@@ -164,7 +167,7 @@ template <class Fetch>
         return f;
     }
     f.crossed = true;
-    const std::array<float, 2> qt = LayersBlend(s.size, LayersTapsAt(s.size, Vec3{x, y, z}), fetch);
+    const auto qt = LayersBlend(s.size, LayersTapsAt(s.size, Vec3{x, y, z}), fetch);
     if (!(qt[0] > 0.0f)) return f;
     f.drawn = true;
     if (s.wang) {
@@ -177,7 +180,10 @@ template <class Fetch>
     const float gain = lit * sunPhase;
     // The sample (voxel units, before the drift and the wrap).
     const Vec3 at{s.eye[0] + hx, s.eye[1] + hy, z};
-    f.color = InScattered(s.light, LightSample{gain, lit, 1.0f, at, ray.dir});
+    float skyGain = 0.0f;
+    if constexpr (qt.size() > 2)
+        if (s.light.skyOn) skyGain = qt[2] * SkyPhase(s.light, ray.dir);
+    f.color = InScattered(s.light, LightSample{gain, lit, 1.0f, at, ray.dir, skyGain});
     return f;
 }
 

@@ -1,6 +1,6 @@
 // The light a sample scatters toward the eye, ONE function for every renderer
 // (ray march, layers, splats) on every backend: the scene's enabled light terms
-// (the sun, the ambient light, the lightning's point light, the city glow, eye scattering) gathered at a
+// (the sun, the ambient light, the sky light, the lightning's point light, the city glow, eye scattering) gathered at a
 // sample. GLSL twin: core/math/light.glsl (InScattered, LightGpu), which the
 // GPU blocks of the renderers (MarchGpu, LayersGpu, SplatFrame) nest as their
 // member `light`, made by MakeLightGpu below.
@@ -9,7 +9,7 @@
 // (MarchSetup, LayersSetup, SplatParams), made by MakeLightTerms
 // (core/pipeline/LightTerms.h) in each renderer's Make*Params.
 //
-// Adding a light term (sky light): a member of
+// Adding a light term: a member of
 // LightTerms (and, if it varies per sample, of LightSample) and its lines in
 // InScattered, here and in light.glsl; its member of LightGpu in both languages
 // and its line in MakeLightGpu / LightTermsOf; its line in MakeLightTerms and
@@ -17,6 +17,7 @@
 //
 // The operations, in this order (bit-identical on every backend, built with
 // -ffp-contract=off): per channel c = sunRadiance_c * sunGain + ambient_c,
+// then with the sky light on c += skyRadiance_c * skyGain,
 // then with the point light on c += pointRadiance_c * g, g = T_point / max(d^2, r0^2) P^(cos theta_point),
 // then with the city glow on c += glowColor_c * GlowMap(x, y) (1 - clamp(glowFade (z invThickness), 0, 1)),
 // then with eye scattering on c += sunRadiance_c * (sunT ((eyeIntensity cone) rise)).
@@ -73,18 +74,31 @@ struct LightTerms {
     float eyeCosCone = 0;         // cos phi
     float eyeInvOneMinusCos = 1;  // 1 / (1 - cos phi)
     float eyeHeightGain = 0;      // f_e
+    // The sky light (Wang, Ji and Zhang, section 3.3): skyRadiance T_sky P^(skyDirection . d), T_sky its own
+    // attenuation (stage shade_sky).
+    bool skyOn = false;
+    Vec3 skyRadiance{};          // colour * intensity
+    Vec3 skyDirection{0, 0, 1};  // unit, toward the sky light
 };
 
 // What varies per sample: the sun's gain (its transmittance times the phase,
 // times the powder where the renderer has it), the sun's transmittance alone, the
-// point light's transmittance, the sample's position (voxel units) and the ray's unit direction.
+// point light's transmittance, the sample's position (voxel units), the ray's unit direction and the sky light's
+// gain (T_sky P^(skyDirection . d); read only with the sky light on).
 struct LightSample {
     float sunGain = 0;
     float sunT = 0;
     float pointT = 1;
     Vec3 position{};
     Vec3 dir{};
+    float skyGain = 0;
 };
+
+// The sky light's P^(skyDirection . d) on a ray of unit direction d; 0 with the sky light off.
+inline float SkyPhase(const LightTerms& L, const Vec3& d) {
+    if (!L.skyOn) return 0.0f;
+    return PhaseValue(L.phase, L.skyDirection[0] * d[0] + L.skyDirection[1] * d[1] + L.skyDirection[2] * d[2]);
+}
 
 // The city glow, then eye scattering, each where it is on (InScattered's last terms). Out of line: a renderer's
 // loop without them keeps InScattered small.
@@ -107,6 +121,8 @@ struct LightSample {
 inline Vec3 InScattered(const LightTerms& L, const LightSample& s) {
     Vec3 c{L.sunRadiance[0] * s.sunGain + L.ambient[0], L.sunRadiance[1] * s.sunGain + L.ambient[1],
            L.sunRadiance[2] * s.sunGain + L.ambient[2]};
+    if (L.skyOn)
+        for (int i = 0; i < 3; ++i) c[i] += L.skyRadiance[i] * s.skyGain;
     if (L.pointOn) {
         const Vec3 toLight{L.pointPosition[0] - s.position[0], L.pointPosition[1] - s.position[1],
                            L.pointPosition[2] - s.position[2]};
@@ -153,8 +169,12 @@ struct alignas(16) LightGpu {
     float eyeCosCone;
     float eyeInvOneMinusCos;
     float eyeHeightGain;
+    std::array<float, 3> skyRadiance;
+    uint32_t skyOn;  // 1: the sky light shines
+    std::array<float, 3> skyDirection;
+    uint32_t skyUnused;
 };
-static_assert(sizeof(LightGpu) == (9 + kMaxGlowBlobs) * 16, "LightGpu is nine 16-byte rows and one per glow blob");
+static_assert(sizeof(LightGpu) == (11 + kMaxGlowBlobs) * 16, "LightGpu is eleven 16-byte rows and one per glow blob");
 
 inline LightGpu MakeLightGpu(const LightTerms& L) {
     LightGpu g{};
@@ -181,6 +201,9 @@ inline LightGpu MakeLightGpu(const LightTerms& L) {
     g.eyeCosCone = L.eyeCosCone;
     g.eyeInvOneMinusCos = L.eyeInvOneMinusCos;
     g.eyeHeightGain = L.eyeHeightGain;
+    g.skyRadiance = L.skyRadiance;
+    g.skyOn = L.skyOn ? 1u : 0u;
+    g.skyDirection = L.skyDirection;
     return g;
 }
 
@@ -207,6 +230,9 @@ inline LightTerms LightTermsOf(const LightGpu& g) {
     L.eyeCosCone = g.eyeCosCone;
     L.eyeInvOneMinusCos = g.eyeInvOneMinusCos;
     L.eyeHeightGain = g.eyeHeightGain;
+    L.skyOn = g.skyOn != 0u;
+    L.skyRadiance = g.skyRadiance;
+    L.skyDirection = g.skyDirection;
     return L;
 }
 

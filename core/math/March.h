@@ -273,10 +273,10 @@ inline void MarchBrickBox(const MarchSetup& s, const MarchBrickCell& c, float B,
 
 // ---- Light functor for the light march (Olajos) -----------------------------------
 
-// What a light functor returns at a sample: transmittance toward the sun and
-// toward the point light (1 where the light is off).
+// What a light functor returns at a sample: transmittance toward the sun, toward
+// the point light and toward the sky light (T_sky; 1 where a light is off).
 struct MarchLightSample {
-    float sun = 1, point = 1;
+    float sun = 1, point = 1, sky = 1;
 };
 
 // T along the segment from p toward unit direction u over length `length`
@@ -337,6 +337,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
     if (!ray.Empty()) {
         // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
         const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
+        const float skyPhase = SkyPhase(s.light, ray.dir);
         const float B = bricks ? float(bricks->brick) : 1.0f, invB = 1.0f / B;
         const Vec3 invDir = InverseDirection(ray.dir);
         float tn = ray.tMin;
@@ -396,7 +397,8 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                 const MarchLightSample l = light(p);
                 float sunGain = l.sun * sunPhase;
                 if (s.powder) sunGain *= PowderTerm(s.powderC, l.sun);
-                const Vec3 in = InScattered(s.light, LightSample{sunGain, l.sun, l.point, p, ray.dir});
+                const Vec3 in =
+                    InScattered(s.light, LightSample{sunGain, l.sun, l.point, p, ray.dir, l.sky * skyPhase});
                 const float w = T * (1.0f - tau);
                 L0 += w * in[0];
                 L1 += w * in[1];

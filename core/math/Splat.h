@@ -67,12 +67,13 @@ static_assert(sizeof(Splat) == 48);
 // q at the frame's time: q_prev + alpha (q_cur - q_prev).
 inline float SplatQ(float qPrev, float qCur, float alpha) { return qPrev + alpha * (qCur - qPrev); }
 
-// The splat of voxel (i, j, k) with q_alpha qa and transmittance t. False, and
+// The splat of voxel (i, j, k) with q_alpha qa, transmittance t and the sky light's tSky (read with it on). False, and
 // no splat, when qa <= q_min, the voxel centre is not beyond the near plane, or
 // the centre or size in pixels is not finite (an extreme focal length). The
 // covered pixels are clamped in float before the conversion to int, so a splat
 // far outside the image gets an empty range (x0 > x1 or y0 > y1), never a wrap.
-inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, float qa, float t, Splat& s) {
+inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, float qa, float t, float tSky,
+                      Splat& s) {
     s = Splat{0, 0, 0, 0, {0, 0, 0}, 0, 0, -1, 0, -1};
     if (!(qa > F.qMin)) return false;
     const float h = F.voxelSize;
@@ -99,7 +100,8 @@ inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, f
     // The sample: the voxel centre in voxel units, seen along the unit direction from the eye.
     const Vec3 at{float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f};
     const Vec3 dir{dx / len, dy / len, dz / len};
-    const Vec3 colour = InScattered(terms, LightSample{light, t, 1.0f, at, dir});
+    const float skyGain = terms.skyOn ? tSky * SkyPhase(terms, dir) : 0.0f;
+    const Vec3 colour = InScattered(terms, LightSample{light, t, 1.0f, at, dir, skyGain});
     for (int c = 0; c < 3; ++c) s.colour[c] = colour[c];
     // Covered pixels: px - s/2 <= x + 0.5 < px + s/2.
     // Clamped to [0, image] and [-1, image - 1] in float, so the ints cannot overflow.

@@ -6,7 +6,7 @@
 // Include after random.glsl, shading.glsl, phase_table.glsl, light.glsl and march.glsl,
 // whose pixel ray, padded sampler (PaddedTapsAt, PaddedBlend), SegmentTransmittance
 // and phase it uses. The including shader defines march.glsl's MarchFetchQT as the
-// layers' padded (q_alpha, T) volume, (nx+2) x (ny+2) x (nz+2) with voxel
+// layers' padded (q_alpha, T) volume and MarchFetchSkyT as T_sky's (read with the sky light on), (nx+2) x (ny+2) x (nz+2) with voxel
 // (i, j, k) at (i+1, j+1, k+1), PhaseTableValue (phase Mie only) and
 //   float LayersMapValue(uint i);  // the modulation map, nx * ny, x fastest (wang opacity only)
 //   LayersBillboard LayersBillboardAt(uint i);  // the billboards in drawing order (billboardCount of them)
@@ -137,7 +137,8 @@ LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, float sunPhase, f
         return f;
     }
     f.crossed = true;
-    const vec2 qt = PaddedBlend(s.strideY, s.strideZ, PaddedTapsAt(s.size, s.strideY, s.strideZ, vec3(x, y, z)));
+    const MarchTaps taps = PaddedTapsAt(s.size, s.strideY, s.strideZ, vec3(x, y, z));
+    const vec2 qt = PaddedBlend(s.strideY, s.strideZ, taps);
     if (!(qt.x > 0.0)) return f;
     f.drawn = true;
     if ((s.flags & kLayersWang) != 0u) {
@@ -152,7 +153,9 @@ LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, float sunPhase, f
     precise float gain = lit * sunPhase;
     // The sample (voxel units, before the drift and the wrap).
     precise vec3 at = vec3(s.eye.x + hx, s.eye.y + hy, z);
-    f.color = InScattered(s.light, LightSample(gain, lit, 1.0, at, ray.dir));
+    precise float skyGain = 0.0;
+    if (s.light.skyOn != 0u) skyGain = PaddedBlendSky(s.strideY, s.strideZ, taps) * SkyPhase(s.light, ray.dir);
+    f.color = InScattered(s.light, LightSample(gain, lit, 1.0, at, ray.dir, skyGain));
     return f;
 }
 

@@ -34,6 +34,10 @@ struct LightGpu {
     float eyeCosCone;
     float eyeInvOneMinusCos;
     float eyeHeightGain;
+    vec3 skyRadiance;
+    uint skyOn;
+    vec3 skyDirection;
+    uint skyUnused;
 };
 
 // core/math/Light.h LightSample.
@@ -43,11 +47,19 @@ struct LightSample {
     float pointT;
     vec3 position;
     vec3 dir;
+    float skyGain;
 };
 
 // P^(cos theta) of the scene's phase function (core/math/Shading.h PhaseValue).
 float LightPhase(LightGpu L, float cosTheta) {
     return PhaseOf(L.phaseKind, L.phaseG, L.mieIndexPerRadian, L.mieCount, cosTheta);
+}
+
+// core/math/Light.h SkyPhase.
+float SkyPhase(LightGpu L, vec3 d) {
+    if (L.skyOn == 0u) return 0.0;
+    precise float cosSky = L.skyDirection.x * d.x + L.skyDirection.y * d.y + L.skyDirection.z * d.z;
+    return LightPhase(L, cosSky);
 }
 
 // 1 / max(d2, r0^2) (core/math/Light.h PointLightFalloff).
@@ -70,6 +82,11 @@ vec3 InScattered(LightGpu L, LightSample s) {
     precise float c0 = L.sunRadiance.x * s.sunGain + L.ambient.x;
     precise float c1 = L.sunRadiance.y * s.sunGain + L.ambient.y;
     precise float c2 = L.sunRadiance.z * s.sunGain + L.ambient.z;
+    if (L.skyOn != 0u) {
+        c0 += L.skyRadiance.x * s.skyGain;
+        c1 += L.skyRadiance.y * s.skyGain;
+        c2 += L.skyRadiance.z * s.skyGain;
+    }
     if (L.pointOn != 0u) {
         precise vec3 toLight = vec3(L.pointPosition.x - s.position.x, L.pointPosition.y - s.position.y,
                                     L.pointPosition.z - s.position.z);

@@ -60,6 +60,8 @@ const uint kMarchStreamOther = 3u;
 const float kMarchFloatMax = 3.402823466e+38;
 
 vec2 MarchFetchQT(uint paddedIndex);
+// The sky light's T_sky in the same padded layout (border 1, or wrapped with tiling); read only with the sky light on.
+float MarchFetchSkyT(uint paddedIndex);
 bool MarchBrickEmpty(uint brick);
 
 // ---- Rays ----
@@ -195,6 +197,16 @@ vec2 PaddedBlend(uint px, uint pxy, MarchTaps t) {
 
 vec2 MarchBlend(MarchGpu m, MarchTaps t) { return PaddedBlend(m.strideY, m.strideZ, t); }
 
+// T_sky trilinear at the taps (the same order of operations as PaddedBlend's).
+float PaddedBlendSky(uint px, uint pxy, MarchTaps t) {
+    const uint a = t.base, b = t.base + pxy;
+    const float c00 = Lerp(MarchFetchSkyT(a), MarchFetchSkyT(a + 1u), t.w.x);
+    const float c10 = Lerp(MarchFetchSkyT(a + px), MarchFetchSkyT(a + px + 1u), t.w.x);
+    const float c01 = Lerp(MarchFetchSkyT(b), MarchFetchSkyT(b + 1u), t.w.x);
+    const float c11 = Lerp(MarchFetchSkyT(b + px), MarchFetchSkyT(b + px + 1u), t.w.x);
+    return Lerp(Lerp(c00, c10, t.w.y), Lerp(c01, c11, t.w.y), t.w.z);
+}
+
 float MarchSampleQ(MarchGpu m, vec3 p) { return MarchBlend(m, MarchTapsAt(m, p)).x; }
 
 // ---- Kernel formulas (core/math/March.h) ----
@@ -326,6 +338,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
     const bool powder = (m.flags & kMarchPowder) != 0u;
     if (ray.tMin < ray.tMax) {
         const float sunPhase = MarchPhase(m, MarchDot(m.sun, ray.dir));
+        const float skyPhase = SkyPhase(m.light, ray.dir);
         const float B = skipping ? float(m.brick) : 1.0;
         precise float invB = 1.0 / B;
         const vec3 invDir = InverseDirection(ray.dir);
@@ -385,7 +398,10 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
                 precise float sunGain = lightSun * sunPhase;
                 if (powder) sunGain *= PowderTerm(m.powderC, lightSun);
                 const float lightPoint = pointOn ? PointLightMarch(m, p) : 1.0;
-                const vec3 inLight = InScattered(m.light, LightSample(sunGain, lightSun, lightPoint, p, ray.dir));
+                const float lightSky = m.light.skyOn != 0u ? PaddedBlendSky(m.strideY, m.strideZ, taps) : 1.0;
+                precise float skyGain = lightSky * skyPhase;
+                const vec3 inLight =
+                    InScattered(m.light, LightSample(sunGain, lightSun, lightPoint, p, ray.dir, skyGain));
                 precise float w = T * (1.0 - tau);
                 L0 += w * inLight.x;
                 L1 += w * inLight.y;

@@ -56,9 +56,9 @@ float SplatQ(float qPrev, float qCur, float alpha) {
 // std::isfinite.
 bool SplatFinite(float v) { return !isnan(v) && !isinf(v); }
 
-// The splat of voxel idx with q_alpha qa and transmittance t; false when it makes none
+// The splat of voxel idx with q_alpha qa, transmittance t and the sky light's tSky; false when it makes none
 // (also when px, py or size is not finite). Covered pixels are clamped before int().
-bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
+bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, float tSky, out Splat s) {
     s = Splat(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, 0, -1);
     if (!(qa > F.qMin)) return false;
     const float h = F.voxelSize;
@@ -84,7 +84,8 @@ bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, out Splat s) {
     // The sample: the voxel centre in voxel units, seen along the unit direction from the eye.
     const vec3 at = vec3(float(idx.x) + 0.5, float(idx.y) + 0.5, float(idx.z) + 0.5);
     precise vec3 dir = vec3(dx / len, dy / len, dz / len);
-    const vec3 colour = InScattered(F.light, LightSample(light, t, 1.0, at, dir));
+    precise float skyGain = F.light.skyOn != 0u ? tSky * SkyPhase(F.light, dir) : 0.0;
+    const vec3 colour = InScattered(F.light, LightSample(light, t, 1.0, at, dir, skyGain));
     s.r = colour.x;
     s.g = colour.y;
     s.b = colour.z;

@@ -140,8 +140,13 @@ Status CheckGroundInput(const GroundParams& ground, const Buffer* G, const Exten
     X(RenderLayers, RenderLayers, \
       (const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats))
 
+// The sky light's attenuation (SPEC 16): shade's sweep toward the sky light, T_sky (F32, grid size) from q, with
+// stage objects of its own (a sky shade between two shares of the sun's sweep leaves them as they were).
+#define CB_SKY_ENTRIES(X) X(ShadeSky, ShadeSky, (const ShadeParams& params, const Buffer& q, Buffer& T))
+
 // Every entry point.
-#define CB_BACKEND_ENTRIES(X) CB_SPLAT_PIPELINE_ENTRIES(X) CB_NOISE_ENTRIES(X) CB_MARCH_ENTRIES(X) CB_LAYERS_ENTRIES(X)
+#define CB_BACKEND_ENTRIES(X) \
+    CB_SPLAT_PIPELINE_ENTRIES(X) CB_SKY_ENTRIES(X) CB_NOISE_ENTRIES(X) CB_MARCH_ENTRIES(X) CB_LAYERS_ENTRIES(X)
 
 // In a backend's class: declares the override of one entry.
 #define CB_OVERRIDE_BACKEND_ENTRY(stage, Method, parameters) Status Method parameters override;

@@ -42,6 +42,12 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
             L.glowBlobs[i][3] = float(b.strength);
         }
     }
+    const SkyLightSettings& sky = sc.lighting.sky;
+    L.skyOn = sky.on;
+    if (sky.on) {
+        L.skyRadiance = sky.Radiance();
+        L.skyDirection = sky.Direction();
+    }
     const EyeScatteringSettings& eye = sc.lighting.eyeScattering;
     L.eyeOn = eye.on;
     L.sunDirection = sc.sun.DirectionAt(step);
@@ -61,7 +67,8 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering", "sky"};
+constexpr std::string_view kSkyKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity"};
 constexpr std::string_view kEyeScatteringKeys[] = {"intensity", "cone_deg", "height_gain", "replaces_phase"};
 constexpr std::string_view kCityGlowKeys[] = {"color", "fade", "blobs"};
 constexpr std::string_view kGlowBlobKeys[] = {"center", "radius", "strength"};
@@ -93,6 +100,38 @@ void ReadEyeScattering(const Json& lighting, Validator& check, EyeScatteringSett
     if (const Json* v = Validator::Find(*section, "replaces_phase")) {
         if (auto b = check.Boolean(*v, "lighting.eye_scattering.replaces_phase")) eye.replacesPhase = *b;
     }
+}
+
+// The sky light is scattered sunlight from the sky above the horizon: its elevation is in (0, 90] (below the
+// horizon is the ground's side; a light there would light the clouds through the ground). colour * intensity is
+// bounded like the sun's (ReadSun), so the term adds at most what the sun does to a sample's light.
+void ReadSky(const Json& lighting, Validator& check, SkyLightSettings& sky) {
+    const Json* section = check.Section(lighting, "lighting", "sky", kSkyKeys);
+    if (!section) return;
+    sky.on = true;
+    if (const Json* v = Validator::Find(*section, "elevation_deg")) {
+        if (v->is_number() && v->get<double>() <= 0)
+            check.Fail("lighting.sky.elevation_deg",
+                       "the sky light shines from above the horizon (elevation in (0, 90] degrees; below is the "
+                       "ground), got " +
+                           FormatNumber(v->get<double>()));
+        else if (auto d = check.Number(*v, "lighting.sky.elevation_deg", Range{.lo = 0, .loOpen = true, .hi = 90}))
+            sky.elevationDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "azimuth_deg")) {
+        if (auto d = check.Number(*v, "lighting.sky.azimuth_deg", Range{.lo = -360, .hi = 360})) sky.azimuthDeg = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "color")) {
+        if (auto a = check.Numbers<3>(*v, "lighting.sky.color", kSingleNonNegative)) sky.color = *a;
+    }
+    if (const Json* v = Validator::Find(*section, "intensity")) {
+        if (auto d = check.Number(*v, "lighting.sky.intensity", kSingleNonNegative)) sky.intensity = *d;
+    }
+    const double brightest = std::max({sky.color[0], sky.color[1], sky.color[2]}) * sky.intensity;
+    if (brightest > kMaxSingle)
+        check.Fail("lighting.sky.intensity",
+                   "color * intensity (the sky light's radiance) must be at most 1e+30 in each channel, got " +
+                       FormatNumber(brightest));
 }
 
 void ReadCityGlow(const Json& lighting, Validator& check, CityGlowSettings& glow) {
@@ -155,6 +194,7 @@ void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting
     }
     ReadCityGlow(*section, check, lighting.cityGlow);
     ReadEyeScattering(*section, check, lighting.eyeScattering);
+    ReadSky(*section, check, lighting.sky);
 }
 
 void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {

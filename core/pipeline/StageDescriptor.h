@@ -36,6 +36,7 @@ namespace cb {
     X(Tiles, "tiles", U8, "tiles")        /* tile occupancy, (tx, ty, 1) */         \
     X(Bands, "bands", U8, "bands")        /* tile x band occupancy, (tx, ty, bz) */ \
     X(T, "T", F32, "T")                   /* transmittance toward the sun, grid */  \
+    X(TSky, "T_sky", F32, "T_sky")        /* toward the sky light, grid */          \
     X(Shadow, "G", F32, "shadow")         /* ground shadow, (nx, ny, 1) */          \
     X(SplatImage, "image_splat", F32, "") /* (3, width, height) per camera */       \
     X(MarchImage, "image_march", F32, "")                                           \
@@ -115,13 +116,15 @@ struct FrameToneMap {
 };
 
 // What a renderer's accuracy measurement (harness/accuracy) hands it: the volume, the image to draw, the camera
-// and step, and `shadedT`, which shades T on the same backend when the renderer reads it (untimed).
+// and step, `shadedT`, which shades T on the same backend when the renderer reads it (untimed), and
+// `shadedSkyT`, which shades the sky light's T_sky likewise (read with the sky light on).
 struct AccuracyRenderInputs {
     const Buffer* q = nullptr;
     Buffer* image = nullptr;
     const CameraSettings* camera = nullptr;
     uint32_t step = 0;
     std::function<Result<const Buffer*>()> shadedT;
+    std::function<Result<const Buffer*>()> shadedSkyT;
 };
 // The renderer's call, made ready: `call` draws the image once (the measurement times it, repeatedly);
 // `prepMs` is the untimed work the renderer's inputs took (shading T, the density stage's occupancy).

@@ -200,6 +200,16 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
                    "needs the stage \"shadow\", which computes the ground shadow G it is lit "
                    "through; enable it or remove render.ground");
 
+    // The sky light is lit through T_sky: it shines iff the stage that shades toward it runs.
+    if (scene.lighting.sky.on && !scene.stages.Has(Stage::ShadeSky))
+        check.Fail("lighting.sky",
+                   "needs the stage \"shade_sky\", which computes T_sky, the sky light's attenuation; enable it or "
+                   "remove lighting.sky");
+    if (!scene.lighting.sky.on && scene.stages.Has(Stage::ShadeSky))
+        check.Fail("stages",
+                   "\"shade_sky\" shades toward the sky light, and the scene has none (lighting.sky); add "
+                   "lighting.sky or remove the stage");
+
     if (sections.steps) CheckSunSpeed(scene, check);
     CheckTiling(scene, check);
     CheckRelight(scene, check);

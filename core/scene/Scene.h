@@ -109,11 +109,33 @@ struct EyeScatteringSettings {
     bool replacesPhase = false;
 };
 
+// Skylight (Wang, Ji and Zhang, section 3.3): a second directional light, fixed, above the horizon, lit through its
+// own attenuation T_sky (stage shade_sky, which runs iff the section is present): colour term
+// sky T_sky P^(s_sky . d) (section `lighting.sky`; docs/pipeline.md, "Skylight").
+struct SkyLightSettings {
+    bool on = false;                             // the section is present
+    double elevationDeg = 20;                    // above the horizon, degrees, in (0, 90]
+    double azimuthDeg = 0;                       // from +x toward +y, degrees
+    std::array<double, 3> color{0.5, 0.6, 0.9};  // linear RGB
+    double intensity = 1.0;                      // multiplies color
+
+    // Unit vector toward the sky light.
+    Vec3 Direction() const {
+        constexpr double kDeg = 3.14159265358979323846 / 180.0;
+        return SunDirection(elevationDeg * kDeg, azimuthDeg * kDeg);
+    }
+    // color * intensity.
+    Vec3 Radiance() const {
+        return {float(color[0] * intensity), float(color[1] * intensity), float(color[2] * intensity)};
+    }
+};
+
 struct LightingSettings {
     std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
     std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
     CityGlowSettings cityGlow;
     EyeScatteringSettings eyeScattering;
+    SkyLightSettings sky;
 
     // In single precision, as the renderers use them.
     Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }

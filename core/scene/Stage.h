@@ -25,6 +25,7 @@ namespace cb {
     X(Smooth, "smooth", "4", true)                /* binomial smoothing cld -> q */                  \
     X(Density, "density", "5", true)              /* column sums D, tile/band occupancy, cover */    \
     X(Shade, "shade", "6", true)                  /* light attenuation T by inverse shear-warp */    \
+    X(ShadeSky, "shade_sky", "16", false)         /* the sky light's T_sky, by shade's sweep */      \
     X(Shadow, "shadow", "7", true)                /* ground shadow G */                              \
     X(RenderSplat, "render_splat", "8", true)     /* point-sprite splatting */                       \
     X(RenderMarch, "render_march", "10", false)   /* per-pixel ray march */                          \

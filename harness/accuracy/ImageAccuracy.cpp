@@ -9,6 +9,7 @@
 
 #include "core/scene/SceneNames.h"
 #include "core/stages/shade/Shade.h"
+#include "core/stages/shade_sky/ShadeSky.h"
 #include "harness/platform/Isolation.h"
 
 namespace cb {
@@ -122,7 +123,7 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     // T from shade on this backend when the renderer reads it, untimed in the render's time.
     std::unique_ptr<Buffer> T;
     std::optional<std::string> unsupported;
-    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr};
+    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr, nullptr};
     inputs.shadedT = [&]() -> Result<const Buffer*> {
         if (!backend.Supports(Stage::Shade)) {
             unsupported = backend.Name() + " does not implement shade, which feeds T";
@@ -135,6 +136,21 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
         if (Status s = backend.Shade(MakeShadeParams(scene), **q, *T); !s) return MakeError("shade: " + s.error().message);
         a.prepMs += MillisecondsSince(start);
         return T.get();
+    };
+    std::unique_ptr<Buffer> skyT;
+    inputs.shadedSkyT = [&]() -> Result<const Buffer*> {
+        if (!backend.Supports(Stage::ShadeSky)) {
+            unsupported = backend.Name() + " does not implement shade_sky, which feeds T_sky";
+            return MakeError(*unsupported);
+        }
+        auto t = backend.CreateBuffer(BufferFormat::F32, in.grid);
+        if (!t) return std::unexpected(t.error());
+        skyT = std::move(*t);
+        const auto start = std::chrono::steady_clock::now();
+        if (Status s = backend.ShadeSky(MakeShadeSkyParams(scene), **q, *skyT); !s)
+            return MakeError("shade_sky: " + s.error().message);
+        a.prepMs += MillisecondsSince(start);
+        return skyT.get();
     };
     auto render = descriptor->accuracyRender(backend, scene, inputs);
     if (!render) return RenderNotMeasured(unsupported ? "unsupported" : "failed", render.error().message);

@@ -18,6 +18,8 @@ layout(std430, binding = 3) readonly buffer LayersPhaseTable { float layersPhase
 // fragments, drawn: 64-bit sums as (low, high) word pairs.
 layout(std430, binding = 4) buffer LayersCounters { uint layersCounters[]; };
 layout(std430, binding = 5) readonly buffer LayersMap { float layersMap[]; };  // read with wang opacity only
+// The sky light's padded T_sky volume, read with the sky light on only.
+layout(std430, binding = 7) readonly buffer LayersSkyVolume { float layersSkyT[]; };
 #ifdef LAYERS_BILLBOARDS
 layout(std430, binding = 6) readonly buffer LayersBillboards { LayersBillboard layersBillboards[]; };
 LayersBillboard LayersBillboardAt(uint i) { return layersBillboards[i]; }
@@ -28,6 +30,7 @@ flat in uint layerIndex;  // with LAYERS_BILLBOARDS, the billboard's index
 layout(location = 0) out vec4 colour;
 
 vec2 MarchFetchQT(uint paddedIndex) { return layersQT[paddedIndex]; }
+float MarchFetchSkyT(uint paddedIndex) { return layersSkyT[paddedIndex]; }
 float PhaseTableValue(uint i) { return layersPhaseTable[i]; }
 float LayersMapValue(uint i) { return layersMap[i]; }
 bool MarchBrickEmpty(uint brick) { return false; }  // march.glsl's bricks: never read here

@@ -28,8 +28,9 @@ LayersBillboard LayersBillboardAt(uint i) { return LayersBillboard(vec3(0.0), 0.
 flat out uint layerIndex;  // with LAYERS_BILLBOARDS, the billboard's index
 out float gl_ClipDistance[1];
 
-// march.glsl's fetches: the vertex stage reads no volume.
+// march.glsl's fetches: the vertex stage reads no volume (it never samples one; render_layers.frag does).
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(0.0, 1.0); }
+float MarchFetchSkyT(uint paddedIndex) { return 1.0; }
 bool MarchBrickEmpty(uint brick) { return false; }
 float PhaseTableValue(uint i) { return 1.0; }
 float LayersMapValue(uint i) { return 0.0; }

@@ -24,6 +24,7 @@ float PhaseTableValue(uint i) { return phaseTable[i]; }
 layout(binding = 0) uniform sampler2DArray qPrev;
 layout(binding = 1) uniform sampler2DArray qCur;
 layout(binding = 2) uniform sampler2DArray transmittance;
+layout(binding = 6) uniform sampler2DArray skyTransmittance;  // the sky light's T_sky, read with it on only
 uniform float guard;       // pixels of viewport beyond each image edge
 flat out vec4 colour;      // rgb, q_alpha * opacity
 flat out vec3 splat;       // px, py, size (pixels; row 0 at the top)
@@ -50,7 +51,8 @@ void main() {
     }
     const float qa = SplatQ(texelFetch(qPrev, idx, 0).r, texelFetch(qCur, idx, 0).r, F.alpha);
     Splat s;
-    if (!MakeSplat(F, uvec3(idx), qa, texelFetch(transmittance, idx, 0).r, s)) {
+    const float tSky = F.light.skyOn != 0u ? texelFetch(skyTransmittance, idx, 0).r : 1.0;
+    if (!MakeSplat(F, uvec3(idx), qa, texelFetch(transmittance, idx, 0).r, tSky, s)) {
         Reject();
         return;
     }

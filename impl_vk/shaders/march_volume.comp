@@ -8,6 +8,7 @@
 // (q, T) pairs, else q alone.
 #extension GL_GOOGLE_include_directive : require
 #include "shading.glsl"
+#include "padded_volume.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer QPrev { float qPrev[]; };
@@ -15,13 +16,6 @@ layout(std430, binding = 1) readonly buffer QCur { float qCur[]; };
 layout(std430, binding = 2) readonly buffer Shade { float shadeT[]; };  // read only with hasT
 layout(std430, binding = 3) writeonly buffer Volume { float volume[]; };
 layout(push_constant) uniform Params { uint nx, ny, nz, hasT; float alpha; uint wrap; } pc;
-
-// The voxel padded index i stands for along an axis of n voxels; -1 for the border.
-int PaddedSource(uint i, uint n, bool wrap) {
-    if (i >= 1u && i <= n) return int(i) - 1;
-    if (!wrap) return -1;
-    return i == 0u ? int(n) - 1 : 0;
-}
 
 void main() {
     const uint px = pc.nx + 2u, py = pc.ny + 2u;

@@ -3,7 +3,8 @@
 // workgroups, LayersPixel of core/math/layers.glsl (the CPU's loop over the
 // layers the pixel's ray crosses, back to front, then LOD0's billboards, those
 // that meet the workgroup's tile, picked 64 at a time in shared memory), over
-// the padded (q_alpha, T) volume of pass 1 (march_volume.comp, wrapped with tiling). Writes linear RGB
+// the padded (q_alpha, T) volume of pass 1 (march_volume.comp, wrapped with tiling) and, with the sky light,
+// T_sky's (sky_volume.comp). Writes linear RGB
 // and adds the LayersStats counters (a reduction in shared memory, then one
 // atomic per workgroup and counter).
 #extension GL_GOOGLE_include_directive : require
@@ -23,8 +24,11 @@ layout(std430, binding = 3) writeonly buffer Image { float image[]; };
 layout(std430, binding = 4) buffer Stats { uint stats[]; };
 layout(std430, binding = 5) readonly buffer Map { float layersMap[]; };  // read with wang opacity only
 layout(std430, binding = 6) readonly buffer Billboards { LayersBillboard billboards[]; };  // LOD0, back to front
+// The sky light's T_sky, padded like the volume (sky_volume.comp); read only with the sky light on.
+layout(std430, binding = 7) readonly buffer SkyVolume { float skyVolume[]; };
 
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
+float MarchFetchSkyT(uint paddedIndex) { return skyVolume[paddedIndex]; }
 float PhaseTableValue(uint i) { return mieTable[i]; }
 float LayersMapValue(uint i) { return layersMap[i]; }
 LayersBillboard LayersBillboardAt(uint i) { return billboards[i]; }

@@ -23,12 +23,15 @@ layout(std430, binding = 5) buffer Stats { uint stats[]; };
 // The ground (flag kMarchGround): its block and G, (nx, ny); read only with the flag.
 layout(std430, binding = 6) readonly buffer Ground { GroundGpu ground; };
 layout(std430, binding = 7) readonly buffer GroundG { float groundG[]; };
+// The sky light's T_sky, padded like the volume (sky_volume.comp); read only with the sky light on.
+layout(std430, binding = 8) readonly buffer SkyVolume { float skyVolume[]; };
 
 #if MARCH_WITH_T
 vec2 MarchFetchQT(uint paddedIndex) { return volume[paddedIndex]; }
 #else
 vec2 MarchFetchQT(uint paddedIndex) { return vec2(volume[paddedIndex], 1.0); }
 #endif
+float MarchFetchSkyT(uint paddedIndex) { return skyVolume[paddedIndex]; }
 bool MarchBrickEmpty(uint brick) { return brickEmpty[brick] != 0u; }
 float PhaseTableValue(uint i) { return mieTable[i]; }
 float GroundFetchG(uint i, uint j) { return groundG[i + ground.gridX * j]; }

@@ -24,6 +24,8 @@ layout(std430, binding = 5) readonly buffer Frame { SplatFrame F; };
 // Read with phase Mie only: kMieCloudTable's values (F.light.mieIndexPerRadian, F.light.mieCount).
 layout(std430, binding = 10) readonly buffer PhaseTable { float phaseTable[]; };
 float PhaseTableValue(uint i) { return phaseTable[i]; }
+// The sky light's T_sky, a grid like transmittance; read only with the sky light on (F.light.skyOn).
+layout(std430, binding = 11) readonly buffer SkyTransmittance { float skyTransmittance[]; };
 
 uint AxisSize(uint axis) { return axis == 0u ? F.grid.x : (axis == 1u ? F.grid.y : F.grid.z); }
 
@@ -48,7 +50,8 @@ bool MakePartsSplat(uvec4 outer, uvec4 mid, uvec4 inner, out Splat s) {
     idx[F.axes.x] = outer.x;
     idx[F.axes.y] = mid.x;
     idx[F.axes.z] = inner.x;
-    return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.alpha), transmittance[v], s);
+    const float tSky = F.light.skyOn != 0u ? skyTransmittance[v] : 1.0;
+    return MakeSplat(F, idx, SplatQ(qPrev[v], qCur[v], F.alpha), transmittance[v], tSky, s);
 }
 
 // The splat of the voxel at cursor c (RankCursor), whose box is visible.

@@ -37,6 +37,8 @@ vec2 MarchFetchQT(uint i) {
     return vec2(float(LowBias32(i) >> 8u) * (1.0 / 16777216.0),
                 float(LowBias32(i ^ 0x9E3779B9u) >> 8u) * (1.0 / 16777216.0));
 }
+// march.glsl's T_sky: a third hash of the padded index (tests/GlslTwinHarness.h TwinPaddedSkyT).
+float MarchFetchSkyT(uint i) { return float(LowBias32(i ^ 0x2545F491u) >> 8u) * (1.0 / 16777216.0); }
 bool MarchBrickEmpty(uint brick) { return brick % 3u == 0u; }
 // ground.glsl's G: a hash of the cell (tests/GlslTwinMarchCases.cpp TwinGroundG).
 float GroundFetchG(uint i, uint j) { return float(LowBias32(i + 4096u * j) >> 8u) * (1.0 / 16777216.0); }
@@ -49,7 +51,7 @@ LayersBillboard LayersBillboardAt(uint i) { return twinBillboards[i]; }
 LightGpu ZeroLight() {
     return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, vec3(0.0), 0u, 0.0,
                     0.0, 0u, 0u, vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0)), vec3(0.0, 0.0, 1.0), 0u, 0.0,
-                    0.0, 0.0, 0.0);
+                    0.0, 0.0, 0.0, vec3(0.0), 0u, vec3(0.0, 0.0, 1.0), 0u);
 }
 
 MarchGpu ZeroMarch() {
@@ -265,6 +267,7 @@ void main() {
             PutF(6u, MarchSampleQ(march, p));
             PutF(7u, SunLightMarch(march, p));
             PutF(8u, PointLightMarch(march, p));
+            PutF(9u, PaddedBlendSky(march.strideY, march.strideZ, t));
             break;
         }
         // With the bound LayersGpu (tests/GlslTwinLayersTest.cpp).
@@ -338,16 +341,18 @@ void main() {
         }
         // With the bound MarchGpu's light (tests/GlslTwinTest.cpp InScatteredMatchesTheCpp).
         case kTwinInScattered: {
-            const LightSample s = LightSample(F(0u), F(1u), F(2u), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)));
+            const LightSample s =
+                LightSample(F(0u), F(1u), F(2u), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), F(9u));
             const vec3 c = InScattered(march.light, s);
             PutF(0u, c.x);
             PutF(1u, c.y);
             PutF(2u, c.z);
+            PutF(3u, SkyPhase(march.light, s.dir));
             break;
         }
         case kTwinMakeSplat: {
             Splat s;
-            const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), s);
+            const bool made = MakeSplat(frame, uvec3(U(0u), U(1u), U(2u)), F(3u), F(4u), F(5u), s);
             PutU(0u, made ? 1u : 0u);
             PutF(1u, s.px);
             PutF(2u, s.py);

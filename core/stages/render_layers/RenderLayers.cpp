@@ -185,7 +185,12 @@ Result<AccuracyRender> LayersAccuracyRender(Backend& backend, const Scene& scene
     auto map = std::make_shared<const std::vector<float>>(MakeLayersMap(scene, in.step));
     auto p = std::make_shared<LayersParams>(MakeLayersParams(scene, *in.camera, in.step));
     p->setup.map = map->empty() ? nullptr : map->data();
-    const LayersInputs inputs{in.q, in.q, *T};
+    LayersInputs inputs{in.q, in.q, *T};
+    if (scene.lighting.sky.on) {
+        auto skyT = in.shadedSkyT();
+        if (!skyT) return std::unexpected(skyT.error());
+        inputs.TSky = *skyT;
+    }
     return AccuracyRender{[&backend, p, map, inputs, image = in.image] {
         return backend.RenderLayers(*p, inputs, *image, nullptr);
     }};
@@ -263,6 +268,7 @@ const StageDescriptor& DescribeRenderLayers() {
                 scene_io::CheckLayersLod0(scene, grid, check);
             },
         .reads = {Resource::Q, Resource::T},
+        .optionalReads = {Resource::TSky},  // the sky light's: checked when the scene is loaded
         .readsPrevious = LayersPrevious,
         .writes = {Resource::LayersImage},
         .outputStepsOnly = true,
@@ -283,7 +289,8 @@ Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs
         Stage::RenderLayers, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
             LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
             p.setup.map = map.empty() ? nullptr : map.data();
-            const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
+            const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T),
+                                  io.Current(Resource::TSky)};
             LayersStats stats;
             Status drawn =
                 timed([&] { return backend.RenderLayers(p, in, *io.Current(Resource::LayersImage, n), &stats); });

@@ -66,6 +66,7 @@ struct LayersInputs {
     const Buffer* qPrev = nullptr;  // F32 volume
     const Buffer* qCur = nullptr;   // F32 volume
     const Buffer* T = nullptr;      // F32 volume: shade's T
+    const Buffer* TSky = nullptr;   // F32 volume: the sky light's T_sky; read only with the sky light on
 };
 
 struct LayersStats {

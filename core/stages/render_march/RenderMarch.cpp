@@ -155,7 +155,12 @@ Result<AccuracyRender> MarchAccuracyRender(Backend& backend, const Scene& scene,
         T = *shaded;
     }
     auto p = std::make_shared<const MarchParams>(MakeMarchParams(scene, *in.camera, in.step));
-    const MarchInputs inputs{in.q, in.q, T};
+    MarchInputs inputs{in.q, in.q, T};
+    if (scene.lighting.sky.on) {
+        auto skyT = in.shadedSkyT();
+        if (!skyT) return std::unexpected(skyT.error());
+        inputs.TSky = *skyT;
+    }
     return AccuracyRender{[&backend, p, inputs, image = in.image] {
         return backend.RenderMarch(*p, inputs, *image, nullptr);
     }};
@@ -256,8 +261,9 @@ const StageDescriptor& DescribeRenderMarch() {
         .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
                            Scene& scene) { scene_io::ReadMarch(root, check, scene.stages, scene.march); },
         .reads = {Resource::Q},
-        // march.light "shade" (the default) needs T, render.ground G: checked when the scene is loaded.
-        .optionalReads = {Resource::T, Resource::Shadow},
+        // march.light "shade" (the default) needs T, render.ground G, the sky light T_sky: checked when the scene is
+        // loaded.
+        .optionalReads = {Resource::T, Resource::Shadow, Resource::TSky},
         .readsPrevious = MarchPrevious,
         .writes = {Resource::MarchImage},
         .outputStepsOnly = true,
@@ -278,6 +284,7 @@ Status CallRenderMarch(Backend& backend, const Scene& sc, const StageHostInputs&
             // T only where shade runs (the light source "shade").
             MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
             in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
+            in.TSky = io.Current(Resource::TSky);
             MarchStats stats;
             Status drawn =
                 timed([&] { return backend.RenderMarch(p, in, *io.Current(Resource::MarchImage, n), &stats); });

@@ -62,6 +62,7 @@ struct MarchInputs {
     const Buffer* qCur = nullptr;   // F32 volume
     const Buffer* T = nullptr;      // F32 volume; required with MarchLightSource::Shade, else unread
     const Buffer* G = nullptr;      // F32 (nx, ny, 1): the ground shadow; read only with params.ground.on
+    const Buffer* TSky = nullptr;   // F32 volume: the sky light's T_sky; read only with the sky light on
 };
 
 struct MarchStats {

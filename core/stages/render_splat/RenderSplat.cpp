@@ -111,8 +111,12 @@ Result<AccuracyRender> SplatAccuracyRender(Backend& backend, const Scene& scene,
         p->skipping = false;
     }
     std::shared_ptr<Buffer> occupancy[] = {std::move(*D), std::move(*tiles), std::move(*bands)};
-    const SplatInputs inputs{in.q, in.q, *T, occupancy[1].get(), occupancy[1].get(), occupancy[2].get(),
-                             occupancy[2].get()};
+    SplatInputs inputs{in.q, in.q, *T, occupancy[1].get(), occupancy[1].get(), occupancy[2].get(), occupancy[2].get()};
+    if (scene.lighting.sky.on) {
+        auto skyT = in.shadedSkyT();
+        if (!skyT) return std::unexpected(skyT.error());
+        inputs.TSky = *skyT;
+    }
     out.call = [&backend, p, order, occupancy, inputs, image = in.image] {
         return backend.RenderSplat(*p, inputs, *image, nullptr);
     };
@@ -160,7 +164,8 @@ const StageDescriptor& DescribeRenderSplat() {
         .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
                            Scene& scene) { scene_io::ReadSplat(root, check, scene.splat); },
         .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
-        .optionalReads = {Resource::Shadow},  // render.ground needs it: checked when the scene is loaded
+        // render.ground needs G, the sky light T_sky: both checked when the scene is loaded.
+        .optionalReads = {Resource::Shadow, Resource::TSky},
         .readsPrevious = SplatPrevious,
         .writes = {Resource::SplatImage},
         .outputStepsOnly = true,
@@ -187,6 +192,7 @@ Status CallRenderSplat(Backend& backend, const Scene& sc, const StageHostInputs&
                 io.Previous(Resource::Tiles),       io.Current(Resource::Tiles), io.Previous(Resource::Bands),
                 io.Current(Resource::Bands)};
             in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only
+            in.TSky = io.Current(Resource::TSky);
             SplatStats stats;
             Status drawn =
                 timed([&] { return backend.RenderSplat(p, in, *io.Current(Resource::SplatImage, n), &stats); });

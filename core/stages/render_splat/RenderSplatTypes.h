@@ -56,6 +56,7 @@ struct SplatInputs {
     const Buffer* bandsPrev = nullptr;
     const Buffer* bandsCur = nullptr;
     const Buffer* G = nullptr;  // F32 (nx, ny, 1): the ground shadow; read only with params.ground.on
+    const Buffer* TSky = nullptr;  // F32 volume: the sky light's T_sky; read only with the sky light on
 };
 
 struct SplatStats {

@@ -82,16 +82,17 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade) {
 }  // namespace cb::scene_io
 
 namespace cb {
-namespace {
 
 // SPEC 6: 1e-5 in fp32; one storage quantum in the narrower formats, compared on the stored codes.
-CompareRule ShadeRule(const Scene& scene) {
+CompareRule ShadeCompareRule(const Scene& scene) {
     const StorageFormat storage = scene.shade.storage;
     if (storage == StorageFormat::Fp32) return {CompareRule::Kind::Absolute, 1e-5};
     CompareRule rule{CompareRule::Kind::Codes, 1};
     rule.storage = storage;
     return rule;
 }
+
+namespace {
 
 // Time-slicing's shares (SliceRange): the sweep's slices, whose axis follows the sun at the step.
 uint32_t SweepSlices(const Scene& scene, uint32_t step) {
@@ -149,7 +150,7 @@ const StageDescriptor& DescribeShade() {
         .sunAt = ShadeSunAt,
         .shareCount = SweepSlices,
         .symbol = "T",
-        .rule = ShadeRule,
+        .rule = ShadeCompareRule,
         .ruleNote = "one storage quantum with fp16 or unorm8 storage",
         .choices = kShadeChoices,
         .sceneFields = kShadeSceneFields,

@@ -22,6 +22,9 @@ void ReadShade(const Json& root, Validator& check, ShadeSettings& shade);
 Vec3 ShadeSunAt(const Scene& scene, uint32_t step);
 ShadeParams MakeShadeParams(const Scene& scene, uint32_t step = 0);
 
+// SPEC 6's comparison of T: 1e-5 in fp32, one storage quantum on the stored codes otherwise (T_sky's too).
+CompareRule ShadeCompareRule(const Scene& scene);
+
 // Two of its choice settings (its descriptor's `choices`), for the commands that set them.
 const ChoiceSetting& ShadeResolutionSetting();
 const ChoiceSetting& ShadeScatteringSetting();
