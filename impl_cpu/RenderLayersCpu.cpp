@@ -1,7 +1,7 @@
 // The layered renderer on the CPU (SPEC 15): per call, q_alpha and T are formed
 // once into a padded volume of (q, T) pairs, or (q, T, T_sky) triples with the sky light (core/math/Layers.h's
 // taps: the border holds (0, 1) or (0, 1, 1), or with tiling the opposite edge's voxels;
-// impl_cpu/PaddedVolumeCpu.h), then every
+// impl_cpu/PaddedVolumeCpu.h), with a bit per cell where its taps read no cloud (LayersOccupancyCpu.h), then every
 // pixel runs LayersPixel, the layers its ray crosses back to front and then
 // LOD0's billboards (a list made once per call, culled per tile), TBB over 8 x 8 pixel tiles. A pixel's loop is the
 // fastest form here: it touches only the layers on its side of the eye, where OpenGL rasterises every layer.
@@ -14,6 +14,7 @@
 
 #include "core/math/Layers.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/LayersOccupancyCpu.h"
 #include "impl_cpu/PaddedVolumeCpu.h"
 #include "impl_cpu/RenderLayersCpuState.h"
 
@@ -65,7 +66,8 @@ void LayersPixels(const LayersParams& params, Fetch&& fetch, float* out, std::at
 uint64_t RenderLayersCpuState::ScratchBytes(const Scene& scene) const {
     const Extent3 e = scene.grid.size;
     const uint64_t fields = scene.lighting.sky.on ? 3 : 2;
-    return SaturatingMul(uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull), fields * sizeof(float));
+    const uint64_t cells = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
+    return SaturatingAdd(SaturatingMul(cells, fields * sizeof(float)), (cells + 63) / 64 * 8);  // and the bits
 }
 
 Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats) {
@@ -89,20 +91,26 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
     std::atomic<uint64_t> fragments{0}, drawn{0};
 
     mArena.execute([&] {
-        // 1. The padded volume, 2. the pixels; with the sky light the volume's cells carry T_sky as a third field.
+        // 1. The padded volume (with the sky light its cells carry T_sky as a third field), 2. its empty taps,
+        // 3. the pixels.
         const float alpha = params.alpha;
+        auto readQ = [](const auto& cell) { return cell[0]; };
         if (skyLight) {
-            FormPaddedVolume(state.volumeWithSky, e, s.tiling, std::array<float, 3>{0.0f, 1.0f, 1.0f}, [&](size_t v) {
-                return std::array<float, 3>{Lerp(qPrev[v], qCur[v], alpha), T[v], skyT[v]};
+            using Cell = std::array<float, 3>;
+            FormPaddedVolume(state.volumeWithSky, e, s.tiling, Cell{0.0f, 1.0f, 1.0f}, [&](size_t v) {
+                return Cell{Lerp(qPrev[v], qCur[v], alpha), T[v], skyT[v]};
             });
-            const std::array<float, 3>* volume = state.volumeWithSky.data();
-            LayersPixels(params, [volume](uint32_t i) { return volume[i]; }, out, fragments, drawn);
+            FormEmptyTaps(state.emptyTaps, state.volumeWithSky, e, readQ);
+            LayersPixels(params, LayersPaddedFetch<Cell>{state.volumeWithSky.data(), state.emptyTaps.data()}, out,
+                         fragments, drawn);
         } else {
-            FormPaddedVolume(state.volume, e, s.tiling, std::array<float, 2>{0.0f, 1.0f}, [&](size_t v) {
-                return std::array<float, 2>{Lerp(qPrev[v], qCur[v], alpha), T[v]};
+            using Cell = std::array<float, 2>;
+            FormPaddedVolume(state.volume, e, s.tiling, Cell{0.0f, 1.0f}, [&](size_t v) {
+                return Cell{Lerp(qPrev[v], qCur[v], alpha), T[v]};
             });
-            const std::array<float, 2>* volume = state.volume.data();
-            LayersPixels(params, [volume](uint32_t i) { return volume[i]; }, out, fragments, drawn);
+            FormEmptyTaps(state.emptyTaps, state.volume, e, readQ);
+            LayersPixels(params, LayersPaddedFetch<Cell>{state.volume.data(), state.emptyTaps.data()}, out, fragments,
+                         drawn);
         }
     });
     if (stats) *stats = {fragments, drawn};

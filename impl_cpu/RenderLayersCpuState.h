@@ -13,7 +13,8 @@ struct RenderLayersCpuState {
     static constexpr Stage kStage = Stage::RenderLayers;
     std::vector<std::array<float, 2>> volume;  // the padded (q_alpha, T) volume, wrapped horizontally with tiling
     std::vector<std::array<float, 3>> volumeWithSky;  // instead, with the sky light: (q_alpha, T, T_sky)
-    // The padded volume of pairs, or of triples with the sky light.
+    std::vector<uint64_t> emptyTaps;                  // a bit per padded cell: its taps all read q = 0
+    // The padded volume of pairs, or of triples with the sky light, and its bits of empty taps.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

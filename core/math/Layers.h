@@ -167,7 +167,12 @@ template <class Fetch>
         return f;
     }
     f.crossed = true;
-    const auto qt = LayersBlend(s.size, LayersTapsAt(s.size, Vec3{x, y, z}), fetch);
+    const LayersTaps taps = LayersTapsAt(s.size, Vec3{x, y, z});
+    // A fetch that knows where all eight taps read q = 0 (the CPU's, impl_cpu/LayersOccupancyCpu.h) skips the blend
+    // there: the blended q would be 0 exactly, and the fragment is crossed but not drawn, as below.
+    if constexpr (requires { fetch.TapsEmpty(taps.base); })
+        if (fetch.TapsEmpty(taps.base)) return f;
+    const auto qt = LayersBlend(s.size, taps, fetch);
     if (!(qt[0] > 0.0f)) return f;
     f.drawn = true;
     if (s.wang) {
