@@ -113,15 +113,20 @@ Result<DeviceBuffer*> BackendVk::MiePhaseTable(BufferSlot& slot) {
     return ScratchHolding(slot, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count)), 0);
 }
 
-Result<SkyVolumePass> BackendVk::PrepareSkyVolume(BufferSlot& slot, const Buffer& TSky, bool tiling) {
-    const Extent3 e = TSky.Extent();
+Result<SkyVolumePass> BackendVk::PrepareSkyVolume(BufferSlot& slot, const Buffer* TSky, bool tiling,
+                                                  const DeviceBuffer* standIn) {
     SkyVolumePass pass;
+    if (!TSky) {
+        pass.buffers = {standIn, standIn};
+        return pass;
+    }
+    const Extent3 e = TSky->Extent();
     auto pipeline = mContext->GetPipeline("sky_volume", 2);
     if (!pipeline) return std::unexpected(pipeline.error());
     auto volume = Scratch(slot, SkyVolumeBytes(e));
     if (!volume) return std::unexpected(volume.error());
     pass.pipeline = *pipeline;
-    pass.buffers = {&Dev(TSky), *volume};
+    pass.buffers = {&Dev(*TSky), *volume};
     pass.push = {e.nx, e.ny, e.nz, tiling ? 1u : 0u};
     return pass;
 }

@@ -135,8 +135,10 @@ class BackendVk final : public Backend {
     // Shade's sweep (ShadeVk.cpp) from q into T with `state`'s coarse grids: the sun's T (Shade) or the sky
     // light's T_sky (ShadeSky); `stage` names it in errors.
     Status ShadeInto(ShadeVkState& state, const char* stage, const ShadeParams& params, const Buffer& q, Buffer& T);
-    // The pass that forms T_sky's padded volume in the slot's buffer (SkyVolumeVk.h), `tiling` wrapping it.
-    Result<SkyVolumePass> PrepareSkyVolume(BufferSlot& slot, const Buffer& TSky, bool tiling);
+    // The pass that forms T_sky's padded volume in the slot's buffer (SkyVolumeVk.h), `tiling` wrapping it; with
+    // TSky null (no sky light) none, and `standIn` bound in its place.
+    Result<SkyVolumePass> PrepareSkyVolume(BufferSlot& slot, const Buffer* TSky, bool tiling,
+                                           const DeviceBuffer* standIn);
 
     std::unique_ptr<VulkanContext> mContext;
     StagesVk mStages;  // after mContext: their buffers are destroyed before it

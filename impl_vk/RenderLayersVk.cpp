@@ -10,7 +10,6 @@
 //      which each workgroup blends those that meet its 8 x 8 tile.
 // The constants are core/pipeline/LayersGpu.h's block in a storage buffer.
 #include <array>
-#include <optional>
 #include <vector>
 
 #include "core/pipeline/LayersGpu.h"
@@ -82,23 +81,17 @@ Status BackendVk::RenderLayers(const LayersParams& params, const LayersInputs& i
         billboardBuffer = *b;
     }
     // T_sky's padded volume with the sky light; without it, the frame stands in, unread.
-    std::optional<SkyVolumePass> sky;
-    const DeviceBuffer* skyVolume = *frameBuffer;
-    if (skyLight) {
-        auto pass = PrepareSkyVolume(state.skyVolume, *in.TSky, params.setup.tiling);
-        if (!pass) return std::unexpected(pass.error());
-        sky = *pass;
-        skyVolume = &sky->Volume();
-    }
+    auto sky = PrepareSkyVolume(state.skyVolume, skyLight ? in.TSky : nullptr, params.setup.tiling, *frameBuffer);
+    if (!sky) return std::unexpected(sky.error());
 
     const MarchVolumePush volumePush{e.nx, e.ny, e.nz, 1u, params.alpha, params.setup.tiling ? 1u : 0u};
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), &Dev(*in.T), *volume};
     const DeviceBuffer* layerBuffers[] = {*frameBuffer, *volume, table,           &Dev(image),
-                                          *statsBuffer, map,     billboardBuffer, skyVolume};
+                                          *statsBuffer, map,     billboardBuffer, sky->Volume()};
     CB_TRY(Record("render_layers", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(**volumePipe, volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);
-        if (sky) sky->Record(r);
+        sky->Record(r);
         r.Barrier();
         r.DispatchGroups(**layersPipe, layerBuffers, nullptr, 0, CeilDiv(W, 8), CeilDiv(H, 8), 1);
     }));

@@ -13,7 +13,6 @@
 // (kMieCloudTable) is uploaded once, on the first call whose phase is Mie.
 #include <algorithm>
 #include <array>
-#include <optional>
 
 #include "core/pipeline/MarchGpu.h"
 #include "impl_vk/BackendVk.h"
@@ -107,14 +106,8 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
         groundG = &Dev(*in.G);
     }
     // T_sky's padded volume with the sky light; without it, the frame stands in, unread.
-    std::optional<SkyVolumePass> sky;
-    const DeviceBuffer* skyVolume = *frameBuffer;
-    if (skyLight) {
-        auto pass = PrepareSkyVolume(state.skyVolume, *in.TSky, params.setup.tiling);
-        if (!pass) return std::unexpected(pass.error());
-        sky = *pass;
-        skyVolume = &sky->Volume();
-    }
+    auto sky = PrepareSkyVolume(state.skyVolume, skyLight ? in.TSky : nullptr, params.setup.tiling, *frameBuffer);
+    if (!sky) return std::unexpected(sky.error());
 
     const MarchVolumePush volumePush{
         e.nx, e.ny, e.nz, shadeLight ? 1u : 0u, params.alpha, params.setup.tiling ? 1u : 0u};
@@ -123,12 +116,12 @@ Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, 
     const DeviceBuffer* volumeBuffers[] = {&Dev(*in.qPrev), &Dev(*in.qCur), shadeLight ? &Dev(*in.T) : &Dev(*in.qCur),
                                            *volume};
     const DeviceBuffer* brickBuffers[] = {*volume, bricks, *statsBuffer};
-    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,     bricks,  table,    &Dev(image),
-                                          *statsBuffer, groundBlock, groundG, skyVolume};
+    const DeviceBuffer* marchBuffers[] = {*frameBuffer, *volume,     bricks,  table,        &Dev(image),
+                                          *statsBuffer, groundBlock, groundG, sky->Volume()};
     CB_TRY(Record("render_march", [&](VulkanContext::Recorder& r) {
         r.Fill(**statsBuffer, 0);
         r.DispatchGroups(*pipes[0], volumeBuffers, &volumePush, sizeof volumePush, CeilDiv(px, 64), py, pz);
-        if (sky) sky->Record(r);
+        sky->Record(r);
         r.Barrier();
         if (params.skipping) {
             r.DispatchGroups(*pipes[1], brickBuffers, &brickPush, sizeof brickPush, CeilDiv(frame.bricks[0], 64),

@@ -15,6 +15,7 @@ Status CheckSkyInput(const Buffer* TSky, const Extent3& e, const char* stage) {
 }
 
 void SkyVolumePass::Record(VulkanContext::Recorder& r) const {
+    if (!pipeline) return;
     const uint32_t px = push.nx + 2, py = push.ny + 2, pz = push.nz + 2;
     r.DispatchGroups(*pipeline, buffers, &push, sizeof push, CeilDiv(px, 64u), py, pz);
 }

@@ -19,14 +19,15 @@ uint64_t SkyVolumeBytes(const Extent3& e);
 // An error naming the backend and `stage` unless T_sky is there and of q's extent e.
 Status CheckSkyInput(const Buffer* TSky, const Extent3& e, const char* stage);
 
-// The dispatch that forms T_sky's padded volume (BackendVk::PrepareSkyVolume), recorded in a renderer's submit
-// before the barrier that orders its volume before the pixels.
+// T_sky's padded volume for one renderer call (BackendVk::PrepareSkyVolume): the dispatch that forms it, recorded
+// in the renderer's submit before the barrier that orders its volume before the pixels, and the buffer the renderer
+// binds. Without the sky light there is no dispatch and a stand-in is bound, unread.
 struct SkyVolumePass {
-    Pipeline* pipeline = nullptr;
-    std::array<const DeviceBuffer*, 2> buffers{};  // T_sky, the padded volume
+    Pipeline* pipeline = nullptr;                  // null: no sky light
+    std::array<const DeviceBuffer*, 2> buffers{};  // T_sky, the padded volume (or the stand-in)
     SkyVolumePush push{};
-    const DeviceBuffer& Volume() const { return *buffers[1]; }
-    void Record(VulkanContext::Recorder& r) const;
+    const DeviceBuffer* Volume() const { return buffers[1]; }
+    void Record(VulkanContext::Recorder& r) const;  // records nothing without the sky light
 };
 
 }  // namespace cb::vk

@@ -90,10 +90,9 @@ uint64_t ComparePixels(const Scene& scene, const std::vector<Cell>& volume, cons
 TEST(LayersOccupancy, SkippingChangesNoPixel) {
     const std::string path = std::string(CLOUDBENCH_SCENES_DIR) + "/layers-small.json";
     for (const char* tiling : {"true", "false"}) {
-        auto scene = LoadScene(path, {{"grid.tiling", tiling},
-                                      {"layers.lod0_radius", "600"},
-                                      {"render.width", "64"},
-                                      {"render.height", "48"}});
+        auto scene = LoadScene(
+            path,
+            {{"grid.tiling", tiling}, {"layers.lod0_radius", "600"}, {"render.width", "64"}, {"render.height", "48"}});
         ASSERT_TRUE(scene.has_value()) << scene.error().message;
         const Extent3 e = scene->grid.size;
         Pcg32 rng(0x0cc0);
@@ -107,8 +106,9 @@ TEST(LayersOccupancy, SkippingChangesNoPixel) {
         auto readQ = [](const auto& cell) { return cell[0]; };
         std::vector<std::array<float, 2>> pairs;
         std::vector<uint64_t> bits;
-        cpu::FormPaddedVolume(pairs, e, wrap, std::array<float, 2>{0.0f, 1.0f},
-                              [&](size_t v) { return std::array<float, 2>{q[v], T[v]}; });
+        cpu::FormPaddedVolume(pairs, e, wrap, std::array<float, 2>{0.0f, 1.0f}, [&](size_t v) {
+            return std::array<float, 2>{q[v], T[v]};
+        });
         cpu::FormEmptyTaps(bits, pairs, e, readQ);
         EXPECT_GT(ComparePixels(*scene, pairs, bits), 1000u) << "tiling " << tiling;
         // The sky light's triples, its term on.
@@ -119,8 +119,9 @@ TEST(LayersOccupancy, SkippingChangesNoPixel) {
                                     {"lighting.sky", R"({"elevation_deg": 10, "azimuth_deg": 200})"}});
         ASSERT_TRUE(lit.has_value()) << lit.error().message;
         std::vector<std::array<float, 3>> triples;
-        cpu::FormPaddedVolume(triples, e, wrap, std::array<float, 3>{0.0f, 1.0f, 1.0f},
-                              [&](size_t v) { return std::array<float, 3>{q[v], T[v], skyT[v]}; });
+        cpu::FormPaddedVolume(triples, e, wrap, std::array<float, 3>{0.0f, 1.0f, 1.0f}, [&](size_t v) {
+            return std::array<float, 3>{q[v], T[v], skyT[v]};
+        });
         cpu::FormEmptyTaps(bits, triples, e, readQ);
         EXPECT_GT(ComparePixels(*lit, triples, bits), 1000u) << "tiling " << tiling << ", the sky light";
     }

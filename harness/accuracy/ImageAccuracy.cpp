@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <numbers>
 
@@ -120,37 +121,32 @@ RenderAccuracy MeasureRender(Backend& backend, Stage renderer, const Scene& scen
     auto image = backend.CreateBuffer(BufferFormat::F32, {3, scene.render.width, scene.render.height});
     if (!image) return fail("", image.error());
     RenderAccuracy a;
-    // T from shade on this backend when the renderer reads it, untimed in the render's time.
-    std::unique_ptr<Buffer> T;
+    // T from shade, T_sky from shade_sky, on this backend when the renderer reads them, untimed in the render's time.
+    std::unique_ptr<Buffer> T, skyT;
     std::optional<std::string> unsupported;
-    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr, nullptr};
-    inputs.shadedT = [&]() -> Result<const Buffer*> {
-        if (!backend.Supports(Stage::Shade)) {
-            unsupported = backend.Name() + " does not implement shade, which feeds T";
+    auto shadeInto = [&](Stage stage, const char* feeds, std::unique_ptr<Buffer>& out,
+                         const std::function<Status(Buffer&)>& shade) -> Result<const Buffer*> {
+        const std::string name(StageName(stage));
+        if (!backend.Supports(stage)) {
+            unsupported = backend.Name() + " does not implement " + name + ", which feeds " + feeds;
             return MakeError(*unsupported);
         }
         auto t = backend.CreateBuffer(BufferFormat::F32, in.grid);
         if (!t) return std::unexpected(t.error());
-        T = std::move(*t);
+        out = std::move(*t);
         const auto start = std::chrono::steady_clock::now();
-        if (Status s = backend.Shade(MakeShadeParams(scene), **q, *T); !s) return MakeError("shade: " + s.error().message);
+        if (Status s = shade(*out); !s) return MakeError(name + ": " + s.error().message);
         a.prepMs += MillisecondsSince(start);
-        return T.get();
+        return out.get();
     };
-    std::unique_ptr<Buffer> skyT;
-    inputs.shadedSkyT = [&]() -> Result<const Buffer*> {
-        if (!backend.Supports(Stage::ShadeSky)) {
-            unsupported = backend.Name() + " does not implement shade_sky, which feeds T_sky";
-            return MakeError(*unsupported);
-        }
-        auto t = backend.CreateBuffer(BufferFormat::F32, in.grid);
-        if (!t) return std::unexpected(t.error());
-        skyT = std::move(*t);
-        const auto start = std::chrono::steady_clock::now();
-        if (Status s = backend.ShadeSky(MakeShadeSkyParams(scene), **q, *skyT); !s)
-            return MakeError("shade_sky: " + s.error().message);
-        a.prepMs += MillisecondsSince(start);
-        return skyT.get();
+    AccuracyRenderInputs inputs{q->get(), image->get(), &scene.render.cameras[0], in.step, nullptr, nullptr};
+    inputs.shadedT = [&] {
+        return shadeInto(Stage::Shade, "T", T,
+                         [&](Buffer& b) { return backend.Shade(MakeShadeParams(scene), **q, b); });
+    };
+    inputs.shadedSkyT = [&] {
+        return shadeInto(Stage::ShadeSky, "T_sky", skyT,
+                         [&](Buffer& b) { return backend.ShadeSky(MakeShadeSkyParams(scene), **q, b); });
     };
     auto render = descriptor->accuracyRender(backend, scene, inputs);
     if (!render) return RenderNotMeasured(unsupported ? "unsupported" : "failed", render.error().message);
