@@ -1,5 +1,6 @@
 // The sky light (Wang, Ji and Zhang, section 3.3; lighting.sky and the stage shade_sky): the term InScattered adds
-// worked by hand, its terms and settings from a scene, shade_sky as shade's sweep toward the sky, and on every
+// worked by hand, its terms and settings from a scene, shade_sky as shade's sweep toward the sky (and between two
+// shares of the sun's sweep, which it leaves alone), and on every
 // backend and renderer two properties that owe nothing to the code under test: a sky light standing where the sun
 // stood, with the sun's radiance and the sun dark, lights the clouds as the sun did; and light adds up (the image
 // with both lights is the sun's image plus the sky's alone). The GLSL twins are GlslTwin.InScatteredMatchesTheCpp,
@@ -14,12 +15,15 @@
 
 #include "core/math/Light.h"
 #include "core/pipeline/LightTerms.h"
+#include "core/pipeline/ShadePlan.h"
 #include "core/plan/SceneLoad.h"
 #include "core/plan/StageGraph.h"
 #include "core/stages/render_march/RenderMarch.h"
 #include "harness/run/Simulation.h"
+#include "impl_cpu/BackendCpu.h"
 #include "reference/MarchReference.h"
 #include "tests/BackendTestUtil.h"
+#include "tests/MarchTestUtil.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
@@ -293,6 +297,40 @@ TEST(SkyLight, ReferenceSkyLightWhereTheSunStandsLightsAsTheSun) {
     ASSERT_TRUE(a && b);
     EXPECT_EQ(a->image, b->image);
     EXPECT_EQ(b->light.rays, 2 * a->light.rays);  // the sun's exact light is traced still, then the sky's
+}
+
+// Test on the CPU what the GPU backends' tests check (TimeSliceGL.ShadeSkyBetweenSharesLeavesTheSunsSweep, the
+// Vulkan shade's): shade's sweep in shares of 3 slices with a whole shade_sky between each two, at the resolutions
+// that keep coarse grids between shares, gives the sun's T of the whole call, and each T_sky the sky's whole call.
+TEST(SkyLight, ShadeSkyBetweenSharesLeavesTheSunsSweepOnTheCpu) {
+    const Extent3 e{29, 23, 17};
+    cpu::BackendCpu cpu(2);
+    auto q = test::MakeFilled(cpu, BufferFormat::F32, e,
+                              test::GaussianBlobField(e, {{9, 8, 6, 4}, {20, 15, 11, 5}, {14, 4, 9, 3}}));
+    for (int resolution : {2, 4}) {
+        ShadeParams sun;
+        sun.sun = {0.36f, -0.48f, 0.8f};
+        sun.resolution = resolution;
+        ShadeParams sky = sun;
+        sky.sun = {-0.6f, 0.0f, 0.8f};
+        auto whole = test::MakeBuffer(cpu, BufferFormat::F32, e),
+             skyWhole = test::MakeBuffer(cpu, BufferFormat::F32, e);
+        ASSERT_TRUE(cpu.Shade(sun, *q, *whole));
+        ASSERT_TRUE(cpu.Shade(sky, *q, *skyWhole));
+        const auto wholeT = test::Read<float>(cpu, *whole), skyT = test::Read<float>(cpu, *skyWhole);
+        ASSERT_NE(wholeT, skyT) << "the two lights must shade differently for the test to see a mix-up";
+        auto shared = test::MakeBuffer(cpu, BufferFormat::F32, e),
+             skyShared = test::MakeBuffer(cpu, BufferFormat::F32, e);
+        const uint32_t nw = MakeShadePlan(sun, e).nw;
+        for (uint32_t m = 0; m < nw; m += 3) {
+            ShadeParams share = sun;
+            share.slices = {m, m + 3};
+            ASSERT_TRUE(cpu.Shade(share, *q, *shared));
+            ASSERT_TRUE(cpu.ShadeSky(sky, *q, *skyShared));
+            EXPECT_EQ(test::Read<float>(cpu, *skyShared), skyT) << "resolution " << resolution << ", share at " << m;
+        }
+        EXPECT_EQ(test::Read<float>(cpu, *shared), wholeT) << "resolution " << resolution;
+    }
 }
 
 }  // namespace
