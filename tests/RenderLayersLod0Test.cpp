@@ -1,7 +1,7 @@
 // The layered renderer's billboards near the eye (LOD0; SPEC 15, docs/pipeline.md "The billboards"): eq. 13's sizes
 // as read, the grid points within r0 of the eye, the layers starting at r0, one billboard fragment by hand, a field
 // of billboards against its closed form back to front on every backend, and the GPU backends against the CPU with
-// billboards on. The fixtures and cases are tests/RenderLayersTestUtil.h's.
+// billboards on. The fixtures and cases are tests/RenderLayersTestUtil.h's (the tests live in its namespace).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,18 +17,8 @@
 #include "tests/RenderLayersTestUtil.h"
 #include "tests/TestUtil.h"
 
-namespace cb {
+namespace cb::test {
 namespace {
-
-using test::CameraLayers;
-using test::Eyes;
-using test::LayersCase;
-using test::LayersImage;
-using test::RenderLayersAll;
-using test::RenderLayersGpu;
-using test::RenderLayersOn;
-using test::UniformLayers;
-using test::BlobLayers;
 
 // ---- Billboards (LOD0) ----
 
@@ -311,4 +301,4 @@ TEST_P(RenderLayersGpu, MatchesTheCpuWithBillboards) {
 }
 
 }  // namespace
-}  // namespace cb
+}  // namespace cb::test

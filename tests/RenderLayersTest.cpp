@@ -26,19 +26,8 @@
 #include "tests/RenderLayersTestUtil.h"
 #include "tests/TestUtil.h"
 
-namespace cb {
+namespace cb::test {
 namespace {
-
-// The cases, their rendering and the fixtures: tests/RenderLayersTestUtil.h.
-using test::BlobLayers;
-using test::CameraLayers;
-using test::Eyes;
-using test::LayersCase;
-using test::LayersImage;
-using test::RenderLayersAll;
-using test::RenderLayersGpu;
-using test::RenderLayersOn;
-using test::UniformLayers;
 
 // Test that an empty sky leaves the background bit for bit on every backend, with every crossing counted and none
 // drawn: alpha 0 blends nothing.
@@ -446,4 +435,4 @@ INSTANTIATE_TEST_SUITE_P(Backends, RenderLayersGpu, ::testing::ValuesIn(test::Gp
                          [](const auto& info) { return info.param; });
 
 }  // namespace
-}  // namespace cb
+}  // namespace cb::test

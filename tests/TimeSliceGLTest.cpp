@@ -4,16 +4,14 @@
 // a whole step into shares; smooth reuses the xy sums a preceding share left,
 // which must not survive a change of cld in place. Both are checked against
 // whole calls (the RGBA8 steps against the packed layout's, which keeps no
-// state between calls). Shade's shares must survive a shade_sky between them.
-// TimeSliceStagesTest covers each stage's shares alone.
+// state between calls). TimeSliceStagesTest covers each stage's shares alone; SkyLight's, shade's shares with a
+// shade_sky between them.
 #include <gtest/gtest.h>
 
 #include <span>
 #include <vector>
 
 #include "core/math/Random.h"
-#include "core/pipeline/ShadePlan.h"
-#include "core/stages/shade/ShadeTypes.h"
 #include "registry/Registry.h"
 #include "tests/TestUtil.h"
 
@@ -87,40 +85,6 @@ TEST(TimeSliceGL, SmoothSharesSeeACldChangedInPlace) {
     for (uint32_t k = 0; k < e.nz; k += 2) ASSERT_TRUE(A->Smooth(2, *cld, *q, {k, k + 2}));
     ASSERT_TRUE(A->Smooth(2, *cld, *w));
     EXPECT_EQ(test::Read<float>(*A, *q), test::Read<float>(*A, *w));
-}
-
-// Shade's sweep in shares of 3 slices with a whole shade_sky between each two: the sun's T equals its whole call's
-// (shade_sky keeps textures of its own), and each T_sky equals shade's whole call toward the sky light.
-TEST(TimeSliceGL, ShadeSkyBetweenSharesLeavesTheSunsSweep) {
-    const Extent3 e{29, 23, 17};
-    auto A = GlsMake(false);
-    if (!A) GTEST_SKIP() << "no gl backend here";
-    auto q = test::MakeFilled(*A, BufferFormat::F32, e,
-                              test::GaussianBlobField(e, {{9, 8, 6, 4}, {20, 15, 11, 5}, {14, 4, 9, 3}}));
-    for (int resolution : {1, 2}) {
-        ShadeParams sun;
-        sun.sun = {0.36f, -0.48f, 0.8f};
-        sun.resolution = resolution;
-        ShadeParams sky = sun;
-        sky.sun = {-0.6f, 0.0f, 0.8f};
-        auto whole = test::MakeBuffer(*A, BufferFormat::F32, e), skyWhole = test::MakeBuffer(*A, BufferFormat::F32, e);
-        ASSERT_TRUE(A->Shade(sun, *q, *whole));
-        ASSERT_TRUE(A->Shade(sky, *q, *skyWhole));
-        const auto wholeT = test::Read<float>(*A, *whole), skyT = test::Read<float>(*A, *skyWhole);
-        ASSERT_NE(wholeT, skyT) << "the two lights must shade differently for the test to see a mix-up";
-
-        auto shared = test::MakeBuffer(*A, BufferFormat::F32, e),
-             skyShared = test::MakeBuffer(*A, BufferFormat::F32, e);
-        const uint32_t nw = MakeShadePlan(sun, e).nw;
-        for (uint32_t m = 0; m < nw; m += 3) {
-            ShadeParams share = sun;
-            share.slices = {m, m + 3};
-            ASSERT_TRUE(A->Shade(share, *q, *shared));
-            ASSERT_TRUE(A->ShadeSky(sky, *q, *skyShared));
-            EXPECT_EQ(test::Read<float>(*A, *skyShared), skyT) << "resolution " << resolution << ", share at " << m;
-        }
-        EXPECT_EQ(test::Read<float>(*A, *shared), wholeT) << "resolution " << resolution;
-    }
 }
 
 }  // namespace
