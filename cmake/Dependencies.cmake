@@ -15,6 +15,10 @@ find_package(Threads REQUIRED)
 find_package(TBB CONFIG QUIET)
 cloudbench_require(TBB_FOUND "oneTBB" libtbb-dev)
 
+# Google Highway: the CPU kernels' SIMD layer and its run-time dispatch (impl_cpu/CpuIsa.h).
+find_package(hwy CONFIG QUIET)
+cloudbench_require(hwy_FOUND "Google Highway" libhwy-dev)
+
 find_package(nlohmann_json CONFIG QUIET)
 cloudbench_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)
 

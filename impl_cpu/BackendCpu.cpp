@@ -10,7 +10,7 @@
 #include "core/base/ProcessCpuTime.h"
 #include "core/base/ProcessMemory.h"
 #include "core/scene/Scene.h"
-#include "impl_cpu/CaKernels.h"
+#include "impl_cpu/CpuIsa.h"
 
 namespace cb::cpu {
 
@@ -36,7 +36,7 @@ void BackendCpu::BusyFor(double wallMs, double cpuMs) {
 }
 
 std::string BackendCpu::Device() const {
-    return std::to_string(mArena.max_concurrency()) + " threads (TBB), " + CaKernelName();
+    return std::to_string(mArena.max_concurrency()) + " threads (TBB), SIMD " + ActiveCpuIsaDescription();
 }
 
 Result<std::unique_ptr<Buffer>> BackendCpu::CreateBuffer(BufferFormat format, Extent3 extent) {

@@ -85,8 +85,6 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
     const BitField& cld = static_cast<const BufferCpu&>(*in.cld).Bits();
     const uint8_t* region = static_cast<const BufferCpu&>(regionBuffer).U8();
     const Extent3 e = hum.Extent();
-    const uint32_t words = hum.WordsPerRow();
-    const uint64_t lastMask = hum.LastWordMask();
     // The share: slices k in [k0, k1) of `out`. A bit field packs x into words,
     // so a slice is whole rows of words; the rules read `in` at k - 2 .. k + 1,
     // and the advection stays within a slice, so the scratch of these slices
@@ -109,39 +107,8 @@ Status BackendCpu::CaStep(const CaStepParams& params, ConstCaFields in, const Bu
 
     const CaEvents events = MakeCaEvents(params.seed, params.step, params.qExt, params.qHum, params.qAct);
 
-    auto rows = [&](const tbb::blocked_range<uint32_t>& range) {
-        for (uint32_t r = range.begin(); r != range.end(); ++r) {
-            const uint32_t j = r % e.ny, k = r / e.ny;
-            const uint64_t* a = act.Row(j, k);
-            const uint64_t* h = hum.Row(j, k);
-            const uint64_t* c = cld.Row(j, k);
-            // The 7 neighbour rows of the growth rule that are not in this row.
-            const uint64_t* across[7] = {act.RowOrNull(j + 1, k),     act.RowOrNull(int64_t(j) - 1, k),
-                                         act.RowOrNull(j + 2, k),     act.RowOrNull(int64_t(j) - 2, k),
-                                         act.RowOrNull(j, k + 1),     act.RowOrNull(j, int64_t(k) - 1),
-                                         act.RowOrNull(j, int64_t(k) - 2)};
-            const uint8_t* rRow = region + size_t(e.nx) * (j + size_t(e.ny) * k);
-            uint64_t* hOut = dst[0]->Row(j, k);
-            uint64_t* aOut = dst[1]->Row(j, k);
-            uint64_t* cOut = dst[2]->Row(j, k);
-            const uint32_t rowBase = VoxelIndex(e, 0, j, k);
-
-            for (uint32_t w = 0; w < words; ++w) {
-                const uint64_t aw = a[w];
-                const uint64_t prev = w > 0 ? a[w - 1] : 0;
-                const uint64_t next = w + 1 < words ? a[w + 1] : 0;
-                uint64_t f = CaRowNeighbours(aw, prev, next);
-                for (const uint64_t* n : across)
-                    if (n) f |= n[w];
-                const uint32_t i0 = 64 * w;
-                const CaBits<uint64_t> s = CaStepWord({h[w], aw, c[w]}, f, rRow + i0, w == words - 1 ? lastMask : ~0ull,
-                                                      rowBase + i0, events);
-                hOut[w] = s.hum;
-                aOut[w] = s.act;
-                cOut[w] = s.cld;
-            }
-        }
-    };
+    const CaStepRowsJob job{&hum, &act, &cld, region, dst[0], dst[1], dst[2], events};
+    auto rows = [&](const tbb::blocked_range<uint32_t>& range) { CaStepRows(job, range.begin(), range.end()); };
 
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(e.ny * k0, e.ny * k1, 16), rows);

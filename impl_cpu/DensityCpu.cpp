@@ -1,6 +1,10 @@
 // Stage `density` on the CPU (SPEC 5): column sums, tile and band occupancy,
 // and cloud cover. Work is split by rows of tiles, so each task owns its
 // outputs and no two tasks write the same byte.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/DensityCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -10,7 +14,8 @@
 
 #include "impl_cpu/BackendCpu.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 namespace {
 
 // Writes flags[tx] = 1 iff some value > 0 in tile column tx of `rows` rows of
@@ -58,8 +63,8 @@ uint32_t ColumnsAboveZero(const float* D, size_t columns) {
 
 }  // namespace
 
-Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer* cldBuffer,
-                           DensityOutputs& out) {
+Status Density(tbb::task_arena& arena, const DensityParams& params, const Buffer& qBuffer, const Buffer* cldBuffer,
+               DensityOutputs& out) {
     if (params.tile == 0 || params.band == 0) return MakeError("cpu: density tile and band must be positive");
     const float* q = static_cast<const BufferCpu&>(qBuffer).F32();
     float* D = static_cast<BufferCpu&>(*out.columnSum).F32();
@@ -75,7 +80,7 @@ Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, c
     if (ty0 >= ty1) return {};
     const uint32_t jBegin = ty0 * T, jEnd = std::min(e.ny, ty1 * T);
 
-    mArena.execute([&] {
+    arena.execute([&] {
         tbb::parallel_for(
             tbb::blocked_range<uint32_t>(ty0, ty1, 1), [&](const tbb::blocked_range<uint32_t>& tileRows) {
                 // The columns of one row of tiles are contiguous in D and in each
@@ -125,4 +130,18 @@ Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, c
     return {};
 }
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(Density);
+
+Status BackendCpu::Density(const DensityParams& params, const Buffer& qBuffer, const Buffer* cldBuffer,
+                           DensityOutputs& out) {
+    return HWY_DYNAMIC_DISPATCH(Density)(mArena, params, qBuffer, cldBuffer, out);
+}
+
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

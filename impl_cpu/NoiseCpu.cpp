@@ -9,6 +9,10 @@
 // for voxel. Perlin fBm runs octave by octave along a row: y and z are the
 // same for the whole row, and a cell's eight corner hashes are reused until x
 // enters the next cell (at octave 0 of frequency 4 on 128 voxels, once per 32).
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/NoiseCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -19,7 +23,8 @@
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/NoiseCpuState.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 namespace {
 
 // sums[i] = the Perlin fBm sum (noise::Fbm) at voxel (i, j, k) of row (j, k), for i in [0, nx).
@@ -65,19 +70,10 @@ void PerlinFbmRow(const noise::NoiseForm& form, const noise::StepOffsets& offset
 
 }  // namespace
 
-uint64_t NoiseCpuState::ScratchBytes(const Scene& scene) const {
-    const NoiseSettings& n = scene.noise;
-    uint64_t bytes = 0;
-    if (n.detail.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(n.detail.size) * n.detail.size * n.detail.size);
-    if (n.coverage.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(scene.grid.size.nx) * scene.grid.size.ny);
-    return bytes;
-}
-
-Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
+Status Noise(tbb::task_arena& arena, NoiseCpuState& state, const NoiseParams& params, Buffer& q) {
     if (!params.settings) return MakeError("cpu: noise without settings");
     if (q.Format() != BufferFormat::F32 || !(q.Extent() == params.grid))
         return MakeError("cpu: noise: q must be an F32 volume of the grid's size");
-    NoiseCpuState& state = mStages.Get<NoiseCpuState>();
     if (!state.form || !(state.form->Settings() == *params.settings) || !(state.form->Grid() == params.grid))
         state.form = std::make_unique<noise::NoiseForm>(*params.settings, params.grid);
     const noise::NoiseForm& form = *state.form;
@@ -86,7 +82,7 @@ Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
     const bool coverage = params.settings->coverage.enabled;
     float* out = static_cast<BufferCpu&>(q).F32();
 
-    mArena.execute([&] {
+    arena.execute([&] {
         if (coverage) {
             state.map.resize(size_t(e.nx) * e.ny);
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny), [&](const tbb::blocked_range<uint32_t>& rows) {
@@ -99,28 +95,53 @@ Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
         const FbmSettings& fbm = params.settings->fbm;
         const bool perlinRows = fbm.basis == NoiseBasis::Perlin;
         tbb::enumerable_thread_specific<std::vector<float>> rowSums(std::vector<float>(e.nx));
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz), [&](const tbb::blocked_range<uint32_t>& rows) {
-            std::vector<float>& sums = rowSums.local();
-            for (uint32_t row = rows.begin(); row != rows.end(); ++row) {
-                const uint32_t j = row % e.ny, k = row / e.ny;
-                float* o = out + size_t(e.nx) * row;
-                const float* map = coverage ? state.map.data() + size_t(e.nx) * j : nullptr;
-                if (perlinRows) PerlinFbmRow(form, offsets, j, k, sums.data());
-                for (uint32_t i = 0; i < e.nx; ++i) {
-                    float base;
-                    if (perlinRows) {
-                        base = noise::Fbm01FromSum(fbm.basis, fbm, sums[i]);
-                    } else {
-                        float p[3];
-                        form.BaseCoordinates(offsets, i, j, k, p);
-                        base = noise::Fbm01(lattice, fbm, p[0], p[1], p[2], period);
+        // flatten: the noise functions (core/math, compiled for the baseline
+        // where they are not inlined) become this target's code.
+        tbb::parallel_for(
+            tbb::blocked_range<uint32_t>(0, e.ny * e.nz), [&](const tbb::blocked_range<uint32_t>& rows) __attribute__((
+                                                              flatten)) {
+                std::vector<float>& sums = rowSums.local();
+                for (uint32_t row = rows.begin(); row != rows.end(); ++row) {
+                    const uint32_t j = row % e.ny, k = row / e.ny;
+                    float* o = out + size_t(e.nx) * row;
+                    const float* map = coverage ? state.map.data() + size_t(e.nx) * j : nullptr;
+                    if (perlinRows) PerlinFbmRow(form, offsets, j, k, sums.data());
+                    for (uint32_t i = 0; i < e.nx; ++i) {
+                        float base;
+                        if (perlinRows) {
+                            base = noise::Fbm01FromSum(fbm.basis, fbm, sums[i]);
+                        } else {
+                            float p[3];
+                            form.BaseCoordinates(offsets, i, j, k, p);
+                            base = noise::Fbm01(lattice, fbm, p[0], p[1], p[2], period);
+                        }
+                        o[i] = form.Form(offsets, i, j, k, base, map ? map[i] : 0.0f);
                     }
-                    o[i] = form.Form(offsets, i, j, k, base, map ? map[i] : 0.0f);
                 }
-            }
-        });
+            });
     });
     return {};
 }
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(Noise);
+
+uint64_t NoiseCpuState::ScratchBytes(const Scene& scene) const {
+    const NoiseSettings& n = scene.noise;
+    uint64_t bytes = 0;
+    if (n.detail.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(n.detail.size) * n.detail.size * n.detail.size);
+    if (n.coverage.enabled) bytes = SaturatingAdd(bytes, 4 * uint64_t(scene.grid.size.nx) * scene.grid.size.ny);
+    return bytes;
+}
+
+Status BackendCpu::Noise(const NoiseParams& params, Buffer& q) {
+    return HWY_DYNAMIC_DISPATCH(Noise)(mArena, mStages.Get<NoiseCpuState>(), params, q);
+}
+
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

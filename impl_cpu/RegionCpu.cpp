@@ -1,5 +1,9 @@
 // Stage `region` on the CPU (SPEC 2): each ellipsoid is evaluated only over the
 // voxels of each row that its surface can reach, and max-blended into R.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/RegionCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
@@ -8,7 +12,8 @@
 
 #include "impl_cpu/BackendCpu.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 namespace {
 
 // Where an ellipsoid can be nonzero, in double precision (scheduling only: the
@@ -42,7 +47,8 @@ EllipsoidBounds ComputeBounds(const RasterEllipsoid& e) {
 
 }  // namespace
 
-Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& regionBuffer, SliceRange slices) {
+Status Region(tbb::task_arena& arena, std::span<const RasterEllipsoid> ellipsoids, Buffer& regionBuffer,
+              SliceRange slices) {
     uint8_t* region = static_cast<BufferCpu&>(regionBuffer).U8();
     const Extent3 e = regionBuffer.Extent();
     std::vector<EllipsoidBounds> bounds(ellipsoids.size());
@@ -111,8 +117,21 @@ Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& r
     // position alone, so a share is the whole call's loop over fewer slices.
     const uint32_t k0 = slices.Begin(e.nz), k1 = slices.End(e.nz);
     if (k0 >= k1) return {};
-    mArena.execute([&] { tbb::parallel_for(tbb::blocked_range2d<uint32_t>(k0, k1, 1, 0, e.ny, 16), rows); });
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range2d<uint32_t>(k0, k1, 1, 0, e.ny, 16), rows); });
     return {};
 }
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(Region);
+
+Status BackendCpu::Region(std::span<const RasterEllipsoid> ellipsoids, Buffer& regionBuffer, SliceRange slices) {
+    return HWY_DYNAMIC_DISPATCH(Region)(mArena, ellipsoids, regionBuffer, slices);
+}
+
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

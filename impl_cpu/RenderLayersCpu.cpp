@@ -5,6 +5,10 @@
 // pixel runs LayersPixel, the layers its ray crosses back to front and then
 // LOD0's billboards (a list made once per call, culled per tile), TBB over 8 x 8 pixel tiles. A pixel's loop is the
 // fastest form here: it touches only the layers on its side of the eye, where OpenGL rasterises every layer.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/RenderLayersCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -18,7 +22,8 @@
 #include "impl_cpu/PaddedVolumeCpu.h"
 #include "impl_cpu/RenderLayersCpuState.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 
 namespace {
 
@@ -35,43 +40,40 @@ void LayersPixels(const LayersParams& params, Fetch&& fetch, float* out, std::at
     // a billboard outside has no fragment there, so the pixels are the same as with the whole list.
     std::vector<LayersPixelRect> rects(list.size());
     for (size_t n = 0; n < list.size(); ++n) rects[n] = LayersBillboardRect(s, params.camera, list[n]);
-    tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) {
-        uint64_t nFragments = 0, nDrawn = 0;
-        std::vector<LayersBillboard> near;
-        const double x0 = r.cols().begin(), x1 = r.cols().end();
-        const double y0 = r.rows().begin(), y1 = r.rows().end();
-        for (size_t n = 0; n < list.size(); ++n)
-            if (rects[n].x1 >= x0 && rects[n].x0 <= x1 && rects[n].y1 >= y0 && rects[n].y0 <= y1)
-                near.push_back(list[n]);
-        const LayersBillboards billboards{near.data(), uint32_t(near.size()), params.camera.right,
-                                          params.camera.upVector};
-        for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
-            for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
-                const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
-                const LayersPixelResult p = LayersPixel(s, walks, ray, fetch, billboards);
-                float* o = out + 3 * (size_t(x) + size_t(W) * y);
-                o[0] = p.color[0];
-                o[1] = p.color[1];
-                o[2] = p.color[2];
-                nFragments += p.fragments;
-                nDrawn += p.drawn;
-            }
-        fragments += nFragments;
-        drawn += nDrawn;
-    });
+    // flatten: the layers' fragment functions (core/math, compiled for the
+    // baseline where they are not inlined) become this target's code.
+    tbb::parallel_for(
+        tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
+                                                              flatten)) {
+            uint64_t nFragments = 0, nDrawn = 0;
+            std::vector<LayersBillboard> near;
+            const double x0 = r.cols().begin(), x1 = r.cols().end();
+            const double y0 = r.rows().begin(), y1 = r.rows().end();
+            for (size_t n = 0; n < list.size(); ++n)
+                if (rects[n].x1 >= x0 && rects[n].x0 <= x1 && rects[n].y1 >= y0 && rects[n].y0 <= y1)
+                    near.push_back(list[n]);
+            const LayersBillboards billboards{near.data(), uint32_t(near.size()), params.camera.right,
+                                              params.camera.upVector};
+            for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
+                for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
+                    const LayersRay ray = MakeLayersRay(params.camera, s.voxelSize, x, y);
+                    const LayersPixelResult p = LayersPixel(s, walks, ray, fetch, billboards);
+                    float* o = out + 3 * (size_t(x) + size_t(W) * y);
+                    o[0] = p.color[0];
+                    o[1] = p.color[1];
+                    o[2] = p.color[2];
+                    nFragments += p.fragments;
+                    nDrawn += p.drawn;
+                }
+            fragments += nFragments;
+            drawn += nDrawn;
+        });
 }
 
 }  // namespace
 
-uint64_t RenderLayersCpuState::ScratchBytes(const Scene& scene) const {
-    const Extent3 e = scene.grid.size;
-    const uint64_t fields = scene.lighting.sky.on ? 3 : 2;
-    const uint64_t cells = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
-    return SaturatingAdd(SaturatingMul(cells, fields * sizeof(float)), (cells + 63) / 64 * 8);  // and the bits
-}
-
-Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats) {
-    RenderLayersCpuState& state = mStages.Get<RenderLayersCpuState>();
+Status RenderLayers(tbb::task_arena& arena, RenderLayersCpuState& state, const LayersParams& params,
+                    const LayersInputs& in, Buffer& image, LayersStats* stats) {
     if (!in.qPrev || !in.qCur || !in.T) return MakeError("cpu: render_layers needs q and T");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e || in.T->Extent() != e)
@@ -90,7 +92,7 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
     const LayersSetup& s = params.setup;
     std::atomic<uint64_t> fragments{0}, drawn{0};
 
-    mArena.execute([&] {
+    arena.execute([&] {
         // 1. The padded volume (with the sky light its cells carry T_sky as a third field), 2. its empty taps,
         // 3. the pixels.
         const float alpha = params.alpha;
@@ -117,4 +119,24 @@ Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& 
     return {};
 }
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(RenderLayers);
+
+uint64_t RenderLayersCpuState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint64_t fields = scene.lighting.sky.on ? 3 : 2;
+    const uint64_t cells = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
+    return SaturatingAdd(SaturatingMul(cells, fields * sizeof(float)), (cells + 63) / 64 * 8);  // and the bits
+}
+
+Status BackendCpu::RenderLayers(const LayersParams& params, const LayersInputs& in, Buffer& image, LayersStats* stats) {
+    return HWY_DYNAMIC_DISPATCH(RenderLayers)(mArena, mStages.Get<RenderLayersCpuState>(), params, in, image, stats);
+}
+
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

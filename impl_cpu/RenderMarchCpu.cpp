@@ -5,6 +5,10 @@
 // light T_sky into a second one,
 // the brick skip structure is built from it, and then every pixel runs the
 // shared kernel MarchRay (core/math/March.h), TBB over 8 x 8 pixel tiles.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/RenderMarchCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/blocked_range3d.h>
@@ -19,7 +23,8 @@
 #include "impl_cpu/PaddedVolumeCpu.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 namespace {
 
 // Trilinear reads of the padded (q, T) volume; p in voxel units (wrapped with
@@ -89,37 +94,41 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
     const CameraFrame& cam = params.camera;
     const uint32_t W = cam.width, H = cam.height;
     std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0};
-    tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) {
-        uint64_t nRays = 0, nSamples = 0, nLight = 0, nSkipped = 0;
-        MarchCachedDensity density{&volume};
-        auto light = makeLight(density);
-        for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
-            for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
-                const MarchRayGeometry ray = MakePixelRay(cam, params.origin, params.setup.voxelSize, params.setup.size,
-                                                          x, y, params.setup.tiling);
-                const uint32_t pixel = x + W * y;
-                const float xi = params.jitter ? MarchJitter(params.seed, params.frame, pixel) : 0.5f;
-                const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
-                float* out = image + 3 * size_t(pixel);
-                if (G) {
-                    const Vec3 bg = GroundBackground(cam, eyeVoxel, params.setup.voxelSize, groundLight, G, grid.nx,
-                                                     grid.ny, x, y);
-                    for (int c = 0; c < 3; ++c) out[c] = m.light[c] + m.transmittance * bg[c];
-                } else {
-                    out[0] = m.color[0];
-                    out[1] = m.color[1];
-                    out[2] = m.color[2];
+    // flatten: MarchRay and what it calls (core/math, compiled for the baseline
+    // where they are not inlined) become this target's code.
+    tbb::parallel_for(
+        tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
+                                                              flatten)) {
+            uint64_t nRays = 0, nSamples = 0, nLight = 0, nSkipped = 0;
+            MarchCachedDensity density{&volume};
+            auto light = makeLight(density);
+            for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
+                for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
+                    const MarchRayGeometry ray = MakePixelRay(cam, params.origin, params.setup.voxelSize,
+                                                              params.setup.size, x, y, params.setup.tiling);
+                    const uint32_t pixel = x + W * y;
+                    const float xi = params.jitter ? MarchJitter(params.seed, params.frame, pixel) : 0.5f;
+                    const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
+                    float* out = image + 3 * size_t(pixel);
+                    if (G) {
+                        const Vec3 bg = GroundBackground(cam, eyeVoxel, params.setup.voxelSize, groundLight, G, grid.nx,
+                                                         grid.ny, x, y);
+                        for (int c = 0; c < 3; ++c) out[c] = m.light[c] + m.transmittance * bg[c];
+                    } else {
+                        out[0] = m.color[0];
+                        out[1] = m.color[1];
+                        out[2] = m.color[2];
+                    }
+                    nRays += ray.Empty() ? 0 : 1;
+                    nSamples += m.samples;
+                    nLight += m.lightCalls;
+                    nSkipped += m.bricksSkipped;
                 }
-                nRays += ray.Empty() ? 0 : 1;
-                nSamples += m.samples;
-                nLight += m.lightCalls;
-                nSkipped += m.bricksSkipped;
-            }
-        rays += nRays;
-        samples += nSamples;
-        lightSamples += nLight;
-        skipped += nSkipped;
-    });
+            rays += nRays;
+            samples += nSamples;
+            lightSamples += nLight;
+            skipped += nSkipped;
+        });
     stats.rays = rays;
     stats.samples = samples;
     stats.lightSamples = lightSamples;
@@ -129,17 +138,8 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
 
 }  // namespace
 
-uint64_t RenderMarchCpuState::ScratchBytes(const Scene& scene) const {
-    const Extent3 e = scene.grid.size;
-    const uint64_t padded = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
-    const uint32_t b = std::max(scene.march.brick, 1u);
-    const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
-    const uint64_t cell = sizeof(MarchQT) + (scene.lighting.sky.on ? sizeof(float) : 0);
-    return SaturatingAdd(SaturatingMul(padded, cell), bricks);
-}
-
-Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
-    RenderMarchCpuState& state = mStages.Get<RenderMarchCpuState>();
+Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const MarchParams& params, const MarchInputs& in,
+                   Buffer& image, MarchStats* stats) {
     if (!in.qPrev || !in.qCur) return MakeError("cpu: render_march needs q");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e) return MakeError("cpu: render_march: q_prev and q_cur differ in size");
@@ -166,7 +166,7 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
     const uint32_t bx = CeilDiv(e.nx, B), by = CeilDiv(e.ny, B), bz = CeilDiv(e.nz, B);
     MarchStats local;
 
-    mArena.execute([&] {
+    arena.execute([&] {
         // 1. q_alpha and T into the padded volume, T_sky into its own with the sky light; the border reads
         //    q = 0, T = 1, T_sky = 1, or with tiling the opposite edge's voxel in x and y.
         FormPaddedVolume(state.volume, e, wrap, MarchQT{0.0f, 1.0f}, [&](size_t v) {
@@ -236,4 +236,26 @@ Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in,
     return {};
 }
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(RenderMarch);
+
+uint64_t RenderMarchCpuState::ScratchBytes(const Scene& scene) const {
+    const Extent3 e = scene.grid.size;
+    const uint64_t padded = uint64_t(e.nx + 2ull) * (e.ny + 2ull) * (e.nz + 2ull);
+    const uint32_t b = std::max(scene.march.brick, 1u);
+    const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
+    const uint64_t cell = sizeof(MarchQT) + (scene.lighting.sky.on ? sizeof(float) : 0);
+    return SaturatingAdd(SaturatingMul(padded, cell), bricks);
+}
+
+Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
+    return HWY_DYNAMIC_DISPATCH(RenderMarch)(mArena, mStages.Get<RenderMarchCpuState>(), params, in, image, stats);
+}
+
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

@@ -15,6 +15,13 @@
 // every pixel's arithmetic is the scalar formula's (SplatCoord, SplatKernel,
 // SplatAlpha, Lerp) operation for operation, so the image is the same bit for
 // bit as one pixel at a time (docs/performance.md, "render_splat on 2 cores").
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/RenderSplatCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <atomic>
 #include <bit>
@@ -22,20 +29,14 @@
 #include <cstring>
 #include <vector>
 
-#include "impl_cpu/RenderSplatCpuState.h"
-
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "core/math/Splat.h"
 #include "core/pipeline/SplatFrame.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/RenderSplatCpuState.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
 namespace {
 
 constexpr uint32_t kSplatCpuRowsPerBand = 8;
@@ -53,68 +54,57 @@ inline float SplatCpuKernelSquare(float pixelCentre, float centre, float size) {
 // (R, G, B: rows of `stride` floats, row 0 = image row `rowLo`). Per pixel:
 // alpha = clamp(alphaScale t^2, 0, 1) with t = max(0, 1 - (xx + yy)), xx and
 // yy the squared kernel coordinates of its column and row, then
-// C <- C (1 - alpha) + colour alpha (Lerp).
+// C <- C (1 - alpha) + colour alpha: SplatAlpha's and Lerp's operations, in
+// their order, on every target (one lane at a time on the scalar one).
 inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo, size_t stride, float* R, float* G,
                           float* B) {
-#if defined(__AVX512F__)
-    // Aligned blocks of sixteen columns, each block's xx kept in a register for
-    // all rows. Loads and stores are whole aligned vectors (the rows are
-    // 64-byte aligned and a multiple of 16 floats long), lanes outside the
-    // splat storing back what they loaded, so that every load meets an earlier
-    // store of exactly the same vector and can be forwarded from it (a load
-    // that overlaps a store only in part waits until the store reaches the
-    // cache; the splats of a band overlap their neighbours' columns). max_ps(a, b)
-    // is a > b ? a : b and min_ps(a, b) is a < b ? a : b, so the operand order
-    // below is std::max(0, u) and std::clamp(v, 0, 1) (std::min(std::max(v, 0),
-    // 1)) as <algorithm> defines them, signed zeros included.
-    const __m512 half = _mm512_set1_ps(0.5f), two = _mm512_set1_ps(2.0f), one = _mm512_set1_ps(1.0f);
-    const __m512 zero = _mm512_setzero_ps();
-    const __m512 vpx = _mm512_set1_ps(s.px), vsize = _mm512_set1_ps(s.size), scale = _mm512_set1_ps(s.alphaScale);
-    const __m512 cr = _mm512_set1_ps(s.colour[0]), cg = _mm512_set1_ps(s.colour[1]), cb = _mm512_set1_ps(s.colour[2]);
-    const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    // Aligned blocks of N columns (N lanes of the target), each block's xx kept
+    // in a register for all rows. Loads and stores are whole aligned vectors
+    // (the rows are 64-byte aligned and a multiple of 16 floats long), lanes
+    // outside the splat storing back what they loaded, so that every load
+    // meets an earlier store of exactly the same vector and can be forwarded
+    // from it (a load that overlaps a store only in part waits until the store
+    // reaches the cache; the splats of a band overlap their neighbours'
+    // columns). max(0, u) and the clamp are written as the comparisons
+    // <algorithm> defines them, so that every target (and NaN and signed
+    // zeros) gives the per-pixel formula's bits.
+    const hn::ScalableTag<float> d;
+    const hn::RebindToSigned<decltype(d)> di;
+    const int32_t N = int32_t(hn::Lanes(d));
+    const auto half = hn::Set(d, 0.5f), two = hn::Set(d, 2.0f), one = hn::Set(d, 1.0f), zero = hn::Zero(d);
+    const auto vpx = hn::Set(d, s.px), vsize = hn::Set(d, s.size), scale = hn::Set(d, s.alphaScale);
+    const auto cr = hn::Set(d, s.colour[0]), cg = hn::Set(d, s.colour[1]), cb = hn::Set(d, s.colour[2]);
+    const auto first = hn::Set(di, s.x0), last = hn::Set(di, s.x1);
+    const auto iota = hn::Iota(di, 0);
     float yy[kSplatCpuRowsPerBand];  // y1 - y0 < kSplatCpuRowsPerBand: the rows lie in one band
     for (int32_t y = y0; y <= y1; ++y) yy[y - y0] = SplatCpuKernelSquare(float(y) + 0.5f, s.py, s.size);
-    for (int32_t xb = s.x0 & ~15; xb <= s.x1; xb += 16) {
-        const __m512i column = _mm512_add_epi32(_mm512_set1_epi32(xb), iota);
-        const __mmask16 m = _mm512_cmpge_epi32_mask(column, _mm512_set1_epi32(s.x0)) &
-                            _mm512_cmple_epi32_mask(column, _mm512_set1_epi32(s.x1));
+    for (int32_t xb = s.x0 & ~(N - 1); xb <= s.x1; xb += N) {
+        const auto column = hn::Add(hn::Set(di, xb), iota);
+        const auto inside = hn::RebindMask(d, hn::And(hn::Not(hn::Lt(column, first)), hn::Not(hn::Gt(column, last))));
         // SplatCoord and SplatKernel's x: exact int -> float (|x| < 2^24), then the same operations.
-        const __m512 a = _mm512_add_ps(_mm512_div_ps(_mm512_sub_ps(_mm512_add_ps(_mm512_cvtepi32_ps(column), half), vpx), vsize), half);
-        const __m512 c = _mm512_sub_ps(_mm512_mul_ps(two, a), one);
-        const __m512 xx = _mm512_mul_ps(c, c);
+        const auto a = hn::Add(hn::Div(hn::Sub(hn::Add(hn::ConvertTo(d, column), half), vpx), vsize), half);
+        const auto c = hn::Sub(hn::Mul(two, a), one);
+        const auto xx = hn::Mul(c, c);
         for (int32_t y = y0; y <= y1; ++y) {
-            const __m512 vyy = _mm512_set1_ps(yy[y - y0]);
-            const __m512 u = _mm512_sub_ps(one, _mm512_add_ps(xx, vyy));
-            const __m512 t = _mm512_max_ps(u, zero);
-            const __m512 v = _mm512_mul_ps(scale, _mm512_mul_ps(t, t));
-            const __m512 alpha = _mm512_min_ps(one, _mm512_max_ps(zero, v));
-            const __m512 keep = _mm512_sub_ps(one, alpha);
+            const auto u = hn::Sub(one, hn::Add(xx, hn::Set(d, yy[y - y0])));
+            const auto t = hn::IfThenElse(hn::Lt(zero, u), u, zero);  // std::max(0, u)
+            const auto v = hn::Mul(scale, hn::Mul(t, t));
+            const auto alpha = hn::IfThenElse(hn::Lt(v, zero), zero, hn::IfThenElse(hn::Lt(one, v), one, v));
+            const auto keep = hn::Sub(one, alpha);
             const size_t o = stride * uint32_t(y - int32_t(rowLo)) + uint32_t(xb);
-            const __m512 r = _mm512_load_ps(R + o), g = _mm512_load_ps(G + o), b = _mm512_load_ps(B + o);
-            _mm512_store_ps(R + o, _mm512_mask_blend_ps(m, r, _mm512_add_ps(_mm512_mul_ps(r, keep), _mm512_mul_ps(cr, alpha))));
-            _mm512_store_ps(G + o, _mm512_mask_blend_ps(m, g, _mm512_add_ps(_mm512_mul_ps(g, keep), _mm512_mul_ps(cg, alpha))));
-            _mm512_store_ps(B + o, _mm512_mask_blend_ps(m, b, _mm512_add_ps(_mm512_mul_ps(b, keep), _mm512_mul_ps(cb, alpha))));
+            const auto r = hn::Load(d, R + o), g = hn::Load(d, G + o), b = hn::Load(d, B + o);
+            hn::Store(hn::IfThenElse(inside, hn::Add(hn::Mul(r, keep), hn::Mul(cr, alpha)), r), d, R + o);
+            hn::Store(hn::IfThenElse(inside, hn::Add(hn::Mul(g, keep), hn::Mul(cg, alpha)), g), d, G + o);
+            hn::Store(hn::IfThenElse(inside, hn::Add(hn::Mul(b, keep), hn::Mul(cb, alpha)), b), d, B + o);
         }
     }
-#else
-    // The per-pixel formula itself.
-    for (int32_t y = y0; y <= y1; ++y) {
-        const float bCoord = SplatCoord(float(y) + 0.5f, s.py, s.size);
-        const size_t o = stride * uint32_t(y - int32_t(rowLo));
-        for (int32_t x = s.x0; x <= s.x1; ++x) {
-            const float alpha = SplatAlpha(s.alphaScale, SplatCoord(float(x) + 0.5f, s.px, s.size), bCoord);
-            R[o + x] = Lerp(R[o + x], s.colour[0], alpha);
-            G[o + x] = Lerp(G[o + x], s.colour[1], alpha);
-            B[o + x] = Lerp(B[o + x], s.colour[2], alpha);
-        }
-    }
-#endif
 }
 
 }  // namespace
 
-Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& imageBuffer, SplatStats* stats) {
-    std::vector<std::vector<Splat>>& slicesKept = mStages.Get<RenderSplatCpuState>().slices;
+Status RenderSplat(tbb::task_arena& arena, RenderSplatCpuState& state, const SplatParams& p, const SplatInputs& in,
+                   Buffer& imageBuffer, SplatStats* stats) {
+    std::vector<std::vector<Splat>>& slicesKept = state.slices;
     if (!p.order || !in.qPrev || !in.qCur || !in.T) return MakeError("cpu: render_splat needs q (both steps), T and an order");
     if (p.skipping && (!in.tilesPrev || !in.tilesCur || !in.bandsPrev || !in.bandsCur))
         return MakeError("cpu: render_splat with skipping needs both steps' occupancy");
@@ -186,7 +176,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const size_t sliceWords = marked ? (size_t(nMiddle) * nInner + 63) / 64 : 0;
     std::vector<uint64_t> marks(sliceWords * outerIdx.size(), 0);
     if (marked) {
-        mArena.execute([&] {
+        arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, e.ny * e.nz), [&](const tbb::blocked_range<uint32_t>& rows) {
                 std::vector<uint8_t> candidate(size_t(e.nx) + 8, 0);
                 uint32_t idx[3];
@@ -225,56 +215,60 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
         return runs;
     };
     const std::vector<PartRun> middleRuns = partRuns(middle), innerRuns = partRuns(inner);
-    mArena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t n = range.begin(); n != range.end(); ++n) {
-                std::vector<Splat>& out = slicesKept[n];
-                out.clear();
-                uint64_t visited = 0;
-                uint32_t idx[3];
-                idx[outer] = outerIdx[n];
-                const size_t vOuter = voxelStride[outer] * idx[outer];
-                const uint32_t bOuter = boxPart[outer][idx[outer]];
-                if (marked) {
-                    for (const PartRun& m : middleRuns)
-                        for (const PartRun& i : innerRuns)
-                            if (visible[bOuter + m.part + i.part]) visited += uint64_t(m.voxels) * i.voxels;
-                    const uint64_t* sliceMarks = marks.data() + sliceWords * n;
-                    for (size_t w = 0; w < sliceWords; ++w)
-                        for (uint64_t bits = sliceMarks[w]; bits != 0; bits &= bits - 1) {
-                            const size_t bit = 64 * w + size_t(std::countr_zero(bits));
-                            idx[middle] = middleIdx[bit / nInner];
-                            idx[inner] = innerIdx[bit % nInner];
-                            const size_t v = vOuter + strideMiddle * idx[middle] + strideInner * idx[inner];
+    // flatten: MakeSplat and what it calls (core/math, compiled for the
+    // baseline where they are not inlined) become this target's code.
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, outerIdx.size()), [&](const tbb::blocked_range<size_t>& range) __attribute__((
+                                                                flatten)) {
+                for (size_t n = range.begin(); n != range.end(); ++n) {
+                    std::vector<Splat>& out = slicesKept[n];
+                    out.clear();
+                    uint64_t visited = 0;
+                    uint32_t idx[3];
+                    idx[outer] = outerIdx[n];
+                    const size_t vOuter = voxelStride[outer] * idx[outer];
+                    const uint32_t bOuter = boxPart[outer][idx[outer]];
+                    if (marked) {
+                        for (const PartRun& m : middleRuns)
+                            for (const PartRun& i : innerRuns)
+                                if (visible[bOuter + m.part + i.part]) visited += uint64_t(m.voxels) * i.voxels;
+                        const uint64_t* sliceMarks = marks.data() + sliceWords * n;
+                        for (size_t w = 0; w < sliceWords; ++w)
+                            for (uint64_t bits = sliceMarks[w]; bits != 0; bits &= bits - 1) {
+                                const size_t bit = 64 * w + size_t(std::countr_zero(bits));
+                                idx[middle] = middleIdx[bit / nInner];
+                                idx[inner] = innerIdx[bit % nInner];
+                                const size_t v = vOuter + strideMiddle * idx[middle] + strideInner * idx[inner];
+                                Splat s;
+                                if (MakeSplat(frame, idx[0], idx[1], idx[2], SplatQ(qPrev[v], qCur[v], alpha), T[v],
+                                              skyT ? skyT[v] : 1.0f, s))
+                                    out.push_back(s);
+                            }
+                        visitedPerSlice[n] = visited;
+                        continue;
+                    }
+                    for (uint32_t mr = 0; mr < nMiddle; ++mr) {
+                        const uint32_t mIndex = middleIdx[mr];
+                        idx[middle] = mIndex;
+                        const size_t vMiddle = vOuter + strideMiddle * mIndex;
+                        const uint32_t bMiddle = bOuter + boxMiddle[mIndex];
+                        for (uint32_t ir = 0; ir < nInner; ++ir) {
+                            const uint32_t iIndex = innerIdx[ir];
+                            if (!visible[bMiddle + boxInner[iIndex]]) continue;
+                            ++visited;
+                            const size_t v = vMiddle + strideInner * iIndex;
+                            const float qa = SplatQ(qPrev[v], qCur[v], alpha);
+                            if (!(qa > qMin)) continue;  // MakeSplat's first test
+                            idx[inner] = iIndex;
                             Splat s;
-                            if (MakeSplat(frame, idx[0], idx[1], idx[2], SplatQ(qPrev[v], qCur[v], alpha), T[v],
-                                          skyT ? skyT[v] : 1.0f, s))
+                            if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, T[v], skyT ? skyT[v] : 1.0f, s))
                                 out.push_back(s);
                         }
-                    visitedPerSlice[n] = visited;
-                    continue;
-                }
-                for (uint32_t mr = 0; mr < nMiddle; ++mr) {
-                    const uint32_t mIndex = middleIdx[mr];
-                    idx[middle] = mIndex;
-                    const size_t vMiddle = vOuter + strideMiddle * mIndex;
-                    const uint32_t bMiddle = bOuter + boxMiddle[mIndex];
-                    for (uint32_t ir = 0; ir < nInner; ++ir) {
-                        const uint32_t iIndex = innerIdx[ir];
-                        if (!visible[bMiddle + boxInner[iIndex]]) continue;
-                        ++visited;
-                        const size_t v = vMiddle + strideInner * iIndex;
-                        const float qa = SplatQ(qPrev[v], qCur[v], alpha);
-                        if (!(qa > qMin)) continue;  // MakeSplat's first test
-                        idx[inner] = iIndex;
-                        Splat s;
-                        if (MakeSplat(frame, idx[0], idx[1], idx[2], qa, T[v], skyT ? skyT[v] : 1.0f, s))
-                            out.push_back(s);
                     }
+                    visitedPerSlice[n] = visited;
                 }
-                visitedPerSlice[n] = visited;
-            }
-        });
+            });
     });
 
     // 3. Bin by bands of rows, keeping the order: a counting sort in parallel
@@ -286,7 +280,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     const size_t runs = std::clamp<size_t>(slices.size(), 1, 64), perRun = (slices.size() + runs - 1) / runs;
     std::vector<uint32_t> runCount(runs * bands, 0);  // runCount[run * bands + band]
     std::vector<uint64_t> runFragments(runs, 0);
-    mArena.execute([&] {
+    arena.execute([&] {
         tbb::parallel_for(size_t(0), runs, [&](size_t r) {
             uint32_t* c = runCount.data() + r * bands;
             uint64_t f = 0;
@@ -323,7 +317,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
         count[b + 1] = at;
     }
     std::vector<const Splat*> binned(count[bands]);
-    mArena.execute([&] {
+    arena.execute([&] {
         tbb::parallel_for(size_t(0), runs, [&](size_t r) {
             uint32_t* cursor = runCount.data() + r * bands;
             for (size_t n = r * perRun; n < std::min(slices.size(), (r + 1) * perRun); ++n)
@@ -340,7 +334,7 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     // the image. Per splat the squared kernel coordinate of each of its columns
     // is worked out once (the division), per row once more; each pixel then
     // adds, clamps and blends (SplatCpuBlendRow).
-    mArena.execute([&] {
+    arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, bands), [&](const tbb::blocked_range<uint32_t>& range) {
             // Rows of `stride` floats, 64-byte aligned (SplatCpuBlend's aligned blocks).
             const size_t stride = (size_t(W) + 15) & ~size_t(15), plane = kSplatCpuRowsPerBand * stride;
@@ -388,4 +382,17 @@ Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buff
     return {};
 }
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(RenderSplat);
+
+Status BackendCpu::RenderSplat(const SplatParams& p, const SplatInputs& in, Buffer& imageBuffer, SplatStats* stats) {
+    return HWY_DYNAMIC_DISPATCH(RenderSplat)(mArena, mStages.Get<RenderSplatCpuState>(), p, in, imageBuffer, stats);
+}
+
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

@@ -8,6 +8,10 @@
 // q = 0. The row kernel runs on whole vectors. At resolution f > 1 the same
 // loop runs on the mean of each f^3 block and the result is read back
 // trilinearly (ShadeCoarseCpu.cpp). The ground's shadow is in ShadowCpu.cpp.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "impl_cpu/ShadeCpu.cpp"
+#include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
+#include <hwy/highway.h>
 #include <tbb/parallel_for_each.h>
 
 #include <algorithm>
@@ -23,7 +27,8 @@
 #include "impl_cpu/ShadeCpuState.h"
 #include "impl_cpu/ShadeSchedule.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 namespace {
 
 constexpr uint32_t kMaxStackRow = 512;
@@ -39,6 +44,9 @@ uint32_t PaddedToVectors(uint32_t n) { return (n + kRowLanes - 1) / kRowLanes * 
 // Sixteen floats (a cache line along x, or sixteen cells of a row) in the
 // compilers' generic vectors (GCC and Clang): one AVX-512 register here,
 // split on narrower CPUs.
+// Passed by value only between functions of this file: GCC's note that the
+// ABI of such a vector depends on the target does not apply (GCC and Clang).
+#pragma GCC diagnostic ignored "-Wpsabi"
 typedef float Lanes16 __attribute__((vector_size(64)));
 
 Lanes16 LoadLanes(const float* p) {
@@ -466,18 +474,6 @@ void ShadeGrid(const ShadePlan& plan, StorageFormat storage, const float* Q, flo
     });
 }
 
-}  // namespace
-
-uint64_t ShadeCpuState::ScratchBytes(const Scene& scene) const {
-    const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
-    if (f == 1) return 0;
-    const Extent3 e = scene.grid.size;
-    const uint64_t cells[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
-    return SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4);
-}
-
-namespace {
-
 // Shade's sweep for the sun's T or the sky light's T_sky, each with its own state (its coarse grids).
 Status ShadeInto(ShadeCpuState& state, tbb::task_arena& arena, const ShadeParams& params, const Buffer& qBuffer,
                  Buffer& TBuffer) {
@@ -517,12 +513,29 @@ Status ShadeInto(ShadeCpuState& state, tbb::task_arena& arena, const ShadeParams
 
 }  // namespace
 
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace cb::cpu {
+
+HWY_EXPORT(ShadeInto);
+
+uint64_t ShadeCpuState::ScratchBytes(const Scene& scene) const {
+    const uint32_t f = uint32_t(std::max(scene.shade.resolution, 1));
+    if (f == 1) return 0;
+    const Extent3 e = scene.grid.size;
+    const uint64_t cells[3] = {CeilDiv(e.nx, f), CeilDiv(e.ny, f), CeilDiv(e.nz, f)};
+    return SaturatingMul(SaturatingMul(cells[0] * cells[1], cells[2]), 2 * 4);
+}
+
 Status BackendCpu::Shade(const ShadeParams& params, const Buffer& q, Buffer& T) {
-    return ShadeInto(mStages.Get<ShadeCpuState>(), mArena, params, q, T);
+    return HWY_DYNAMIC_DISPATCH(ShadeInto)(mStages.Get<ShadeCpuState>(), mArena, params, q, T);
 }
 
 Status BackendCpu::ShadeSky(const ShadeParams& params, const Buffer& q, Buffer& T) {
-    return ShadeInto(mStages.Get<ShadeSkyCpuState>(), mArena, params, q, T);
+    return HWY_DYNAMIC_DISPATCH(ShadeInto)(mStages.Get<ShadeSkyCpuState>(), mArena, params, q, T);
 }
 
 }  // namespace cb::cpu
+#endif  // HWY_ONCE

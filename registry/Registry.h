@@ -11,6 +11,7 @@
 
 #include "core/base/Error.h"
 #include "core/pipeline/Backend.h"
+#include "impl_cpu/CpuIsa.h"
 #include "impl_gl/GLOptions.h"
 
 namespace cb {

@@ -6,6 +6,7 @@
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/CaKernels.h"
 #include "tests/CaReference.h"
+#include "tests/CpuIsaTestUtil.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
@@ -112,10 +113,12 @@ INSTANTIATE_TEST_SUITE_P(
                       CaCase{"Column1x1x9", {1, 1, 9}, true, 0}, CaCase{"Row130x1x1", {130, 1, 1}, false, 2}),
     [](const ::testing::TestParamInfo<CaCase>& info) { return std::string(info.param.name); });
 
-// Test the AVX-512 event kernel against the scalar one it replaces, on every
-// region value, both polarities and probabilities at the ends.
-TEST(CaKernels, VectorEqualsScalar) {
-    if (!cpu::HasVectorKernels()) GTEST_SKIP() << "unsupported here: this CPU has no AVX-512BW";
+// Test every SIMD target's event and mask kernels against the scalar ones they
+// replace, on every region value, both polarities and probabilities at the ends.
+class CaKernels : public test::OnEveryCpuIsa {};
+INSTANTIATE_TEST_SUITE_P(Targets, CaKernels, test::EveryCpuIsa(), test::CpuIsaTestName);
+
+TEST_P(CaKernels, VectorEqualsScalar) {
     std::vector<uint8_t> region(64 * 4 + 64);
     for (size_t n = 0; n < region.size(); ++n) region[n] = uint8_t(n * 37 + 11);
     region[3] = 0;

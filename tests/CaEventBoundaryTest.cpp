@@ -23,6 +23,7 @@
 #include "impl_cpu/CaKernels.h"
 #include "tests/BackendTestUtil.h"
 #include "tests/CaReference.h"
+#include "tests/CpuIsaTestUtil.h"
 #include "tests/LowBias32Inverse.h"
 #include "tests/TestUtil.h"
 
@@ -116,10 +117,10 @@ void EbCheckKernel(EbKernel kernel) {
 
 TEST(CaEventBoundary, ScalarKernelAtThresholds) { EbCheckKernel(cpu::EventBitsScalar); }
 
-TEST(CaEventBoundary, VectorKernelAtThresholds) {
-    if (!cpu::HasVectorKernels()) GTEST_SKIP() << "unsupported here: this CPU has no AVX-512BW";
-    EbCheckKernel(cpu::EventBitsVector);
-}
+class CaEventBoundaryVector : public test::OnEveryCpuIsa {};
+INSTANTIATE_TEST_SUITE_P(Targets, CaEventBoundaryVector, test::EveryCpuIsa(), test::CpuIsaTestName);
+
+TEST_P(CaEventBoundaryVector, KernelAtThresholds) { EbCheckKernel(cpu::EventBitsVector); }
 
 // ---- Whole stages through the Backend interface --------------------------------
 

@@ -20,7 +20,7 @@ not timed. On lavapipe and llvmpipe the device is this machine's CPU.
 
 Usage: tools/thesis_tables.py [--cli build/release/cloudbench] [--backends cpu,gl,vk]
        [--scenes thesis-low,thesis-medium,thesis-high] [--rounds 3] [--frames 2]
-       [--size 1024x768] [--out /tmp/thesis-tables] [--json reports/loop/thesis-tables.json]
+       [--size 1024x768] [--cpu-isa auto] [--out /tmp/thesis-tables] [--json reports/loop/thesis-tables.json]
 --frames F renders F frames per camera at the one render step (render.frames_per_step; alpha 1/F .. 1),
 so a run's median is over F frames.
 """
@@ -45,8 +45,8 @@ THESIS = {"thesis-low": (33, 95, 118), "thesis-medium": (25, 51, 55), "thesis-hi
 THESIS_GPU = "NVIDIA GeForce 8700M GT"
 
 
-def run_once(cli, scene, backend, overrides, out, warmup, frames, size):
-    args = [cli, "run", scene, "--backend", backend, "--quiet", "--out", str(out),
+def run_once(cli, scene, backend, overrides, out, warmup, frames, size, cpu_isa):
+    args = [cli, "run", scene, "--backend", backend, "--quiet", "--out", str(out), "--cpu-isa", cpu_isa,
             "--set", f"steps={warmup + 1}", "--set", f"warmup_steps={warmup}", "--set", "render.every_steps=1",
             "--set", f"render.frames_per_step={frames}"]
     w, h = size.split("x")
@@ -75,6 +75,7 @@ def main():
     ap.add_argument("--warmup", type=int, default=100, help="simulation steps before the one render step")
     ap.add_argument("--frames", type=int, default=2, help="frames per camera per run (render.frames_per_step)")
     ap.add_argument("--size", default="1024x768")
+    ap.add_argument("--cpu-isa", default="auto", help="the CPU kernels' SIMD target (cloudbench --cpu-isa)")
     ap.add_argument("--out", default="/tmp/thesis-tables")
     ap.add_argument("--json", default=None, help="write the raw runs here")
     a = ap.parse_args()
@@ -87,7 +88,7 @@ def main():
                 for b in backends:
                     loads.append(os.getloadavg()[0])
                     out = Path(a.out) / b / s / key
-                    r = run_once(a.cli, s, b, overrides, out, a.warmup, a.frames, a.size)
+                    r = run_once(a.cli, s, b, overrides, out, a.warmup, a.frames, a.size, a.cpu_isa)
                     runs[b][s][key].append(r)
                     print(f"round {rnd} {s} {key} {b}: " + ", ".join(
                         f"{c} {v['fps']:.1f} fps" for c, v in r["cameras"].items()), file=sys.stderr, flush=True)

@@ -137,44 +137,6 @@ float NoiseForm::Map(const StepOffsets& o, uint32_t i, uint32_t j) const {
     return std::max(2.0f * f - 1.0f, 0.0f);
 }
 
-float NoiseForm::Detail(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k) const {
-    const int32_t s = int32_t(mSettings.detail.size);
-    const float p[3] = {float(i) + o.detail[0], float(j) + o.detail[1], float(k) + o.detail[2]};
-    int32_t i0[3], i1[3];
-    float t[3];
-    for (int a = 0; a < 3; ++a) {
-        const float f = std::floor(p[a]);
-        t[a] = p[a] - f;
-        i0[a] = WrapIndex(int32_t(f), s);
-        i1[a] = i0[a] + 1 == s ? 0 : i0[a] + 1;
-    }
-    auto at = [&](int32_t a, int32_t b, int32_t c) {
-        return mDetail[size_t(a) + size_t(s) * (size_t(b) + size_t(s) * c)];
-    };
-    const float c00 = Lerp(t[0], at(i0[0], i0[1], i0[2]), at(i1[0], i0[1], i0[2]));
-    const float c10 = Lerp(t[0], at(i0[0], i1[1], i0[2]), at(i1[0], i1[1], i0[2]));
-    const float c01 = Lerp(t[0], at(i0[0], i0[1], i1[2]), at(i1[0], i0[1], i1[2]));
-    const float c11 = Lerp(t[0], at(i0[0], i1[1], i1[2]), at(i1[0], i1[1], i1[2]));
-    return Lerp(t[2], Lerp(t[1], c00, c10), Lerp(t[1], c01, c11));
-}
-
-float NoiseForm::Towers(uint32_t i, uint32_t j, uint32_t k) const {
-    return TowerSum(mTowers.data(), mTowers.size(), float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f, float(mGrid.nx),
-                    float(mGrid.ny));
-}
-
-float NoiseForm::Height(uint32_t k) const {
-    return HeightDistribution((float(k) + 0.5f) / float(mGrid.nz), float(mSettings.heightA), float(mSettings.heightB));
-}
-
-float NoiseForm::Form(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k, float base01, float map) const {
-    float v = base01 * Height(k) + Towers(i, j, k);
-    if (mSettings.detail.enabled) v = Erode(v, Detail(o, i, j, k), float(mSettings.detail.strength));
-    if (mSettings.coverage.enabled)
-        return CoverageModulate(v, map, float(mSettings.coverage.coverage), float(mSettings.coverage.density));
-    return Threshold(v, float(mSettings.threshold));
-}
-
 float NoiseForm::Q(const StepOffsets& o, uint32_t i, uint32_t j, uint32_t k) const {
     float p[3];
     BaseCoordinates(o, i, j, k, p);

@@ -58,7 +58,8 @@ over the voxels in cloud (q > 0) or ground cells under cloud (G_ref < 1), the
 reference's own speed in rays per second, and writes DIR/accuracy.json and
 DIR/accuracy.md.
 
-With a renderer in the scene ()" + RendererNames(", ") + R"()
+With a renderer in the scene ()" +
+                              RendererNames(", ") + R"()
 it also renders the exact reference image (the ray march's kernel with exact
 light toward the sun and the point light, a fine step, no early termination,
 no jitter; with grid.tiling over the repeated volume) and measures
@@ -80,6 +81,7 @@ Options:
   --out DIR          output folder (default: out/<scene name>/accuracy)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend and reference threads (default: all)
+  --cpu-isa ISA      CPU kernels' SIMD target: auto (default: the best here), scalar, sse4, avx2, avx512
   --vk-device DEV    Vulkan device: index or part of the name
   --quiet            no progress lines
 )";

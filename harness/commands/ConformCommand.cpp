@@ -36,6 +36,7 @@ Options:
   --out DIR          output folder (default: out/<scene name>/conform)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend threads (default: all)
+  --cpu-isa ISA      CPU kernels' SIMD target: auto (default: the best here), scalar, sse4, avx2, avx512
   --quiet            no progress lines
   --vk-device DEV    Vulkan device: index or part of the name
   --baseline FILE    known failures, "stage,backend,status" a line (a conform.csv

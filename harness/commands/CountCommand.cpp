@@ -36,6 +36,8 @@ Options:
   --set PATH=VALUE   override a scene field by its dotted path
   --threads 1        the only thread count: at 2 threads counts vary from run
                      to run (up to 0.57 %, docs/performance.md "Stable")
+  --cpu-isa ISA      the CPU kernels' SIMD target counted (default: the best
+                     valgrind's CPU reports): scalar, sse4, avx2 or avx512
   --quiet            no progress lines
   --gl-context, --gl-ca-layout, --vk-device
                      accepted as by every scene command, and unused: only
@@ -129,6 +131,9 @@ int Count(const CommonOptions& options) {
     std::string valgrindVersion;
     for (const std::string& name : backends) {
         CountRequest request{.scenePath = (*session)->ScenePath(), .overrides = options.overrides, .backend = name, .extraArgs = {}};
+        // The child counts the target this command was given (valgrind's CPU decides an automatic one).
+        if (options.cpuIsa != cpu::CpuIsa::Auto)
+            request.extraArgs = {"--cpu-isa", std::string(cpu::CpuIsaName(options.cpuIsa))};
         auto run = CountUnderCallgrind(*self, request);
         if (!run) {
             std::fprintf(stderr, "cloudbench: count: backend %s: %s\n", name.c_str(), run.error().message.c_str());

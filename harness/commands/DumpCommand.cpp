@@ -33,6 +33,7 @@ Options:
   --out DIR          output folder (default: out/<scene name>/dump)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
   --threads N        CPU backend threads (default: all)
+  --cpu-isa ISA      CPU kernels' SIMD target: auto (default: the best here), scalar, sse4, avx2, avx512
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
 )";
 constexpr const char* kHelpTail = R"(  --quiet            no progress lines

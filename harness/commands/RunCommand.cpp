@@ -36,6 +36,7 @@ Options:
   --set PATH=VALUE   override a scene field by its dotted path, validated like
                      the file: --set ca.seed=42 --set grid.size=[64,16,64]
   --threads N        CPU backend threads (default: all)
+  --cpu-isa ISA      CPU kernels' SIMD target: auto (default: the best here), scalar, sse4, avx2, avx512
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
 )";
 constexpr const char* kHelpTail = R"(                     (the contexts and layouts: docs/cli.md; cloudbench devices)

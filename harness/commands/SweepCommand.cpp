@@ -62,6 +62,7 @@ Options:
   --out DIR          output folder (default: out/<scene name>/sweep)
   --set PATH=VALUE   override a scene field for every point
   --threads N        CPU backend and reference threads (default: all)
+  --cpu-isa ISA      CPU kernels' SIMD target: auto (default: the best here), scalar, sse4, avx2, avx512
   --vk-device DEV    Vulkan device: index or part of the name
   --gl-context CTX   OpenGL context: osmesa (default) or egl
   --gl-ca-layout L   OpenGL automaton layout: packed (default) or rgba8

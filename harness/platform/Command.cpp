@@ -79,6 +79,15 @@ std::vector<OptionSpec> MakeSceneCommandOptions() {
              o.cpuThreads = int(threads);
              return std::nullopt;
          }},
+        // Process-wide, at once: the CPU kernels' dispatch is (impl_cpu/CpuIsa.h).
+        {"--cpu-isa", "", true,
+         [](CommonOptions& o, const char* v) -> std::optional<std::string> {
+             const std::optional<cpu::CpuIsa> isa = v ? ValueNamed(cpu::kCpuIsaNames, v) : std::nullopt;
+             if (!isa) return "--cpu-isa needs " + ChoiceOf(cpu::kCpuIsaNames);
+             if (Status s = cpu::SelectCpuIsa(*isa); !s) return s.error().message;
+             o.cpuIsa = *isa;
+             return std::nullopt;
+         }},
         Choice("--gl-context", &CommonOptions::glContext, gl::kContextKindNames),
         Choice("--gl-ca-layout", &CommonOptions::glCaLayout, gl::kCaLayoutNames),
         TextOption("--vk-device", &CommonOptions::vkDevice, "--vk-device needs an index or a name"),

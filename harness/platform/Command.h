@@ -40,6 +40,7 @@ struct CommonOptions {
     std::vector<SceneOverride> overrides;  // --set, and --steps as "steps"
     std::string outDir;                    // "" = the command's default under out/<scene name>
     int cpuThreads = 0;
+    cpu::CpuIsa cpuIsa = cpu::CpuIsa::Auto;               // --cpu-isa, already applied when parsed
     std::string vkDevice;                                 // --vk-device INDEX|NAME
     gl::ContextKind glContext = gl::ContextKind::OSMesa;  // --gl-context, gl::kContextKindNames
     gl::CaLayout glCaLayout = gl::CaLayout::Packed;       // --gl-ca-layout, gl::kCaLayoutNames
