@@ -50,6 +50,29 @@ inline float SplatCpuKernelSquare(float pixelCentre, float centre, float size) {
     return x * x;
 }
 
+// std::max(0, u), which is (0 < u) ? u : 0. The x86 max instructions give
+// their second operand unless the first is greater, the same; Highway's
+// one-lane Max differs for NaN, so the scalar target compares.
+template <class V>
+HWY_INLINE V MaxOfZeroAnd(V zero, V u) {
+#if HWY_TARGET == HWY_SCALAR || HWY_TARGET == HWY_EMU128
+    return hn::IfThenElse(hn::Lt(zero, u), u, zero);
+#else
+    return hn::Max(u, zero);
+#endif
+}
+
+// std::clamp(v, 0, 1), which is v < 0 ? 0 : (1 < v ? 1 : v): on x86
+// min(1, max(0, v)) in that operand order (see MaxOfZeroAnd).
+template <class V>
+HWY_INLINE V ClampToUnit(V zero, V one, V v) {
+#if HWY_TARGET == HWY_SCALAR || HWY_TARGET == HWY_EMU128
+    return hn::IfThenElse(hn::Lt(v, zero), zero, hn::IfThenElse(hn::Lt(one, v), one, v));
+#else
+    return hn::Min(one, hn::Max(zero, v));
+#endif
+}
+
 // Blends the rows y0 .. y1 of splat `s` into the band's planar channel rows
 // (R, G, B: rows of `stride` floats, row 0 = image row `rowLo`). Per pixel:
 // alpha = clamp(alphaScale t^2, 0, 1) with t = max(0, 1 - (xx + yy)), xx and
@@ -65,9 +88,8 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
     // meets an earlier store of exactly the same vector and can be forwarded
     // from it (a load that overlaps a store only in part waits until the store
     // reaches the cache; the splats of a band overlap their neighbours'
-    // columns). max(0, u) and the clamp are written as the comparisons
-    // <algorithm> defines them, so that every target (and NaN and signed
-    // zeros) gives the per-pixel formula's bits.
+    // columns). max(0, u) and the clamp give <algorithm>'s results on every
+    // target, NaN and signed zeros included.
     const hn::ScalableTag<float> d;
     const hn::RebindToSigned<decltype(d)> di;
     const int32_t N = int32_t(hn::Lanes(d));
@@ -87,9 +109,9 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
         const auto xx = hn::Mul(c, c);
         for (int32_t y = y0; y <= y1; ++y) {
             const auto u = hn::Sub(one, hn::Add(xx, hn::Set(d, yy[y - y0])));
-            const auto t = hn::IfThenElse(hn::Lt(zero, u), u, zero);  // std::max(0, u)
+            const auto t = MaxOfZeroAnd(zero, u);
             const auto v = hn::Mul(scale, hn::Mul(t, t));
-            const auto alpha = hn::IfThenElse(hn::Lt(v, zero), zero, hn::IfThenElse(hn::Lt(one, v), one, v));
+            const auto alpha = ClampToUnit(zero, one, v);
             const auto keep = hn::Sub(one, alpha);
             const size_t o = stride * uint32_t(y - int32_t(rowLo)) + uint32_t(xb);
             const auto r = hn::Load(d, R + o), g = hn::Load(d, G + o), b = hn::Load(d, B + o);

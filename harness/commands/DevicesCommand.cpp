@@ -1,5 +1,5 @@
-// `cloudbench devices`: the backends of this build, the Vulkan devices and the
-// OpenGL contexts, as the registry lists them.
+// `cloudbench devices`: the backends of this build, the CPU's SIMD targets, the
+// Vulkan devices and the OpenGL contexts, as the registry lists them.
 #include <algorithm>
 #include <cstdio>
 
@@ -11,8 +11,9 @@ namespace {
 
 constexpr const char* kHelp = R"(usage: cloudbench devices
 
-Lists the backends of this build, the Vulkan devices with the index and name
-that --vk-device takes, and the OpenGL contexts that --gl-context takes, each
+Lists the backends of this build, the SIMD targets of the CPU backend's
+kernels that --cpu-isa takes (those this CPU runs; auto picks the last), the
+Vulkan devices with the index and name that --vk-device takes, and the OpenGL contexts that --gl-context takes, each
 tried here: its GL_RENDERER and GL_VERSION, or why it cannot be created. Under
 each device and context, its limits that bound a scene (for gl
 GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS and GL_MAX_VIEWPORT_DIMS, for
@@ -45,6 +46,12 @@ bool PrintVulkanDevices() {
     return true;
 }
 
+void PrintCpuTargets() {
+    std::printf("CPU SIMD targets (--cpu-isa NAME):");
+    for (cpu::CpuIsa isa : cpu::SupportedCpuIsas()) std::printf(" %s", std::string(cpu::CpuIsaName(isa)).c_str());
+    std::printf("\n  auto here: %s\n", cpu::ActiveCpuIsaDescription().c_str());
+}
+
 void PrintGLContexts() {
     auto contexts = ListGLContexts();
     if (!contexts) {
@@ -66,6 +73,7 @@ int Devices(const CommonOptions&) {
     std::printf("backends in this build:");
     for (const std::string& name : BuiltBackends()) std::printf(" %s", name.c_str());
     std::printf("\n");
+    PrintCpuTargets();
     const bool vulkanOk = PrintVulkanDevices();
     PrintGLContexts();
     return vulkanOk ? kExitOk : kExitNoBackend;
@@ -73,7 +81,7 @@ int Devices(const CommonOptions&) {
 
 const CommandRegistration kRegistration({
     .name = "devices",
-    .summary = "List the backends of this build, the Vulkan devices and the OpenGL contexts",
+    .summary = "List the backends of this build, the CPU's SIMD targets, the Vulkan devices and the OpenGL contexts",
     .help = kHelp,
     .helpOrder = 3,
     .takesScene = false,
