@@ -1,10 +1,10 @@
 // The layered renderer on the CPU (SPEC 15): per call, q_alpha and T are formed
 // once into a padded volume of (q, T) pairs, or (q, T, T_sky) triples with the sky light (core/math/Layers.h's
 // taps: the border holds (0, 1) or (0, 1, 1), or with tiling the opposite edge's voxels;
-// impl_cpu/PaddedVolumeCpu.h), with a bit per cell where its taps read no cloud (LayersOccupancyCpu.h), then every
-// pixel runs LayersPixel, the layers its ray crosses back to front and then
-// LOD0's billboards (a list made once per call, culled per tile), TBB over 8 x 8 pixel tiles. A pixel's loop is the
-// fastest form here: it touches only the layers on its side of the eye, where OpenGL rasterises every layer.
+// impl_cpu/PaddedVolumeCpu-inl.h), with a bit per cell where its taps read no cloud (LayersOccupancyCpu-inl.h), then
+// every pixel runs LayersPixel, the layers its ray crosses back to front and then LOD0's billboards (a list made once
+// per call, culled per tile), TBB over 8 x 8 pixel tiles. A pixel's loop is the fastest form here: it touches only the
+// layers on its side of the eye, where OpenGL rasterises every layer.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "impl_cpu/RenderLayersCpu.cpp"
 #include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
@@ -18,8 +18,8 @@
 
 #include "core/math/Layers.h"
 #include "impl_cpu/BackendCpu.h"
-#include "impl_cpu/LayersOccupancyCpu.h"
-#include "impl_cpu/PaddedVolumeCpu.h"
+#include "impl_cpu/LayersOccupancyCpu-inl.h"
+#include "impl_cpu/PaddedVolumeCpu-inl.h"
 #include "impl_cpu/RenderLayersCpuState.h"
 
 HWY_BEFORE_NAMESPACE();

@@ -1,7 +1,7 @@
 // The ray marcher on the CPU (SPEC 10): per call, q_alpha and T are formed
 // once into one padded volume of (q, T) pairs (a border voxel of q = 0, T = 1
 // stands for "outside the grid", or with tiling holds the opposite edge's
-// voxel in x and y, so the trilinear taps need no bounds checks; impl_cpu/PaddedVolumeCpu.h), and with the sky
+// voxel in x and y, so the trilinear taps need no bounds checks; impl_cpu/PaddedVolumeCpu-inl.h), and with the sky
 // light T_sky into a second one,
 // the brick skip structure is built from it, and then every pixel runs the
 // shared kernel MarchRay (core/math/March.h), TBB over 8 x 8 pixel tiles.
@@ -20,7 +20,7 @@
 
 #include "core/math/March.h"
 #include "impl_cpu/BackendCpu.h"
-#include "impl_cpu/PaddedVolumeCpu.h"
+#include "impl_cpu/PaddedVolumeCpu-inl.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
 HWY_BEFORE_NAMESPACE();

@@ -1,8 +1,9 @@
-// The CPU layers' empty-space skip (impl_cpu/LayersOccupancyCpu.h): its bits worked by hand, and the fast path
+// The CPU layers' empty-space skip (impl_cpu/LayersOccupancyCpu-inl.h): its bits worked by hand, and the fast path
 // against the slow path it replaces: LayersPixel with the skipping fetch equals LayersPixel with a plain fetch, bit
 // for bit, on every pixel of layers-small's cameras over sparse random clouds, tiled and not, with LOD0's
 // billboards and with the sky light's third field.
 #include <gtest/gtest.h>
+#include <hwy/highway.h>  // the per-target helpers below, at this file's static target
 
 #include <array>
 #include <string>
@@ -11,8 +12,8 @@
 #include "core/math/Layers.h"
 #include "core/plan/SceneLoad.h"
 #include "core/stages/render_layers/RenderLayers.h"
-#include "impl_cpu/LayersOccupancyCpu.h"
-#include "impl_cpu/PaddedVolumeCpu.h"
+#include "impl_cpu/LayersOccupancyCpu-inl.h"
+#include "impl_cpu/PaddedVolumeCpu-inl.h"
 #include "tests/TestUtil.h"
 
 namespace cb {
@@ -24,12 +25,12 @@ namespace {
 TEST(LayersOccupancy, EmptyTapsByHand) {
     const Extent3 e{3, 2, 2};
     std::vector<std::array<float, 2>> volume;
-    cpu::FormPaddedVolume(volume, e, false, std::array<float, 2>{0.0f, 1.0f}, [](size_t v) {
+    cpu::HWY_NAMESPACE::FormPaddedVolume(volume, e, false, std::array<float, 2>{0.0f, 1.0f}, [](size_t v) {
         return std::array<float, 2>{v == 1 ? 0.5f : 0.0f, 1.0f};
     });
     std::vector<uint64_t> bits;
-    cpu::FormEmptyTaps(bits, volume, e, [](const std::array<float, 2>& c) { return c[0]; });
-    const cpu::LayersPaddedFetch<std::array<float, 2>> fetch{volume.data(), bits.data()};
+    cpu::HWY_NAMESPACE::FormEmptyTaps(bits, volume, e, [](const std::array<float, 2>& c) { return c[0]; });
+    const cpu::HWY_NAMESPACE::LayersPaddedFetch<std::array<float, 2>> fetch{volume.data(), bits.data()};
     int set = 0;
     for (uint32_t k = 0; k < 4; ++k)
         for (uint32_t j = 0; j < 4; ++j)
@@ -51,10 +52,10 @@ struct PlainFetch {
 
 // The skipping fetch, counting its skips.
 template <class Cell>
-struct CountingFetch : cpu::LayersPaddedFetch<Cell> {
+struct CountingFetch : cpu::HWY_NAMESPACE::LayersPaddedFetch<Cell> {
     uint64_t* skips;
     bool TapsEmpty(uint32_t base) const {
-        const bool empty = cpu::LayersPaddedFetch<Cell>::TapsEmpty(base);
+        const bool empty = cpu::HWY_NAMESPACE::LayersPaddedFetch<Cell>::TapsEmpty(base);
         *skips += empty ? 1 : 0;
         return empty;
     }
@@ -106,10 +107,10 @@ TEST(LayersOccupancy, SkippingChangesNoPixel) {
         auto readQ = [](const auto& cell) { return cell[0]; };
         std::vector<std::array<float, 2>> pairs;
         std::vector<uint64_t> bits;
-        cpu::FormPaddedVolume(pairs, e, wrap, std::array<float, 2>{0.0f, 1.0f}, [&](size_t v) {
+        cpu::HWY_NAMESPACE::FormPaddedVolume(pairs, e, wrap, std::array<float, 2>{0.0f, 1.0f}, [&](size_t v) {
             return std::array<float, 2>{q[v], T[v]};
         });
-        cpu::FormEmptyTaps(bits, pairs, e, readQ);
+        cpu::HWY_NAMESPACE::FormEmptyTaps(bits, pairs, e, readQ);
         EXPECT_GT(ComparePixels(*scene, pairs, bits), 1000u) << "tiling " << tiling;
         // The sky light's triples, its term on.
         auto lit = LoadScene(path, {{"grid.tiling", tiling},
@@ -119,10 +120,10 @@ TEST(LayersOccupancy, SkippingChangesNoPixel) {
                                     {"lighting.sky", R"({"elevation_deg": 10, "azimuth_deg": 200})"}});
         ASSERT_TRUE(lit.has_value()) << lit.error().message;
         std::vector<std::array<float, 3>> triples;
-        cpu::FormPaddedVolume(triples, e, wrap, std::array<float, 3>{0.0f, 1.0f, 1.0f}, [&](size_t v) {
+        cpu::HWY_NAMESPACE::FormPaddedVolume(triples, e, wrap, std::array<float, 3>{0.0f, 1.0f, 1.0f}, [&](size_t v) {
             return std::array<float, 3>{q[v], T[v], skyT[v]};
         });
-        cpu::FormEmptyTaps(bits, triples, e, readQ);
+        cpu::HWY_NAMESPACE::FormEmptyTaps(bits, triples, e, readQ);
         EXPECT_GT(ComparePixels(*lit, triples, bits), 1000u) << "tiling " << tiling << ", the sky light";
     }
 }

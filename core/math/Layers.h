@@ -168,7 +168,7 @@ template <class Fetch>
     }
     f.crossed = true;
     const LayersTaps taps = LayersTapsAt(s.size, Vec3{x, y, z});
-    // A fetch that knows where all eight taps read q = 0 (the CPU's, impl_cpu/LayersOccupancyCpu.h) skips the blend
+    // A fetch that knows where all eight taps read q = 0 (the CPU's, impl_cpu/LayersOccupancyCpu-inl.h) skips the blend
     // there: the blended q would be 0 exactly, and the fragment is crossed but not drawn, as below.
     if constexpr (requires { fetch.TapsEmpty(taps.base); })
         if (fetch.TapsEmpty(taps.base)) return f;

@@ -1,8 +1,17 @@
-// Empty-space skipping for the CPU's layers: one bit per padded cell of the padded volume (PaddedVolumeCpu.h), set
+// Empty-space skipping for the CPU's layers: one bit per padded cell of the padded volume (PaddedVolumeCpu-inl.h), set
 // where the trilinear taps based there (core/math/Layers.h LayersTapsAt: the cell and its neighbours +1 in x, y and
 // z) all read q = 0. Most of a wide view's fragments fall in clear sky (90 % on wang-20km); with the bit set
 // LayersSampleAt skips their blend, whose q would be 0 exactly, so the pixels are those without it, bit for bit.
-#pragma once
+// Per-target code (Highway's -inl.h form): included by a file that compiles itself once per SIMD target
+// (impl_cpu/CpuIsa.h), after hwy/highway.h, so that each target has its own copy; no #pragma once.
+#if defined(CB_IMPL_CPU_LAYERS_OCCUPANCY_CPU_INL_H) == defined(HWY_TARGET_TOGGLE)
+#ifdef CB_IMPL_CPU_LAYERS_OCCUPANCY_CPU_INL_H
+#undef CB_IMPL_CPU_LAYERS_OCCUPANCY_CPU_INL_H
+#else
+#define CB_IMPL_CPU_LAYERS_OCCUPANCY_CPU_INL_H
+#endif
+
+#include <hwy/highway.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -12,7 +21,8 @@
 
 #include "core/pipeline/Backend.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 
 // Sets bit b of `bits` (b = i + px (j + py k), the padded index) iff the eight cells b + {0, 1} x {0, px} x {0, pxy}
 // all hold q == 0 (q(cell) reads a cell's q); bases on the last row, column or slab, which no tap starts from, are
@@ -54,4 +64,7 @@ struct LayersPaddedFetch {
     bool TapsEmpty(uint32_t base) const { return (emptyTaps[base >> 6] >> (base & 63)) & 1u; }
 };
 
-}  // namespace cb::cpu
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // CB_IMPL_CPU_LAYERS_OCCUPANCY_CPU_INL_H

@@ -2,7 +2,16 @@
 // (i, j, k) at (i + 1, j + 1, k + 1), so that a trilinear sample needs no bounds checks. A border cell holds
 // `border` (outside the grid), or with tiling, in x and y, the opposite edge's voxel (PaddedSourceVoxel,
 // core/math/March.h). Call inside the backend's task arena.
-#pragma once
+// Per-target code (Highway's -inl.h form): included by a file that compiles itself once per SIMD target
+// (impl_cpu/CpuIsa.h), after hwy/highway.h, so that each target has its own copy; no #pragma once.
+#if defined(CB_IMPL_CPU_PADDED_VOLUME_CPU_INL_H) == defined(HWY_TARGET_TOGGLE)
+#ifdef CB_IMPL_CPU_PADDED_VOLUME_CPU_INL_H
+#undef CB_IMPL_CPU_PADDED_VOLUME_CPU_INL_H
+#else
+#define CB_IMPL_CPU_PADDED_VOLUME_CPU_INL_H
+#endif
+
+#include <hwy/highway.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -13,7 +22,8 @@
 #include "core/math/March.h"
 #include "core/pipeline/Backend.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 
 // Forms the volume, each cell written once: cell(v) is voxel v's (v = i + nx (j + ny k)).
 template <class Cell, class MakeCell>
@@ -42,4 +52,7 @@ void FormPaddedVolume(std::vector<Cell>& volume, const Extent3& e, bool tiling, 
     });
 }
 
-}  // namespace cb::cpu
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // CB_IMPL_CPU_PADDED_VOLUME_CPU_INL_H
