@@ -7,7 +7,7 @@
 // slices when a row is strided (w = x); taps outside the slice read T = 1,
 // q = 0. The row kernel runs on whole vectors. At resolution f > 1 the same
 // loop runs on the mean of each f^3 block and the result is read back
-// trilinearly (ShadeCoarseCpu.cpp). The ground's shadow is in ShadowCpu.cpp.
+// trilinearly (ShadeCoarseCpu-inl.h). The ground's shadow is in ShadowCpu.cpp.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "impl_cpu/ShadeCpu.cpp"
 #include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
@@ -23,7 +23,7 @@
 
 #include "core/pipeline/ShadePlan.h"
 #include "impl_cpu/BackendCpu.h"
-#include "impl_cpu/ShadeCoarse.h"
+#include "impl_cpu/ShadeCoarseCpu-inl.h"
 #include "impl_cpu/ShadeCpuState.h"
 #include "impl_cpu/ShadeSchedule.h"
 

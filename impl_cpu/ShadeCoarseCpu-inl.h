@@ -1,5 +1,15 @@
 // Shade at resolution f > 1 on the CPU (SPEC 6): the coarse grid of q that
 // the sweep runs on, and T read back from the coarse grid trilinearly.
+// Per-target code (Highway's -inl.h form), included by impl_cpu/ShadeCpu.cpp
+// once per SIMD target after hwy/highway.h; no #pragma once.
+#if defined(CB_IMPL_CPU_SHADE_COARSE_CPU_INL_H) == defined(HWY_TARGET_TOGGLE)
+#ifdef CB_IMPL_CPU_SHADE_COARSE_CPU_INL_H
+#undef CB_IMPL_CPU_SHADE_COARSE_CPU_INL_H
+#else
+#define CB_IMPL_CPU_SHADE_COARSE_CPU_INL_H
+#endif
+
+#include <hwy/highway.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -8,9 +18,9 @@
 
 #include "core/math/Shading.h"
 #include "core/pipeline/ShadePlan.h"
-#include "impl_cpu/ShadeCoarse.h"
 
-namespace cb::cpu {
+HWY_BEFORE_NAMESPACE();
+namespace cb::cpu::HWY_NAMESPACE {
 namespace {
 
 // cell[I] += sum of row[I*f .. I*f + f) (the last block may be short), with
@@ -56,19 +66,25 @@ void UpsampleRowT(const float* __restrict b, uint32_t cells, const uint32_t* x0,
 
 void UpsampleRow(const float* b, uint32_t cells, int f, const uint32_t* x0, const uint32_t* x1, const float* fx,
                  float* out, uint32_t n) {
-    if (f == 2) UpsampleRowT<2>(b, cells, x0, x1, fx, out, n);
-    else UpsampleRowT<4>(b, cells, x0, x1, fx, out, n);
+    if (f == 2)
+        UpsampleRowT<2>(b, cells, x0, x1, fx, out, n);
+    else
+        UpsampleRowT<4>(b, cells, x0, x1, fx, out, n);
 }
 
 void AddRowBlocks(const float* row, uint32_t n, int f, float* cell) {
-    if (f == 2) AddRowBlocksT<2>(row, n, cell);
-    else AddRowBlocksT<4>(row, n, cell);
+    if (f == 2)
+        AddRowBlocksT<2>(row, n, cell);
+    else
+        AddRowBlocksT<4>(row, n, cell);
 }
 
 }  // namespace
 
-void DownsampleShadeQ(const ShadePlan& plan, int f, const float* q, const Extent3& e, float* cq,
-                      tbb::task_arena& arena) {
+// The coarse grid of q at resolution f: the mean of each f^3 block (partial
+// blocks: of the voxels present). `cq` (plan.cells) must hold zeros.
+inline void DownsampleShadeQ(const ShadePlan& plan, int f, const float* q, const Extent3& e, float* cq,
+                             tbb::task_arena& arena) {
     const uint32_t* c = plan.cells;
     const size_t coarseSlice = size_t(c[0]) * c[1];
     auto blockSize = [&](uint32_t cell, uint32_t n) { return std::min<uint32_t>(f, n - cell * f); };
@@ -85,13 +101,18 @@ void DownsampleShadeQ(const ShadePlan& plan, int f, const float* q, const Extent
                     }
                 for (uint32_t J = 0; J < c[1]; ++J)
                     for (uint32_t I = 0; I < c[0]; ++I)
-                        out[I + size_t(c[0]) * J] /= float(blockSize(I, e.nx) * blockSize(J, e.ny) * blockSize(K, e.nz));
+                        out[I + size_t(c[0]) * J] /=
+                            float(blockSize(I, e.nx) * blockSize(J, e.ny) * blockSize(K, e.nz));
             }
         });
     });
 }
 
-void UpsampleShadeT(const ShadePlan& plan, int f, const float* ct, const Extent3& e, float* T, tbb::task_arena& arena) {
+// T at full resolution (extent e), trilinear from the coarse T `ct` (plan.cells):
+// full voxel i sits at coarse coordinate (i + 0.5) / f - 0.5, clamped to the
+// coarse grid's centres.
+inline void UpsampleShadeT(const ShadePlan& plan, int f, const float* ct, const Extent3& e, float* T,
+                           tbb::task_arena& arena) {
     const uint32_t* c = plan.cells;
     // Per fine row, the four coarse rows around it are blended in y and z first
     // (a coarse row in L1), then each voxel blends two of its cells in x.
@@ -134,4 +155,7 @@ void UpsampleShadeT(const ShadePlan& plan, int f, const float* ct, const Extent3
     });
 }
 
-}  // namespace cb::cpu
+}  // namespace cb::cpu::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // CB_IMPL_CPU_SHADE_COARSE_CPU_INL_H
