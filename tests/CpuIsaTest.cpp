@@ -89,13 +89,19 @@ struct IsaScene {
 void PrintTo(const IsaScene& c, std::ostream* os) { *os << c.name; }
 
 // Scenes that between them run every CPU stage with its options: the
-// automaton with and without wind, fp16 and coarse shade, the ground, the sky
-// light, the noise, and the splat, march and layers renderers.
+// automaton with and without wind, fp16 and coarse shade, shade's sweep along
+// each axis, the ground, the sky light, the noise, and the splat, march and
+// layers renderers.
 const IsaScene kIsaScenes[] = {
     {"SplatWind", "ci-small-wind.json", {{"steps", "4"}, {"warmup_steps", "1"}}},
     {"SplatCoarseFp16",
      "ci-small.json",
      {{"steps", "3"}, {"warmup_steps", "1"}, {"shade.resolution", "2"}, {"shade.storage", "\"fp16\""}}},
+    // shade's sweep along x (rows transposed 16 at a time) and along z (whole planes).
+    {"SunAlongX",
+     "ci-small.json",
+     {{"steps", "2"}, {"warmup_steps", "0"}, {"sun.azimuth_deg", "10"}, {"sun.elevation_deg", "20"}}},
+    {"SunAlongZ", "ci-small.json", {{"steps", "2"}, {"warmup_steps", "0"}, {"sun.elevation_deg", "70"}}},
     {"SplatGround", "ground-shadow.json", {{"steps", "2"}, {"warmup_steps", "0"}, {"grid.size", "[64,64,16]"}}},
     {"MarchNoise",
      "noise-layer.json",

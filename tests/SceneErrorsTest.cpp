@@ -74,7 +74,8 @@ TEST(SceneTest, MissingGridSize) {
 // Test that warmup_steps must stay below steps.
 TEST(SceneTest, WarmupNotBelowSteps) {
     EXPECT_TRUE(HasLine(ErrorOf(R"({"grid": {"size": [8, 4, 6]}, "steps": 10, "warmup_steps": 10})"),
-                        "test.json: warmup_steps: must be < steps (10), got 10"));
+                        "test.json: warmup_steps: must be < steps (10), got 10 (more steps, or fewer warm-up "
+                        "steps: --set warmup_steps=N)"));
 }
 
 // Test that a stage listed twice is refused.

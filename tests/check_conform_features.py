@@ -51,8 +51,9 @@ MATRIX_CASES = [
 PLANTED = "shade.storage=fp16"
 
 
-def matrix_rows(proc):
-    """(case, stage) -> status from conform.json and conform.csv (case first), which must agree row for row."""
+def matrix_rows(proc, quiet=False):
+    """(case, stage) -> status from conform.json and conform.csv (case first), which must agree row for row;
+    a progress line per case on stdout, none with --quiet."""
     with open(os.path.join(folder, "conform.json")) as f:
         doc = json.load(f)
     from_json = [(r.get("case"), r["stage"], r["backend"], r["status"]) for r in doc["results"]]
@@ -72,16 +73,19 @@ def matrix_rows(proc):
     for c in MATRIX_CASES:
         if not any(k[0] == c for k in got):
             fail("no row of case " + c, proc)
-        if "case %d/%d: %s\n" % (MATRIX_CASES.index(c) + 1, len(MATRIX_CASES), c) not in proc.stdout:
+        line = "case %d/%d: %s\n" % (MATRIX_CASES.index(c) + 1, len(MATRIX_CASES), c)
+        if quiet and line in proc.stdout:
+            fail("a progress line under --quiet: " + line.strip(), proc)
+        if not quiet and line not in proc.stdout:
             fail("no progress line for case " + c, proc)
     return doc, got
 
 
-def expect_matrix(proc, code, want):
+def expect_matrix(proc, code, want, quiet=False):
     """Exit `code`; the (case, stage) rows of `want` have their status, every other row passes."""
     if proc.returncode != code:
         fail("expected exit %d" % code, proc)
-    doc, got = matrix_rows(proc)
+    doc, got = matrix_rows(proc, quiet)
     for key, status in want.items():
         if got.get(key) != status:
             fail("%s: expected %s, got %s" % (key, status, got.get(key)), proc)
@@ -289,8 +293,8 @@ elif case == "matrix-baseline":
     expect_matrix(first, 5, {(PLANTED, "shade"): "fail"})
     path = os.path.join(out, case + ".csv")
     shutil.copy(os.path.join(folder, "conform.csv"), path)
-    expect_matrix(conform(["--matrix", "--baseline", path], backend + ":shade@" + PLANTED, steps="1"), 0,
-                  {(PLANTED, "shade"): "expected-fail"})
+    expect_matrix(conform(["--matrix", "--baseline", path, "--quiet"], backend + ":shade@" + PLANTED, steps="1"), 0,
+                  {(PLANTED, "shade"): "expected-fail"}, quiet=True)
     other = "shade.storage=unorm8"
     expect_matrix(conform(["--matrix", "--baseline", path], backend + ":shade@" + other, steps="1"), 5,
                   {(PLANTED, "shade"): "unexpected-pass", (other, "shade"): "fail"})

@@ -55,7 +55,8 @@ SectionsRead ReadSceneSections(const Json& root, const std::string& label, Valid
             scene.warmupSteps = uint32_t(*n);
             if (stepsOk && scene.warmupSteps >= scene.steps)
                 check.Fail("warmup_steps", "must be < steps (" + std::to_string(scene.steps) + "), got " +
-                                               std::to_string(scene.warmupSteps));
+                                               std::to_string(scene.warmupSteps) +
+                                               " (more steps, or fewer warm-up steps: --set warmup_steps=N)");
         }
     }
 

@@ -231,8 +231,10 @@ int Conform(const CommonOptions& options, const ConformOptions& own) {
                 std::fprintf(stderr, "%s\n", made.error().message.c_str());
                 return kExitFailed;
             }
-            std::printf("case %zu/%zu: %s\n", k + 1, cases.size(), c.name.c_str());
-            std::fflush(stdout);
+            if (!options.quiet) {
+                std::printf("case %zu/%zu: %s\n", k + 1, cases.size(), c.name.c_str());
+                std::fflush(stdout);
+            }
         }
         for (const std::string& name : names) {
             if (!c.onlyBackends.empty() && std::ranges::find(c.onlyBackends, name) == c.onlyBackends.end()) continue;

@@ -34,7 +34,7 @@ Options:
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>)
   --set PATH=VALUE   override a scene field by its dotted path, validated like
-                     the file: --set ca.seed=42 --set grid.size=[64,16,64]
+                     the file: --set ca.seed=42 --set grid.size=[64,64,16]
   --threads N        CPU backend threads (default: all)
   --cpu-isa ISA      CPU kernels' SIMD target: auto (default: the best here), scalar, sse4, avx2, avx512
   --vk-device DEV    Vulkan device: index or part of the name (cloudbench devices)
