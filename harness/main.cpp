@@ -13,6 +13,7 @@
 #include "core/base/ShownText.h"
 #include "harness/platform/Command.h"
 #include "harness/platform/Isolation.h"
+#include "harness/platform/Provenance.h"
 
 namespace {
 
@@ -30,7 +31,9 @@ std::string MainHelp() {
                       std::string(command->summary).c_str());
         out += line;
     }
-    return out + "  help   Show help for a command: cloudbench help run\n" + kExitCodesHelp;
+    return out + "  help   Show help for a command: cloudbench help run\n" +
+           "  --version  the version, commit and build, and where the scenes and the image module are read from\n" +
+           kExitCodesHelp;
 }
 
 int Usage(const std::string& message, std::string_view help) {
@@ -66,6 +69,10 @@ int main(int argc, char** argv) {
         return cb::kExitUsage;
     }
     const std::string_view name = argv[1];
+    if (name == "--version") {
+        std::fputs(cb::VersionText().c_str(), stdout);
+        return cb::kExitOk;
+    }
     if (name == "--help" || name == "-h") {
         std::fputs(MainHelp().c_str(), stdout);
         return cb::kExitOk;

@@ -15,6 +15,7 @@
 
 #include "harness/accuracy/SweepFields.h"
 #include "harness/platform/Command.h"
+#include "harness/platform/InstallLayout.h"
 #include "harness/run/Session.h"
 
 extern char** environ;
@@ -101,7 +102,7 @@ PlotOutcome Plot(const std::string& jsonPath, const std::string& mdPath, const s
                      jsonPath.c_str(), mdPath.c_str());
         return PlotOutcome::NotPromised;
     }
-    const std::string script = std::string(CLOUDBENCH_TOOLS_DIR) + "/plot_sweep.py";
+    const std::string script = ToolsFolder() + "/plot_sweep.py";
     const Status plotted = Session::WriteAtomically(pngPath, [&](const Session::TemporaryFile& temp) -> Status {
         auto ran = RunCaptured({python, script, jsonPath, "/proc/self/fd/3", pngPath}, temp.fd);
         if (!ran) return MakeError(pngPath + ": cannot write: " + ran.error().message);

@@ -12,6 +12,7 @@
 
 #include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
+#include "harness/platform/InstallLayout.h"
 
 namespace cb {
 namespace {
@@ -245,8 +246,7 @@ Result<std::vector<std::string>> SceneNamesIn(const std::string& folder) {
 Result<std::string> ResolveScenePath(const std::string& nameOrPath) {
     const std::string& name = nameOrPath.empty() ? std::string(kDefaultScene) : nameOrPath;
     if (name.find('/') != std::string::npos || name.ends_with(".json")) return name;
-    const char* env = std::getenv("CLOUDBENCH_SCENES");
-    const std::string folder = env ? std::string(env) : std::string(CLOUDBENCH_SCENES_DIR);
+    const std::string folder = SceneFolder();
     const std::string path = (std::filesystem::path(folder) / (name + ".json")).string();
     // Only a file that is not there makes the name unknown; any other failure is the loader's to name.
     std::error_code error;

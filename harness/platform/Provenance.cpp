@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <ctime>
+#include <filesystem>
 #include <sstream>
 #include <thread>
 
 #include "cloudbench_build_info.h"
 #include "core/base/PathPolicy.h"
 #include "core/base/SystemFile.h"
+#include "harness/platform/InstallLayout.h"
 
 namespace cb {
 namespace {
@@ -78,6 +80,24 @@ json SceneWithOverrides(const std::string& path, std::span<const SceneOverride> 
     return root;
 }
 
+std::string VersionText() {
+    const std::string dirty = CLOUDBENCH_GIT_DIRTY;
+    std::string module = "not found (looked for";
+    std::error_code error;
+    for (const std::string& path : ImageModuleCandidates()) {
+        if (std::filesystem::exists(path, error)) {
+            module = path;
+            break;
+        }
+        module += " " + path;
+    }
+    if (module.starts_with("not found")) module += ")";
+    return std::string("cloudbench ") + CLOUDBENCH_VERSION + "\ncommit " + CLOUDBENCH_GIT_COMMIT +
+           (dirty == "true" ? " (with uncommitted changes)" : dirty == "unknown" ? " (not a git checkout)" : "") +
+           "\nbuild " + CLOUDBENCH_BUILD_TYPE + ", " + CLOUDBENCH_COMPILER + "\nscenes " + SceneFolder() +
+           "\nimage module " + module + "\n";
+}
+
 json MakeProvenance(std::span<const std::string> commandLine, const SceneProvenance& scene,
                     std::span<const BackendProvenance> backends) {
     const std::string dirty = CLOUDBENCH_GIT_DIRTY;
@@ -85,7 +105,10 @@ json MakeProvenance(std::span<const std::string> commandLine, const SceneProvena
         {"git",
          {{"commit", CLOUDBENCH_GIT_COMMIT}, {"dirty", dirty == "unknown" ? json(dirty) : json(dirty == "true")}}},
         {"build",
-         {{"type", CLOUDBENCH_BUILD_TYPE}, {"flags", CLOUDBENCH_CXX_FLAGS}, {"compiler", CLOUDBENCH_COMPILER}}},
+         {{"version", CLOUDBENCH_VERSION},
+          {"type", CLOUDBENCH_BUILD_TYPE},
+          {"flags", CLOUDBENCH_CXX_FLAGS},
+          {"compiler", CLOUDBENCH_COMPILER}}},
         {"machine", {{"cpu", CpuModel()}, {"threads", std::thread::hardware_concurrency()}, {"os", OperatingSystem()}}},
         {"date", UtcNow()},
         {"backends", json::array()},

@@ -26,7 +26,12 @@ struct SceneProvenance {
     std::span<const SceneOverride> overrides;
 };
 
-// Keys: git {commit, dirty}, build {type, flags, compiler}, machine {cpu,
+// `cloudbench --version`: the version, the commit (and whether the tree was
+// dirty), the build type and compiler, and where this executable reads its
+// scenes and its image module from (harness/platform/InstallLayout.h).
+std::string VersionText();
+
+// Keys: git {commit, dirty}, build {version, type, flags, compiler}, machine {cpu,
 // threads, os}, date (UTC, ISO 8601), backends [...], scene {path, name,
 // overrides, resolved}, command_line [...].
 nlohmann::json MakeProvenance(std::span<const std::string> commandLine, const SceneProvenance& scene,

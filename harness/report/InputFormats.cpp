@@ -68,7 +68,7 @@ Node Provenance() {
                                  {"api", Text()}});
     return OpenObject({
         {"git", Object({{"commit", Text()}, {"dirty", AnyValue()}})},
-        {"build", Object({{"type", Text()}, {"flags", Text()}, {"compiler", Text()}})},
+        {"build", Object({{"version", Text()}, {"type", Text()}, {"flags", Text()}, {"compiler", Text()}})},
         {"machine", OpenObject({{"cpu", Text()}, {"threads", Count()}, {"os", Text()}})},
         {"date", Text()},
         {"backends", ArrayOf(backend)},

@@ -1,23 +1,19 @@
-// Opens libcloudbench_images.so (harness/report/images/ImageModule.h) on first use:
-// beside the executable (the cloudbench binary, installed or in the build
-// tree), else at the path the build put it (the test and benchmark
-// executables, which live in other folders of the build tree).
+// Opens libcloudbench_images.so (harness/report/images/ImageModule.h) on first use,
+// at the first of harness/platform/InstallLayout.h's places that holds it.
 #include <dlfcn.h>
 
 #include <filesystem>
 #include <mutex>
 
+#include "harness/platform/InstallLayout.h"
 #include "harness/report/images/ImageModule.h"
 
 namespace cb::images {
 namespace {
 
 Result<const Module*> Open() {
-    std::vector<std::string> candidates;
+    const std::vector<std::string> candidates = ImageModuleCandidates();
     std::error_code error;
-    const auto executable = std::filesystem::read_symlink("/proc/self/exe", error);
-    if (!error) candidates.push_back((executable.parent_path() / kModuleFileName).string());
-    candidates.push_back(CLOUDBENCH_IMAGE_MODULE_PATH);
     std::string tried;
     for (const std::string& path : candidates) {
         if (!std::filesystem::exists(path, error)) {

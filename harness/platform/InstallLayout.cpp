@@ -1,0 +1,55 @@
+#include "harness/platform/InstallLayout.h"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "harness/report/images/ImageModule.h"
+
+namespace cb {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The folder of this executable, or "" when /proc/self/exe cannot be read.
+fs::path ExecutableFolder() {
+    std::error_code error;
+    const fs::path executable = fs::read_symlink("/proc/self/exe", error);
+    return error ? fs::path() : executable.parent_path();
+}
+
+// `relative` under the install prefix this executable would have (its folder's parent), or "" without one.
+fs::path Installed(const char* relative) {
+    const fs::path folder = ExecutableFolder();
+    return folder.empty() ? fs::path() : folder.parent_path() / relative;
+}
+
+}  // namespace
+
+std::string SceneFolder() {
+    if (const char* env = std::getenv("CLOUDBENCH_SCENES")) return env;
+    std::error_code error;
+    if (const fs::path installed = Installed(CLOUDBENCH_INSTALL_SCENES_DIR);
+        !installed.empty() && fs::is_directory(installed, error))
+        return installed.string();
+    return CLOUDBENCH_SCENES_DIR;
+}
+
+std::string ToolsFolder() {
+    std::error_code error;
+    if (const fs::path installed = Installed(CLOUDBENCH_INSTALL_TOOLS_DIR);
+        !installed.empty() && fs::is_directory(installed, error))
+        return installed.string();
+    return CLOUDBENCH_TOOLS_DIR;
+}
+
+std::vector<std::string> ImageModuleCandidates() {
+    std::vector<std::string> candidates;
+    if (const fs::path folder = ExecutableFolder(); !folder.empty())
+        candidates.push_back((folder / images::kModuleFileName).string());
+    if (const fs::path installed = Installed(CLOUDBENCH_INSTALL_MODULE_DIR); !installed.empty())
+        candidates.push_back((installed / images::kModuleFileName).string());
+    candidates.push_back(CLOUDBENCH_IMAGE_MODULE_PATH);
+    return candidates;
+}
+
+}  // namespace cb
