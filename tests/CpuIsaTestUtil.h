@@ -6,9 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <ostream>
 #include <string>
 
 #include "impl_cpu/CpuIsa.h"
+
+namespace cb::cpu {
+// gtest's name for a target in messages ("avx2", not the enum's bytes).
+inline void PrintTo(CpuIsa isa, std::ostream* os) { *os << CpuIsaName(isa); }
+}  // namespace cb::cpu
 
 namespace cb::test {
 
