@@ -216,6 +216,20 @@ TEST(RunOutputTable, PerCameraFrameBesideTheDocuments) {
     EXPECT_NE(html::FrameFigureLines(doc, "cpu")[0].find("frame: 6.000 ms"), std::string::npos);
 }
 
+// Test the other stages' lines: shade's two figures in the thesis's section 8.2 (8.696 ms at full resolution,
+// 2.174 ms at half), each with its setting, in one line; none for noise, which no document times; none for the
+// renderer, whose figure is FrameFigureLines's.
+TEST(RunOutputTable, StageFiguresBesideTheDocuments) {
+    Scene scene = RunOutputScene();
+    scene.name = "wang-20km";
+    const nlohmann::json doc = ResultsJson(scene, {RunOutputRun(scene)});
+    const std::vector<std::string> lines = html::StageFigureLines(doc, "cpu");
+    ASSERT_EQ(lines.size(), 1u);
+    EXPECT_EQ(lines[0],
+              "  shade in the source documents: 8.696 ms at shade.resolution 1, 2.174 ms at shade.resolution 2 "
+              "(seed 000, section 8.2, NVIDIA GeForce 8700M GT)");
+}
+
 // Test that the shipped wang scenes measure warm steps: a warm-up step (noise and shade, once), then at least 5
 // steps that each render every camera, so that the quartiles are not one cold sample.
 TEST(RunOutputScenes, WangScenesHaveWarmRenderedSteps) {

@@ -97,11 +97,15 @@ struct StateOptions {
     const SimulationState* resume = nullptr;  // read and checked before any backend opened
 };
 
-// A backend's section of the report: its timing table, then its renderers' time per camera
-// frame beside the source documents' figures (the comparison `cloudbench report` makes).
+// A backend's section of the report: its timing table, the source documents' figures for its
+// stages, then its renderers' time per camera frame beside theirs (the comparison `cloudbench
+// report` makes).
 report::Section RunSection(const Scene& scene, const BackendRun& run) {
     report::Section section = TimingSection(scene, run);
-    for (const std::string& line : html::FrameFigureLines(ResultsJson(scene, {run}), run.name))
+    const nlohmann::json doc = ResultsJson(scene, {run});
+    for (const std::string& line : html::StageFigureLines(doc, run.name))
+        section.blocks.push_back(report::Paragraph{line});
+    for (const std::string& line : html::FrameFigureLines(doc, run.name))
         section.blocks.push_back(report::Paragraph{line});
     return section;
 }

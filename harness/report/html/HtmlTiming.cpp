@@ -103,6 +103,35 @@ std::optional<double> FramesPerStep(const json& doc, const std::string& backend,
     return perStep * double(cameras);
 }
 
+std::vector<std::string> StageFigureLines(const json& doc, const std::string& backend) {
+    std::vector<std::string> lines;
+    const std::string scene = Str(Obj(doc, "scene"), "name");
+    const json& stages = Obj(Obj(Obj(doc, "backends"), backend.c_str()), "stages");
+    for (const std::string& stage : ResultStages(doc)) {
+        if (!FramesKey(stage).empty() || !stages.contains(stage)) continue;  // a renderer: FrameFigureLines
+        // By document and table: "8.696 ms at shade.resolution 1, 2.174 ms at shade.resolution 2 (seed 000, ...)".
+        std::vector<std::pair<std::string, std::string>> groups;  // (seed + table, the group's figures)
+        for (const json* f : SeedFigures(stage, scene)) {
+            std::string figure = Fixed(Number(*f, "ms").value_or(0)) + " ms";
+            for (const auto& [key, value] : Obj(*f, "settings").items()) figure += " at " + key + " " + value.dump();
+            const json& source = Obj(Obj(SeedTimings(), "sources"), Str(*f, "seed").c_str());
+            const std::string where =
+                "seed " + Str(*f, "seed") + ", " + Str(*f, "table") + ", " + Str(source, "hardware");
+            auto group = std::ranges::find(groups, where, &std::pair<std::string, std::string>::first);
+            if (group == groups.end())
+                groups.push_back({where, figure});
+            else
+                group->second += ", " + figure;
+        }
+        if (groups.empty()) continue;
+        std::string line = "  " + stage + " in the source documents:";
+        for (size_t n = 0; n < groups.size(); ++n)
+            line += (n ? ";" : "") + std::string(" ") + groups[n].second + " (" + groups[n].first + ")";
+        lines.push_back(line);
+    }
+    return lines;
+}
+
 std::vector<std::string> FrameFigureLines(const json& doc, const std::string& backend) {
     std::vector<std::string> lines;
     const std::string scene = Str(Obj(doc, "scene"), "name");

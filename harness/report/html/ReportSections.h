@@ -26,6 +26,9 @@ std::optional<double> FramesPerStep(const nlohmann::json& doc, const std::string
 // `run`'s lines under a backend's timing table, one per renderer: its time per camera frame (the step's median
 // over FramesPerStep) and the source documents' figures for a frame of the scene.
 std::vector<std::string> FrameFigureLines(const nlohmann::json& doc, const std::string& backend);
+// `run`'s lines for the other stages: each stage's figures in the source documents (docs/seed-timings.json),
+// with the settings a figure was measured at, by document and table.
+std::vector<std::string> StageFigureLines(const nlohmann::json& doc, const std::string& backend);
 // Every figure of docs/seed-timings.json, and the document and setup of each seed.
 report::Table SeedTable();
 report::KeyValues SeedSources();
