@@ -96,6 +96,14 @@ TEST(HtmlPlot, LogAxisDecades) {
     EXPECT_FALSE(MakeAxis(0, 30, true).log);
 }
 
+// Test that an axis of whole numbers has whole ticks: records 0 to 3 over 8 ticks would step by 0.5.
+TEST(HtmlPlot, WholeNumberAxis) {
+    EXPECT_EQ(MakeAxis(0, 3, false, 8).ticks, (std::vector<double>{0, 0.5, 1, 1.5, 2, 2.5, 3}));
+    const Axis a = MakeAxis(0, 3, false, 8, /*whole=*/true);
+    EXPECT_EQ(a.ticks, (std::vector<double>{0, 1, 2, 3}));
+    EXPECT_EQ(MakeAxis(0, 40, false, 8, true).ticks, (std::vector<double>{0, 5, 10, 15, 20, 25, 30, 35, 40}));
+}
+
 // Test the degenerate ranges: one value is widened around it, no value gives [0, 1].
 TEST(HtmlPlot, DegenerateAxes) {
     const Axis one = MakeAxis(5, 5, false);
@@ -181,6 +189,28 @@ TEST(HtmlPareto, RenderersShareOnePlot) {
     const std::vector<report::Block> image = ParetoBlocks(accuracy);
     ASSERT_EQ(image.size(), 1u);
     EXPECT_NE(std::get<report::Figure>(image[0]).svg.find("layers gl"), std::string::npos);
+}
+
+// Test that accuracy.json's stages get a plot of the max and one of the mean: the ground shadow's max is near 1 for
+// every form (its shadow edges), and only its mean tells the forms apart.
+TEST(HtmlPareto, AccuracyPlotsMaxAndMean) {
+    auto row = [](const char* form, double ms, double max, double mean) {
+        return nlohmann::json{{"stage", "shadow"},
+                              {"backend", "cpu"},
+                              {"status", "ok"},
+                              {"time", {{"median_ms", ms}}},
+                              {"error", {{"all", {{"max", max}, {"mean", mean}}}}},
+                              {"settings", {{"shadow.form", form}}}};
+    };
+    ReportInput accuracy{"a.json", InputKind::Accuracy, {{"scene", "x"}}};
+    accuracy.doc["rows"] = {row("beer", 0.02, 0.9996, 0.128), row("thesis", 0.03, 0.9995, 0.31)};
+    const std::vector<report::Block> blocks = ParetoBlocks(accuracy);
+    ASSERT_EQ(blocks.size(), 2u);
+    const std::string max = std::get<report::Figure>(blocks[0]).svg, mean = std::get<report::Figure>(blocks[1]).svg;
+    EXPECT_NE(max.find("shadow, max"), std::string::npos);
+    EXPECT_NE(mean.find("shadow, mean"), std::string::npos);
+    EXPECT_NE(mean.find("error 0.128"), std::string::npos);
+    EXPECT_NE(mean.find("error 0.31"), std::string::npos);
 }
 
 // Test a sweep on PSNR: the front drawn is the rows sweep.json marks (higher PSNR is better, so a plain

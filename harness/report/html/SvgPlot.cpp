@@ -140,7 +140,7 @@ double Axis::ToPixel(double value, double pixelLo, double pixelHi) const {
     return pixelLo + t * (pixelHi - pixelLo);
 }
 
-Axis MakeAxis(double min, double max, bool log, int targetTicks) {
+Axis MakeAxis(double min, double max, bool log, int targetTicks, bool whole) {
     Axis axis;
     if (!(min <= max)) min = 0, max = 1;  // no value (also NaN)
     if (log && min > 0) {
@@ -161,7 +161,8 @@ Axis MakeAxis(double min, double max, bool log, int targetTicks) {
     const double raw = (max - min) / std::max(1, targetTicks);
     const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
     const double r = raw / magnitude;
-    const double step = (r <= 1 ? 1 : r <= 2 ? 2 : r <= 5 ? 5 : 10) * magnitude;
+    const double round = (r <= 1 ? 1 : r <= 2 ? 2 : r <= 5 ? 5 : 10) * magnitude;
+    const double step = whole ? std::max(1.0, round) : round;
     const double first = std::floor(min / step + 1e-9), last = std::ceil(max / step - 1e-9);
     axis.lo = first * step;
     axis.hi = last * step;
@@ -252,8 +253,8 @@ std::string RenderHistoryPlot(const LinePlot& plot) {
     const auto [xs, ys, names] = Pooled(plot.series);
     auto [xlo, xhi] = RangeOf(xs, false);
     auto [ylo, yhi] = RangeOf(ys, false);
-    const Axis x = MakeAxis(xlo, xhi, false, 8);
-    const Axis y = MakeAxis(std::min(0.0, ylo), yhi, false);  // times from 0: a step reads at its true size
+    const Axis x = MakeAxis(xlo, xhi, false, 8, /*whole=*/true);  // record indices
+    const Axis y = MakeAxis(std::min(0.0, ylo), yhi, false);      // times from 0: a step reads at its true size
     std::string out = Open("history", plot.title) + Legend(names) + YAxis(y, plot.yLabel) + XAxis(x, plot.xLabel);
     for (size_t i = 0; i < plot.series.size(); ++i) {
         const Series& s = plot.series[i];

@@ -25,8 +25,9 @@ struct Axis {
 };
 // An axis covering [min, max] with about `targetTicks` ticks. A log axis
 // needs min > 0 (otherwise it is linear); an empty or one-value range is
-// widened around the value (to [0, 1] for no value at all: min > max).
-Axis MakeAxis(double min, double max, bool log, int targetTicks = 5);
+// widened around the value (to [0, 1] for no value at all: min > max). A
+// linear axis of `whole` numbers (counts, record indices) has whole ticks.
+Axis MakeAxis(double min, double max, bool log, int targetTicks = 5, bool whole = false);
 // A tick label: up to 4 significant digits, no trailing zeros (0.05, 2, 1000, 1e+04).
 std::string TickLabel(double value);
 
