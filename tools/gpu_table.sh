@@ -1,18 +1,17 @@
 #!/usr/bin/env bash
 # The measurements to make on a real GPU, in one call of a few minutes.
-# Here:       cmake --workflow --preset release, then pack the release build (cloudbench, cloudbench_tests,
-#             libcloudbench_images.so, the libraries they need, scenes/) into .gpu/ with an env.sh
-# GPU host:   . .gpu/env.sh && tools/gpu_table.sh "$OUT"      (carry .gpu; $OUT comes back)
+# Here:       cmake --workflow --preset release, then tools/bundle.sh build/release bundle (docs/gpu.md)
+# GPU host:   . bundle/env.sh && tools/gpu_table.sh "$OUT"      (carry bundle/; $OUT comes back)
 # Writes to DIR (default /tmp/gpu16): devices.txt, conform-*.txt, run-*.txt with their results.json,
 # gtest-*.txt, and summary.txt, the lines for a new dated report under reports/perf/. Every command has
 # its own time limit, so one that hangs costs only itself.
 set -uo pipefail
 out=${1:-/tmp/gpu16}
 mkdir -p "$out"
-cli=${CLOUDBENCH_CLI:-.gpu/cloudbench}
-tests=${CLOUDBENCH_TESTS:-.gpu/cloudbench_tests}
-scenes=${CLOUDBENCH_SCENES:-.gpu/scenes}
-[ -x "$cli" ] || { echo "gpu_table: no $cli; pack the release build into .gpu first" >&2; exit 1; }
+cli=${CLOUDBENCH_CLI:-bundle/bin/cloudbench}
+tests=${CLOUDBENCH_TESTS:-bundle/bin/cloudbench_tests}
+scenes=${CLOUDBENCH_SCENES:-bundle/share/cloudbench/scenes}
+[ -x "$cli" ] || { echo "gpu_table: no $cli; make it with tools/bundle.sh (docs/gpu.md)" >&2; exit 1; }
 step() {  # step NAME SECONDS COMMAND...: runs it, keeps its output and exit status
     local name=$1 limit=$2; shift 2
     echo "== $name: $*" | tee -a "$out/summary.txt"
