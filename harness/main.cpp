@@ -14,6 +14,7 @@
 #include "harness/platform/Command.h"
 #include "harness/platform/Isolation.h"
 #include "harness/platform/Provenance.h"
+#include "harness/report/images/ImageModule.h"
 
 namespace {
 
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
     }
     const std::string_view name = argv[1];
     if (name == "--version") {
-        std::fputs(cb::VersionText().c_str(), stdout);
+        std::fputs(cb::VersionText(cb::images::kModuleFileName).c_str(), stdout);
         return cb::kExitOk;
     }
     if (name == "--help" || name == "-h") {

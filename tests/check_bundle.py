@@ -13,6 +13,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 
 build, source, out = sys.argv[1:4]
 C_RUNTIME = re.compile(r"/(libc|libm|libpthread|libdl|librt|libresolv|ld-linux-x86-64)\.so")
@@ -26,7 +27,9 @@ def fail(message, proc=None):
 
 shutil.rmtree(out, ignore_errors=True)
 os.makedirs(out)
-bundle = os.path.join(out, "bundle")
+# Outside the source tree (the build folder, and so OUT_DIR, may lie inside it, and it is hidden below).
+outside = tempfile.mkdtemp(prefix="cloudbench-bundle-")
+bundle = os.path.join(outside, "bundle")
 p = subprocess.run([os.path.join(source, "tools", "bundle.sh"), build, bundle], capture_output=True, text=True)
 if p.returncode != 0:
     fail("tools/bundle.sh failed", p)
@@ -47,7 +50,7 @@ for binary in (os.path.join(bundle, "bin", "cloudbench"),
                 fail("%s loads %s from outside the bundle" % (binary, path))
 
 hidden = subprocess.run(["unshare", "--map-root-user", "--mount", "true"], capture_output=True).returncode == 0
-work = os.path.join(out, "work")
+work = os.path.join(outside, "work")
 os.makedirs(work)
 script = ('set -e\nif [ "$HIDE" = 1 ]; then mount -t tmpfs none "$SOURCE"; fi\n. "$ENV_SH"\ncd "$WORK"\n'
           'cloudbench run ci-small --backend cpu --steps 2 --set warmup_steps=0 --quiet --out run\n')
@@ -61,5 +64,5 @@ if p.returncode != 0:
     fail("the bundled cloudbench failed", p)
 if not any(n.endswith(".png") for n in os.listdir(os.path.join(work, "run"))):
     fail("the bundled cloudbench wrote no PNG frame")
-shutil.rmtree(bundle)  # about half a gigabyte: OpenImageIO's libraries
+shutil.rmtree(outside)  # about half a gigabyte: OpenImageIO's libraries
 print("bundle: ok (%s)" % ("source tree hidden" if hidden else "source tree visible"))

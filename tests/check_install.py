@@ -58,7 +58,9 @@ for library in ("libtbb12", "libhwy1", "libopenimageio", "libvulkan1", "libembre
     if library not in depends:
         fail("the .deb does not depend on %s: Depends: %s" % (library, depends))
 
-prefix = tempfile.mkdtemp(prefix="cloudbench-install-", dir=out)
+# Outside the source tree (the build folder, and so OUT_DIR, may lie inside it, and it is hidden below).
+outside = tempfile.mkdtemp(prefix="cloudbench-install-")
+prefix = os.path.join(outside, "usr")
 shutil.copytree(os.path.join(stage, "usr"), prefix, dirs_exist_ok=True)
 shutil.rmtree(stage)
 cli = os.path.join(prefix, "bin", "cloudbench")
@@ -72,9 +74,9 @@ for path in [cli, os.path.join(prefix, "lib/cloudbench/libcloudbench_images.so")
 hidden = subprocess.run(["unshare", "--map-root-user", "--mount", "true"], capture_output=True).returncode == 0
 if not hidden:
     print("install: note: no private mount namespace here (unshare); the source tree stays visible")
-work = os.path.join(out, "work")
+work = os.path.join(outside, "work")
 os.makedirs(work)
-script = os.path.join(out, "steps.sh")
+script = os.path.join(outside, "steps.sh")
 with open(script, "w") as f:
     f.write("""set -e
 if [ "$HIDE" = 1 ]; then mount -t tmpfs none "$SOURCE"; test -z "$(ls -A "$SOURCE")"; fi
@@ -122,4 +124,5 @@ with open(os.path.join(work, "by-path", "results.json")) as f:
         fail("a scene given by path was not used")
 if not os.path.getsize(os.path.join(work, "report.html")):
     fail("report wrote nothing")
+shutil.rmtree(outside)
 print("install: ok (%s)" % ("source tree hidden" if hidden else "source tree visible"))

@@ -2,7 +2,8 @@
 """Plots a `cloudbench sweep` result: error against time, one series per backend,
 one panel per stage (shade, shadow; the renderers render_march, render_splat and
 render_layers share one "images" panel, one series per renderer x backend), the
-Pareto front marked. With metric psnr the y axis is the PSNR in dB (higher is
+Pareto front marked and its points labelled with their settings (every point when
+at most 2 fields vary and a series has at most 24). With metric psnr the y axis is the PSNR in dB (higher is
 better) and an infinite PSNR (null) is a triangle labelled "inf" above the rest.
 
 Usage: plot_sweep.py SWEEP_JSON OUT_PNG [NAME]
@@ -68,8 +69,11 @@ def plot(doc, source):
                 if r["inf"]:
                     ax.plot([x], [y], marker="^", color=colours[backend])
                     ax.annotate("inf", (x, y), textcoords="offset points", xytext=(4, -9), fontsize=7)
-            if len(varied) <= 2 and len(mine) <= 24:
-                for r, x, y in zip(mine, t, e):
+            # Every point is labelled with its values of the varied fields when the panel stays legible; past
+            # that, the points on the front still are, since they are the ones a reader picks from.
+            few = len(varied) <= 2 and len(mine) <= 24
+            for r, x, y in zip(mine, t, e):
+                if few or r.get("pareto"):
                     label = ",".join(str(r["settings"].get(p, "any")) for p in varied)
                     ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
         front = sorted((r["time"]["median_ms"], r["y"]) for r in stage_rows if r.get("pareto"))

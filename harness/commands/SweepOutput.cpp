@@ -13,9 +13,9 @@
 #include <cstring>
 #include <string_view>
 
+#include "core/base/InstallLayout.h"
 #include "harness/accuracy/SweepFields.h"
 #include "harness/platform/Command.h"
-#include "harness/platform/InstallLayout.h"
 #include "harness/run/Session.h"
 
 extern char** environ;

@@ -10,9 +10,9 @@
 #include <filesystem>
 #include <map>
 
+#include "core/base/InstallLayout.h"
 #include "core/base/NamedValues.h"
 #include "core/base/ShownText.h"
-#include "harness/platform/InstallLayout.h"
 
 namespace cb {
 namespace {

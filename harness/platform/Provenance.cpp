@@ -9,9 +9,9 @@
 #include <thread>
 
 #include "cloudbench_build_info.h"
+#include "core/base/InstallLayout.h"
 #include "core/base/PathPolicy.h"
 #include "core/base/SystemFile.h"
-#include "harness/platform/InstallLayout.h"
 
 namespace cb {
 namespace {
@@ -80,11 +80,11 @@ json SceneWithOverrides(const std::string& path, std::span<const SceneOverride> 
     return root;
 }
 
-std::string VersionText() {
+std::string VersionText(std::string_view imageModuleFileName) {
     const std::string dirty = CLOUDBENCH_GIT_DIRTY;
     std::string module = "not found (looked for";
     std::error_code error;
-    for (const std::string& path : ImageModuleCandidates()) {
+    for (const std::string& path : ModuleCandidates(imageModuleFileName)) {
         if (std::filesystem::exists(path, error)) {
             module = path;
             break;

@@ -28,8 +28,8 @@ struct SceneProvenance {
 
 // `cloudbench --version`: the version, the commit (and whether the tree was
 // dirty), the build type and compiler, and where this executable reads its
-// scenes and its image module from (harness/platform/InstallLayout.h).
-std::string VersionText();
+// scenes and its image module (`imageModuleFileName`) from (core/base/InstallLayout.h).
+std::string VersionText(std::string_view imageModuleFileName);
 
 // Keys: git {commit, dirty}, build {version, type, flags, compiler}, machine {cpu,
 // threads, os}, date (UTC, ISO 8601), backends [...], scene {path, name,

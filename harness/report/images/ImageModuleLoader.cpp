@@ -1,18 +1,18 @@
 // Opens libcloudbench_images.so (harness/report/images/ImageModule.h) on first use,
-// at the first of harness/platform/InstallLayout.h's places that holds it.
+// at the first of core/base/InstallLayout.h's places that holds it.
 #include <dlfcn.h>
 
 #include <filesystem>
 #include <mutex>
 
-#include "harness/platform/InstallLayout.h"
+#include "core/base/InstallLayout.h"
 #include "harness/report/images/ImageModule.h"
 
 namespace cb::images {
 namespace {
 
 Result<const Module*> Open() {
-    const std::vector<std::string> candidates = ImageModuleCandidates();
+    const std::vector<std::string> candidates = ModuleCandidates(kModuleFileName);
     std::error_code error;
     std::string tried;
     for (const std::string& path : candidates) {

@@ -1,9 +1,7 @@
-#include "harness/platform/InstallLayout.h"
+#include "core/base/InstallLayout.h"
 
 #include <cstdlib>
 #include <filesystem>
-
-#include "harness/report/images/ImageModule.h"
 
 namespace cb {
 namespace {
@@ -42,13 +40,12 @@ std::string ToolsFolder() {
     return CLOUDBENCH_TOOLS_DIR;
 }
 
-std::vector<std::string> ImageModuleCandidates() {
+std::vector<std::string> ModuleCandidates(std::string_view fileName) {
     std::vector<std::string> candidates;
-    if (const fs::path folder = ExecutableFolder(); !folder.empty())
-        candidates.push_back((folder / images::kModuleFileName).string());
+    if (const fs::path folder = ExecutableFolder(); !folder.empty()) candidates.push_back((folder / fileName).string());
     if (const fs::path installed = Installed(CLOUDBENCH_INSTALL_MODULE_DIR); !installed.empty())
-        candidates.push_back((installed / images::kModuleFileName).string());
-    candidates.push_back(CLOUDBENCH_IMAGE_MODULE_PATH);
+        candidates.push_back((installed / fileName).string());
+    candidates.push_back((fs::path(CLOUDBENCH_BUILD_MODULE_DIR) / fileName).string());
     return candidates;
 }
 

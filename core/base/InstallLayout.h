@@ -4,10 +4,11 @@
 // share/cloudbench/scenes/ and share/cloudbench/tools/ (the scripts it runs);
 // in a build tree, the image module is at the top of the build folder and the
 // scenes and scripts in the source tree. The relative paths are
-// the install rules' (harness/CMakeLists.txt), passed in as definitions.
+// the install rules' (CMakeLists.txt, harness/CMakeLists.txt), passed in as definitions.
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace cb {
@@ -20,8 +21,9 @@ std::string SceneFolder();
 // installed one when this executable has one, else the source tree's.
 std::string ToolsFolder();
 
-// Where the image module may be, in the order to try: beside the executable,
-// the installed place, the build tree's.
-std::vector<std::string> ImageModuleCandidates();
+// Where a module cloudbench loads (the image module: harness/report/images)
+// may be, in the order to try: beside the executable, the installed place,
+// the top of the build tree.
+std::vector<std::string> ModuleCandidates(std::string_view fileName);
 
 }  // namespace cb
