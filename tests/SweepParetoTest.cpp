@@ -36,6 +36,35 @@ std::string Marks(const std::vector<Row>& rows) {
     return out;
 }
 
+// Test the fastest row within an error bound, per front and backend: shade on cpu, shade on vk and the renderers
+// (march and splat together) on cpu, each worked by hand; a bound no shade row on cpu meets leaves it out; with
+// psnr the bound is a floor in dB, and an infinite PSNR (an exact image) meets every bound.
+TEST(SweepPareto, FastestWithinABound) {
+    auto on = [](Row r, const char* backend) {
+        r.backend = backend;
+        return r;
+    };
+    const std::vector<Row> rows = {
+        TimedRow(Stage::Shade, 1.0, 0.9, 1.1, 0.1), TimedRow(Stage::Shade, 0.5, 0.4, 0.6, 0.3),
+        on(TimedRow(Stage::Shade, 2.0, 1.9, 2.1, 0.05), "vk"), TimedRow(Stage::RenderMarch, 3.0, 2.9, 3.1, 0.01, 40.0),
+        TimedRow(Stage::RenderSplat, 1.0, 0.9, 1.1, 0.02, 30.0)};
+    std::vector<const Row*> picks = FastestWithin(rows, "max", 0.2);
+    ASSERT_EQ(picks.size(), 3u);
+    EXPECT_EQ(picks[0], &rows[0]);             // shade on cpu: 0.5 ms is faster, but its error 0.3 is over the bound
+    EXPECT_EQ(picks[1], &rows[2]);             // shade on vk
+    EXPECT_EQ(picks[2], &rows[4]);             // the renderers on cpu: splat, 1 ms against the march's 3
+    picks = FastestWithin(rows, "max", 0.06);  // shade on cpu: 0.1 and 0.3 are both over it
+    ASSERT_EQ(picks.size(), 2u);
+    EXPECT_EQ(picks[0], &rows[2]);
+    EXPECT_EQ(picks[1], &rows[4]);
+    EXPECT_TRUE(WithinBound(rows[0], "max", 0.1));  // at the bound is within it
+    picks = FastestWithin(rows, "psnr", 35.0);      // renderers only; splat's 30 dB is under the floor
+    ASSERT_EQ(picks.size(), 1u);
+    EXPECT_EQ(picks[0], &rows[3]);
+    Row exact = TimedRow(Stage::RenderLayers, 5.0, 4.9, 5.1, 0.0);  // no PSNR: the image equals the reference
+    EXPECT_TRUE(WithinBound(exact, "psnr", 1e9));
+}
+
 // Two settings that differ only by timing noise (overlapping q1-q3, equal error) are a tie, both on the
 // front; a clearly slower row with no better error is off it; a slower, more accurate one is on it.
 TEST(SweepPareto, NoiseDuplicatesAreTiesNotAStar) {

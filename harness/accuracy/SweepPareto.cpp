@@ -1,5 +1,6 @@
 #include "harness/accuracy/SweepPareto.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "core/plan/StageGraph.h"
@@ -61,6 +62,24 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
                 break;
             }
     }
+}
+
+bool WithinBound(const Row& row, std::string_view metric, double bound) {
+    return SweepOnFront(row, metric) && MetricLoss(row, metric) <= (metric == "psnr" ? -bound : bound);
+}
+
+std::vector<const Row*> FastestWithin(const std::vector<Row>& rows, const std::string& metric, double bound) {
+    std::vector<const Row*> fastest;  // one per front and backend, in first-appearance order
+    for (const Row& r : rows) {
+        if (!WithinBound(r, metric, bound)) continue;
+        auto same = std::ranges::find_if(
+            fastest, [&](const Row* f) { return f->backend == r.backend && SameParetoFront(f->stage, r.stage); });
+        if (same == fastest.end())
+            fastest.push_back(&r);
+        else if (r.result.timeMs.median < (*same)->result.timeMs.median)
+            *same = &r;
+    }
+    return fastest;
 }
 
 }  // namespace cb

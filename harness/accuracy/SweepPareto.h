@@ -31,4 +31,13 @@ bool ParetoBeats(const Row& a, const Row& b, std::string_view metric);
 // front row's and whose q1-q3 time interval overlaps that row's is a tie (paretoTie) for both.
 void MarkPareto(std::vector<Row>& rows, const std::string& metric);
 
+// Whether an ok row's error on `metric` is within `bound`: |error| at most `bound`, or for psnr at least
+// `bound` dB.
+bool WithinBound(const Row& row, std::string_view metric, double bound);
+
+// The answer to "the fastest setting within an error bound": per front (a stage; the renderers together) and
+// backend, the ok row within `bound` with the least median time (the first on a tie), in the order the fronts
+// and backends first appear in `rows`; a front and backend with no row within the bound has none.
+std::vector<const Row*> FastestWithin(const std::vector<Row>& rows, const std::string& metric, double bound);
+
 }  // namespace cb

@@ -4,9 +4,11 @@
 // reads, the Pareto front marked with its ties; writes sweep.json, sweep.md and
 // the plot sweep.png (tools/plot_sweep.py); exits as `report` judges sweep.json.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <expected>
+#include <optional>
 
 #include "core/base/ShownText.h"
 #include "core/plan/StageGraph.h"
@@ -14,8 +16,10 @@
 #include "harness/accuracy/IsolatedMeasurement.h"
 #include "harness/accuracy/Measurement.h"
 #include "harness/accuracy/SweepFields.h"
+#include "harness/accuracy/SweepPareto.h"
 #include "harness/commands/SweepOutput.h"
 #include "harness/report/html/ReportInput.h"
+#include "harness/report/html/ReportJson.h"
 #include "harness/run/RunTransfer.h"
 
 namespace cb {
@@ -55,6 +59,9 @@ Options:
   --backend LIST     backends to measure (default: all built); also --backends
   --metric M         error for the Pareto front: max (default), mean or p99 of
                      |error|, or psnr (renderers only; higher is better)
+  --within E         also print (and write in sweep.json's "within") the fastest
+                     setting of each stage and backend whose error is within E:
+                     |error| <= E, or PSNR >= E dB with --metric psnr
   --repeat N         timed calls per point, after one warm-up (default 5)
   --reference-step X the exact reference render's step in voxel edges
                      (default 0.125), when images are measured
@@ -141,9 +148,39 @@ std::expected<std::vector<std::vector<SceneOverride>>, int> Points(const Session
 }
 
 // sweep's own options (docs/cli.md), besides --repeat and --reference-step.
+// "fastest within max |error| <= 0.01: shade on cpu: shade shade.resolution=2, 0.412 ms, error 0.0087", a line
+// per front (a stage; the renderers together) and backend measured, "none" where no row is within the bound.
+void PrintFastestWithin(const std::vector<Row>& rows, const std::string& metric, double within,
+                        const std::vector<const Row*>& fastest) {
+    const std::string bound = metric == "psnr" ? "PSNR >= " + html::Fixed(within) + " dB"
+                                               : metric + " |error| <= " + html::Fixed(within, "%.6g");
+    auto sameFront = [](Stage a, Stage b) { return a == b || (Describe(a).renderer && Describe(b).renderer); };
+    std::vector<std::pair<Stage, std::string>> fronts;
+    for (const Row& r : rows)
+        if (r.result.status == "ok" && MetricApplies(metric, r.stage) &&
+            std::ranges::none_of(fronts,
+                                 [&](const auto& f) { return f.second == r.backend && sameFront(f.first, r.stage); }))
+            fronts.push_back({r.stage, r.backend});
+    for (const auto& [stage, backend] : fronts) {
+        const auto pick = std::ranges::find_if(
+            fastest, [&](const Row* f) { return f->backend == backend && sameFront(f->stage, stage); });
+        const std::string front = Describe(stage).renderer ? "the renderers" : std::string(StageName(stage));
+        if (pick == fastest.end()) {
+            std::printf("fastest within %s: %s on %s: none\n", bound.c_str(), front.c_str(), backend.c_str());
+            continue;
+        }
+        const Row& r = **pick;
+        const double error = metric == "psnr" ? -MetricLoss(r, metric) : MetricLoss(r, metric);
+        std::printf("fastest within %s: %s on %s: %s %s, %s ms, error %s\n", bound.c_str(), front.c_str(),
+                    backend.c_str(), std::string(StageName(r.stage)).c_str(), SettingsLabel(r.settings).c_str(),
+                    html::Fixed(r.result.timeMs.median).c_str(), html::Fixed(error, "%.4g").c_str());
+    }
+}
+
 struct SweepOptions : MeasurementOptions {
     std::vector<std::string> vary;  // --vary PATH=V1,V2,...
     std::string metric = "max";     // --metric: max, mean, p99 or psnr
+    std::optional<double> within;   // --within E: the fastest setting with an error within E
     int shardIndex = 0;             // --shard I/N: share I (1-based) of N; shardCount 0 = not sharded
     int shardCount = 0;
 };
@@ -256,6 +293,9 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
     std::vector<size_t> rowItem;
     std::vector<Row> rows = MergeRows(scene, plan, *parts, &rowItem);
     MarkPareto(rows, own.metric);
+    const std::vector<const Row*> fastest =
+        own.within ? FastestWithin(rows, own.metric, *own.within) : std::vector<const Row*>{};
+    if (own.within) PrintFastestWithin(rows, own.metric, *own.within, fastest);
 
     json doc = {{"format", "cloudbench-sweep/1"},
                 {"scene", scene.name},
@@ -265,6 +305,11 @@ int Sweep(const CommonOptions& options, const SweepOptions& own) {
                 {"repeats", own.repeats},
                 {"reference_start", "voxel-exit"},
                 {"references", ReferencesJson(FirstRecords(*parts), options.cpuThreads)}};
+    if (own.within) {
+        json picks = json::array();
+        for (const Row* r : fastest) picks.push_back(RowJson(*r));
+        doc["within"] = {{"bound", *own.within}, {"fastest", std::move(picks)}};
+    }
     if (sharded) {
         // Every measured row with its point's global index, for `cloudbench merge`.
         json shardRows = json::array();
@@ -307,6 +352,19 @@ const CommandRegistration kRegistration({
     .extraOptions = WithIsolationOptions(
         {ListOption("--vary", &SweepOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary shade.resolution=1,2,4"),
          TextOption("--metric", &SweepOptions::metric, "--metric needs max, mean, p99 or psnr"), RepeatOption(),
+         OwnOption<SweepOptions>("--within", true,
+                                 [](SweepOptions& o, const char* v) -> std::optional<std::string> {
+                                     const std::string bad =
+                                         "--within needs a number, the error bound in the "
+                                         "--metric's unit (dB for psnr), e.g. --within 0.01";
+                                     if (!v) return bad;
+                                     char* end = nullptr;
+                                     const double e = std::strtod(v, &end);
+                                     if (end == v || *end != '\0' || !std::isfinite(e))
+                                         return bad + ", got '" + ShownArgument(v) + "'";
+                                     o.within = e;
+                                     return std::nullopt;
+                                 }),
          ReferenceStepOption(),
          OwnOption<SweepOptions>("--shard", true,
                                  [](SweepOptions& o, const char* v) -> std::optional<std::string> {

@@ -297,6 +297,7 @@ Node SweepSchema() {
                    {"references", AnyValue()},
                    {"vary", ArrayOf(Object({{"path", Text(), true}, {"values", Names(), true}})), true},
                    {"rows", ArrayOf(MeasuredRow()), true},
+                   {"within", Object({{"bound", Statistic(), true}, {"fastest", ArrayOf(MeasuredRow()), true}})},
                    {"shard", shard},
                    {"report", ReportBlock()},
                    {"provenance", Provenance()}});
