@@ -75,6 +75,24 @@ TEST(SweepPareto, NoiseDuplicatesAreTiesNotAStar) {
     EXPECT_EQ(Marks(rows), "==*.");
 }
 
+// Errors that print alike (3 significant digits) are equal on the front: a clearly faster row beats a slower one
+// whose error is smaller only past the printed digits (0.3991 against 0.3992: both "0.399"), and with
+// overlapping times the two are a tie; a difference the table shows (0.398) still counts.
+TEST(SweepPareto, ErrorsAlikeAsPrintedAreEqual) {
+    std::vector<Row> clearly = {TimedRow(Stage::Shade, 0.033, 0.032, 0.034, 0.39919),
+                                TimedRow(Stage::Shade, 0.048, 0.047, 0.049, 0.39910)};
+    MarkPareto(clearly, "max");
+    EXPECT_EQ(Marks(clearly), "*.");
+    std::vector<Row> overlapping = {TimedRow(Stage::Shade, 0.033, 0.030, 0.040, 0.39919),
+                                    TimedRow(Stage::Shade, 0.035, 0.031, 0.041, 0.39910)};
+    MarkPareto(overlapping, "max");
+    EXPECT_EQ(Marks(overlapping), "==");
+    std::vector<Row> shown = {TimedRow(Stage::Shade, 0.033, 0.032, 0.034, 0.39919),
+                              TimedRow(Stage::Shade, 0.048, 0.047, 0.049, 0.398)};
+    MarkPareto(shown, "max");
+    EXPECT_EQ(Marks(shown), "**");
+}
+
 // Overlapping times: the faster median is noise, so the smaller error wins (the old median rule kept both).
 TEST(SweepPareto, OverlappingTimesLetTheSmallerErrorWin) {
     std::vector<Row> rows = {TimedRow(Stage::Shade, 1.0, 0.9, 1.2, 0.6), TimedRow(Stage::Shade, 1.1, 1.0, 1.3, 0.5)};

@@ -62,7 +62,8 @@ json RowJson(const Row& r) {
 
 std::vector<report::Column> StatsColumns(const std::string& suffix) {
     std::vector<report::Column> columns;
-    for (const char* title : {"max", "mean", "p99"}) columns.push_back(report::Column(title + suffix).Real("%.3g"));
+    for (const char* title : {"max", "mean", "p99"})
+        columns.push_back(report::Column(title + suffix).Real(kErrorFormat));
     return columns;
 }
 
@@ -75,7 +76,7 @@ std::vector<report::Column> ErrorColumns(std::initializer_list<std::string> firs
     columns.push_back(report::Column("time ms (q1-q3)").Unit("ms"));
     for (auto& c : StatsColumns()) columns.push_back(c);
     if (IsRenderer(stage)) {
-        columns.push_back(report::Column("PSNR dB").Real("%.2f"));
+        columns.push_back(report::Column("PSNR dB").Real(kPsnrFormat));
         return columns;
     }
     for (auto& c : StatsColumns(stage == Stage::Shade ? " (in cloud)" : " (under cloud)")) columns.push_back(c);

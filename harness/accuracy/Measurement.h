@@ -36,6 +36,10 @@ std::vector<report::Cell> RowCells(const Row& row);
 // The columns of `first`, then backend, time and the error statistics over
 // all elements and over the stage's subset (in cloud, under cloud).
 std::vector<report::Column> ErrorColumns(std::initializer_list<std::string> first, Stage stage);
+// How the tables print an error statistic and a PSNR (sweep.md, accuracy.md, the CLI's tables).
+inline constexpr const char* kErrorFormat = "%.3g";
+inline constexpr const char* kPsnrFormat = "%.2f";
+
 // The error statistics columns alone ("max", "mean", "p99", with `suffix`).
 std::vector<report::Column> StatsColumns(const std::string& suffix = "");
 std::vector<report::Cell> StatsCells(const ErrorStats& e);

@@ -1,7 +1,10 @@
 #include "harness/accuracy/SweepPareto.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 #include "core/plan/StageGraph.h"
 
@@ -15,6 +18,15 @@ bool SweepClearlyFaster(const Row& a, const Row& b) { return a.result.timeMs.q3 
 
 bool SweepOnFront(const Row& r, std::string_view metric) {
     return r.result.status == "ok" && MetricApplies(metric, r.stage);
+}
+
+// The row's error as the tables print it (kErrorFormat, or kPsnrFormat for psnr; "inf" for an infinite PSNR).
+std::string PrintedError(const Row& r, std::string_view metric) {
+    const double loss = MetricLoss(r, metric);
+    if (metric == "psnr" && std::isinf(loss)) return "inf";
+    char text[64];
+    std::snprintf(text, sizeof text, metric == "psnr" ? kPsnrFormat : kErrorFormat, metric == "psnr" ? -loss : loss);
+    return text;
 }
 
 }  // namespace
@@ -33,10 +45,15 @@ double MetricLoss(const Row& row, std::string_view metric) {
     return metric == "mean" ? e.mean : metric == "p99" ? e.p99 : e.max;
 }
 
+bool ErrorsAlike(const Row& a, const Row& b, std::string_view metric) {
+    return PrintedError(a, metric) == PrintedError(b, metric);
+}
+
 bool ParetoBeats(const Row& a, const Row& b, std::string_view metric) {
     const double la = MetricLoss(a, metric), lb = MetricLoss(b, metric);
-    if (!(la <= lb) || SweepClearlyFaster(b, a)) return false;
-    return SweepClearlyFaster(a, b) || la < lb;
+    const bool alike = ErrorsAlike(a, b, metric);
+    if (!(la <= lb || alike) || SweepClearlyFaster(b, a)) return false;
+    return SweepClearlyFaster(a, b) || (la < lb && !alike);
 }
 
 void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
@@ -55,9 +72,8 @@ void MarkPareto(std::vector<Row>& rows, const std::string& metric) {
     for (Row& r : rows) {
         if (!r.pareto) continue;
         for (const Row& o : rows)
-            if (&o != &r && o.pareto && SameParetoFront(o.stage, r.stage) &&
-                MetricLoss(o, metric) == MetricLoss(r, metric) && !SweepClearlyFaster(o, r) &&
-                !SweepClearlyFaster(r, o)) {
+            if (&o != &r && o.pareto && SameParetoFront(o.stage, r.stage) && ErrorsAlike(o, r, metric) &&
+                !SweepClearlyFaster(o, r) && !SweepClearlyFaster(r, o)) {
                 r.paretoTie = true;
                 break;
             }

@@ -21,13 +21,17 @@ bool MetricApplies(std::string_view metric, Stage stage);
 // (-infinity for an image equal to the reference, whose PSNR is infinite).
 double MetricLoss(const Row& row, std::string_view metric);
 
-// Whether ok row `a` beats ok row `b` on the front: a's loss is at most b's and b is not clearly faster,
-// and a is clearly faster or its loss is smaller. Clearly faster: its time's q3 is below the other's q1
-// (the q1-q3 intervals do not overlap).
+// Whether two ok rows' errors on `metric` print the same in the tables (kErrorFormat, kPsnrFormat): a
+// difference the tables do not show is no difference on the front.
+bool ErrorsAlike(const Row& a, const Row& b, std::string_view metric);
+
+// Whether ok row `a` beats ok row `b` on the front: a's loss is at most b's (or alike) and b is not clearly
+// faster, and a is clearly faster or its loss is smaller and not alike. Clearly faster: its time's q3 is below
+// the other's q1 (the q1-q3 intervals do not overlap).
 bool ParetoBeats(const Row& a, const Row& b, std::string_view metric);
 
 // Marks the front per stage (the renderers share one: they make the same image): a row is on it (pareto)
-// when it is ok, its metric applies, and no other such row beats it; a front row whose loss equals another
+// when it is ok, its metric applies, and no other such row beats it; a front row whose error is alike another
 // front row's and whose q1-q3 time interval overlaps that row's is a tie (paretoTie) for both.
 void MarkPareto(std::vector<Row>& rows, const std::string& metric);
 
