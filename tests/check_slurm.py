@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """A real Slurm cluster runs a sharded sweep: tools/slurm/sweep-shard.sh as a job array, then tools/slurm/merge.sh
-as a job that depends on it (afterok), and the merged sweep equals the unsharded one but for the times.
+as a job that depends on it (afterok), and the merged sweep equals the unsharded one but for the times; and
+`perf record` on each of its two nodes, then `merge` of the two histories, keeps both records once.
 
 Usage: check_slurm.py CLOUDBENCH SOURCE_DIR OUT_DIR
 
-Starts a single-node cluster of its own from Debian's slurm-wlm and munge in a fresh folder: munged with a new key
-and its own socket, slurmctld and slurmd with a generated slurm.conf (ports of their own, proctrack/linuxproc,
-task/none) and cgroup.conf (cgroup/v1, IgnoreSystemd), every path and pid file in that folder. Every daemon it
+Starts a cluster of its own on this machine from Debian's slurm-wlm and munge in a fresh folder: munged with a new
+key and its own socket, slurmctld, and a slurmd for each of two nodes (slurmd -N, a port each) with a generated
+slurm.conf (ports of their own, proctrack/linuxproc, task/none) and cgroup.conf (cgroup/v1, IgnoreSystemd), every
+path and pid file in that folder. Every daemon it
 started is stopped by its pid when it ends, failed or not; it never talks to another cluster (SLURM_CONF and
 the munge socket are its own). Exit 77 (a skip) where the daemons are not installed.
 """
@@ -67,13 +69,12 @@ AuthType=auth/munge
 AuthInfo=socket={sock}
 CredType=cred/munge
 SlurmctldPort={free_port()}
-SlurmdPort={free_port()}
 StateSaveLocation={home}/state
-SlurmdSpoolDir={home}/spool
+SlurmdSpoolDir={home}/spool/%n
 SlurmctldPidFile={home}/slurmctld.pid
-SlurmdPidFile={home}/slurmd.pid
+SlurmdPidFile={home}/slurmd-%n.pid
 SlurmctldLogFile={home}/log/slurmctld.log
-SlurmdLogFile={home}/log/slurmd.log
+SlurmdLogFile={home}/log/slurmd-%n.log
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 MpiDefault=none
@@ -84,7 +85,8 @@ ReturnToService=2
 JobCompType=jobcomp/none
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
-NodeName={host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} State=UNKNOWN
+NodeName=cb-node1 NodeHostname={host} NodeAddr=127.0.0.1 Port={free_port()} CPUs={os.cpu_count()} State=UNKNOWN
+NodeName=cb-node2 NodeHostname={host} NodeAddr=127.0.0.1 Port={free_port()} CPUs={os.cpu_count()} State=UNKNOWN
 PartitionName=test Nodes=ALL Default=YES MaxTime=INFINITE State=UP
 """)
 with open(os.path.join(home, "cgroup.conf"), "w") as f:
@@ -106,7 +108,7 @@ def start(name, command, pid_file):
 
 
 def stop_all():
-    for name in ("slurmd", "slurmctld", "munged"):  # the reverse of the start
+    for name in ("slurmd-cb-node2", "slurmd-cb-node1", "slurmctld", "munged"):  # the reverse of the start
         pid = pids.pop(name, None)
         if pid is None:
             continue
@@ -136,13 +138,15 @@ try:
                      "--log-file", home + "/log/munged.log", "--seed-file", home + "/munge.seed", "--force"],
           home + "/munged.pid")
     start("slurmctld", ["slurmctld", "-f", conf], home + "/slurmctld.pid")
-    start("slurmd", ["slurmd", "-f", conf], home + "/slurmd.pid")
+    for node in ("cb-node1", "cb-node2"):
+        os.makedirs(os.path.join(home, "spool", node))
+        start("slurmd-" + node, ["slurmd", "-f", conf, "-N", node], home + "/slurmd-%s.pid" % node)
     for _ in range(300):
-        if "idle" in slurm("sinfo", "-h", "-o", "%t"):
+        if slurm("sinfo", "-h", "-o", "%t").split() == ["idle"] and "2" in slurm("sinfo", "-h", "-o", "%D"):
             break
         time.sleep(0.1)
     else:
-        fail("the node never became idle: " + slurm("sinfo"))
+        fail("the nodes never became idle: " + slurm("sinfo"))
 
     # The unsharded sweep, here; the sharded one through the cluster, with the scripts users submit.
     whole = subprocess.run([cli, "sweep"] + SWEEP + ["--quiet", "--out", os.path.join(out, "whole")],
@@ -171,7 +175,38 @@ try:
         got = [deterministic(r) for r in json.load(f)["rows"]]
     if got != want:
         fail("the merged sweep differs from the unsharded one:\n%s\n%s" % (got, want))
-    print("slurm: ok (%d array tasks and a dependent merge; %d rows equal the unsharded sweep's)" % (TASKS, len(got)))
+
+    # perf record on each node into a history of its own, then merge: both records, once each.
+    suite = os.path.join(out, "suite.json")
+    with open(suite, "w") as f:
+        json.dump({"scenes": [{"scene": "ci-small", "set": ["steps=6", "warmup_steps=2"]}]}, f)
+    records = []
+    for node in ("cb-node1", "cb-node2"):
+        history = os.path.join(out, "history-%s.jsonl" % node)
+        records.append((history, slurm("sbatch", "--parsable", "-w", node, "-o", os.path.join(home, "log", node + ".txt"),
+                                       "--wrap", '"$CLOUDBENCH" perf record --suite %s --history %s --backend cpu '
+                                       '--quiet' % (suite, history))))
+    deadline = time.time() + 300
+    while time.time() < deadline and slurm("squeue", "-h", "-j", ",".join(job for _, job in records)):
+        time.sleep(0.5)
+    ids = []
+    for history, job in records:
+        if not os.path.exists(history):
+            fail("perf record wrote no %s (job %s)" % (history, job))
+        with open(history) as f:
+            ids += [json.loads(line)["id"] for line in f if line.strip()]
+    if len(ids) != 2 or ids[0] == ids[1]:
+        fail("expected one record from each node, got %s" % ids)
+    p = subprocess.run([cli, "merge", records[0][0], records[1][0], records[0][0], "--out", os.path.join(out, "all")],
+                       capture_output=True, text=True, timeout=120)
+    if p.returncode != 0:
+        fail("merge of the histories failed: " + p.stderr)
+    with open(os.path.join(out, "all", "history.jsonl")) as f:
+        merged_ids = [json.loads(line)["id"] for line in f if line.strip()]
+    if sorted(merged_ids) != sorted(ids):
+        fail("the merged history holds %s, not each node's record once (%s)" % (merged_ids, ids))
+    print("slurm: ok (%d array tasks and a dependent merge: %d rows equal the unsharded sweep's; perf record on "
+          "two nodes, merged once each)" % (TASKS, len(got)))
 finally:
     stop_all()
     shutil.rmtree(home, ignore_errors=True)
