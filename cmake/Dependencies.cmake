@@ -19,6 +19,17 @@ cloudbench_require(TBB_FOUND "oneTBB" libtbb-dev)
 find_package(hwy CONFIG QUIET)
 cloudbench_require(hwy_FOUND "Google Highway" libhwy-dev)
 
+# OpenVDB, for dump --vdb in the image module: Debian's package has no CMake config of its own, and its
+# FindOpenVDB.cmake brings a FindTBB that shadows oneTBB's; the library, the header and Imath (its half type).
+find_library(CLOUDBENCH_OPENVDB_LIBRARY openvdb)
+find_path(CLOUDBENCH_OPENVDB_INCLUDE openvdb/openvdb.h)
+find_library(CLOUDBENCH_IMATH_LIBRARY NAMES Imath-3_1 Imath)
+if(CLOUDBENCH_OPENVDB_LIBRARY AND CLOUDBENCH_OPENVDB_INCLUDE AND CLOUDBENCH_IMATH_LIBRARY)
+  set(CLOUDBENCH_OPENVDB_FOUND TRUE)
+  set(CLOUDBENCH_OPENVDB_LIBRARIES ${CLOUDBENCH_OPENVDB_LIBRARY} ${CLOUDBENCH_IMATH_LIBRARY} TBB::tbb)
+endif()
+cloudbench_require(CLOUDBENCH_OPENVDB_FOUND "OpenVDB" libopenvdb-dev)
+
 find_package(nlohmann_json CONFIG QUIET)
 cloudbench_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)
 

@@ -29,6 +29,9 @@ Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
 Options:
   --backend NAME     the backend to dump (default: cpu); --backends is the same
   --reference        also write T_ref.npy and shadow_ref.npy (docs/accuracy.md)
+  --vdb              also write each float volume (q, T, T_sky) as an OpenVDB fog
+                     volume, <name>.vdb: voxel (i, j, k) at its centre in world
+                     units, every value not +0 an active voxel
   --steps N          number of steps (same as --set steps=N)
   --out DIR          output folder (default: out/<scene name>/dump)
   --set PATH=VALUE   override a scene field (see cloudbench help run)
@@ -67,6 +70,7 @@ Status WriteReferenceDump(const Simulation& sim, const std::string& dir, int thr
 // dump's own options (docs/cli.md).
 struct DumpOptions : OwnOptions {
     bool reference = false;  // --reference: also the exact (Embree) reference of each step
+    bool vdb = false;        // --vdb: also each float volume as an OpenVDB fog volume
 };
 
 Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOptions& options, const DumpOptions& own) {
@@ -79,7 +83,16 @@ Status WriteStep(const Simulation& s, const std::string& outDir, const CommonOpt
     for (Resource r : kAllResources) {
         if (!s.Get(r)) continue;
         if (!IsPerCamera(r)) {
-            CB_TRY(Session::WriteNpy(dir + "/" + std::string(ResourceDumpStem(r)) + ".npy", s.GetBackend(), *s.Get(r)));
+            const std::string stem = dir + "/" + std::string(ResourceDumpStem(r));
+            CB_TRY(Session::WriteNpy(stem + ".npy", s.GetBackend(), *s.Get(r)));
+            // The float volumes of the grid (not the 2-D maps D and G): also as OpenVDB.
+            const bool floatVolume = r == Resource::Q || r == Resource::T || r == Resource::TSky;
+            if (own.vdb && floatVolume) {
+                auto values = Download<float>(s.GetBackend(), *s.Get(r));
+                if (!values) return std::unexpected(values.error());
+                CB_TRY(WriteVdbVolume(stem + ".vdb", std::string(ResourceDumpStem(r)), *values, scene.grid.size,
+                                      scene.grid.origin, scene.grid.voxelSize));
+            }
             continue;
         }
         const Stage renderer = *ProducerOf(r, scene.stages);
@@ -136,7 +149,7 @@ const CommandRegistration kRegistration({
     .summary = "Write each step's canonical stage outputs as NumPy .npy files",
     .help = kHelp,
     .helpOrder = 1,
-    .extraOptions = {FlagOption("--reference", &DumpOptions::reference)},
+    .extraOptions = {FlagOption("--reference", &DumpOptions::reference), FlagOption("--vdb", &DumpOptions::vdb)},
     .makeOptions = MakeOwnOptions<DumpOptions>,
     .run = RunWith(Dump),
 });

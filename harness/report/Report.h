@@ -80,6 +80,11 @@ nlohmann::json TimingJson(const Scene& scene, const BackendRun& run);
 // with no sample after warm-up; each camera's frames) and the cover line.
 report::Section TimingSection(const Scene& scene, const BackendRun& run);
 
+// Writes a float volume (x fastest, extent `e`) as an OpenVDB file of one fog-volume grid named `name`, voxel
+// (i, j, k) at world `origin` + (i + 1/2, j + 1/2, k + 1/2) `voxelSize` (images::Module::writeVdb), atomically.
+Status WriteVdbVolume(const std::string& path, const std::string& name, const std::vector<float>& values,
+                      const Extent3& e, const std::array<double, 3>& origin, double voxelSize);
+
 // Writes D as a grey top view (x right, y up, white = densest column), 8-bit
 // PNG through the image module. `columnSum` is canonical D, nx*ny floats.
 Status WriteTopView(const std::string& path, const std::vector<float>& columnSum, uint32_t nx, uint32_t ny,

@@ -104,6 +104,19 @@ Status WriteDifferenceImage(const std::string& path, const std::vector<float>& r
     return WriteImage(path, difference.View(), /*eightBit=*/false);
 }
 
+Status WriteVdbVolume(const std::string& path, const std::string& name, const std::vector<float>& values,
+                      const Extent3& e, const std::array<double, 3>& origin, double voxelSize) {
+    auto module = ModuleToWrite(path);
+    if (!module) return std::unexpected(module.error());
+    images::VolumeView volume{e.nx,      e.ny,        e.nz, values.data(), {origin[0], origin[1], origin[2]},
+                              voxelSize, name.c_str()};
+    return Session::WriteAtomically(path, [&](const Session::TemporaryFile& temp) -> Status {
+        const std::string why = (*module)->writeVdb(temp.path, volume);
+        if (!why.empty()) return MakeError(path + ": cannot write: " + why);
+        return {};
+    });
+}
+
 Result<std::vector<std::string>> WriteFrame(const std::string& stem, const std::vector<float>& rgb, uint32_t width,
                                             uint32_t height, bool png, const std::optional<FrameToneMap>& toneMap) {
     std::vector<std::string> written;

@@ -1,5 +1,6 @@
-// The image operations that need OpenImageIO, in a module of their own
-// (libcloudbench_images.so) that the harness loads on first use.
+// The image operations that need OpenImageIO, and the OpenVDB volume writer, in
+// a module of their own (libcloudbench_images.so) that the harness loads on
+// first use.
 //
 // OpenImageIO brings about 260 shared libraries with it; loading them and
 // running their initialisers takes about 0.2 s of every process (measured on
@@ -22,7 +23,7 @@
 namespace cb::images {
 
 // Bumped whenever Module changes, so that a stale module is refused by name.
-inline constexpr int kModuleVersion = 2;
+inline constexpr int kModuleVersion = 3;
 
 // The file name of the module, beside the executable.
 inline constexpr const char* kModuleFileName = "libcloudbench_images.so";
@@ -42,6 +43,16 @@ struct FloatImage {
     std::vector<float> pixels;
     std::string colorSpace;
     ImageView View() const { return {width, height, channels, pixels.data(), colorSpace.c_str()}; }
+};
+
+// A float volume to write: nx * ny * nz values, x fastest, voxel (i, j, k) centred at world
+// origin + (i + 1/2, j + 1/2, k + 1/2) voxelSize.
+struct VolumeView {
+    unsigned nx = 0, ny = 0, nz = 0;
+    const float* values = nullptr;
+    double origin[3] = {0, 0, 0};
+    double voxelSize = 1;
+    const char* name = "";  // the grid's name
 };
 
 // OpenImageIO's ImageBufAlgo::compare of two images of one size.
@@ -69,6 +80,11 @@ struct Module {
     std::string (*linearToSrgb)(ImageView linear, FloatImage& srgb);
     // `image` as an 8-bit PNG file in memory.
     std::string (*encodePng)(ImageView image, std::string& bytes);
+    // `volume` as an OpenVDB file of one fog-volume float grid: background 0, every voxel whose value is not
+    // +0 (its bits) active with that value, so that reading every voxel back gives the values bit for bit;
+    // the index-to-world transform scales by voxelSize and translates by origin + voxelSize / 2. The file is
+    // read back and its active voxels counted.
+    std::string (*writeVdb)(const std::string& path, VolumeView volume);
 };
 
 // The module, opened on the first call and kept; an error names the file

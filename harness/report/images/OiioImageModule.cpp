@@ -1,16 +1,18 @@
 // libcloudbench_images.so: the operations of harness/report/images/ImageModule.h
-// through OpenImageIO. Nothing else in cloudbench includes OpenImageIO.
-#include <sys/mman.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
-
+// through OpenImageIO and OpenVDB. Nothing else in cloudbench includes either.
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <openvdb/openvdb.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <bit>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
 
 #include "harness/report/images/ImageModule.h"
 
@@ -133,7 +135,45 @@ std::string EncodePng(ImageView image, std::string& bytes) {
     return "";
 }
 
-const Module kModule{kModuleVersion, Write, Decode, Compare, Difference, LinearToSrgb, EncodePng};
+std::string WriteVdb(const std::string& path, VolumeView volume) {
+    try {
+        openvdb::initialize();
+        openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+        openvdb::FloatGrid::Accessor voxels = grid->getAccessor();
+        size_t active = 0;
+        for (unsigned k = 0; k < volume.nz; ++k)
+            for (unsigned j = 0; j < volume.ny; ++j)
+                for (unsigned i = 0; i < volume.nx; ++i) {
+                    const float value = volume.values[i + size_t(volume.nx) * (j + size_t(volume.ny) * k)];
+                    if (std::bit_cast<uint32_t>(value) == 0) continue;  // +0: the background
+                    voxels.setValue(openvdb::Coord(int(i), int(j), int(k)), value);
+                    ++active;
+                }
+        const double h = volume.voxelSize;
+        openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(h);
+        transform->postTranslate(
+            openvdb::Vec3d(volume.origin[0] + 0.5 * h, volume.origin[1] + 0.5 * h, volume.origin[2] + 0.5 * h));
+        grid->setTransform(transform);
+        grid->setName(volume.name);
+        grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+        openvdb::io::File file(path);
+        file.write({grid});
+        file.close();
+        // Read back: the grid is there, whole.
+        openvdb::io::File back(path);
+        back.open();
+        const openvdb::GridBase::Ptr read = back.readGrid(volume.name);
+        back.close();
+        if (!read || read->activeVoxelCount() != openvdb::Index64(active))
+            return "it does not read back whole (" + std::to_string(read ? read->activeVoxelCount() : 0) + " of " +
+                   std::to_string(active) + " voxels)";
+        return "";
+    } catch (const std::exception& e) {
+        return std::string("OpenVDB: ") + e.what();
+    }
+}
+
+const Module kModule{kModuleVersion, Write, Decode, Compare, Difference, LinearToSrgb, EncodePng, WriteVdb};
 
 }  // namespace
 }  // namespace cb::images
