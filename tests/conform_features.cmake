@@ -16,6 +16,11 @@ if(DEFINED conform_features_backend)
     set_tests_properties(Cli.ConformFeatures.${case} PROPERTIES PASS_REGULAR_EXPRESSION
                          "conform features ${case}: ok" TIMEOUT 300)
   endforeach()
+  # conform --junit, read back by Debian's python3-junitparser (skipped, 77, without it).
+  add_test(NAME Cli.ConformJUnit
+           COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_junit.py ${cli} ${cli_out}/conform-junit
+                   ${conform_features_backend})
+  set_tests_properties(Cli.ConformJUnit PROPERTIES PASS_REGULAR_EXPRESSION "junit: ok" SKIP_RETURN_CODE 77 TIMEOUT 300)
 endif()
 # ci-small-wind (a 3x2 wind grid of distinct, asymmetric vectors) on every built
 # backend, with the Khronos validation layer on; exit 4 (no backend besides the CPU could start) is a skip.

@@ -42,6 +42,9 @@ Options:
   --baseline FILE    known failures, "stage,backend,status" a line (a conform.csv
                      will do): a listed failure is expected-fail and does not fail
                      the command; a listed row that passes is unexpected-pass (exit 5)
+  --junit FILE       also write the rows as JUnit XML for a CI system: a test
+                     case per stage x backend (x case), failures with the worst
+                     difference, the tolerance and the rule
   --flake-reruns N   rerun a backend with a failing row up to N times (its whole
                      comparison); a row that then passes is flaky, not a failure
   --matrix           compare over the built-in option set, one option at a time
@@ -115,6 +118,7 @@ struct ConformOptions : OwnOptions {
     uint32_t flakeReruns = 0;       // --flake-reruns N
     bool matrix = false;            // --matrix: the stages' choice settings (harness/conform/ConformMatrix.h)
     std::vector<std::string> vary;  // --vary PATH=V1,V2,...
+    std::string junit;              // --junit FILE: the rows as JUnit XML
 };
 
 int Conform(const CommonOptions& options, const ConformOptions& own) {
@@ -319,7 +323,14 @@ int Conform(const CommonOptions& options, const ConformOptions& own) {
         std::fprintf(stderr, "%s\n", s.error().message.c_str());
         return kExitFailed;
     }
-    std::printf("results: %s, %s\n", path.c_str(), csvPath.c_str());
+    if (!own.junit.empty()) {
+        if (Status s = Session::WriteText(own.junit, ConformJUnit(rows, scene.name)); !s) {
+            std::fprintf(stderr, "%s\n", s.error().message.c_str());
+            return kExitFailed;
+        }
+    }
+    std::printf("results: %s, %s%s\n", path.c_str(), csvPath.c_str(),
+                own.junit.empty() ? "" : (", " + own.junit).c_str());
     std::printf("conform: %s\n", ConformSummary(rows).c_str());
     return ConformExitCode(rows);
 }
@@ -331,6 +342,7 @@ const CommandRegistration kRegistration({
     .helpOrder = 2,
     .extraOptions = WithIsolationOptions({
         TextOption("--baseline", &ConformOptions::baseline, "--baseline needs a file of known failures"),
+        TextOption("--junit", &ConformOptions::junit, "--junit needs a file to write"),
         FlagOption("--matrix", &ConformOptions::matrix),
         ListOption("--vary", &ConformOptions::vary, "--vary needs PATH=V1,V2,..., e.g. --vary smooth.radius=0,2"),
         OwnOption<ConformOptions>("--flake-reruns", true,

@@ -100,6 +100,13 @@ std::string ConformSummary(const std::vector<ConformRow>& rows);
 // row has a case (--matrix), every row starts with its case: case,stage,...
 std::string ConformCsv(const std::vector<ConformRow>& rows);
 
+// conform --junit: JUnit XML for CI systems, one testsuite `suite` ("conform SCENE") and one testcase per row,
+// named by its stage, classname "SCENE.BACKEND" (with the case: "SCENE.CASE.BACKEND"). fail and
+// unexpected-pass are <failure> (the message names the worst difference, the tolerance and the rule; the text
+// holds the detail), failed (the backend broke or crashed) is <error>, skipped and expected-fail are
+// <skipped> with the reason, pass and flaky pass (flaky with a <system-out> that says which attempt passed).
+std::string ConformJUnit(const std::vector<ConformRow>& rows, const std::string& scene);
+
 // stage x backend: result, rule, worst error and where, as `conform` prints it
 // (a first column "case" when a row has one).
 report::Table ConformTable(const std::vector<ConformRow>& rows);
