@@ -196,4 +196,24 @@ if CASE == "slowdown":
             print(f"FAIL: report {source}: exit {r.returncode}; the page must mark {PLANTED_STAGE} alone with + and "
                   f"give exit code 6; rows marked +: {flagged}\n{r.stderr}")
             sys.exit(1)
+    # --junit on the kept folder: a test case per time and count comparison, the planted stage the one failure,
+    # read back by Debian's python3-junitparser where it is installed.
+    junit = os.path.join(WORK, "compare.xml")
+    r = compare(kept, "--junit", junit)
+    try:
+        from junitparser import Failure, JUnitXml
+    except ImportError:
+        JUnitXml = None
+    if r.returncode != 6:
+        print(f"FAIL: perf compare {kept} --junit: exit {r.returncode}\n{r.stderr}")
+        sys.exit(1)
+    if JUnitXml is not None:
+        suite = next(iter(JUnitXml.fromfile(junit)))
+        failed = [(c.classname, c.name, c.result[0].message) for c in suite
+                  if any(isinstance(x, Failure) for x in c.result)]
+        if suite.tests != len(doc["comparisons"]) or len(failed) != 1 or failed[0][:2] != ("ci-small.cpu",
+                                                                                              PLANTED_STAGE) or \
+                "threshold" not in failed[0][2]:
+            print(f"FAIL: --junit: {suite.tests} cases for {len(doc['comparisons'])} comparisons, failures {failed}")
+            sys.exit(1)
 print(f"perf gate {CASE}: ok")

@@ -73,6 +73,9 @@ compare  compares stage times run by run, each run's median step (a
   --instruction-threshold F  an instruction count regresses above 1 + F
                   (default 0.02)
   --json FILE     also write every comparison as JSON
+  --junit FILE    also write them as JUnit XML for a CI system: a test case
+                  per stage x backend, a regression a failure, a stage that
+                  cannot be judged skipped with the reason
 history  marks step changes in each stage's time over the records (binary
          segmentation, permutation test at p <= A / series, --alpha A default
          0.01) and what changed in the provenance; --json gives each series'

@@ -21,7 +21,9 @@
 #include "core/scene/Stage.h"
 #include "harness/commands/PerfCommon.h"
 #include "harness/platform/OutputFolder.h"
+#include "harness/report/JUnit.h"
 #include "harness/report/ReportModel.h"
+#include "harness/run/Session.h"
 
 namespace cb::perf_command {
 namespace {
@@ -97,11 +99,41 @@ json FailedRunJson(const perf::FailedRun& run) {
         {"side", run.side}, {"scene", run.scene}, {"round", run.round}, {"exit", run.exit}, {"compared", run.compared}};
 }
 
+// --junit: a test case per comparison (SCENE.BACKEND, the stage; "STAGE instructions" for a count): a regression
+// is a failure naming the ratio, its interval, the threshold and the adjusted p, a row that cannot be judged ('?')
+// is skipped with the note, a stage that failed or is missing in HEAD ('x') is an error.
+std::string CompareJUnit(const perf::CompareOutcome& outcome, const std::string& base, const std::string& head) {
+    std::vector<JUnitCase> cases;
+    char text[256];
+    for (const perf::Comparison& c : outcome.rows) {
+        JUnitCase j{c.scene + "." + c.backend, c.stage + (c.metric == "time" ? "" : " " + c.metric)};
+        if (c.regression) {
+            std::snprintf(text, sizeof text,
+                          "%s slower: ratio %.4g (95 %% interval %.4g to %.4g) above the threshold %.4g, Holm p %.3g",
+                          c.metric == "time" ? "HEAD is" : "HEAD's count is", c.ratio, c.interval.low, c.interval.high,
+                          c.threshold, c.pSlowerHolm);
+            j.result = JUnitCase::Result::Failure;
+            j.type = "regression";
+            j.message = text;
+            j.text = c.note;
+        } else if (c.mark == '?') {
+            j.result = JUnitCase::Result::Skipped;
+            j.message = "cannot be judged: " + c.note;
+        } else if (c.mark == 'x') {
+            j.result = JUnitCase::Result::Error;
+            j.type = "head-failed";
+            j.message = c.note.empty() ? "failed or missing in HEAD" : c.note;
+        }
+        cases.push_back(std::move(j));
+    }
+    return JUnitXml("cloudbench perf compare", "perf compare " + base + " -> " + head, cases);
+}
+
 // Prints the comparison, writes the JSON to each of `jsonPaths` (--json, a kept folder's compare.json), returns
 // the exit code: 6 for a regression, else 1 when HEAD failed, a run failed or the runs were cut short, else 0.
 // Each failed run gets a line on stderr.
 int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::CompareSettings& settings,
-                    const std::string& mode, const std::vector<std::string>& jsonPaths,
+                    const std::string& mode, const std::vector<std::string>& jsonPaths, const std::string& junitPath,
                     const RunProblems& problems = {}) {
     const perf::CompareOutcome outcome = perf::Compare(base, head, settings);
     report::Report rep("perf compare");
@@ -208,6 +240,12 @@ int PrintComparison(const perf::Side& base, const perf::Side& head, const perf::
         if (problems.plant) doc["plant"] = {{"stage", problems.plant->stage}, {"factor", problems.plant->factor}};
         for (const std::string& path : jsonPaths)
             if (!WriteJsonFile(path, doc) && code == kExitOk) code = kExitFailed;
+    }
+    if (!junitPath.empty()) {
+        if (Status s = Session::WriteText(junitPath, CompareJUnit(outcome, base.label, head.label)); !s) {
+            std::fprintf(stderr, "%s\n", s.error().message.c_str());
+            if (code == kExitOk) code = kExitFailed;
+        }
     }
     return code;
 }
@@ -343,7 +381,7 @@ std::optional<std::string> ParsePlant(const ParsedArgs& a, std::optional<perf::P
 // `perf compare FOLDER`: the verdict again from a kept interleave's runs, with the exit code the live
 // command ended with for the same runs.
 int CompareKept(const std::string& folder, perf::CompareSettings settings, perf::Clock clock,
-                const std::string& jsonPath) {
+                const std::string& jsonPath, const std::string& junitPath) {
     auto kept = perf::LoadInterleave(folder, clock);
     if (!kept) {
         std::fprintf(stderr, "%s\n", kept.error().message.c_str());
@@ -359,7 +397,7 @@ int CompareKept(const std::string& folder, perf::CompareSettings settings, perf:
     settings.interleaved = true;
     const int code = PrintComparison(kept->sides[0], kept->sides[1], settings,
                                      InterleavedMode(kept->rounds, kept->order) + ", kept in " + folder,
-                                     JsonPaths(jsonPath), problems);
+                                     JsonPaths(jsonPath), junitPath, problems);
     WarnIfLoaded(kept->peakLoad, clock);
     return code;
 }
@@ -368,11 +406,11 @@ int CompareKept(const std::string& folder, perf::CompareSettings settings, perf:
 
 int ComparePerf(const std::vector<std::string>& args) {
     ParsedArgs a;
-    if (auto m = Parse(args,
-                       {"--threshold", "--separate-threshold", "--floor", "--alpha", "--instruction-threshold",
-                        "--json", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile", "--clock",
-                        "--plant"},
-                       {"--interleave", "--quiet"}, a))
+    if (auto m = Parse(
+            args,
+            {"--threshold", "--separate-threshold", "--floor", "--alpha", "--instruction-threshold", "--json",
+             "--junit", "--rounds", "--backend", "--steps", "--set", "--keep", "--run-quantile", "--clock", "--plant"},
+            {"--interleave", "--quiet"}, a))
         return Usage(*m);
     perf::CompareSettings settings;
     // --threshold R sets the default; --threshold BACKEND=R that backend's own.
@@ -408,11 +446,12 @@ int ComparePerf(const std::vector<std::string>& args) {
         clock = name == "cpu" ? perf::Clock::Cpu : perf::Clock::Wall;
     }
     const std::string jsonPath = a.Value("--json");
+    const std::string junitPath = a.Value("--junit");
     if (!a.Has("--interleave")) {
         for (const char* o : {"--rounds", "--backend", "--steps", "--set", "--keep", "--plant"})
             if (a.Has(o)) return Usage(std::string(o) + " is for perf compare --interleave");
         if (a.positional.size() == 1 && std::filesystem::is_directory(a.positional[0]))
-            return CompareKept(a.positional[0], settings, clock, jsonPath);
+            return CompareKept(a.positional[0], settings, clock, jsonPath, junitPath);
         if (a.positional.size() != 2)
             return Usage("perf compare needs BASE and HEAD, or the FOLDER of a kept interleave");
         perf::Side sides[2];
@@ -431,7 +470,7 @@ int ComparePerf(const std::vector<std::string>& args) {
                          "but the file with itself\n",
                          ShownArgument(a.positional[0]).c_str());
         settings.interleaved = false;
-        return PrintComparison(sides[0], sides[1], settings, "separate files", JsonPaths(jsonPath));
+        return PrintComparison(sides[0], sides[1], settings, "separate files", JsonPaths(jsonPath), junitPath);
     }
     if (a.positional.size() < 3) return Usage("perf compare --interleave needs BASE_BINARY HEAD_BINARY SCENE...");
     // Without --rounds, the rounds follow from the first: as many as every time comparison needs to be judged.
@@ -528,7 +567,7 @@ int ComparePerf(const std::vector<std::string>& args) {
     settings.interleaved = true;
     const int code = PrintComparison(sides[0], sides[1], settings, InterleavedMode(int(rounds), "random"),
                                      JsonPaths(jsonPath, a.Has("--keep") ? folder + "/" + perf::kKeptVerdictFile : ""),
-                                     problems);
+                                     junitPath, problems);
     WarnIfLoaded(peakLoad, clock);
     return code;
 }

@@ -8,14 +8,15 @@
 #include <cstring>
 #include <sstream>
 
-#include "core/base/PathPolicy.h"
 #include "core/base/NamedValues.h"
+#include "core/base/PathPolicy.h"
 #include "core/base/ShownText.h"
 #include "core/math/Shading.h"
 #include "core/scene/SceneNames.h"
 #include "harness/conform/Conform.h"
 #include "harness/platform/Command.h"
 #include "harness/platform/TransferJson.h"
+#include "harness/report/JUnit.h"
 
 namespace cb {
 namespace {
@@ -338,79 +339,31 @@ std::string ConformCsv(const std::vector<ConformRow>& rows) {
     return csv;
 }
 
-namespace {
-
-// Text for an XML attribute or element: the five markup characters as entities, other control characters
-// (which XML 1.0 does not allow) as U+FFFD's UTF-8.
-std::string XmlText(std::string_view text) {
-    std::string out;
-    for (const char c : text) {
-        switch (c) {
-            case '&':
-                out += "&amp;";
-                break;
-            case '<':
-                out += "&lt;";
-                break;
-            case '>':
-                out += "&gt;";
-                break;
-            case '"':
-                out += "&quot;";
-                break;
-            case '\'':
-                out += "&apos;";
-                break;
-            default:
-                if ((unsigned char)c < 0x20 && c != '\n' && c != '\t' && c != '\r')
-                    out += "\xEF\xBF\xBD";
-                else
-                    out += c;
-        }
-    }
-    return out;
-}
-
-}  // namespace
-
 std::string ConformJUnit(const std::vector<ConformRow>& rows, const std::string& scene) {
-    size_t failures = 0, errors = 0, skipped = 0;
-    std::string cases;
-    char number[64];
+    std::vector<JUnitCase> cases;
+    char numbers[96];
     for (const ConformRow& r : rows) {
-        const std::string classname = scene + (r.caseName.empty() ? "" : "." + r.caseName) + "." + r.backend;
-        cases += "    <testcase classname=\"" + XmlText(classname) + "\" name=\"" + XmlText(r.stage) + "\"";
-        if (r.status == "pass") {
-            cases += "/>\n";
-            continue;
-        }
-        cases += ">\n";
+        JUnitCase c{scene + (r.caseName.empty() ? "" : "." + r.caseName) + "." + r.backend, r.stage};
         if (r.status == "fail" || r.status == "unexpected-pass") {
-            ++failures;
-            std::snprintf(number, sizeof number, "worst %.9g, tolerance %.9g", r.worst, r.tolerance);
-            const std::string message =
-                std::string(r.status == "fail" ? "" : "listed as a known failure, but passes: ") + number + " (" +
-                r.rule + ")";
-            cases += "      <failure type=\"" + XmlText(r.status) + "\" message=\"" + XmlText(message) + "\">" +
-                     XmlText(r.detail) + "</failure>\n";
+            std::snprintf(numbers, sizeof numbers, "worst %.9g, tolerance %.9g", r.worst, r.tolerance);
+            c.result = JUnitCase::Result::Failure;
+            c.type = r.status;
+            c.message = std::string(r.status == "fail" ? "" : "listed as a known failure, but passes: ") + numbers +
+                        " (" + r.rule + ")";
+            c.text = r.detail;
         } else if (r.status == "failed") {
-            ++errors;
-            cases += "      <error type=\"failed\" message=\"" + XmlText(r.detail) + "\"/>\n";
+            c.result = JUnitCase::Result::Error;
+            c.type = "failed";
+            c.message = r.detail;
         } else if (r.status == "skipped" || r.status == "expected-fail") {
-            ++skipped;
-            const std::string why = r.status == "skipped" ? r.detail : "a known failure (--baseline): " + r.detail;
-            cases += "      <skipped message=\"" + XmlText(why) + "\"/>\n";
-        } else {  // flaky: passed on a rerun
-            cases += "      <system-out>" + XmlText(r.status + ": " + r.detail) + "</system-out>\n";
+            c.result = JUnitCase::Result::Skipped;
+            c.message = r.status == "skipped" ? r.detail : "a known failure (--baseline): " + r.detail;
+        } else if (r.status != "pass") {  // flaky: passed on a rerun
+            c.text = r.status + ": " + r.detail;
         }
-        cases += "    </testcase>\n";
+        cases.push_back(std::move(c));
     }
-    const std::string counts = "tests=\"" + std::to_string(rows.size()) + "\" failures=\"" + std::to_string(failures) +
-                               "\" errors=\"" + std::to_string(errors) + "\" skipped=\"" + std::to_string(skipped) +
-                               "\"";
-    return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"cloudbench conform\" " + counts +
-           ">\n  <testsuite name=\"" + XmlText("conform " + scene) + "\" " + counts + ">\n" + cases +
-           "  </testsuite>\n</testsuites>\n";
+    return JUnitXml("cloudbench conform", "conform " + scene, cases);
 }
 
 }  // namespace cb
