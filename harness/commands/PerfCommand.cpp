@@ -35,7 +35,7 @@ record   runs the suite (default: thesis-low, thesis-medium, thesis-high, each a
          with --repeat 3 and keep at least 8 records on each side of a step
          (docs/cli.md, "perf record"). It also counts each scene's CPU
          instructions (`cloudbench count`) when this build can (no
-         -march=native: the exact preset; valgrind installed), else the
+         -march=native, as by default; valgrind installed), else the
          record's "instructions_not_counted" says why; --instructions FILE
          merges a `cloudbench count` output instead.
 compare  compares stage times run by run, each run's median step (a
