@@ -107,6 +107,8 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
         const auto a = hn::Add(hn::Div(hn::Sub(hn::Add(hn::ConvertTo(d, column), half), vpx), vsize), half);
         const auto c = hn::Sub(hn::Mul(two, a), one);
         const auto xx = hn::Mul(c, c);
+        // A block wholly inside the splat stores its blend as it is; an edge block keeps its outside lanes.
+        const bool whole = hn::AllTrue(d, inside);
         for (int32_t y = y0; y <= y1; ++y) {
             const auto u = hn::Sub(one, hn::Add(xx, hn::Set(d, yy[y - y0])));
             const auto t = MaxOfZeroAnd(zero, u);
@@ -115,9 +117,12 @@ inline void SplatCpuBlend(const Splat& s, int32_t y0, int32_t y1, uint32_t rowLo
             const auto keep = hn::Sub(one, alpha);
             const size_t o = stride * uint32_t(y - int32_t(rowLo)) + uint32_t(xb);
             const auto r = hn::Load(d, R + o), g = hn::Load(d, G + o), b = hn::Load(d, B + o);
-            hn::Store(hn::IfThenElse(inside, hn::Add(hn::Mul(r, keep), hn::Mul(cr, alpha)), r), d, R + o);
-            hn::Store(hn::IfThenElse(inside, hn::Add(hn::Mul(g, keep), hn::Mul(cg, alpha)), g), d, G + o);
-            hn::Store(hn::IfThenElse(inside, hn::Add(hn::Mul(b, keep), hn::Mul(cb, alpha)), b), d, B + o);
+            const auto nr = hn::Add(hn::Mul(r, keep), hn::Mul(cr, alpha));
+            const auto ng = hn::Add(hn::Mul(g, keep), hn::Mul(cg, alpha));
+            const auto nb = hn::Add(hn::Mul(b, keep), hn::Mul(cb, alpha));
+            hn::Store(whole ? nr : hn::IfThenElse(inside, nr, r), d, R + o);
+            hn::Store(whole ? ng : hn::IfThenElse(inside, ng, g), d, G + o);
+            hn::Store(whole ? nb : hn::IfThenElse(inside, nb, b), d, B + o);
         }
     }
 }
