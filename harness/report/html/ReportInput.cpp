@@ -12,6 +12,7 @@
 #include "core/base/ShownText.h"
 #include "harness/perf/Compare.h"
 #include "harness/report/InputFormats.h"
+#include "harness/report/ReportModel.h"
 #include "harness/report/html/ReportJson.h"
 
 namespace cb::html {

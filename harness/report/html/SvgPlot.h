@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "harness/report/XmlText.h"
+
 namespace cb::html {
 
 // A plot axis: the data range [lo, hi] shown, widened to round numbers, and
@@ -87,8 +89,5 @@ std::string RenderParetoPlot(const ScatterPlot& plot);
 // The points of `points` that no other point beats in both coordinates
 // (smaller x and smaller y, one of them strictly), sorted by x.
 std::vector<std::pair<double, double>> ParetoFront(std::vector<std::pair<double, double>> points);
-
-// `text` with &, <, >, " and ' replaced by entities, for HTML and SVG text and attributes.
-std::string EscapeXml(const std::string& text);
 
 }  // namespace cb::html
