@@ -21,24 +21,22 @@ fs::path Installed(const char* relative) {
     return folder.empty() ? fs::path() : folder.parent_path() / relative;
 }
 
+// The installed folder `relative` when this executable has one, else the build tree's `buildTree`.
+std::string InstalledFolderOr(const char* relative, const char* buildTree) {
+    std::error_code error;
+    if (const fs::path installed = Installed(relative); !installed.empty() && fs::is_directory(installed, error))
+        return installed.string();
+    return buildTree;
+}
+
 }  // namespace
 
 std::string SceneFolder() {
     if (const char* env = std::getenv("CLOUDBENCH_SCENES")) return env;
-    std::error_code error;
-    if (const fs::path installed = Installed(CLOUDBENCH_INSTALL_SCENES_DIR);
-        !installed.empty() && fs::is_directory(installed, error))
-        return installed.string();
-    return CLOUDBENCH_SCENES_DIR;
+    return InstalledFolderOr(CLOUDBENCH_INSTALL_SCENES_DIR, CLOUDBENCH_SCENES_DIR);
 }
 
-std::string ToolsFolder() {
-    std::error_code error;
-    if (const fs::path installed = Installed(CLOUDBENCH_INSTALL_TOOLS_DIR);
-        !installed.empty() && fs::is_directory(installed, error))
-        return installed.string();
-    return CLOUDBENCH_TOOLS_DIR;
-}
+std::string ToolsFolder() { return InstalledFolderOr(CLOUDBENCH_INSTALL_TOOLS_DIR, CLOUDBENCH_TOOLS_DIR); }
 
 std::vector<std::string> ModuleCandidates(std::string_view fileName) {
     std::vector<std::string> candidates;

@@ -11,9 +11,6 @@
 namespace cb {
 namespace {
 
-// Rows on one front: a stage's own, and every renderer's together (their images answer to one reference).
-bool SameParetoFront(Stage a, Stage b) { return a == b || (Describe(a).renderer && Describe(b).renderer); }
-
 bool SweepClearlyFaster(const Row& a, const Row& b) { return a.result.timeMs.q3 < b.result.timeMs.q1; }
 
 bool SweepOnFront(const Row& r, std::string_view metric) {
@@ -30,6 +27,8 @@ std::string PrintedError(const Row& r, std::string_view metric) {
 }
 
 }  // namespace
+
+bool SameParetoFront(Stage a, Stage b) { return a == b || (Describe(a).renderer && Describe(b).renderer); }
 
 bool IsSweepMetric(std::string_view metric) {
     return metric == "max" || metric == "mean" || metric == "p99" || metric == "psnr";

@@ -14,6 +14,9 @@ namespace cb {
 // The error metrics a sweep's front may use: max, mean and p99 of |error| (lower is better) and psnr (the
 // renderers' images only; higher is better).
 bool IsSweepMetric(std::string_view metric);
+// Whether rows of stages `a` and `b` share a front: a stage's own, and every renderer's together (their images
+// answer to one reference).
+bool SameParetoFront(Stage a, Stage b);
 // Whether `metric` is defined for a row of `stage` (psnr: renderers only).
 bool MetricApplies(std::string_view metric, Stage stage);
 

@@ -154,16 +154,15 @@ void PrintFastestWithin(const std::vector<Row>& rows, const std::string& metric,
                         const std::vector<const Row*>& fastest) {
     const std::string bound = metric == "psnr" ? "PSNR >= " + html::Fixed(within) + " dB"
                                                : metric + " |error| <= " + html::Fixed(within, "%.6g");
-    auto sameFront = [](Stage a, Stage b) { return a == b || (Describe(a).renderer && Describe(b).renderer); };
     std::vector<std::pair<Stage, std::string>> fronts;
     for (const Row& r : rows)
         if (r.result.status == "ok" && MetricApplies(metric, r.stage) &&
-            std::ranges::none_of(fronts,
-                                 [&](const auto& f) { return f.second == r.backend && sameFront(f.first, r.stage); }))
+            std::ranges::none_of(
+                fronts, [&](const auto& f) { return f.second == r.backend && SameParetoFront(f.first, r.stage); }))
             fronts.push_back({r.stage, r.backend});
     for (const auto& [stage, backend] : fronts) {
         const auto pick = std::ranges::find_if(
-            fastest, [&](const Row* f) { return f->backend == backend && sameFront(f->stage, stage); });
+            fastest, [&](const Row* f) { return f->backend == backend && SameParetoFront(f->stage, stage); });
         const std::string front = Describe(stage).renderer ? "the renderers" : std::string(StageName(stage));
         if (pick == fastest.end()) {
             std::printf("fastest within %s: %s on %s: none\n", bound.c_str(), front.c_str(), backend.c_str());
