@@ -20,57 +20,13 @@
 
 #include "core/math/March.h"
 #include "impl_cpu/BackendCpu.h"
+#include "impl_cpu/MarchLanesCpu-inl.h"
 #include "impl_cpu/PaddedVolumeCpu-inl.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace cb::cpu::HWY_NAMESPACE {
 namespace {
-
-// Trilinear reads of the padded (q, T) volume; p in voxel units (wrapped with
-// tiling, MarchWrapped) is clamped to the box [0, n], where the padded taps
-// (p + 0.5 floored, and +1) stay inside.
-struct MarchPaddedVolume {
-    const MarchQT* v = nullptr;
-    const float* sky = nullptr;  // T_sky's padded volume (the sky light on)
-    size_t px = 0, pxy = 0;  // padded row and slice strides
-    const MarchSetup* setup = nullptr;  // the box (size) and the tiling's wrap
-
-    struct Taps {
-        size_t base;
-        float wx, wy, wz;
-    };
-    Taps TapsAt(const Vec3& point) const {
-        const Vec3 p = MarchWrapped(*setup, point);
-        const Vec3& size = setup->size;
-        const float cx = std::clamp(p[0], 0.0f, size[0]) + 0.5f;
-        const float cy = std::clamp(p[1], 0.0f, size[1]) + 0.5f;
-        const float cz = std::clamp(p[2], 0.0f, size[2]) + 0.5f;
-        const size_t i = size_t(cx), j = size_t(cy), k = size_t(cz);
-        return {i + px * j + pxy * k, cx - float(i), cy - float(j), cz - float(k)};
-    }
-    template <float MarchQT::*Field>
-    float Blend(const Taps& t) const {
-        const MarchQT* a = v + t.base;
-        const MarchQT* b = a + pxy;
-        const float c00 = Lerp(a[0].*Field, a[1].*Field, t.wx);
-        const float c10 = Lerp(a[px].*Field, a[px + 1].*Field, t.wx);
-        const float c01 = Lerp(b[0].*Field, b[1].*Field, t.wx);
-        const float c11 = Lerp(b[px].*Field, b[px + 1].*Field, t.wx);
-        return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
-    }
-    float Q(const Vec3& p) const { return Blend<&MarchQT::q>(TapsAt(p)); }
-    // T_sky at the taps, blended as Blend blends a field.
-    float SkyT(const Taps& t) const {
-        const float* a = sky + t.base;
-        const float* b = a + pxy;
-        const float c00 = Lerp(a[0], a[1], t.wx);
-        const float c10 = Lerp(a[px], a[px + 1], t.wx);
-        const float c01 = Lerp(b[0], b[1], t.wx);
-        const float c11 = Lerp(b[px], b[px + 1], t.wx);
-        return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
-    }
-};
 
 // The main march's density functor: keeps the taps of its last sample so that
 // the shade light source reads T there without recomputing them.
@@ -85,14 +41,46 @@ struct MarchCachedDensity {
     float LastSkyT() const { return volume->SkyT(last); }
 };
 
+// Writes pixel (x, y) from its march's L and T_view: C = L + T_view background, the background the scene's colour
+// or, with the ground G, the ground where the pixel's ray meets it (core/math/Ground.h).
+class MarchPixelWriter {
+  public:
+    MarchPixelWriter(const MarchParams& params, float* image, const float* G, const Extent3& grid)
+        : params_(params),
+          image_(image),
+          G_(G),
+          grid_(grid),
+          groundLight_(MakeGroundLight(params)),
+          eyeVoxel_(GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize)) {}
+    void operator()(uint32_t x, uint32_t y, const Vec3& light, float transmittance) const {
+        float* out = image_ + 3 * (size_t(x) + size_t(params_.camera.width) * y);
+        const Vec3 bg = G_ ? GroundBackground(params_.camera, eyeVoxel_, params_.setup.voxelSize, groundLight_, G_,
+                                              grid_.nx, grid_.ny, x, y)
+                           : params_.setup.background;
+        for (int c = 0; c < 3; ++c) out[c] = light[c] + transmittance * bg[c];
+    }
+
+  private:
+    const MarchParams& params_;
+    float* image_;
+    const float* G_;
+    Extent3 grid_;
+    GroundLight groundLight_;
+    Vec3 eyeVoxel_;
+};
+
+// Pixel (x, y)'s ray and its jitter xi.
+inline MarchRayGeometry PixelRay(const MarchParams& params, uint32_t x, uint32_t y, float& xi) {
+    xi = params.jitter ? MarchJitter(params.seed, params.frame, x + params.camera.width * y) : 0.5f;
+    return MakePixelRay(params.camera, params.origin, params.setup.voxelSize, params.setup.size, x, y,
+                        params.setup.tiling);
+}
+
+// Every pixel through MarchRay, one ray at a time, TBB over 8 x 8 pixel tiles.
 template <class Light>
-void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks, float* image,
-                 MarchStats& stats, const float* G, const Extent3& grid, Light&& makeLight) {
-    // The ground (core/math/Ground.h): with G, each pixel's background where its ray meets the plane.
-    const GroundLight groundLight = MakeGroundLight(params);
-    const Vec3 eyeVoxel = GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize);
-    const CameraFrame& cam = params.camera;
-    const uint32_t W = cam.width, H = cam.height;
+void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks,
+                 const MarchPixelWriter& write, MarchStats& stats, Light&& makeLight) {
+    const uint32_t W = params.camera.width, H = params.camera.height;
     std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0};
     // flatten: MarchRay and what it calls (core/math, compiled for the baseline
     // where they are not inlined) become this target's code.
@@ -104,21 +92,10 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
             auto light = makeLight(density);
             for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
                 for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
-                    const MarchRayGeometry ray = MakePixelRay(cam, params.origin, params.setup.voxelSize,
-                                                              params.setup.size, x, y, params.setup.tiling);
-                    const uint32_t pixel = x + W * y;
-                    const float xi = params.jitter ? MarchJitter(params.seed, params.frame, pixel) : 0.5f;
+                    float xi;
+                    const MarchRayGeometry ray = PixelRay(params, x, y, xi);
                     const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
-                    float* out = image + 3 * size_t(pixel);
-                    if (G) {
-                        const Vec3 bg = GroundBackground(cam, eyeVoxel, params.setup.voxelSize, groundLight, G, grid.nx,
-                                                         grid.ny, x, y);
-                        for (int c = 0; c < 3; ++c) out[c] = m.light[c] + m.transmittance * bg[c];
-                    } else {
-                        out[0] = m.color[0];
-                        out[1] = m.color[1];
-                        out[2] = m.color[2];
-                    }
+                    write(x, y, m.light, m.transmittance);
                     nRays += ray.Empty() ? 0 : 1;
                     nSamples += m.samples;
                     nLight += m.lightCalls;
@@ -133,8 +110,50 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
     stats.samples = samples;
     stats.lightSamples = lightSamples;
     stats.bricksSkipped = skipped;
+}
+
+#if HWY_TARGET != HWY_SCALAR
+// Every pixel through MarchLanes (impl_cpu/MarchLanesCpu-inl.h), a packet of rays per 16 x 16 pixel tile.
+void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volume, const MarchLaneVolume& lanes,
+                        const MarchPixelWriter& write, MarchStats& stats) {
+    const uint32_t W = params.camera.width, H = params.camera.height;
+    const bool shadeLight = params.light == MarchLightSource::Shade;
+    std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0}, laneSteps{0}, packetSteps{0};
+    tbb::parallel_for(
+        tbb::blocked_range2d<uint32_t>(0, H, 16, 0, W, 16), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
+                                                                flatten)) {
+            const hn::ScalableTag<float> d;
+            MarchLanes march(d, params.setup, lanes, lanes.brickEmpty != nullptr, shadeLight, params.lightSteps,
+                             volume);
+            uint32_t x = r.cols().begin(), y = r.rows().begin();
+            auto next = [&](MarchRayGeometry& ray, float& xi, uint32_t& pixel) {
+                if (y >= r.rows().end()) return false;
+                ray = PixelRay(params, x, y, xi);
+                pixel = x + W * y;
+                if (++x == r.cols().end()) x = r.cols().begin(), ++y;
+                return true;
+            };
+            auto finish = [&](uint32_t pixel, const Vec3& light, float transmittance) {
+                write(pixel % W, pixel / W, light, transmittance);
+            };
+            MarchLaneCounters c;
+            march.Run(next, finish, c);
+            rays += c.rays;
+            samples += c.samples;
+            lightSamples += c.lightCalls;
+            skipped += c.bricksSkipped;
+            laneSteps += c.laneSteps;
+            packetSteps += c.packetSteps;
+        });
+    stats.rays = rays;
+    stats.samples = samples;
+    stats.lightSamples = lightSamples;
+    stats.bricksSkipped = skipped;
+    stats.laneSteps = laneSteps;
+    stats.laneSlots = packetSteps;
     (void)H;
 }
+#endif
 
 }  // namespace
 
@@ -175,8 +194,10 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
         if (skyLight) FormPaddedVolume(state.skyVolume, e, wrap, 1.0f, [&](size_t v) { return skyT[v]; });
         // 2. Bricks: empty iff q_alpha = 0 over the brick grown by one voxel (padded indices b B .. (b+1) B + 1).
         MarchBricks bricks;
+        const size_t brickCount = size_t(bx) * by * bz;
         if (params.skipping) {
-            state.bricks.assign(size_t(bx) * by * bz, 0);
+            // Three bytes past the last brick: the lanes read a brick's byte with a 32-bit gather.
+            state.bricks.assign(brickCount + 3, 0);
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, bz), [&](const tbb::blocked_range<uint32_t>& r) {
                 for (uint32_t c = r.begin(); c < r.end(); ++c)
                     for (uint32_t b = 0; b < by; ++b)
@@ -200,8 +221,9 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
             bricks.count[0] = bx;
             bricks.count[1] = by;
             bricks.count[2] = bz;
-            local.bricks = state.bricks.size();
-            local.emptyBricks = uint64_t(std::count(state.bricks.begin(), state.bricks.end(), uint8_t(1)));
+            local.bricks = brickCount;
+            local.emptyBricks =
+                uint64_t(std::count(state.bricks.begin(), state.bricks.begin() + brickCount, uint8_t(1)));
         }
         // 3. The rays.
         const MarchPaddedVolume volume{state.volume.data(), skyLight ? state.skyVolume.data() : nullptr, px, px * py,
@@ -209,9 +231,26 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
         const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
         const MarchSetup& s = params.setup;
         const uint32_t nl = params.lightSteps;
+        const MarchPixelWriter write(params, out, G, e);
+#if HWY_TARGET != HWY_SCALAR
+        if (MarchLanesFit(px * py * pz)) {
+            MarchLaneVolume lanes;
+            lanes.qt = &state.volume.data()->q;
+            lanes.sky = skyLight ? state.skyVolume.data() : nullptr;
+            lanes.px = int32_t(px), lanes.pxy = int32_t(px * py);
+            if (params.skipping) {
+                lanes.brickEmpty = state.bricks.data();
+                lanes.brick = float(B), lanes.invBrick = 1.0f / float(B);
+                lanes.brickCount[0] = float(bx), lanes.brickCount[1] = float(by), lanes.brickCount[2] = float(bz);
+                lanes.brickStride[0] = int32_t(bx), lanes.brickStride[1] = int32_t(bx * by);
+            }
+            MarchPixelsInLanes(params, volume, lanes, write, local);
+            return;
+        }
+#endif
         auto plainQ = [&volume](const Vec3& p) { return volume.Q(p); };
         if (shadeLight) {
-            MarchPixels(params, volume, brickPtr, out, local, G, e, [&](MarchCachedDensity& density) {
+            MarchPixels(params, volume, brickPtr, write, local, [&](MarchCachedDensity& density) {
                 return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = density.LastT();
@@ -221,7 +260,7 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
                 };
             });
         } else {
-            MarchPixels(params, volume, brickPtr, out, local, G, e, [&](MarchCachedDensity& density) {
+            MarchPixels(params, volume, brickPtr, write, local, [&](MarchCachedDensity& density) {
                 return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = SunLightMarch(s, p, nl, plainQ);
@@ -250,7 +289,7 @@ uint64_t RenderMarchCpuState::ScratchBytes(const Scene& scene) const {
     const uint32_t b = std::max(scene.march.brick, 1u);
     const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
     const uint64_t cell = sizeof(MarchQT) + (scene.lighting.sky.on ? sizeof(float) : 0);
-    return SaturatingAdd(SaturatingMul(padded, cell), bricks);
+    return SaturatingAdd(SaturatingMul(padded, cell), bricks + 3);
 }
 
 Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {

@@ -18,7 +18,7 @@ struct RenderMarchCpuState {
     static constexpr Stage kStage = Stage::RenderMarch;
     std::vector<MarchQT> volume;  // the padded (q_alpha, T) volume
     std::vector<float> skyVolume;  // the padded T_sky volume (the sky light on), border 1
-    std::vector<uint8_t> bricks;  // skipping: 1 per empty brick
+    std::vector<uint8_t> bricks;   // skipping: 1 per empty brick, then 3 bytes of 0 (the lanes' 32-bit reads)
     // The padded volume (and T_sky's with the sky light) and one byte per brick.
     uint64_t ScratchBytes(const Scene& scene) const;
 };

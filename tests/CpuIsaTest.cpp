@@ -8,6 +8,7 @@
 
 #include "core/pipeline/StageDescriptor.h"
 #include "core/plan/SceneLoad.h"
+#include "core/plan/StageGraph.h"
 #include "harness/run/Simulation.h"
 #include "impl_cpu/BackendCpu.h"
 #include "tests/CpuIsaTestUtil.h"
@@ -68,6 +69,19 @@ std::vector<Output> EveryOutput(const Scene& scene) {
         StepRecord record;
         const Status stepped = (*sim)->Step(record);
         EXPECT_TRUE(stepped.has_value()) << stepped.error().message;
+        // Each frame's counters but how full the SIMD lanes were (which the lane count sets), as an output.
+        for (const FrameRecord& frame : record.frames) {
+            Output out{"step " + std::to_string(t) + ": counters of " + std::string(StageName(frame.renderer)) +
+                           ", camera " + frame.camera,
+                       {}};
+            const auto& fields = Describe(frame.renderer).renderer->counters;
+            for (size_t i = 0; i < fields.size(); ++i) {
+                if (fields[i].name.starts_with("lane_")) continue;
+                const auto* bytes = reinterpret_cast<const std::byte*>(&frame.counters[i]);
+                out.bytes.insert(out.bytes.end(), bytes, bytes + sizeof(frame.counters[i]));
+            }
+            outputs.push_back(std::move(out));
+        }
         for (Resource resource : kAllResources)
             for (size_t n = 0; n < (IsPerCamera(resource) ? scene.render.cameras.size() : 1); ++n)
                 if (const Buffer* buffer = (*sim)->Get(resource, n)) {
@@ -87,6 +101,15 @@ struct IsaScene {
     std::vector<SceneOverride> overrides;
 };
 void PrintTo(const IsaScene& c, std::ostream* os) { *os << c.name; }
+
+// noise-track's clouds and cameras on a small grid of its size in metres, a small image, and `extra` on top.
+std::vector<SceneOverride> MarchOptions(std::vector<SceneOverride> extra) {
+    std::vector<SceneOverride> o{
+        {"steps", "1"},         {"warmup_steps", "0"},  {"grid.size", "[32,32,32]"}, {"grid.voxel_size", "200"},
+        {"render.width", "64"}, {"render.height", "48"}};
+    o.insert(o.end(), extra.begin(), extra.end());
+    return o;
+}
 
 // Scenes that between them run every CPU stage with its options: the
 // automaton with and without wind, fp16 and coarse shade, shade's sweep along
@@ -112,6 +135,51 @@ const IsaScene kIsaScenes[] = {
       {"render.height", "48"}}},
     {"Layers", "layers-small.json", {{"render.width", "64"}, {"render.height", "48"}}},
     {"SkyLight", "wang-sunset.json", {{"render.width", "64"}, {"render.height", "48"}, {"grid.size", "[32,32,8]"}}},
+    // The ray march's rays in SIMD lanes against its scalar kernel, option by option: every camera of the track
+    // (outside, at the edge of and inside the clouds), the jitter, the adaptive step with small bricks, the light
+    // march with powder, tiling, no skipping, no early stop, the point light, city glow and eye scattering, every
+    // phase, the sky light and the ground.
+    {"MarchTrack", "noise-track.json", MarchOptions({})},
+    {"MarchJitterAdaptive", "noise-track.json",
+     MarchOptions({{"march.jitter", "true"},
+                   {"march.adaptive.enabled", "true"},
+                   {"march.adaptive.kappa", "0.3"},
+                   {"march.adaptive.start", "4"},
+                   {"march.skipping.brick", "2"}})},
+    {"MarchLightPowderMie", "noise-track.json",
+     MarchOptions({{"march.light", "\"march\""},
+                   {"march.light_steps", "3"},
+                   {"march.powder.enabled", "true"},
+                   {"phase.function", "\"mie\""}})},
+    {"MarchTiledAdaptive", "noise-track.json",
+     MarchOptions({{"grid.tiling", "true"},
+                   {"march.adaptive.enabled", "true"},
+                   {"march.light", "\"march\""},
+                   {"march.skipping.brick", "3"},
+                   {"phase.function", "\"cornette-shanks\""}})},
+    {"MarchNoSkipNoStop", "noise-track.json",
+     MarchOptions({{"march.skipping.enabled", "false"}, {"march.epsilon", "0"}, {"phase.function", "\"none\""}})},
+    {"MarchFineStep", "noise-track.json", MarchOptions({{"march.step", "0.05"}, {"render.width", "24"}})},
+    {"MarchCoarseStep", "noise-track.json", MarchOptions({{"march.step", "7"}})},
+    {"MarchGlowEye", "noise-track.json",
+     MarchOptions({{"lighting.city_glow", R"({"blobs": [{"center": [3000, 3000], "radius": 2000}]})"},
+                   {"lighting.eye_scattering", "{}"},
+                   {"march.powder.enabled", "true"}})},
+    {"MarchLightning", "lightning.json", MarchOptions({{"steps", "3"}})},
+    {"MarchSky",
+     "wang-sunset.json",
+     {{"render.width", "64"},
+      {"render.height", "48"},
+      {"grid.size", "[32,32,8]"},
+      {"stages", R"(["noise", "shade", "shade_sky", "render_march"])"}}},
+    {"MarchGround",
+     "ground-shadow.json",
+     {{"steps", "2"},
+      {"warmup_steps", "0"},
+      {"grid.size", "[64,64,16]"},
+      {"render.width", "64"},
+      {"render.height", "48"},
+      {"stages", R"(["region", "ca", "smooth", "density", "shade", "shadow", "render_march"])"}}},
 };
 
 class CpuIsaSameBits : public ::testing::TestWithParam<IsaScene> {};
@@ -136,6 +204,48 @@ TEST_P(CpuIsaSameBits, EveryTargetGivesTheScalarBits) {
                 << cpu::CpuIsaName(isa) << ": " << scalar[n].name << " differs";
     }
     ASSERT_TRUE(cpu::SelectCpuIsa(cpu::CpuIsa::Auto).has_value());
+}
+
+class MarchLanes : public test::OnEveryCpuIsa {};
+INSTANTIATE_TEST_SUITE_P(Targets, MarchLanes, test::EveryCpuIsa(), test::CpuIsaTestName);
+
+// Test that the ray march's lane counters add up on every camera of a track: each lane-step samples, or meets an
+// empty brick, or ends a walk through empty bricks at a brick that is not (at most once per walk, and a walk
+// skips at least one brick), so samples + skipped <= lane-steps <= samples + 2 skipped; the slots are the packet
+// steps times the lanes, so a multiple of the lane count and at least the lane-steps. The scalar target runs one
+// ray at a time and counts neither.
+TEST_P(MarchLanes, CountersAddUp) {
+    auto scene = LoadScene(std::string(CLOUDBENCH_SCENES_DIR) + "/noise-track.json", MarchOptions({}));
+    ASSERT_TRUE(scene.has_value()) << scene.error().message;
+    cpu::BackendCpu backend(2);
+    auto sim = Simulation::Create(*scene, backend, /*everyStepOutputs=*/false);
+    ASSERT_TRUE(sim.has_value()) << sim.error().message;
+    StepRecord record;
+    ASSERT_TRUE((*sim)->Step(record).has_value());
+    ASSERT_EQ(record.frames.size(), scene->render.cameras.size());
+    const uint64_t lanes = GetParam() == cpu::CpuIsa::Avx512 ? 16 : GetParam() == cpu::CpuIsa::Avx2 ? 8 : 4;
+    for (const FrameRecord& frame : record.frames) {
+        const auto counter = [&](std::string_view name) {
+            const auto& fields = Describe(Stage::RenderMarch).renderer->counters;
+            for (size_t i = 0; i < fields.size(); ++i)
+                if (fields[i].name == name) return frame.counters[i];
+            ADD_FAILURE() << "no counter " << name;
+            return uint64_t(0);
+        };
+        const uint64_t samples = counter("samples"), skipped = counter("bricks_skipped");
+        const uint64_t steps = counter("lane_steps"), slots = counter("lane_slots");
+        SCOPED_TRACE(frame.camera);
+        ASSERT_GT(samples, 0u);
+        if (GetParam() == cpu::CpuIsa::Scalar) {
+            EXPECT_EQ(steps, 0u);
+            EXPECT_EQ(slots, 0u);
+            continue;
+        }
+        EXPECT_GE(steps, samples + skipped);
+        EXPECT_LE(steps, samples + 2 * skipped);
+        EXPECT_EQ(slots % lanes, 0u);
+        EXPECT_GE(slots, steps);
+    }
 }
 
 }  // namespace

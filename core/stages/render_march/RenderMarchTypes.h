@@ -71,6 +71,9 @@ struct MarchStats {
     uint64_t lightSamples = 0;             // light functor calls (samples with q_alpha > 0)
     uint64_t bricksSkipped = 0;            // empty bricks jumped over, summed over rays
     uint64_t emptyBricks = 0, bricks = 0;  // of the skip structure (0 without skipping)
+    // Rays in SIMD lanes (the CPU, impl_cpu/MarchLanesCpu-inl.h): lane-steps that sampled or skipped, of the packet
+    // steps times the lane count; their ratio is the lanes' utilisation. 0 where rays run one at a time.
+    uint64_t laneSteps = 0, laneSlots = 0;
 };
 
 // The ray marcher's counters (core/base/Counter.h).
@@ -81,6 +84,8 @@ inline constexpr Counter<MarchStats> kMarchCounters[] = {
     {"bricks_skipped", &MarchStats::bricksSkipped, CounterShown::Results},
     {"empty_bricks", &MarchStats::emptyBricks, CounterShown::ReadBack},
     {"bricks", &MarchStats::bricks, CounterShown::ReadBack},
+    {"lane_steps", &MarchStats::laneSteps, CounterShown::Results},
+    {"lane_slots", &MarchStats::laneSlots, CounterShown::Results},
 };
 static_assert(ReportedCounter(kMarchCounters).name == "samples");
 static_assert(sizeof(MarchStats) == std::size(kMarchCounters) * sizeof(uint64_t), "a MarchStats member is unlisted");
