@@ -75,7 +75,7 @@ struct MarchPaddedVolume {
     }
 };
 
-
+#if HWY_TARGET != HWY_SCALAR  // the scalar target marches one ray at a time (MarchRay)
 // The padded volumes and bricks as the lanes read them: float and byte arrays indexed by 32-bit gathers.
 struct MarchLaneVolume {
     const float* qt = nullptr;   // the padded (q, T) volume as floats: cell c's q at 2c, T at 2c + 1
@@ -352,6 +352,36 @@ class MarchLanes {
     }
     V Q(const Taps& t) const { return Blend(vol_.qt, 2, t); }
 
+    // The eight taps' q and T, each (q, T) cell read by one 64-bit gather: half the elements of a gather of each.
+    struct CellTaps {
+        V q[8], t[8];
+    };
+    CellTaps GatherCells(const Taps& taps) const {
+        const hn::Repartition<double, D> dd;  // half as many lanes
+        const hn::RebindToSigned<decltype(dd)> dl;
+        const hn::Half<DI> dh;
+        const auto* cells = reinterpret_cast<const double*>(vol_.qt);
+        const auto lo = hn::PromoteTo(dl, hn::LowerHalf(dh, taps.base));
+        const auto hi = hn::PromoteTo(dl, hn::UpperHalf(dh, taps.base));
+        const int64_t offset[8] = {
+            0, 1, vol_.px, vol_.px + 1, vol_.pxy, vol_.pxy + 1, vol_.pxy + vol_.px, vol_.pxy + vol_.px + 1};
+        CellTaps c;
+        for (int i = 0; i < 8; ++i) {
+            const auto o = hn::Set(dl, offset[i]);
+            const V a = hn::BitCast(d_, hn::GatherIndex(dd, cells, hn::Add(lo, o)));
+            const V b = hn::BitCast(d_, hn::GatherIndex(dd, cells, hn::Add(hi, o)));
+            c.q[i] = hn::ConcatEven(d_, b, a);
+            c.t[i] = hn::ConcatOdd(d_, b, a);
+        }
+        return c;
+    }
+    // Blend of taps v[0..7] in CellTaps's order (x fastest, then y, then z), as MarchPaddedVolume::Blend.
+    V BlendTaps(const V* v, const Taps& t) const {
+        const V c00 = Lerp(v[0], v[1], t.wx), c10 = Lerp(v[2], v[3], t.wx);
+        const V c01 = Lerp(v[4], v[5], t.wx), c11 = Lerp(v[6], v[7], t.wx);
+        return Lerp(Lerp(c00, c10, t.wy), Lerp(c01, c11, t.wy), t.wz);
+    }
+
     // SunLightMarch with MarchPaddedVolume::Q as the density: ClipRayToVolume toward the (fixed) sun, then
     // MarchTransmittance.
     V SunLight(V px, V py, V pz, M lanes) const {
@@ -399,12 +429,19 @@ class MarchLanes {
         const V ts = hn::Add(tn, hn::Mul(xi, len));
         const V px = hn::Add(ox, hn::Mul(dx, ts)), py = hn::Add(oy, hn::Mul(dy, ts)), pz = hn::Add(oz, hn::Mul(dz, ts));
 
-        M sample = active;
+        // The taps are read before the brick is known, for every lane not walking: a lane whose brick is empty
+        // reads q = 0 there for nothing, but no lane waits for the brick's byte before its taps are on their way.
+        const M walkers = hn::And(active, walking);
+        const M samplers = hn::AndNot(walkers, active);
+        const Taps taps = TapsAt(px, py, pz, samplers);
+        // With shade's T, q and T of the taps come together; the light march reads q alone.
+        CellTaps cells;
+        if (shadeLight_) cells = GatherCells(taps);
+        M sample = samplers;
         M ended = hn::FirstN(d_, 0);
         if (bricks_) {
             // A sampling lane looks up its sample's brick; a walking lane the brick a hundredth of a voxel past its
             // last exit. Either way an empty brick moves tExit to that brick's exit.
-            const M walkers = hn::And(active, walking);
             const V at = hn::IfThenElse(walkers, hn::Add(tExit, hn::Set(d_, 0.01f)), ts);
             const BrickCell cell =
                 BrickAt(hn::Add(ox, hn::Mul(dx, at)), hn::Add(oy, hn::Mul(dy, at)), hn::Add(oz, hn::Mul(dz, at)));
@@ -416,19 +453,18 @@ class MarchLanes {
                 const M landing = hn::AndNot(walking, hn::Or(empty, walkers));
                 if (!hn::AllFalse(d_, landing)) Land(landing, tNext, delta);
                 ended = hn::And(landing, hn::Not(hn::Lt(tn, tMax)));
-                sample = hn::AndNot(hn::Or(empty, walkers), active);
+                sample = hn::AndNot(empty, samplers);
             }
         }
         if (hn::AllFalse(d_, sample)) return ended;
         counters.samples += hn::CountTrue(d_, sample);
-        const Taps taps = TapsAt(px, py, pz, sample);
-        const V qa = Q(taps);
+        const V qa = shadeLight_ ? BlendTaps(cells.q, taps) : Q(taps);
         const M lit = hn::And(sample, hn::Gt(qa, hn::Zero(d_)));
         M stop = hn::FirstN(d_, 0);
         if (!hn::AllFalse(d_, lit)) {
             counters.lightCalls += hn::CountTrue(d_, lit);
             const V tau = Exp(hn::Mul(hn::Neg(hn::Mul(hn::Set(d_, s_.sigmaH), qa)), len));
-            const V sunT = shadeLight_ ? Blend(vol_.qt + 1, 2, taps) : SunLight(px, py, pz, lit);
+            const V sunT = shadeLight_ ? BlendTaps(cells.t, taps) : SunLight(px, py, pz, lit);
             const V skyT = s_.light.skyOn ? Blend(vol_.sky, 1, taps) : hn::Set(d_, 1.0f);
             V sunGain = hn::Mul(sunT, sunPhase);
             if (s_.powder) sunGain = PerLane(lit, sunGain, [&](size_t, float gain, const float* lane) {
@@ -456,10 +492,11 @@ class MarchLanes {
             T = hn::IfThenElse(lit, hn::Mul(T, tau), T);
             stop = hn::And(lit, hn::Or(hn::Lt(T, hn::Set(d_, s_.epsilon)), hn::Eq(T, hn::Zero(d_))));
         }
-        const M moved = hn::AndNot(stop, sample);
-        n = hn::IfThenElse(hn::RebindMask(di, moved), hn::Add(n, hn::Set(di, 1)), n);
-        tn = hn::IfThenElse(moved, tNext, tn);
-        return hn::Or(ended, hn::Or(stop, hn::And(moved, hn::Not(hn::Lt(tn, tMax)))));
+        // Every sampling lane moves on, also one that stops here (its ray ends, and the next pixel replaces tn
+        // and n): so the next step's position does not wait for this step's light.
+        n = hn::IfThenElse(hn::RebindMask(di, sample), hn::Add(n, hn::Set(di, 1)), n);
+        tn = hn::IfThenElse(sample, tNext, tn);
+        return hn::Or(ended, hn::Or(stop, hn::And(sample, hn::Not(hn::Lt(tn, tMax)))));
     }
 
     // The end of a walk through empty bricks, for the lanes in `landing`: on to the first sample at or past tExit
@@ -537,6 +574,8 @@ class MarchLanes {
     alignas(64) float tExit_[kMax];
     alignas(64) int32_t n_[kMax], walking_[kMax], pixel_[kMax];
 };
+
+#endif  // HWY_TARGET != HWY_SCALAR
 
 }  // namespace cb::cpu::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
