@@ -505,16 +505,13 @@ class MarchLanes {
         const DI di;
         const M skip = landing;
         if (s_.adaptive) {
-            V t = tNext;
-            M going = hn::And(skip, hn::Lt(t, tMax));
-            while (!hn::AllFalse(d_, going)) {
-                const V after = Advance(t, hn::Add(t, StepAt(t)), going);
-                const V sample = hn::Add(t, hn::Mul(xi, hn::Sub(Min(after, tMax), t)));
-                going = hn::And(going, hn::Not(hn::Ge(sample, tExit)));
-                t = hn::IfThenElse(going, after, t);
-                going = hn::And(going, hn::Lt(t, tMax));
-            }
-            tn = hn::IfThenElse(skip, t, tn);
+            // Per lane: a lane or two land in a step, and the recurrence's iterations are a few operations each.
+            alignas(64) float t[kMax], end[kMax], xs[kMax], exit[kMax];
+            hn::Store(tNext, d_, t), hn::Store(tMax, d_, end), hn::Store(xi, d_, xs), hn::Store(tExit, d_, exit);
+            tn = PerLane(
+                skip, tn,
+                [&](size_t i, float, const float*) { return MarchAdaptiveLanding(s_, t[i], end[i], xs[i], exit[i]); },
+                tn);
         } else {
             const V m = hn::Floor(hn::Sub(hn::Div(hn::Sub(tExit, tMin), delta), xi));
             const VI mi = hn::ConvertTo(di, Clamp(m, hn::Zero(d_), hn::Set(d_, 16777216.0f)));

@@ -3,8 +3,9 @@
 // stands for "outside the grid", or with tiling holds the opposite edge's
 // voxel in x and y, so the trilinear taps need no bounds checks; impl_cpu/PaddedVolumeCpu-inl.h), and with the sky
 // light T_sky into a second one,
-// the brick skip structure is built from it, and then every pixel runs the
-// shared kernel MarchRay (core/math/March.h), TBB over 8 x 8 pixel tiles.
+// the brick skip structure is built from it, and then the rays: on a SIMD target a packet of rays in lanes per
+// 16 x 16 pixel tile (impl_cpu/MarchLanesCpu-inl.h), on the scalar target, or a volume too large for 32-bit
+// gathers, the shared kernel MarchRay (core/math/March.h) per pixel over 8 x 8 pixel tiles; the same bits.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "impl_cpu/RenderMarchCpu.cpp"
 #include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)

@@ -182,6 +182,24 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      s.adaptive = in[3] != 0;
                      out[0] = Bits(MarchStepAt(s, Float(in[4])));
                  }});
+    // Inputs: step, kappa, t_a, t, tMax, xi, tExit (the adaptive step on); the landing from t = 40 past the exit at
+    // 52.3, one that the far end stops, and a step below the float spacing at t = 2^24.
+    c.push_back({"MarchAdaptiveLanding",
+                 kTwinMarchAdaptiveLanding,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     const float t = Uniform(r, 0, 300);
+                     in = WF({Uniform(r, 0.05f, 4), Uniform(r, 0, 0.5f), Uniform(r, 0, 200), t, t + Uniform(r, 0, 400),
+                              Uniform(r, 0, 1), t + Uniform(r, 0, 60)});
+                 },
+                 {WF({0.5f, 0.05f, 64, 40, 400, 0.5f, 52.3f}), WF({0.5f, 0.05f, 64, 40, 45, 0.5f, 52.3f}),
+                  WF({1e-6f, 0, 0, 16777216.0f, 16777220.0f, 0.5f, 16777218.0f})},
+                 [](const Words& in, Words& out) {
+                     MarchSetup s;
+                     s.step = Float(in[0]), s.kappa = Float(in[1]), s.adaptiveStart = Float(in[2]);
+                     s.adaptive = true;
+                     out[0] = Bits(MarchAdaptiveLanding(s, Float(in[3]), Float(in[4]), Float(in[5]), Float(in[6])));
+                 }});
     c.push_back({"MarchJitter",
                  kTwinMarchJitter,
                  {Kind::F},

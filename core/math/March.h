@@ -271,6 +271,20 @@ inline void MarchBrickBox(const MarchSetup& s, const MarchBrickCell& c, float B,
     }
 }
 
+// The adaptive step's landing after a skip to tExit: the segment starts t_n from t (the skipped sample's segment
+// end) on by the recurrence, which is cheap, to the first whose sample t_n + xi l_n lies at or past tExit (or to
+// tMax); the positions are those of the unskipped march.
+inline float MarchAdaptiveLanding(const MarchSetup& s, float t, float tMax, float xi, float tExit) {
+    while (t < tMax) {
+        float tAfter = t + MarchStepAt(s, t);
+        if (!(tAfter > t)) tAfter = std::nextafter(t, std::numeric_limits<float>::max());
+        const float sample = t + xi * (std::min(tAfter, tMax) - t);
+        if (sample >= tExit) break;
+        t = tAfter;
+    }
+    return t;
+}
+
 // ---- Light functor for the light march (Olajos) -----------------------------------
 
 // What a light functor returns at a sample: transmittance toward the sun, toward
@@ -370,16 +384,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                         ++r.bricksSkipped;
                     }
                     if (s.adaptive) {
-                        // Iterate the cheap recurrence; the positions are those of the unskipped march.
-                        float t = tNext;
-                        while (t < ray.tMax) {
-                            float tAfter = t + MarchStepAt(s, t);
-                            if (!(tAfter > t)) tAfter = std::nextafter(t, std::numeric_limits<float>::max());
-                            const float sample = t + xi * (std::min(tAfter, ray.tMax) - t);
-                            if (sample >= tExit) break;
-                            t = tAfter;
-                        }
-                        tn = t;
+                        tn = MarchAdaptiveLanding(s, tNext, ray.tMax, xi, tExit);
                     } else {
                         // First m > n with tMin + (m + xi) Delta >= tExit, rounded down (never past it).
                         const float m = std::floor((tExit - ray.tMin) / delta - xi);

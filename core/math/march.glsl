@@ -221,6 +221,19 @@ float MarchStepAt(MarchGpu m, float t) {
     return (m.flags & kMarchAdaptive) != 0u ? adaptive : m.baseStep;
 }
 
+// MarchAdaptiveLanding (March.h): after a skip to tExit, the segment starts from t on by the recurrence to the first
+// whose sample lies at or past tExit (or to tMax).
+float MarchAdaptiveLanding(MarchGpu m, float t, float tMax, float xi, float tExit) {
+    while (t < tMax) {
+        precise float tAfter = t + MarchStepAt(m, t);
+        if (!(tAfter > t)) tAfter = MarchNextUp(t);
+        precise float sampleT = t + xi * (min(tAfter, tMax) - t);
+        if (sampleT >= tExit) break;
+        t = tAfter;
+    }
+    return t;
+}
+
 float MarchJitter(uint seed, uint frame, uint pixel) {
     return float(Rand24FromKey(StreamKey(seed, frame, kMarchStreamOther), pixel)) * (1.0 / 16777216.0);
 }
@@ -369,15 +382,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
                         ++r.bricksSkipped;
                     }
                     if (adaptive) {
-                        float t = tNext;
-                        while (t < ray.tMax) {
-                            precise float tAfter = t + MarchStepAt(m, t);
-                            if (!(tAfter > t)) tAfter = MarchNextUp(t);
-                            precise float sampleT = t + xi * (min(tAfter, ray.tMax) - t);
-                            if (sampleT >= tExit) break;
-                            t = tAfter;
-                        }
-                        tn = t;
+                        tn = MarchAdaptiveLanding(m, tNext, ray.tMax, xi, tExit);
                     } else {
                         precise float mm = floor((tExit - ray.tMin) / delta - xi);
                         n = max(n + 1u, uint(clamp(mm, 0.0, 16777216.0)));

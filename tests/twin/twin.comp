@@ -225,6 +225,15 @@ void main() {
             PutF(0u, MarchStepAt(m, F(4u)));
             break;
         }
+        case kTwinMarchAdaptiveLanding: {
+            MarchGpu m = ZeroMarch();
+            m.baseStep = F(0u);
+            m.kappa = F(1u);
+            m.adaptiveStart = F(2u);
+            m.flags = kMarchAdaptive;
+            PutF(0u, MarchAdaptiveLanding(m, F(3u), F(4u), F(5u), F(6u)));
+            break;
+        }
         case kTwinMarchJitter: PutF(0u, MarchJitter(U(0u), U(1u), U(2u))); break;
         case kTwinRayExitFromBox: {
             const vec3 inv = InverseDirection(vec3(F(3u), F(4u), F(5u)));
