@@ -1,7 +1,8 @@
 // No state survives a backend call unless it should, on every backend and
 // every GL automaton layout: an automaton state uploaded between steps (the
 // --resume path) is what the next step reads, however the backend caches the
-// state it left (gl rgba8 keeps it repacked); and a scene run after another
+// state it left (gl rgba8 keeps it repacked); shade and shadow after a sunset
+// and a sunrise equal them on a fresh backend; and a scene run after another
 // on the same backend object equals it on a fresh backend, every resource at
 // every step, bit for bit.
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <span>
 
 #include "core/plan/SceneLoad.h"
 #include "core/scene/Scene.h"
@@ -113,6 +115,61 @@ TEST_P(StateLeakCaUpload, StepsAfterAnUploadEqualAFreshBackend) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, StateLeakCaUpload, ::testing::ValuesIn(test::TestBackendsAndCaLayouts()),
+                         [](const auto& info) { return info.param; });
+
+using StateLeakSunset = test::BackendTest;
+
+// Test that shade and shadow under a sun that has risen again equal a fresh backend's, bit for bit, after a call
+// with the sun above the horizon and one with it below (no sun: G = 1 everywhere), for every shadow form: a backend
+// that keeps "no sun" from the sunset (gl's shadow program setting its noSun uniform only to 1) shades the sunrise
+// without its shadow.
+TEST_P(StateLeakSunset, SunriseAfterSunsetEqualsAFreshBackend) {
+    const Extent3 e{23, 19, 7};
+    const std::vector<float> q = test::GaussianBlobField(e, {{6, 5, 3, 2.5}, {15, 12, 4, 3}});
+    std::vector<float> D(size_t(e.nx) * e.ny, 0.0f);
+    for (size_t v = 0; v < q.size(); ++v) D[v % D.size()] += q[v];
+    const Vec3 suns[] = {SunDirection(0.5, 0.4), SunDirection(-0.3, 1.2), SunDirection(0.7, 2.0)};
+    ASSERT_LT(suns[1][2], 0.0f) << "the second sun must be below the horizon";
+    for (ShadowForm form : {ShadowForm::Beer, ShadowForm::Thesis, ShadowForm::Wang}) {
+        SCOPED_TRACE("shadow form " + std::to_string(int(form)));
+        // Shade's T and shadow's G on `b` for each sun in turn; the last call's.
+        auto run = [&](Backend& b, std::span<const Vec3> path) {
+            auto qb = test::MakeFilled(b, BufferFormat::F32, e, q);
+            auto Db = test::MakeFilled(b, BufferFormat::F32, {e.nx, e.ny, 1}, D);
+            auto T = test::MakeBuffer(b, BufferFormat::F32, e);
+            auto G = test::MakeBuffer(b, BufferFormat::F32, {e.nx, e.ny, 1});
+            std::vector<float> t, g;
+            for (const Vec3& sun : path) {
+                ShadeParams sp;
+                sp.sun = sun, sp.sigma = 0.05f;
+                ShadowParams gp;
+                gp.sun = sun, gp.form = form, gp.sigma = 0.05f, gp.nz = e.nz, gp.coverage = 0.8f;
+                Status s = b.Shade(sp, *qb, *T);
+                EXPECT_TRUE(s.has_value()) << s.error().message;
+                s = b.Shadow(gp, *Db, *G);
+                EXPECT_TRUE(s.has_value()) << s.error().message;
+                t = test::Read<float>(b, *T), g = test::Read<float>(b, *G);
+                if (sun[2] < 0) {
+                    EXPECT_EQ(g, std::vector<float>(g.size(), 1.0f)) << "no sun casts no shadow (docs/pipeline.md)";
+                }
+            }
+            return std::pair{t, g};
+        };
+        std::pair<std::vector<float>, std::vector<float>> want;
+        {
+            auto fresh = test::MakeTestBackend(GetParam());
+            ASSERT_TRUE(fresh.has_value()) << fresh.error().message;
+            want = run(**fresh, std::span(suns).last(1));
+            test::ExpectNoValidationMessages(fresh->get());
+        }
+        EXPECT_NE(want.second, std::vector<float>(want.second.size(), 1.0f)) << "the risen sun casts no shadow here";
+        const auto got = run(*mBackend, suns);
+        EXPECT_TRUE(got.first == want.first) << "T after sunrise differs from a fresh backend's";
+        EXPECT_TRUE(got.second == want.second) << "G after sunrise differs from a fresh backend's";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, StateLeakSunset, ::testing::ValuesIn(test::TestBackends()),
                          [](const auto& info) { return info.param; });
 
 // scenes/ci-small.json with `sets` applied as --set does, a few small steps.

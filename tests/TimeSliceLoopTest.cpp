@@ -57,6 +57,11 @@ Scene SlicedLoopScene(std::vector<SceneOverride> more) {
     return scene ? *scene : Scene{};
 }
 
+// The slices of shade's sweep at `step`'s sun.
+uint32_t SweepSlicesAt(const Scene& scene, uint32_t step) {
+    return MakeShadePlan(MakeShadeParams(scene, step), scene.grid.size).nw;
+}
+
 // Everything the observer sees at each step: each resource's bytes (images per camera) and the step's records.
 struct StepView {
     std::map<std::string, std::vector<std::byte>> bytes;
@@ -125,6 +130,66 @@ TEST_P(TimeSliceLoop, EveryStepEqualsTheUnslicedLoop) {
     }
 }
 
+// A sun that stands on each principal axis in turn, one keyframe a step from step 1 on: x, y, z, -x, z, -y, x
+// (el, az in degrees; the direction (cos el cos az, cos el sin az, sin el) worked by hand beside each). Each ordered
+// pair of axes follows once, so the sweep's length on the 23 x 19 x 7 grid (23 slices along x, 19 along y, 7 along
+// z) grows on three steps (z -> x, z -> y, y -> x) and shrinks on three.
+struct AxisSun {
+    double elevation, azimuth;
+    uint32_t slices;  // shade's sweep on the 23 x 19 x 7 grid at resolution 1: the cells along the principal axis
+};
+constexpr AxisSun kAxisSuns[] = {
+    {15, 20, 23},   // (0.908, 0.330, 0.259): x
+    {15, 20, 23},   // step 1, the same: x
+    {20, 110, 19},  // (-0.321, 0.883, 0.342): y
+    {70, 200, 7},   // (-0.321, -0.117, 0.940): z
+    {25, 170, 23},  // (-0.893, 0.157, 0.423): -x
+    {65, 340, 7},   // (0.397, -0.145, 0.906): z
+    {10, 260, 19},  // (-0.171, -0.970, 0.174): -y
+    {30, 350, 23},  // (0.853, -0.150, 0.500): x
+    {30, 350, 23},  // step 8, the last: the same
+};
+
+std::vector<SceneOverride> AxisCrossingSun() {
+    std::string path = "[";
+    for (size_t t = 0; t < std::size(kAxisSuns); ++t)
+        path += (t ? ", " : "") + std::string(R"({"step": )") + std::to_string(t) + R"(, "elevation_deg": )" +
+                std::to_string(kAxisSuns[t].elevation) + R"(, "azimuth_deg": )" + std::to_string(kAxisSuns[t].azimuth) +
+                "}";
+    return {{"steps", std::to_string(std::size(kAxisSuns))}, {"sun.path", path + "]"}};
+}
+
+// Test that the sliced loop equals the unsliced loop, every resource at every step, while the sun crosses every
+// boundary between principal axes, at 1, 2, 3 and 5 slices a frame: the next step's shade shares must be counted
+// with the next step's sun, whose sweep may be longer than this step's.
+TEST_P(TimeSliceLoop, SunCrossingEveryAxisBoundaryEqualsTheUnslicedLoop) {
+    const SceneOverride ground{"render.ground", R"({"albedo": [0.3, 0.35, 0.3]})"};
+    std::vector<SceneOverride> sets = AxisCrossingSun();
+    sets.push_back({"render.frames_per_step", "56"});  // above the 48 shares of one slice a frame
+    sets.push_back(ground);
+    const Scene whole = SlicedLoopScene(sets);
+    for (uint32_t t = 0; t < whole.steps; ++t)
+        ASSERT_EQ(SweepSlicesAt(whole, t), kAxisSuns[t].slices) << "step " << t << ": the sun is not where intended";
+    const std::vector<StepView> expected = RunAndKeepEveryStep(whole, *mBackend);
+    ASSERT_EQ(expected.size(), whole.steps);
+    EXPECT_GT(expected.back().record.coveredColumns.value_or(0), 0u) << "the test needs clouds";
+    for (const char* slices : {"1", "2", "3", "5"}) {
+        std::vector<SceneOverride> slicedSets = sets;
+        slicedSets.push_back({"render.slices_per_frame", slices});
+        const std::vector<StepView> got = RunAndKeepEveryStep(SlicedLoopScene(slicedSets), *mBackend);
+        ASSERT_EQ(got.size(), expected.size());
+        for (size_t t = whole.warmupSteps; t < got.size(); ++t) {
+            SCOPED_TRACE(std::string("slices per frame ") + slices + ", step " + std::to_string(t));
+            ASSERT_EQ(got[t].bytes.size(), expected[t].bytes.size());
+            for (const auto& [name, data] : expected[t].bytes) {
+                ASSERT_TRUE(got[t].bytes.count(name)) << name;
+                EXPECT_TRUE(got[t].bytes.at(name) == data) << name << " differs from the unsliced loop";
+            }
+            EXPECT_EQ(got[t].record.framesRendered, expected[t].record.framesRendered);
+        }
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, TimeSliceLoop, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return info.param; });
 
@@ -173,6 +238,30 @@ TEST(TimeSliceLoopPlan, FramesComputeTheNextStepsShares) {
     EXPECT_EQ(r.framesRendered, 1u);
     EXPECT_TRUE(r.frameWork.empty());
     EXPECT_EQ(backend.alphas.back(), 1.0f);
+}
+
+// The frame plan under the sun of kAxisSuns, one frame a step and 4 slices a frame: each render step t computes
+// step t+1's shade in ceil(n / 4) frames of 4 slices, n being the sweep at step t+1's sun (23, 19 or 7 by hand),
+// whatever the sweep at step t's sun.
+TEST(TimeSliceLoopPlan, ShadeSharesFollowTheNextStepsSun) {
+    std::vector<SceneOverride> sets = AxisCrossingSun();
+    sets.push_back({"render.slices_per_frame", "4"});
+    const Scene scene = SlicedLoopScene(sets);
+    cpu::BackendCpu backend;
+    auto sim = Simulation::Create(scene, backend);
+    ASSERT_TRUE(sim.has_value()) << sim.error().message;
+    for (uint32_t t = 0; t < scene.steps; ++t) {
+        StepRecord r;
+        ASSERT_TRUE((*sim)->Step(r));
+        if (t < scene.warmupSteps || t + 1 == scene.steps) continue;
+        std::vector<std::string> shade, want;
+        for (const std::string& work : r.frameWork)
+            if (work.starts_with("shade")) shade.push_back(work);
+        const uint32_t n = kAxisSuns[t + 1].slices;
+        for (uint32_t b = 0; b < n; b += 4)
+            want.push_back("shade " + std::to_string(b) + "-" + std::to_string(std::min(b + 4, n) - 1));
+        EXPECT_EQ(shade, want) << "step " << t << " computes step " << t + 1 << "'s shade, sweep of " << n;
+    }
 }
 
 // Without time-slicing the whole step is charged to its first frame (the thesis's drop in frame rate).

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
-"""Plants a failed write, rename or remove of one output of `cloudbench run`
-(CLOUDBENCH_TEST_FAIL_FS, docs/cli.md) and checks the folder's bookkeeping
-after it (docs/results.md#output-folders):
+"""Plants a failed write, rename or remove of each output of `cloudbench run`
+in turn (CLOUDBENCH_TEST_FAIL_FS, docs/cli.md: results.json, the frame as
+.exr and .png, the top view) and checks the folder's bookkeeping after it
+(docs/results.md#output-folders):
 
 - the command exits 1 and its message names the file;
 - a file that was not placed is not in the folder, is not in results.json's
@@ -29,6 +30,8 @@ FRAME = "frame-splat-above-cpu.png"
 # What a whole run of ci-small on cpu places, worked from docs/results.md: results.json, each camera's frame
 # as .exr and .png (one camera, "above"), and the backend's top view.
 ALL = {"results.json", "frame-splat-above-cpu.exr", FRAME, "topview-cpu.png"}
+# A frame is written as .exr, then .png: when the .exr fails, the frame's .png is not written either.
+NOT_AFTER = {"frame-splat-above-cpu.exr": {FRAME}}
 
 
 def run(cli, folder, plant=None):
@@ -106,14 +109,15 @@ def check(cli, folder, op, name):
             problems.append("results.json lists %s, which was not placed" % name)
         if name == "results.json" and inside is not None:
             problems.append("results.json is there although its %s failed" % op)
+        others = ALL - {name} - NOT_AFTER.get(name, set())
         if name != "results.json":
             if inside is None:
                 problems.append("no results.json")
-            elif inside != ALL - {"results.json", name}:
-                expected = ALL - {"results.json", name}
-                problems.append("results.json lists %s, expected %s" % (sorted(inside), sorted(expected)))
-        if placed != ALL - {name}:
-            problems.append("the journal places %s, expected %s" % (sorted(placed), sorted(ALL - {name})))
+            elif inside != others - {"results.json"}:
+                expected = sorted(others - {"results.json"})
+                problems.append("results.json lists %s, expected %s" % (sorted(inside), expected))
+        if placed != others:
+            problems.append("the journal places %s, expected %s" % (sorted(placed), sorted(others)))
     if output_checks.temporary_files(folder):
         problems.append("temporary files left: %s" % output_checks.temporary_files(folder))
     problems += lock_problems(folder)
@@ -128,7 +132,7 @@ def main():
     cli, folder = sys.argv[1], sys.argv[2]
     failed = False
     for op in ("write", "rename", "remove"):
-        for name in (FRAME, "results.json"):
+        for name in sorted(ALL):
             problems = check(cli, os.path.join(folder, "%s-%s" % (op, name)), op, name)
             print("%s %s: %s" % (op, name, "; ".join(problems) if problems else "ok"), flush=True)
             failed |= bool(problems)

@@ -114,8 +114,9 @@ add_test(NAME Cli.PathPolicy COMMAND /usr/bin/python3 ${outputs_py}/check_path_p
 set_tests_properties(Cli.PathPolicy PROPERTIES TIMEOUT 400 FAIL_REGULAR_EXPRESSION "FAIL: "
                      PASS_REGULAR_EXPRESSION "every reader and writer follows the path policy")
 
-# Test that a planted failed write, rename and remove (CLOUDBENCH_TEST_FAIL_FS) of a frame and of results.json
-# exits 1 naming the file, never lists a file not placed (results.json, the journal), and frees the lock.
+# Test that a planted failed write, rename and remove (CLOUDBENCH_TEST_FAIL_FS) of each file run places (results.json,
+# the frame's .exr and .png, the top view) exits 1 naming the file, never lists a file not placed (results.json, the
+# journal), and frees the lock.
 add_test(NAME Cli.FailedWritesKeepBookkeeping
          COMMAND /usr/bin/python3 ${outputs_py}/check_output_faults.py ${cli} ${cli_out}/faults)
 set_tests_properties(Cli.FailedWritesKeepBookkeeping PROPERTIES TIMEOUT 120 PASS_REGULAR_EXPRESSION

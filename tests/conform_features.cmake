@@ -54,21 +54,53 @@ add_test(NAME Cli.ConformLargeSplats
                  --out ${cli_out}/conform-large-splats)
 set_tests_properties(Cli.ConformLargeSplats PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
                      TIMEOUT 300)
-# NaN, +Inf and -Inf planted in the first non-CPU backend's T through the test-only
-# CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE switch: conform exits 5 and its table names the voxel and the value.
+# NaN, +Inf and -Inf planted through the test-only CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE switch in the first
+# element of a row, in the first non-CPU backend's output (Cli.ConformNonFinite.<rule>.<value>) or in the CPU
+# reference's (Cli.ConformNonFinite.<rule>.cpu<value>), under each kind of comparison rule: bit-exact (smooth's q),
+# absolute (shade's T on fp32), stored codes (T on unorm8, where a clamp would turn an Inf into a code), the image
+# rule with a limit (render_splat) and without one (render_march: |d| <= 1e-4 on 99.9 % of the pixels, where one Inf
+# pixel is within the share). conform exits 5 and its table names the step, the element and both values.
 if(DEFINED conform_features_backend)
-  foreach(value IN ITEMS nan inf -inf)
-    add_test(NAME Cli.ConformNonFinite.${value} COMMAND /bin/sh -c [=[
-      mkdir -p "$(dirname "$2")"
-      "$0" conform ci-small --steps 1 --backend "$1" --out "$2" > "$2.log" 2>&1; rc=$?
-      cat "$2.log"
-      [ "$rc" = 5 ] && grep -q "step 0 at (0, 0, 0): not finite: cpu [0-9.e+-]*, $1 $3" "$2.log" &&
-        echo "conform non-finite: ok"
-    ]=] ${cli} ${conform_features_backend} ${cli_out}/conform-nonfinite-${value} ${value})
-    set_tests_properties(Cli.ConformNonFinite.${value} PROPERTIES PASS_REGULAR_EXPRESSION "conform non-finite: ok"
-                         ENVIRONMENT
-                         "CLOUDBENCH_TEST_CONFORM_MISMATCH=${conform_features_backend}:shade;CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE=${value}"
-                         TIMEOUT 300)
+  foreach(rule IN ITEMS bit-exact absolute codes image image-unlimited)
+    set(nonfinite_scene ci-small)
+    set(nonfinite_sets "")
+    set(nonfinite_where "step 0 at (0, 0, 0)")
+    if(rule STREQUAL "bit-exact")
+      set(nonfinite_stage smooth)
+    elseif(rule STREQUAL "absolute")
+      set(nonfinite_stage shade)
+    elseif(rule STREQUAL "codes")
+      set(nonfinite_stage shade)
+      set(nonfinite_sets "--set shade.storage=unorm8")
+    elseif(rule STREQUAL "image")
+      set(nonfinite_stage render_splat)
+      set(nonfinite_where "step 0 camera above pixel (0, 0) channel 0")
+    else()
+      set(nonfinite_stage render_march)
+      set(nonfinite_scene noise-layer)
+      set(nonfinite_sets "--set grid.size=[32,32,16] --set render.width=32 --set render.height=24")
+      set(nonfinite_where "step 0 camera above pixel (0, 0) channel 0")
+    endif()
+    foreach(side IN ITEMS "" cpu)
+      set(nonfinite_target ${conform_features_backend})
+      if(side STREQUAL "cpu")
+        set(nonfinite_target cpu)
+      endif()
+      foreach(value IN ITEMS nan inf -inf)
+        add_test(NAME Cli.ConformNonFinite.${rule}.${side}${value} COMMAND /bin/sh -c [=[
+          mkdir -p "$(dirname "$2")"
+          "$0" conform "$4" --steps 1 --backend "$1" --out "$2" $6 > "$2.log" 2>&1; rc=$?
+          cat "$2.log"
+          want="cpu [0-9.e+-]*, $1 $3"
+          [ "$7" = cpu ] && want="cpu $3, $1 [0-9.e+-]*"
+          [ "$rc" = 5 ] && grep -q "$5: not finite: $want" "$2.log" && echo "conform non-finite: ok"
+        ]=] ${cli} ${conform_features_backend} ${cli_out}/conform-nonfinite-${rule}-${side}${value} ${value}
+            ${nonfinite_scene} "${nonfinite_where}" "${nonfinite_sets}" "${nonfinite_target}")
+        set_tests_properties(Cli.ConformNonFinite.${rule}.${side}${value} PROPERTIES PASS_REGULAR_EXPRESSION
+                             "conform non-finite: ok" TIMEOUT 300 ENVIRONMENT
+                             "CLOUDBENCH_TEST_CONFORM_MISMATCH=${nonfinite_target}:${nonfinite_stage};CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE=${value}")
+      endforeach()
+    endforeach()
   endforeach()
 endif()
 # Wang, Ji and Zhang's light terms, city glow (one blob off the diagonal x = y, so that a swapped x and y shows) and

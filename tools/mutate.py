@@ -8,6 +8,8 @@ incrementally) with its own build folder.
 
   tools/mutate.py --list                      the mutant set
   tools/mutate.py --check [--tree DIR]        every `find` occurs exactly once (no build; CTest Tools.MutantsApply)
+  tools/mutate.py --list-ctest-oracle --build-dir DIR
+                                              the tests the CTest oracle runs in a configured build folder
   tools/mutate.py [--only ID,ID] [--resume]   the run: results.json and summary.md under --out
 
 Oracles, cheapest first (a mutant stops at the first that catches it unless --all-oracles):
@@ -214,11 +216,14 @@ def oracle_conform(scene, tree, build, out, logs, mid, timeout, env):
     return result
 
 
+def ctest_selection(exclude, label_exclude=""):
+    """The CTest oracle's choice of tests: every test less `exclude`'s names and `label_exclude`'s labels."""
+    return ["-E", exclude] + (["-LE", label_exclude] if label_exclude else [])
+
+
 def ctest_cmd(build, exclude, jobs, junit, timeout_each, stop, label_exclude=""):
     cmd = ["ctest", "--test-dir", build, "-j", str(jobs), "--output-on-failure", "--output-junit", junit,
-           "--timeout", str(timeout_each), "-E", exclude]
-    if label_exclude:
-        cmd += ["-LE", label_exclude]
+           "--timeout", str(timeout_each)] + ctest_selection(exclude, label_exclude)
     if stop:
         cmd.append("--stop-on-failure")
     return cmd
@@ -398,6 +403,8 @@ def main():
     p.add_argument("--list", action="store_true", help="list the mutants and exit")
     p.add_argument("--check", action="store_true",
                    help="no build: every find text occurs exactly once in --tree (default: this checkout)")
+    p.add_argument("--list-ctest-oracle", action="store_true",
+                   help="print the tests the CTest oracle runs in --build-dir, one a line, and exit (no build)")
     p.add_argument("--only", help="comma-separated mutant ids")
     p.add_argument("--layer", help="comma-separated layers")
     p.add_argument("--resume", action="store_true", help="keep results.json's finished mutants and skip them")
@@ -432,6 +439,17 @@ def main():
             return 1
         counts = ", ".join(f"{l} {sum(m['layer'] == l for m in mutants)}" for l in LAYERS)
         print(f"mutate: all {len(mutants)} mutants apply ({counts})")
+        return 0
+    if args.list_ctest_oracle:
+        if not args.build_dir:
+            sys.exit("mutate: --list-ctest-oracle: needs --build-dir, a configured build folder")
+        exclude = "|".join(x for x in [args.ctest_exclude, ALWAYS_EXCLUDED] if x)
+        listed = subprocess.run(["ctest", "--test-dir", os.path.abspath(args.build_dir), "--show-only=json-v1"] +
+                                ctest_selection(exclude, args.ctest_exclude_label), capture_output=True, text=True)
+        if listed.returncode != 0:
+            sys.exit(f"mutate: --list-ctest-oracle: ctest --show-only failed: {listed.stderr.strip()}")
+        for test in json.loads(listed.stdout).get("tests", []):
+            print(test["name"])
         return 0
     if problems:
         for line in problems:

@@ -72,7 +72,8 @@ bool ConformTestMismatchEveryElement() {
 }
 
 // The test-only switch's value variant CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE=nan|inf|-inf: a float row's first
-// element set to that value instead of moved by 1. Empty when unset or not one of the three.
+// element set to that value instead of moved by 1 (with the backend "cpu", the reference's). Empty when unset or not
+// one of the three.
 std::optional<float> ConformTestMismatchValue() {
     const char* value = std::getenv("CLOUDBENCH_TEST_CONFORM_MISMATCH_VALUE");
     const std::string text = value ? value : "";
@@ -214,6 +215,10 @@ Status CompareOutput(Tally& tally, const Scene& scene, Stage stage, const std::s
         else
             (*g)[0] += (*g)[0] >= 0.5f ? -1.0f : 1.0f;
     }
+    // The value variant with the backend "cpu": the reference's first element, against every other backend.
+    if (const std::optional<float> planted = ConformTestMismatchValue();
+        planted && !r->empty() && ConformTestMismatch("cpu", stageName, tally.attempt, tally.caseName))
+        (*r)[0] = *planted;
     // Any NaN or Inf, the backend's or the CPU's, fails the row under every rule (no stage may return one, SPEC 12):
     // worst becomes inf, so a later step's finite worst never replaces this detail.
     if (const size_t v = FirstNonFinite(*r, *g); v < r->size()) {
