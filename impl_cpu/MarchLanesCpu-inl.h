@@ -76,7 +76,8 @@ struct MarchPaddedVolume {
 };
 
 #if HWY_TARGET != HWY_SCALAR  // the scalar target marches one ray at a time (MarchRay)
-// The padded volumes and bricks as the lanes read them: float and byte arrays indexed by 32-bit gathers.
+// The padded volumes and bricks as the lanes read them: q and T as floats (32-bit gathers) or as 64-bit (q, T)
+// cells, T_sky as floats, the bricks as bytes (a 32-bit gather at a byte's offset).
 struct MarchLaneVolume {
     const float* qt = nullptr;   // the padded (q, T) volume as floats: cell c's q at 2c, T at 2c + 1
     const float* sky = nullptr;  // T_sky's padded volume (the sky light on)
@@ -105,7 +106,8 @@ class MarchLanes {
     static constexpr size_t kMax = 16;  // the widest target's float lanes (AVX-512)
 
   public:
-    // finish(pixel, light, transmittance) writes a pixel from its march's L and T_view.
+    // bricks: skipping on (vol's bricks set); shadeLight: the sun's light from T (else the light march of
+    // lightSteps taps); scalarVolume: the same volume for the per-lane scalar functions.
     MarchLanes(D d, const MarchSetup& s, const MarchLaneVolume& vol, bool bricks, bool shadeLight, uint32_t lightSteps,
                const MarchPaddedVolume& scalarVolume)
         : d_(d), s_(s), vol_(vol), bricks_(bricks), shadeLight_(shadeLight), nl_(lightSteps),
@@ -503,13 +505,12 @@ class MarchLanes {
     // (MarchRay's skip, from the step that found the first empty brick: tn, n, tNext and delta are still its).
     void Land(M landing, V tNext, V delta) {
         const DI di;
-        const M skip = landing;
         if (s_.adaptive) {
             // Per lane: a lane or two land in a step, and the recurrence's iterations are a few operations each.
             alignas(64) float t[kMax], end[kMax], xs[kMax], exit[kMax];
             hn::Store(tNext, d_, t), hn::Store(tMax, d_, end), hn::Store(xi, d_, xs), hn::Store(tExit, d_, exit);
             tn = PerLane(
-                skip, tn,
+                landing, tn,
                 [&](size_t i, float, const float*) { return MarchAdaptiveLanding(s_, t[i], end[i], xs[i], exit[i]); },
                 tn);
         } else {
@@ -517,8 +518,8 @@ class MarchLanes {
             const VI mi = hn::ConvertTo(di, Clamp(m, hn::Zero(d_), hn::Set(d_, 16777216.0f)));
             const VI n1 = hn::Add(n, hn::Set(di, 1));
             const VI nSkip = hn::IfThenElse(hn::Lt(n1, mi), mi, n1);
-            n = hn::IfThenElse(hn::RebindMask(di, skip), nSkip, n);
-            tn = hn::IfThenElse(skip, hn::Add(tMin, hn::Mul(hn::ConvertTo(d_, n), delta)), tn);
+            n = hn::IfThenElse(hn::RebindMask(di, landing), nSkip, n);
+            tn = hn::IfThenElse(landing, hn::Add(tMin, hn::Mul(hn::ConvertTo(d_, n), delta)), tn);
         }
     }
 
