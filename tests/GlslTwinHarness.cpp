@@ -72,7 +72,9 @@ std::vector<Words> GlslTwin::Run(TwinFn fn, const std::vector<Words>& inputs, co
     EXPECT_TRUE(ctx.Upload(*frameBuffer, std::as_bytes(std::span(&frame, 1))));
     EXPECT_TRUE(ctx.Upload(*marchBuffer, std::as_bytes(std::span(&march, 1))));
     EXPECT_TRUE(ctx.Upload(*layersBuffer, std::as_bytes(std::span(&layers, 1))));
-    if (!billboards.empty()) EXPECT_TRUE(ctx.Upload(*billboardBuffer, std::as_bytes(billboards)));
+    if (!billboards.empty()) {
+        EXPECT_TRUE(ctx.Upload(*billboardBuffer, std::as_bytes(billboards)));
+    }
     EXPECT_TRUE(ctx.Upload(*table, std::as_bytes(std::span(kMieCloudTable.values, kMieCloudTable.count))));
     const struct { uint32_t fn, count; } push{uint32_t(fn), uint32_t(inputs.size())};
     const vk::DeviceBuffer* buffers[] = {&*in,    &*out,          &*frameBuffer,    &*marchBuffer,

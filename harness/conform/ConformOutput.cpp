@@ -343,7 +343,9 @@ std::string ConformJUnit(const std::vector<ConformRow>& rows, const std::string&
     std::vector<JUnitCase> cases;
     char numbers[96];
     for (const ConformRow& r : rows) {
-        JUnitCase c{scene + (r.caseName.empty() ? "" : "." + r.caseName) + "." + r.backend, r.stage};
+        JUnitCase c;
+        c.classname = scene + (r.caseName.empty() ? "" : "." + r.caseName) + "." + r.backend;
+        c.name = r.stage;
         if (r.status == "fail" || r.status == "unexpected-pass") {
             std::snprintf(numbers, sizeof numbers, "worst %.9g, tolerance %.9g", r.worst, r.tolerance);
             c.result = JUnitCase::Result::Failure;
