@@ -126,19 +126,26 @@ void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volu
             const hn::ScalableTag<float> d;
             MarchLanes march(d, params.setup, lanes, lanes.brickEmpty != nullptr, shadeLight, params.lightSteps,
                              volume);
-            uint32_t x = r.cols().begin(), y = r.rows().begin();
-            auto next = [&](MarchRayGeometry& ray, float& xi, uint32_t& pixel) {
-                if (y >= r.rows().end()) return false;
-                ray = PixelRay(params, x, y, xi);
-                pixel = x + W * y;
-                if (++x == r.cols().end()) x = r.cols().begin(), ++y;
-                return true;
-            };
             auto finish = [&](uint32_t pixel, const Vec3& light, float transmittance) {
                 write(pixel % W, pixel / W, light, transmittance);
             };
+            const CameraFrame& cam = params.camera;
+            const float h = params.setup.voxelSize;
+            const Vec3 origin{(cam.eye[0] - params.origin[0]) / h, (cam.eye[1] - params.origin[1]) / h,
+                              (cam.eye[2] - params.origin[2]) / h};  // MakePixelRay's
             MarchLaneCounters c;
-            march.Run(next, finish, c);
+            // The range in tiles of at most 16 x 16 pixels, each a batch of rays made in lanes, then marched.
+            MarchPixelRays batch;
+            uint32_t xs[kMarchTilePixels], ys[kMarchTilePixels];
+            for (uint32_t y0 = r.rows().begin(); y0 < r.rows().end(); y0 += 16)
+                for (uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += 16) {
+                    size_t count = 0;
+                    for (uint32_t y = y0; y < std::min(y0 + 16, r.rows().end()); ++y)
+                        for (uint32_t x = x0; x < std::min(x0 + 16, r.cols().end()); ++x)
+                            xs[count] = x, ys[count] = y, ++count;
+                    march.PrepareRays(cam, origin, xs, ys, count, params.jitter, params.seed, params.frame, batch);
+                    march.Run(batch, origin, finish, c);
+                }
             rays += c.rays;
             samples += c.samples;
             lightSamples += c.lightCalls;
