@@ -23,6 +23,7 @@
 #include <limits>
 
 #include "core/math/March.h"
+#include "impl_cpu/MarchPixelRaysCpu-inl.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -97,18 +98,6 @@ struct MarchLaneCounters {
     uint64_t laneSteps = 0, packetSteps = 0;  // MarchStats's laneSteps and laneSlots
 };
 
-// The rays of up to kMarchTilePixels pixels, as MarchRay starts them (SoA): MakePixelRay's direction and
-// [tMin, tMax], InverseDirection, the jitter xi and the sun's and sky light's phases; `pixel` the image index.
-inline constexpr size_t kMarchTilePixels = 16 * 16;
-struct MarchPixelRays {
-    alignas(64) float dx[kMarchTilePixels], dy[kMarchTilePixels], dz[kMarchTilePixels];
-    alignas(64) float ix[kMarchTilePixels], iy[kMarchTilePixels], iz[kMarchTilePixels];
-    alignas(64) float tMin[kMarchTilePixels], tMax[kMarchTilePixels], xi[kMarchTilePixels];
-    alignas(64) float sunPhase[kMarchTilePixels], skyPhase[kMarchTilePixels];
-    alignas(64) uint32_t pixel[kMarchTilePixels];
-    size_t count = 0;
-};
-
 template <class D>
 class MarchLanes {
     using V = hn::Vec<D>;
@@ -126,70 +115,6 @@ class MarchLanes {
           scalarVolume_(scalarVolume) {
         HWY_DASSERT(hn::Lanes(d) <= kMax);
         rareLight_ = s.light.pointOn || s.light.glowOn || s.light.eyeOn;
-    }
-
-    // The rays of pixels (x[i], y[i]), i < count <= kMarchTilePixels, Lanes(d) at a time: MakePixelRay,
-    // InverseDirection and MarchRay's two phases operation for operation (Mie's table and the jitter per lane).
-    void PrepareRays(const CameraFrame& c, const Vec3& origin, const uint32_t* x, const uint32_t* y, size_t count,
-                     bool jitter, uint32_t seed, uint32_t frame, MarchPixelRays& rays) const {
-        const size_t N = hn::Lanes(d_);
-        const DI di;
-        rays.count = count;
-        for (size_t b = 0; b < count; b += N) {
-            alignas(64) int32_t xs[kMax] = {}, ys[kMax] = {};
-            for (size_t i = 0; i < N && b + i < count; ++i) xs[i] = int32_t(x[b + i]), ys[i] = int32_t(y[b + i]);
-            const V fx = hn::ConvertTo(d_, hn::Load(di, xs)), fy = hn::ConvertTo(d_, hn::Load(di, ys));
-            const V focal = hn::Set(d_, c.focalPx), half = hn::Set(d_, 0.5f);
-            const V u = hn::Div(hn::Sub(hn::Add(fx, half), hn::Set(d_, 0.5f * float(c.width))), focal);
-            const V v = hn::Div(hn::Sub(hn::Set(d_, 0.5f * float(c.height)), hn::Add(fy, half)), focal);
-            V dir[3];
-            for (int a = 0; a < 3; ++a)
-                dir[a] = hn::Add(hn::Add(hn::Set(d_, c.forward[a]), hn::Mul(u, hn::Set(d_, c.right[a]))),
-                                 hn::Mul(v, hn::Set(d_, c.upVector[a])));
-            const V dot = hn::Add(hn::Add(hn::Mul(dir[0], dir[0]), hn::Mul(dir[1], dir[1])), hn::Mul(dir[2], dir[2]));
-            const V inv = hn::Div(hn::Set(d_, 1.0f), hn::Sqrt(dot));
-            for (int a = 0; a < 3; ++a) dir[a] = hn::Mul(dir[a], inv);
-            const V perDepth = hn::Div(hn::Set(d_, 1.0f), hn::Mul(hn::Set(d_, s_.voxelSize), inv));
-            V t0 = hn::Mul(hn::Set(d_, c.nearPlane), perDepth), t1 = hn::Mul(hn::Set(d_, c.farPlane), perDepth);
-            V invDir[3];
-            for (int a = 0; a < 3; ++a) {
-                // ClipRayToSlab and InverseDirection: a (nearly) zero component keeps the interval where the eye
-                // lies inside that slab and empties it otherwise.
-                const M tiny = hn::Lt(hn::Abs(dir[a]), hn::Set(d_, 1e-20f));
-                const V inverse = hn::Div(hn::Set(d_, 1.0f), dir[a]);
-                invDir[a] = hn::IfThenElse(tiny, hn::Set(d_, std::numeric_limits<float>::max()), inverse);
-                if (a < (s_.tiling ? 2 : 0)) continue;
-                const V lo0 = hn::Mul(hn::Set(d_, 0.0f - origin[a]), inverse);
-                const V hi0 = hn::Mul(hn::Set(d_, s_.size[a] - origin[a]), inverse);
-                const M swap = hn::Gt(lo0, hi0);
-                const V clipMin = Max(t0, hn::IfThenElse(swap, hi0, lo0));
-                const V clipMax = Min(t1, hn::IfThenElse(swap, lo0, hi0));
-                const bool outside = origin[a] < 0.0f || origin[a] > s_.size[a];
-                t0 = hn::IfThenElse(tiny, outside ? hn::Zero(d_) : t0, clipMin);
-                t1 = hn::IfThenElse(tiny, outside ? hn::Zero(d_) : t1, clipMax);
-            }
-            const V sunCos =
-                hn::Add(hn::Add(hn::Mul(hn::Set(d_, s_.sun[0]), dir[0]), hn::Mul(hn::Set(d_, s_.sun[1]), dir[1])),
-                        hn::Mul(hn::Set(d_, s_.sun[2]), dir[2]));
-            const V sunPhase = Phase(sunCos);
-            V skyPhase = hn::Zero(d_);
-            if (s_.light.skyOn) {
-                const Vec3& k = s_.light.skyDirection;
-                skyPhase =
-                    Phase(hn::Add(hn::Add(hn::Mul(hn::Set(d_, k[0]), dir[0]), hn::Mul(hn::Set(d_, k[1]), dir[1])),
-                                  hn::Mul(hn::Set(d_, k[2]), dir[2])));
-            }
-            hn::StoreU(dir[0], d_, rays.dx + b), hn::StoreU(dir[1], d_, rays.dy + b),
-                hn::StoreU(dir[2], d_, rays.dz + b);
-            hn::StoreU(invDir[0], d_, rays.ix + b), hn::StoreU(invDir[1], d_, rays.iy + b);
-            hn::StoreU(invDir[2], d_, rays.iz + b);
-            hn::StoreU(t0, d_, rays.tMin + b), hn::StoreU(t1, d_, rays.tMax + b);
-            hn::StoreU(sunPhase, d_, rays.sunPhase + b), hn::StoreU(skyPhase, d_, rays.skyPhase + b);
-            for (size_t i = 0; i < N && b + i < count; ++i) {
-                rays.pixel[b + i] = x[b + i] + c.width * y[b + i];
-                rays.xi[b + i] = jitter ? MarchJitter(seed, frame, rays.pixel[b + i]) : 0.5f;
-            }
-        }
     }
 
     // Marches `rays` with origin `origin` and hands each finished pixel to finish(index, L, T_view).
@@ -244,32 +169,6 @@ class MarchLanes {
             ++next;
             return;
         }
-    }
-
-    // PhaseValue of the scene's phase function at cos theta, per lane (Mie's table through the scalar function).
-    V Phase(V cosTheta) const {
-        const PhaseParams& phase = s_.light.phase;
-        const float g = phase.g;
-        switch (phase.kind) {
-            case PhaseKind::None:
-                return hn::Set(d_, 1.0f);
-            case PhaseKind::HenyeyGreenstein: {
-                const V denom = hn::Sub(hn::Set(d_, 1.0f + g * g), hn::Mul(hn::Set(d_, 2.0f * g), cosTheta));
-                return hn::Div(hn::Set(d_, 1.0f - g * g), hn::Mul(denom, hn::Sqrt(denom)));
-            }
-            case PhaseKind::CornetteShanks: {
-                const V denom = hn::Sub(hn::Set(d_, 1.0f + g * g), hn::Mul(hn::Set(d_, 2.0f * g), cosTheta));
-                const V rise = hn::Add(hn::Set(d_, 1.0f), hn::Mul(cosTheta, cosTheta));
-                return hn::Div(hn::Mul(hn::Set(d_, 1.5f * (1.0f - g * g) / (2.0f + g * g)), rise),
-                               hn::Mul(denom, hn::Sqrt(denom)));
-            }
-            case PhaseKind::Mie:
-                break;
-        }
-        alignas(64) float c[kMax];
-        hn::Store(cosTheta, d_, c);
-        for (size_t i = 0; i < hn::Lanes(d_); ++i) c[i] = PhaseValue(phase, c[i]);
-        return hn::Load(d_, c);
     }
 
     // The state lives in registers during a step and in the arrays across a refill.

@@ -143,7 +143,8 @@ void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volu
                     for (uint32_t y = y0; y < std::min(y0 + 16, r.rows().end()); ++y)
                         for (uint32_t x = x0; x < std::min(x0 + 16, r.cols().end()); ++x)
                             xs[count] = x, ys[count] = y, ++count;
-                    march.PrepareRays(cam, origin, xs, ys, count, params.jitter, params.seed, params.frame, batch);
+                    MakePixelRaysInLanes(d, params.setup, cam, origin, xs, ys, count, params.jitter, params.seed,
+                                         params.frame, batch);
                     march.Run(batch, origin, finish, c);
                 }
             rays += c.rays;
