@@ -23,6 +23,7 @@
 #include <limits>
 
 #include "core/math/March.h"
+#include "core/stages/render_march/RenderMarchTypes.h"
 #include "impl_cpu/MarchPixelRaysCpu-inl.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
@@ -92,12 +93,6 @@ struct MarchLaneVolume {
 // Whether the lanes can index the volumes with 32-bit gathers (else the scalar kernel runs).
 inline bool MarchLanesFit(size_t paddedCells) { return paddedCells <= size_t(std::numeric_limits<int32_t>::max() / 2 - 8); }
 
-// MarchRay's counters summed over a packet's rays, and how full its lanes were.
-struct MarchLaneCounters {
-    uint64_t rays = 0, samples = 0, lightCalls = 0, bricksSkipped = 0;
-    uint64_t laneSteps = 0, packetSteps = 0;  // MarchStats's laneSteps and laneSlots
-};
-
 template <class D>
 class MarchLanes {
     using V = hn::Vec<D>;
@@ -107,11 +102,16 @@ class MarchLanes {
     static constexpr size_t kMax = 16;  // the widest target's float lanes (AVX-512)
 
   public:
-    // bricks: skipping on (vol's bricks set); shadeLight: the sun's light from T (else the light march of
-    // lightSteps taps); scalarVolume: the same volume for the per-lane scalar functions.
-    MarchLanes(D d, const MarchSetup& s, const MarchLaneVolume& vol, bool bricks, bool shadeLight, uint32_t lightSteps,
+    // Skipping is on where vol has bricks; shadeLight: the sun's light from T (else the light march of lightSteps
+    // taps); scalarVolume: the same volume for the per-lane scalar functions.
+    MarchLanes(D d, const MarchSetup& s, const MarchLaneVolume& vol, bool shadeLight, uint32_t lightSteps,
                const MarchPaddedVolume& scalarVolume)
-        : d_(d), s_(s), vol_(vol), bricks_(bricks), shadeLight_(shadeLight), nl_(lightSteps),
+        : d_(d),
+          s_(s),
+          vol_(vol),
+          bricks_(vol.brickEmpty != nullptr),
+          shadeLight_(shadeLight),
+          nl_(lightSteps),
           scalarVolume_(scalarVolume) {
         HWY_DASSERT(hn::Lanes(d) <= kMax);
         rareLight_ = s.light.pointOn || s.light.glowOn || s.light.eyeOn;
@@ -119,7 +119,7 @@ class MarchLanes {
 
     // Marches `rays` with origin `origin` and hands each finished pixel to finish(index, L, T_view).
     template <class Finish>
-    void Run(const MarchPixelRays& rays, const Vec3& origin, Finish&& finish, MarchLaneCounters& counters) {
+    void Run(const MarchPixelRays& rays, const Vec3& origin, Finish&& finish, MarchStats& counters) {
         const size_t N = hn::Lanes(d_);
         for (size_t i = 0; i < kMax; ++i) pixel_[i] = -1;
         size_t next = 0;
@@ -130,7 +130,7 @@ class MarchLanes {
         while (true) {
             const M active = hn::RebindMask(d_, hn::Gt(hn::Load(di, pixel_), hn::Set(di, -1)));
             if (hn::AllFalse(d_, active)) break;
-            counters.packetSteps += N;
+            counters.laneSlots += N;
             counters.laneSteps += hn::CountTrue(d_, active);
             const M finished = Step(active, counters);
             if (!hn::AllFalse(d_, finished)) {
@@ -151,7 +151,7 @@ class MarchLanes {
   private:
     // Lane i takes rays until one passes through the volume; a pixel without one is finished at once.
     template <class Finish>
-    void Refill(size_t i, const MarchPixelRays& rays, size_t& next, Finish& finish, MarchLaneCounters& counters) {
+    void Refill(size_t i, const MarchPixelRays& rays, size_t& next, Finish& finish, MarchStats& counters) {
         for (; next < rays.count; ++next) {
             const size_t r = next;
             if (!(rays.tMin[r] < rays.tMax[r])) {
@@ -196,7 +196,7 @@ class MarchLanes {
     // more instructions).
     static VI Truncate(V v) {
 #if HWY_TARGET <= HWY_AVX3
-        return VI{_mm512_cvttps_epi32(v.raw)};
+        return VI{_mm512_maskz_cvttps_epi32(__mmask16(0xFFFF), v.raw)};  // maskz: no undefined source to warn of
 #elif HWY_TARGET <= HWY_AVX2
         return VI{_mm256_cvttps_epi32(v.raw)};
 #elif HWY_TARGET <= HWY_SSE4
@@ -419,7 +419,7 @@ class MarchLanes {
     // One step of every active lane: MarchRay's loop body, or one brick of its walk through empty bricks (a lane
     // walks one brick a step, so one lane's long walk does not hold up the others). Returns the lanes whose ray
     // has ended.
-    M Step(M active, MarchLaneCounters& counters) {
+    M Step(M active, MarchStats& counters) {
         const DI di;
         const V delta = StepAt(tn);
         V tNext = s_.adaptive ? hn::Add(tn, delta)
@@ -462,7 +462,7 @@ class MarchLanes {
         const M lit = hn::And(sample, hn::Gt(qa, hn::Zero(d_)));
         M stop = hn::FirstN(d_, 0);
         if (!hn::AllFalse(d_, lit)) {
-            counters.lightCalls += hn::CountTrue(d_, lit);
+            counters.lightSamples += hn::CountTrue(d_, lit);
             const V tau = Exp(hn::Mul(hn::Neg(hn::Mul(hn::Set(d_, s_.sigmaH), qa)), len));
             const V sunT = shadeLight_ ? BlendTaps(cells.t, taps) : SunLight(px, py, pz, lit);
             const V skyT = s_.light.skyOn ? Blend(vol_.sky, 1, taps) : hn::Set(d_, 1.0f);

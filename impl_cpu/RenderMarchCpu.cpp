@@ -13,10 +13,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/blocked_range3d.h>
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include "core/math/March.h"
@@ -77,18 +77,28 @@ inline MarchRayGeometry PixelRay(const MarchParams& params, uint32_t x, uint32_t
                         params.setup.tiling);
 }
 
+// Adds part's per-ray counters (its rays' samples, skips and lanes) to total; the skip structure's are the call's.
+void AddRayCounters(MarchStats& total, const MarchStats& part) {
+    total.rays += part.rays;
+    total.samples += part.samples;
+    total.lightSamples += part.lightSamples;
+    total.bricksSkipped += part.bricksSkipped;
+    total.laneSteps += part.laneSteps;
+    total.laneSlots += part.laneSlots;
+}
+
 // Every pixel through MarchRay, one ray at a time, TBB over 8 x 8 pixel tiles.
 template <class Light>
 void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks,
                  const MarchPixelWriter& write, MarchStats& stats, Light&& makeLight) {
     const uint32_t W = params.camera.width, H = params.camera.height;
-    std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0};
+    tbb::combinable<MarchStats> perThread;
     // flatten: MarchRay and what it calls (core/math, compiled for the baseline
     // where they are not inlined) become this target's code.
     tbb::parallel_for(
         tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
                                                               flatten)) {
-            uint64_t nRays = 0, nSamples = 0, nLight = 0, nSkipped = 0;
+            MarchStats& c = perThread.local();
             MarchCachedDensity density{&volume};
             auto light = makeLight(density);
             for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
@@ -97,20 +107,13 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
                     const MarchRayGeometry ray = PixelRay(params, x, y, xi);
                     const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
                     write(x, y, m.light, m.transmittance);
-                    nRays += ray.Empty() ? 0 : 1;
-                    nSamples += m.samples;
-                    nLight += m.lightCalls;
-                    nSkipped += m.bricksSkipped;
+                    c.rays += ray.Empty() ? 0 : 1;
+                    c.samples += m.samples;
+                    c.lightSamples += m.lightCalls;
+                    c.bricksSkipped += m.bricksSkipped;
                 }
-            rays += nRays;
-            samples += nSamples;
-            lightSamples += nLight;
-            skipped += nSkipped;
         });
-    stats.rays = rays;
-    stats.samples = samples;
-    stats.lightSamples = lightSamples;
-    stats.bricksSkipped = skipped;
+    perThread.combine_each([&](const MarchStats& c) { AddRayCounters(stats, c); });
 }
 
 #if HWY_TARGET != HWY_SCALAR
@@ -119,21 +122,17 @@ void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volu
                         const MarchPixelWriter& write, MarchStats& stats) {
     const uint32_t W = params.camera.width, H = params.camera.height;
     const bool shadeLight = params.light == MarchLightSource::Shade;
-    std::atomic<uint64_t> rays{0}, samples{0}, lightSamples{0}, skipped{0}, laneSteps{0}, packetSteps{0};
+    const Vec3 origin = GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize);  // MakePixelRay's
+    tbb::combinable<MarchStats> perThread;
     tbb::parallel_for(
         tbb::blocked_range2d<uint32_t>(0, H, 16, 0, W, 16), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
                                                                 flatten)) {
             const hn::ScalableTag<float> d;
-            MarchLanes march(d, params.setup, lanes, lanes.brickEmpty != nullptr, shadeLight, params.lightSteps,
-                             volume);
+            MarchLanes march(d, params.setup, lanes, shadeLight, params.lightSteps, volume);
             auto finish = [&](uint32_t pixel, const Vec3& light, float transmittance) {
                 write(pixel % W, pixel / W, light, transmittance);
             };
-            const CameraFrame& cam = params.camera;
-            const float h = params.setup.voxelSize;
-            const Vec3 origin{(cam.eye[0] - params.origin[0]) / h, (cam.eye[1] - params.origin[1]) / h,
-                              (cam.eye[2] - params.origin[2]) / h};  // MakePixelRay's
-            MarchLaneCounters c;
+            MarchStats& c = perThread.local();
             // The range in tiles of at most 16 x 16 pixels, each a batch of rays made in lanes, then marched.
             MarchPixelRays batch;
             uint32_t xs[kMarchTilePixels], ys[kMarchTilePixels];
@@ -143,24 +142,12 @@ void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volu
                     for (uint32_t y = y0; y < std::min(y0 + 16, r.rows().end()); ++y)
                         for (uint32_t x = x0; x < std::min(x0 + 16, r.cols().end()); ++x)
                             xs[count] = x, ys[count] = y, ++count;
-                    MakePixelRaysInLanes(d, params.setup, cam, origin, xs, ys, count, params.jitter, params.seed,
-                                         params.frame, batch);
+                    MakePixelRaysInLanes(d, params.setup, params.camera, origin, xs, ys, count, params.jitter,
+                                         params.seed, params.frame, batch);
                     march.Run(batch, origin, finish, c);
                 }
-            rays += c.rays;
-            samples += c.samples;
-            lightSamples += c.lightCalls;
-            skipped += c.bricksSkipped;
-            laneSteps += c.laneSteps;
-            packetSteps += c.packetSteps;
         });
-    stats.rays = rays;
-    stats.samples = samples;
-    stats.lightSamples = lightSamples;
-    stats.bricksSkipped = skipped;
-    stats.laneSteps = laneSteps;
-    stats.laneSlots = packetSteps;
-    (void)H;
+    perThread.combine_each([&](const MarchStats& c) { AddRayCounters(stats, c); });
 }
 #endif
 
