@@ -117,7 +117,7 @@ class MarchLanes {
         rareLight_ = s.light.pointOn || s.light.glowOn || s.light.eyeOn;
     }
 
-    // Marches `rays` with origin `origin` and hands each finished pixel to finish(index, L, T_view).
+    // Marches `rays` with origin `origin` and hands each finished pixel to finish(index, L, T_view, depthSum).
     template <class Finish>
     void Run(const MarchPixelRays& rays, const Vec3& origin, Finish&& finish, MarchStats& counters) {
         const size_t N = hn::Lanes(d_);
@@ -139,7 +139,7 @@ class MarchLanes {
                 hn::Store(hn::VecFromMask(di, hn::RebindMask(di, finished)), di, done);
                 for (size_t i = 0; i < N; ++i)
                     if (done[i]) {
-                        finish(uint32_t(pixel_[i]), Vec3{L0_[i], L1_[i], L2_[i]}, T_[i]);
+                        finish(uint32_t(pixel_[i]), Vec3{L0_[i], L1_[i], L2_[i]}, T_[i], depthSum_[i]);
                         pixel_[i] = -1;
                         Refill(i, rays, next, finish, counters);
                     }
@@ -155,7 +155,7 @@ class MarchLanes {
         for (; next < rays.count; ++next) {
             const size_t r = next;
             if (!(rays.tMin[r] < rays.tMax[r])) {
-                finish(rays.pixel[r], Vec3{0, 0, 0}, 1.0f);
+                finish(rays.pixel[r], Vec3{0, 0, 0}, 1.0f, 0.0f);
                 continue;
             }
             ++counters.rays;
@@ -164,7 +164,7 @@ class MarchLanes {
             tMin_[i] = rays.tMin[r], tMax_[i] = rays.tMax[r], xi_[i] = rays.xi[r];
             sunPhase_[i] = rays.sunPhase[r], skyPhase_[i] = rays.skyPhase[r];
             tn_[i] = rays.tMin[r], n_[i] = 0, tExit_[i] = 0.0f, walking_[i] = 0;
-            T_[i] = 1.0f, L0_[i] = L1_[i] = L2_[i] = 0.0f;
+            T_[i] = 1.0f, L0_[i] = L1_[i] = L2_[i] = depthSum_[i] = 0.0f;
             pixel_[i] = int32_t(rays.pixel[r]);
             ++next;
             return;
@@ -178,7 +178,7 @@ class MarchLanes {
         ix = hn::Load(d_, ix_), iy = hn::Load(d_, iy_), iz = hn::Load(d_, iz_);
         tMin = hn::Load(d_, tMin_), tMax = hn::Load(d_, tMax_), xi = hn::Load(d_, xi_);
         tn = hn::Load(d_, tn_), T = hn::Load(d_, T_);
-        L0 = hn::Load(d_, L0_), L1 = hn::Load(d_, L1_), L2 = hn::Load(d_, L2_);
+        L0 = hn::Load(d_, L0_), L1 = hn::Load(d_, L1_), L2 = hn::Load(d_, L2_), depthSum = hn::Load(d_, depthSum_);
         sunPhase = hn::Load(d_, sunPhase_), skyPhase = hn::Load(d_, skyPhase_);
         n = hn::Load(DI(), n_);
         tExit = hn::Load(d_, tExit_);
@@ -186,7 +186,7 @@ class MarchLanes {
     }
     void Store() {
         hn::Store(tn, d_, tn_), hn::Store(T, d_, T_);
-        hn::Store(L0, d_, L0_), hn::Store(L1, d_, L1_), hn::Store(L2, d_, L2_);
+        hn::Store(L0, d_, L0_), hn::Store(L1, d_, L1_), hn::Store(L2, d_, L2_), hn::Store(depthSum, d_, depthSum_);
         hn::Store(n, DI(), n_);
         hn::Store(tExit, d_, tExit_);
         hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), walking)), DI(), walking_);
@@ -489,6 +489,7 @@ class MarchLanes {
             L0 = hn::IfThenElse(lit, hn::Add(L0, hn::Mul(w, in0)), L0);
             L1 = hn::IfThenElse(lit, hn::Add(L1, hn::Mul(w, in1)), L1);
             L2 = hn::IfThenElse(lit, hn::Add(L2, hn::Mul(w, in2)), L2);
+            depthSum = hn::IfThenElse(lit, hn::Add(depthSum, hn::Mul(w, ts)), depthSum);
             T = hn::IfThenElse(lit, hn::Mul(T, tau), T);
             stop = hn::And(lit, hn::Or(hn::Lt(T, hn::Set(d_, s_.epsilon)), hn::Eq(T, hn::Zero(d_))));
         }
@@ -558,14 +559,15 @@ class MarchLanes {
     uint32_t nl_;
     const MarchPaddedVolume& scalarVolume_;
 
-    // A lane's ray: origin, direction and its inverse, [tMin, tMax], jitter, the two phases; MarchRay's tn, n, T
-    // and L; and, while it walks through empty bricks, the last one's exit.
-    V ox, oy, oz, dx, dy, dz, ix, iy, iz, tMin, tMax, xi, tn, T, L0, L1, L2, sunPhase, skyPhase, tExit;
+    // A lane's ray: origin, direction and its inverse, [tMin, tMax], jitter, the two phases; MarchRay's tn, n, T,
+    // L and depthSum; and, while it walks through empty bricks, the last one's exit.
+    V ox, oy, oz, dx, dy, dz, ix, iy, iz, tMin, tMax, xi, tn, T, L0, L1, L2, depthSum, sunPhase, skyPhase, tExit;
     VI n;
     M walking;
     alignas(64) float ox_[kMax], oy_[kMax], oz_[kMax], dx_[kMax], dy_[kMax], dz_[kMax], ix_[kMax], iy_[kMax],
         iz_[kMax];
-    alignas(64) float tMin_[kMax], tMax_[kMax], xi_[kMax], tn_[kMax], T_[kMax], L0_[kMax], L1_[kMax], L2_[kMax];
+    alignas(64) float tMin_[kMax], tMax_[kMax], xi_[kMax], tn_[kMax], T_[kMax], L0_[kMax], L1_[kMax], L2_[kMax],
+        depthSum_[kMax];
     alignas(64) float sunPhase_[kMax], skyPhase_[kMax];
     alignas(64) float tExit_[kMax];
     alignas(64) int32_t n_[kMax], walking_[kMax], pixel_[kMax];

@@ -18,8 +18,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/math/March.h"
+#include "core/math/Reprojection.h"
 #include "impl_cpu/BackendCpu.h"
 #include "impl_cpu/MarchLanesCpu-inl.h"
 #include "impl_cpu/PaddedVolumeCpu-inl.h"
@@ -42,28 +44,56 @@ struct MarchCachedDensity {
     float LastSkyT() const { return volume->SkyT(last); }
 };
 
-// Writes pixel (x, y) from its march's L and T_view: C = L + T_view background, the background the scene's colour
-// or, with the ground G, the ground where the pixel's ray meets it (core/math/Ground.h).
+// The pixels a pass traces: cell (cx, cy) of a cols x rows grid traces pixel (X(cx), Y(cy)): every pixel in a full
+// frame, else each k x k block's traced pixel (core/math/Reprojection.h).
+struct MarchPixelGrid {
+    uint32_t cols = 0, rows = 0, k = 1, offsetX = 0, offsetY = 0, width = 0, height = 0;
+    explicit MarchPixelGrid(const MarchParams& p) : width(p.camera.width), height(p.camera.height) {
+        const ReprojectionSetup& r = p.reprojection;
+        if (!r.full) k = r.block, offsetX = r.offsetX, offsetY = r.offsetY;
+        cols = ReprojectionBlocks(width, k), rows = ReprojectionBlocks(height, k);
+    }
+    uint32_t X(uint32_t cx) const { return TracedCoordinate(cx, k, offsetX, width); }
+    uint32_t Y(uint32_t cy) const { return TracedCoordinate(cy, k, offsetY, height); }
+    size_t Cells() const { return size_t(cols) * rows; }
+};
+
+// Writes traced pixel (x, y) from its march's L, T_view and depth sum: C = L + T_view background, the background the
+// scene's colour or, with the ground G, the ground where the pixel's ray meets it (core/math/Ground.h). A full frame
+// writes C into the image; a reprojected one writes C and the view depth into its block's cell of `traced` (4 floats a
+// cell).
 class MarchPixelWriter {
   public:
-    MarchPixelWriter(const MarchParams& params, float* image, const float* G, const Extent3& grid)
+    MarchPixelWriter(const MarchParams& params, const MarchPixelGrid& cells, float* image, float* traced,
+                     const float* G, const Extent3& grid)
         : params_(params),
+          cells_(cells),
           image_(image),
+          traced_(traced),
           G_(G),
           grid_(grid),
           groundLight_(MakeGroundLight(params)),
           eyeVoxel_(GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize)) {}
-    void operator()(uint32_t x, uint32_t y, const Vec3& light, float transmittance) const {
-        float* out = image_ + 3 * (size_t(x) + size_t(params_.camera.width) * y);
+    void operator()(uint32_t x, uint32_t y, const Vec3& light, float transmittance, float depthSum) const {
         const Vec3 bg = G_ ? GroundBackground(params_.camera, eyeVoxel_, params_.setup.voxelSize, groundLight_, G_,
                                               grid_.nx, grid_.ny, x, y)
                            : params_.setup.background;
+        if (cells_.k == 1) {
+            float* out = image_ + 3 * (size_t(x) + size_t(params_.camera.width) * y);
+            for (int c = 0; c < 3; ++c) out[c] = light[c] + transmittance * bg[c];
+            return;
+        }
+        float* out = traced_ + 4 * (size_t(x / cells_.k) + size_t(cells_.cols) * (y / cells_.k));
         for (int c = 0; c < 3; ++c) out[c] = light[c] + transmittance * bg[c];
+        out[3] = MarchViewDepth(depthSum, transmittance, params_.setup.voxelSize,
+                                PixelRayDirection(params_.camera, x, y).cosForward, params_.camera.farPlane);
     }
 
   private:
     const MarchParams& params_;
+    const MarchPixelGrid& cells_;
     float* image_;
+    float* traced_;
     const float* G_;
     Extent3 grid_;
     GroundLight groundLight_;
@@ -87,26 +117,26 @@ void AddRayCounters(MarchStats& total, const MarchStats& part) {
     total.laneSlots += part.laneSlots;
 }
 
-// Every pixel through MarchRay, one ray at a time, TBB over 8 x 8 pixel tiles.
+// The grid's pixels through MarchRay, one ray at a time, TBB over 8 x 8 cell tiles.
 template <class Light>
-void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, const MarchBricks* bricks,
-                 const MarchPixelWriter& write, MarchStats& stats, Light&& makeLight) {
-    const uint32_t W = params.camera.width, H = params.camera.height;
+void MarchPixels(const MarchParams& params, const MarchPixelGrid& cells, const MarchPaddedVolume& volume,
+                 const MarchBricks* bricks, const MarchPixelWriter& write, MarchStats& stats, Light&& makeLight) {
     tbb::combinable<MarchStats> perThread;
     // flatten: MarchRay and what it calls (core/math, compiled for the baseline
     // where they are not inlined) become this target's code.
     tbb::parallel_for(
-        tbb::blocked_range2d<uint32_t>(0, H, 8, 0, W, 8), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
-                                                              flatten)) {
+        tbb::blocked_range2d<uint32_t>(0, cells.rows, 8, 0, cells.cols, 8), [&](const tbb::blocked_range2d<uint32_t>&
+                                                                                    r) __attribute__((flatten)) {
             MarchStats& c = perThread.local();
             MarchCachedDensity density{&volume};
             auto light = makeLight(density);
-            for (uint32_t y = r.rows().begin(); y < r.rows().end(); ++y)
-                for (uint32_t x = r.cols().begin(); x < r.cols().end(); ++x) {
+            for (uint32_t cy = r.rows().begin(); cy < r.rows().end(); ++cy)
+                for (uint32_t cx = r.cols().begin(); cx < r.cols().end(); ++cx) {
+                    const uint32_t x = cells.X(cx), y = cells.Y(cy);
                     float xi;
                     const MarchRayGeometry ray = PixelRay(params, x, y, xi);
                     const MarchRayResult m = MarchRay(params.setup, ray, xi, bricks, density, light);
-                    write(x, y, m.light, m.transmittance);
+                    write(x, y, m.light, m.transmittance, m.depthSum);
                     c.rays += ray.Empty() ? 0 : 1;
                     c.samples += m.samples;
                     c.lightSamples += m.lightCalls;
@@ -117,31 +147,31 @@ void MarchPixels(const MarchParams& params, const MarchPaddedVolume& volume, con
 }
 
 #if HWY_TARGET != HWY_SCALAR
-// Every pixel through MarchLanes (impl_cpu/MarchLanesCpu-inl.h), a packet of rays per 16 x 16 pixel tile.
-void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volume, const MarchLaneVolume& lanes,
-                        const MarchPixelWriter& write, MarchStats& stats) {
-    const uint32_t W = params.camera.width, H = params.camera.height;
+// The grid's pixels through MarchLanes (impl_cpu/MarchLanesCpu-inl.h), a packet of rays per 16 x 16 cell tile.
+void MarchPixelsInLanes(const MarchParams& params, const MarchPixelGrid& cells, const MarchPaddedVolume& volume,
+                        const MarchLaneVolume& lanes, const MarchPixelWriter& write, MarchStats& stats) {
+    const uint32_t W = params.camera.width;
     const bool shadeLight = params.light == MarchLightSource::Shade;
     const Vec3 origin = GroundEyeVoxel(params.camera, params.origin, params.setup.voxelSize);  // MakePixelRay's
     tbb::combinable<MarchStats> perThread;
     tbb::parallel_for(
-        tbb::blocked_range2d<uint32_t>(0, H, 16, 0, W, 16), [&](const tbb::blocked_range2d<uint32_t>& r) __attribute__((
-                                                                flatten)) {
+        tbb::blocked_range2d<uint32_t>(0, cells.rows, 16, 0, cells.cols, 16), [&](const tbb::blocked_range2d<uint32_t>&
+                                                                                      r) __attribute__((flatten)) {
             const hn::ScalableTag<float> d;
             MarchLanes march(d, params.setup, lanes, shadeLight, params.lightSteps, volume);
-            auto finish = [&](uint32_t pixel, const Vec3& light, float transmittance) {
-                write(pixel % W, pixel / W, light, transmittance);
+            auto finish = [&](uint32_t pixel, const Vec3& light, float transmittance, float depthSum) {
+                write(pixel % W, pixel / W, light, transmittance, depthSum);
             };
             MarchStats& c = perThread.local();
-            // The range in tiles of at most 16 x 16 pixels, each a batch of rays made in lanes, then marched.
+            // The range in tiles of at most 16 x 16 cells, each a batch of rays made in lanes, then marched.
             MarchPixelRays batch;
             uint32_t xs[kMarchTilePixels], ys[kMarchTilePixels];
             for (uint32_t y0 = r.rows().begin(); y0 < r.rows().end(); y0 += 16)
                 for (uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += 16) {
                     size_t count = 0;
-                    for (uint32_t y = y0; y < std::min(y0 + 16, r.rows().end()); ++y)
-                        for (uint32_t x = x0; x < std::min(x0 + 16, r.cols().end()); ++x)
-                            xs[count] = x, ys[count] = y, ++count;
+                    for (uint32_t cy = y0; cy < std::min(y0 + 16, r.rows().end()); ++cy)
+                        for (uint32_t cx = x0; cx < std::min(x0 + 16, r.cols().end()); ++cx)
+                            xs[count] = cells.X(cx), ys[count] = cells.Y(cy), ++count;
                     MakePixelRaysInLanes(d, params.setup, params.camera, origin, xs, ys, count, params.jitter,
                                          params.seed, params.frame, batch);
                     march.Run(batch, origin, finish, c);
@@ -150,6 +180,48 @@ void MarchPixelsInLanes(const MarchParams& params, const MarchPaddedVolume& volu
     perThread.combine_each([&](const MarchStats& c) { AddRayCounters(stats, c); });
 }
 #endif
+
+// A reprojected frame's pixels (SPEC 19): a traced pixel its traced colour, every other the previous frame (`history`)
+// reprojected by its block's traced depth and clamped to the traced colours of the 3 x 3 blocks around its own
+// (ReprojectedColor). `bounds` takes 6 floats a block.
+void ResolveReprojected(const MarchParams& params, const MarchPixelGrid& cells, const float* traced,
+                        const float* history, float* bounds, float* image) {
+    // Each block's least and greatest traced colour over itself and its neighbours.
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, cells.rows), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t cy = r.begin(); cy < r.end(); ++cy)
+            for (uint32_t cx = 0; cx < cells.cols; ++cx) {
+                float* b = bounds + 6 * (cx + size_t(cells.cols) * cy);
+                for (int c = 0; c < 3; ++c)
+                    b[c] = std::numeric_limits<float>::infinity(), b[3 + c] = -std::numeric_limits<float>::infinity();
+                for (uint32_t ny = cy > 0 ? cy - 1 : 0; ny <= std::min(cy + 1, cells.rows - 1); ++ny)
+                    for (uint32_t nx = cx > 0 ? cx - 1 : 0; nx <= std::min(cx + 1, cells.cols - 1); ++nx) {
+                        const float* t = traced + 4 * (nx + size_t(cells.cols) * ny);
+                        for (int c = 0; c < 3; ++c) b[c] = std::min(b[c], t[c]), b[3 + c] = std::max(b[3 + c], t[c]);
+                    }
+            }
+    });
+    const uint32_t W = cells.width, H = cells.height;
+    tbb::parallel_for(
+        tbb::blocked_range<uint32_t>(0, H, 8), [&](const tbb::blocked_range<uint32_t>& r) __attribute__((flatten)) {
+            for (uint32_t y = r.begin(); y < r.end(); ++y) {
+                const uint32_t cy = y / cells.k;
+                for (uint32_t x = 0; x < W; ++x) {
+                    const uint32_t cx = x / cells.k;
+                    const size_t cell = cx + size_t(cells.cols) * cy;
+                    const float* t = traced + 4 * cell;
+                    float* out = image + 3 * (size_t(x) + size_t(W) * y);
+                    if (x == cells.X(cx) && y == cells.Y(cy)) {
+                        out[0] = t[0], out[1] = t[1], out[2] = t[2];
+                        continue;
+                    }
+                    const float* b = bounds + 6 * cell;
+                    const Vec3 c = ReprojectedColor(params.reprojection, params.camera, history, x, y, t[3],
+                                                    {t[0], t[1], t[2]}, {b[0], b[1], b[2]}, {b[3], b[4], b[5]});
+                    out[0] = c[0], out[1] = c[1], out[2] = c[2];
+                }
+            }
+        });
+}
 
 }  // namespace
 
@@ -227,7 +299,22 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
         const MarchBricks* brickPtr = params.skipping ? &bricks : nullptr;
         const MarchSetup& s = params.setup;
         const uint32_t nl = params.lightSteps;
-        const MarchPixelWriter write(params, out, G, e);
+        const MarchPixelGrid cells(params);
+        const bool reprojected = !params.reprojection.full;
+        if (reprojected) state.traced.resize(4 * cells.Cells());
+        const MarchPixelWriter write(params, cells, out, state.traced.data(), G, e);
+        // A reprojected frame reads the previous frame from the image, which it then overwrites.
+        auto resolve = [&] {
+            if (!reprojected) return;
+            const size_t pixels = size_t(params.camera.width) * params.camera.height;
+            state.history.resize(3 * pixels);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, 3 * pixels, size_t(1) << 16),
+                              [&](const tbb::blocked_range<size_t>& r) {
+                                  std::copy(out + r.begin(), out + r.end(), state.history.data() + r.begin());
+                              });
+            state.bounds.resize(6 * cells.Cells());
+            ResolveReprojected(params, cells, state.traced.data(), state.history.data(), state.bounds.data(), out);
+        };
 #if HWY_TARGET != HWY_SCALAR
         if (MarchLanesFit(px * py * pz)) {
             MarchLaneVolume lanes;
@@ -240,13 +327,14 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
                 lanes.brickCount[0] = float(bx), lanes.brickCount[1] = float(by), lanes.brickCount[2] = float(bz);
                 lanes.brickStride[0] = int32_t(bx), lanes.brickStride[1] = int32_t(bx * by);
             }
-            MarchPixelsInLanes(params, volume, lanes, write, local);
+            MarchPixelsInLanes(params, cells, volume, lanes, write, local);
+            resolve();
             return;
         }
 #endif
         auto plainQ = [&volume](const Vec3& p) { return volume.Q(p); };
         if (shadeLight) {
-            MarchPixels(params, volume, brickPtr, write, local, [&](MarchCachedDensity& density) {
+            MarchPixels(params, cells, volume, brickPtr, write, local, [&](MarchCachedDensity& density) {
                 return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = density.LastT();
@@ -256,7 +344,7 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
                 };
             });
         } else {
-            MarchPixels(params, volume, brickPtr, write, local, [&](MarchCachedDensity& density) {
+            MarchPixels(params, cells, volume, brickPtr, write, local, [&](MarchCachedDensity& density) {
                 return [&density, &s, nl, plainQ](const Vec3& p) {
                     MarchLightSample l;
                     l.sun = SunLightMarch(s, p, nl, plainQ);
@@ -266,6 +354,7 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
                 };
             });
         }
+        resolve();
     });
     if (stats) *stats = local;
     return {};
@@ -285,7 +374,15 @@ uint64_t RenderMarchCpuState::ScratchBytes(const Scene& scene) const {
     const uint32_t b = std::max(scene.march.brick, 1u);
     const uint64_t bricks = uint64_t(CeilDiv(e.nx, b)) * CeilDiv(e.ny, b) * CeilDiv(e.nz, b);
     const uint64_t cell = sizeof(MarchQT) + (scene.lighting.sky.on ? sizeof(float) : 0);
-    return SaturatingAdd(SaturatingMul(padded, cell), bricks + 3);
+    const uint64_t volumes = SaturatingAdd(SaturatingMul(padded, cell), bricks + 3);
+    const uint32_t k = scene.march.reprojectionBlock;
+    if (k <= 1) return volumes;
+    // Reprojecting: the previous frame (3 floats a pixel) and per block its traced colour and depth and its bounds.
+    const uint64_t pixels = uint64_t(scene.render.width) * scene.render.height;
+    const uint64_t blocks =
+        uint64_t(ReprojectionBlocks(scene.render.width, k)) * ReprojectionBlocks(scene.render.height, k);
+    return SaturatingAdd(
+        volumes, SaturatingMul(SaturatingAdd(SaturatingMul(pixels, 3), SaturatingMul(blocks, 10)), sizeof(float)));
 }
 
 Status BackendCpu::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {

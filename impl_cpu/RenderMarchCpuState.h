@@ -19,7 +19,10 @@ struct RenderMarchCpuState {
     std::vector<MarchQT> volume;  // the padded (q_alpha, T) volume
     std::vector<float> skyVolume;  // the padded T_sky volume (the sky light on), border 1
     std::vector<uint8_t> bricks;   // skipping: 1 per empty brick, then 3 bytes of 0 (the lanes' 32-bit reads)
-    // The padded volume (and T_sky's with the sky light) and one byte per brick.
+    // Reprojecting (core/math/Reprojection.h): per block its traced colour and view depth (4 floats) and the bounds of
+    // its neighbourhood's traced colours (6), and the previous frame.
+    std::vector<float> traced, bounds, history;
+    // The padded volume (and T_sky's with the sky light), one byte per brick, and what reprojecting holds.
     uint64_t ScratchBytes(const Scene& scene) const;
 };
 

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/pipeline/Backend.h"
+#include "core/pipeline/MarchGpu.h"
 #include "core/pipeline/StageObjects.h"
 #include "impl_gl/CaGLState.h"
 #include "impl_gl/DensityGLState.h"
@@ -129,6 +130,7 @@ class BackendGL final : public Backend {
     // The context's texture and viewport limits, read when the backend is made.
     std::vector<DeviceLimit> Limits() const override { return DescribeGLLimits(mLimits); }
     std::optional<LimitExceeded> ExceededLimit(const Scene& scene) const override {
+        if (auto unbuilt = MarchReprojectionNotBuilt(scene, "gl")) return unbuilt;
         return FindExceededGLLimit(mLimits, scene);
     }
 

@@ -42,6 +42,10 @@ uint64_t RenderMarchGLState::ScratchBytes(const Scene& scene) const {
 Status BackendGL::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
     RenderMarchGLState& state = mStages.Get<RenderMarchGLState>();
     if (!in.qPrev || !in.qCur) return MakeError("gl: render_march needs q");
+    if (!params.reprojection.full)
+        return MakeError(
+            "gl: render_march: temporal reprojection (march.reprojection.block > 1) is implemented on "
+            "the cpu backend only so far");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e) return MakeError("gl: render_march: q_prev and q_cur differ in size");
     const bool shadeLight = params.light == MarchLightSource::Shade;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/pipeline/Backend.h"
+#include "core/pipeline/MarchGpu.h"
 #include "core/pipeline/StageObjects.h"
 #include "impl_vk/CaVkState.h"
 #include "impl_vk/DensityVkState.h"
@@ -70,6 +71,7 @@ class BackendVk final : public Backend {
     // The device's workgroup count and storage buffer range.
     std::vector<DeviceLimit> Limits() const override { return DescribeVkLimits(mContext->DeviceLimits()); }
     std::optional<LimitExceeded> ExceededLimit(const Scene& scene) const override {
+        if (auto unbuilt = MarchReprojectionNotBuilt(scene, "vk")) return unbuilt;
         return FindExceededVkLimit(mContext->DeviceLimits(), scene);
     }
 

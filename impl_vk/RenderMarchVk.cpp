@@ -48,6 +48,10 @@ uint64_t RenderMarchVkState::ScratchBytes(const Scene& scene) const {
 Status BackendVk::RenderMarch(const MarchParams& params, const MarchInputs& in, Buffer& image, MarchStats* stats) {
     RenderMarchVkState& state = mStages.Get<RenderMarchVkState>();
     if (!in.qPrev || !in.qCur) return MakeError("vk: render_march needs q");
+    if (!params.reprojection.full)
+        return MakeError(
+            "vk: render_march: temporal reprojection (march.reprojection.block > 1) is implemented on "
+            "the cpu backend only so far");
     const Extent3 e = in.qCur->Extent();
     if (in.qPrev->Extent() != e) return MakeError("vk: render_march: q_prev and q_cur differ in size");
     const bool shadeLight = params.light == MarchLightSource::Shade;

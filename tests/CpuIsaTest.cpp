@@ -166,6 +166,14 @@ const IsaScene kIsaScenes[] = {
                    {"lighting.eye_scattering", "{}"},
                    {"march.powder.enabled", "true"}})},
     {"MarchLightning", "lightning.json", MarchOptions({{"steps", "3"}})},
+    // Frames 1 to 3 reprojected from the frame before, along a camera track.
+    {"MarchReprojected", "noise-track.json",
+     MarchOptions({{"steps", "4"},
+                   {"render.every_steps", "1"},
+                   {"march.reprojection", R"({"block": 2})"},
+                   {"render.cameras", R"([{"name": "fly", "track": [
+                       {"frame": 0, "eye": [1600, 1800, 150], "target": [4600, 4800, 1800]},
+                       {"frame": 3, "eye": [1900, 2100, 260], "target": [4700, 4500, 1700]}]}])"}})},
     {"MarchSky",
      "wang-sunset.json",
      {{"render.width", "64"},

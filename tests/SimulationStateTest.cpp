@@ -260,6 +260,40 @@ TEST_P(SimulationStateSplit, SplitRunOfAStillField) {
     }
 }
 
+// A reprojecting march along a camera track (two frames a step): each frame reads the frame before from its image and
+// its camera from the frames drawn so far, so a resumed run must restore both, the count among the state's fields.
+TEST_P(SimulationStateSplit, SplitRunOfAReprojectedFlight) {
+    const Scene scene = SavedRunScene({
+        {"stages", R"(["noise", "density", "shade", "shadow", "render_march"])"},
+        {"noise", R"({"seed": 3, "basis": "perlin", "frequency": [4, 4, 2], "octaves": 2, "threshold": 0.1})"},
+        {"grid.size", "[32, 32, 8]"},
+        {"steps", "5"},
+        {"warmup_steps", "0"},
+        {"march.reprojection", R"({"block": 2})"},
+        {"render.cameras", R"([{"name": "a", "fov_deg": 70, "far": 20000, "track": [
+            {"frame": 0, "eye": [575, -700, 1100], "target": [575, 475, 150]},
+            {"frame": 9, "eye": [700, -500, 1000], "target": [600, 500, 150]}]}])"},
+    });
+    if (auto unbuilt = mBackend->ExceededLimit(scene)) GTEST_SKIP() << unbuilt->reason;
+    auto whole = MakeSim(scene, *mBackend);
+    ASSERT_TRUE(whole);
+    const std::vector<SavedRunView> expected = StepAndKeep(*whole, *mBackend, scene.steps);
+    ASSERT_EQ(expected.size(), scene.steps);
+    const uint32_t split = 2;
+    auto a = MakeSim(scene, *mBackend);
+    ASSERT_TRUE(a);
+    StepAndKeep(*a, *mBackend, split);
+    const std::string dir = StateTestDir("flight_" + GetParam());
+    ASSERT_TRUE(SaveSimulationState(*a, dir, kStateTestHash).has_value());
+    auto state = ReadSimulationState(dir, scene, kStateTestHash);
+    ASSERT_TRUE(state.has_value()) << state.error().message;
+    EXPECT_EQ(state->framesDrawn, 2 * split);
+    auto b = MakeSim(scene, *mBackend);
+    ASSERT_TRUE(b);
+    ASSERT_TRUE(RestoreSimulationState(*b, *state).has_value());
+    ExpectSameSteps(expected, StepAndKeep(*b, *mBackend, scene.steps), split, scene, SameAs::Bits);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, SimulationStateSplit, ::testing::ValuesIn(cb::test::TestBackends()),
                          [](const auto& info) { return info.param; });
 

@@ -22,6 +22,36 @@ Vec3 ToFloat(const std::array<double, 3>& a) { return {float(a[0]), float(a[1]),
 
 }  // namespace
 
+CameraSettings CameraSettings::At(uint32_t frame) const {
+    CameraSettings pose = *this;
+    pose.track.clear();
+    if (track.empty()) return pose;
+    auto set = [&pose](const CameraKeyframe& k) { pose.eye = k.eye, pose.target = k.target; };
+    set(track.front());
+    for (size_t i = 0; i + 1 < track.size(); ++i) {
+        const CameraKeyframe &a = track[i], &b = track[i + 1];
+        if (frame < a.frame) break;
+        if (frame >= b.frame) {
+            set(b);
+            continue;
+        }
+        set(a);
+        if (b.cut) break;
+        const double w = double(frame - a.frame) / double(b.frame - a.frame);
+        for (int c = 0; c < 3; ++c) {
+            pose.eye[c] = a.eye[c] + (b.eye[c] - a.eye[c]) * w;
+            pose.target[c] = a.target[c] + (b.target[c] - a.target[c]) * w;
+        }
+        break;
+    }
+    return pose;
+}
+
+bool CameraSettings::CutAt(uint32_t frame) const {
+    return std::any_of(track.begin(), track.end(),
+                       [frame](const CameraKeyframe& k) { return k.cut && k.frame == frame; });
+}
+
 CameraFrame MakeCameraFrame(const CameraSettings& camera, uint32_t width, uint32_t height) {
     CameraFrame frame;
     const std::array<double, 3> forward = Normalize(Sub(camera.target, camera.eye));

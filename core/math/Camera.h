@@ -14,6 +14,13 @@
 
 namespace cb {
 
+// A pose on a camera's track at one frame of the run (the frames drawn before it).
+struct CameraKeyframe {
+    uint32_t frame = 0;
+    std::array<double, 3> eye{0, 0, 0}, target{1, 0, 0};
+    bool cut = false;  // a camera cut: the pose jumps here from the previous keyframe's (no motion between them)
+};
+
 struct CameraSettings {
     std::string name = "view";
     std::array<double, 3> eye{0, 0, 0};     // world, metres
@@ -21,6 +28,15 @@ struct CameraSettings {
     std::array<double, 3> up{0, 0, 1};
     double fovDeg = 60;  // vertical field of view
     double nearPlane = 1, farPlane = 100000;
+    // Keyframes by increasing frame, or none for a fixed camera. Between two keyframes the eye and the target move
+    // linearly (in double), unless the later one is a cut: then the earlier pose holds until the cut's frame. Before
+    // the first keyframe and after the last, their poses hold.
+    std::vector<CameraKeyframe> track;
+
+    // This camera at frame `frame` of the run: eye and target from the track; itself without one.
+    CameraSettings At(uint32_t frame) const;
+    // Whether frame `frame` starts at a keyframe marked as a cut.
+    bool CutAt(uint32_t frame) const;
 };
 
 // A camera resolved for one image size: orthonormal basis (right-handed look-at,

@@ -332,6 +332,7 @@ struct MarchRayResult {
     Vec3 color{};                // C = L + T_view background (linear HDR)
     Vec3 light{};                // L alone (a per-pixel background, the ground, composites as L + T_view background)
     float transmittance = 1;     // T_view at the end
+    float depthSum = 0;          // sum of T_view (1 - tau) t_sample: the depth's numerator (MarchViewDepth)
     uint32_t samples = 0;        // density samples taken
     uint32_t lightCalls = 0;     // light functor calls (samples with q > 0)
     uint32_t bricksSkipped = 0;  // empty bricks jumped over
@@ -347,7 +348,7 @@ template <class Density, class Light>
 MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float xi, const MarchBricks* bricks,
                         Density&& q, Light&& light) {
     MarchRayResult r;
-    float L0 = 0, L1 = 0, L2 = 0, T = 1;
+    float L0 = 0, L1 = 0, L2 = 0, T = 1, D = 0;
     if (!ray.Empty()) {
         // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
         const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
@@ -408,6 +409,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                 L0 += w * in[0];
                 L1 += w * in[1];
                 L2 += w * in[2];
+                D += w * ts;
                 T *= tau;
                 if (T < s.epsilon || T == 0.0f) break;
             }
@@ -416,6 +418,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
         }
     }
     r.transmittance = T;
+    r.depthSum = D;
     r.light = {L0, L1, L2};
     r.color = {L0 + T * s.background[0], L1 + T * s.background[1], L2 + T * s.background[2]};
     return r;

@@ -1,6 +1,9 @@
 #include "core/pipeline/MarchGpu.h"
 
 #include <algorithm>
+#include <string>
+
+#include "core/scene/Scene.h"
 
 namespace cb {
 
@@ -47,6 +50,13 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e) {
     g.invSize = s.invSize;
     g.light = MakeLightGpu(s.light);
     return g;
+}
+
+std::optional<LimitExceeded> MarchReprojectionNotBuilt(const Scene& scene, const std::string& backend) {
+    if (!scene.stages.Has(Stage::RenderMarch) || scene.march.reprojectionBlock <= 1) return std::nullopt;
+    return LimitExceeded{"march.reprojection.block",
+                         backend + ": temporal reprojection (block " + std::to_string(scene.march.reprojectionBlock) +
+                             ") is implemented on the cpu backend only so far; set it to 1 to trace every pixel"};
 }
 
 }  // namespace cb

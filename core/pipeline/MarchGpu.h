@@ -13,6 +13,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
 
 #include "core/math/Light.h"
 #include "core/pipeline/Backend.h"
@@ -73,5 +75,9 @@ MarchGpu MakeMarchGpu(const MarchParams& params, const Extent3& e);
 
 // Bricks along each axis for the skip structure: ceil(n / B), B >= 1.
 std::array<uint32_t, 3> MarchBrickCounts(const Extent3& e, uint32_t brick);
+
+// For a GPU backend whose render_march does not reproject yet: the scene's march.reprojection.block > 1 as the setting
+// it cannot run (Backend::ExceededLimit), so that the backend is unavailable for the scene before any stage runs.
+std::optional<LimitExceeded> MarchReprojectionNotBuilt(const Scene& scene, const std::string& backend);
 
 }  // namespace cb

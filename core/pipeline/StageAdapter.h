@@ -49,6 +49,9 @@ struct StageHostInputs {
     SliceRange slices;
     // Pipelined timing: call backend.MarkBatch() before each backend call (StageCallRecord::marks).
     bool markBatch = false;
+    // Renderers: the frame's number in the run, the frames drawn before it (a camera's track and the reprojection's
+    // order run on it; core/math/Camera.h, core/math/Reprojection.h).
+    uint32_t sequence = 0;
 };
 
 // One rendered image.

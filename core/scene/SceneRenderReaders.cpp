@@ -20,7 +20,91 @@ constexpr std::string_view kRenderKeys[] = {
     "width",    "height",      "q_min",           "splat_scale",      "opacity", "alpha", "culling",
     "skipping", "every_steps", "frames_per_step", "slices_per_frame", "cameras", "ground"};
 constexpr std::string_view kGroundKeys[] = {"albedo"};
-constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far"};
+constexpr std::string_view kCameraKeys[] = {"name", "eye", "target", "up", "fov_deg", "near", "far", "track"};
+constexpr std::string_view kCameraKeyframeKeys[] = {"frame", "eye", "target", "cut"};
+
+// An eye and a target that differ; false (and a message at `field`) where they are equal.
+bool CheckEyeAndTarget(const std::array<double, 3>& eye, const std::array<double, 3>& target, const std::string& field,
+                       Validator& check) {
+    if (eye != target) return true;
+    check.Fail(field, "must differ from eye");
+    return false;
+}
+
+// A camera's track (CameraSettings::track): keyframes by strictly increasing frame, each with its eye and target.
+// Between two keyframes that are not a cut the eye and the target move linearly; a segment along which the view
+// direction turns through 180 degrees would pass through eye = target on the way and is refused.
+std::vector<CameraKeyframe> ReadCameraTrack(const Json& value, const std::string& field, Validator& check) {
+    std::vector<CameraKeyframe> track;
+    if (!value.is_array() || value.empty()) {
+        check.Fail(field, "expected a non-empty array of keyframes {frame, eye, target, cut}, got " + Describe(value));
+        return track;
+    }
+    for (size_t i = 0; i < value.size(); ++i) {
+        const std::string at = IndexField(field, i);
+        const Json& entry = value[i];
+        if (!entry.is_object()) {
+            check.Fail(at, "expected a keyframe object {frame, eye, target, cut}, got " + Describe(entry));
+            continue;
+        }
+        check.CheckKeys(entry, at, kCameraKeyframeKeys);
+        CameraKeyframe k;
+        bool ok = true;
+        for (std::string_view key : {std::string_view("frame"), std::string_view("eye"), std::string_view("target")})
+            if (!Validator::Find(entry, key)) {
+                check.Fail(JoinField(at, key), "required field is missing");
+                ok = false;
+            }
+        if (const Json* v = Validator::Find(entry, "frame")) {
+            if (auto n = check.Integer(*v, JoinField(at, "frame"), 0, kU32Max))
+                k.frame = uint32_t(*n);
+            else
+                ok = false;
+        }
+        if (const Json* v = Validator::Find(entry, "eye")) {
+            if (auto a = check.Numbers<3>(*v, JoinField(at, "eye"), kFinite))
+                k.eye = *a;
+            else
+                ok = false;
+        }
+        if (const Json* v = Validator::Find(entry, "target")) {
+            if (auto a = check.Numbers<3>(*v, JoinField(at, "target"), kFinite))
+                k.target = *a;
+            else
+                ok = false;
+        }
+        if (const Json* v = Validator::Find(entry, "cut")) {
+            if (auto b = check.Boolean(*v, JoinField(at, "cut")))
+                k.cut = *b;
+            else
+                ok = false;
+        }
+        if (!ok || !CheckEyeAndTarget(k.eye, k.target, JoinField(at, "target"), check)) continue;
+        if (!track.empty() && k.frame <= track.back().frame) {
+            check.Fail(JoinField(at, "frame"), "keyframes must come by increasing frame, got " +
+                                                   std::to_string(k.frame) + " after " +
+                                                   std::to_string(track.back().frame));
+            continue;
+        }
+        if (!track.empty() && !k.cut) {
+            const CameraKeyframe& p = track.back();
+            double a[3], b[3];
+            for (int c = 0; c < 3; ++c) a[c] = p.target[c] - p.eye[c], b[c] = k.target[c] - k.eye[c];
+            const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            const double cross[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+            const double crossLength = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+            if (dot < 0 && crossLength <= 1e-9 * std::sqrt(dot * dot)) {
+                check.Fail(JoinField(at, "target"),
+                           "the view direction turns through 180 degrees from the previous keyframe, so the "
+                           "camera would pass through eye = target on the way; add a keyframe between them or "
+                           "mark this one as a cut");
+                continue;
+            }
+        }
+        track.push_back(k);
+    }
+    return track;
+}
 
 constexpr int64_t kMaxImageEdge = 16384;
 constexpr int64_t kMaxFramesPerStep = 1024;
@@ -42,20 +126,31 @@ std::optional<CameraSettings> ReadCamera(const Json& value, const std::string& f
     if (const Json* v = find("name")) {
         if (auto s = check.PathName(*v, sub("name"))) camera.name = *s;
     }
-    std::optional<std::array<double, 3>> eye, target;
-    if (const Json* v = find("eye")) {
-        eye = check.Numbers<3>(*v, sub("eye"), kFinite);
+    if (const Json* track = find("track")) {
+        // The track gives every pose; a fixed eye or target beside it would be ignored, so it is refused.
+        for (std::string_view key : {std::string_view("eye"), std::string_view("target")})
+            if (find(key))
+                check.Fail(sub(key),
+                           "cannot be combined with track (the track's keyframes give the pose); remove "
+                           "one");
+        camera.track = ReadCameraTrack(*track, sub("track"), check);
+        if (!camera.track.empty()) camera.eye = camera.track.front().eye, camera.target = camera.track.front().target;
     } else {
-        check.Fail(sub("eye"), "required field is missing");
+        std::optional<std::array<double, 3>> eye, target;
+        if (const Json* v = find("eye")) {
+            eye = check.Numbers<3>(*v, sub("eye"), kFinite);
+        } else {
+            check.Fail(sub("eye"), "required field is missing");
+        }
+        if (const Json* v = find("target")) {
+            target = check.Numbers<3>(*v, sub("target"), kFinite);
+        } else {
+            check.Fail(sub("target"), "required field is missing");
+        }
+        if (eye && target) CheckEyeAndTarget(*eye, *target, sub("target"), check);
+        if (eye) camera.eye = *eye;
+        if (target) camera.target = *target;
     }
-    if (const Json* v = find("target")) {
-        target = check.Numbers<3>(*v, sub("target"), kFinite);
-    } else {
-        check.Fail(sub("target"), "required field is missing");
-    }
-    if (eye && target && *eye == *target) check.Fail(sub("target"), "must differ from eye");
-    if (eye) camera.eye = *eye;
-    if (target) camera.target = *target;
     if (const Json* v = find("up")) {
         if (auto a = check.Numbers<3>(*v, sub("up"), kFinite)) {
             if ((*a)[0] == 0 && (*a)[1] == 0 && (*a)[2] == 0)

@@ -12,6 +12,7 @@
 #include "harness/accuracy/ImageAccuracy.h"
 #include "harness/accuracy/IsolatedMeasurement.h"
 #include "harness/accuracy/Measurement.h"
+#include "harness/accuracy/ReprojectionAccuracy.h"
 #include "harness/report/ReportTransfer.h"
 #include "harness/run/RunTransfer.h"
 
@@ -277,6 +278,7 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
     if (!session) return session.error();
     const Scene& scene = (*session)->GetScene();
     const bool images = RunsARenderer(scene.stages);
+    const bool reprojects = scene.stages.Has(Stage::RenderMarch) && scene.march.reprojectionBlock > 1;
     if (!scene.stages.Has(Stage::Shade) && !scene.stages.Has(Stage::Shadow) && !images) {
         std::string renderers;
         for (Stage stage : RendererStages())
@@ -328,6 +330,14 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
             if (!rows) return MakeError("images: " + rows.error().message);
             extra["images"] = std::move(*rows);
         }
+        if (reprojects)
+            for (const OpenedBackend& slot : backends) {
+                if (!slot.backend) continue;
+                // A backend that cannot reproject says why in its row; the other measurements stand.
+                auto rows = MeasureReprojection(*slot.backend, slot.name, scene);
+                extra["reprojection"] =
+                    rows ? std::move(*rows) : json::array({{{"backend", slot.name}, {"error", rows.error().message}}});
+            }
         return extra;
     };
     auto parts = MeasureEachBackend(**session, own, names, plan, more);
@@ -436,6 +446,16 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
                       "render, and PSNR (peak: the reference's largest value)",
                       {ImageRowsTable(imageRows)}});
         Emit(report, {"Reference render", {ImageReferenceTable(imageRefs)}});
+    }
+    if (reprojects) {
+        json rows = json::array();
+        for (const BackendMeasurement& part : *parts)
+            if (part.extra.contains("reprojection"))
+                for (const json& r : part.extra["reprojection"]) rows.push_back(r);
+        doc["reprojection"] = rows;
+        Emit(report, {"Temporal reprojection: each step's ray-marched frame against the full frame (every pixel "
+                      "traced) along the scene's frames, and render_march's median time a frame in each run",
+                      {ReprojectionTable(rows)}});
     }
     doc["references"] = ReferencesJson(FirstRecords(*parts), options.cpuThreads);
     Emit(report, {"Reference speed", {ReferenceSpeedTable(FirstRecords(*parts))}});

@@ -262,6 +262,7 @@ Status Simulation::RenderFrames(StepRecord& record, uint32_t frames, std::span<c
             return {};
         }));
         record.frameMs.push_back(MsSince(start));
+        ++mFramesDrawn;
     }
     record.framesRendered = frames;
     return {};
@@ -520,7 +521,7 @@ StageBuffers Simulation::AheadBuffers() {
 Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame, uint32_t frames) {
     if (stage == Stage::Region) mRaster = mEllipsoids.Raster();
     StageCallRecord call;
-    StageHostInputs host{mStep, mRaster, frame, frames, {}, mBatchOpen};
+    StageHostInputs host{mStep, mRaster, frame, frames, {}, mBatchOpen, mFramesDrawn};
     CB_TRY(CallStage(stage, mBackend, mScene, host, Buffers(), call));
     AddCallTimes(stage, call, record, record.frames.size());
     if (call.coveredColumns) record.coveredColumns = mLastCoveredColumns = call.coveredColumns;

@@ -158,6 +158,8 @@ class Simulation {
     const Buffer* Image(size_t n) const { return Get(Resource::SplatImage, n); }
     // The step whose images are in Image(); nullopt before the first render.
     std::optional<uint32_t> LastRenderedStep() const { return mLastRendered; }
+    // Frames drawn so far (StageHostInputs::sequence of the next frame).
+    uint32_t FramesDrawn() const { return mFramesDrawn; }
     bool IsOutputStep(uint32_t step) const;
     // The ellipsoids the current step's region came from.
     const std::vector<RasterEllipsoid>& RasterList() const { return mRaster; }
@@ -242,6 +244,7 @@ class Simulation {
     std::array<std::optional<std::vector<uint64_t>>, kStageCount> mInputsAtLastRun;
     const bool mEveryStepOutputs;
     std::optional<uint32_t> mLastRendered;
+    uint32_t mFramesDrawn = 0;
     std::optional<uint32_t> mLastCoveredColumns;  // the density stage's last cover
     // Time-sliced: the next step's ellipsoids, and what its stages recorded (merged into its record when it starts).
     std::vector<RasterEllipsoid> mRasterAhead;

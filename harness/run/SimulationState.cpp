@@ -74,6 +74,7 @@ struct SimulationStateAccess {
         copy(sim.mRaster, s.raster);
         copy(sim.mRasterAhead, s.rasterAhead);
         copy(sim.mLastRendered, s.lastRendered);
+        copy(sim.mFramesDrawn, s.framesDrawn);
         copy(sim.mLastCoveredColumns, s.lastCoveredColumns);
         copy(sim.mInputsAtLastRun, s.inputsAtLastRun);
         copy(sim.mAheadComputed, s.aheadComputed);
@@ -207,6 +208,7 @@ json ManifestOf(const SimulationState& s) {
         {"raster", RasterJson(s.raster)},
         {"raster_ahead", RasterJson(s.rasterAhead)},
         {"last_rendered_step", OptionalJson(s.lastRendered)},
+        {"frames_drawn", s.framesDrawn},
         {"last_covered_columns", OptionalJson(s.lastCoveredColumns)},
         {"resources", resources},
         {"inputs_at_last_run", inputs},

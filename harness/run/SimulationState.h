@@ -62,6 +62,7 @@ struct SimulationState {
     uint64_t rngState = 0, rngIncrement = 0;
     std::vector<RasterEllipsoid> raster, rasterAhead;
     std::optional<uint32_t> lastRendered, lastCoveredColumns;
+    uint32_t framesDrawn = 0;  // the next frame's number (a camera's track and the reprojection run on it)
     std::array<std::optional<std::vector<uint64_t>>, kStageCount> inputsAtLastRun{};
     std::array<uint64_t, kResourceCount> versions{};
     std::array<bool, kResourceCount> ahead{};

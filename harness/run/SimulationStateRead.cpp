@@ -229,6 +229,9 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
     s.rasterAhead = read.Raster(m, "raster_ahead");
     if (const json* v = read.Find(m, "last_rendered_step", "last_rendered_step"))
         s.lastRendered = read.OptionalU32(*v, "last_rendered_step");
+    // Absent from states saved before frames were numbered: none drawn.
+    if (m.is_object() && m.contains("frames_drawn"))
+        s.framesDrawn = uint32_t(read.Unsigned(m["frames_drawn"], "frames_drawn", UINT32_MAX).value_or(0));
     if (const json* v = read.Find(m, "last_covered_columns", "last_covered_columns"))
         s.lastCoveredColumns = read.OptionalU32(*v, "last_covered_columns");
     if (const json* res = read.Find(m, "resources", "resources")) {

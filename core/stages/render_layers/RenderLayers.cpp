@@ -287,7 +287,8 @@ Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs
     const std::vector<float> map = MakeLayersMap(sc, host.step);
     return RenderEachCamera(
         Stage::RenderLayers, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            LayersParams p = MakeLayersParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            LayersParams p =
+                MakeLayersParams(sc, sc.render.cameras[n].At(host.sequence), host.step, host.frame, host.frames);
             p.setup.map = map.empty() ? nullptr : map.data();
             const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T),
                                   io.Current(Resource::TSky)};

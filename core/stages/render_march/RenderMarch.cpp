@@ -16,11 +16,12 @@
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kMarchKeys[] = {"step",   "adaptive", "jitter",   "light",    "light_steps",
-                                           "powder", "epsilon",  "skipping", "exposure", "tone_map"};
+constexpr std::string_view kMarchKeys[] = {"step",    "adaptive", "jitter",   "light",        "light_steps", "powder",
+                                           "epsilon", "skipping", "exposure", "reprojection", "tone_map"};
 constexpr std::string_view kAdaptiveKeys[] = {"enabled", "kappa", "start"};
 constexpr std::string_view kPowderKeys[] = {"enabled", "c"};
 constexpr std::string_view kSkippingKeys[] = {"enabled", "brick"};
+constexpr std::string_view kReprojectionKeys[] = {"block"};
 
 constexpr std::array<NamedValue<MarchLightSource>, 2> kMarchLightNames{{
     {"shade", MarchLightSource::Shade},
@@ -83,6 +84,13 @@ void ReadMarch(const Json& root, Validator& check, const StageSet& stages, March
         }
         if (const Json* v = find("tone_map")) {
             if (auto b = check.Boolean(*v, "march.tone_map")) march.toneMap = *b;
+        }
+        if (const Json* reprojection = check.Section(*section, "march", "reprojection", kReprojectionKeys)) {
+            if (const Json* v = Validator::Find(*reprojection, "block")) {
+                constexpr int64_t kBlocks[] = {kReprojectionBlocks[0], kReprojectionBlocks[1], kReprojectionBlocks[2]};
+                if (auto k = check.IntegerChoice(*v, "march.reprojection.block", kBlocks, "1, 2 or 4"))
+                    march.reprojectionBlock = uint32_t(*k);
+            }
         }
     }
     // The default light source reads T, which only the shade stage writes.
@@ -211,6 +219,7 @@ constexpr std::string_view kMarchReferenceIgnores[] = {"march.step",
                                                        "march.skipping.brick",
                                                        "march.exposure",
                                                        "march.tone_map",
+                                                       "march.reprojection.block",
                                                        "lighting.eye_scattering"};
 
 // The exact reference's parameters: the march's, with single scattering exact through the scene's phase function.
@@ -280,7 +289,12 @@ Status CallRenderMarch(Backend& backend, const Scene& sc, const StageHostInputs&
                        StageCallRecord& record) {
     return RenderEachCamera(
         Stage::RenderMarch, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            const MarchParams p = MakeMarchParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            const CameraSettings& camera = sc.render.cameras[n];
+            MarchParams p = MakeMarchParams(sc, camera.At(host.sequence), host.step, host.frame, host.frames);
+            // The previous frame's camera: that of the frame before (the first frame traces every pixel).
+            const uint32_t previous = host.sequence > 0 ? host.sequence - 1 : 0;
+            p.reprojection = MakeReprojection(sc.march.reprojectionBlock, host.sequence, camera.CutAt(host.sequence),
+                                              MakeCameraFrame(camera.At(previous), sc.render.width, sc.render.height));
             // T only where shade runs (the light source "shade").
             MarchInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T)};
             in.G = p.ground.on ? io.Current(Resource::Shadow) : nullptr;  // the ground only

@@ -13,6 +13,7 @@
 #include "core/math/Camera.h"
 #include "core/math/Ground.h"
 #include "core/math/March.h"
+#include "core/math/Reprojection.h"
 
 namespace cb {
 
@@ -39,6 +40,9 @@ struct MarchSettings {
     uint32_t brick = 8;     // brick edge in voxels
     double exposure = 1.0;  // PNG: Reinhard(exposure C), sRGB encoded
     bool toneMap = true;    // PNG only; false: clamp(exposure C)
+    // Temporal reprojection (SPEC 19, core/math/Reprojection.h): one pixel of each block x block traced a frame, the
+    // rest reprojected from the previous frame; 1 traces every pixel.
+    uint32_t reprojectionBlock = 1;
 };
 
 // Inputs of the ray marcher (SPEC 10) besides its buffers: the kernel's
@@ -55,6 +59,9 @@ struct MarchParams {
     bool skipping = true;
     uint32_t brick = 8;
     GroundParams ground;  // the ground plane under the clouds (core/math/Ground.h); on: MarchInputs::G
+    // Which pixels this frame traces. Not full: the image holds the previous frame (drawn with reprojection.previous)
+    // on entry, and its untraced pixels are reprojected from it.
+    ReprojectionSetup reprojection;
 };
 
 struct MarchInputs {

@@ -183,7 +183,8 @@ Status CallRenderSplat(Backend& backend, const Scene& sc, const StageHostInputs&
                        StageCallRecord& record) {
     return RenderEachCamera(
         Stage::RenderSplat, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
-            SplatParams p = MakeSplatParams(sc, sc.render.cameras[n], host.step, host.frame, host.frames);
+            SplatParams p =
+                MakeSplatParams(sc, sc.render.cameras[n].At(host.sequence), host.step, host.frame, host.frames);
             // The order is host work shared by all backends, outside the stage time.
             const SplatOrder order = MakeSplatOrder(p.camera, sc.grid.size, sc.grid.origin, sc.grid.voxelSize);
             p.order = &order;
