@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "core/math/March.h"
 #include "core/math/Reprojection.h"
@@ -201,10 +202,14 @@ void ResolveReprojected(const MarchParams& params, const MarchPixelGrid& cells, 
             }
     });
     const uint32_t W = cells.width, H = cells.height;
+    // The image-plane offsets of every column, made once.
+    std::vector<float> us(W);
+    for (uint32_t x = 0; x < W; ++x) us[x] = PixelPlaneU(params.camera, x);
     tbb::parallel_for(
         tbb::blocked_range<uint32_t>(0, H, 8), [&](const tbb::blocked_range<uint32_t>& r) __attribute__((flatten)) {
             for (uint32_t y = r.begin(); y < r.end(); ++y) {
                 const uint32_t cy = y / cells.k;
+                const float v = PixelPlaneV(params.camera, y);
                 for (uint32_t x = 0; x < W; ++x) {
                     const uint32_t cx = x / cells.k;
                     const size_t cell = cx + size_t(cells.cols) * cy;
@@ -215,7 +220,7 @@ void ResolveReprojected(const MarchParams& params, const MarchPixelGrid& cells, 
                         continue;
                     }
                     const float* b = bounds + 6 * cell;
-                    const Vec3 c = ReprojectedColor(params.reprojection, params.camera, history, x, y, t[3],
+                    const Vec3 c = ReprojectedColor(params.reprojection, params.camera, history, us[x], v, t[3],
                                                     {t[0], t[1], t[2]}, {b[0], b[1], b[2]}, {b[3], b[4], b[5]});
                     out[0] = c[0], out[1] = c[1], out[2] = c[2];
                 }

@@ -139,7 +139,7 @@ TEST(Reprojection, AStillCameraFindsEveryPixelAtItsOwnCentre) {
         for (uint32_t y : {0u, 17u, 47u})
             for (uint32_t x : {0u, 31u, 63u}) {
                 float px = -1, py = -1;
-                ASSERT_TRUE(PreviousImagePosition(c, c, x, y, z, px, py));
+                ASSERT_TRUE(PreviousImagePosition(c, c, PixelPlaneU(c, x), PixelPlaneV(c, y), z, px, py));
                 EXPECT_NEAR(px, x + 0.5f, 2e-3f) << z;
                 EXPECT_NEAR(py, y + 0.5f, 2e-3f) << z;
             }
@@ -151,15 +151,16 @@ TEST(Reprojection, ASidewaysMoveShiftsAPointByFocalTimesMoveOverDepth) {
     ASSERT_NEAR(now.right[1], -1.0f, 1e-6f);
     const float z = 60;
     float px, py;
-    ASSERT_TRUE(PreviousImagePosition(now, before, 20, 24, z, px, py));
+    const float u = PixelPlaneU(now, 20), v = PixelPlaneV(now, 24);
+    ASSERT_TRUE(PreviousImagePosition(now, before, u, v, z, px, py));
     // The point is 3 m further to the previous camera's left: focal 3 / z pixels to the left.
     EXPECT_NEAR(px, 20.5f - now.focalPx * 3.0f / z, 1e-3f);
     EXPECT_NEAR(py, 24.5f, 1e-3f);
     // A point behind the previous camera, or beyond its image, is not found.
     const CameraFrame turned = Camera({0, 0, 0}, {-10, 0, 0});
-    EXPECT_FALSE(PreviousImagePosition(now, turned, 20, 24, z, px, py));
+    EXPECT_FALSE(PreviousImagePosition(now, turned, u, v, z, px, py));
     const CameraFrame far = Camera({0, -300, 0}, {10, -300, 0});
-    EXPECT_FALSE(PreviousImagePosition(now, far, 20, 24, z, px, py));
+    EXPECT_FALSE(PreviousImagePosition(now, far, u, v, z, px, py));
 }
 
 TEST(Reprojection, BilinearReadsAPlaneExactlyAndClampsAtTheEdges) {
@@ -172,10 +173,10 @@ TEST(Reprojection, BilinearReadsAPlaneExactlyAndClampsAtTheEdges) {
     for (float px : {0.5f, 1.75f, 3.2f, 6.5f})
         for (float py : {0.5f, 2.9f, 4.5f})
             for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(BilinearChannel(rgb.data(), W, H, px, py, c), plane(c, px - 0.5f, py - 0.5f), 1e-5f);
+                EXPECT_NEAR(BilinearRgb(rgb.data(), W, H, px, py)[c], plane(c, px - 0.5f, py - 0.5f), 1e-5f);
     // Within half a pixel of the border the edge pixels are read.
-    EXPECT_FLOAT_EQ(BilinearChannel(rgb.data(), W, H, 0.0f, 0.0f, 0), plane(0, 0, 0));
-    EXPECT_FLOAT_EQ(BilinearChannel(rgb.data(), W, H, 7.0f, 5.0f, 2), plane(2, 6, 4));
+    EXPECT_FLOAT_EQ(BilinearRgb(rgb.data(), W, H, 0.0f, 0.0f)[0], plane(0, 0, 0));
+    EXPECT_FLOAT_EQ(BilinearRgb(rgb.data(), W, H, 7.0f, 5.0f)[2], plane(2, 6, 4));
 }
 
 // The march's depth through a homogeneous slab along z from t0 to t1 with optical depth s per voxel edge: the mean

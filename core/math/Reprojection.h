@@ -75,51 +75,63 @@ inline float MarchViewDepth(float depthSum, float transmittance, float voxelSize
     return depthSum / opacity * voxelSize * cosForward;
 }
 
-// Where the point at view depth z on pixel (x, y)'s ray of camera c lay in the previous camera's image: pixel
-// coordinates (px, py) with pixel i's centre at i + 0.5 (core/math/Camera.h Project's convention). False where the
-// point lies behind the previous camera or outside its image.
-inline bool PreviousImagePosition(const CameraFrame& c, const CameraFrame& prev, uint32_t x, uint32_t y, float z,
-                                  float& px, float& py) {
-    // The ray's direction scaled to unit depth: forward + u right + v up (PixelRayDirection before normalising).
-    const float u = (float(x) + 0.5f - 0.5f * float(c.width)) / c.focalPx;
-    const float v = (0.5f * float(c.height) - (float(y) + 0.5f)) / c.focalPx;
+// Pixel column x's and row y's offsets on camera c's image plane at unit depth: the ray through pixel (x, y) is
+// forward + u right + v up (PixelRayDirection before normalising).
+inline float PixelPlaneU(const CameraFrame& c, uint32_t x) {
+    return (float(x) + 0.5f - 0.5f * float(c.width)) / c.focalPx;
+}
+inline float PixelPlaneV(const CameraFrame& c, uint32_t y) {
+    return (0.5f * float(c.height) - (float(y) + 0.5f)) / c.focalPx;
+}
+
+// Where the point at view depth z on camera c's ray through image-plane offsets (u, v) (PixelPlaneU, PixelPlaneV) lay
+// in the previous camera's image: pixel coordinates (px, py) with pixel i's centre at i + 0.5 (core/math/Camera.h
+// Project's convention). False where the point lies behind the previous camera or outside its image.
+inline bool PreviousImagePosition(const CameraFrame& c, const CameraFrame& prev, float u, float v, float z, float& px,
+                                  float& py) {
     float d[3];
     for (int i = 0; i < 3; ++i) d[i] = (c.eye[i] + z * (c.forward[i] + u * c.right[i] + v * c.upVector[i])) - prev.eye[i];
     const float right = d[0] * prev.right[0] + d[1] * prev.right[1] + d[2] * prev.right[2];
     const float up = d[0] * prev.upVector[0] + d[1] * prev.upVector[1] + d[2] * prev.upVector[2];
     const float depth = d[0] * prev.forward[0] + d[1] * prev.forward[1] + d[2] * prev.forward[2];
     if (!(depth > 0.0f)) return false;
-    px = 0.5f * float(prev.width) + right * prev.focalPx / depth;
-    py = 0.5f * float(prev.height) - up * prev.focalPx / depth;
+    const float perDepth = prev.focalPx / depth;
+    px = 0.5f * float(prev.width) + right * perDepth;
+    py = 0.5f * float(prev.height) - up * perDepth;
     return px >= 0.0f && px <= float(prev.width) && py >= 0.0f && py <= float(prev.height);
 }
 
-// Channel c of an RGB image (3 floats a pixel, row 0 at the top) read bilinearly at pixel position (px, py) (centres at
-// i + 0.5), the taps clamped to the image.
-inline float BilinearChannel(const float* rgb, uint32_t width, uint32_t height, float px, float py, int c) {
+// An RGB image (3 floats a pixel, row 0 at the top) read bilinearly at pixel position (px, py) (centres at i + 0.5),
+// the taps clamped to the image.
+inline Vec3 BilinearRgb(const float* rgb, uint32_t width, uint32_t height, float px, float py) {
     const float cx = px - 0.5f, cy = py - 0.5f;
     const float fx = std::floor(cx), fy = std::floor(cy);
     const float wx = cx - fx, wy = cy - fy;
-    const int32_t x0 = std::clamp(int32_t(fx), 0, int32_t(width) - 1), x1 = std::min(std::max(int32_t(fx) + 1, 0), int32_t(width) - 1);
-    const int32_t y0 = std::clamp(int32_t(fy), 0, int32_t(height) - 1), y1 = std::min(std::max(int32_t(fy) + 1, 0), int32_t(height) - 1);
-    const float a = rgb[3 * (size_t(x0) + size_t(width) * size_t(y0)) + c];
-    const float b = rgb[3 * (size_t(x1) + size_t(width) * size_t(y0)) + c];
-    const float d = rgb[3 * (size_t(x0) + size_t(width) * size_t(y1)) + c];
-    const float e = rgb[3 * (size_t(x1) + size_t(width) * size_t(y1)) + c];
-    const float top = a + wx * (b - a), bottom = d + wx * (e - d);
-    return top + wy * (bottom - top);
+    const int32_t ix = int32_t(fx), iy = int32_t(fy), w = int32_t(width), h = int32_t(height);
+    const int32_t x0 = std::clamp(ix, 0, w - 1), x1 = std::clamp(ix + 1, 0, w - 1);
+    const int32_t y0 = std::clamp(iy, 0, h - 1), y1 = std::clamp(iy + 1, 0, h - 1);
+    const float* a = rgb + 3 * (size_t(x0) + size_t(width) * size_t(y0));
+    const float* b = rgb + 3 * (size_t(x1) + size_t(width) * size_t(y0));
+    const float* d = rgb + 3 * (size_t(x0) + size_t(width) * size_t(y1));
+    const float* e = rgb + 3 * (size_t(x1) + size_t(width) * size_t(y1));
+    Vec3 out;
+    for (int c = 0; c < 3; ++c) {
+        const float top = a[c] + wx * (b[c] - a[c]), bottom = d[c] + wx * (e[c] - d[c]);
+        out[c] = top + wy * (bottom - top);
+    }
+    return out;
 }
 
-// Untraced pixel (x, y)'s colour: the previous image (`previous`, the previous camera's) read where the point at its
-// block's traced view depth z lay, clamped per channel to [lo, hi] (the least and greatest traced colours of its block
-// and the eight around it); where that point was not in the previous image, its block's traced colour.
-inline Vec3 ReprojectedColor(const ReprojectionSetup& r, const CameraFrame& c, const float* previous, uint32_t x,
-                             uint32_t y, float z, const Vec3& traced, const Vec3& lo, const Vec3& hi) {
+// An untraced pixel's colour, its ray through image-plane offsets (u, v): the previous image (`previous`, the previous
+// camera's) read where the point at its block's traced view depth z lay, clamped per channel to [lo, hi] (the least
+// and greatest traced colours of its block and the eight around it); where that point was not in the previous image,
+// its block's traced colour.
+inline Vec3 ReprojectedColor(const ReprojectionSetup& r, const CameraFrame& c, const float* previous, float u, float v,
+                             float z, const Vec3& traced, const Vec3& lo, const Vec3& hi) {
     float px, py;
-    if (!PreviousImagePosition(c, r.previous, x, y, z, px, py)) return traced;
-    Vec3 out;
-    for (int i = 0; i < 3; ++i)
-        out[i] = std::clamp(BilinearChannel(previous, r.previous.width, r.previous.height, px, py, i), lo[i], hi[i]);
+    if (!PreviousImagePosition(c, r.previous, u, v, z, px, py)) return traced;
+    Vec3 out = BilinearRgb(previous, r.previous.width, r.previous.height, px, py);
+    for (int i = 0; i < 3; ++i) out[i] = std::min(std::max(out[i], lo[i]), hi[i]);
     return out;
 }
 

@@ -69,6 +69,12 @@ its own settings changed one at a time:
 )" + AccuracyVariantsHelp() + R"(per-pixel error = max over channels of |C - C_ref|, with max, mean, p99 and
 PSNR.
 
+With temporal reprojection (march.reprojection.block > 1) it also runs the
+scene twice in lock step on each backend, as it is and with every pixel
+traced, and compares each step's ray-marched frame: PSNR per frame, its
+median and the worst frame, beside render_march's median time a frame in
+each run and the speed-up.
+
 Options:
   --backend LIST     backends to measure (default: all built); unavailable ones
                      are reported, and a stage a backend lacks is listed as
