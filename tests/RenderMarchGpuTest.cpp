@@ -161,6 +161,15 @@ TEST_P(RenderMarchGpu, MatchesTheCpuOnEveryOptionOnOddSizes) {
              c.params.setup.light.phase = {PhaseKind::CornetteShanks, -0.3f};
          }},
         {"phase mie", [](GpuMarchCase& c) { c.params.setup.light.phase.kind = PhaseKind::Mie; }},
+        {"phase dual-lobe, mostly backward",
+         [](GpuMarchCase& c) {
+             c.params.setup.light.phase = {PhaseKind::DualLobe, 0.6f, 0.7f, -0.6f, 0.7f};
+         }},
+        {"point light, dual-lobe",
+         [&](GpuMarchCase& c) {
+             pointLight(c);
+             c.params.setup.light.phase = {PhaseKind::DualLobe, 0.6f, 0.8f, -0.5f, 0.5f};
+         }},
         {"point light", pointLight},
         {"point light, mie, light march, powder",
          [&](GpuMarchCase& c) {
