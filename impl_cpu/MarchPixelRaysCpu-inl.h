@@ -37,7 +37,8 @@ struct MarchPixelRays {
     size_t count = 0;
 };
 
-// PhaseValue at cos theta, per lane, operation for operation (Mie's table through the scalar function).
+// PhaseValue at cos theta, per lane, operation for operation (Mie's table and the dual lobe through the scalar
+// function: once a ray, not a sample).
 template <class D>
 hn::Vec<D> PhaseInLanes(D d, const PhaseParams& phase, hn::Vec<D> cosTheta) {
     using V = hn::Vec<D>;
@@ -56,6 +57,7 @@ hn::Vec<D> PhaseInLanes(D d, const PhaseParams& phase, hn::Vec<D> cosTheta) {
                            hn::Mul(denom, hn::Sqrt(denom)));
         }
         case PhaseKind::Mie:
+        case PhaseKind::DualLobe:
             break;
     }
     alignas(64) float c[16];

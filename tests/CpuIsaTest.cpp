@@ -161,6 +161,8 @@ const IsaScene kIsaScenes[] = {
      MarchOptions({{"march.skipping.enabled", "false"}, {"march.epsilon", "0"}, {"phase.function", "\"none\""}})},
     {"MarchFineStep", "noise-track.json", MarchOptions({{"march.step", "0.05"}, {"render.width", "24"}})},
     {"MarchCoarseStep", "noise-track.json", MarchOptions({{"march.step", "7"}})},
+    {"MarchDualLobe", "noise-track.json",
+     MarchOptions({{"phase.function", "\"dual-lobe\""}, {"phase.g_backward", "-0.6"}, {"phase.blend", "0.3"}})},
     {"MarchGlowEye", "noise-track.json",
      MarchOptions({{"lighting.city_glow", R"({"blobs": [{"center": [3000, 3000], "radius": 2000}]})"},
                    {"lighting.eye_scattering", "{}"},

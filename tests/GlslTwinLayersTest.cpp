@@ -61,8 +61,10 @@ LayersParams RandomLayersParams(Pcg32& r, std::vector<float>& map) {
     s.light.sunRadiance = {Uniform(r, 0, 3), Uniform(r, 0, 3), Uniform(r, 0, 3)};
     s.light.ambient = {Uniform(r, 0, 0.4), Uniform(r, 0, 0.4), Uniform(r, 0, 0.4)};
     s.background = {Uniform(r, 0, 1), Uniform(r, 0, 1), Uniform(r, 0, 1)};
-    const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
-    s.light.phase = {kinds[r.Below(4)], Uniform(r, -0.9, 0.9)};
+    const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie,
+                               PhaseKind::DualLobe};
+    s.light.phase = {kinds[r.Below(5)], Uniform(r, -0.9, 0.9), Uniform(r, 0, 0.9), Uniform(r, -0.9, 0),
+                     Uniform(r, 0, 1)};
     s.wang = r.Below(2) == 1;
     s.coverage = Uniform(r, 0, 1);
     s.density = Uniform(r, 0.5, 8);

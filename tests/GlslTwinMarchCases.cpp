@@ -47,22 +47,46 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      edges,
                      [](const Words& in, Words& out) { out[0] = Bits(SamplePhaseTable(kMieCloudTable, Float(in[2]))); },
                      /*otherDeviceUlps=*/64});
-        // PhaseValue of every kind through march.glsl's MarchPhase (Mie: the table; the others: shading.glsl).
+        // PhaseValue of every kind through march.glsl's MarchPhase (Mie: the table; the dual lobe: its three
+        // words 5-7 of LightGpu; the others: shading.glsl).
+        const uint32_t dual = uint32_t(PhaseKind::DualLobe);
         c.push_back({"MarchPhase",
                      kTwinMarchPhase,
                      {Kind::F},
                      [perRadian, count](Pcg32& r, Words& in) {
-                         in = W({r.Below(4), Bits(Uniform(r, -0.95, 0.95)), Bits(Uniform(r, -1, 1)), Bits(perRadian),
-                                 count});
+                         in = W({r.Below(5), Bits(Uniform(r, -0.95, 0.95)), Bits(Uniform(r, -1, 1)), Bits(perRadian),
+                                 count, Bits(Uniform(r, 0, 0.95)), Bits(Uniform(r, -0.95, 0)), Bits(Uniform(r, 0, 1))});
                      },
                      {W({3, Bits(0.6f), Bits(1.0f), Bits(perRadian), count}),
                       W({3, Bits(0.6f), Bits(-1.0f), Bits(perRadian), count}),
                       W({3, Bits(0.0f), Bits(0.0f), Bits(perRadian), count}),
-                      W({1, Bits(0.6f), Bits(1.0f), Bits(perRadian), count})},
+                      W({1, Bits(0.6f), Bits(1.0f), Bits(perRadian), count}),
+                      W({dual, Bits(0.6f), Bits(1.0f), Bits(perRadian), count, Bits(0.8f), Bits(-0.5f), Bits(0.5f)}),
+                      W({dual, Bits(0.6f), Bits(-1.0f), Bits(perRadian), count, Bits(0.8f), Bits(-0.5f), Bits(0.5f)})},
                      [](const Words& in, Words& out) {
-                         out[0] = Bits(PhaseValue({PhaseKind(in[0]), Float(in[1])}, Float(in[2])));
+                         out[0] = Bits(PhaseValue(
+                             {PhaseKind(in[0]), Float(in[1]), Float(in[5]), Float(in[6]), Float(in[7])}, Float(in[2])));
                      },
                      /*otherDeviceUlps=*/64});
+        // The dual lobe alone (shading.glsl DualLobePhase): g_forward in [0, 1), g_backward in (-1, 0], the blend
+        // in [0, 1]; the ends of each range, cos at +-1 and 0.
+        std::vector<Words> lobeEdges;
+        for (float gf : {0.0f, 0.8f, 0.99f})
+            for (float gb : {0.0f, -0.5f, -0.99f})
+                for (float w : {0.0f, 0.5f, 1.0f})
+                    for (float x : {1.0f, -1.0f, 0.0f}) lobeEdges.push_back(WF({gf, gb, w, x}));
+        c.push_back({"DualLobePhase",
+                     kTwinDualLobePhase,
+                     {Kind::F},
+                     [](Pcg32& r, Words& in) {
+                         in = WF({Uniform(r, 0, 0.95), Uniform(r, -0.95, 0), Uniform(r, 0, 1), Uniform(r, -1, 1)});
+                     },
+                     lobeEdges,
+                     [](const Words& in, Words& out) {
+                         PhaseParams phase{PhaseKind::DualLobe, 0.0f, Float(in[0]), Float(in[1]), Float(in[2])};
+                         out[0] = Bits(PhaseValue(phase, Float(in[3])));
+                     },
+                     /*otherDeviceUlps=*/4});
     }
     {
         // Boxes up to 300 voxels, origins inside and outside, directions with zero components (and

@@ -92,7 +92,10 @@ SplatFrame RandomSplatFrame(Pcg32& r) {
     F.nearPlane = f.nearPlane;
     F.focalPx = f.focalPx;
     F.light.phaseG = Uniform(r, -0.9, 0.9);
-    F.light.phaseKind = r.Below(4);  // every PhaseKind, Mie (3) with the table its frame names
+    F.light.phaseKind = r.Below(5);  // every PhaseKind, Mie (3) with the table its frame names, the dual lobe (4)
+    F.light.phaseGForward = Uniform(r, 0, 0.9);
+    F.light.phaseGBackward = Uniform(r, -0.9, 0);
+    F.light.phaseBlend = Uniform(r, 0, 1);
     F.light.mieIndexPerRadian = kMieCloudTable.indexPerRadian;
     F.light.mieCount = kMieCloudTable.count;
     F.light.voxelSize = 50;
@@ -289,13 +292,15 @@ TEST_F(GlslTwin, PaddedSamplerAndLightMarchesEqualTheirCppTwins) {
 // and eye scattering on and off (a sample looking straight at the sun among them).
 TEST_F(GlslTwin, InScatteredMatchesTheCpp) {
     Pcg32 rng(0x11947);
-    const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie};
-    for (int call = 0; call < 16; ++call) {
+    const PhaseKind kinds[] = {PhaseKind::None, PhaseKind::HenyeyGreenstein, PhaseKind::CornetteShanks, PhaseKind::Mie,
+                               PhaseKind::DualLobe};
+    for (int call = 0; call < 20; ++call) {
         Extent3 e;
         MarchParams p = RandomMarchParams(rng, e);
         p.setup.light.sunRadiance = {Uniform(rng, 0, 3), Uniform(rng, 0, 3), Uniform(rng, 0, 3)};
         p.setup.light.ambient = {Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5), Uniform(rng, 0, 0.5)};
-        p.setup.light.phase = {kinds[call % 4], Uniform(rng, -0.9, 0.9)};
+        p.setup.light.phase = {kinds[call % 5], Uniform(rng, -0.9, 0.9), Uniform(rng, 0, 0.9), Uniform(rng, -0.9, 0),
+                               Uniform(rng, 0, 1)};
         p.setup.light.pointOn = call % 8 < 6;
         p.setup.light.pointRadiance = {Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4), Uniform(rng, 0, 1e4)};
         p.setup.light.pointMinDistance2 = Uniform(rng, 1, 1e4);

@@ -48,7 +48,8 @@ Scene HpmScene() {
     sc.sun.intensity = 2;
     sc.lighting.ambient = {0.25, 0.5, 0.75};
     sc.lighting.background = {0.125, 0.375, 0.625};
-    sc.phase = {PhaseKind::CornetteShanks, 0.375f};
+    // The dual lobe's numbers too, though Cornette-Shanks ignores them: the blocks carry them for any kind.
+    sc.phase = {PhaseKind::CornetteShanks, 0.375f, 0.625f, -0.25f, 0.875f};
     sc.shade.sigma = 0.03125;
     sc.march.step = 0.75;
     sc.march.adaptive = true;
@@ -134,6 +135,9 @@ TEST(HostParamsMarch, SetupFromTheScene) {
     EXPECT_EQ(s.background, (Vec3{0.125f, 0.375f, 0.625f}));
     EXPECT_EQ(s.light.phase.kind, PhaseKind::CornetteShanks);
     EXPECT_EQ(s.light.phase.g, 0.375f);
+    EXPECT_EQ(s.light.phase.gForward, 0.625f);
+    EXPECT_EQ(s.light.phase.gBackward, -0.25f);
+    EXPECT_EQ(s.light.phase.blend, 0.875f);
     EXPECT_TRUE(s.powder);
     EXPECT_EQ(s.powderC, 3.0f);
     EXPECT_EQ(p.light, MarchLightSource::March);
@@ -258,6 +262,9 @@ TEST(HostParamsMarch, GpuBlockCarriesTheHostValues) {
     EXPECT_NEAR(g.sun[2], -0.99619470f, 1e-6f);
     EXPECT_EQ(g.light.phaseG, 0.375f);
     EXPECT_EQ(g.light.phaseKind, uint32_t(PhaseKind::CornetteShanks));
+    EXPECT_EQ(g.light.phaseGForward, 0.625f);
+    EXPECT_EQ(g.light.phaseGBackward, -0.25f);
+    EXPECT_EQ(g.light.phaseBlend, 0.875f);
     EXPECT_EQ(g.light.sunRadiance, (F3{1.0f, 2.0f, 0.5f}));
     EXPECT_EQ(g.powderC, 3.0f);
     EXPECT_EQ(g.light.ambient, (F3{0.25f, 0.5f, 0.75f}));
@@ -343,6 +350,8 @@ TEST(HostParamsMarch, SplatFrameCarriesTheHostValues) {
     EXPECT_EQ(f.light.phaseG, 0.375f);
     EXPECT_EQ(f.light.sunRadiance, (std::array<float, 3>{1.0f, 2.0f, 0.5f}));
     EXPECT_EQ(f.light.phaseKind, uint32_t(PhaseKind::CornetteShanks));
+    EXPECT_EQ(f.light.phaseGForward, 0.625f);
+    EXPECT_EQ(f.light.phaseBlend, 0.875f);
     EXPECT_EQ(f.light.pointOn, 0u);
     EXPECT_EQ(f.qMin, 0.125f);
     EXPECT_EQ(f.opacity, 0.625f);

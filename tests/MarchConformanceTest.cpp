@@ -74,6 +74,10 @@ std::vector<MarchVariant> MarchVariants(const Extent3& e) {
              p.setup.light.phase = {PhaseKind::CornetteShanks, 0.75f};
          }},
         {"phase Mie", [](MarchParams& p) { p.setup.light.phase.kind = PhaseKind::Mie; }},
+        {"phase dual-lobe 0.85 / -0.4, blend 0.3",
+         [](MarchParams& p) {
+             p.setup.light.phase = {PhaseKind::DualLobe, 0.6f, 0.85f, -0.4f, 0.3f};
+         }},
         {"point light, shade light", point},
         {"point light, light march, Mie, jitter, adaptive",
          [point](MarchParams& p) {

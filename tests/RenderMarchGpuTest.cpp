@@ -161,6 +161,15 @@ TEST_P(RenderMarchGpu, MatchesTheCpuOnEveryOptionOnOddSizes) {
              c.params.setup.light.phase = {PhaseKind::CornetteShanks, -0.3f};
          }},
         {"phase mie", [](GpuMarchCase& c) { c.params.setup.light.phase.kind = PhaseKind::Mie; }},
+        {"phase dual-lobe, mostly backward",
+         [](GpuMarchCase& c) {
+             c.params.setup.light.phase = {PhaseKind::DualLobe, 0.6f, 0.7f, -0.6f, 0.7f};
+         }},
+        {"point light, dual-lobe",
+         [&](GpuMarchCase& c) {
+             pointLight(c);
+             c.params.setup.light.phase = {PhaseKind::DualLobe, 0.6f, 0.8f, -0.5f, 0.5f};
+         }},
         {"point light", pointLight},
         {"point light, mie, light march, powder",
          [&](GpuMarchCase& c) {
@@ -473,8 +482,8 @@ TEST_P(RenderMarchGpu, ScratchBytesByHand) {
         scene.march.brick = 4;
         scene.march.skipping = true;
         scene.march.light = MarchLightSource::Shade;
-        // MarchGpu: its own twelve 16-byte rows and LightGpu's fifteen (eleven and four glow blobs).
-        const uint64_t block = 12u * 16u + 15u * 16u;
+        // MarchGpu: its own twelve 16-byte rows and LightGpu's sixteen (twelve and four glow blobs).
+        const uint64_t block = 12u * 16u + 16u * 16u;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 8 + 36u * 4);
         scene.march.light = MarchLightSource::March;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4 + 36u * 4);

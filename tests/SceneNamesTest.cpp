@@ -19,7 +19,7 @@
 namespace cb {
 namespace {
 
-static_assert(kPhaseKindNames.size() == size_t(PhaseKind::Mie) + 1);
+static_assert(kPhaseKindNames.size() == size_t(PhaseKind::DualLobe) + 1);
 static_assert(kAttenuationKindNames.size() == size_t(AttenuationKind::Thesis) + 1);
 static_assert(kShadowFormNames.size() == size_t(ShadowForm::Wang) + 1);
 static_assert(kSampleFilterNames.size() == size_t(SampleFilter::Nearest) + 1);

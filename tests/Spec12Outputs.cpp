@@ -37,6 +37,14 @@ double PhaseMax(const PhaseParams& phase) {
         // Linear interpolation never exceeds the largest tabulated value.
         case PhaseKind::Mie:
             return *std::max_element(kMieCloudTable.values, kMieCloudTable.values + kMieCloudTable.count);
+        // A blend of lobes convex in cos: its largest value is at cos = 1 or -1, where HG(g) is
+        // (1 + g) / (1 - g)^2, respectively (1 - g) / (1 + g)^2.
+        case PhaseKind::DualLobe: {
+            const double f = phase.gForward, b = phase.gBackward, w = phase.blend;
+            const double at1 = (1 - w) * (1 + f) / ((1 - f) * (1 - f)) + w * (1 + b) / ((1 - b) * (1 - b));
+            const double atMinus1 = (1 - w) * (1 - f) / ((1 + f) * (1 + f)) + w * (1 - b) / ((1 + b) * (1 + b));
+            return std::max(at1, atMinus1);
+        }
     }
     return std::numeric_limits<double>::infinity();
 }

@@ -45,6 +45,7 @@ MATRIX_CASES = [
     "shade.scattering.enabled=true", "phase.function=none+shade.scattering.enabled=true",
     "phase.function=cornette-shanks+shade.scattering.enabled=true",
     "phase.function=mie+shade.scattering.enabled=true",
+    "phase.function=dual-lobe+shade.scattering.enabled=true",
     "shadow.form=thesis", "shadow.form=wang", "render.culling=false", "render.skipping=false",
     "sun.elevation_deg=20+sun.azimuth_deg=10", "sun.elevation_deg=70+sun.azimuth_deg=30", "ca.wind_shift=[[1,-1]]",
 ] + (["gl-ca-layout=rgba8"] if backend == "gl" else [])
@@ -258,8 +259,8 @@ elif case == "matrix":
     # The coverage lists every value compared on this backend: every phase in shade and render_splat,
     # every storage, radius, shadow form and attenuation.
     cov = doc["coverage"]
-    want = {("shade", "phase"): ["none", "henyey-greenstein", "cornette-shanks", "mie"],
-            ("render_splat", "phase"): ["none", "henyey-greenstein", "cornette-shanks", "mie"],
+    want = {("shade", "phase"): ["none", "henyey-greenstein", "cornette-shanks", "mie", "dual-lobe"],
+            ("render_splat", "phase"): ["none", "henyey-greenstein", "cornette-shanks", "mie", "dual-lobe"],
             ("shade", "storage"): ["fp32", "fp16", "unorm8"], ("shade", "attenuation"): ["beer", "thesis"],
             ("shade", "resolution"): ["1", "2", "4"], ("shade", "filter"): ["bilinear", "nearest"],
             ("smooth", "radius"): ["0", "1", "2"], ("shadow", "form"): ["beer", "thesis", "wang"],

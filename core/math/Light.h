@@ -156,6 +156,10 @@ struct alignas(16) LightGpu {
     float mieIndexPerRadian;  // kMieCloudTable's, read with phase Mie
     uint32_t mieCount;        // likewise
     uint32_t unused;
+    float phaseGForward;  // the dual lobe's (PhaseParams), read with phase dual-lobe
+    float phaseGBackward;
+    float phaseBlend;
+    uint32_t phaseUnused;
     std::array<float, 3> glowColor;
     uint32_t glowOn;  // 1: the city glow shines
     float glowFade;
@@ -174,7 +178,7 @@ struct alignas(16) LightGpu {
     std::array<float, 3> skyDirection;
     uint32_t skyUnused;
 };
-static_assert(sizeof(LightGpu) == (11 + kMaxGlowBlobs) * 16, "LightGpu is eleven 16-byte rows and one per glow blob");
+static_assert(sizeof(LightGpu) == (12 + kMaxGlowBlobs) * 16, "LightGpu is twelve 16-byte rows and one per glow blob");
 
 inline LightGpu MakeLightGpu(const LightTerms& L) {
     LightGpu g{};
@@ -189,6 +193,9 @@ inline LightGpu MakeLightGpu(const LightTerms& L) {
     g.voxelSize = L.voxelSize;
     g.mieIndexPerRadian = kMieCloudTable.indexPerRadian;
     g.mieCount = kMieCloudTable.count;
+    g.phaseGForward = L.phase.gForward;
+    g.phaseGBackward = L.phase.gBackward;
+    g.phaseBlend = L.phase.blend;
     g.glowColor = L.glowColor;
     g.glowOn = L.glowOn ? 1u : 0u;
     g.glowFade = L.glowFade;
@@ -212,7 +219,7 @@ inline LightTerms LightTermsOf(const LightGpu& g) {
     LightTerms L;
     L.sunRadiance = g.sunRadiance;
     L.ambient = g.ambient;
-    L.phase = PhaseParams{PhaseKind(uint8_t(g.phaseKind)), g.phaseG};
+    L.phase = PhaseParams{PhaseKind(uint8_t(g.phaseKind)), g.phaseG, g.phaseGForward, g.phaseGBackward, g.phaseBlend};
     L.voxelSize = g.voxelSize;
     L.pointOn = g.pointOn != 0u;
     L.pointPosition = g.pointPosition;

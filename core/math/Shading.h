@@ -146,11 +146,19 @@ inline float CoverageModulate(float v, float m, float coverage, float density) {
 
 // ---- Phase functions (SPEC 9), normalised so that isotropic gives 1 ----------
 
-enum class PhaseKind : uint8_t { None, HenyeyGreenstein, CornetteShanks, Mie };
+enum class PhaseKind : uint8_t { None, HenyeyGreenstein, CornetteShanks, Mie, DualLobe };
+
+// The dual lobe's defaults (docs/scenes.md, "phase"): Hillaire's Frostbite clouds (2016), a forward lobe of g 0.8
+// and a backward one of g -0.5 blended half and half.
+inline constexpr float kDualLobeGForward = 0.8f, kDualLobeGBackward = -0.5f, kDualLobeBlend = 0.5f;
 
 struct PhaseParams {
     PhaseKind kind = PhaseKind::HenyeyGreenstein;
     float g = 0.6f;  // Henyey-Greenstein and Cornette-Shanks; Mie ignores it (its g is the table's)
+    // The dual lobe, (1 - blend) HG(gForward) + blend HG(gBackward); only it reads these.
+    float gForward = kDualLobeGForward;    // in [0, 1)
+    float gBackward = kDualLobeGBackward;  // in (-1, 0]
+    float blend = kDualLobeBlend;          // the backward lobe's weight w, in [0, 1]
 };
 
 // P^ tabulated at `count` uniform angles theta_i = i pi / (count - 1), values[0]
@@ -195,22 +203,30 @@ inline float SamplePhaseTable(const PhaseTable& table, float cosTheta) {
 // of cloudbench_core.
 extern const PhaseTable kMieCloudTable;
 
+// Henyey-Greenstein's P^(cos theta) = (1 - g^2) / (1 + g^2 - 2 g cos)^1.5. GLSL twin: shading.glsl HenyeyGreenstein.
+inline float HenyeyGreenstein(float g, float cosTheta) {
+    const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
+    return (1.0f - g * g) / (denom * std::sqrt(denom));
+}
+
 // P^(cos theta) = 4 pi p(theta).
 inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
     const float g = phase.g;
     switch (phase.kind) {
         case PhaseKind::None:
             return 1.0f;
-        case PhaseKind::HenyeyGreenstein: {
-            const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
-            return (1.0f - g * g) / (denom * std::sqrt(denom));
-        }
+        case PhaseKind::HenyeyGreenstein:
+            return HenyeyGreenstein(g, cosTheta);
         case PhaseKind::CornetteShanks: {
             const float denom = 1.0f + g * g - 2.0f * g * cosTheta;
             return 1.5f * (1.0f - g * g) / (2.0f + g * g) * (1.0f + cosTheta * cosTheta) / (denom * std::sqrt(denom));
         }
         case PhaseKind::Mie:
             return SamplePhaseTable(kMieCloudTable, cosTheta);
+        case PhaseKind::DualLobe:
+            // Lerp: a blend of 0 gives the forward lobe's bits, 1 the backward's (each lobe is finite).
+            return Lerp(HenyeyGreenstein(phase.gForward, cosTheta), HenyeyGreenstein(phase.gBackward, cosTheta),
+                        phase.blend);
     }
     return 1.0f;
 }
@@ -222,7 +238,13 @@ inline float PhaseValue(const PhaseParams& phase, float cosTheta) {
 // interpolation lies between two values), 1 for none. Near |g| = 1 the float
 // value is far from the exact (1 + g)/(1 - g)^2: the denominator 1 + g^2 - 2g
 // is a difference of numbers near 2, a multiple of 2^-23, and 0 (peak inf)
-// for most |g| within 3e-4 of 1 (the first at 0.999701).
+// for most |g| within 3e-4 of 1 (the first at 0.999701). The dual lobe: the larger of its values at cos = 1
+// and -1. Its lobes run opposite ways (the forward one, g >= 0, rises with cos, the backward one falls), so
+// the blend is not monotone, but each lobe is convex in cos ((a - b cos)^-1.5 with a > |b|) and so is any
+// blend with weights >= 0: its largest value on [-1, 1] is at an end, and either end may be it (cos = -1
+// with blend 0.9 and g_backward -0.9). In float an inner cos may round an ulp above the larger end where
+// the blend is nearly flat ((0.2, -0.2, 1/2) at cos = -1 + 2^-22; DualLobe.PeakIsAtAnEnd bounds it at 2),
+// far inside kMaxPhasePeak's margin of 2^1.5 (below).
 inline float PhasePeak(const PhaseParams& phase) {
     if (phase.kind == PhaseKind::Mie) {
         float peak = 0;

@@ -21,6 +21,10 @@ struct LightGpu {
     float mieIndexPerRadian;
     uint mieCount;
     uint unused;
+    float phaseGForward;
+    float phaseGBackward;
+    float phaseBlend;
+    uint phaseUnused;
     vec3 glowColor;
     uint glowOn;
     float glowFade;
@@ -52,7 +56,8 @@ struct LightSample {
 
 // P^(cos theta) of the scene's phase function (core/math/Shading.h PhaseValue).
 float LightPhase(LightGpu L, float cosTheta) {
-    return PhaseOf(L.phaseKind, L.phaseG, L.mieIndexPerRadian, L.mieCount, cosTheta);
+    return PhaseOf(L.phaseKind, L.phaseG, vec3(L.phaseGForward, L.phaseGBackward, L.phaseBlend), L.mieIndexPerRadian,
+                   L.mieCount, cosTheta);
 }
 
 // core/math/Light.h SkyPhase.

@@ -6,7 +6,8 @@
 #ifndef CLOUDBENCH_PHASE_TABLE_GLSL
 #define CLOUDBENCH_PHASE_TABLE_GLSL
 
-const uint kPhaseMie = 3u;  // PhaseKind::Mie
+const uint kPhaseMie = 3u;       // PhaseKind::Mie
+const uint kPhaseDualLobe = 4u;  // PhaseKind::DualLobe
 
 float PhaseTableValue(uint i);
 
@@ -19,10 +20,11 @@ float SamplePhaseTable(float indexPerRadian, uint count, float cosTheta) {
     return Lerp(PhaseTableValue(i), PhaseTableValue(i + 1u), x - float(i));
 }
 
-// P^(cos theta) = 4 pi p(theta) for phase `kind` (PhaseValue); the table's
-// index per radian and count are read with phase Mie only.
-float PhaseOf(uint kind, float g, float indexPerRadian, uint count, float cosTheta) {
+// P^(cos theta) = 4 pi p(theta) for phase `kind` (PhaseValue); `lobes` (g_forward, g_backward, blend) are
+// read with phase dual-lobe only, the table's index per radian and count with phase Mie only.
+float PhaseOf(uint kind, float g, vec3 lobes, float indexPerRadian, uint count, float cosTheta) {
     if (kind == kPhaseMie) return SamplePhaseTable(indexPerRadian, count, cosTheta);
+    if (kind == kPhaseDualLobe) return DualLobePhase(lobes.x, lobes.y, lobes.z, cosTheta);
     return PhaseValue(kind, g, cosTheta);
 }
 

@@ -104,7 +104,20 @@ void UpsampleTap(int i, int f, int cells, out int i0, out int i1, out float w) {
     w = x - float(i0);
 }
 
-// phase kind: 0 none, 1 Henyey-Greenstein, 2 Cornette-Shanks. Returns 4 pi p.
+// core/math/Shading.h HenyeyGreenstein: (1 - g^2) / (1 + g^2 - 2 g cos)^1.5.
+float HenyeyGreenstein(float g, float cosTheta) {
+    precise float denom = 1.0 + g * g - 2.0 * g * cosTheta;
+    precise float hg = (1.0 - g * g) / (denom * sqrt(denom));
+    return hg;
+}
+
+// core/math/Shading.h PhaseValue's dual lobe: (1 - blend) HG(gForward) + blend HG(gBackward), through Lerp.
+float DualLobePhase(float gForward, float gBackward, float blend, float cosTheta) {
+    return Lerp(HenyeyGreenstein(gForward, cosTheta), HenyeyGreenstein(gBackward, cosTheta), blend);
+}
+
+// phase kind: 0 none, 1 Henyey-Greenstein, 2 Cornette-Shanks (the dual lobe, 4, is DualLobePhase and Mie, 3,
+// phase_table.glsl's). Returns 4 pi p.
 float PhaseValue(uint kind, float g, float cosTheta) {
     if (kind == 0u) return 1.0;
     precise float denom = 1.0 + g * g - 2.0 * g * cosTheta;

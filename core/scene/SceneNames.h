@@ -12,11 +12,12 @@
 namespace cb {
 
 // Each table holds every value of its enum exactly once, in the order errors and help list them.
-inline constexpr std::array<NamedValue<PhaseKind>, 4> kPhaseKindNames{{
+inline constexpr std::array<NamedValue<PhaseKind>, 5> kPhaseKindNames{{
     {"none", PhaseKind::None},
     {"henyey-greenstein", PhaseKind::HenyeyGreenstein},
     {"cornette-shanks", PhaseKind::CornetteShanks},
     {"mie", PhaseKind::Mie},
+    {"dual-lobe", PhaseKind::DualLobe},
 }};
 inline constexpr std::array<NamedValue<AttenuationKind>, 2> kAttenuationKindNames{{
     {"beer", AttenuationKind::Beer},

@@ -15,7 +15,7 @@ namespace {
 constexpr std::string_view kSunKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity", "path", "speed"};
 constexpr std::string_view kSunKeyframeKeys[] = {"step", "elevation_deg", "azimuth_deg"};
 constexpr std::string_view kSunSpeedKeys[] = {"elevation_deg", "azimuth_deg"};
-constexpr std::string_view kPhaseKeys[] = {"function", "g"};
+constexpr std::string_view kPhaseKeys[] = {"function", "g", "g_forward", "g_backward", "blend"};
 constexpr std::string_view kRenderKeys[] = {
     "width",    "height",      "q_min",           "splat_scale",      "opacity", "alpha", "culling",
     "skipping", "every_steps", "frames_per_step", "slices_per_frame", "cameras", "ground"};
@@ -339,6 +339,55 @@ void ReadPhase(const Json& root, Validator& check, PhaseParams& phase) {
             else
                 phase.g = float(*d);
         }
+    }
+    // The dual lobe's fields, read whatever the function (as g is): only dual-lobe uses them. A g stays a float
+    // inside its half-open range there too.
+    struct LobeField {
+        const char* key;
+        float& value;
+        Range range;
+        const char* rangeText;
+    };
+    const LobeField lobes[] = {
+        {"g_forward", phase.gForward, Range{.lo = 0, .hi = 1, .hiOpen = true}, "[0, 1)"},
+        {"g_backward", phase.gBackward, Range{.lo = -1, .loOpen = true, .hi = 0}, "(-1, 0]"},
+        {"blend", phase.blend, Range{.lo = 0, .hi = 1}, "[0, 1]"},
+    };
+    for (const LobeField& lobe : lobes) {
+        const Json* v = Validator::Find(*section, lobe.key);
+        if (!v) continue;
+        const std::string field = std::string("phase.") + lobe.key;
+        if (auto d = check.Number(*v, field, lobe.range)) {
+            if (std::string_view(lobe.key) != "blend" && std::fabs(float(*d)) >= 1.0f)
+                check.Fail(field,
+                           "must be in " + std::string(lobe.rangeText) + " in single precision, got " + Describe(*v));
+            else
+                lobe.value = float(*d);
+        }
+    }
+    if (phase.kind == PhaseKind::DualLobe) {
+        // Each lobe within the peak bound, whatever its weight (a weight of 0 times an infinite lobe is NaN); the
+        // blend of two such lobes may round a few ulps above the larger, so it is bounded too.
+        struct LobeEnd {
+            const char* field;
+            const char* cosTheta;
+            float peak;
+        };
+        const LobeEnd ends[] = {{"phase.g_forward", "1", HenyeyGreenstein(phase.gForward, 1.0f)},
+                                {"phase.g_backward", "-1", HenyeyGreenstein(phase.gBackward, -1.0f)}};
+        bool lobesBounded = true;
+        for (const LobeEnd& end : ends)
+            if (!(end.peak <= kMaxPhasePeak)) {
+                lobesBounded = false;
+                check.Fail(end.field, std::string("the lobe's peak (Henyey-Greenstein at cos theta = ") + end.cosTheta +
+                                          ", in single precision as the stages evaluate it) must be at most " +
+                                          FormatNumber(kMaxPhasePeak) + " (2^18), got " + FormatNumber(end.peak));
+            }
+        const float peak = PhasePeak(phase);
+        if (lobesBounded && !(peak <= kMaxPhasePeak))
+            check.Fail("phase.blend", "the blended peak P^max must be at most " + FormatNumber(kMaxPhasePeak) +
+                                          " (2^18), got " + FormatNumber(peak));
+        return;
     }
     // The peak bounds every P^ the stages form (core/math/Shading.h kMaxPhasePeak); only g moves it (Mie's is ~7400).
     const float peak = PhasePeak(phase);

@@ -49,7 +49,8 @@ float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1
 LayersBillboard LayersBillboardAt(uint i) { return twinBillboards[i]; }
 
 LightGpu ZeroLight() {
-    return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, vec3(0.0), 0u, 0.0,
+    return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, 0.0, 0.0, 0.0, 0u,
+                    vec3(0.0), 0u, 0.0,
                     0.0, 0u, 0u, vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0)), vec3(0.0, 0.0, 1.0), 0u, 0.0,
                     0.0, 0.0, 0.0, vec3(0.0), 0u, vec3(0.0, 0.0, 1.0), 0u);
 }
@@ -91,6 +92,7 @@ void main() {
         case kTwinLerp: PutF(0u, Lerp(F(0u), F(1u), F(2u))); break;
         case kTwinBilinear: PutF(0u, Bilinear(F(0u), F(1u), F(2u), F(3u), F(4u), F(5u))); break;
         case kTwinPhaseValue: PutF(0u, PhaseValue(U(0u), F(1u), F(2u))); break;
+        case kTwinDualLobePhase: PutF(0u, DualLobePhase(F(0u), F(1u), F(2u), F(3u))); break;
         case kTwinSplatKernel: PutF(0u, SplatKernel(F(0u), F(1u))); break;
         case kTwinSliceFactor: PutF(0u, SliceFactor(U(0u), F(1u), F(2u), F(3u), F(4u))); break;
         case kTwinStoreTransmittance: PutF(0u, StoreTransmittance(U(0u), F(1u), F(2u))); break;
@@ -180,6 +182,9 @@ void main() {
             MarchGpu m = ZeroMarch();
             m.light.phaseKind = U(0u);
             m.light.phaseG = F(1u);
+            m.light.phaseGForward = F(5u);
+            m.light.phaseGBackward = F(6u);
+            m.light.phaseBlend = F(7u);
             m.light.mieIndexPerRadian = F(3u);
             m.light.mieCount = U(4u);
             PutF(0u, MarchPhase(m, F(2u)));
