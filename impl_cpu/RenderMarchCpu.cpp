@@ -5,7 +5,9 @@
 // light T_sky into a second one,
 // the brick skip structure is built from it, and then the rays: on a SIMD target a packet of rays in lanes per
 // 16 x 16 pixel tile (impl_cpu/MarchLanesCpu-inl.h), on the scalar target, or a volume too large for 32-bit
-// gathers, the shared kernel MarchRay (core/math/March.h) per pixel over 8 x 8 pixel tiles; the same bits.
+// gathers, the shared kernel MarchRay (core/math/March.h) per pixel over 8 x 8 pixel tiles; the same bits. A frame
+// with temporal reprojection (core/math/Reprojection.h) traces one pixel of each block into a cell of its own, then
+// fills the image from the previous frame it held on entry (ResolveReprojected).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "impl_cpu/RenderMarchCpu.cpp"
 #include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
