@@ -8,6 +8,8 @@ set(layers_cases
     # Not tiled, half and twice the layers, a short l_max, the Mie phase, an odd grid and image.
     "UntiledHalfLayersMie|layers-small|--set|grid.tiling=false|--set|layers.count=4|--set|phase.function=\"mie\"|--set|grid.size=[31,29,9]|--set|render.width=67|--set|render.height=45"
     "TwiceLayersShortPathCornetteShanks|layers-small|--set|layers.count=16|--set|layers.max_length=1.5|--set|phase.function=\"cornette-shanks\"|--set|layers.extent=6000"
+    # The dual lobe at its defaults, LOD0's billboards on.
+    "DualLobeLod0|layers-small|--set|phase.function=\"dual-lobe\"|--set|layers.lod0_radius=1500"
     # The wind's drift (eq. 18) over three steps, with alpha interpolating between them.
     "WindThreeSteps|layers-small|--steps|3|--set|layers.wind=[170,-45]|--set|render.alpha=0.4"
     # Wang, Ji and Zhang's opacity (eq. 16) with its modulation map, tiled and not.

@@ -24,6 +24,8 @@ set(march_cases
     "OddEveryOption|${march_small}|--set|stages=[\"noise\",\"density\",\"render_march\"]|--set|grid.size=[31,29,13]|--set|render.width=37|--set|render.height=23|--set|march.jitter=true|--set|march.skipping.enabled=false|--set|march.adaptive.enabled=true|--set|march.adaptive.start=8|--set|march.light=\"march\"|--set|march.light_steps=4|--set|march.powder.enabled=true|--set|phase.function=\"mie\"|--set|lightning.position=[800,700,300]|--set|lightning.intensity=200000"
     "OddNoSkippingCornetteShanks|${march_small}|--set|${march_stages}|--set|grid.size=[31,29,13]|--set|render.width=67|--set|render.height=45|--set|march.skipping.enabled=false|--set|phase.function=\"cornette-shanks\""
     "OddBrick3LightMarchNoPhase|${march_small}|--set|${march_stages}|--set|grid.size=[31,29,13]|--set|march.skipping.brick=3|--set|march.light=\"march\"|--set|phase.function=\"none\""
+    # The dual lobe, mostly backward (its peak at cos theta = -1), with the light march and the lightning.
+    "OddDualLobeLightMarch|${march_small}|--set|${march_stages}|--set|grid.size=[31,29,13]|--set|render.width=67|--set|render.height=45|--set|march.light=\"march\"|--set|phase.function=\"dual-lobe\"|--set|phase.g_backward=-0.7|--set|phase.blend=0.8|--set|lightning.position=[800,700,300]|--set|lightning.intensity=200000"
     # The shipped noise scene (128^3) at small images.
     "NoiseLayer|${march_layer}|--steps|1|--set|render.width=160|--set|render.height=90"
     "NoiseLayerBrick1LightMarch|${march_layer}|--steps|1|--set|render.width=97|--set|render.height=61|--set|march.skipping.brick=1|--set|march.light=\"march\"")
