@@ -3,7 +3,8 @@
 
   check_counts.py same A.json B.json
       the same scene counted twice: every stage's total and every step's count
-      identical, and the simulation stages all counted (non-zero).
+      identical (render_splat's within 1e-5: see same()), and the simulation
+      stages all counted (non-zero).
   check_counts.py more SMALL.json LARGE.json STAGE[,STAGE...]
       LARGE ran the same scene with twice the voxels: each named stage, whose
       work is a pass over every voxel, counts more than 2 % more (the exact
@@ -13,6 +14,7 @@ import json
 import sys
 
 SIMULATION_STAGES = ["region", "ca", "smooth", "density"]
+LAYOUT_SENSITIVE = {"render_splat"}
 
 
 def load(path):
@@ -29,8 +31,18 @@ def same(a_path, b_path):
     b, b_totals, b_steps = load(b_path)
     for stage in SIMULATION_STAGES:
         assert a_totals.get(stage, 0) > 0, f"{stage} not counted: {a_totals}"
-    assert a_totals == b_totals, f"totals differ:\n{a_totals}\n{b_totals}"
-    assert a_steps == b_steps, "per-step counts differ"
+    # render_splat alone may move by a few instructions: on 2026-12-07 (an AVX2-only machine) two identical ctest
+    # counts of ci-small gave 5787851 and 5787816 (6e-6) in 3 of 5 runs, every other stage identical, while six
+    # counts run by hand all gave 5787851; where the heap puts its buffers moves the vectorised stages' counts
+    # (tests/exact.cmake). It is held to 1e-5 of its count; every other stage to the instruction.
+    def close(stage, x, y):
+        return x == y or (stage in LAYOUT_SENSITIVE and abs(x - y) <= 1e-5 * max(x, y))
+    assert a_totals.keys() == b_totals.keys(), f"stages differ:\n{a_totals}\n{b_totals}"
+    for stage in a_totals:
+        assert close(stage, a_totals[stage], b_totals[stage]), f"totals differ:\n{a_totals}\n{b_totals}"
+        assert a_steps[stage].keys() == b_steps[stage].keys(), f"{stage}: counted steps differ"
+        for step, n in a_steps[stage].items():
+            assert close(stage, n, b_steps[stage][step]), f"{stage}: step {step} counts differ"
     first, last = a["counted_steps"]
     for stage, total in a_totals.items():
         counted = sum(n for step, n in a_steps[stage].items() if first <= int(step) <= last)
