@@ -24,6 +24,7 @@
 
 #include "core/math/March.h"
 #include "core/stages/render_march/RenderMarchTypes.h"
+#include "impl_cpu/LaneMathCpu-inl.h"
 #include "impl_cpu/MarchPixelRaysCpu-inl.h"
 #include "impl_cpu/RenderMarchCpuState.h"
 
@@ -192,45 +193,13 @@ class MarchLanes {
         hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), walking)), DI(), walking_);
     }
 
-    // int(v) for v whose integer part fits in int32 (Highway's ConvertTo also mends values out of range, at four
-    // more instructions).
-    static VI Truncate(V v) {
-#if HWY_TARGET <= HWY_AVX3
-        return VI{_mm512_maskz_cvttps_epi32(__mmask16(0xFFFF), v.raw)};  // maskz: no undefined source to warn of
-#elif HWY_TARGET <= HWY_AVX2
-        return VI{_mm256_cvttps_epi32(v.raw)};
-#elif HWY_TARGET <= HWY_SSE4
-        return VI{_mm_cvttps_epi32(v.raw)};
-#else
-        return hn::ConvertTo(DI(), v);
-#endif
-    }
-
-    // std::min(a, b), std::max(a, b) and std::clamp(v, lo, hi) with their own rules for NaN, not the hardware's.
-    static V Min(V a, V b) { return hn::IfThenElse(hn::Lt(b, a), b, a); }
-    static V Max(V a, V b) { return hn::IfThenElse(hn::Lt(a, b), b, a); }
-    static V Clamp(V v, V lo, V hi) { return hn::IfThenElse(hn::Lt(v, lo), lo, hn::IfThenElse(hn::Lt(hi, v), hi, v)); }
-    V Lerp(V a, V b, V t) const { return hn::Add(hn::Mul(a, hn::Sub(hn::Set(d_, 1.0f), t)), hn::Mul(b, t)); }
-
-    // ExpNonPositive (core/math/Shading.h), step for step.
-    V Exp(V x) const {
-        const DI di;
-        const M underflows = hn::Lt(x, hn::Set(d_, -87.0f));
-        x = Max(x, hn::Set(d_, -87.0f));
-        const V k = hn::Round(hn::Mul(x, hn::Set(d_, 1.44269504088896341f)));
-        V r = hn::Sub(x, hn::Mul(k, hn::Set(d_, 0.693145751953125f)));
-        r = hn::Sub(r, hn::Mul(k, hn::Set(d_, 1.42860682030941723212e-6f)));
-        V p = hn::Set(d_, 1.0f / 5040.0f);
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 1.0f / 720.0f));
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 1.0f / 120.0f));
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 1.0f / 24.0f));
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 1.0f / 6.0f));
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 0.5f));
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 1.0f));
-        p = hn::Add(hn::Mul(p, r), hn::Set(d_, 1.0f));
-        const VI bits = hn::ShiftLeft<23>(hn::Add(Truncate(k), hn::Set(di, 127)));
-        return hn::IfThenZeroElse(underflows, hn::Mul(p, hn::BitCast(d_, bits)));
-    }
+    // core/math's helpers in lanes (LaneMathCpu-inl.h).
+    static VI Truncate(V v) { return LaneTruncate(v); }
+    static V Min(V a, V b) { return LaneMin(a, b); }
+    static V Max(V a, V b) { return LaneMax(a, b); }
+    static V Clamp(V v, V lo, V hi) { return LaneClamp(v, lo, hi); }
+    V Lerp(V a, V b, V t) const { return LaneLerp(a, b, t); }
+    V Exp(V x) const { return LaneExpNonPositive(x); }
 
     // MarchStepAt.
     V StepAt(V t) const {

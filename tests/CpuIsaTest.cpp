@@ -134,6 +134,27 @@ const IsaScene kIsaScenes[] = {
       {"render.width", "64"},
       {"render.height", "48"}}},
     {"Layers", "layers-small.json", {{"render.width", "64"}, {"render.height", "48"}}},
+    // The layers' pixels in lanes against LayersPixel, option by option: rows that end inside a packet (61
+    // columns), the box without tiling, the wind's drift, LOD0's billboards, wang's opacity, the falloff,
+    // relighting and fewer layers.
+    {"LayersBoxWindLod0",
+     "layers-small.json",
+     {{"steps", "2"},
+      {"render.every_steps", "1"},
+      {"render.width", "61"},
+      {"render.height", "37"},
+      {"grid.tiling", "false"},
+      {"layers.wind", "[30, -20]"},
+      {"layers.lod0_radius", "600"},
+      {"layers.fade", "0.4"}}},
+    {"LayersWangFadeRelight",
+     "layers-small.json",
+     {{"render.width", "64"},
+      {"render.height", "48"},
+      {"layers.count", "5"},
+      {"layers.fade", "0.3"},
+      {"layers.relight", "\"vector\""},
+      {"layers.wang", R"({"coverage": 0.6, "density": 1.3})"}}},
     {"SkyLight", "wang-sunset.json", {{"render.width", "64"}, {"render.height", "48"}, {"grid.size", "[32,32,8]"}}},
     // The ray march's rays in SIMD lanes against its scalar kernel, option by option: every camera of the track
     // (outside, at the edge of and inside the clouds), the jitter, the adaptive step with small bricks, the light

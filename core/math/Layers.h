@@ -365,6 +365,35 @@ struct LayersPixelResult {
     uint32_t drawn = 0;      // of them with q > 0
 };
 
+// The sun's phase value on a ray, P(s . d): one per pixel, shared by its fragments.
+inline float LayersSunPhase(const LayersSetup& s, const LayersRay& ray) {
+    return PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
+}
+
+// A fragment into a pixel's result: counted when crossed, blended over it when drawn.
+inline void LayersAccumulate(LayersPixelResult& r, const LayerFragmentResult& f) {
+    r.fragments += f.crossed ? 1u : 0u;
+    if (!f.drawn) return;
+    ++r.drawn;
+    r.color = LayersOver(r.color, f.alpha, f.color);
+}
+
+// The billboards' fragments of one pixel in their order, over what its layers left in r.
+template <class Fetch>
+inline void LayersBillboardsOver(const LayersSetup& s, const LayersBillboards& billboards, const LayersRay& ray,
+                                 float sunPhase, Fetch&& fetch, LayersPixelResult& r) {
+    for (uint32_t n = 0; n < billboards.count; ++n)
+        LayersAccumulate(r, BillboardFragment(s, billboards, ray, sunPhase, billboards.items[n], fetch));
+}
+
+// The layer walk of a ray: walks.up or walks.down by the sign of d_z; none for a level ray, and none where
+// |d_z| < 1e-20, where LayerFragment crosses no plane.
+inline LayersWalk LayersWalkOfRay(const LayersWalks& walks, const LayersRay& ray) {
+    const float dz = ray.dir[2];
+    if (!(std::fabs(dz) >= 1e-20f)) return {};
+    return dz > 0.0f ? walks.up : walks.down;
+}
+
 // One pixel: the background, then every layer the ray crosses, back to front
 // (walks: MakeLayersWalks(s)), then the billboards in their order: every billboard fragment lies within r0 of the
 // eye horizontally and every layer fragment at r0 or beyond, so on one ray all the billboards' are nearer.
@@ -373,24 +402,11 @@ inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersWalks& wa
                                      Fetch&& fetch, const LayersBillboards& billboards = {}) {
     LayersPixelResult r;
     r.color = s.background;
-    const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
-    const float dz = ray.dir[2];
-    const LayersWalk w = dz > 0.0f ? walks.up : dz < 0.0f ? walks.down : LayersWalk{};
-    for (uint32_t n = 0; n < w.count; ++n) {
-        const uint32_t i = uint32_t(w.first + w.step * int(n));
-        const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i, fetch);
-        r.fragments += f.crossed ? 1u : 0u;
-        if (!f.drawn) continue;
-        ++r.drawn;
-        r.color = LayersOver(r.color, f.alpha, f.color);
-    }
-    for (uint32_t n = 0; n < billboards.count; ++n) {
-        const LayerFragmentResult f = BillboardFragment(s, billboards, ray, sunPhase, billboards.items[n], fetch);
-        r.fragments += f.crossed ? 1u : 0u;
-        if (!f.drawn) continue;
-        ++r.drawn;
-        r.color = LayersOver(r.color, f.alpha, f.color);
-    }
+    const float sunPhase = LayersSunPhase(s, ray);
+    const LayersWalk w = LayersWalkOfRay(walks, ray);
+    for (uint32_t n = 0; n < w.count; ++n)
+        LayersAccumulate(r, LayerFragment(s, ray, sunPhase, uint32_t(w.first + w.step * int(n)), fetch));
+    LayersBillboardsOver(s, billboards, ray, sunPhase, fetch, r);
     return r;
 }
 

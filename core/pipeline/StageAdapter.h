@@ -52,6 +52,10 @@ struct StageHostInputs {
     // Renderers: the frame's number in the run, the frames drawn before it (a camera's track and the reprojection's
     // order run on it; core/math/Camera.h, core/math/Reprojection.h).
     uint32_t sequence = 0;
+    // Renderers: a stamp of what the buffers they read hold. Two calls with the same non-zero stamp read buffers
+    // whose contents are unchanged between them (for the same buffers), so a backend may keep what it formed from
+    // them; 0: unknown (form anew). Stamps are unique in the process.
+    uint64_t inputsStamp = 0;
 };
 
 // One rendered image.

@@ -1,6 +1,7 @@
 #include "harness/run/Simulation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cstdio>
@@ -98,6 +99,12 @@ bool Simulation::InputsChangedSinceLastRun(Stage stage, uint32_t step) const {
 }
 
 namespace {
+
+// Stamps unique in the process, so that no two simulations (nor one simulation's two input states) share one.
+uint64_t NewInputsStamp() {
+    static std::atomic<uint64_t> next{1};
+    return next.fetch_add(1, std::memory_order_relaxed);
+}
 
 double MsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -522,6 +529,13 @@ Status Simulation::RunStage(Stage stage, StepRecord& record, uint32_t frame, uin
     if (stage == Stage::Region) mRaster = mEllipsoids.Raster();
     StageCallRecord call;
     StageHostInputs host{mStep, mRaster, frame, frames, {}, mBatchOpen, mFramesDrawn};
+    if (Describe(stage).renderer) {
+        // A new stamp whenever a buffer it reads was written (or planned to be) since its last call.
+        auto& [versions, stamp] = mRendererInputs[size_t(stage)];
+        std::vector<uint64_t> now = InputVersions(stage, mStep);
+        if (stamp == 0 || now != versions) versions = std::move(now), stamp = NewInputsStamp();
+        host.inputsStamp = stamp;
+    }
     CB_TRY(CallStage(stage, mBackend, mScene, host, Buffers(), call));
     AddCallTimes(stage, call, record, record.frames.size());
     if (call.coveredColumns) record.coveredColumns = mLastCoveredColumns = call.coveredColumns;

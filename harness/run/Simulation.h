@@ -245,6 +245,8 @@ class Simulation {
     const bool mEveryStepOutputs;
     std::optional<uint32_t> mLastRendered;
     uint32_t mFramesDrawn = 0;
+    // Per renderer: the input versions its last call read, and their stamp (StageHostInputs::inputsStamp).
+    std::array<std::pair<std::vector<uint64_t>, uint64_t>, kStageCount> mRendererInputs;
     std::optional<uint32_t> mLastCoveredColumns;  // the density stage's last cover
     // Time-sliced: the next step's ellipsoids, and what its stages recorded (merged into its record when it starts).
     std::vector<RasterEllipsoid> mRasterAhead;

@@ -291,7 +291,7 @@ Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs
                 MakeLayersParams(sc, sc.render.cameras[n].At(host.sequence), host.step, host.frame, host.frames);
             p.setup.map = map.empty() ? nullptr : map.data();
             const LayersInputs in{PreviousOrCurrent(io, Resource::Q), io.Current(Resource::Q), io.Current(Resource::T),
-                                  io.Current(Resource::TSky)};
+                                  io.Current(Resource::TSky), host.inputsStamp};
             LayersStats stats;
             Status drawn =
                 timed([&] { return backend.RenderLayers(p, in, *io.Current(Resource::LayersImage, n), &stats); });

@@ -67,6 +67,7 @@ struct LayersInputs {
     const Buffer* qCur = nullptr;   // F32 volume
     const Buffer* T = nullptr;      // F32 volume: shade's T
     const Buffer* TSky = nullptr;   // F32 volume: the sky light's T_sky; read only with the sky light on
+    uint64_t stamp = 0;             // StageHostInputs::inputsStamp: equal non-zero stamps, unchanged contents
 };
 
 struct LayersStats {
