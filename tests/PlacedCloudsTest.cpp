@@ -103,9 +103,9 @@ PcCover PcCoverOf(const Scene& scene, const std::vector<uint8_t>& cld, const Ell
 
 // Test that each shape of placed-shapes fills with cloud and clears again (SPEC 17): from kPcBuildSteps after its
 // start until its shrink begins, at least 70 % of its core is cloud and its core's cover is at least four times the
-// cover outside every placed ellipsoid; at its start its core holds at most 20 %; one step after its death (when no
-// region is left there, SPEC 3's cld AND R > 0) none. The step t's cloud field is the automaton's output from R_t,
-// which list step t's ellipsoids made (docs/pipeline.md).
+// cover outside every placed ellipsoid; at its start its core holds at most 20 %; at the first step it no longer
+// lives (no region is left there, SPEC 3's cld AND R > 0) none. Step t's cloud field is the automaton's output
+// from R_t, which list step t's ellipsoids made (docs/pipeline.md).
 TEST(PlacedClouds, EachShapeFillsWhileItLivesAndClearsAfter) {
     const Scene scene = PcLoadPlacedShapes();
     cpu::BackendCpu backend;
