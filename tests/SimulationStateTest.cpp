@@ -396,6 +396,7 @@ TEST_F(SimulationStateFiles, ReadsBackWhatWasSaved) {
     auto state = ReadSimulationState(mDir, mScene, kStateTestHash);
     ASSERT_TRUE(state.has_value()) << state.error().message;
     EXPECT_EQ(state->step, 3u);
+    EXPECT_EQ(state->listStep, 3u);  // three unsliced steps: three list updates
     // q_t, the state, the image; not q_{t-1} (the next step rewrites or does not read it); no third set unsliced.
     std::set<std::string> files;
     for (const auto& entry : fs::directory_iterator(mDir)) files.insert(entry.path().filename().string());
@@ -497,6 +498,13 @@ TEST_F(SimulationStateFiles, BadItemField) {
     m["ellipsoids"]["items"][1]["age"] = -1;
     WriteManifest(m);
     EXPECT_EQ(ErrorOfRead(), Manifest() + ": ellipsoids.items[1].age: must be a non-negative integer, got -1");
+}
+
+TEST_F(SimulationStateFiles, BadListStep) {
+    nlohmann::json m = ReadManifest();
+    m["ellipsoids"]["list_step"] = "3";
+    WriteManifest(m);
+    EXPECT_EQ(ErrorOfRead(), Manifest() + ": ellipsoids.list_step: must be a non-negative integer, got \"3\"");
 }
 
 TEST_F(SimulationStateFiles, MissingBufferEntry) {
