@@ -223,6 +223,30 @@ TEST_P(SimulationStateSplit, SplitRunEqualsTheUnsplitRun) {
     }
 }
 
+// Placed ellipsoids (SPEC 17) across a split: one drifting along keyframes over the whole run, one born at step 3
+// (after the first split) that lives across the second, one that dies at step 3. The resumed list must be at the
+// saved list step, or the placed ellipsoids would start over and the region differ.
+TEST_P(SimulationStateSplit, SplitRunWithPlacedEllipsoids) {
+    for (const char* slices : {"0", "2"}) {
+        const Scene scene = SavedRunScene({{"render.slices_per_frame", slices},
+                                           {"ellipsoids.placed",
+                                            R"([{"semi_axes": [5, 3, 2], "yaw_deg": 40, "persistent": true,
+                   "keyframes": [{"step": 0, "center": [3, 4, 3]}, {"step": 6, "center": [19, 14, 4]}]},
+                  {"center": [16, 5, 3], "semi_axes": [4, 4, 2], "start": 3, "lifetime": 3},
+                  {"center": [6, 15, 3], "semi_axes": [4, 3, 2], "start": 1, "lifetime": 2}])"}});
+        ASSERT_EQ(scene.ellipsoids.placed.size(), 3u);
+        auto whole = MakeSim(scene, *mBackend);
+        ASSERT_TRUE(whole);
+        const std::vector<SavedRunView> expected = StepAndKeep(*whole, *mBackend, scene.steps);
+        ASSERT_EQ(expected.size(), scene.steps);
+        for (uint32_t split : {2u, 4u}) {
+            SCOPED_TRACE(std::string("slices per frame ") + slices + ", split at " + std::to_string(split));
+            const auto got = SplitRun(scene, split, false, *mBackend, *mBackend, StateTestDir(GetParam()));
+            ExpectSameSteps(expected, got, split, scene, SameAs::Bits);
+        }
+    }
+}
+
 // A still field: noise forms q once (step 0) and skips after, so q, D, tiles and bands keep their step-0 values and
 // the renderer interpolates the current value (q_0) with itself at every step: the saved previous_is_current flags
 // and skip state are read at every resumed step here (in the automaton scene each step's smooth runs).
@@ -372,6 +396,7 @@ TEST_F(SimulationStateFiles, ReadsBackWhatWasSaved) {
     auto state = ReadSimulationState(mDir, mScene, kStateTestHash);
     ASSERT_TRUE(state.has_value()) << state.error().message;
     EXPECT_EQ(state->step, 3u);
+    EXPECT_EQ(state->listStep, 3u);  // three unsliced steps: three list updates
     // q_t, the state, the image; not q_{t-1} (the next step rewrites or does not read it); no third set unsliced.
     std::set<std::string> files;
     for (const auto& entry : fs::directory_iterator(mDir)) files.insert(entry.path().filename().string());
@@ -473,6 +498,13 @@ TEST_F(SimulationStateFiles, BadItemField) {
     m["ellipsoids"]["items"][1]["age"] = -1;
     WriteManifest(m);
     EXPECT_EQ(ErrorOfRead(), Manifest() + ": ellipsoids.items[1].age: must be a non-negative integer, got -1");
+}
+
+TEST_F(SimulationStateFiles, BadListStep) {
+    nlohmann::json m = ReadManifest();
+    m["ellipsoids"]["list_step"] = "3";
+    WriteManifest(m);
+    EXPECT_EQ(ErrorOfRead(), Manifest() + ": ellipsoids.list_step: must be a non-negative integer, got \"3\"");
 }
 
 TEST_F(SimulationStateFiles, MissingBufferEntry) {

@@ -27,6 +27,11 @@ endif()
 add_test(NAME Cli.ConformCiSmallWind COMMAND ${cli} conform ci-small-wind --steps 4 --out ${cli_out}/conform-wind)
 set_tests_properties(Cli.ConformCiSmallWind PROPERTIES ENVIRONMENT CLOUDBENCH_VK_VALIDATION=1 SKIP_RETURN_CODE 4
                      FAIL_REGULAR_EXPRESSION "vk validation|fail ")
+# placed-shapes (placed ellipsoids among random ones, SPEC 17) on every built backend, with the Khronos
+# validation layer on (conform compares whole steps; TimeSliceLoop.PlacedEllipsoidsEqualTheUnslicedLoop the loop).
+add_test(NAME Cli.ConformPlacedShapes COMMAND ${cli} conform placed-shapes --steps 30 --out ${cli_out}/conform-placed)
+set_tests_properties(Cli.ConformPlacedShapes PROPERTIES ENVIRONMENT CLOUDBENCH_VK_VALIDATION=1 SKIP_RETURN_CODE 4
+                     FAIL_REGULAR_EXPRESSION "vk validation|fail " TIMEOUT 600)
 # render_splat at 2176 x 1440 (every built backend) and 3840 x 2160 (vk: gl's images hold at most 2048
 # rows here, and says so): above 48 000 screen tiles vk's binning used to run an invocation's loops past
 # lavapipe's budget of 65535 iterations in all, which ends them silently, and above 65535 tiles its serial

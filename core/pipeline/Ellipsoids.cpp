@@ -13,6 +13,37 @@ double Ellipsoid::ShrinkFactor(uint32_t shrinkSteps) const {
     return double(left) / double(shrinkSteps);
 }
 
+std::array<double, 3> PlacedCenterAt(const PlacedEllipsoid& placed, uint32_t step) {
+    const std::vector<PlacedKeyframe>& k = placed.keyframes;
+    if (k.empty()) return placed.center;
+    if (step <= k.front().step) return k.front().center;
+    if (step >= k.back().step) return k.back().center;
+    size_t b = 1;
+    while (k[b].step < step) ++b;
+    const PlacedKeyframe &lo = k[b - 1], &hi = k[b];
+    const double w = double(step - lo.step) / double(hi.step - lo.step);
+    std::array<double, 3> out{};
+    for (int axis = 0; axis < 3; ++axis) out[axis] = lo.center[axis] + (hi.center[axis] - lo.center[axis]) * w;
+    return out;
+}
+
+std::optional<Ellipsoid> PlacedAt(const PlacedEllipsoid& placed, uint32_t step) {
+    if (step < placed.start) return std::nullopt;
+    const uint32_t age = step - placed.start;
+    if (placed.lifetime && age >= *placed.lifetime) return std::nullopt;
+    Ellipsoid e{};
+    const std::array<double, 3> center = PlacedCenterAt(placed, step);
+    for (int axis = 0; axis < 3; ++axis) {
+        e.center[axis] = center[axis];
+        e.semiAxes[axis] = placed.semiAxes[axis];
+    }
+    e.yaw = placed.yawDeg * (std::numbers::pi / 180.0);
+    e.age = age;
+    // Persistent: the largest lifetime; Raster() never shrinks it.
+    e.lifetime = placed.lifetime.value_or(UINT32_MAX);
+    return e;
+}
+
 EllipsoidList::EllipsoidList(const EllipsoidSettings& settings, const Extent3& grid)
     : mSettings(settings), mGrid(grid), mRng(settings.seed) {
     mItems.reserve(settings.targetCount + settings.densityAdaption);
@@ -68,6 +99,7 @@ std::array<double, 2> EllipsoidList::WindAt(double x, double y) const {
 
 void EllipsoidList::Update() {
     const EllipsoidSettings& s = mSettings;
+    if (mListStep < UINT32_MAX) ++mListStep;
     for (Ellipsoid& e : mItems) {
         std::array<double, 2> wind = WindAt(e.center[0], e.center[1]);
         e.center[0] += wind[0] + mRng.Uniform(-s.jitter, s.jitter);
@@ -90,10 +122,9 @@ void EllipsoidList::Update() {
 
 std::vector<RasterEllipsoid> EllipsoidList::Raster() const {
     std::vector<RasterEllipsoid> out;
-    out.reserve(mItems.size());
-    for (const Ellipsoid& e : mItems) {
-        double shrink = e.ShrinkFactor(mSettings.shrinkSteps);
-        if (shrink <= 0.0) continue;
+    out.reserve(mItems.size() + mSettings.placed.size());
+    auto add = [&](const Ellipsoid& e, double shrink) {
+        if (shrink <= 0.0) return;
         RasterEllipsoid r{};
         for (int axis = 0; axis < 3; ++axis) {
             r.center[axis] = static_cast<float>(e.center[axis]);
@@ -102,6 +133,12 @@ std::vector<RasterEllipsoid> EllipsoidList::Raster() const {
         r.cosYaw = static_cast<float>(std::cos(e.yaw));
         r.sinYaw = static_cast<float>(std::sin(e.yaw));
         out.push_back(r);
+    };
+    for (const Ellipsoid& e : mItems) add(e, e.ShrinkFactor(mSettings.shrinkSteps));
+    for (const PlacedEllipsoid& placed : mSettings.placed) {
+        const std::optional<Ellipsoid> e = PlacedAt(placed, mListStep);
+        if (!e) continue;
+        add(*e, placed.lifetime ? e->ShrinkFactor(mSettings.shrinkSteps) : 1.0);
     }
     return out;
 }

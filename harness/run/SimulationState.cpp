@@ -119,6 +119,7 @@ struct SimulationStateAccess {
         s.ellipsoids = sim.mEllipsoids.Items();
         s.rngState = sim.mEllipsoids.Rng().StateWord();
         s.rngIncrement = sim.mEllipsoids.Rng().Increment();
+        s.listStep = sim.mEllipsoids.ListStep();
         PlainFields(sim, s, [](const auto& from, auto& to) { to = from; });
         return s;
     }
@@ -156,7 +157,7 @@ struct SimulationStateAccess {
             SlotFields(sim.mSlots[size_t(r)], s, r, [](auto& to, const auto& from) { to = from; });
         Pcg32 rng(0);
         rng.Restore(s.rngState, s.rngIncrement);
-        sim.mEllipsoids.Restore(s.ellipsoids, rng);
+        sim.mEllipsoids.Restore(s.ellipsoids, rng, s.listStep);
         PlainFields(sim, s, [](auto& to, const auto& from) { to = from; });
         sim.mStep = s.step;
         return {};
@@ -204,7 +205,9 @@ json ManifestOf(const SimulationState& s) {
         {"scene", {{"name", s.sceneName}, {"settings_hash", s.sceneHash}}},
         {"step", s.step},
         {"ellipsoids",
-         {{"rng", {{"state", Hex64(s.rngState)}, {"increment", Hex64(s.rngIncrement)}}}, {"items", items}}},
+         {{"rng", {{"state", Hex64(s.rngState)}, {"increment", Hex64(s.rngIncrement)}}},
+          {"list_step", s.listStep},
+          {"items", items}}},
         {"raster", RasterJson(s.raster)},
         {"raster_ahead", RasterJson(s.rasterAhead)},
         {"last_rendered_step", OptionalJson(s.lastRendered)},

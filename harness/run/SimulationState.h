@@ -9,7 +9,8 @@
 // while time-sliced work is ahead; not the previous step's, which the next
 // step rewrites before a renderer reads it, or does not read at all), read
 // back in the canonical layout of SPEC 0, so any backend can upload it; the
-// ellipsoid list with its Pcg32 state; the ellipsoids step t's region came
+// ellipsoid list with its Pcg32 state and its list step (where the placed
+// ellipsoids are); the ellipsoids step t's region came
 // from (and, time-sliced, step t+1's); the last rendered step
 // and cover; each resource's write count and each stage's input versions at
 // its last run (so that stages skip exactly as in the unsplit run); and the
@@ -58,8 +59,9 @@ struct SimulationState {
     std::string sceneHash;
     uint32_t step = 0;  // the next step to run
     std::vector<SavedBuffer> buffers;
-    std::vector<Ellipsoid> ellipsoids;
+    std::vector<Ellipsoid> ellipsoids;  // the random ones; the placed ones are the scene's, at listStep
     uint64_t rngState = 0, rngIncrement = 0;
+    uint32_t listStep = 0;  // the list's updates so far (EllipsoidList::ListStep)
     std::vector<RasterEllipsoid> raster, rasterAhead;
     std::optional<uint32_t> lastRendered, lastCoveredColumns;
     uint32_t framesDrawn = 0;  // the next frame's number (a camera's track and the reprojection run on it)

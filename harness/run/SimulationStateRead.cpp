@@ -202,6 +202,9 @@ Result<SimulationState> ReadSimulationState(const std::string& dir, const Scene&
                 }
             }
         }
+        // Absent from states saved before placed ellipsoids (whose scenes had none to place): 0.
+        if (e->is_object() && e->contains("list_step"))
+            s.listStep = uint32_t(read.Unsigned((*e)["list_step"], "ellipsoids.list_step", UINT32_MAX).value_or(0));
         if (const json* items = read.Array(*e, "items", "ellipsoids.items")) {
             for (size_t i = 0; i < items->size(); ++i) {
                 const json& it = (*items)[i];

@@ -9,10 +9,18 @@ constexpr int64_t kSeed64Max = int64_t(1) << 53;
 // clang-format off
 constexpr std::string_view kEllipsoidKeys[] = {
     "seed",              "target_count", "density_adaption", "size_mean",    "size_variance", "lifetime_mean",
-    "lifetime_variance", "shrink_steps", "margin",           "height_range", "wind",          "jitter"};
+    "lifetime_variance", "shrink_steps", "margin",           "height_range", "wind",          "jitter",
+    "placed"};
+constexpr std::string_view kPlacedKeys[] = {
+    "name", "center", "semi_axes", "yaw_deg", "start", "lifetime", "persistent", "keyframes"};
 // clang-format on
-// clang-format on
+constexpr std::string_view kPlacedKeyframeKeys[] = {"step", "center"};
 constexpr std::string_view kWindGridKeys[] = {"grid", "vectors"};
+// A placed ellipsoid's centre and semi-axes, in voxels: within a float's exact integers' reach of the grid.
+constexpr double kPlacedReach = 1e9;
+constexpr Range kPlacedCentre{.lo = -kPlacedReach, .hi = kPlacedReach};
+constexpr Range kPlacedSemiAxis{.lo = 0, .loOpen = true, .hi = kPlacedReach};
+constexpr size_t kMostPlaced = 100000;
 
 void ReadWind(const Json& value, Validator& check, EllipsoidWind& wind) {
     const std::string field = "ellipsoids.wind";
@@ -53,6 +61,123 @@ void ReadWind(const Json& value, Validator& check, EllipsoidWind& wind) {
         if (auto v = check.Numbers<2>((*vectors)[i], IndexField(field + ".vectors", i), kFinite))
             wind.grid.push_back(*v);
     }
+}
+
+// Keyframes {step, center} in strictly increasing step order; nullopt (with the errors reported) when any is wrong.
+std::optional<std::vector<PlacedKeyframe>> ReadPlacedKeyframes(const Json& value, Validator& check,
+                                                               const std::string& field) {
+    if (!value.is_array() || value.empty()) {
+        check.Fail(field, "expected a non-empty array of keyframes {\"step\", \"center\"}, got " + Describe(value));
+        return std::nullopt;
+    }
+    std::vector<PlacedKeyframe> keyframes;
+    bool ok = true;
+    for (size_t i = 0; i < value.size(); ++i) {
+        const Json& k = value[i];
+        const std::string at = IndexField(field, i);
+        if (!k.is_object()) {
+            check.Fail(at, "expected a keyframe object {\"step\", \"center\"}, got " + Describe(k));
+            ok = false;
+            continue;
+        }
+        check.CheckKeys(k, at, kPlacedKeyframeKeys);
+        std::optional<int64_t> step;
+        std::optional<std::array<double, 3>> center;
+        if (const Json* v = Validator::Find(k, "step"))
+            step = check.Integer(*v, JoinField(at, "step"), 0, kU32Max);
+        else
+            check.Fail(JoinField(at, "step"), "required field is missing");
+        if (const Json* v = Validator::Find(k, "center"))
+            center = check.Numbers<3>(*v, JoinField(at, "center"), kPlacedCentre);
+        else
+            check.Fail(JoinField(at, "center"), "required field is missing");
+        if (!step || !center) {
+            ok = false;
+            continue;
+        }
+        if (!keyframes.empty() && uint32_t(*step) <= keyframes.back().step) {
+            check.Fail(JoinField(at, "step"), "must be greater than the previous keyframe's step (" +
+                                                  std::to_string(keyframes.back().step) + "), got " +
+                                                  std::to_string(*step));
+            ok = false;
+            continue;
+        }
+        keyframes.push_back({uint32_t(*step), *center});
+    }
+    if (!ok) return std::nullopt;
+    return keyframes;
+}
+
+// One hand-placed ellipsoid (SPEC 17); nullopt (with the errors reported) when any field is wrong.
+std::optional<PlacedEllipsoid> ReadPlaced(const Json& value, Validator& check, const std::string& field) {
+    if (!value.is_object()) {
+        check.Fail(field,
+                   "expected a placed ellipsoid object {\"center\" or \"keyframes\", \"semi_axes\", "
+                   "\"lifetime\" or \"persistent\", ...}, got " +
+                       Describe(value));
+        return std::nullopt;
+    }
+    const size_t errorsBefore = check.ErrorCount();
+    check.CheckKeys(value, field, kPlacedKeys);
+    auto at = [&](std::string_view key) { return JoinField(field, key); };
+    auto find = [&](std::string_view key) { return Validator::Find(value, key); };
+    PlacedEllipsoid p;
+    if (const Json* v = find("name")) {
+        if (auto name = check.String(*v, at("name"))) p.name = *name;
+    }
+    const Json* center = find("center");
+    const Json* keyframes = find("keyframes");
+    if (center && keyframes)
+        check.Fail(at("center"), "cannot be combined with keyframes (the keyframes give the centre)");
+    else if (!center && !keyframes)
+        check.Fail(at("center"), "required field is missing (or \"keyframes\")");
+    else if (center) {
+        if (auto c = check.Numbers<3>(*center, at("center"), kPlacedCentre)) p.center = *c;
+    } else if (auto k = ReadPlacedKeyframes(*keyframes, check, at("keyframes"))) {
+        p.keyframes = std::move(*k);
+        p.center = p.keyframes.front().center;
+    }
+    if (const Json* v = find("semi_axes")) {
+        if (auto a = check.Numbers<3>(*v, at("semi_axes"), kPlacedSemiAxis)) p.semiAxes = *a;
+    } else {
+        check.Fail(at("semi_axes"), "required field is missing");
+    }
+    if (const Json* v = find("yaw_deg")) {
+        if (auto d = check.Number(*v, at("yaw_deg"), Range{.lo = -360, .hi = 360})) p.yawDeg = *d;
+    }
+    if (const Json* v = find("start")) {
+        if (auto n = check.Integer(*v, at("start"), 0, kU32Max)) p.start = uint32_t(*n);
+    }
+    const Json* lifetime = find("lifetime");
+    std::optional<bool> persistent;
+    if (const Json* v = find("persistent")) persistent = check.Boolean(*v, at("persistent"));
+    if (lifetime && persistent.value_or(false)) {
+        check.Fail(at("persistent"), "cannot be combined with lifetime (a persistent ellipsoid never expires)");
+    } else if (lifetime) {
+        if (auto n = check.Integer(*lifetime, at("lifetime"), 1, kU32Max)) p.lifetime = uint32_t(*n);
+    } else if (persistent.has_value() && !*persistent) {
+        check.Fail(at("lifetime"), "required field is missing (\"persistent\" is false)");
+    } else if (!persistent.has_value() && !find("persistent")) {
+        check.Fail(at("lifetime"), "required field is missing (or \"persistent\": true)");
+    }
+    if (check.ErrorCount() != errorsBefore) return std::nullopt;
+    return p;
+}
+
+void ReadPlacedList(const Json& value, Validator& check, std::vector<PlacedEllipsoid>& placed) {
+    const std::string field = "ellipsoids.placed";
+    if (!value.is_array()) {
+        check.Fail(field, "expected an array of placed ellipsoids, got " + Describe(value));
+        return;
+    }
+    if (value.size() > kMostPlaced) {
+        check.Fail(field, "at most " + std::to_string(kMostPlaced) + " placed ellipsoids, got " +
+                              std::to_string(value.size()));
+        return;
+    }
+    placed.clear();
+    for (size_t i = 0; i < value.size(); ++i)
+        if (auto p = ReadPlaced(value[i], check, IndexField(field, i))) placed.push_back(std::move(*p));
 }
 
 }  // namespace
@@ -135,6 +260,7 @@ void ReadEllipsoids(const Json& root, Validator& check, EllipsoidSettings& e) {
     if (const Json* v = find("jitter")) {
         if (auto d = check.Number(*v, field("jitter"), kNonNegative)) e.jitter = *d;
     }
+    if (const Json* v = find("placed")) ReadPlacedList(*v, check, e.placed);
 }
 
 }  // namespace cb::scene_io

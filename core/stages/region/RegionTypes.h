@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace cb {
@@ -15,6 +17,26 @@ struct EllipsoidWind {
     std::array<double, 2> vector{0, 0};
     uint32_t gridNx = 0, gridNy = 0;          // 0: use `vector`
     std::vector<std::array<double, 2>> grid;  // gridNx*gridNy, x fastest
+};
+
+// A placed ellipsoid's centre at one list step (SPEC 17, docs/contract.md).
+struct PlacedKeyframe {
+    uint32_t step = 0;
+    std::array<double, 3> center{0, 0, 0};  // voxel units
+};
+
+// An ellipsoid an artist placed by hand (SPEC 17): it enters the region volume as a random one does, but
+// the wind and the jitter do not move it, no bound removes it and target_count does not count it.
+// At list step t it lives when t >= start and, unless persistent, t - start < lifetime; its age is t - start
+// and it shrinks over the last shrink_steps of its life like a random one.
+struct PlacedEllipsoid {
+    std::string name;                         // for messages and docs only
+    std::array<double, 3> center{0, 0, 0};    // voxel units; with keyframes, the first keyframe's
+    std::array<double, 3> semiAxes{1, 1, 1};  // voxels, each > 0
+    double yawDeg = 0;                        // about z
+    uint32_t start = 0;                       // the list step it appears at
+    std::optional<uint32_t> lifetime;         // steps; none: persistent
+    std::vector<PlacedKeyframe> keyframes;    // strictly increasing steps; empty: the centre holds
 };
 
 struct EllipsoidSettings {
@@ -30,6 +52,7 @@ struct EllipsoidSettings {
     std::array<double, 2> heightRange{0.25, 0.5};  // centre height, fraction of nz
     EllipsoidWind wind;
     double jitter = 0.05;  // uniform +- per axis per step, voxels
+    std::vector<PlacedEllipsoid> placed;  // hand-placed, beside the random list (SPEC 17)
 };
 
 }  // namespace cb
