@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/math/Keyframes.h"
+
 namespace cb {
 
 double Ellipsoid::ShrinkFactor(uint32_t shrinkSteps) const {
@@ -14,17 +16,8 @@ double Ellipsoid::ShrinkFactor(uint32_t shrinkSteps) const {
 }
 
 std::array<double, 3> PlacedCenterAt(const PlacedEllipsoid& placed, uint32_t step) {
-    const std::vector<PlacedKeyframe>& k = placed.keyframes;
-    if (k.empty()) return placed.center;
-    if (step <= k.front().step) return k.front().center;
-    if (step >= k.back().step) return k.back().center;
-    size_t b = 1;
-    while (k[b].step < step) ++b;
-    const PlacedKeyframe &lo = k[b - 1], &hi = k[b];
-    const double w = double(step - lo.step) / double(hi.step - lo.step);
-    std::array<double, 3> out{};
-    for (int axis = 0; axis < 3; ++axis) out[axis] = lo.center[axis] + (hi.center[axis] - lo.center[axis]) * w;
-    return out;
+    if (placed.keyframes.empty()) return placed.center;
+    return KeyframesAt(placed.keyframes, step, [](const PlacedKeyframe& k) { return k.center; });
 }
 
 std::optional<Ellipsoid> PlacedAt(const PlacedEllipsoid& placed, uint32_t step) {
