@@ -278,10 +278,9 @@ void ReadSun(const Json& root, Validator& check, SunSettings& sun) {
                     continue;
                 }
                 frame = {uint32_t(*step), *el, *az};
-                if (!keyframes.empty() && frame.step <= keyframes.back().step) {
-                    check.Fail(JoinField(field, "step"), "must be greater than the previous keyframe's step (" +
-                                                             std::to_string(keyframes.back().step) + "), got " +
-                                                             std::to_string(frame.step));
+                const std::optional<uint32_t> previous =
+                    keyframes.empty() ? std::nullopt : std::optional(keyframes.back().step);
+                if (!check.StepAfterPrevious(JoinField(field, "step"), previous, frame.step)) {
                     pathOk = false;
                     continue;
                 }

@@ -186,6 +186,13 @@ std::optional<std::string> Validator::PathName(const Json& value, std::string_vi
     return name;
 }
 
+bool Validator::StepAfterPrevious(std::string_view field, std::optional<uint32_t> previous, uint32_t step) {
+    if (!previous || step > *previous) return true;
+    Fail(field, "must be greater than the previous keyframe's step (" + std::to_string(*previous) + "), got " +
+                    std::to_string(step));
+    return false;
+}
+
 std::optional<bool> Validator::Boolean(const Json& value, std::string_view field) {
     if (!value.is_boolean()) {
         Fail(field, "expected true or false, got " + Describe(value));

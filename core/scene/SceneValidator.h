@@ -101,6 +101,10 @@ class Validator {
     // A JSON true or false; numbers and strings such as 1 or "true" are refused.
     std::optional<bool> Boolean(const Json& value, std::string_view field);
 
+    // Keyframes by strictly increasing step: true when there is no previous keyframe or `step` is after it; else
+    // `field` fails ("must be greater than the previous keyframe's step") and false.
+    bool StepAfterPrevious(std::string_view field, std::optional<uint32_t> previous, uint32_t step);
+
     // One of the names of `options` (case-sensitive), mapped to its value.
     template <typename T, size_t N>
     std::optional<T> Choice(const Json& value, std::string_view field, const std::array<NamedValue<T>, N>& options) {

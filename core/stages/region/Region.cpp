@@ -95,10 +95,9 @@ std::optional<std::vector<PlacedKeyframe>> ReadPlacedKeyframes(const Json& value
             ok = false;
             continue;
         }
-        if (!keyframes.empty() && uint32_t(*step) <= keyframes.back().step) {
-            check.Fail(JoinField(at, "step"), "must be greater than the previous keyframe's step (" +
-                                                  std::to_string(keyframes.back().step) + "), got " +
-                                                  std::to_string(*step));
+        const std::optional<uint32_t> previous =
+            keyframes.empty() ? std::nullopt : std::optional(keyframes.back().step);
+        if (!check.StepAfterPrevious(JoinField(at, "step"), previous, uint32_t(*step))) {
             ok = false;
             continue;
         }
