@@ -1,9 +1,11 @@
 // `cloudbench dump`: every step's canonical stage outputs as NumPy .npy files
 // (docs/results.md#dumps), and with --reference the exact references.
+#include <algorithm>
 #include <cstdio>
 
 #include "core/base/Npy.h"
 #include "harness/accuracy/Accuracy.h"
+#include "harness/accuracy/Evaluator.h"
 #include "harness/report/Report.h"
 #include "harness/run/Session.h"
 #include "harness/run/Simulation.h"
@@ -23,12 +25,15 @@ Runs SCENE on one backend and writes, for every step t, DIR/step_tttt/ with
   shadow.npy               float32 ground shadow, shape (1, ny, nx)
   T_ref.npy shadow_ref.npy with --reference: the exact references (Embree) for
                            T and the ground shadow, same shapes
-  frame-splat-<camera>.exr step t from each camera
+  frame-splat-<camera>.exr step t from each camera (likewise march, layers)
+  frame-reference-<camera>.exr  with --reference and a renderer: the exact
+                           reference render of the first camera
 Volumes are C order with shape (nz, ny, nx). Only enabled stages are written.
 
 Options:
   --backend NAME     the backend to dump (default: cpu); --backends is the same
-  --reference        also write T_ref.npy and shadow_ref.npy (docs/accuracy.md)
+  --reference        also write T_ref.npy, shadow_ref.npy and the reference
+                     render (docs/accuracy.md)
   --vdb              also write each float volume (q, T, T_sky) as an OpenVDB fog
                      volume, <name>.vdb: voxel (i, j, k) at its centre in world
                      units, every value not +0 an active voxel
@@ -43,25 +48,39 @@ constexpr const char* kHelpTail = R"(  --quiet            no progress lines
 )";
 const std::string kHelp = kHelpHead + GlOptionsHelp() + kHelpTail;
 
-// dump --reference: T_ref.npy (with shade) and shadow_ref.npy (with shadow)
-// of the simulation's current step, computed from its q.
+// dump --reference: T_ref.npy (with shade), shadow_ref.npy (with shadow) and, with a renderer, the exact reference
+// render of the first camera (frame-reference-<camera>.exr: what `accuracy` measures the renderers against), of the
+// simulation's current step, computed from its q.
 Status WriteReferenceDump(const Simulation& sim, const std::string& dir, int threads) {
     const Scene& scene = sim.GetScene();
     const bool wantT = scene.stages.Has(Stage::Shade), wantG = scene.stages.Has(Stage::Shadow);
-    if ((!wantT && !wantG) || !sim.Q()) return {};
+    const bool wantImage = std::ranges::any_of(kAllStages, [&](Stage s) {
+        return scene.stages.Has(s) && Describe(s).renderer && !scene.render.cameras.empty();
+    });
+    if ((!wantT && !wantG && !wantImage) || !sim.Q()) return {};
     auto q = Download<float>(sim.GetBackend(), *sim.Q());
     if (!q) return std::unexpected(q.error());
     const Extent3 e = scene.grid.size;
-    auto tracer = ref::OpticalDepthTracer::Create(e, *q, threads);
-    if (!tracer) return std::unexpected(tracer.error());
-    const ref::ReferenceParams p = MakeReferenceParams(scene, ref::RayStart::VoxelExit);
     auto write = [&](const std::string& path, const uint64_t(&shape)[3], const std::vector<float>& values) {
         return Session::WriteAtomically(path, [&](const Session::TemporaryFile& temp) {
             return WriteNpy(temp.fd, path, NpyType::F32, shape, std::as_bytes(std::span(values)));
         });
     };
-    if (wantT) CB_TRY(write(dir + "/T_ref.npy", {e.nz, e.ny, e.nx}, (*tracer)->Transmittance(p)));
-    if (wantG) CB_TRY(write(dir + "/shadow_ref.npy", {1, e.ny, e.nx}, (*tracer)->GroundShadow(p)));
+    if (wantT || wantG) {
+        auto tracer = ref::OpticalDepthTracer::Create(e, *q, threads);
+        if (!tracer) return std::unexpected(tracer.error());
+        const ref::ReferenceParams p = MakeReferenceParams(scene, ref::RayStart::VoxelExit);
+        if (wantT) CB_TRY(write(dir + "/T_ref.npy", {e.nz, e.ny, e.nx}, (*tracer)->Transmittance(p)));
+        if (wantG) CB_TRY(write(dir + "/shadow_ref.npy", {1, e.ny, e.nx}, (*tracer)->GroundShadow(p)));
+    }
+    if (wantImage) {
+        const LightingInputs in{e, sim.CurrentStep(), std::move(*q), {}};
+        auto image = ComputeImageReference(scene, in, ref::MarchReferenceOptions{}.stepVoxels, threads);
+        if (!image) return std::unexpected(image.error());
+        const std::string stem = dir + "/frame-reference-" + scene.render.cameras[0].name;
+        auto paths = WriteFrame(stem, image->result.image, image->width, image->height, /*png=*/false);
+        if (!paths) return std::unexpected(paths.error());
+    }
     return {};
 }
 
