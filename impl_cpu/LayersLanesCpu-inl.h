@@ -4,12 +4,12 @@
 // the crossing (the plane, the near and far planes, the annulus, the drift and the wrap or the box), the
 // empty-taps bit of its point (FormEmptyTaps), and where that is not set the blend of the taps, beer's opacity, the
 // falloff, the sun, ambient and sky light and the blend over the pixel. What the lanes do not replay runs
-// LayerFragment itself for its lane: a point that is not finite, and in a call with wang's opacity, city glow or
-// eye scattering every fragment whose bit is not set; LOD0's billboards run per lane through LayersBillboardsOver.
-// So each pixel blends LayersPixel's fragments in its order, bit for bit (tests/CpuIsaTest.cpp compares every
-// target with the scalar one, which runs LayersPixel per pixel).
-// Per-target code (Highway's -inl.h form): included by a file that compiles itself once per SIMD target
-// (impl_cpu/CpuIsa.h), after hwy/highway.h, so that each target has its own copy; no #pragma once.
+// LayerFragment itself for its lane: a point that is not finite, and in a call with wang's opacity, city glow, eye
+// scattering or multiple-scattering octaves every fragment whose bit is not set; LOD0's billboards run per lane through
+// LayersBillboardsOver. So each pixel blends LayersPixel's fragments in its order, bit for bit (tests/CpuIsaTest.cpp
+// compares every target with the scalar one, which runs LayersPixel per pixel). Per-target code (Highway's -inl.h
+// form): included by a file that compiles itself once per SIMD target (impl_cpu/CpuIsa.h), after hwy/highway.h, so that
+// each target has its own copy; no #pragma once.
 #if defined(CB_IMPL_CPU_LAYERS_LANES_CPU_INL_H) == defined(HWY_TARGET_TOGGLE)
 #ifdef CB_IMPL_CPU_LAYERS_LANES_CPU_INL_H
 #undef CB_IMPL_CPU_LAYERS_LANES_CPU_INL_H
@@ -49,6 +49,7 @@ void LayersRowInLanes(const LayersSetup& s, const LayersWalks& walks, const Came
 
     // Each lane's ray and walk, made as LayersPixel makes them, and what LayerFragment holds for the whole walk.
     LayersRay rays[kMost];
+    SunPhases phases[kMost];  // each lane's (its value[0] in sunPhase, for the lanes)
     HWY_ALIGN float sunPhase[kMost], skyPhase[kMost], dx[kMost], dy[kMost], tNear[kMost], tFar[kMost], invDz[kMost],
         length[kMost];
     HWY_ALIGN float red[kMost], green[kMost], blue[kMost];  // the pixels' colours so far
@@ -58,9 +59,11 @@ void LayersRowInLanes(const LayersSetup& s, const LayersWalks& walks, const Came
         LayersWalk w;
         rays[l] = {};
         sunPhase[l] = skyPhase[l] = 0.0f;
+        phases[l] = {};
         if (l < count) {
             rays[l] = MakeLayersRay(camera, s.voxelSize, x0 + uint32_t(l), y);
-            sunPhase[l] = LayersSunPhase(s, rays[l]);
+            phases[l] = LayersSunPhases(s, rays[l]);
+            sunPhase[l] = phases[l].value[0];
             skyPhase[l] = SkyPhase(s.light, rays[l].dir);
             w = LayersWalkOfRay(walks, rays[l]);
         }
@@ -94,7 +97,7 @@ void LayersRowInLanes(const LayersSetup& s, const LayersWalks& walks, const Came
     const LightTerms& light = s.light;
     // The lanes gather cells by an int32 float index.
     const bool indexFits = uint64_t(pxy) * (uint64_t(s.size[2]) + 2u) * kFields < (uint64_t(1) << 31);
-    const bool inLanes = !s.wang && !light.pointOn && !light.glowOn && !light.eyeOn && indexFits;
+    const bool inLanes = !s.wang && !light.pointOn && !light.glowOn && !light.eyeOn && light.octaves == 1 && indexFits;
 
     HWY_ALIGN int32_t layerOf[kMost];
     uint8_t scalarBits[(kMost + 7) / 8];
@@ -180,7 +183,7 @@ void LayersRowInLanes(const LayersSetup& s, const LayersWalks& walks, const Came
         hn::StoreMaskBits(d, viaScalar, scalarBits);
         for (size_t l = 0; l < lanes; ++l) {
             if (!((scalarBits[l / 8] >> (l % 8)) & 1u)) continue;
-            const LayerFragmentResult f = LayerFragment(s, rays[l], sunPhase[l], uint32_t(layerOf[l]), fetch);
+            const LayerFragmentResult f = LayerFragment(s, rays[l], phases[l], uint32_t(layerOf[l]), fetch);
             if (!f.drawn) continue;
             ++drawn;
             const Vec3 over = LayersOver({red[l], green[l], blue[l]}, f.alpha, f.color);
@@ -190,7 +193,7 @@ void LayersRowInLanes(const LayersSetup& s, const LayersWalks& walks, const Came
     for (size_t l = 0; l < count; ++l) {
         LayersPixelResult pixel;
         pixel.color = {red[l], green[l], blue[l]};
-        LayersBillboardsOver(s, billboards, rays[l], sunPhase[l], fetch, pixel);
+        LayersBillboardsOver(s, billboards, rays[l], phases[l], fetch, pixel);
         fragments += pixel.fragments;  // the billboards' (the layers' were counted in lanes)
         drawn += pixel.drawn;
         float* o = out + 3 * l;

@@ -4,10 +4,10 @@
 // voxel in x and y, so the trilinear taps need no bounds checks; impl_cpu/PaddedVolumeCpu-inl.h), and with the sky
 // light T_sky into a second one,
 // the brick skip structure is built from it, and then the rays: on a SIMD target a packet of rays in lanes per
-// 16 x 16 pixel tile (impl_cpu/MarchLanesCpu-inl.h), on the scalar target, or a volume too large for 32-bit
-// gathers, the shared kernel MarchRay (core/math/March.h) per pixel over 8 x 8 pixel tiles; the same bits. A frame
-// with temporal reprojection (core/math/Reprojection.h) traces one pixel of each block into a cell of its own, then
-// fills the image from the previous frame it held on entry (ResolveReprojected).
+// 16 x 16 pixel tile (impl_cpu/MarchLanesCpu-inl.h), on the scalar target, a volume too large for 32-bit
+// gathers or with multiple-scattering octaves, the shared kernel MarchRay (core/math/March.h) per pixel over 8 x 8
+// pixel tiles; the same bits. A frame with temporal reprojection (core/math/Reprojection.h) traces one pixel of each
+// block into a cell of its own, then fills the image from the previous frame it held on entry (ResolveReprojected).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "impl_cpu/RenderMarchCpu.cpp"
 #include <hwy/foreach_target.h>  // includes this file again, once per SIMD target (impl_cpu/CpuIsa.h)
@@ -323,7 +323,8 @@ Status RenderMarch(tbb::task_arena& arena, RenderMarchCpuState& state, const Mar
             ResolveReprojected(params, cells, state.traced.data(), state.history.data(), state.bounds.data(), out);
         };
 #if HWY_TARGET != HWY_SCALAR
-        if (MarchLanesFit(px * py * pz)) {
+        // Multiple-scattering octaves run through MarchRay per pixel (their sum is not in lanes).
+        if (MarchLanesFit(px * py * pz) && params.setup.light.octaves == 1) {
             MarchLaneVolume lanes;
             lanes.qt = &state.volume.data()->q;
             lanes.sky = skyLight ? state.skyVolume.data() : nullptr;

@@ -152,12 +152,12 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
         Compare("LayerFragment", fragmentKinds, ulps, fragmentsIn,
                 Run(test::kTwinLayerFragment, fragmentsIn, {}, {}, g), [&](const Words& in, Words& out) {
                     const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
-                    const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, r.dir));
-                    const LayerFragmentResult f = s.light.skyOn ? LayerFragment(s, r, sunPhase, in[2], TwinFetchSky)
-                                                                : LayerFragment(s, r, sunPhase, in[2], TwinFetch);
+                    const SunPhases sunPhases = LayersSunPhases(s, r);
+                    const LayerFragmentResult f = s.light.skyOn ? LayerFragment(s, r, sunPhases, in[2], TwinFetchSky)
+                                                                : LayerFragment(s, r, sunPhases, in[2], TwinFetch);
                     const Vec3 over = LayersOver({Float(in[3]), Float(in[4]), Float(in[5])}, f.alpha, f.color);
                     out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]), Bits(f.color[1]),
-                             Bits(f.color[2]), Bits(sunPhase), Bits(over[0]), Bits(over[1]), Bits(over[2])});
+                             Bits(f.color[2]), Bits(sunPhases.value[0]), Bits(over[0]), Bits(over[1]), Bits(over[2])});
                     drawn += f.drawn ? 1 : 0;
                 });
         const std::vector<Kind> pixelKinds = {Kind::F, Kind::F, Kind::F, Kind::U, Kind::U};
@@ -193,10 +193,10 @@ TEST_F(GlslTwin, LayersFunctionsEqualTheirCppTwins) {
             Compare("BillboardFragment", billboardKinds, ulps, billboardIn,
                     Run(test::kTwinBillboardFragment, billboardIn, {}, {}, g, list), [&](const Words& in, Words& out) {
                         const LayersRay r = MakeLayersRay(p.camera, s.voxelSize, in[0], in[1]);
-                        const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, r.dir));
+                        const SunPhases sunPhases = LayersSunPhases(s, r);
                         const LayerFragmentResult f =
-                            s.light.skyOn ? BillboardFragment(s, billboards, r, sunPhase, list[in[2]], TwinFetchSky)
-                                          : BillboardFragment(s, billboards, r, sunPhase, list[in[2]], TwinFetch);
+                            s.light.skyOn ? BillboardFragment(s, billboards, r, sunPhases, list[in[2]], TwinFetchSky)
+                                          : BillboardFragment(s, billboards, r, sunPhases, list[in[2]], TwinFetch);
                         out = W({uint32_t(f.crossed), uint32_t(f.drawn), Bits(f.alpha), Bits(f.color[0]),
                                  Bits(f.color[1]), Bits(f.color[2]), Bits(r.cosForward)});
                         billboardDrawn += f.drawn ? 1 : 0;

@@ -107,7 +107,11 @@ std::vector<Member> LightMembers(const std::string& prefix, size_t at) {
                                  CB_MEMBER(LightGpu, skyRadiance),
                                  CB_MEMBER(LightGpu, skyOn),
                                  CB_MEMBER(LightGpu, skyDirection),
-                                 CB_MEMBER(LightGpu, skyUnused)};
+                                 CB_MEMBER(LightGpu, skyUnused),
+                                 CB_MEMBER(LightGpu, octaves),
+                                 CB_MEMBER(LightGpu, octaveAttenuation),
+                                 CB_MEMBER(LightGpu, octaveContribution),
+                                 CB_MEMBER(LightGpu, octaveEccentricity)};
     for (Member& m : light) m.name = prefix + m.name, m.offset += at;
     return light;
 }

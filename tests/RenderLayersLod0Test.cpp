@@ -110,9 +110,9 @@ TEST(LayersLod0, LayersStartAtR0) {
             const double r = std::hypot(double(ray.dir[0] * t), double(ray.dir[1] * t));
             if (std::fabs(r - 2.0) < 1e-3) continue;  // the float test at r0 may fall either way
             SetLayersLod0(s, 0.0, 1.0);
-            EXPECT_TRUE(LayerFragment(s, ray, 1.0f, 3, fetch).crossed);
+            EXPECT_TRUE(LayerFragment(s, ray, SunPhases{{1.0f}}, 3, fetch).crossed);
             SetLayersLod0(s, 2.0, 1.0);
-            EXPECT_EQ(LayerFragment(s, ray, 1.0f, 3, fetch).crossed, r > 2.0) << x << ", " << y;
+            EXPECT_EQ(LayerFragment(s, ray, SunPhases{{1.0f}}, 3, fetch).crossed, r > 2.0) << x << ", " << y;
             (r > 2.0 ? outside : inside) += 1;
         }
     EXPECT_GT(inside, 10u);
@@ -240,15 +240,16 @@ TEST(LayersLod0, OneBillboardFragmentByHand) {
     const LayersRay ray = MakeLayersRay(p.camera, 1.0f, 16, 16);
     ASSERT_NEAR(ray.cosForward, 1.0f, 1e-6f);
     const float phase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
-    const LayerFragmentResult f = BillboardFragment(s, list, ray, phase, {{4, 4, 2.2f}, 3.0f}, fetch);
+    const SunPhases phases{{phase}};
+    const LayerFragmentResult f = BillboardFragment(s, list, ray, phases, {{4, 4, 2.2f}, 3.0f}, fetch);
     EXPECT_TRUE(f.crossed && f.drawn);
     EXPECT_NEAR(f.alpha, 1 - std::exp(-double(s.sigmaH)), 1e-6);
     for (int ch = 0; ch < 3; ++ch)
         EXPECT_NEAR(f.color[ch], s.light.sunRadiance[ch] * phase + s.light.ambient[ch], 1e-5);
-    EXPECT_FALSE(BillboardFragment(s, list, ray, phase, {{4.6f, 4, 2.2f}, 3.0f}, fetch).crossed);
-    EXPECT_FALSE(BillboardFragment(s, list, ray, phase, {{4, -2, 2.2f}, -3.0f}, fetch).crossed);
+    EXPECT_FALSE(BillboardFragment(s, list, ray, phases, {{4.6f, 4, 2.2f}, 3.0f}, fetch).crossed);
+    EXPECT_FALSE(BillboardFragment(s, list, ray, phases, {{4, -2, 2.2f}, -3.0f}, fetch).crossed);
     // Beyond r0 horizontally (3.5): the same billboard 4 ahead is LOD1's, not LOD0's.
-    EXPECT_FALSE(BillboardFragment(s, list, ray, phase, {{4, 5, 2.2f}, 4.0f}, fetch).crossed);
+    EXPECT_FALSE(BillboardFragment(s, list, ray, phases, {{4, 5, 2.2f}, 4.0f}, fetch).crossed);
 }
 
 // Test that each GPU backend's image matches the CPU's by SPEC 8's image rule (within 1e-4 everywhere) with LOD0's

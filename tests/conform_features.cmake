@@ -120,6 +120,27 @@ foreach(scene IN ITEMS ci-small noise-layer layers-small)
   set_tests_properties(Cli.ConformWangLight.${scene} PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
                        TIMEOUT 300)
 endforeach()
+# Multiple-scattering octaves (4, with a 0.5, b 0.7, c 0.5) on every built backend for each renderer: splats
+# (ci-small), the march (imgacc-small, beside splats) and the layers (layers-small); exit 4 (no backend besides the CPU
+# could start) is a skip.
+foreach(scene IN ITEMS ci-small imgacc-small layers-small)
+  set(scene_path ${scene})
+  if(scene STREQUAL "imgacc-small")
+    set(scene_path ${CMAKE_CURRENT_SOURCE_DIR}/scenes/imgacc-small.json)
+  endif()
+  add_test(NAME Cli.ConformOctaves.${scene}
+           COMMAND ${cli} conform ${scene_path} --steps 2 --set warmup_steps=0
+                   --set "lighting.octaves={\"count\":4,\"attenuation\":0.5,\"contribution\":0.7,\"eccentricity\":0.5}"
+                   --out ${cli_out}/conform-octaves-${scene})
+  set_tests_properties(Cli.ConformOctaves.${scene} PROPERTIES SKIP_RETURN_CODE 4 FAIL_REGULAR_EXPRESSION "fail"
+                       TIMEOUT 300)
+endforeach()
+# Octaves that keep the extinction and the phase (a = b = c = 1, 3 of them) triple every renderer's image on every
+# backend (no ambient light, a black background): conform cannot see a renderer that ignores the octaves on every
+# backend alike, this can (tests/check_octaves_scale.py).
+add_test(NAME Cli.OctavesScaleEveryRenderer
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_octaves_scale.py ${cli} ${cli_out}/octaves-scale)
+set_tests_properties(Cli.OctavesScaleEveryRenderer PROPERTIES PASS_REGULAR_EXPRESSION "octaves scale: ok" TIMEOUT 300)
 # Tiling in the march: layers-small's tiled clouds out to its 20 km far plane, drawn by render_march beside
 # render_layers (shade's T, then the light march, whose light crosses the neighbouring tiles), on every built
 # backend; exit 4 (no backend besides the CPU could start) is a skip.

@@ -16,7 +16,8 @@ outside referee").
    differ by a few standard errors. --check exits 1 unless the RMS ratio is at most 1.5 and the totals' relative
    difference at most 4 standard errors plus 0.002 (the bounds' reasons at RMS_RATIO_BOUND below).
 4. Multiple scattering: how far each of cloudbench's images (the single-scattering reference, the march with the
-   scene's settings, the march with multiple forward scattering) is from Cycles with many bounces.
+   scene's settings, the march with multiple forward scattering, and with --octaves the march and the exact-light
+   render with multiple-scattering octaves) is from Cycles with many bounces.
 Writes DIR/referee.json and DIR/referee.md (DIR: --out, default out/<scene>/referee).
 
 The scene must state every field the referee reads (grid, sun, phase, shade.sigma, render, the first camera) and
@@ -160,6 +161,10 @@ def main():
     ap.add_argument("--bounces", type=int, default=32, help="volume bounces of the multiple-scattering render; 0 skips it")
     ap.add_argument("--step-rate", type=float, default=0.1, help="Cycles' ray-marching step, in voxels (default 0.1)")
     ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE", help="passed to cloudbench")
+    ap.add_argument("--octaves", action="append", default=[], metavar="N,A,B,C",
+                    help="also measure render_march and the exact-light render with these multiple-scattering "
+                         "octaves (lighting.octaves count, attenuation, contribution, eccentricity) against Cycles' "
+                         "multiple scattering; repeatable")
     ap.add_argument("--cycles-param", action="append", default=[], metavar="NAME=JSON",
                     help="override one of Cycles' parameters (tools/cycles_render.py), e.g. volume_offset=[0,0,0] "
                          "to see a convention's effect")
@@ -207,6 +212,17 @@ def main():
         "march": step_dir / f"frame-march-{camera}.exr",
         "march_forward": forward_dir / f"frame-march-{camera}.exr",
     }
+    labels = {"reference": "exact reference (single scattering)", "march": "render_march, the scene's settings",
+              "march_forward": "render_march, multiple forward scattering"}
+    for k, setting in enumerate(args.octaves if args.bounces > 0 else []):
+        n, a, b, c = setting.split(",")
+        octaves = json.dumps({"count": int(n), "attenuation": float(a), "contribution": float(b),
+                              "eccentricity": float(c)}, separators=(",", ":"))
+        folder = dump(f"dump-octaves-{k}", ["--set", f"lighting.octaves={octaves}"])
+        ours[f"reference_octaves_{k}"] = folder / f"frame-reference-{camera}.exr"
+        ours[f"march_octaves_{k}"] = folder / f"frame-march-{camera}.exr"
+        labels[f"reference_octaves_{k}"] = f"exact light, octaves n={n} a={a} b={b} c={c}"
+        labels[f"march_octaves_{k}"] = f"render_march, octaves n={n} a={a} b={b} c={c}"
     blender(args.blender, {"convert": [[str(p), str(out / f"{k}.npy")] for k, p in ours.items() if p.exists()]},
             out / "convert.json")
     images = {k: np.load(out / f"{k}.npy") for k, p in ours.items() if p.exists()}
@@ -231,7 +247,7 @@ def main():
 
     single = compare_noisy(images["reference"], renders["single-1"], renders["single-2"])
     single_ok = agrees(single)
-    result = {"scene": str(file), "samples": args.samples, "step_rate": args.step_rate, "bounces": args.bounces,
+    result = {"scene": str(file), "labels": labels, "samples": args.samples, "step_rate": args.step_rate, "bounces": args.bounces,
               "width": params["width"], "height": params["height"], "single_scattering": single,
               "single_scattering_agrees": single_ok, "seconds": seconds}
     if "multiple-1" in renders:
@@ -249,8 +265,7 @@ def main():
                      f"{c['rms_difference']:.3g} | {c['rms_noise']:.3g} | {c['rms_ratio']:.2f} | {c['psnr_db']:.1f} |")
     row("exact reference (single scattering)", "no bounce", single)
     for k, c in result.get("multiple_scattering", {}).items():
-        row({"reference": "exact reference (single scattering)", "march": "render_march, the scene's settings",
-             "march_forward": "render_march, multiple forward scattering"}[k], f"{args.bounces} bounces", c)
+        row(labels[k], f"{args.bounces} bounces", c)
     verdict = "agrees" if single_ok else "DISAGREES"
     lines += ["", f"Single scattering {verdict}: RMS difference {single['rms_ratio']:.2f} times the noise's "
               f"(bound {RMS_RATIO_BOUND}), total {single['relative_difference']:+.4f} (bound "

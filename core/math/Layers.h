@@ -150,14 +150,14 @@ struct LayerFragmentResult {
 // at squared horizontal distance r2 from the eye, standing for `length` of path. Moved by the drift and wrapped
 // (tiling), or outside the box [0, nx] x [0, ny] not a fragment; drawn where q > 0. Its opacity is beer's,
 // alpha = 1 - exp(-sigma h q length), or wang's (eq. 16 of q and the map, without a path length), times
-// LayersFade(r2); its colour c = sun (T lightScale) P^(s . d) + ambient (sunPhase = P^(s . d), the ray's), plus the
-// sky light's T_sky P^(s_sky . d) where fetch returns T_sky as a third field.
+// LayersFade(r2); its colour c = sun SunGain(T lightScale) + ambient (with the ray's sunPhases: T lightScale P^(s . d)
+// with one octave), plus the sky light's T_sky P^(s_sky . d) where fetch returns T_sky as a third field.
 // Always inlined: with two callers GCC keeps it out of line, and the call costs the CPU's layers a quarter of
 // their time on wang-20km (reports/perf/lod0-layers-cost.md).
 template <class Fetch>
 [[gnu::always_inline]] inline LayerFragmentResult LayersSampleAt(const LayersSetup& s, const LayersRay& ray,
-                                                                 float sunPhase, float hx, float hy, float z, float r2,
-                                                                 float length, Fetch&& fetch) {
+                                                                 const SunPhases& sunPhases, float hx, float hy,
+                                                                 float z, float r2, float length, Fetch&& fetch) {
     LayerFragmentResult f;
     float x = (s.eye[0] + hx) - s.drift[0], y = (s.eye[1] + hy) - s.drift[1];
     if (s.tiling) {
@@ -182,7 +182,7 @@ template <class Fetch>
     }
     f.alpha = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     const float lit = qt[1] * s.lightScale;  // T, or relit
-    const float gain = lit * sunPhase;
+    const float gain = SunGain(s.light, sunPhases, lit);
     // The sample (voxel units, before the drift and the wrap).
     const Vec3 at{s.eye[0] + hx, s.eye[1] + hy, z};
     float skyGain = 0.0f;
@@ -197,8 +197,8 @@ template <class Fetch>
 // (r0 <= r <= extent) and (without tiling) inside the box, where q > 0
 // (LayersSampleAt, with l = min(spacing / |d_z|, l_max)).
 template <class Fetch>
-inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& ray, float sunPhase, uint32_t i,
-                                         Fetch&& fetch) {
+inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& ray, const SunPhases& sunPhases,
+                                         uint32_t i, Fetch&& fetch) {
     LayerFragmentResult f;
     const float dz = ray.dir[2];
     if (!(std::fabs(dz) >= 1e-20f)) return f;
@@ -210,7 +210,7 @@ inline LayerFragmentResult LayerFragment(const LayersSetup& s, const LayersRay& 
     const float r2 = hx * hx + hy * hy;
     if (!(r2 <= s.outer2 && r2 >= s.inner2)) return f;
     const float length = std::min(s.spacing * std::fabs(invDz), s.maxLength);
-    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length, fetch);
+    return LayersSampleAt(s, ray, sunPhases, hx, hy, z, r2, length, fetch);
 }
 
 // ---- Billboards (LOD0) ----
@@ -246,7 +246,7 @@ inline void SetLayersLod0(LayersSetup& s, double radius, double spacing) {
 // l = min(billboardLength / cosForward, l_max)).
 template <class Fetch>
 inline LayerFragmentResult BillboardFragment(const LayersSetup& s, const LayersBillboards& b, const LayersRay& ray,
-                                             float sunPhase, const LayersBillboard& bb, Fetch&& fetch) {
+                                             const SunPhases& sunPhases, const LayersBillboard& bb, Fetch&& fetch) {
     LayerFragmentResult f;
     const float t = bb.depth / ray.cosForward;
     if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0f)) return f;
@@ -261,7 +261,7 @@ inline LayerFragmentResult BillboardFragment(const LayersSetup& s, const LayersB
     if (!(std::fabs(u) <= s.halfWidth && std::fabs(v) <= s.halfHeight)) return f;
     if (!(z >= 0.0f && z <= s.size[2])) return f;
     const float length = std::min(s.billboardLength / ray.cosForward, s.maxLength);
-    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length, fetch);
+    return LayersSampleAt(s, ray, sunPhases, hx, hy, z, r2, length, fetch);
 }
 
 // The pixels a billboard's fragments can cover, conservatively: its quad projected (a rectangle, the quad being
@@ -365,9 +365,9 @@ struct LayersPixelResult {
     uint32_t drawn = 0;      // of them with q > 0
 };
 
-// The sun's phase value on a ray, P(s . d): one per pixel, shared by its fragments.
-inline float LayersSunPhase(const LayersSetup& s, const LayersRay& ray) {
-    return PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
+// The sun's phase values on a ray, P^(s . d) of each octave (MakeSunPhases): one per pixel, shared by its fragments.
+inline SunPhases LayersSunPhases(const LayersSetup& s, const LayersRay& ray) {
+    return MakeSunPhases(s.light, MarchDot(s.sun, ray.dir));
 }
 
 // A fragment into a pixel's result: counted when crossed, blended over it when drawn.
@@ -381,9 +381,9 @@ inline void LayersAccumulate(LayersPixelResult& r, const LayerFragmentResult& f)
 // The billboards' fragments of one pixel in their order, over what its layers left in r.
 template <class Fetch>
 inline void LayersBillboardsOver(const LayersSetup& s, const LayersBillboards& billboards, const LayersRay& ray,
-                                 float sunPhase, Fetch&& fetch, LayersPixelResult& r) {
+                                 const SunPhases& sunPhases, Fetch&& fetch, LayersPixelResult& r) {
     for (uint32_t n = 0; n < billboards.count; ++n)
-        LayersAccumulate(r, BillboardFragment(s, billboards, ray, sunPhase, billboards.items[n], fetch));
+        LayersAccumulate(r, BillboardFragment(s, billboards, ray, sunPhases, billboards.items[n], fetch));
 }
 
 // The layer walk of a ray: walks.up or walks.down by the sign of d_z; none for a level ray, and none where
@@ -402,11 +402,11 @@ inline LayersPixelResult LayersPixel(const LayersSetup& s, const LayersWalks& wa
                                      Fetch&& fetch, const LayersBillboards& billboards = {}) {
     LayersPixelResult r;
     r.color = s.background;
-    const float sunPhase = LayersSunPhase(s, ray);
+    const SunPhases sunPhases = LayersSunPhases(s, ray);
     const LayersWalk w = LayersWalkOfRay(walks, ray);
     for (uint32_t n = 0; n < w.count; ++n)
-        LayersAccumulate(r, LayerFragment(s, ray, sunPhase, uint32_t(w.first + w.step * int(n)), fetch));
-    LayersBillboardsOver(s, billboards, ray, sunPhase, fetch, r);
+        LayersAccumulate(r, LayerFragment(s, ray, sunPhases, uint32_t(w.first + w.step * int(n)), fetch));
+    LayersBillboardsOver(s, billboards, ray, sunPhases, fetch, r);
     return r;
 }
 

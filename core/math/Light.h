@@ -15,7 +15,8 @@
 // and its line in MakeLightGpu / LightTermsOf; its line in MakeLightTerms and
 // the scene section it reads; and the exact reference. The renderers do not change.
 //
-// The operations, in this order (bit-identical on every backend, built with
+// The sun's gain is the renderer's: SunGain (below) of the sample's transmittance and the ray's SunPhases, times
+// the powder where the renderer has it. The operations, in this order (bit-identical on every backend, built with
 // -ffp-contract=off): per channel c = sunRadiance_c * sunGain + ambient_c,
 // then with the sky light on c += skyRadiance_c * skyGain,
 // then with the point light on c += pointRadiance_c * g, g = T_point / max(d^2, r0^2) P^(cos theta_point),
@@ -37,6 +38,9 @@ inline float PointLightFalloff(float distance2, float minDistance2) { return 1.0
 
 // The most blobs a city glow map has (LightGpu's rows).
 inline constexpr uint32_t kMaxGlowBlobs = 4;
+
+// The most multiple-scattering octaves (SunPhases' size).
+inline constexpr uint32_t kMaxOctaves = 8;
 
 // City glow's map g at (x, y) (voxel units): the sum of the blobs' strength exp(-d^2 k), in blob order.
 inline float GlowMap(const std::array<std::array<float, 4>, kMaxGlowBlobs>& blobs, uint32_t count, float x, float y) {
@@ -79,7 +83,46 @@ struct LightTerms {
     bool skyOn = false;
     Vec3 skyRadiance{};          // colour * intensity
     Vec3 skyDirection{0, 0, 1};  // unit, toward the sky light
+    // Multiple scattering as octaves of single scattering (Wrenninge, Kulla and Lundqvist's approximation, as
+    // Frostbite, Unreal Engine and Nubis use it): octave i scales the extinction toward the sun by a^i (T^(a^i)),
+    // its contribution by b^i and the phase's eccentricity by c^i (SunPhases, SunGain). 1 octave: single scattering.
+    uint32_t octaves = 1;                                                         // n, in [1, kMaxOctaves]
+    float octaveAttenuation = 1, octaveContribution = 1, octaveEccentricity = 1;  // a, b, c
 };
+
+// The sun's phase values on one ray, P^_i(s . d) for octave i < octaves: the scene's phase function with its
+// eccentricity (g, or the dual lobe's gForward and gBackward) times c^i; Mie's table and none unchanged (a scene
+// with Mie and c < 1 is refused). value[0] is PhaseValue(phase, cos) itself.
+struct SunPhases {
+    std::array<float, kMaxOctaves> value{};
+};
+inline SunPhases MakeSunPhases(const LightTerms& L, float cosTheta) {
+    SunPhases p;
+    p.value[0] = PhaseValue(L.phase, cosTheta);
+    PhaseParams scaled = L.phase;
+    for (uint32_t i = 1; i < L.octaves; ++i) {
+        scaled.g *= L.octaveEccentricity;
+        scaled.gForward *= L.octaveEccentricity;
+        scaled.gBackward *= L.octaveEccentricity;
+        p.value[i] = PhaseValue(scaled, cosTheta);
+    }
+    return p;
+}
+
+// The sun's gain at a sample whose transmittance toward the sun is T: T P^_0, plus with octaves the sum over
+// i = 1 .. n - 1 of b^i P^_i T^(a^i) (b^i and a^i as running products, in that order; T^x as std::pow, GLSL's pow).
+inline float SunGain(const LightTerms& L, const SunPhases& p, float T) {
+    float gain = T * p.value[0];
+    if (L.octaves > 1) [[unlikely]] {
+        float contribution = 1.0f, attenuation = 1.0f;
+        for (uint32_t i = 1; i < L.octaves; ++i) {
+            contribution *= L.octaveContribution;
+            attenuation *= L.octaveAttenuation;
+            gain += (contribution * p.value[i]) * std::pow(T, attenuation);
+        }
+    }
+    return gain;
+}
 
 // What varies per sample: the sun's gain (its transmittance times the phase,
 // times the powder where the renderer has it), the sun's transmittance alone, the
@@ -177,8 +220,12 @@ struct alignas(16) LightGpu {
     uint32_t skyOn;  // 1: the sky light shines
     std::array<float, 3> skyDirection;
     uint32_t skyUnused;
+    uint32_t octaves;
+    float octaveAttenuation;
+    float octaveContribution;
+    float octaveEccentricity;
 };
-static_assert(sizeof(LightGpu) == (12 + kMaxGlowBlobs) * 16, "LightGpu is twelve 16-byte rows and one per glow blob");
+static_assert(sizeof(LightGpu) == (13 + kMaxGlowBlobs) * 16, "LightGpu is 13 16-byte rows and one per glow blob");
 
 inline LightGpu MakeLightGpu(const LightTerms& L) {
     LightGpu g{};
@@ -211,6 +258,10 @@ inline LightGpu MakeLightGpu(const LightTerms& L) {
     g.skyRadiance = L.skyRadiance;
     g.skyOn = L.skyOn ? 1u : 0u;
     g.skyDirection = L.skyDirection;
+    g.octaves = L.octaves;
+    g.octaveAttenuation = L.octaveAttenuation;
+    g.octaveContribution = L.octaveContribution;
+    g.octaveEccentricity = L.octaveEccentricity;
     return g;
 }
 
@@ -240,6 +291,10 @@ inline LightTerms LightTermsOf(const LightGpu& g) {
     L.skyOn = g.skyOn != 0u;
     L.skyRadiance = g.skyRadiance;
     L.skyDirection = g.skyDirection;
+    L.octaves = g.octaves;
+    L.octaveAttenuation = g.octaveAttenuation;
+    L.octaveContribution = g.octaveContribution;
+    L.octaveEccentricity = g.octaveEccentricity;
     return L;
 }
 

@@ -351,7 +351,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
     float L0 = 0, L1 = 0, L2 = 0, T = 1, D = 0;
     if (!ray.Empty()) {
         // cos theta = s . normalize(sample - eye) = s . d on the whole ray (SPEC 8's convention).
-        const float sunPhase = PhaseValue(s.light.phase, MarchDot(s.sun, ray.dir));
+        const SunPhases sunPhases = MakeSunPhases(s.light, MarchDot(s.sun, ray.dir));
         const float skyPhase = SkyPhase(s.light, ray.dir);
         const float B = bricks ? float(bricks->brick) : 1.0f, invB = 1.0f / B;
         const Vec3 invDir = InverseDirection(ray.dir);
@@ -401,7 +401,7 @@ MarchRayResult MarchRay(const MarchSetup& s, const MarchRayGeometry& ray, float 
                 ++r.lightCalls;
                 const float tau = SegmentTransmittance(s.sigmaH, qa, len);
                 const MarchLightSample l = light(p);
-                float sunGain = l.sun * sunPhase;
+                float sunGain = SunGain(s.light, sunPhases, l.sun);
                 if (s.powder) sunGain *= PowderTerm(s.powderC, l.sun);
                 const Vec3 in =
                     InScattered(s.light, LightSample{sunGain, l.sun, l.point, p, ray.dir, l.sky * skyPhase});

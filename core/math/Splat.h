@@ -95,7 +95,7 @@ inline bool MakeSplat(const SplatFrame& F, uint32_t i, uint32_t j, uint32_t k, f
     const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float cosTheta = (F.sun[0] * dx + F.sun[1] * dy + F.sun[2] * dz) / len;
     const LightTerms terms = LightTermsOf(F.light);
-    const float light = t * PhaseValue(terms.phase, cosTheta);
+    const float light = SunGain(terms, MakeSunPhases(terms, cosTheta), t);
     s.alphaScale = qa * F.opacity;
     // The sample: the voxel centre in voxel units, seen along the unit direction from the eye.
     const Vec3 at{float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f};

@@ -97,6 +97,9 @@ LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
 // P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
 float LayersPhase(LayersGpu s, float cosTheta) { return LightPhase(s.light, cosTheta); }
 
+// core/math/Layers.h LayersSunPhases.
+SunPhases LayersSunPhases(LayersGpu s, LayersRay ray) { return MakeSunPhases(s.light, MarchDot(s.sun, ray.dir)); }
+
 // core/math/Layers.h LayersMapAt.
 float LayersMapAt(LayersGpu s, float x, float y) {
     const int nx = int(s.size.x), ny = int(s.size.y);
@@ -126,7 +129,7 @@ struct LayerFragmentResult {
 };
 
 // core/math/Layers.h LayersSampleAt.
-LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, float sunPhase, float hx, float hy, float z, float r2,
+LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, SunPhases sunPhases, float hx, float hy, float z, float r2,
                                    float length) {
     LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
     precise float x = (s.eye.x + hx) - s.drift.x, y = (s.eye.y + hy) - s.drift.y;
@@ -150,7 +153,7 @@ LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, float sunPhase, f
     precise float faded = f.alpha * LayersFade(r2, s.outer2, s.fadeInv2);
     f.alpha = faded;
     precise float lit = qt.y * s.lightScale;  // T, or relit
-    precise float gain = lit * sunPhase;
+    precise float gain = SunGain(s.light, sunPhases, lit);
     // The sample (voxel units, before the drift and the wrap).
     precise vec3 at = vec3(s.eye.x + hx, s.eye.y + hy, z);
     precise float skyGain = 0.0;
@@ -160,7 +163,7 @@ LayerFragmentResult LayersSampleAt(LayersGpu s, LayersRay ray, float sunPhase, f
 }
 
 // core/math/Layers.h LayerFragment.
-LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, uint i) {
+LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, SunPhases sunPhases, uint i) {
     LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
     const float dz = ray.dir.z;
     if (!(abs(dz) >= 1e-20)) return f;
@@ -172,11 +175,11 @@ LayerFragmentResult LayerFragment(LayersGpu s, LayersRay ray, float sunPhase, ui
     precise float r2 = hx * hx + hy * hy;
     if (!(r2 <= s.outer2 && r2 >= s.inner2)) return f;
     precise float length = min(s.spacing * abs(invDz), s.maxLength);
-    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length);
+    return LayersSampleAt(s, ray, sunPhases, hx, hy, z, r2, length);
 }
 
 // core/math/Layers.h BillboardFragment (the billboards' plane: s.right, s.up).
-LayerFragmentResult BillboardFragment(LayersGpu s, LayersRay ray, float sunPhase, LayersBillboard bb) {
+LayerFragmentResult BillboardFragment(LayersGpu s, LayersRay ray, SunPhases sunPhases, LayersBillboard bb) {
     LayerFragmentResult f = LayerFragmentResult(false, false, 0.0, vec3(0.0));
     precise float t = bb.depth / ray.cosForward;
     if (!(t >= ray.tNear && t <= ray.tFar && t > 0.0)) return f;
@@ -191,7 +194,7 @@ LayerFragmentResult BillboardFragment(LayersGpu s, LayersRay ray, float sunPhase
     if (!(abs(u) <= s.halfWidth && abs(v) <= s.halfHeight)) return f;
     if (!(z >= 0.0 && z <= s.size.z)) return f;
     precise float length = min(s.billboardLength / ray.cosForward, s.maxLength);
-    return LayersSampleAt(s, ray, sunPhase, hx, hy, z, r2, length);
+    return LayersSampleAt(s, ray, sunPhases, hx, hy, z, r2, length);
 }
 
 vec3 LayersOver(vec3 C, float alpha, vec3 c) {
@@ -229,18 +232,18 @@ struct LayersPixelResult {
 LayersPixelResult LayersPixel(LayersGpu s, uint x, uint y) {
     LayersPixelResult r = LayersPixelResult(s.background, 0u, 0u);
     const LayersRay ray = MakeLayersRay(s, x, y);
-    const float sunPhase = LayersPhase(s, MarchDot(s.sun, ray.dir));
+    const SunPhases sunPhases = LayersSunPhases(s, ray);
     const LayersWalk w = LayersWalkOf(s, ray.dir.z);
     for (uint n = 0u; n < w.count; ++n) {
         const uint i = uint(w.first + w.step * int(n));
-        const LayerFragmentResult f = LayerFragment(s, ray, sunPhase, i);
+        const LayerFragmentResult f = LayerFragment(s, ray, sunPhases, i);
         r.fragments += f.crossed ? 1u : 0u;
         if (!f.drawn) continue;
         ++r.drawn;
         r.color = LayersOver(r.color, f.alpha, f.color);
     }
     for (uint n = 0u; n < s.billboardCount; ++n) {
-        const LayerFragmentResult f = BillboardFragment(s, ray, sunPhase, LayersBillboardAt(n));
+        const LayerFragmentResult f = BillboardFragment(s, ray, sunPhases, LayersBillboardAt(n));
         r.fragments += f.crossed ? 1u : 0u;
         if (!f.drawn) continue;
         ++r.drawn;

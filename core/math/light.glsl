@@ -42,6 +42,16 @@ struct LightGpu {
     uint skyOn;
     vec3 skyDirection;
     uint skyUnused;
+    uint octaves;
+    float octaveAttenuation;
+    float octaveContribution;
+    float octaveEccentricity;
+};
+
+// core/math/Light.h kMaxOctaves and SunPhases.
+const uint kMaxOctaves = 8u;
+struct SunPhases {
+    float value[kMaxOctaves];
 };
 
 // core/math/Light.h LightSample.
@@ -58,6 +68,34 @@ struct LightSample {
 float LightPhase(LightGpu L, float cosTheta) {
     return PhaseOf(L.phaseKind, L.phaseG, vec3(L.phaseGForward, L.phaseGBackward, L.phaseBlend), L.mieIndexPerRadian,
                    L.mieCount, cosTheta);
+}
+
+// core/math/Light.h MakeSunPhases.
+SunPhases MakeSunPhases(LightGpu L, float cosTheta) {
+    SunPhases p;
+    for (uint i = 0u; i < kMaxOctaves; ++i) p.value[i] = 0.0;
+    p.value[0] = LightPhase(L, cosTheta);
+    precise float g = L.phaseG, gForward = L.phaseGForward, gBackward = L.phaseGBackward;
+    for (uint i = 1u; i < L.octaves; ++i) {
+        g *= L.octaveEccentricity;
+        gForward *= L.octaveEccentricity;
+        gBackward *= L.octaveEccentricity;
+        p.value[i] = PhaseOf(L.phaseKind, g, vec3(gForward, gBackward, L.phaseBlend), L.mieIndexPerRadian, L.mieCount,
+                             cosTheta);
+    }
+    return p;
+}
+
+// core/math/Light.h SunGain.
+float SunGain(LightGpu L, SunPhases p, float T) {
+    precise float gain = T * p.value[0];
+    precise float contribution = 1.0, attenuation = 1.0;
+    for (uint i = 1u; i < L.octaves; ++i) {
+        contribution *= L.octaveContribution;
+        attenuation *= L.octaveAttenuation;
+        gain += (contribution * p.value[i]) * pow(T, attenuation);
+    }
+    return gain;
 }
 
 // core/math/Light.h SkyPhase.

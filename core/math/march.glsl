@@ -350,7 +350,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
     const bool pointOn = m.light.pointOn != 0u;
     const bool powder = (m.flags & kMarchPowder) != 0u;
     if (ray.tMin < ray.tMax) {
-        const float sunPhase = MarchPhase(m, MarchDot(m.sun, ray.dir));
+        const SunPhases sunPhases = MakeSunPhases(m.light, MarchDot(m.sun, ray.dir));
         const float skyPhase = SkyPhase(m.light, ray.dir);
         const float B = skipping ? float(m.brick) : 1.0;
         precise float invB = 1.0 / B;
@@ -400,7 +400,7 @@ MarchRayResult MarchRay(MarchGpu m, MarchRayGeometry ray, float xi) {
                 ++r.lightCalls;
                 const float tau = SegmentTransmittance(m.sigmaH, qa, len);
                 const float lightSun = lightMarch ? SunLightMarch(m, p) : qt.y;
-                precise float sunGain = lightSun * sunPhase;
+                precise float sunGain = SunGain(m.light, sunPhases, lightSun);
                 if (powder) sunGain *= PowderTerm(m.powderC, lightSun);
                 const float lightPoint = pointOn ? PointLightMarch(m, p) : 1.0;
                 const float lightSky = m.light.skyOn != 0u ? PaddedBlendSky(m.strideY, m.strideZ, taps) : 1.0;

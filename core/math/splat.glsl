@@ -76,7 +76,7 @@ bool MakeSplat(SplatFrame F, uvec3 idx, float qa, float t, float tSky, out Splat
     if (!SplatFinite(px) || !SplatFinite(py) || !SplatFinite(size)) return false;
     precise float len = sqrt(dx * dx + dy * dy + dz * dz);
     precise float cosTheta = (F.sun.x * dx + F.sun.y * dy + F.sun.z * dz) / len;
-    precise float light = t * LightPhase(F.light, cosTheta);
+    precise float light = SunGain(F.light, MakeSunPhases(F.light, cosTheta), t);
     s.px = px;
     s.py = py;
     s.size = size;

@@ -48,6 +48,13 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
         L.skyRadiance = sky.Radiance();
         L.skyDirection = sky.Direction();
     }
+    const OctaveSettings& octaves = sc.lighting.octaves;
+    L.octaves = octaves.count;
+    if (octaves.count > 1) {
+        L.octaveAttenuation = float(octaves.attenuation);
+        L.octaveContribution = float(octaves.contribution);
+        L.octaveEccentricity = float(octaves.eccentricity);
+    }
     const EyeScatteringSettings& eye = sc.lighting.eyeScattering;
     L.eyeOn = eye.on;
     L.sunDirection = sc.sun.DirectionAt(step);
@@ -67,7 +74,8 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering", "sky"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering", "sky", "octaves"};
+constexpr std::string_view kOctaveKeys[] = {"count", "attenuation", "contribution", "eccentricity"};
 constexpr std::string_view kSkyKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity"};
 constexpr std::string_view kEyeScatteringKeys[] = {"intensity", "cone_deg", "height_gain", "replaces_phase"};
 constexpr std::string_view kCityGlowKeys[] = {"color", "fade", "blobs"};
@@ -100,6 +108,34 @@ void ReadEyeScattering(const Json& lighting, Validator& check, EyeScatteringSett
     if (const Json* v = Validator::Find(*section, "replaces_phase")) {
         if (auto b = check.Boolean(*v, "lighting.eye_scattering.replaces_phase")) eye.replacesPhase = *b;
     }
+}
+
+// Octaves: count in [1, kMaxOctaves]; a in (0, 1] (T^0 would light a sample however deep in cloud; GLSL's pow(0, 0)
+// is undefined), b and c in [0, 1], and a <= b (Wrenninge, Kulla and Lundqvist's condition for energy
+// conservation). The sum is at most count times the sun's single-scattering gain: ReadSun's bound holds with 8x.
+void ReadOctaves(const Json& lighting, Validator& check, OctaveSettings& octaves) {
+    const Json* section = check.Section(lighting, "lighting", "octaves", kOctaveKeys);
+    if (!section) return;
+    if (const Json* v = Validator::Find(*section, "count")) {
+        if (auto n = check.Integer(*v, "lighting.octaves.count", 1, kMaxOctaves)) octaves.count = uint32_t(*n);
+    }
+    if (const Json* v = Validator::Find(*section, "attenuation")) {
+        if (auto d = check.Number(*v, "lighting.octaves.attenuation", Range{.lo = 0, .loOpen = true, .hi = 1}))
+            octaves.attenuation = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "contribution")) {
+        if (auto d = check.Number(*v, "lighting.octaves.contribution", Range{.lo = 0, .hi = 1}))
+            octaves.contribution = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "eccentricity")) {
+        if (auto d = check.Number(*v, "lighting.octaves.eccentricity", Range{.lo = 0, .hi = 1}))
+            octaves.eccentricity = *d;
+    }
+    if (octaves.attenuation > octaves.contribution)
+        check.Fail("lighting.octaves.attenuation",
+                   "must be at most contribution (" + FormatNumber(octaves.contribution) +
+                       ": an octave's light may not fall slower than its extinction, or the octaves add energy), got " +
+                       FormatNumber(octaves.attenuation));
 }
 
 // The sky light is scattered sunlight from the sky above the horizon: its elevation is in (0, 90] (below the
@@ -195,6 +231,7 @@ void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting
     ReadCityGlow(*section, check, lighting.cityGlow);
     ReadEyeScattering(*section, check, lighting.eyeScattering);
     ReadSky(*section, check, lighting.sky);
+    ReadOctaves(*section, check, lighting.octaves);
 }
 
 void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {

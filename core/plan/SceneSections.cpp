@@ -65,6 +65,12 @@ SectionsRead ReadSceneSections(const Json& root, const std::string& label, Valid
     ReadLighting(root, check, scene.lighting);
     ReadLightning(root, check, scene.lightning);
     ReadPhase(root, check, scene.phase);
+    // Mie's table has no eccentricity for the octaves to scale.
+    if (scene.lighting.octaves.count > 1 && scene.phase.kind == PhaseKind::Mie &&
+        scene.lighting.octaves.eccentricity != 1)
+        check.Fail("lighting.octaves.eccentricity",
+                   "must be 1 with phase.function \"mie\" (the table's shape cannot be scaled), got " +
+                       FormatNumber(scene.lighting.octaves.eccentricity));
     sections.cameras = ReadRender(root, check, scene.render);
 
     // Each stage's own sections, by its descriptor's reader, in CB_STAGES order (also for stages not enabled).

@@ -130,12 +130,21 @@ struct SkyLightSettings {
     }
 };
 
+// Multiple scattering as octaves of the sun's single scattering (section `lighting.octaves`; core/math/Light.h
+// LightTerms): octave i < count scales the extinction toward the sun by attenuation^i, its light by
+// contribution^i and the phase's eccentricity by eccentricity^i. count 1: single scattering.
+struct OctaveSettings {
+    uint32_t count = 1;
+    double attenuation = 0.5, contribution = 0.5, eccentricity = 0.5;
+};
+
 struct LightingSettings {
     std::array<double, 3> ambient{0.25, 0.3, 0.38};     // linear RGB, added to every splat
     std::array<double, 3> background{0.45, 0.6, 0.85};  // linear RGB behind the clouds
     CityGlowSettings cityGlow;
     EyeScatteringSettings eyeScattering;
     SkyLightSettings sky;
+    OctaveSettings octaves;
 
     // In single precision, as the renderers use them.
     Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }

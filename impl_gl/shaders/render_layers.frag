@@ -43,11 +43,11 @@ void LayersCount(uint n) {
 void main() {
     const uint x = uint(gl_FragCoord.x), y = uint(gl_FragCoord.y);
     const LayersRay ray = MakeLayersRay(layers, x, y);
-    const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, ray.dir));
+    const SunPhases sunPhases = LayersSunPhases(layers, ray);
 #ifdef LAYERS_BILLBOARDS
-    const LayerFragmentResult f = BillboardFragment(layers, ray, sunPhase, LayersBillboardAt(layerIndex));
+    const LayerFragmentResult f = BillboardFragment(layers, ray, sunPhases, LayersBillboardAt(layerIndex));
 #else
-    const LayerFragmentResult f = LayerFragment(layers, ray, sunPhase, layerIndex);
+    const LayerFragmentResult f = LayerFragment(layers, ray, sunPhases, layerIndex);
 #endif
     if (f.crossed) LayersCount(0u);
     if (!f.drawn) discard;

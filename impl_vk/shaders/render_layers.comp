@@ -78,7 +78,7 @@ void main() {
     LayersPixelResult r = LayersPixelResult(s.background, 0u, 0u);
     if (inside) r = LayersPixel(layersOnly, x, y);
     const LayersRay ray = MakeLayersRay(s, min(x, s.width - 1u), min(y, s.height - 1u));
-    const float sunPhase = LayersPhase(s, MarchDot(s.sun, ray.dir));
+    const SunPhases sunPhases = LayersSunPhases(s, ray);
     const float tileX = float(gl_WorkGroupID.x * 8u), tileY = float(gl_WorkGroupID.y * 8u);
     for (uint base = 0u; base < s.billboardCount; base += 64u) {
         const uint n = base + local;
@@ -93,7 +93,7 @@ void main() {
         barrier();
         if (inside)
             for (uint i = 0u; i < gKeptCount; ++i) {
-                const LayerFragmentResult f = BillboardFragment(s, ray, sunPhase, LayersBillboardAt(gKept[i]));
+                const LayerFragmentResult f = BillboardFragment(s, ray, sunPhases, LayersBillboardAt(gKept[i]));
                 r.fragments += f.crossed ? 1u : 0u;
                 if (!f.drawn) continue;
                 ++r.drawn;

@@ -52,7 +52,7 @@ LightGpu ZeroLight() {
     return LightGpu(vec3(0.0), 0u, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0u, 0.0, 0.0, 0u, 0u, 0.0, 0.0, 0.0, 0u,
                     vec3(0.0), 0u, 0.0,
                     0.0, 0u, 0u, vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0)), vec3(0.0, 0.0, 1.0), 0u, 0.0,
-                    0.0, 0.0, 0.0, vec3(0.0), 0u, vec3(0.0, 0.0, 1.0), 0u);
+                    0.0, 0.0, 0.0, vec3(0.0), 0u, vec3(0.0, 0.0, 1.0), 0u, 1u, 1.0, 1.0, 1.0);
 }
 
 MarchGpu ZeroMarch() {
@@ -313,15 +313,15 @@ void main() {
         }
         case kTwinLayerFragment: {
             const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
-            const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, r.dir));
-            const LayerFragmentResult f = LayerFragment(layers, r, sunPhase, U(2u));
+            const SunPhases sunPhases = LayersSunPhases(layers, r);
+            const LayerFragmentResult f = LayerFragment(layers, r, sunPhases, U(2u));
             PutU(0u, f.crossed ? 1u : 0u);
             PutU(1u, f.drawn ? 1u : 0u);
             PutF(2u, f.alpha);
             PutF(3u, f.color.x);
             PutF(4u, f.color.y);
             PutF(5u, f.color.z);
-            PutF(6u, sunPhase);
+            PutF(6u, sunPhases.value[0]);
             const vec3 over = LayersOver(vec3(F(3u), F(4u), F(5u)), f.alpha, f.color);
             PutF(7u, over.x);
             PutF(8u, over.y);
@@ -342,8 +342,8 @@ void main() {
             break;
         case kTwinBillboardFragment: {
             const LayersRay r = MakeLayersRay(layers, U(0u), U(1u));
-            const float sunPhase = LayersPhase(layers, MarchDot(layers.sun, r.dir));
-            const LayerFragmentResult f = BillboardFragment(layers, r, sunPhase, LayersBillboardAt(U(2u)));
+            const SunPhases sunPhases = LayersSunPhases(layers, r);
+            const LayerFragmentResult f = BillboardFragment(layers, r, sunPhases, LayersBillboardAt(U(2u)));
             PutU(0u, f.crossed ? 1u : 0u);
             PutU(1u, f.drawn ? 1u : 0u);
             PutF(2u, f.alpha);
@@ -354,6 +354,7 @@ void main() {
             break;
         }
         // With the bound MarchGpu's light (tests/GlslTwinTest.cpp InScatteredMatchesTheCpp).
+        case kTwinSunGain: PutF(0u, SunGain(march.light, MakeSunPhases(march.light, F(0u)), F(1u))); break;
         case kTwinInScattered: {
             const LightSample s =
                 LightSample(F(0u), F(1u), F(2u), vec3(F(3u), F(4u), F(5u)), vec3(F(6u), F(7u), F(8u)), F(9u));

@@ -72,3 +72,4 @@ CB_TWIN_FN(LayersFade, 64u)
 CB_TWIN_FN(BillboardFragment, 66u)
 // ---- light.glsl, with the bound MarchGpu's light ----
 CB_TWIN_FN(InScattered, 65u)
+CB_TWIN_FN(SunGain, 70u)
