@@ -240,7 +240,8 @@ struct TrilinearDepthTracer::Impl {
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
         if (any) rtcIntersect16(valid, embree.Scene(), &ctx.base, &rh);
-        for (size_t i = begin; i < end; ++i) out[i] = ctx.lane[i - begin].sum;
+        // A lane with no ray (a point on the light: depth 0) reads 0, whatever a callback made of its unset lane.
+        for (size_t i = begin; i < end; ++i) out[i] = valid[i - begin] ? ctx.lane[i - begin].sum : 0.0;
     }
 
     // A batch: depth(i) for every point, in parallel; with packets on,

@@ -482,8 +482,8 @@ TEST_P(RenderMarchGpu, ScratchBytesByHand) {
         scene.march.brick = 4;
         scene.march.skipping = true;
         scene.march.light = MarchLightSource::Shade;
-        // MarchGpu: its own twelve 16-byte rows and LightGpu's sixteen (twelve and four glow blobs).
-        const uint64_t block = 12u * 16u + 16u * 16u;
+        // MarchGpu: its own twelve 16-byte rows and LightGpu's seventeen (thirteen and four glow blobs).
+        const uint64_t block = 12u * 16u + 17u * 16u;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 8 + 36u * 4);
         scene.march.light = MarchLightSource::March;
         EXPECT_EQ(mBackend->ScratchBytes(scene), block + 40u + 2688u * 4 + 36u * 4);

@@ -5,8 +5,8 @@ folder (docs/testing.md, "What the ctest oracle leaves out"):
 - every GoogleTest case of the unit-test binary is in it, the regression gate's statistics (PerfStats.*,
   PerfGateBoundary.*) among them;
 - what it leaves out is one of the slow groups, named here by hand: the sanitized build (Sanitized.*), the fuzz
-  run (Fuzz.*), exact mode's build and counts (Exact.*), the benchmarks (Bench.*), and Tools.MutantsApply, which
-  fails in every mutated tree by construction;
+  run (Fuzz.*), exact mode's build and counts (Exact.*), the benchmarks (Bench.*), Blender's Cycles renders
+  (Cycles.*), and Tools.MutantsApply, which fails in every mutated tree by construction;
 - every test of the sanitized build, the fuzz run and the benchmarks is left out.
 
 usage: check_mutate_oracle.py MUTATE_PY BUILD_DIR
@@ -15,7 +15,7 @@ import json
 import subprocess
 import sys
 
-SLOW_GROUPS = ("Sanitized.", "Fuzz.", "Exact.", "Bench.")
+SLOW_GROUPS = ("Sanitized.", "Fuzz.", "Exact.", "Bench.", "Cycles.")
 ALWAYS_OUT = ("Sanitized.", "Fuzz.", "Bench.")
 
 
