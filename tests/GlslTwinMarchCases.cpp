@@ -47,11 +47,11 @@ void AddMarchCases(std::vector<TwinCase>& c) {
                      edges,
                      [](const Words& in, Words& out) { out[0] = Bits(SamplePhaseTable(kMieCloudTable, Float(in[2]))); },
                      /*otherDeviceUlps=*/64});
-        // PhaseValue of every kind through march.glsl's MarchPhase (Mie: the table; the dual lobe: its three
-        // words 5-7 of LightGpu; the others: shading.glsl).
+        // PhaseValue of every kind through light.glsl's LightPhase of a MarchGpu's light (Mie: the table; the dual
+        // lobe: its three words 5-7 of LightGpu; the others: shading.glsl).
         const uint32_t dual = uint32_t(PhaseKind::DualLobe);
-        c.push_back({"MarchPhase",
-                     kTwinMarchPhase,
+        c.push_back({"LightPhase",
+                     kTwinLightPhase,
                      {Kind::F},
                      [perRadian, count](Pcg32& r, Words& in) {
                          in = W({r.Below(5), Bits(Uniform(r, -0.95, 0.95)), Bits(Uniform(r, -1, 1)), Bits(perRadian),

@@ -94,9 +94,6 @@ LayersRay MakeLayersRay(LayersGpu s, uint x, uint y) {
     return r;
 }
 
-// P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
-float LayersPhase(LayersGpu s, float cosTheta) { return LightPhase(s.light, cosTheta); }
-
 // core/math/Layers.h LayersSunPhases.
 SunPhases LayersSunPhases(LayersGpu s, LayersRay ray) { return MakeSunPhases(s.light, MarchDot(s.sun, ray.dir)); }
 

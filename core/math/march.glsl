@@ -240,9 +240,6 @@ float MarchJitter(uint seed, uint frame, uint pixel) {
 
 float PowderTerm(float c, float lightT) { return 1.0 - pow(max(lightT, 0.0), c); }
 
-// P^(cos theta) for every PhaseKind (core/math/Shading.h PhaseValue).
-float MarchPhase(MarchGpu m, float cosTheta) { return LightPhase(m.light, cosTheta); }
-
 // 1/d per component; FLT_MAX where d is (nearly) zero.
 vec3 InverseDirection(vec3 d) {
     vec3 inv;

@@ -178,7 +178,7 @@ void main() {
         // ---- march.glsl ----
         case kTwinArcCos: PutF(0u, ArcCos(F(0u))); break;
         case kTwinSamplePhaseTable: PutF(0u, SamplePhaseTable(F(0u), U(1u), F(2u))); break;
-        case kTwinMarchPhase: {
+        case kTwinLightPhase: {
             MarchGpu m = ZeroMarch();
             m.light.phaseKind = U(0u);
             m.light.phaseG = F(1u);
@@ -187,7 +187,7 @@ void main() {
             m.light.phaseBlend = F(7u);
             m.light.mieIndexPerRadian = F(3u);
             m.light.mieCount = U(4u);
-            PutF(0u, MarchPhase(m, F(2u)));
+            PutF(0u, LightPhase(m.light, F(2u)));
             break;
         }
         case kTwinClipRayToBox: {

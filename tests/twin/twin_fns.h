@@ -47,7 +47,7 @@ CB_TWIN_FN(NoiseHeightAndTower, 33u)
 // ---- phase_table.glsl, march.glsl ----
 CB_TWIN_FN(ArcCos, 34u)
 CB_TWIN_FN(SamplePhaseTable, 35u)
-CB_TWIN_FN(MarchPhase, 36u)
+CB_TWIN_FN(LightPhase, 36u)  // light.glsl's, of a zeroed MarchGpu's light
 CB_TWIN_FN(ClipRayToBox, 37u)
 CB_TWIN_FN(MarchStepAt, 38u)
 CB_TWIN_FN(MarchAdaptiveLanding, 68u)
