@@ -181,6 +181,9 @@ def main():
         sys.exit(f"cycles_referee: {file}: {error}")
     for item in args.set:  # the overrides cloudbench applies, applied here too (a dotted path, a JSON value)
         path, _, value = item.partition("=")
+        if "[" in path:  # read here as a key, it would leave Cycles' copy of the field unchanged
+            sys.exit(f"cycles_referee: --set {path}: the referee applies dotted paths only; give the whole array "
+                     f"(e.g. render.cameras=[...]) or edit the scene file")
         node = scene
         keys = path.split(".")
         for key in keys[:-1]:
