@@ -68,6 +68,7 @@ class BackendCpu : public Backend {
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    Status AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) override;
 
     int Threads() const { return mArena.max_concurrency(); }
     // Every thread of the arena spins for an equal share of `cpuMs` of CPU time, at most `wallMs` each.

@@ -125,7 +125,14 @@ class BackendGL final : public Backend {
     // says which in its <Stage>GLState.h) and the ray marcher's storage and pixel
     // copies; other buffer objects (lists, counters, blocks) are not counted.
     // GL does not report available memory.
-    uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
+    // The stage objects' and, with shafts of light, the shafts pass's target, image copy and block.
+    uint64_t ScratchBytes(const Scene& scene) const override {
+        const uint64_t shafts =
+            scene.lighting.shafts.on
+                ? uint64_t(scene.render.width) * scene.render.height * (16 + 12) + sizeof(ShaftsFrame)
+                : 0;
+        return mStages.ScratchBytes(scene) + shafts;
+    }
 
     // The context's texture and viewport limits, read when the backend is made.
     std::vector<DeviceLimit> Limits() const override { return DescribeGLLimits(mLimits); }
@@ -139,6 +146,7 @@ class BackendGL final : public Backend {
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    Status AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) override;
 
   private:
     // The stage objects (core/pipeline/StageObjects.h): each stage's textures,
@@ -257,6 +265,11 @@ class BackendGL final : public Backend {
 
     std::unique_ptr<GLContext> mContext;
     StagesGL mStages;  // after mContext: their names are deleted while it is current
+    // The shafts pass's block, its RGBA32F target and the image's pixel buffer (ShaftsGL.cpp); after mContext likewise.
+    struct {
+        BufferSlot block, imageCopy;
+        TextureSlot target;
+    } mShafts;
     std::optional<double> mLastDeviceMs;
     SubmissionCounts mCounts;
     bool mLayered = true, mLayeredFailed = false;

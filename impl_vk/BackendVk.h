@@ -65,7 +65,10 @@ class BackendVk final : public Backend {
     // floats, each buffer padded to a multiple of 4 bytes.
     uint64_t BufferBytes(BufferFormat format, const Extent3& extent) const override;
     // The sum of the stage objects' (each says what it counts in its <Stage>VkState.h).
-    uint64_t ScratchBytes(const Scene& scene) const override { return mStages.ScratchBytes(scene); }
+    // The stage objects' and, with shafts of light, the shafts pass's block.
+    uint64_t ScratchBytes(const Scene& scene) const override {
+        return mStages.ScratchBytes(scene) + (scene.lighting.shafts.on ? sizeof(ShaftsFrame) : 0);
+    }
     // The largest device-local heap.
     std::optional<uint64_t> AvailableBytes() const override { return mContext->LargestDeviceLocalHeap(); }
     // The device's workgroup count and storage buffer range.
@@ -80,6 +83,7 @@ class BackendVk final : public Backend {
     CB_NOISE_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_MARCH_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
     CB_LAYERS_ENTRIES(CB_OVERRIDE_BACKEND_ENTRY)
+    Status AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) override;
 
     // Pipelined timing (core/pipeline/Backend.h): the context records the batch into one
     // command buffer (VulkanContext::BeginBatch); a Download inside it, and
@@ -144,6 +148,7 @@ class BackendVk final : public Backend {
 
     std::unique_ptr<VulkanContext> mContext;
     StagesVk mStages;  // after mContext: their buffers are destroyed before it
+    BufferSlot mShaftsFrame;  // the shafts pass's block (ShaftsVk.cpp); after mContext likewise
     std::optional<double> mLastDeviceMs;
     ShadeSweep mShadeSweep = ShadeSweep::Auto;
     uint32_t mSplatChunkRanks = 0;

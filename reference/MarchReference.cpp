@@ -9,78 +9,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <utility>
 
 #include "core/math/March.h"
+#include "reference/ExactDepth.h"
 #include "reference/Trilinear.h"
 
 namespace cb::ref {
-namespace {
-
-// The exact integral of q_alpha (voxel edges) along o + t u, t in [0, tEnd] (tEnd may be +infinity: to the
-// volume's edge). Without tiling the tracer covers the box. With tiling it covers one period grown by a wrapped
-// column on each side (voxel (i, j, k) at (i + 1, j + 1, k)), where the trilinear field over [1, n + 1] in x and y
-// is the periodic field over [0, n]: the ray is clipped to the slab 0 <= z <= nz, cut where it crosses a
-// period's side, and each piece integrated in its own period. The walk stops once the depth reaches `stopDepth`
-// (where exp(-sigma h depth) rounds to 0 in float), or after kMaxTilePieces pieces: a light within about 0.001
-// degrees of the horizon, whose path through the slab crosses that many periods, is integrated that far.
-class ExactDepth {
-  public:
-    static constexpr int kMaxTilePieces = 1 << 16;
-
-    ExactDepth(const TrilinearDepthTracer& tracer, const Extent3& grid, bool tiling, double stopDepth)
-        : mTracer(tracer),
-          mTiling(tiling),
-          mN{double(grid.nx), double(grid.ny), double(grid.nz)},
-          mStopDepth(stopDepth) {}
-
-    double Along(const Point3d& o, const Point3d& u, double tEnd) const {
-        if (!mTiling) return mTracer.Integrate(o, u, 0.0, tEnd);
-        if (u[2] > 0) tEnd = std::min(tEnd, (mN[2] - o[2]) / u[2]);
-        if (u[2] < 0) tEnd = std::min(tEnd, (0.0 - o[2]) / u[2]);
-        if (!(tEnd > 0)) return 0.0;
-        // The period (kx, ky) the ray starts in, and where it leaves each.
-        double k[2] = {std::floor(o[0] / mN[0]), std::floor(o[1] / mN[1])};
-        double depth = 0, t = 0;
-        for (int piece = 0; piece < kMaxTilePieces && t < tEnd && depth < mStopDepth; ++piece) {
-            double side[2];
-            for (int a = 0; a < 2; ++a)
-                side[a] = u[a] > 0   ? ((k[a] + 1) * mN[a] - o[a]) / u[a]
-                          : u[a] < 0 ? (k[a] * mN[a] - o[a]) / u[a]
-                                     : std::numeric_limits<double>::infinity();
-            const double tNext = std::min({side[0], side[1], tEnd});
-            const Point3d local{o[0] - k[0] * mN[0] + 1.0, o[1] - k[1] * mN[1] + 1.0, o[2]};
-            if (tNext > t) depth += mTracer.Integrate(local, u, t, tNext);
-            for (int a = 0; a < 2; ++a)
-                if (side[a] == tNext) k[a] += u[a] > 0 ? 1 : -1;
-            t = std::max(t, tNext);
-        }
-        return depth;
-    }
-
-  private:
-    const TrilinearDepthTracer& mTracer;
-    bool mTiling;
-    double mN[3];
-    double mStopDepth;
-};
-
-// The field the tracer holds: q itself, or with tiling one period grown by a wrapped column on each side in x and y.
-std::pair<Extent3, std::vector<float>> TracedField(const Extent3& grid, std::vector<float> q, bool tiling) {
-    if (!tiling) return {grid, std::move(q)};
-    const Extent3 grown{grid.nx + 2, grid.ny + 2, grid.nz};
-    std::vector<float> out(grown.Count());
-    for (uint32_t k = 0; k < grid.nz; ++k)
-        for (uint32_t j = 0; j < grown.ny; ++j)
-            for (uint32_t i = 0; i < grown.nx; ++i) {
-                const size_t si = size_t(PaddedSourceVoxel(i, grid.nx, true));
-                const size_t sj = size_t(PaddedSourceVoxel(j, grid.ny, true));
-                out[i + size_t(grown.nx) * (j + size_t(grown.ny) * k)] = q[si + size_t(grid.nx) * (sj + grid.ny * k)];
-            }
-    return {grown, std::move(out)};
-}
-
-}  // namespace
 
 Result<MarchReferenceResult> RenderMarchReference(const MarchParams& params, const Extent3& grid,
                                                   std::span<const float> qPrev, std::span<const float> qCur,

@@ -584,6 +584,7 @@ std::vector<TwinCase> Cases() {
     }
     AddMarchCases(c);
     AddGroundCases(c);
+    AddShaftsCases(c);
     return c;
 }
 

@@ -92,6 +92,8 @@ std::vector<TwinCase> Cases();
 void AddMarchCases(std::vector<TwinCase>& cases);
 // The ground.glsl part of Cases() (GlslTwinMarchCases.cpp).
 void AddGroundCases(std::vector<TwinCase>& cases);
+// The shafts.glsl part of Cases() (GlslTwinMarchCases.cpp).
+void AddShaftsCases(std::vector<TwinCase>& cases);
 
 // Compares the GLSL's outputs with the C++ twin's, element by element; the
 // failure message shows the first few mismatches with their inputs.

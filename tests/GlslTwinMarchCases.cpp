@@ -8,6 +8,7 @@
 #include "core/math/Ground.h"
 #include "core/math/March.h"
 #include "core/math/Shading.h"
+#include "core/math/Shafts.h"
 
 namespace cb::test {
 
@@ -304,6 +305,59 @@ void AddGroundCases(std::vector<TwinCase>& c) {
                  [](const Words& in, Words& out) {
                      out[0] = Bits(GroundChannel(Float(in[0]), Float(in[1]), Float(in[2]), Float(in[3]), Float(in[4])));
                  }});
+}
+
+// twin.comp's D of column (i, j): a hash of the column, up to 16.
+float TwinShaftsD(uint32_t i, uint32_t j) {
+    return float(LowBias32(i * 7919u + 65537u * j) >> 8) * (1.0f / 1048576.0f);
+}
+
+void AddShaftsCases(std::vector<TwinCase>& c) {
+    // Points inside, on the column centres and edges of, and outside grids from 1 x 1 up, tiled and not; points
+    // periods away (the remainder) and far away (the clamps).
+    std::vector<Words> edges;
+    for (uint32_t n : {1u, 2u, 7u})
+        for (uint32_t tiling : {0u, 1u})
+            for (float x : {0.0f, 0.25f, 0.5f, 1.0f, float(n) - 0.5f, float(n), float(n) + 0.01f, -0.01f, -1.5f,
+                            -3.0f * float(n) + 0.3f, 1e7f, -1e9f, 1e30f})
+                edges.push_back(W({Bits(x), Bits(0.75f), n, n + 1, tiling}));
+    c.push_back({"ShaftsColumnAt",
+                 kTwinShaftsColumnAt,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     const uint32_t nx = 1 + r.Below(40), ny = 1 + r.Below(40);
+                     const float reach = r.Below(4) ? 3.0f : 300.0f;
+                     in = W({Bits(Uniform(r, -reach * nx, reach * nx)), Bits(Uniform(r, -reach * ny, reach * ny)), nx,
+                             ny, r.Below(2)});
+                 },
+                 edges,
+                 [](const Words& in, Words& out) {
+                     out[0] = Bits(ShaftsColumnAt(Float(in[0]), Float(in[1]), in[2], in[3], in[4] != 0, TwinShaftsD));
+                 }});
+    c.push_back({"ShaftsLayerForm",
+                 kTwinShaftsLayerForm,
+                 {Kind::F},
+                 [](Pcg32& r, Words& in) {
+                     in = W({r.Below(3), Bits(Uniform(r, 0, 5)), Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 1)),
+                             Bits(Uniform(r, 0, 1)), Bits(Uniform(r, 0, 20))});
+                 },
+                 {W({0, Bits(1e30f), 0, 0, 0, Bits(0.0f)}), W({0, Bits(1e30f), 0, 0, 0, Bits(1e-3f)}),
+                  W({1, 0, Bits(0.5f), 0, 0, Bits(3.0f)}), W({2, Bits(0.5f), 0, Bits(0.7f), Bits(0.6f), Bits(2.0f)})},
+                 [](const Words& in, Words& out) {
+                     out[0] = Bits(
+                         ShaftsLayerForm(in[0], Float(in[1]), Float(in[2]), Float(in[3]), Float(in[4]), Float(in[5])));
+                 },
+                 /*otherDeviceUlps=*/3});
+    c.push_back(
+        {"ShaftsFalloff",
+         kTwinShaftsFalloff,
+         {Kind::F},
+         [](Pcg32& r, Words& in) {
+             const float cosW = Uniform(r, -1, 0.999);
+             in = WF({Uniform(r, -1, 1), cosW, r.Below(4) ? 1.0f / (1.0f - cosW) : 0.0f});
+         },
+         {WF({1, 0.5f, 2}), WF({0.5f, 0.5f, 2}), WF({0.2f, 0.5f, 2}), WF({0.2f, 0.5f, 0})},
+         [](const Words& in, Words& out) { out[0] = Bits(ShaftsFalloff(Float(in[0]), Float(in[1]), Float(in[2]))); }});
 }
 
 }  // namespace cb::test

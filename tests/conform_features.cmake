@@ -174,3 +174,21 @@ foreach(resolution IN ITEMS 1 2)
                          TIMEOUT 300)
   endforeach()
 endforeach()
+# Shafts of light (SPEC 18) on every built backend: in splat and march frames over automaton clouds (crepuscular)
+# and in layer frames over a tiled noise layer (layers-small with the density stage); exit 4 (no backend besides the
+# CPU could start) is a skip.
+add_test(NAME Cli.ConformShafts.crepuscular
+         COMMAND ${cli} conform crepuscular --steps 6 --set warmup_steps=0 --out ${cli_out}/conform-shafts-crepuscular)
+add_test(NAME Cli.ConformShafts.layers-small
+         COMMAND ${cli} conform layers-small --steps 2 --set warmup_steps=0
+                 --set "stages=[\"noise\",\"density\",\"shade\",\"render_layers\"]"
+                 --set "lighting.shafts={\"shells\":24,\"extinction\":0.0002,\"falloff_deg\":60}"
+                 --out ${cli_out}/conform-shafts-layers)
+set_tests_properties(Cli.ConformShafts.crepuscular Cli.ConformShafts.layers-small PROPERTIES
+                     ENVIRONMENT CLOUDBENCH_VK_VALIDATION=1 SKIP_RETURN_CODE 4
+                     FAIL_REGULAR_EXPRESSION "vk validation|fail " TIMEOUT 300)
+# The shafts are added to every renderer's frame on every backend, the same light whatever the renderer
+# (tests/check_shafts_added.py): conform cannot see a renderer that misses them on every backend alike, this can.
+add_test(NAME Cli.ShaftsAddedToEveryRenderer
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/check_shafts_added.py ${cli} ${cli_out}/shafts-added)
+set_tests_properties(Cli.ShaftsAddedToEveryRenderer PROPERTIES PASS_REGULAR_EXPRESSION "shafts added: ok" TIMEOUT 300)

@@ -25,6 +25,7 @@
 #include "core/math/NoiseSettings.h"
 #include "core/math/Rules.h"
 #include "core/math/Shading.h"
+#include "core/math/Shafts.h"
 #include "core/scene/Scene.h"
 #include "core/scene/Stage.h"
 #include "core/stages/ca/CaTypes.h"
@@ -272,6 +273,13 @@ class Backend {
     virtual Status Method parameters { return Unsupported(Stage::stage); }
     CB_BACKEND_ENTRIES(CB_DEFAULT_BACKEND_ENTRY)
 #undef CB_DEFAULT_BACKEND_ENTRY
+
+    // Shafts of light (SPEC 18, core/math/Shafts.h ShaftsPixel): adds the shells' light to every pixel of a
+    // renderer's (3, width, height) image; columnSum is the density stage's D, (nx, ny, 1). Not a stage of its own:
+    // the renderers' stage calls run it after drawing (core/pipeline/ShaftsPass.h).
+    virtual Status AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) {
+        return MakeError(Name() + " does not implement shafts of light");
+    }
 #pragma GCC diagnostic pop
 
   protected:

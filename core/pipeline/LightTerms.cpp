@@ -74,7 +74,9 @@ LightTerms MakeLightTerms(const Scene& sc, uint32_t step) {
 namespace cb::scene_io {
 namespace {
 
-constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering", "sky", "octaves"};
+constexpr std::string_view kLightingKeys[] = {"ambient", "background", "city_glow", "eye_scattering",
+                                              "sky",     "octaves",    "shafts"};
+constexpr std::string_view kShaftsKeys[] = {"shells", "extinction", "g", "falloff_deg"};
 constexpr std::string_view kOctaveKeys[] = {"count", "attenuation", "contribution", "eccentricity"};
 constexpr std::string_view kSkyKeys[] = {"elevation_deg", "azimuth_deg", "color", "intensity"};
 constexpr std::string_view kEyeScatteringKeys[] = {"intensity", "cone_deg", "height_gain", "replaces_phase"};
@@ -170,6 +172,29 @@ void ReadSky(const Json& lighting, Validator& check, SkyLightSettings& sky) {
                        FormatNumber(brightest));
 }
 
+// Shafts of light: S in [1, kMaxShafts] shells; a haze of extinction in (0, 1] per metre (at 1 per metre the haze
+// hides everything past a few metres); an HG eccentricity within (-1, 1) whose P^ stays below kMaxPhasePeak
+// (|g| <= 0.99: P^ <= 2e4); a falloff width in (0, 180] degrees.
+void ReadShafts(const Json& lighting, Validator& check, ShaftsSettings& shafts) {
+    const Json* section = check.Section(lighting, "lighting", "shafts", kShaftsKeys);
+    if (!section) return;
+    shafts.on = true;
+    if (const Json* v = Validator::Find(*section, "shells")) {
+        if (auto n = check.Integer(*v, "lighting.shafts.shells", 1, kMaxShafts)) shafts.shells = uint32_t(*n);
+    }
+    if (const Json* v = Validator::Find(*section, "extinction")) {
+        if (auto d = check.Number(*v, "lighting.shafts.extinction", Range{.lo = 0, .loOpen = true, .hi = 1}))
+            shafts.extinction = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "g")) {
+        if (auto d = check.Number(*v, "lighting.shafts.g", Range{.lo = -0.99, .hi = 0.99})) shafts.g = *d;
+    }
+    if (const Json* v = Validator::Find(*section, "falloff_deg")) {
+        if (auto d = check.Number(*v, "lighting.shafts.falloff_deg", Range{.lo = 0, .loOpen = true, .hi = 180}))
+            shafts.falloffDeg = *d;
+    }
+}
+
 void ReadCityGlow(const Json& lighting, Validator& check, CityGlowSettings& glow) {
     const Json* section = check.Section(lighting, "lighting", "city_glow", kCityGlowKeys);
     if (!section) return;
@@ -232,6 +257,7 @@ void ReadLighting(const Json& root, Validator& check, LightingSettings& lighting
     ReadEyeScattering(*section, check, lighting.eyeScattering);
     ReadSky(*section, check, lighting.sky);
     ReadOctaves(*section, check, lighting.octaves);
+    ReadShafts(*section, check, lighting.shafts);
 }
 
 void ReadLightning(const Json& root, Validator& check, LightningSettings& lightning) {

@@ -15,6 +15,7 @@
 #include "core/base/CallgrindRequests.h"
 #include "core/base/ProcessCpuTime.h"
 #include "core/pipeline/Backend.h"
+#include "core/pipeline/ShaftsPass.h"
 #include "core/pipeline/StageDescriptor.h"
 #include "core/scene/Scene.h"
 
@@ -132,12 +133,14 @@ Status Timed(Backend& backend, StageCallRecord& record, const StageCountLabel& l
     return status;
 }
 
-// One frame per camera: `renderOne(n, frame, timed)` makes camera n's frame,
-// running its backend call through `timed` (host work outside it is not
-// stage time); each frame's time is what `timed` measured.
+// One frame per camera: `renderOne(n, frame, timed)` makes camera n's frame
+// (buffer n of resource `image`), running its backend call through `timed`
+// (host work outside it is not stage time); each frame's time is what `timed`
+// measured. With shafts of light, `timed` adds them to the frame after the
+// call, in the frame's time (SPEC 18: blended additively after the renderer).
 template <typename RenderOne>
 Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, const StageHostInputs& host,
-                        StageCallRecord& record, RenderOne&& renderOne) {
+                        const StageBuffers& io, Resource image, StageCallRecord& record, RenderOne&& renderOne) {
     const uint32_t step = host.step;
     const std::string backendName = backend.Name();
     for (size_t n = 0; n < sc.render.cameras.size(); ++n) {
@@ -151,7 +154,22 @@ Status RenderEachCamera(Stage renderer, Backend& backend, const Scene& sc, const
         const std::optional<double> deviceBefore = record.deviceMs;
         const StageCountLabel label{StageName(renderer), backendName, step, frame.camera};
         const size_t index = record.frames.size();
-        auto timed = [&](auto&& call) { return Timed(backend, record, label, host.markBatch, index, call); };
+        std::optional<ShaftsFrame> shafts;
+        if (sc.lighting.shafts.on)
+            shafts = MakeSceneShaftsFrame(
+                sc, MakeCameraFrame(sc.render.cameras[n].At(host.sequence), sc.render.width, sc.render.height), step);
+        auto timed = [&](auto&& call) {
+            std::optional<double> drawnDeviceMs;
+            Status status = Timed(backend, record, label, host.markBatch, index, [&]() -> Status {
+                Status drawn = call();
+                if (!drawn || !shafts) return drawn;
+                drawnDeviceMs = backend.LastDeviceMs();
+                return backend.AddShafts(*shafts, *io.Current(Resource::ColumnSum), *io.Current(image, n));
+            });
+            // Timed took the device time of the backend's last call, the shafts'; the renderer's is added here.
+            if (drawnDeviceMs && !host.markBatch) record.deviceMs = record.deviceMs.value_or(0) + *drawnDeviceMs;
+            return status;
+        };
         Status status = renderOne(n, frame, timed);
         frame.ms = record.ms - before;
         if (record.deviceMs) frame.deviceMs = *record.deviceMs - deviceBefore.value_or(0);

@@ -210,6 +210,20 @@ void CheckAcrossSections(const Scene& scene, const scene_io::SectionsRead& secti
                    "\"shade_sky\" shades toward the sky light, and the scene has none (lighting.sky); add "
                    "lighting.sky or remove the stage");
 
+    // Shafts of light are lit through the density map D: the stage that computes it must run.
+    if (scene.lighting.shafts.on && !scene.stages.Has(Stage::Density))
+        check.Fail("lighting.shafts",
+                   "needs the stage \"density\", which computes the density map D the haze is lit through; enable it "
+                   "or remove lighting.shafts");
+    if (scene.lighting.shafts.on && scene.stages.Has(Stage::RenderMarch) && scene.march.reprojectionBlock > 1)
+        check.Fail("lighting.shafts",
+                   "a reprojected march frame (march.reprojection) starts from the previous frame's image, which "
+                   "holds that frame's shafts, so they would add up frame after frame; remove one of the two");
+    if (scene.lighting.shafts.on && !RunsARenderer(scene.stages))
+        check.Fail("lighting.shafts",
+                   "the shafts are added to a renderer's frame, and no renderer is enabled; enable " +
+                       RendererNames(" or ") + ", or remove it");
+
     if (sections.steps) CheckSunSpeed(scene, check);
     CheckTiling(scene, check);
     CheckRelight(scene, check);

@@ -14,6 +14,7 @@
 #include "core/math/Light.h"
 #include "core/math/NoiseSettings.h"
 #include "core/math/Shading.h"
+#include "core/math/Shafts.h"
 #include "core/scene/Stage.h"
 #include "core/stages/ca/CaTypes.h"
 #include "core/stages/density/DensityTypes.h"
@@ -145,6 +146,7 @@ struct LightingSettings {
     EyeScatteringSettings eyeScattering;
     SkyLightSettings sky;
     OctaveSettings octaves;
+    ShaftsSettings shafts;  // shafts of light (SPEC 18), added to every renderer's frame
 
     // In single precision, as the renderers use them.
     Vec3 Ambient() const { return {float(ambient[0]), float(ambient[1]), float(ambient[2])}; }

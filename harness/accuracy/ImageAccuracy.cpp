@@ -198,6 +198,21 @@ Result<json> MeasureImages(Evaluator& eval, const Session& session, std::span<co
     return json{{"rows", rows}, {"references", refs.Records()}};
 }
 
+std::string TimeCell(const json& time) {
+    return Fmt("%.3f", time["median_ms"].get<double>()) + " (" + Fmt("%.3f", time["q1_ms"].get<double>()) + "-" +
+           Fmt("%.3f", time["q3_ms"].get<double>()) + ")";
+}
+
+void AppendImageErrorCells(const json& error, std::vector<report::Cell>& cells) {
+    cells.push_back(error["max"].get<double>());
+    cells.push_back(error["mean"].get<double>());
+    cells.push_back(error["p99"].get<double>());
+    if (error["psnr_db"].is_null())
+        cells.push_back("inf");
+    else
+        cells.push_back(error["psnr_db"].get<double>());
+}
+
 report::Table ImageRowsTable(const json& rows) {
     using report::Column;
     report::Table table({Column("renderer"), Column("setting"), Column("backend"), Column("time ms (q1-q3)").Unit("ms"),
@@ -212,18 +227,9 @@ report::Table ImageRowsTable(const json& rows) {
             table.rows.push_back(std::move(cells));
             continue;
         }
-        const json& t = r["time"];
-        cells.push_back(Fmt("%.3f", t["median_ms"].get<double>()) + " (" + Fmt("%.3f", t["q1_ms"].get<double>()) + "-" +
-                        Fmt("%.3f", t["q3_ms"].get<double>()) + ")");
+        cells.push_back(TimeCell(r["time"]));
         cells.push_back(r["prep_ms"].get<double>());
-        const json& e = r["error"];
-        cells.push_back(e["max"].get<double>());
-        cells.push_back(e["mean"].get<double>());
-        cells.push_back(e["p99"].get<double>());
-        if (e["psnr_db"].is_null())
-            cells.push_back("inf");
-        else
-            cells.push_back(e["psnr_db"].get<double>());
+        AppendImageErrorCells(r["error"], cells);
         cells.push_back(r["reference_phase"].get<std::string>());
         table.rows.push_back(std::move(cells));
     }

@@ -60,6 +60,9 @@ Result<StageAccuracy> MeasureImageStage(Evaluator& eval, const std::vector<Scene
 
 // The Markdown/text table of image rows (as MeasureImages writes them).
 report::Table ImageRowsTable(const nlohmann::json& rows);
+// A row's "time" (TimeJson) as "median (q1-q3)" ms; its "error" (max, mean, p99, psnr_db) as four cells.
+std::string TimeCell(const nlohmann::json& time);
+void AppendImageErrorCells(const nlohmann::json& error, std::vector<report::Cell>& cells);
 report::Table ImageReferenceTable(const nlohmann::json& references);
 
 }  // namespace cb

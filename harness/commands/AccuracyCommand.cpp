@@ -13,6 +13,7 @@
 #include "harness/accuracy/IsolatedMeasurement.h"
 #include "harness/accuracy/Measurement.h"
 #include "harness/accuracy/ReprojectionAccuracy.h"
+#include "harness/accuracy/ShaftsAccuracy.h"
 #include "harness/report/ReportTransfer.h"
 #include "harness/run/RunTransfer.h"
 
@@ -336,6 +337,11 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
             if (!rows) return MakeError("images: " + rows.error().message);
             extra["images"] = std::move(*rows);
         }
+        if (scene.lighting.shafts.on) {
+            auto shafts = MeasureShafts(eval, backends);
+            if (!shafts) return MakeError("shafts: " + shafts.error().message);
+            extra["shafts"] = std::move(*shafts);
+        }
         if (reprojects)
             for (const OpenedBackend& slot : backends) {
                 if (!slot.backend) continue;
@@ -462,6 +468,22 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
         Emit(report, {"Temporal reprojection: each step's ray-marched frame against the full frame (every pixel "
                       "traced) along the scene's frames, and render_march's median time a frame in each run",
                       {ReprojectionTable(rows)}});
+    }
+    if (scene.lighting.shafts.on) {
+        json rows = json::array();
+        for (const BackendMeasurement& part : *parts)
+            if (part.extra.contains("shafts")) {
+                if (!doc.contains("shafts_reference")) doc["shafts_reference"] = part.extra["shafts"]["reference"];
+                for (const json& r : part.extra["shafts"]["rows"]) rows.push_back(r);
+            }
+        // By shell count, then by backend (the parts' order).
+        std::stable_sort(rows.begin(), rows.end(), [](const json& a, const json& b) {
+            return a["shells"].get<uint32_t>() < b["shells"].get<uint32_t>();
+        });
+        doc["shafts"] = rows;
+        Emit(report, {"Shafts of light: the shells' added light against the exact single-scattering haze (per-pixel "
+                      "max over channels, linear HDR; PSNR's peak the reference's largest value) and the pass's time",
+                      {ShaftsRowsTable(rows)}});
     }
     doc["references"] = ReferencesJson(FirstRecords(*parts), options.cpuThreads);
     Emit(report, {"Reference speed", {ReferenceSpeedTable(FirstRecords(*parts))}});

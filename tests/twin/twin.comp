@@ -15,6 +15,7 @@
 #include "march.glsl"
 #include "ground.glsl"
 #include "layers.glsl"
+#include "shafts.glsl"
 
 // The functions' numbers by name (kTwinLowBias32, ...), from the list the C++ reads too.
 #define CB_TWIN_FN(name, number) const uint kTwin##name = number;
@@ -43,6 +44,8 @@ bool MarchBrickEmpty(uint brick) { return brick % 3u == 0u; }
 // ground.glsl's G: a hash of the cell (tests/GlslTwinMarchCases.cpp TwinGroundG).
 float GroundFetchG(uint i, uint j) { return float(LowBias32(i + 4096u * j) >> 8u) * (1.0 / 16777216.0); }
 float PhaseTableValue(uint i) { return mieTable[i]; }
+// shafts.glsl's D: a hash of the column (tests/GlslTwinMarchCases.cpp TwinShaftsD).
+float ShaftsFetchD(uint i, uint j) { return float(LowBias32(i * 7919u + 65537u * j) >> 8u) * (1.0 / 1048576.0); }
 // layers.glsl's modulation map: a hash of the column index (tests/GlslTwinHarness.h TwinLayersMap).
 float LayersMapValue(uint i) { return float(LowBias32(i ^ 0x51ED27u) >> 8u) * (1.0 / 16777216.0); }
 // layers.glsl's billboards: the bound list (GlslTwin::Run's `billboards`).
@@ -108,6 +111,9 @@ void main() {
         }
         case kTwinGroundShadowAt: PutF(0u, GroundShadowAt(F(0u), F(1u), U(2u), U(3u))); break;
         case kTwinGroundChannel: PutF(0u, GroundChannel(F(0u), F(1u), F(2u), F(3u), F(4u))); break;
+        case kTwinShaftsColumnAt: PutF(0u, ShaftsColumnAt(F(0u), F(1u), U(2u), U(3u), U(4u) != 0u)); break;
+        case kTwinShaftsLayerForm: PutF(0u, ShaftsLayerForm(U(0u), F(1u), F(2u), F(3u), F(4u), F(5u))); break;
+        case kTwinShaftsFalloff: PutF(0u, ShaftsFalloff(F(0u), F(1u), F(2u))); break;
         case kTwinUpsampleTap: {
             int i0, i1;
             float w;

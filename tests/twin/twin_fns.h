@@ -73,3 +73,7 @@ CB_TWIN_FN(BillboardFragment, 66u)
 // ---- light.glsl, with the bound MarchGpu's light ----
 CB_TWIN_FN(InScattered, 65u)
 CB_TWIN_FN(SunGain, 70u)
+// ---- shafts.glsl ----
+CB_TWIN_FN(ShaftsColumnAt, 71u)
+CB_TWIN_FN(ShaftsLayerForm, 72u)
+CB_TWIN_FN(ShaftsFalloff, 73u)

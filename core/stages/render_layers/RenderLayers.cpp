@@ -268,7 +268,8 @@ const StageDescriptor& DescribeRenderLayers() {
                 scene_io::CheckLayersLod0(scene, grid, check);
             },
         .reads = {Resource::Q, Resource::T},
-        .optionalReads = {Resource::TSky},  // the sky light's: checked when the scene is loaded
+        // The sky light's T_sky, the shafts' D: checked when the scene is loaded.
+        .optionalReads = {Resource::TSky, Resource::ColumnSum},
         .readsPrevious = LayersPrevious,
         .writes = {Resource::LayersImage},
         .outputStepsOnly = true,
@@ -286,7 +287,8 @@ Status CallRenderLayers(Backend& backend, const Scene& sc, const StageHostInputs
     // The wang map is host work shared by all backends, outside the stage time: one per call, for every camera.
     const std::vector<float> map = MakeLayersMap(sc, host.step);
     return RenderEachCamera(
-        Stage::RenderLayers, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+        Stage::RenderLayers, backend, sc, host, io, Resource::LayersImage, record,
+        [&](size_t n, FrameRecord& frame, auto timed) {
             LayersParams p =
                 MakeLayersParams(sc, sc.render.cameras[n].At(host.sequence), host.step, host.frame, host.frames);
             p.setup.map = map.empty() ? nullptr : map.data();

@@ -272,7 +272,7 @@ const StageDescriptor& DescribeRenderMarch() {
         .reads = {Resource::Q},
         // march.light "shade" (the default) needs T, render.ground G, the sky light T_sky: checked when the scene is
         // loaded.
-        .optionalReads = {Resource::T, Resource::Shadow, Resource::TSky},
+        .optionalReads = {Resource::T, Resource::Shadow, Resource::TSky, Resource::ColumnSum},
         .readsPrevious = MarchPrevious,
         .writes = {Resource::MarchImage},
         .outputStepsOnly = true,
@@ -288,7 +288,8 @@ const StageDescriptor& DescribeRenderMarch() {
 Status CallRenderMarch(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
                        StageCallRecord& record) {
     return RenderEachCamera(
-        Stage::RenderMarch, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+        Stage::RenderMarch, backend, sc, host, io, Resource::MarchImage, record,
+        [&](size_t n, FrameRecord& frame, auto timed) {
             const CameraSettings& camera = sc.render.cameras[n];
             MarchParams p = MakeMarchParams(sc, camera.At(host.sequence), host.step, host.frame, host.frames);
             // The previous frame's camera: that of the frame before (the first frame traces every pixel).

@@ -164,8 +164,8 @@ const StageDescriptor& DescribeRenderSplat() {
         .readSettings = [](const scene_io::Json& root, scene_io::Validator& check, const Extent3*,
                            Scene& scene) { scene_io::ReadSplat(root, check, scene.splat); },
         .reads = {Resource::Q, Resource::T, Resource::Tiles, Resource::Bands},
-        // render.ground needs G, the sky light T_sky: both checked when the scene is loaded.
-        .optionalReads = {Resource::Shadow, Resource::TSky},
+        // render.ground needs G, the sky light T_sky, the shafts D: each checked when the scene is loaded.
+        .optionalReads = {Resource::Shadow, Resource::TSky, Resource::ColumnSum},
         .readsPrevious = SplatPrevious,
         .writes = {Resource::SplatImage},
         .outputStepsOnly = true,
@@ -182,7 +182,8 @@ const StageDescriptor& DescribeRenderSplat() {
 Status CallRenderSplat(Backend& backend, const Scene& sc, const StageHostInputs& host, const StageBuffers& io,
                        StageCallRecord& record) {
     return RenderEachCamera(
-        Stage::RenderSplat, backend, sc, host, record, [&](size_t n, FrameRecord& frame, auto timed) {
+        Stage::RenderSplat, backend, sc, host, io, Resource::SplatImage, record,
+        [&](size_t n, FrameRecord& frame, auto timed) {
             SplatParams p =
                 MakeSplatParams(sc, sc.render.cameras[n].At(host.sequence), host.step, host.frame, host.frames);
             // The order is host work shared by all backends, outside the stage time.
