@@ -58,23 +58,33 @@ Result<json> MeasureShafts(Evaluator& eval, std::span<const OpenedBackend> backe
     auto reference = ref::RenderHazeReference(hp, in.grid, in.q);
     if (!reference) return MakeError("the haze reference: " + reference.error().message);
 
-    std::vector<uint32_t> counts(std::begin(kShaftsShellCounts), std::end(kShaftsShellCounts));
-    if (std::ranges::find(counts, shafts.shells) == counts.end()) counts.push_back(shafts.shells);
-    std::ranges::sort(counts);
+    // The shell counts without the falloff (which the reference does not have), then the scene's own setting.
+    struct Setting {
+        uint32_t shells;
+        double falloffDeg;
+        bool scene;
+    };
+    std::vector<Setting> settings;
+    for (uint32_t count : kShaftsShellCounts) settings.push_back({count, 0.0, false});
+    settings.push_back({shafts.shells, shafts.falloffDeg, true});
     json rows = json::array();
     const Extent3 columns{in.grid.nx, in.grid.ny, 1};
-    for (uint32_t count : counts)
+    for (const Setting& setting : settings)
         for (const OpenedBackend& slot : backends) {
-            json row = {{"shells", count}, {"backend", slot.name}, {"scene_shells", count == shafts.shells}};
+            json row = {{"shells", setting.shells},
+                        {"falloff_deg", setting.falloffDeg},
+                        {"backend", slot.name},
+                        {"scene", setting.scene}};
             if (!slot.backend) {
                 row["status"] = "unavailable";
                 row["detail"] = slot.reason;
                 rows.push_back(row);
                 continue;
             }
-            Scene withCount = scene;
-            withCount.lighting.shafts.shells = count;
-            const ShaftsFrame frame = MakeSceneShaftsFrame(withCount, camera, in.step);
+            Scene measured = scene;
+            measured.lighting.shafts.shells = setting.shells;
+            measured.lighting.shafts.falloffDeg = setting.falloffDeg;
+            const ShaftsFrame frame = MakeSceneShaftsFrame(measured, camera, in.step);
             auto shells = ShellsImage(*slot.backend, frame, in.D, columns, eval.Measurement().repeats);
             if (!shells) {
                 row["status"] = "failed";
@@ -102,13 +112,15 @@ Result<json> MeasureShafts(Evaluator& eval, std::span<const OpenedBackend> backe
 
 report::Table ShaftsRowsTable(const json& rows) {
     using report::Column;
-    report::Table table({Column("shells").Integer(), Column("backend"), Column("time ms (q1-q3)").Unit("ms"),
+    report::Table table({Column("shells").Integer(), Column("falloff"), Column("backend"),
+                         Column("time ms (q1-q3)").Unit("ms"),
                          Column("max").Real("%.3g"), Column("mean").Real("%.3g"), Column("p99").Real("%.3g"),
                          Column("PSNR dB").Real("%.2f")});
     for (const json& r : rows) {
-        std::vector<report::Cell> cells = {
-            int64_t(r["shells"].get<uint32_t>()),
-            r["backend"].get<std::string>() + (r.value("scene_shells", false) ? " (scene)" : "")};
+        const double falloff = r["falloff_deg"].get<double>();
+        std::vector<report::Cell> cells = {int64_t(r["shells"].get<uint32_t>()),
+                                           falloff > 0 ? Fmt("%g deg", falloff) : std::string("none"),
+                                           r["backend"].get<std::string>() + (r["scene"].get<bool>() ? " (scene)" : "")};
         if (r["status"] != "ok") {
             cells.push_back(r["status"].get<std::string>() + ": " + r.value("detail", std::string()));
             table.rows.push_back(std::move(cells));

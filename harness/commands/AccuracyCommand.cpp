@@ -476,9 +476,10 @@ int Accuracy(const CommonOptions& options, const AccuracyOptions& own) {
                 if (!doc.contains("shafts_reference")) doc["shafts_reference"] = part.extra["shafts"]["reference"];
                 for (const json& r : part.extra["shafts"]["rows"]) rows.push_back(r);
             }
-        // By shell count, then by backend (the parts' order).
+        // By setting (the scene's last), then by backend (the parts' order).
         std::stable_sort(rows.begin(), rows.end(), [](const json& a, const json& b) {
-            return a["shells"].get<uint32_t>() < b["shells"].get<uint32_t>();
+            return std::pair(a["scene"].get<bool>(), a["shells"].get<uint32_t>()) <
+                   std::pair(b["scene"].get<bool>(), b["shells"].get<uint32_t>());
         });
         doc["shafts"] = rows;
         Emit(report, {"Shafts of light: the shells' added light against the exact single-scattering haze (per-pixel "
