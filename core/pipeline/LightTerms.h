@@ -21,9 +21,9 @@ namespace cb {
 LightTerms MakeLightTerms(const Scene& scene, uint32_t step);
 
 // The scene sections MakeLightTerms reads besides the sun and the grid: every renderer's image depends on them
-// (a sweep that varies one of them measures every renderer's image). "shadow" and "shade.sigma": the shafts of light
-// (lighting.shafts) are lit through the ground shadow's form and the clouds' sigma.
-inline constexpr std::string_view kLightTermFields[] = {"lighting", "lightning", "phase", "shadow", "shade.sigma"};
+// (a sweep that varies one of them measures every renderer's image). The shafts of light (lighting.shafts) also read
+// the shadow's form and shade.sigma; they are measured apart from the renderers' images (accuracy's shafts rows).
+inline constexpr std::string_view kLightTermFields[] = {"lighting", "lightning", "phase"};
 
 namespace scene_io {
 // Each reads its section from the document root into settings that hold the defaults on entry; a wrong field is
