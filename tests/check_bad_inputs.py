@@ -266,6 +266,18 @@ def command_lines(case, scene):
                                                                                                   ["run", "dump"])]
 
 
+def run_every_backend(cli, scene, steps, out, sets):
+    """`cli run SCENE` on cpu, gl and vk for `steps` steps with no warm-up, each of `sets` a --set; exit 4 (no backend
+    besides the CPU could start) is fine, any other failure ends the calling check."""
+    command = [cli, "run", scene, "--backend", "cpu,gl,vk", "--steps", str(steps), "--set", "warmup_steps=0",
+               "--quiet", "--out", str(out)]
+    for s in sets:
+        command += ["--set", s]
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode not in (0, 4):
+        sys.exit(f"{' '.join(command)} exited {done.returncode}: {done.stderr[-2000:]}")
+
+
 def exr_floats(path):
     """Every pixel value of an OpenEXR file whose channels are all 32-bit floats, uncompressed or ZIP-compressed
     (what the harness writes), as one flat array; the layout does not matter for a finiteness check."""

@@ -6,14 +6,13 @@ the octaves, or applied them twice, fails; conform alone cannot see either, sinc
 
     check_octaves_scale.py CLI OUT
 """
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from check_bad_inputs import exr_floats  # noqa: E402
+from check_bad_inputs import exr_floats, run_every_backend  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 # name: (scene, steps): ci-small's automaton needs a few steps to form clouds.
@@ -24,13 +23,10 @@ FACTOR = sum(B ** i for i in range(N))  # 3
 
 
 def run(cli, scene, steps, out, octaves):
-    command = [cli, "run", scene, "--backend", "cpu,gl,vk", "--steps", str(steps), "--set", "warmup_steps=0", "--quiet",
-               "--set", "lighting.ambient=[0,0,0]", "--set", "lighting.background=[0,0,0]", "--out", str(out)]
+    sets = ["lighting.ambient=[0,0,0]", "lighting.background=[0,0,0]"]
     if octaves:
-        command += ["--set", f'lighting.octaves={{"count":{N},"attenuation":1,"contribution":{B},"eccentricity":1}}']
-    done = subprocess.run(command, capture_output=True, text=True)
-    if done.returncode not in (0, 4):
-        sys.exit(f"{' '.join(command)} exited {done.returncode}: {done.stderr[-2000:]}")
+        sets.append(f'lighting.octaves={{"count":{N},"attenuation":1,"contribution":{B},"eccentricity":1}}')
+    run_every_backend(cli, scene, steps, out, sets)
 
 
 def main():

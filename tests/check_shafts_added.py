@@ -6,14 +6,13 @@ frames miss the shafts on every backend alike passes conform; it fails here.
 
     check_shafts_added.py CLI OUT
 """
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from check_bad_inputs import exr_floats  # noqa: E402
+from check_bad_inputs import exr_floats, run_every_backend  # noqa: E402
 
 SHAFTS = '{"shells":24,"extinction":0.0002,"falloff_deg":60}'
 # name: (scene, steps, extra --set): crepuscular's automaton needs a few steps to form clouds; layers-small runs
@@ -23,13 +22,7 @@ SCENES = {"crepuscular": ("crepuscular", 8, []),
 
 
 def run(cli, scene, steps, extra, out, shafts):
-    command = [cli, "run", scene, "--backend", "cpu,gl,vk", "--steps", str(steps), "--set", "warmup_steps=0",
-               "--quiet", "--out", str(out)]
-    for s in extra + ([f"lighting.shafts={SHAFTS}"] if shafts else []):
-        command += ["--set", s]
-    done = subprocess.run(command, capture_output=True, text=True)
-    if done.returncode not in (0, 4):
-        sys.exit(f"{' '.join(command)} exited {done.returncode}: {done.stderr[-2000:]}")
+    run_every_backend(cli, scene, steps, out, extra + ([f"lighting.shafts={SHAFTS}"] if shafts else []))
 
 
 def main():
