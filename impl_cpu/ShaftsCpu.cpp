@@ -4,19 +4,16 @@
 #include <tbb/parallel_for.h>
 
 #include "core/math/Shafts.h"
+#include "core/pipeline/ShaftsPass.h"
 #include "impl_cpu/BackendCpu.h"
 
 namespace cb::cpu {
 
 Status BackendCpu::AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) {
-    const Extent3 e = columnSum.Extent();
-    if (e.nx != frame.gridX || e.ny != frame.gridY || e.nz != 1)
-        return MakeError("cpu: shafts: D is not (nx, ny, 1) of the frame's grid");
-    if (image.Extent() != Extent3{3, frame.width, frame.height})
-        return MakeError("cpu: shafts: the image is not (3, width, height)");
+    CB_TRY(CheckShaftsBuffers(frame, columnSum, image, "cpu"));
     const float* D = static_cast<const BufferCpu&>(columnSum).F32();
     float* out = static_cast<BufferCpu&>(image).F32();
-    auto fetch = [&](uint32_t i, uint32_t j) { return D[i + size_t(e.nx) * j]; };
+    auto fetch = [&](uint32_t i, uint32_t j) { return D[i + size_t(frame.gridX) * j]; };
     mArena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, frame.height, 4),
                           [&](const tbb::blocked_range<uint32_t>& rows) {

@@ -1,16 +1,14 @@
 // Shafts of light (SPEC 18) on OpenGL: shafts.frag writes the frame plus the
 // shells' light into an RGBA32F target, which then replaces the image (as a
 // renderer's target does, CopyTargetToImage).
+#include "core/pipeline/ShaftsPass.h"
 #include "impl_gl/BackendGL.h"
 
 namespace cb::gl {
 
 Status BackendGL::AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) {
-    const Extent3 e = columnSum.Extent();
-    if (e.nx != frame.gridX || e.ny != frame.gridY || e.nz != 1)
-        return MakeError("gl: shafts: D is not (nx, ny, 1) of the frame's grid");
+    CB_TRY(CheckShaftsBuffers(frame, columnSum, image, "gl"));
     const uint32_t W = frame.width, H = frame.height;
-    if (image.Extent() != Extent3{3, W, H}) return MakeError("gl: shafts: the image is not (3, width, height)");
     auto program = mContext->Program("shafts");
     if (!program) return std::unexpected(program.error());
     const Functions& f = mContext->F();

@@ -1,15 +1,12 @@
 // Shafts of light (SPEC 18) on Vulkan: shafts.comp adds the shells' light to the image in place, the constants
 // (core/math/Shafts.h ShaftsFrame) in a storage buffer.
+#include "core/pipeline/ShaftsPass.h"
 #include "impl_vk/BackendVk.h"
 
 namespace cb::vk {
 
 Status BackendVk::AddShafts(const ShaftsFrame& frame, const Buffer& columnSum, Buffer& image) {
-    const Extent3 e = columnSum.Extent();
-    if (e.nx != frame.gridX || e.ny != frame.gridY || e.nz != 1)
-        return MakeError("vk: shafts: D is not (nx, ny, 1) of the frame's grid");
-    if (image.Extent() != Extent3{3, frame.width, frame.height})
-        return MakeError("vk: shafts: the image is not (3, width, height)");
+    CB_TRY(CheckShaftsBuffers(frame, columnSum, image, "vk"));
     auto pipeline = mContext->GetPipeline("shafts", 3);
     if (!pipeline) return std::unexpected(pipeline.error());
     auto block = Scratch(mShaftsFrame, sizeof frame);

@@ -11,4 +11,13 @@ ShaftsFrame MakeSceneShaftsFrame(const Scene& sc, const CameraFrame& camera, uin
                            float(sc.shadow.densityFactor));
 }
 
+Status CheckShaftsBuffers(const ShaftsFrame& frame, const Buffer& columnSum, const Buffer& image,
+                          std::string_view backend) {
+    if (columnSum.Extent() != Extent3{frame.gridX, frame.gridY, 1})
+        return MakeError(std::string(backend) + ": shafts: D is not (nx, ny, 1) of the frame's grid");
+    if (image.Extent() != Extent3{3, frame.width, frame.height})
+        return MakeError(std::string(backend) + ": shafts: the image is not (3, width, height)");
+    return {};
+}
+
 }  // namespace cb
