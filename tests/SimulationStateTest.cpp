@@ -11,6 +11,7 @@
 // state folder: the file, the field and the reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -75,8 +76,12 @@ Scene SavedRunScene(std::vector<SceneOverride> more) {
 
 constexpr const char* kStateTestHash = "0123456789abcdef";
 
+// A fresh folder of its own for `name` in the running test: ctest runs the tests in parallel processes, and two tests
+// of one backend must not share a folder.
 std::string StateTestDir(const std::string& name) {
-    const std::string dir = ::testing::TempDir() + "/simstate_" + name;
+    std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::ranges::replace(test, '/', '_');
+    const std::string dir = ::testing::TempDir() + "/simstate_" + test + "_" + name;
     fs::remove_all(dir);
     return dir;
 }
